@@ -1,0 +1,57 @@
+# Shared CMake helpers for bims targets. Nothing here edits global flags.
+
+# Warnings and language level for one of our targets.
+function(bims_target_defaults tgt)
+  target_compile_features(${tgt} PUBLIC cxx_std_17)
+  target_compile_options(${tgt} PRIVATE -Wall -Wextra)
+endfunction()
+
+# bims_add_library(NAME sim SOURCES ... DEPS ...)
+# Creates static library bims_<NAME> with alias bims::<NAME>; public headers in
+# libs/<NAME>/include/bims/<NAME>/.
+function(bims_add_library)
+  cmake_parse_arguments(A "" "NAME" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
+  set(tgt bims_${A_NAME})
+  add_library(${tgt} STATIC ${A_SOURCES})
+  add_library(bims::${A_NAME} ALIAS ${tgt})
+  target_include_directories(${tgt} PUBLIC
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
+  target_link_libraries(${tgt} PUBLIC ${A_DEPS} PRIVATE ${A_PRIVATE_DEPS})
+  set_target_properties(${tgt} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  bims_target_defaults(${tgt})
+endfunction()
+
+# bims_add_app(NAME bims-sim SOURCES ... DEPS ...): an executable in build/bin.
+function(bims_add_app)
+  cmake_parse_arguments(A "" "NAME" "SOURCES;DEPS" ${ARGN})
+  add_executable(${A_NAME} ${A_SOURCES})
+  target_link_libraries(${A_NAME} PRIVATE ${A_DEPS})
+  bims_target_defaults(${A_NAME})
+  install(TARGETS ${A_NAME} RUNTIME DESTINATION bin)
+endfunction()
+
+# bims_add_gtest(NAME test_x SOURCES ... DEPS ... [LABELS ...] [TIMEOUT s])
+# A gtest executable in build/bin, its cases registered with CTest one by one.
+# Compile definitions give the tests the source tree, the shared data folder and
+# the binary folder (where the apps are).
+function(bims_add_gtest)
+  cmake_parse_arguments(A "" "NAME;TIMEOUT" "SOURCES;DEPS;LABELS" ${ARGN})
+  if(NOT BIMS_BUILD_TESTS)
+    return()
+  endif()
+  if(NOT A_TIMEOUT)
+    set(A_TIMEOUT 300)
+  endif()
+  add_executable(${A_NAME} ${A_SOURCES})
+  target_link_libraries(${A_NAME} PRIVATE ${A_DEPS} GTest::gtest GTest::gtest_main)
+  target_compile_definitions(${A_NAME} PRIVATE
+    BIMS_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    BIMS_BINARY_DIR="${PROJECT_BINARY_DIR}"
+    BIMS_BIN_DIR="${CMAKE_RUNTIME_OUTPUT_DIRECTORY}"
+    BIMS_SHARED_DATA_DIR="${BIMS_SHARED_DATA_DIR}")
+  bims_target_defaults(${A_NAME})
+  gtest_discover_tests(${A_NAME}
+    DISCOVERY_MODE PRE_TEST
+    WORKING_DIRECTORY ${PROJECT_BINARY_DIR}
+    PROPERTIES TIMEOUT ${A_TIMEOUT} LABELS "${A_LABELS}")
+endfunction()

@@ -1,0 +1,89 @@
+// Strict reading of .ini experiment files (MRPT config classes).
+//
+// Every key read through ConfigSection is remembered; finish() then rejects any
+// key of the section that nobody read, so a typo in an .ini is an error naming
+// the file, the section and the key, never a silently ignored setting.
+#pragma once
+
+#include <mrpt/config/CConfigFileBase.h>
+
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace bims
+{
+/** Error in a configuration file; the message names file, section and key. */
+class ConfigError : public std::runtime_error
+{
+   public:
+	using std::runtime_error::runtime_error;
+};
+
+/** The file name behind a config object ("<memory>" when there is none). */
+std::string configSourceName(const mrpt::config::CConfigFileBase& cfg);
+
+/** Typed, range-checked, unknown-key-rejecting access to one .ini section. */
+class ConfigSection
+{
+   public:
+	/** \param required if true and the section is absent, throws ConfigError. */
+	ConfigSection(
+		const mrpt::config::CConfigFileBase& cfg, std::string section,
+		bool required = false);
+
+	bool exists() const { return exists_; }
+	bool has(const std::string& key) const;
+	const std::string& name() const { return section_; }
+	const std::string& file() const { return file_; }
+
+	/** Reads a real number in [min, max] (inclusive); default if absent. */
+	double getDouble(
+		const std::string& key, double def, double min, double max);
+	/** Same, but the key must be present. */
+	double requireDouble(const std::string& key, double min, double max);
+	/** Reads an integer in [min, max]; default if absent. */
+	long getInt(const std::string& key, long def, long min, long max);
+	long requireInt(const std::string& key, long min, long max);
+	/** true/false, 1/0, yes/no, on/off (any case). */
+	bool getBool(const std::string& key, bool def);
+	std::string getString(const std::string& key, const std::string& def);
+	std::string requireString(const std::string& key);
+	/** One of \a allowed (exact match); default if absent. */
+	std::string getEnum(
+		const std::string& key, const std::string& def,
+		const std::vector<std::string>& allowed);
+	/** A whitespace/comma separated list of exactly \a n reals (or the
+	 * default if absent), each in [min, max]. */
+	std::vector<double> getDoubles(
+		const std::string& key, const std::vector<double>& def, size_t n,
+		double min, double max);
+
+	/** Marks a key as known without reading it (e.g. read by MRPT code). */
+	void allow(const std::string& key);
+
+	/** Throws ConfigError for the first key in the section that was never
+	 * read nor allowed. */
+	void finish() const;
+
+	/** Throws ConfigError naming file, section and key. */
+	[[noreturn]] void fail(const std::string& key, const std::string& what) const;
+
+   private:
+	std::string raw(const std::string& key) const;
+	const mrpt::config::CConfigFileBase& cfg_;
+	std::string section_;
+	std::string file_;
+	bool exists_ = false;
+	std::set<std::string> known_;  // lower case
+};
+
+/** Throws ConfigError if the file has a section not in \a allowed and not
+ * starting with one of \a allowedPrefixes. */
+void checkSections(
+	const mrpt::config::CConfigFileBase& cfg,
+	const std::vector<std::string>& allowed,
+	const std::vector<std::string>& allowedPrefixes = {});
+
+}  // namespace bims

@@ -1,0 +1,91 @@
+// Streaming rawlog input/output with errors that name the file and the entry.
+//
+// Reads both MRPT rawlog formats (observations-only and actions/sensory-frames;
+// observations inside a sensory frame are returned one by one). A truncated or
+// corrupt file raises RawlogError instead of ending silently.
+#pragma once
+
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/obs/CObservation.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <deque>
+#include <fstream>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+namespace bims
+{
+/** Error reading or writing a rawlog; the message names the file. */
+class RawlogError : public std::runtime_error
+{
+   public:
+	using std::runtime_error::runtime_error;
+};
+
+/** The external-images folder MRPT would use for a rawlog
+ * ("<path without extension>_Images"), computed correctly (MRPT 2.5.8's
+ * CRawlog::detectImagesDirectory() drops a '/'). */
+std::string rawlogImagesDirectory(const std::string& rawlogPath);
+
+class RawlogReader
+{
+   public:
+	/** Opens the file (plain or gzip); throws RawlogError if it cannot. Sets
+	 * CImage's external images base path to rawlogImagesDirectory(path) when
+	 * that folder exists. */
+	explicit RawlogReader(const std::string& path);
+
+	/** Next observation, or nullptr at the clean end of the file. Throws
+	 * RawlogError naming the file and the entry on truncation or corruption. */
+	mrpt::obs::CObservation::Ptr next();
+
+	/** Index of the last serialized object read (0-based), -1 before any. */
+	long entryIndex() const { return entry_; }
+	/** Number of observations returned so far. */
+	size_t observationsRead() const { return nObs_; }
+	const std::string& path() const { return path_; }
+
+   private:
+	std::string path_;
+	mrpt::io::CFileGZInputStream in_;
+	std::unique_ptr<mrpt::serialization::CArchive> arch_;
+	std::deque<mrpt::obs::CObservation::Ptr> pending_;
+	long entry_ = -1;
+	size_t nObs_ = 0;
+	bool atEnd_ = false;
+};
+
+class RawlogWriter
+{
+   public:
+	/** Creates (truncates) \a path. gzLevel 1..9 writes a gzip-compressed
+	 * rawlog (flushed only on close); 0 writes a plain rawlog whose flush()
+	 * reaches the OS, for live grabbing. Throws RawlogError if the file
+	 * cannot be created. */
+	explicit RawlogWriter(const std::string& path, int gzLevel = 1);
+	~RawlogWriter();
+	RawlogWriter(const RawlogWriter&) = delete;
+	RawlogWriter& operator=(const RawlogWriter&) = delete;
+
+	/** Appends one observation (observations-only rawlog format). */
+	void write(const mrpt::obs::CObservation& obs);
+	/** Pushes buffered bytes to the OS (so a kill loses at most the last
+	 * object). */
+	void flush();
+	void close();
+	size_t written() const { return n_; }
+	const std::string& path() const { return path_; }
+
+   private:
+	std::string path_;
+	std::ofstream plain_;
+	mrpt::io::CFileGZOutputStream gz_;
+	std::unique_ptr<mrpt::serialization::CArchive> arch_;
+	bool open_ = false;
+	size_t n_ = 0;
+};
+
+}  // namespace bims

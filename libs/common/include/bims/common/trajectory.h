@@ -1,0 +1,35 @@
+// Camera trajectories in the TUM RGB-D format:
+//   timestamp tx ty tz qx qy qz qw     (seconds, metres, unit quaternion)
+// Each pose is T_WC: the camera {C} expressed in the world {W}.
+#pragma once
+
+#include <mrpt/poses/CPose3D.h>
+
+#include <string>
+#include <vector>
+
+namespace bims
+{
+struct StampedPose
+{
+	double t = 0;  ///< seconds (UNIX time or sequence time)
+	mrpt::poses::CPose3D T_WC;  ///< camera pose in the world frame
+};
+using Trajectory = std::vector<StampedPose>;
+
+/** Reads a TUM trajectory file; '#' lines and blank lines are skipped.
+ * Throws std::runtime_error naming the file and line on malformed input,
+ * non-finite values, non-unit quaternions (|q| off by > 1e-3) or timestamps
+ * that go backwards. */
+Trajectory loadTumTrajectory(const std::string& path);
+
+/** Writes a TUM trajectory (header comment, 6 decimals for time, 9 for
+ * values). Throws std::runtime_error if the file cannot be written. */
+void saveTumTrajectory(
+	const std::string& path, const Trajectory& traj,
+	const std::string& headerComment = {});
+
+/** One TUM line for a pose (no newline). */
+std::string tumLine(double t, const mrpt::poses::CPose3D& T_WC);
+
+}  // namespace bims

@@ -1,0 +1,70 @@
+#include <bims/common/trajectory.h>
+#include <mrpt/poses/CPose3DQuat.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace bims
+{
+Trajectory loadTumTrajectory(const std::string& path)
+{
+	std::ifstream f(path);
+	if (!f) throw std::runtime_error(path + ": cannot open trajectory file");
+	Trajectory out;
+	std::string line;
+	size_t lineNo = 0;
+	while (std::getline(f, line))
+	{
+		++lineNo;
+		const auto p = line.find_first_not_of(" \t\r");
+		if (p == std::string::npos || line[p] == '#') continue;
+		std::istringstream ss(line);
+		double v[8];
+		for (double& x : v)
+			if (!(ss >> x) || !std::isfinite(x))
+				throw std::runtime_error(
+					path + ":" + std::to_string(lineNo) +
+					": expected 8 finite numbers 'timestamp tx ty tz qx qy qz qw'");
+		const double qn =
+			std::sqrt(v[4] * v[4] + v[5] * v[5] + v[6] * v[6] + v[7] * v[7]);
+		if (std::abs(qn - 1.0) > 1e-3)
+			throw std::runtime_error(
+				path + ":" + std::to_string(lineNo) +
+				": quaternion is not unit (norm " + std::to_string(qn) + ")");
+		if (!out.empty() && v[0] < out.back().t)
+			throw std::runtime_error(
+				path + ":" + std::to_string(lineNo) + ": timestamp goes backwards");
+		mrpt::math::CQuaternionDouble q(
+			v[7] / qn, v[4] / qn, v[5] / qn, v[6] / qn);
+		out.push_back({v[0], mrpt::poses::CPose3D(
+								 mrpt::poses::CPose3DQuat(v[1], v[2], v[3], q))});
+	}
+	return out;
+}
+
+std::string tumLine(double t, const mrpt::poses::CPose3D& T_WC)
+{
+	const mrpt::poses::CPose3DQuat q(T_WC);
+	char buf[256];
+	std::snprintf(
+		buf, sizeof(buf), "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f", t, q.x(),
+		q.y(), q.z(), q.quat().x(), q.quat().y(), q.quat().z(), q.quat().r());
+	return buf;
+}
+
+void saveTumTrajectory(
+	const std::string& path, const Trajectory& traj,
+	const std::string& headerComment)
+{
+	std::ofstream f(path);
+	if (!f) throw std::runtime_error(path + ": cannot write trajectory file");
+	if (!headerComment.empty()) f << "# " << headerComment << "\n";
+	f << "# timestamp tx ty tz qx qy qz qw\n";
+	for (const auto& p : traj) f << tumLine(p.t, p.T_WC) << "\n";
+	if (!f) throw std::runtime_error(path + ": write failed");
+}
+
+}  // namespace bims

@@ -1,0 +1,110 @@
+#include <bims/common/rawlog.h>
+#include <gtest/gtest.h>
+#include <mrpt/obs/CObservationIMU.h>
+#include <mrpt/system/filesystem.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace
+{
+std::string tmpPath(const std::string& name)
+{
+	const auto dir = std::filesystem::temp_directory_path() / "bims_test_common";
+	std::filesystem::create_directories(dir);
+	return (dir / name).string();
+}
+
+void writeImus(const std::string& path, int n, int gz)
+{
+	bims::RawlogWriter w(path, gz);
+	for (int i = 0; i < n; i++)
+	{
+		mrpt::obs::CObservationIMU imu;
+		imu.sensorLabel = "IMU";
+		imu.timestamp = mrpt::Clock::fromDouble(100.0 + i * 0.01);
+		imu.set(mrpt::obs::IMU_WZ, 0.1 * i);
+		w.write(imu);
+	}
+	EXPECT_EQ(w.written(), static_cast<size_t>(n));
+}
+}  // namespace
+
+TEST(Rawlog, RoundTripPlainAndGzip)
+{
+	for (int gz : {0, 1})
+	{
+		const auto p = tmpPath("rt" + std::to_string(gz) + ".rawlog");
+		writeImus(p, 20, gz);
+		bims::RawlogReader r(p);
+		int n = 0;
+		while (auto o = r.next())
+		{
+			auto imu = std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(o);
+			ASSERT_TRUE(imu);
+			EXPECT_DOUBLE_EQ(imu->get(mrpt::obs::IMU_WZ), 0.1 * n);
+			n++;
+		}
+		EXPECT_EQ(n, 20);
+	}
+}
+
+TEST(Rawlog, MissingFileIsAClearError)
+{
+	try
+	{
+		bims::RawlogReader r(tmpPath("does_not_exist.rawlog"));
+		FAIL() << "no exception";
+	}
+	catch (const bims::RawlogError& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("does_not_exist.rawlog: no such"),
+				  std::string::npos);
+	}
+}
+
+TEST(Rawlog, TruncatedFileIsAnErrorNamingFileAndEntry)
+{
+	const auto p = tmpPath("trunc.rawlog");
+	writeImus(p, 10, 0);
+	const auto size = std::filesystem::file_size(p);
+	std::filesystem::resize_file(p, size - 7);
+	bims::RawlogReader r(p);
+	int n = 0;
+	try
+	{
+		while (r.next()) n++;
+		FAIL() << "truncation not detected";
+	}
+	catch (const bims::RawlogError& e)
+	{
+		const std::string msg = e.what();
+		EXPECT_NE(msg.find("trunc.rawlog: truncated or corrupt rawlog at entry 9"),
+				  std::string::npos)
+			<< msg;
+	}
+	EXPECT_EQ(n, 9);
+}
+
+TEST(Rawlog, GarbageFileIsAnError)
+{
+	const auto p = tmpPath("garbage.rawlog");
+	{
+		std::ofstream f(p, std::ios::binary);
+		for (int i = 0; i < 1000; i++) f.put(static_cast<char>((i * 37) & 0xff));
+	}
+	bims::RawlogReader r(p);
+	EXPECT_THROW(
+		{
+			while (r.next())
+			{
+			}
+		},
+		bims::RawlogError);
+}
+
+TEST(Rawlog, ImagesDirectoryKeepsTheSlash)
+{
+	EXPECT_EQ(bims::rawlogImagesDirectory("dir/foo.rawlog"), "dir/foo_Images");
+	EXPECT_EQ(bims::rawlogImagesDirectory("foo.rawlog"), "foo_Images");
+}

@@ -1,0 +1,58 @@
+#include <bims/common/trajectory.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace
+{
+std::string tmpPath(const std::string& name)
+{
+	const auto dir = std::filesystem::temp_directory_path() / "bims_test_common";
+	std::filesystem::create_directories(dir);
+	return (dir / name).string();
+}
+}  // namespace
+
+TEST(Trajectory, TumRoundTrip)
+{
+	bims::Trajectory t;
+	for (int i = 0; i < 5; i++)
+		t.push_back({1000.0 + i / 30.0,
+					 mrpt::poses::CPose3D(0.1 * i, -0.2 * i, 1.5, 0.3 * i, -0.1, 0.05 * i)});
+	const auto p = tmpPath("traj.txt");
+	bims::saveTumTrajectory(p, t, "test");
+	const auto r = bims::loadTumTrajectory(p);
+	ASSERT_EQ(r.size(), t.size());
+	for (size_t i = 0; i < t.size(); i++)
+	{
+		EXPECT_NEAR(r[i].t, t[i].t, 1e-6);
+		const auto d = (r[i].T_WC - t[i].T_WC);
+		EXPECT_LT(d.translation().norm(), 1e-8);
+		EXPECT_LT(std::abs(d.yaw()) + std::abs(d.pitch()) + std::abs(d.roll()), 1e-8);
+	}
+}
+
+TEST(Trajectory, MalformedLinesAreErrorsWithLineNumbers)
+{
+	const auto p = tmpPath("bad_traj.txt");
+	{
+		std::ofstream f(p);
+		f << "# comment\n1 0 0 0 0 0 0 1\n2 0 0 0 0 0 0\n";
+	}
+	try
+	{
+		bims::loadTumTrajectory(p);
+		FAIL();
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("bad_traj.txt:3:"), std::string::npos)
+			<< e.what();
+	}
+	{
+		std::ofstream f(p);
+		f << "1 0 0 0 0 0 0 2\n";
+	}
+	EXPECT_THROW(bims::loadTumTrajectory(p), std::runtime_error);
+}
