@@ -1,0 +1,54 @@
+#include <bims/flow/observed_flow.h>
+#include <opencv2/imgproc.hpp>
+
+#include <stdexcept>
+
+namespace bims::flow
+{
+ObservedFlow::ObservedFlow(const FlowParams& p) : p_(p)
+{
+	if (p_.method == "dis")
+	{
+		int preset = cv::DISOpticalFlow::PRESET_FAST;
+		if (p_.dis_preset == "ultrafast")
+			preset = cv::DISOpticalFlow::PRESET_ULTRAFAST;
+		if (p_.dis_preset == "medium")
+			preset = cv::DISOpticalFlow::PRESET_MEDIUM;
+		dis_ = cv::DISOpticalFlow::create(preset);
+	}
+	else if (p_.method != "farneback")
+		throw std::invalid_argument("observed flow: unknown method '" +
+		                            p_.method + "'");
+	if (p_.downscale < 1)
+		throw std::invalid_argument("observed flow: downscale must be >= 1");
+}
+
+cv::Mat ObservedFlow::compute(const cv::Mat& prev, const cv::Mat& cur)
+{
+	if (prev.empty() || cur.empty() || prev.size() != cur.size() ||
+	    prev.type() != CV_8UC1 || cur.type() != CV_8UC1)
+		throw std::invalid_argument(
+		    "observed flow: need two non-empty CV_8UC1 images of one size");
+	cv::Mat a = cur, b = prev;
+	if (p_.downscale > 1)
+	{
+		const cv::Size s(cur.cols / p_.downscale, cur.rows / p_.downscale);
+		cv::resize(cur, a, s, 0, 0, cv::INTER_AREA);
+		cv::resize(prev, b, s, 0, 0, cv::INTER_AREA);
+	}
+	cv::Mat flow;
+	if (dis_)
+		dis_->calc(a, b, flow);
+	else
+		cv::calcOpticalFlowFarneback(a, b, flow, 0.5, 4, 15, 3, 5, 1.1, 0);
+	if (p_.downscale > 1)
+	{
+		cv::Mat up;
+		cv::resize(flow, up, cur.size(), 0, 0, cv::INTER_LINEAR);
+		up *= static_cast<double>(p_.downscale);
+		flow = up;
+	}
+	return flow;
+}
+
+}  // namespace bims::flow
