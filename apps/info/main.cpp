@@ -1,0 +1,24 @@
+// bims-info IN.rawlog: summary of any rawlog (observations per sensor label and
+// class, rates, duration, time span, image sizes).
+#include "summary.h"
+
+#include <bims/common/app.h>
+#include <mrpt/3rdparty/tclap/CmdLine.h>
+
+#include <iostream>
+
+int main(int argc, char** argv)
+{
+	return bims::runApp(
+	    "bims-info",
+	    [&]()
+	    {
+		    TCLAP::CmdLine cmd("Summary of an MRPT rawlog.", ' ', "0.1");
+		    TCLAP::UnlabeledValueArg<std::string> in(
+		        "rawlog", "Input rawlog", true, "", "IN.rawlog", cmd);
+		    cmd.parse(argc, argv);
+		    const auto s = bims::info::summarizeRawlog(in.getValue());
+		    bims::info::printSummary(s, std::cout);
+		    return 0;
+	    });
+}

@@ -1,0 +1,249 @@
+#include <bims/common/config.h>
+#include <bims/sim/renderer.h>
+#include <bims/sim/rng.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace bims::sim
+{
+namespace
+{
+constexpr double kDeg = M_PI / 180.0;
+
+/** Procedural texture: a grid of cells of random colours (strong corners for
+ * KLT at every cell junction), plus a small per-cell darker dot pattern. */
+inline void textureColor(uint32_t seed, int face, double s, double t,
+                         double cell, double rgb[3])
+{
+	const double fs = s / cell, ft = t / cell;
+	const int64_t ix = int64_t(std::floor(fs)), iy = int64_t(std::floor(ft));
+	const uint64_t h = hash64(seed, uint64_t(face), uint64_t(ix), uint64_t(iy));
+	for (int c = 0; c < 3; c++)
+		rgb[c] = 35.0 + double((h >> (8 * c)) & 0xFF) * (200.0 / 255.0);
+	// A dark square in one quadrant of some cells: more corners, no symmetry.
+	if ((h >> 32) & 1)
+	{
+		const double u = fs - double(ix), v = ft - double(iy);
+		const int q = int((h >> 33) & 3);
+		const bool in = (q & 1 ? u > 0.55 : u < 0.45) &&
+		                (q & 2 ? v > 0.55 : v < 0.45) &&
+		                std::abs(u - 0.5) < 0.4 && std::abs(v - 0.5) < 0.4;
+		if (in)
+			for (int c = 0; c < 3; c++) rgb[c] *= 0.35;
+	}
+}
+}  // namespace
+
+void CameraParams::setResolution(const std::string& r)
+{
+	if (r == "640x480")
+		width = 640, height = 480;
+	else if (r == "320x240")
+		width = 320, height = 240;
+	else
+		throw std::invalid_argument(
+		    "resolution must be 640x480 or 320x240, got '" + r + "'");
+}
+
+void CameraParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+                                      const std::string& section)
+{
+	ConfigSection s(cfg, section);
+	setResolution(s.getEnum("resolution", "640x480", {"640x480", "320x240"}));
+	fx = s.getDouble("fx", fx, 50, 5000);
+	fy = s.getDouble("fy", fy, 50, 5000);
+	cx = s.getDouble("cx", cx, 0, 639);
+	cy = s.getDouble("cy", cy, 0, 479);
+	s.finish();
+}
+
+void DepthParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+                                     const std::string& section)
+{
+	ConfigSection s(cfg, section);
+	maxRange = s.getDouble("max_range", maxRange, 0.1, 60);
+	minRange = s.getDouble("min_range", minRange, 0.0, 10);
+	if (minRange >= maxRange)
+		s.fail("min_range", "must be smaller than max_range");
+	noiseA = s.getDouble("noise_a", noiseA, 0, 0.1);
+	grazingDeg = s.getDouble("grazing_deg", grazingDeg, 1, 90);
+	dropout = s.getDouble("dropout", dropout, 0, 1);
+	holesPerMpx = s.getDouble("holes_per_mpx", holesPerMpx, 0, 10000);
+	holeRadiusPx = s.getDouble("hole_radius_px", holeRadiusPx, 0.5, 100);
+	if (s.getBool("noiseless", false)) makeNoiseless();
+	s.finish();
+}
+
+void RgbParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+                                   const std::string& section)
+{
+	ConfigSection s(cfg, section);
+	noiseSigma = s.getDouble("noise_sigma", noiseSigma, 0, 100);
+	ambient = s.getDouble("ambient", ambient, 0, 1);
+	const auto l = s.getDoubles(
+	    "light_dir", {lightDir_W.x(), lightDir_W.y(), lightDir_W.z()}, 3, -1e3,
+	    1e3);
+	lightDir_W = Eigen::Vector3d(l[0], l[1], l[2]);
+	if (lightDir_W.norm() < 1e-9)
+		s.fail("light_dir", "must not be the zero vector");
+	s.finish();
+}
+
+Renderer::Renderer(const CameraParams& cam, const DepthParams& depth,
+                   const RgbParams& rgb)
+    : cam_(cam), depth_(depth), rgb_(rgb)
+{
+	xn_.resize(cam_.width);
+	yn_.resize(cam_.height);
+	for (int u = 0; u < cam_.width; u++) xn_[u] = (u - cam_.cxS()) / cam_.fxS();
+	for (int v = 0; v < cam_.height; v++)
+		yn_[v] = (v - cam_.cyS()) / cam_.fyS();
+	rgb_.lightDir_W.normalize();
+}
+
+void Renderer::render(const Scene& scene, double t, const Eigen::Matrix3d& R_WC,
+                      const Eigen::Vector3d& p_WC, uint64_t seed,
+                      uint64_t frameIndex, RenderedFrame& out) const
+{
+	const int W = cam_.width, H = cam_.height, N = W * H;
+	const double fx = cam_.fxS(), fy = cam_.fyS(), cx = cam_.cxS(),
+	             cy = cam_.cyS();
+	out.width = W;
+	out.height = H;
+	out.depthTrue.assign(N, 0.f);
+	out.depthMm.assign(N, 0);
+	out.rgb.assign(3 * size_t(N), 0);
+	out.mask.assign(N, 0);
+	out.objectId.assign(N, 0);
+
+	const std::vector<Primitive> prims = scene.primitivesAt(t);
+	const size_t P = prims.size();
+	std::vector<Eigen::Matrix3d> R_PC(P);
+	std::vector<Eigen::Vector3d> o_P(P);
+	std::vector<double> zbuf(N, std::numeric_limits<double>::infinity());
+	std::vector<int16_t> ibuf(N, -1);
+
+	// Pass 1: nearest hit per pixel, each primitive tested only inside the
+	// screen rectangle of its projected bounding box.
+	for (size_t i = 0; i < P; i++)
+	{
+		const Primitive& pr = prims[i];
+		R_PC[i] = pr.R_WP.transpose() * R_WC;
+		o_P[i] = pr.R_WP.transpose() * (p_WC - pr.t_WP);
+		int u0 = 0, u1 = W - 1, v0 = 0, v1 = H - 1;
+		if (pr.shape != Shape::Room)
+		{
+			const Eigen::Vector3d h =
+			    pr.shape == Shape::Sphere
+			        ? Eigen::Vector3d::Constant(pr.half.x())
+			        : pr.half;
+			double umin = 1e18, umax = -1e18, vmin = 1e18, vmax = -1e18;
+			bool behind = false;
+			for (int c = 0; c < 8; c++)
+			{
+				const Eigen::Vector3d x_P(c & 1 ? h.x() : -h.x(),
+				                          c & 2 ? h.y() : -h.y(),
+				                          c & 4 ? h.z() : -h.z());
+				const Eigen::Vector3d x_C =
+				    R_PC[i].transpose() * (x_P - o_P[i]);
+				if (x_C.z() < 1e-3)
+				{
+					behind = true;
+					break;
+				}
+				const double u = fx * x_C.x() / x_C.z() + cx,
+				             v = fy * x_C.y() / x_C.z() + cy;
+				umin = std::min(umin, u), umax = std::max(umax, u);
+				vmin = std::min(vmin, v), vmax = std::max(vmax, v);
+			}
+			if (!behind)
+			{
+				if (umax < -1 || vmax < -1 || umin > W || vmin > H) continue;
+				u0 = std::max(0, int(std::floor(umin)) - 1);
+				u1 = std::min(W - 1, int(std::ceil(umax)) + 1);
+				v0 = std::max(0, int(std::floor(vmin)) - 1);
+				v1 = std::min(H - 1, int(std::ceil(vmax)) + 1);
+			}
+		}
+		const Eigen::Matrix3d& R = R_PC[i];
+		const Eigen::Vector3d& o = o_P[i];
+		for (int v = v0; v <= v1; v++)
+		{
+			const double y = yn_[v];
+			for (int u = u0; u <= u1; u++)
+			{
+				const Eigen::Vector3d d =
+				    R.col(0) * xn_[u] + R.col(1) * y + R.col(2);
+				const double lam = intersectLocal(pr, o, d);
+				const int k = v * W + u;
+				if (lam < zbuf[k])
+				{
+					zbuf[k] = lam;
+					ibuf[k] = int16_t(i);
+				}
+			}
+		}
+	}
+
+	// Pass 2: shading, sensor model.
+	Rng rng(seed, 0x5EED0000ULL + frameIndex);
+	const double cosGraze = std::cos(depth_.grazingDeg * kDeg);
+	for (int v = 0; v < H; v++)
+	{
+		for (int u = 0; u < W; u++)
+		{
+			const int k = v * W + u;
+			const int i = ibuf[k];
+			if (i < 0) continue;
+			const Primitive& pr = prims[size_t(i)];
+			const double z = zbuf[k];
+			const Eigen::Vector3d d_C(xn_[u], yn_[v], 1.0);
+			const Eigen::Vector3d d_P = R_PC[i] * d_C;
+			const SurfaceHit hit = surfaceAt(pr, o_P[i] + z * d_P);
+			double col[3];
+			textureColor(pr.texture, hit.face, hit.s, hit.t, pr.cell, col);
+			const double shade =
+			    rgb_.ambient + (1 - rgb_.ambient) *
+			                       std::max(0.0, hit.n_W.dot(rgb_.lightDir_W));
+			for (int c = 0; c < 3; c++)
+			{
+				double val = col[c] * shade;
+				if (rgb_.noiseSigma > 0) val += rgb_.noiseSigma * rng.gauss();
+				out.rgb[3 * size_t(k) + c] =
+				    uint8_t(std::clamp(std::lround(val), 0L, 255L));
+			}
+			out.depthTrue[k] = float(z);
+			out.objectId[k] = uint8_t(std::min(pr.objectId, 255));
+			out.mask[k] = pr.objectId > 0 ? 255 : 0;
+			// Depth sensor
+			if (z > depth_.maxRange || z < depth_.minRange) continue;
+			const Eigen::Vector3d d_W = R_WC * d_C;
+			const double cosInc = std::abs(hit.n_W.dot(d_W)) / d_W.norm();
+			if (cosInc < cosGraze) continue;
+			if (depth_.dropout > 0 && rng.uniform() < depth_.dropout) continue;
+			double zn = z;
+			if (depth_.noiseA > 0) zn += depth_.noiseA * z * z * rng.gauss();
+			const long mm = std::lround(zn * 1000.0);
+			out.depthMm[k] = uint16_t(std::clamp(mm, 0L, 65535L));
+		}
+	}
+	// Small round holes.
+	const int nHoles = int(std::lround(depth_.holesPerMpx * N * 1e-6));
+	const double rMax = depth_.holeRadiusPx * W / 640.0;
+	for (int h = 0; h < nHoles; h++)
+	{
+		const double hu = rng.uniform(0, W), hv = rng.uniform(0, H);
+		const double r = rng.uniform(0.5, std::max(0.5, rMax));
+		for (int v = std::max(0, int(hv - r));
+		     v <= std::min(H - 1, int(hv + r)); v++)
+			for (int u = std::max(0, int(hu - r));
+			     u <= std::min(W - 1, int(hu + r)); u++)
+				if ((u - hu) * (u - hu) + (v - hv) * (v - hv) <= r * r)
+					out.depthMm[v * W + u] = 0;
+	}
+}
+
+}  // namespace bims::sim

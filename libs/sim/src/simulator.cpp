@@ -1,0 +1,260 @@
+#include <bims/common/app.h>
+#include <bims/common/progress.h>
+#include <bims/common/rawlog.h>
+#include <bims/common/trajectory.h>
+#include <bims/sim/simulator.h>
+#include <mrpt/math/CMatrixFixed.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationIMU.h>
+#include <mrpt/obs/TPixelLabelInfo.h>
+#include <mrpt/poses/CPose3D.h>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+
+namespace bims::sim
+{
+namespace
+{
+mrpt::poses::CPose3D toPose(const Eigen::Matrix3d& R, const Eigen::Vector3d& t)
+{
+	mrpt::math::CMatrixDouble44 M = mrpt::math::CMatrixDouble44::Identity();
+	for (int r = 0; r < 3; r++)
+	{
+		for (int c = 0; c < 3; c++) M(r, c) = R(r, c);
+		M(r, 3) = t[r];
+	}
+	return mrpt::poses::CPose3D(M);
+}
+
+mrpt::obs::CObservation3DRangeScan::Ptr makeScan(const SimConfig& cfg,
+                                                 RenderedFrame& f, double stamp)
+{
+	using mrpt::obs::CObservation3DRangeScan;
+	auto o = CObservation3DRangeScan::Create();
+	o->sensorLabel = cfg.seq.rgbdLabel;
+	o->timestamp = mrpt::Clock::fromDouble(stamp);
+	o->sensorPose = mrpt::poses::CPose3D();
+	o->maxRange = float(cfg.depth.maxRange);
+	o->hasRangeImage = true;
+	o->range_is_depth = true;
+	o->rangeUnits = 0.001f;
+	o->rangeImage_setSize(f.height, f.width);
+	for (int v = 0; v < f.height; v++)
+		for (int u = 0; u < f.width; u++)
+			o->rangeImage(v, u) = f.depthMm[size_t(v) * f.width + u];
+	o->cameraParams.ncols = uint32_t(f.width);
+	o->cameraParams.nrows = uint32_t(f.height);
+	o->cameraParams.setIntrinsicParamsFromValues(
+	    cfg.camera.fxS(), cfg.camera.fyS(), cfg.camera.cxS(), cfg.camera.cyS());
+	o->cameraParams.distortion = mrpt::img::DistortionModel::none;
+	o->cameraParamsIntensity = o->cameraParams;
+	o->relativePoseIntensityWRTDepth =
+	    mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+	o->hasIntensityImage = true;
+	o->intensityImageChannel = CObservation3DRangeScan::CH_VISIBLE;
+	o->intensityImage.loadFromMemoryBuffer(
+	    unsigned(f.width), unsigned(f.height), true, f.rgb.data(), true);
+	if (cfg.seq.pixelLabels)
+	{
+		auto labels = std::make_shared<mrpt::obs::TPixelLabelInfo<1>>();
+		labels->setSize(f.height, f.width);
+		labels->setLabelName(0, "moving");
+		for (int v = 0; v < f.height; v++)
+			for (int u = 0; u < f.width; u++)
+				if (f.mask[size_t(v) * f.width + u]) labels->setLabel(v, u, 0);
+		o->pixelLabels = labels;
+	}
+	return o;
+}
+
+/** RGB | depth (grey, black = no reading) | mask side by side. */
+void writePreview(const RenderedFrame& f, double maxRange,
+                  const std::string& path)
+{
+	const int W = f.width, H = f.height;
+	cv::Mat img(H, 3 * W, CV_8UC3);
+	for (int v = 0; v < H; v++)
+		for (int u = 0; u < W; u++)
+		{
+			const size_t k = size_t(v) * W + u;
+			img.at<cv::Vec3b>(v, u) =
+			    cv::Vec3b(f.rgb[3 * k + 2], f.rgb[3 * k + 1], f.rgb[3 * k]);
+			const uint8_t d =
+			    f.depthMm[k] ? uint8_t(std::clamp(255.0 - 230.0 * f.depthMm[k] *
+			                                                  1e-3 / maxRange,
+			                                      0.0, 255.0))
+			                 : 0;
+			img.at<cv::Vec3b>(v, W + u) = cv::Vec3b(d, d, d);
+			img.at<cv::Vec3b>(v, 2 * W + u) =
+			    cv::Vec3b(f.mask[k], f.mask[k], f.mask[k]);
+		}
+	if (!cv::imwrite(path, img))
+		throw std::runtime_error(path + ": cannot write preview");
+}
+
+void writeCalibration(const SimConfig& cfg, const std::string& path)
+{
+	std::ofstream f(path);
+	if (!f) throw std::runtime_error(path + ": cannot write");
+	char buf[256];
+	f << "# bims-sim calibration of " << cfg.file << "\n"
+	  << "# Keys match the sections of a bims experiment .ini.\n"
+	  << "[camera]\n";
+	std::snprintf(buf, sizeof(buf),
+	              "width=%d\nheight=%d\nfx=%.6f\nfy=%.6f\ncx=%.6f\ncy=%.6f\n",
+	              cfg.camera.width, cfg.camera.height, cfg.camera.fxS(),
+	              cfg.camera.fyS(), cfg.camera.cxS(), cfg.camera.cyS());
+	f << buf << "; metres per depth unit\ndepth_scale=0.001\n";
+	std::snprintf(buf, sizeof(buf), "max_range=%.3f\n", cfg.depth.maxRange);
+	f << buf << "\n[calibration]\n"
+	  << "; R_IC: orientation of the camera optical frame {C} in the IMU frame "
+	     "{I},\n"
+	  << "; p_I = R_IC * p_C, 9 numbers row-major.\nR_IC=";
+	for (int r = 0; r < 3; r++)
+		for (int c = 0; c < 3; c++)
+		{
+			std::snprintf(buf, sizeof(buf), "%s%.12f", (r || c) ? " " : "",
+			              cfg.imu.R_IC(r, c));
+			f << buf;
+		}
+	std::snprintf(
+	    buf, sizeof(buf),
+	    "\n; IMU stamp = true time + time_offset_s\ntime_offset_s=%.6f\n",
+	    cfg.imu.timeOffsetS);
+	f << buf << "\n[sensors]\nrgbd_label=" << cfg.seq.rgbdLabel
+	  << "\nimu_label=" << cfg.imu.label << "\n";
+	std::snprintf(buf, sizeof(buf), "rgbd_rate_hz=%.6f\nimu_rate_hz=%.6f\n",
+	              cfg.seq.fps, cfg.imu.rateHz);
+	f << buf;
+	const Eigen::Vector3d m = cfg.imu.earthField_W();
+	std::snprintf(buf, sizeof(buf),
+	              "\n; Earth magnetic field in {W} (z up, x north) [gauss]; "
+	              "gravity 9.80665 m/s^2 along -z\n"
+	              "; (informative: not a section of the experiment .ini)\n; "
+	              "mag_field_W=%.9f %.9f %.9f\n",
+	              m.x(), m.y(), m.z());
+	f << buf;
+	if (!f) throw std::runtime_error(path + ": write failed");
+}
+}  // namespace
+
+std::string groundTruthDirFor(const std::string& rawlogPath)
+{
+	std::string base = rawlogPath;
+	const std::string ext = ".rawlog";
+	if (base.size() > ext.size() &&
+	    base.compare(base.size() - ext.size(), ext.size(), ext) == 0)
+		base.resize(base.size() - ext.size());
+	return base + "_gt";
+}
+
+SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
+                       uint64_t seed, bool progress, int previewFrame)
+{
+	const auto tStart = std::chrono::steady_clock::now();
+	SimStats st;
+	st.gtDir = groundTruthDirFor(outRawlog);
+	makeDirs(st.gtDir + "/masks");
+
+	const Scene scene = cfg.buildScene();
+	const HandheldMotion motion(cfg.motion);
+	const Renderer renderer(cfg.camera, cfg.depth, cfg.rgb);
+	ImuSimulator imu(cfg.imu, seed);
+	RawlogWriter out(outRawlog, cfg.seq.gzLevel);
+
+	Trajectory gt;
+	std::vector<ImuTruth> imuTruth;
+	std::ofstream objs(st.gtDir + "/objects.txt");
+	if (!objs)
+		throw std::runtime_error(st.gtDir + "/objects.txt: cannot write");
+	objs << "# bims-sim moving-object poses T_WO (root frame of each object in "
+	        "{W}), one line\n"
+	        "# per frame and object: frame object_id name t[s] tx ty tz qx qy "
+	        "qz qw\n"
+	        "# (object_id = the value in RenderedFrame::objectId; masks are "
+	        "255 for any id > 0)\n";
+
+	const double t0 = cfg.seq.startTime;
+	const double duration = double(cfg.seq.frames - 1) / cfg.seq.fps;
+	size_t nextImu = 0;
+	auto writeImuUntil = [&](double tSeq)
+	{
+		// IMU samples stamped up to sequence time tSeq (inclusive).
+		while (double(nextImu) / cfg.imu.rateHz <= tSeq + 1e-9)
+		{
+			ImuTruth tr;
+			const double stamp = t0 + double(nextImu) / cfg.imu.rateHz;
+			out.write(*imu.sample(motion, stamp, t0, &tr));
+			imuTruth.push_back(tr);
+			nextImu++;
+		}
+	};
+
+	ProgressBar bar("bims-sim", size_t(cfg.seq.frames), progress);
+	RenderedFrame frame;
+	double movingSum = 0;
+	for (int j = 0; j < cfg.seq.frames; j++)
+	{
+		const double tSeq = double(j) / cfg.seq.fps;
+		writeImuUntil(tSeq);
+		const Kinematics k = motion.at(tSeq);
+		const auto r0 = std::chrono::steady_clock::now();
+		renderer.render(scene, tSeq, k.R_WC, k.p_WC, seed, uint64_t(j), frame);
+		st.renderSeconds +=
+		    std::chrono::duration<double>(std::chrono::steady_clock::now() - r0)
+		        .count();
+		out.write(*makeScan(cfg, frame, t0 + tSeq));
+
+		gt.push_back({t0 + tSeq, toPose(k.R_WC, k.p_WC)});
+		char name[64];
+		std::snprintf(name, sizeof(name), "/masks/%06d.png", j);
+		const cv::Mat mask(frame.height, frame.width, CV_8UC1,
+		                   frame.mask.data());
+		if (!cv::imwrite(st.gtDir + name, mask))
+			throw std::runtime_error(st.gtDir + name + ": cannot write mask");
+		if (j == previewFrame)
+			writePreview(frame, cfg.depth.maxRange, st.gtDir + "/preview.png");
+		size_t nMoving = 0;
+		for (auto m : frame.mask) nMoving += m ? 1 : 0;
+		movingSum += double(nMoving) / double(frame.mask.size());
+		for (size_t o = 0; o < scene.objects.size(); o++)
+		{
+			Eigen::Matrix3d R;
+			Eigen::Vector3d x;
+			scene.objects[o]->pose(tSeq, R, x);
+			objs << j << " " << (o + 1) << " " << scene.objects[o]->name()
+			     << " " << tumLine(t0 + tSeq, toPose(R, x)) << "\n";
+		}
+		bar.update(size_t(j + 1));
+	}
+	writeImuUntil(duration +
+	              0.5 / cfg.seq.fps);  // IMU a little past the last frame
+	out.close();
+	bar.finish();
+
+	saveTumTrajectory(st.gtDir + "/groundtruth.txt", gt,
+	                  "bims-sim ground truth: camera optical frame poses T_WC, "
+	                  "world z up, x north");
+	saveImuTruth(st.gtDir + "/imu.txt", imuTruth);
+	writeCalibration(cfg, st.gtDir + "/calibration.ini");
+	if (!objs)
+		throw std::runtime_error(st.gtDir + "/objects.txt: write failed");
+
+	st.frames = size_t(cfg.seq.frames);
+	st.imuSamples = imuTruth.size();
+	st.movingFraction = movingSum / std::max(1, cfg.seq.frames);
+	st.seconds =
+	    std::chrono::duration<double>(std::chrono::steady_clock::now() - tStart)
+	        .count();
+	return st;
+}
+
+}  // namespace bims::sim
