@@ -1,0 +1,177 @@
+// Common part of tiers 1 and 2: per-voxel posterior of independent motion
+// I for the voxels hit in a frame, the moving-pixel mask of the last frame,
+// and the tier-0 map the prior O- is read from.
+#pragma once
+
+#include <bims/maps/COccupancyBayesGrid.h>
+
+#include <memory>
+
+namespace bims::maps
+{
+/** Abstract base of CBackgroundSubtractionGrid and CFlowConsistencyGrid.
+ *
+ * Where O- comes from: a tier-1/2 map reads the previous occupancy from a
+ * tier-0 map. By default it owns a private COccupancyBayesGrid with the
+ * same parameters, which it updates itself after reading O- (so the map
+ * works alone through insertObservation()). linkOccupancy() makes it read
+ * a shared tier-0 map instead, which it then never modifies: the owner
+ * inserts each frame into that map too, before or after this one (the
+ * frame is recognised by its timestamp, see
+ * COccupancyBayesGrid::priorLogOdds). MotionGrids does all of this. */
+class CMotionGridBase : public CBayesVoxelGridBase
+{
+	DEFINE_VIRTUAL_SERIALIZABLE(CMotionGridBase)
+
+   public:
+	/** Stored posterior log-odds of I at the voxel's last hit frame. */
+	struct Cell
+	{
+		float l = 0;
+		uint32_t stamp = 0;  //!< frame of the last hit; 0 = never
+	};
+	using Storage = SparseVoxelGrid<Cell, 3>;
+
+	explicit CMotionGridBase(const GridParams& p = {});
+
+	/** Reads O- from \a t0 (shared; never modified by this map) instead of
+	 * a private tier-0 map. nullptr returns to a private map. Throws
+	 * std::invalid_argument if the voxel sizes differ. */
+	void linkOccupancy(std::shared_ptr<const COccupancyBayesGrid> t0);
+	/** The tier-0 map O- is read from (linked or private). */
+	const COccupancyBayesGrid& occupancySource() const;
+	bool isLinked() const { return linked_ != nullptr; }
+
+	/** Replaces the parameters (clears the map). */
+	void setParams(const GridParams& p);
+
+	/** Stores the posterior log-odds (one per frame.cells) of a frame as
+	 * this map's frame frameCount()+1 and computes the mask. */
+	void store(const FrameCloud& frame, std::vector<float> posteriorLogOdds);
+
+	/** Posterior log-odds of I of each of the last frame's cells. */
+	const std::vector<float>& lastPosterior() const { return lastPost_; }
+	/** Voxels of the last frame (same order as lastPosterior()). */
+	const std::vector<VoxelKey>& lastCells() const { return lastCells_; }
+	/** Moving-pixel mask of the last frame (MAP: posterior > 1/2). Empty
+	 * (0 x 0) for unorganised clouds. */
+	const PixelMask& lastMovingMask() const { return lastMask_; }
+
+	/** Posterior probability of I at the voxel containing \a p_W if that
+	 * voxel was hit in the last frame, else nullopt. */
+	std::optional<double> probabilityAt(const mrpt::math::TPoint3D& p_W) const;
+	/** Whether the voxel was labelled moving (MAP) at its last hit. */
+	bool wasMovingAtLastHit(const VoxelKey& k) const;
+	/** Centres [m, {W}] of the last frame's voxels labelled moving. */
+	std::vector<mrpt::math::TPoint3D> movingCells() const;
+
+	const Storage& storage() const { return grid_; }
+	size_t memoryBytes() const { return grid_.memoryBytes(); }
+
+	std::string asString() const override;
+	/** Writes <prefix>_moving.ply (the last frame's moving voxels). */
+	void saveMetricMapRepresentationToFile(
+		const std::string& prefix) const override;
+
+   protected:
+	/** Posterior log-odds per frame.cell from O- (tier specific). */
+	virtual void computePosterior(
+		const FrameCloud& frame, const std::vector<float>& priorO,
+		std::vector<float>& post) = 0;
+
+	void internal_clear() override;
+	bool internal_insertObservation(
+		const mrpt::obs::CObservation& obs,
+		const std::optional<const mrpt::poses::CPose3D>& robotPose =
+			std::nullopt) override;
+	void writeMotion(mrpt::serialization::CArchive& out) const;
+	void readMotion(mrpt::serialization::CArchive& in);
+	void visualize(
+		mrpt::opengl::CSetOfObjects& o, const mrpt::img::TColor& c,
+		const std::string& name) const;
+
+	Storage grid_;
+	std::vector<float> lastPost_;
+	std::vector<VoxelKey> lastCells_;
+	PixelMask lastMask_;
+	std::shared_ptr<const COccupancyBayesGrid> linked_;
+	std::shared_ptr<COccupancyBayesGrid> private_;
+	mrpt::Clock::time_point lastTimestampLocal_{};
+};
+
+/** Tier 1: background subtraction (paper eq. 4). P(I) recomputed every
+ * frame from O- (not recursive); reported for hit voxels only.
+ * .ini name: "backgroundSubtractionGrid". */
+class CBackgroundSubtractionGrid : public CMotionGridBase
+{
+	DEFINE_SERIALIZABLE(CBackgroundSubtractionGrid, bims::maps)
+
+   public:
+	explicit CBackgroundSubtractionGrid(const GridParams& p = {});
+
+	/** Tier-1 posterior log-odds for each of frame.cells from O-. */
+	void posterior(
+		const FrameCloud& frame, const std::vector<float>& priorO,
+		std::vector<float>& post) const;
+
+	void getVisualizationInto(mrpt::opengl::CSetOfObjects& o) const override;
+
+	MAP_DEFINITION_START(CBackgroundSubtractionGrid)
+	GridParams params;
+	MAP_DEFINITION_END(CBackgroundSubtractionGrid)
+
+   protected:
+	void computePosterior(
+		const FrameCloud& frame, const std::vector<float>& priorO,
+		std::vector<float>& post) override
+	{
+		posterior(frame, priorO, post);
+	}
+};
+
+/** Tier 2: optical-flow consistency (paper eq. 9). Combines tier 1's
+ * posterior with the per-pixel Diff/notDiff labels of the frame.
+ * Through insertObservation(), the labels are those given by
+ * setPendingLabels() before the call (consumed by it; without labels, every
+ * reading is unlabelled and tier 2 equals tier 1). .ini name:
+ * "flowConsistencyGrid". */
+class CFlowConsistencyGrid : public CMotionGridBase
+{
+	DEFINE_SERIALIZABLE(CFlowConsistencyGrid, bims::maps)
+
+   public:
+	explicit CFlowConsistencyGrid(const GridParams& p = {});
+
+	/** Labels for the next insertObservation(). */
+	void setPendingLabels(PixelLabels labels);
+
+	/** Counts the Diff (k) and notDiff (l) readings of each frame cell.
+	 * Throws std::invalid_argument if the label image size differs from
+	 * the frame's. */
+	static void countLabels(
+		const FrameCloud& frame, const PixelLabels& labels,
+		std::vector<uint32_t>& k, std::vector<uint32_t>& l);
+
+	/** Tier-2 posterior log-odds for each of frame.cells from the tier-1
+	 * posterior log-odds \a tier1 and the labels. */
+	void posterior(
+		const FrameCloud& frame, const PixelLabels& labels,
+		const std::vector<float>& tier1, std::vector<float>& post) const;
+
+	void getVisualizationInto(mrpt::opengl::CSetOfObjects& o) const override;
+
+	MAP_DEFINITION_START(CFlowConsistencyGrid)
+	GridParams params;
+	MAP_DEFINITION_END(CFlowConsistencyGrid)
+
+   protected:
+	void computePosterior(
+		const FrameCloud& frame, const std::vector<float>& priorO,
+		std::vector<float>& post) override;
+
+   private:
+	PixelLabels pending_;
+	std::vector<float> t1scratch_;
+};
+
+}  // namespace bims::maps

@@ -1,0 +1,106 @@
+// Tier 0: the Bayesian occupancy grid of the paper's eq. 3 (docs/model.md).
+#pragma once
+
+#include <bims/maps/CBayesVoxelGridBase.h>
+#include <bims/maps/logodds_fixed.h>
+#include <bims/maps/sparse_voxel_grid.h>
+
+#include <mrpt/maps/TMetricMapInitializer.h>
+
+#include <optional>
+
+namespace bims::maps
+{
+/** Tier 0 occupancy grid: log-odds of O per voxel, clamped to
+ * [logit(p_min), logit(p_max)], each voxel updated once per frame (hits
+ * win over misses), unobserved cells decaying by log(2 - p_miss) per frame
+ * according to params().decay (lazily for decay = all).
+ *
+ * Use through the CMetricMap interface (insertObservation of a
+ * CObservation3DRangeScan) or, sharing one FrameCloud with the other tiers,
+ * through integrate(). .ini name: "occupancyBayesGrid" (docs/maps.md). */
+class COccupancyBayesGrid : public CBayesVoxelGridBase
+{
+	DEFINE_SERIALIZABLE(COccupancyBayesGrid, bims::maps)
+
+   public:
+	/** Storage cell: fixed-point log-odds at frame `stamp`, and the value
+	 * O- it had just before that frame's update. Never-touched cells are
+	 * {0, 0, 0}: the prior 0.5 before frame 1. */
+	struct Cell
+	{
+		LogOddsFx l = 0;
+		LogOddsFx lPrev = 0;
+		uint32_t stamp = 0;
+	};
+	using Storage = SparseVoxelGrid<Cell, 3>;
+
+	explicit COccupancyBayesGrid(const GridParams& p = {});
+
+	/** Replaces the parameters (clears the map if voxel_size changes). */
+	void setParams(const GridParams& p);
+
+	/** Folds one frame in (frame number frameCount()+1). If
+	 * \a priorLogOdds is given it receives O- (log-odds before this frame,
+	 * after lazy decay) for each of frame.cells, for tier 1. */
+	void integrate(
+		const FrameCloud& frame, std::vector<float>* priorLogOdds = nullptr);
+
+	/** O- for each of frame.cells, without modifying the map. Order
+	 * independent: if this frame (same non-zero timestamp) was already
+	 * integrated, returns the values from before it. */
+	void priorLogOdds(const FrameCloud& frame, std::vector<float>& out) const;
+
+	/** Current log-odds of the voxel containing \a p_W (after all decay up
+	 * to frameCount()); the prior 0 decayed for never-touched space. */
+	double logOddsAt(const mrpt::math::TPoint3D& p_W) const;
+	/** Current occupancy probability of the voxel containing \a p_W. */
+	double probabilityAt(const mrpt::math::TPoint3D& p_W) const;
+	/** Current fixed-point log-odds of a voxel. */
+	LogOddsFx logOddsFixed(const VoxelKey& k) const;
+	/** Centres [m, {W}] of the stored voxels with probability > p. */
+	std::vector<mrpt::math::TPoint3D> cellsAbove(double p) const;
+	/** Keys of the stored voxels with probability > p. */
+	std::vector<VoxelKey> keysAbove(double p) const;
+
+	/** Quantised update constants (for tests and docs). */
+	LogOddsFx missFixed() const { return miss_; }
+	LogOddsFx minFixed() const { return lmin_; }
+	LogOddsFx maxFixed() const { return lmax_; }
+	LogOddsFx hitFixed(uint32_t n) const;
+
+	const Storage& storage() const { return grid_; }
+	size_t memoryBytes() const { return grid_.memoryBytes(); }
+
+	void getVisualizationInto(mrpt::opengl::CSetOfObjects& o) const override;
+	std::string asString() const override;
+	/** Writes <prefix>_occupied.ply (voxels with p > 0.5). */
+	void saveMetricMapRepresentationToFile(
+		const std::string& prefix) const override;
+
+	MAP_DEFINITION_START(COccupancyBayesGrid)
+	GridParams params;
+	MAP_DEFINITION_END(COccupancyBayesGrid)
+
+   protected:
+	void internal_clear() override;
+	bool internal_insertObservation(
+		const mrpt::obs::CObservation& obs,
+		const std::optional<const mrpt::poses::CPose3D>& robotPose =
+			std::nullopt) override;
+
+   private:
+	void updateConstants();
+	LogOddsFx hitFixedCompute(uint32_t n) const;
+	LogOddsFx currentFixed(const Cell& c) const;
+	void decayFrustum(const FrameCloud& f, uint32_t F);
+	void decayRaycast(const FrameCloud& f, uint32_t F);
+	void applyMiss(Cell& c, uint32_t F) const;
+
+	Storage grid_;
+	LogOddsFx miss_ = 0, lmin_ = 0, lmax_ = 0;
+	double logLambda_ = 0;
+	std::vector<LogOddsFx> hitTable_;
+};
+
+}  // namespace bims::maps

@@ -1,0 +1,155 @@
+// One frame's registered readings, keyed once and shared by the three tiers.
+//
+// Built from a CObservation3DRangeScan and the pose T_WS of MRPT's scan frame
+// {S} in the world {W} (bims/common/frames.h); the optical frame is
+// T_WC = T_WS * T_SC. Every valid pixel becomes a point in {W} with its
+// pixel index and the index of its voxel among the frame's distinct hit
+// voxels (cells), so unprojection and voxel keying happen once per frame.
+#pragma once
+
+#include <bims/maps/flat_hash_map.h>
+#include <bims/maps/grid_params.h>
+#include <bims/maps/voxel_key.h>
+
+#include <mrpt/core/Clock.h>
+#include <mrpt/math/TPoint3D.h>
+#include <mrpt/poses/CPose3D.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace mrpt::obs
+{
+class CObservation3DRangeScan;
+}
+
+namespace bims::maps
+{
+/** Per-pixel flow-consistency labels of one frame (input of tier 2),
+ * row-major, width x height: -1 no label, 0 notDiff, 1 Diff. */
+struct PixelLabels
+{
+	int width = 0, height = 0;
+	std::vector<int8_t> label;
+
+	PixelLabels() = default;
+	PixelLabels(int w, int h, int8_t fill = -1)
+		: width(w), height(h), label(size_t(w) * size_t(h), fill)
+	{
+	}
+	int8_t at(int u, int v) const { return label[size_t(v) * width + u]; }
+	int8_t& at(int u, int v) { return label[size_t(v) * width + u]; }
+};
+
+/** A per-pixel mask (row-major uint8, 255 = moving, 0 = not). */
+struct PixelMask
+{
+	int width = 0, height = 0;
+	std::vector<uint8_t> data;
+	void reset(int w, int h)
+	{
+		width = w;
+		height = h;
+		data.assign(size_t(w) * size_t(h), 0);
+	}
+	size_t count() const;
+};
+
+/** Readings skipped while building a frame, by reason. */
+struct FrameStats
+{
+	size_t valid = 0;  //!< readings used
+	size_t noDepth = 0;  //!< zero depth (no reading)
+	size_t nonFinite = 0;  //!< NaN or inf coordinates
+	size_t beyondRange = 0;  //!< farther than max_range
+	size_t outsideExtent = 0;  //!< outside the configured extent
+	size_t overBudget = 0;  //!< cells not created: memory budget
+	bool badPose = false;  //!< the pose was not finite: frame skipped
+	FrameStats& operator+=(const FrameStats& o);
+	size_t skipped() const
+	{
+		return noDepth + nonFinite + beyondRange + outsideExtent + overBudget;
+	}
+	std::string asString() const;
+};
+
+/** Pinhole intrinsics of the depth image [px] (distortion ignored, as in
+ * MRPT's own unprojection). */
+struct Intrinsics
+{
+	int width = 0, height = 0;
+	double fx = 0, fy = 0, cx = 0, cy = 0;
+};
+
+/** See the file comment. */
+struct FrameCloud
+{
+	/** Voxel size the keys were computed for [m]. */
+	double voxel_size = 0;
+	/** Observation time (used to recognise a frame already folded into a
+	 * linked tier-0 map); INVALID_TIMESTAMP if unknown. */
+	mrpt::Clock::time_point timestamp{};
+	/** Pose of the optical frame {C} in {W}. */
+	mrpt::poses::CPose3D T_WC;
+	/** Sensor origin in {W} [m]. */
+	mrpt::math::TPoint3D origin_W;
+	/** Intrinsics; width = height = 0 for an unorganised cloud (then
+	 * decay = frustum has no frustum and masks are empty). */
+	Intrinsics K;
+	/** Per pixel (row-major) depth used [m] along the optical axis, 0 where
+	 * no valid reading; empty for an unorganised cloud. */
+	std::vector<float> depth;
+
+	/** Valid readings in {W} [m]. */
+	std::vector<mrpt::math::TPoint3Df> points_W;
+	/** Pixel index v * width + u of each reading. */
+	std::vector<uint32_t> pixel;
+	/** Index into cells of each reading's voxel. */
+	std::vector<uint32_t> cellOfPoint;
+	/** Distinct voxels hit this frame. */
+	std::vector<VoxelKey> cells;
+	/** Number of readings in each of cells (n_C >= 1). */
+	std::vector<uint32_t> hits;
+
+	FrameStats stats;
+
+	size_t numPoints() const { return points_W.size(); }
+	size_t numCells() const { return cells.size(); }
+};
+
+/** Builds FrameCloud objects, reusing its scratch memory across frames.
+ * Not thread-safe (one builder per thread). */
+class FrameCloudBuilder
+{
+   public:
+	explicit FrameCloudBuilder(const GridParams& p = {});
+	void setParams(const GridParams& p);
+
+	/** From a depth/range image. \param T_WS pose of MRPT's scan frame {S}
+	 * in {W} (the observation's sensorPose is NOT added: pass
+	 * robotPose + sensorPose yourself). A non-finite pose yields an empty
+	 * frame with stats.badPose = true. Throws std::invalid_argument if the
+	 * scan has no range image or its camera size differs from the image. */
+	void build(
+		const mrpt::obs::CObservation3DRangeScan& scan,
+		const mrpt::poses::CPose3D& T_WS, FrameCloud& out);
+
+	/** From points already in {W}, with the sensor origin (e.g. a
+	 * simulator or a LiDAR). \a pixels may be empty (unorganised cloud). */
+	void buildFromPoints(
+		const std::vector<mrpt::math::TPoint3Df>& points_W,
+		const std::vector<uint32_t>& pixels,
+		const mrpt::math::TPoint3D& origin_W, FrameCloud& out,
+		const Intrinsics& K = {});
+
+	/** Keys the points of \a out (points_W, pixel already filled):
+	 * fills cellOfPoint, cells, hits and the extent/range statistics. */
+	void keyPoints(FrameCloud& out);
+
+   private:
+	GridParams p_;
+	FlatHashMap dedup_;  // packed voxel key -> index into cells
+};
+
+}  // namespace bims::maps

@@ -1,0 +1,108 @@
+// Parameters of the three Bayesian voxel grids (experiment .ini section
+// [grids], or the creationOpts section of an MRPT map definition).
+// The model and the reasons for every default: docs/model.md.
+#pragma once
+
+#include <mrpt/config/CConfigFileBase.h>
+
+#include <cstddef>
+#include <iosfwd>
+#include <string>
+
+namespace bims::maps
+{
+/** Which tier-0 cells that got no reading in a frame receive the "miss"
+ * update -log(2 - P_miss) (docs/model.md, "Decay"). */
+enum class DecayMode
+{
+	/** Every cell of the (unbounded) grid, also outside the view: the
+	 * paper's literal model. Applied lazily, O(points) per frame. */
+	All,
+	/** Existing cells inside the view frustum and in front of the measured
+	 * depth at their pixel. */
+	Frustum,
+	/** Cells traversed by a sensor ray (3D DDA) before its hit. */
+	Raycast
+};
+
+/** How tier 2 reads a Diff-labelled reading (docs/model.md, tier 2). */
+enum class FlowEvidence
+{
+	/** Diff readings are Dirac only for Diff_C = 1 (default). */
+	Symmetric,
+	/** Literal reading: Diff readings are Dirac for either value, so only
+	 * consistent flow carries evidence (tier 2 can only filter tier 1). */
+	Veto
+};
+
+/** Which end point a free-space ray goes to (decay = raycast). */
+enum class RayTarget
+{
+	/** One ray per reading, to the reading itself (exact). */
+	Points,
+	/** One ray per distinct hit voxel, to its centre (OctoMap's
+	 * "discretize" option): fewer rays, same hit cells. */
+	Voxels
+};
+
+const char* toString(DecayMode m);
+const char* toString(FlowEvidence e);
+const char* toString(RayTarget t);
+
+/** All parameters of the grids. Probabilities are in (0, 1); log-odds are
+ * natural logarithms. Defaults are explained in docs/model.md. */
+struct GridParams
+{
+	/** Edge of a cubic voxel [m]. */
+	double voxel_size = 0.05;
+	/** Which unobserved cells decay (tier 0). */
+	DecayMode decay = DecayMode::All;
+	/** P(D = 0): probability that the sensor misses an occupied cell. Also
+	 * sets the decay per frame, log(2 - p_miss). */
+	double p_miss = 0.1;
+	/** Tier 0/1 per-reading likelihood ratio lambda (>= 1); 1 means that a
+	 * reading carries no evidence beyond "the cell was hit". */
+	double reading_lambda = 1.0;
+	/** Tier-0 clamping of the occupancy probability: [p_min, p_max]. */
+	double p_min = 0.12;
+	double p_max = 0.97;
+	/** Tier 1: eps = P(I=1 | O-=1) = 1 - P(I=1 | O-=0). */
+	double bg_transition_eps = 0.01;
+	/** Tier 2: tau = P(Diff_C != I). */
+	double flow_transition_tau = 0.1;
+	/** Tier 2 per-reading likelihood ratio (must be > 1). */
+	double flow_lambda = 4.0;
+	/** Tier 2 reading of Diff labels. */
+	FlowEvidence flow_evidence = FlowEvidence::Symmetric;
+	/** Readings farther than this from the sensor are skipped [m]. */
+	double max_range = 8.0;
+	/** Readings and rays are confined to the cube |x|,|y|,|z| <= extent in
+	 * {W} [m]; points outside are skipped and counted. */
+	double extent = 500.0;
+	/** Memory budget of one grid's voxel storage [MiB]; cells that would
+	 * exceed it are not created (counted, warned once). */
+	double max_memory_mb = 4096;
+	/** decay = raycast: every k-th pixel in u and in v casts a free-space
+	 * ray (hits always use every pixel). 1 = full resolution. */
+	int raycast_decimation = 1;
+	/** decay = raycast: rays to each reading or to each hit voxel. */
+	RayTarget raycast_target = RayTarget::Points;
+
+	/** Throws std::invalid_argument naming the parameter if inconsistent. */
+	void validate() const;
+
+	/** Reads the keys above from \a section (strict: unknown keys throw
+	 * bims::ConfigError naming file, section and key). Keys in
+	 * \a alsoAllowed are accepted without being read. */
+	void loadFromConfigFile(
+		const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+		const std::vector<std::string>& alsoAllowed = {});
+
+	/** Writes every key (for dumps, serialisation checks). */
+	void dump(std::ostream& out) const;
+
+	bool operator==(const GridParams& o) const;
+	bool operator!=(const GridParams& o) const { return !(*this == o); }
+};
+
+}  // namespace bims::maps

@@ -1,0 +1,67 @@
+// The three tiers run in the paper's order for one frame.
+#pragma once
+
+#include <bims/maps/CMotionGridBase.h>
+
+#include <memory>
+
+namespace bims::maps
+{
+/** Output of MotionGrids::processFrame. */
+struct MotionFrameResult
+{
+	/** Moving-pixel masks (255 = moving) by tier-1 MAP and tier-2 MAP. */
+	PixelMask maskTier1, maskTier2;
+	/** Number of hit voxels and of those labelled moving by each tier. */
+	size_t hitVoxels = 0, movingTier1 = 0, movingTier2 = 0;
+	/** Readings used and skipped in this frame. */
+	FrameStats stats;
+	/** Wall time of the map updates (without building the cloud) [ms]. */
+	double updateMs = 0;
+};
+
+/** Owns the three tiers (tiers 1 and 2 linked to tier 0) and runs one frame:
+ * (1) tier 1 reads O- for the hit voxels, (2) tier 0 folds in the frame,
+ * (3) tier 2 combines the labels with tier 1's posterior, (4) MAP per voxel
+ * gives the moving voxels and the masks. */
+class MotionGrids
+{
+   public:
+	explicit MotionGrids(const GridParams& p = {});
+
+	/** One frame from a scan and the pose T_WS of its scan frame {S} in
+	 * {W} (scan.sensorPose is NOT added). \a labels may be null (no flow:
+	 * tier 2 = tier 1). */
+	const MotionFrameResult& processFrame(
+		const mrpt::obs::CObservation3DRangeScan& scan,
+		const mrpt::poses::CPose3D& T_WS, const PixelLabels* labels);
+	/** Same, for a FrameCloud built by the caller with the same voxel
+	 * size (throws std::invalid_argument otherwise). */
+	const MotionFrameResult& processFrame(
+		const FrameCloud& frame, const PixelLabels* labels);
+
+	/** The FrameCloud of the last processFrame(scan, ...). */
+	const FrameCloud& lastFrame() const { return frame_; }
+	const MotionFrameResult& lastResult() const { return result_; }
+
+	std::shared_ptr<COccupancyBayesGrid> occupancy() const { return t0_; }
+	std::shared_ptr<CBackgroundSubtractionGrid> background() const
+	{
+		return t1_;
+	}
+	std::shared_ptr<CFlowConsistencyGrid> flow() const { return t2_; }
+	const GridParams& params() const { return p_; }
+	void clear();
+
+   private:
+	GridParams p_;
+	std::shared_ptr<COccupancyBayesGrid> t0_;
+	std::shared_ptr<CBackgroundSubtractionGrid> t1_;
+	std::shared_ptr<CFlowConsistencyGrid> t2_;
+	FrameCloudBuilder builder_;
+	FrameCloud frame_;
+	MotionFrameResult result_;
+	std::vector<float> prior_, post1_, post2_;
+};
+
+}  // namespace bims::maps

@@ -1,0 +1,252 @@
+// Tiers 1 and 2: shared storage of posteriors, masks and the O- source.
+#include <bims/maps/CMotionGridBase.h>
+#include <bims/maps/closed_form.h>
+#include <bims/maps/export.h>
+
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <sstream>
+#include <stdexcept>
+
+namespace bims::maps
+{
+IMPLEMENTS_VIRTUAL_SERIALIZABLE(CMotionGridBase, CBayesVoxelGridBase, bims::maps)
+
+CMotionGridBase::CMotionGridBase(const GridParams& p) : CBayesVoxelGridBase(p)
+{
+	grid_.setMaxBytes(size_t(p.max_memory_mb * 1048576.0));
+}
+
+void CMotionGridBase::setParams(const GridParams& p)
+{
+	setParamsBase(p);
+	grid_.setMaxBytes(size_t(p.max_memory_mb * 1048576.0));
+	if (private_) private_->setParams(p);
+	clear();
+}
+
+void CMotionGridBase::linkOccupancy(
+	std::shared_ptr<const COccupancyBayesGrid> t0)
+{
+	if (t0 && t0->params().voxel_size != params_.voxel_size)
+		throw std::invalid_argument(
+			std::string(GetRuntimeClass()->className) +
+			"::linkOccupancy: tier-0 voxel size " +
+			std::to_string(t0->params().voxel_size) + " m differs from " +
+			std::to_string(params_.voxel_size) + " m");
+	linked_ = std::move(t0);
+}
+
+const COccupancyBayesGrid& CMotionGridBase::occupancySource() const
+{
+	if (linked_) return *linked_;
+	if (!private_)
+		const_cast<CMotionGridBase*>(this)->private_ =
+			std::make_shared<COccupancyBayesGrid>(params_);
+	return *private_;
+}
+
+void CMotionGridBase::store(const FrameCloud& f, std::vector<float> post)
+{
+	if (post.size() != f.cells.size())
+		throw std::invalid_argument(
+			"CMotionGridBase::store: one posterior per frame cell expected");
+	const uint32_t F = frameCount_ + 1;
+	Storage::Accessor acc(grid_);
+	FrameStats st;
+	for (size_t i = 0; i < f.cells.size(); ++i)
+	{
+		const auto& k = f.cells[i];
+		Cell* c = acc.get(k.x, k.y, k.z);
+		if (!c)
+		{
+			st.overBudget += f.hits[i];
+			continue;
+		}
+		c->l = post[i];
+		c->stamp = F;
+	}
+	if (f.K.width > 0 && f.K.height > 0)
+	{
+		lastMask_.reset(f.K.width, f.K.height);
+		for (size_t j = 0; j < f.pixel.size(); ++j)
+			if (post[f.cellOfPoint[j]] > 0) lastMask_.data[f.pixel[j]] = 255;
+	}
+	else
+		lastMask_.reset(0, 0);
+	lastCells_ = f.cells;
+	lastPost_ = std::move(post);
+	frameCount_ = F;
+	lastTimestamp_ = f.timestamp;
+	if (st.overBudget) accountFrame(st);
+}
+
+std::optional<double> CMotionGridBase::probabilityAt(
+	const mrpt::math::TPoint3D& p) const
+{
+	const Cell* c = grid_.find(keyOf(p));
+	if (!c || c->stamp != frameCount_ || frameCount_ == 0) return std::nullopt;
+	return sigmoid(c->l);
+}
+
+bool CMotionGridBase::wasMovingAtLastHit(const VoxelKey& k) const
+{
+	const Cell* c = grid_.find(k);
+	return c && c->stamp != 0 && c->l > 0;
+}
+
+std::vector<mrpt::math::TPoint3D> CMotionGridBase::movingCells() const
+{
+	std::vector<mrpt::math::TPoint3D> out;
+	for (size_t i = 0; i < lastCells_.size(); ++i)
+		if (lastPost_[i] > 0) out.push_back(centerOf(lastCells_[i]));
+	return out;
+}
+
+bool CMotionGridBase::internal_insertObservation(
+	const mrpt::obs::CObservation& obs,
+	const std::optional<const mrpt::poses::CPose3D>& robotPose)
+{
+	const auto* scan =
+		dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
+	if (!scan) return false;
+	FrameCloud f;
+	if (!buildFrame(*scan, robotPose ? *robotPose : mrpt::poses::CPose3D(), f))
+		return false;
+	std::vector<float> prior, post;
+	occupancySource().priorLogOdds(f, prior);
+	if (!linked_) private_->integrate(f);
+	computePosterior(f, prior, post);
+	store(f, std::move(post));
+	return true;
+}
+
+void CMotionGridBase::internal_clear()
+{
+	grid_.clear();
+	lastPost_.clear();
+	lastCells_.clear();
+	lastMask_.reset(0, 0);
+	if (private_) private_->clear();
+	clearBase();
+}
+
+void CMotionGridBase::writeMotion(mrpt::serialization::CArchive& out) const
+{
+	writeBase(out);
+	const uint64_t nb = grid_.numBlocks();
+	out << nb;
+	constexpr size_t N = Storage::kCellsPerBlock;
+	std::vector<float> l(N);
+	std::vector<uint32_t> st(N);
+	for (size_t b = 0; b < nb; ++b)
+	{
+		const auto& blk = grid_.block(b);
+		for (size_t c = 0; c < N; ++c)
+		{
+			l[c] = blk.cells[c].l;
+			st[c] = blk.cells[c].stamp;
+		}
+		out << grid_.blockKey(b);
+		out.WriteBufferFixEndianness(l.data(), N);
+		out.WriteBufferFixEndianness(st.data(), N);
+	}
+	// Last frame (masks can be recomputed only with the frame; keep the
+	// posteriors and keys, and the mask itself).
+	out << uint64_t(lastCells_.size());
+	for (size_t i = 0; i < lastCells_.size(); ++i)
+		out << lastCells_[i].x << lastCells_[i].y << lastCells_[i].z
+			<< lastPost_[i];
+	out << int32_t(lastMask_.width) << int32_t(lastMask_.height);
+	if (!lastMask_.data.empty())
+		out.WriteBuffer(lastMask_.data.data(), lastMask_.data.size());
+	// The private tier-0 map, if this map owns one.
+	const bool hasPrivate = !linked_ && private_ && !private_->isEmpty();
+	out << hasPrivate;
+	if (hasPrivate) out << *private_;
+}
+
+void CMotionGridBase::readMotion(mrpt::serialization::CArchive& in)
+{
+	grid_.clear();
+	readBase(in);
+	grid_.setMaxBytes(size_t(params_.max_memory_mb * 1048576.0));
+	uint64_t nb;
+	in >> nb;
+	constexpr size_t N = Storage::kCellsPerBlock;
+	std::vector<float> l(N);
+	std::vector<uint32_t> st(N);
+	for (uint64_t b = 0; b < nb; ++b)
+	{
+		uint64_t key;
+		in >> key;
+		in.ReadBufferFixEndianness(l.data(), N);
+		in.ReadBufferFixEndianness(st.data(), N);
+		const uint32_t id = grid_.findOrCreateBlock(key);
+		if (id == FlatHashMap::kNotFound)
+			throw std::runtime_error(
+				"bims::maps: serialised map exceeds max_memory_mb");
+		auto& blk = grid_.block(id);
+		for (size_t c = 0; c < N; ++c) blk.cells[c] = {l[c], st[c]};
+	}
+	uint64_t nl;
+	in >> nl;
+	if (nl > (uint64_t(1) << 32))
+		throw std::runtime_error("bims::maps: corrupt serialised grid");
+	lastCells_.resize(nl);
+	lastPost_.resize(nl);
+	for (size_t i = 0; i < nl; ++i)
+		in >> lastCells_[i].x >> lastCells_[i].y >> lastCells_[i].z >>
+			lastPost_[i];
+	int32_t w, h;
+	in >> w >> h;
+	if (w < 0 || h < 0 || int64_t(w) * h > (int64_t(1) << 28))
+		throw std::runtime_error("bims::maps: corrupt serialised mask size");
+	lastMask_.reset(w, h);
+	if (!lastMask_.data.empty())
+		in.ReadBuffer(lastMask_.data.data(), lastMask_.data.size());
+	bool hasPrivate;
+	in >> hasPrivate;
+	linked_.reset();
+	private_.reset();
+	if (hasPrivate)
+	{
+		private_ = in.ReadObject<COccupancyBayesGrid>();
+	}
+}
+
+void CMotionGridBase::saveMetricMapRepresentationToFile(
+	const std::string& prefix) const
+{
+	std::vector<float> probs;
+	std::vector<mrpt::math::TPoint3D> pts;
+	for (size_t i = 0; i < lastCells_.size(); ++i)
+		if (lastPost_[i] > 0)
+		{
+			pts.push_back(centerOf(lastCells_[i]));
+			probs.push_back(float(sigmoid(lastPost_[i])));
+		}
+	writePointsPly(prefix + "_moving.ply", pts, probs);
+}
+
+std::string CMotionGridBase::asString() const
+{
+	std::ostringstream s;
+	s << GetRuntimeClass()->className << ": voxel " << params_.voxel_size
+	  << " m, " << frameCount_ << " frames, " << grid_.numBlocks()
+	  << " blocks, last frame " << lastCells_.size() << " voxels, "
+	  << movingCells().size() << " moving, O- from "
+	  << (linked_ ? "a linked" : "a private") << " tier-0 map";
+	return s.str();
+}
+
+void CMotionGridBase::visualize(
+	mrpt::opengl::CSetOfObjects& o, const mrpt::img::TColor& c,
+	const std::string& name) const
+{
+	if (!genericMapParams.enableSaveAs3DObject) return;
+	addVoxelsTo(o, movingCells(), c, name);
+}
+
+}  // namespace bims::maps

@@ -1,0 +1,35 @@
+// .bt export through liboctomap (the same library MRPT's maps module links,
+// so there is no duplicate-symbol clash; see docs/maps.md).
+#include <bims/maps/closed_form.h>
+#include <bims/maps/export.h>
+
+#include <octomap/OcTree.h>
+
+#include <stdexcept>
+
+namespace bims::maps
+{
+size_t writeStaticOctomap(
+	const std::string& path, const COccupancyBayesGrid& occ,
+	const CMotionGridBase* motion, double p)
+{
+	const auto keys = staticOccupiedKeys(occ, motion, p);
+	octomap::OcTree tree(occ.params().voxel_size);
+	size_t n = 0;
+	for (const auto& k : keys)
+	{
+		const auto c = occ.centerOf(k);
+		octomap::OcTreeKey ok;
+		if (!tree.coordToKeyChecked(
+				octomap::point3d(float(c.x), float(c.y), float(c.z)), ok))
+			continue;  // outside OctoMap's +-2^15 voxel range
+		tree.setNodeValue(ok, float(fromFixed(occ.logOddsFixed(k))), true);
+		++n;
+	}
+	tree.updateInnerOccupancy();
+	if (!tree.writeBinary(path))
+		throw std::runtime_error("cannot write OctoMap file '" + path + "'");
+	return n;
+}
+
+}  // namespace bims::maps

@@ -1,0 +1,106 @@
+// Tier 1 (background subtraction) and tier 2 (flow consistency): the
+// posterior computations (docs/model.md).
+#include <bims/maps/CMotionGridBase.h>
+#include <bims/maps/closed_form.h>
+
+#include <stdexcept>
+
+namespace bims::maps
+{
+CBackgroundSubtractionGrid::CBackgroundSubtractionGrid(const GridParams& p)
+	: CMotionGridBase(p)
+{
+}
+
+void CBackgroundSubtractionGrid::posterior(
+	const FrameCloud& f, const std::vector<float>& priorO,
+	std::vector<float>& post) const
+{
+	if (priorO.size() != f.cells.size())
+		throw std::invalid_argument(
+			"CBackgroundSubtractionGrid::posterior: one O- per cell expected");
+	const auto& p = params_;
+	const double logLambda = std::log(p.reading_lambda);
+	post.resize(f.cells.size());
+	// The hit evidence depends on n only; cache the common small counts.
+	double hitCache[64];
+	for (uint32_t n = 0; n < 64; ++n)
+		hitCache[n] = n ? hitLogOdds(p.p_miss, logLambda, n) : 0;
+	for (size_t i = 0; i < f.cells.size(); ++i)
+	{
+		const uint32_t n = f.hits[i];
+		const double hit =
+			n < 64 ? hitCache[n] : hitLogOdds(p.p_miss, logLambda, n);
+		post[i] = float(
+			backgroundPriorLogOdds(priorO[i], p.bg_transition_eps) + hit);
+	}
+}
+
+CFlowConsistencyGrid::CFlowConsistencyGrid(const GridParams& p)
+	: CMotionGridBase(p)
+{
+}
+
+void CFlowConsistencyGrid::setPendingLabels(PixelLabels labels)
+{
+	pending_ = std::move(labels);
+}
+
+void CFlowConsistencyGrid::countLabels(
+	const FrameCloud& f, const PixelLabels& labels, std::vector<uint32_t>& k,
+	std::vector<uint32_t>& l)
+{
+	k.assign(f.cells.size(), 0);
+	l.assign(f.cells.size(), 0);
+	if (labels.label.empty()) return;  // no labels: no flow evidence
+	if (labels.width != f.K.width || labels.height != f.K.height ||
+		labels.label.size() != size_t(labels.width) * size_t(labels.height))
+		throw std::invalid_argument(
+			"CFlowConsistencyGrid: labels are " +
+			std::to_string(labels.width) + "x" +
+			std::to_string(labels.height) + " but the frame is " +
+			std::to_string(f.K.width) + "x" + std::to_string(f.K.height));
+	for (size_t j = 0; j < f.pixel.size(); ++j)
+	{
+		const int8_t lab = labels.label[f.pixel[j]];
+		if (lab == 1)
+			k[f.cellOfPoint[j]]++;
+		else if (lab == 0)
+			l[f.cellOfPoint[j]]++;
+	}
+}
+
+void CFlowConsistencyGrid::posterior(
+	const FrameCloud& f, const PixelLabels& labels,
+	const std::vector<float>& tier1, std::vector<float>& post) const
+{
+	if (tier1.size() != f.cells.size())
+		throw std::invalid_argument(
+			"CFlowConsistencyGrid::posterior: one tier-1 value per cell "
+			"expected");
+	std::vector<uint32_t> k, l;
+	countLabels(f, labels, k, l);
+	const auto& p = params_;
+	const double logLambda = std::log(p.flow_lambda);
+	const bool veto = p.flow_evidence == FlowEvidence::Veto;
+	post.resize(f.cells.size());
+	for (size_t i = 0; i < f.cells.size(); ++i)
+		post[i] = (k[i] == 0 && l[i] == 0)
+			? tier1[i]
+			: float(flowPosterior(
+				  tier1[i], p.flow_transition_tau, p.p_miss, logLambda, k[i],
+				  l[i], veto));
+}
+
+void CFlowConsistencyGrid::computePosterior(
+	const FrameCloud& f, const std::vector<float>& priorO,
+	std::vector<float>& post)
+{
+	CBackgroundSubtractionGrid t1(params_);
+	t1.posterior(f, priorO, t1scratch_);
+	PixelLabels labels = std::move(pending_);
+	pending_ = PixelLabels();
+	posterior(f, labels, t1scratch_, post);
+}
+
+}  // namespace bims::maps
