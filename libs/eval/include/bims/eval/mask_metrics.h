@@ -1,0 +1,61 @@
+// Pixel-level segmentation metrics: a predicted moving-pixel mask against a
+// ground-truth mask, counted over the pixels with valid depth.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <string>
+
+namespace bims::eval
+{
+/** Confusion counts of "moving" pixels and the derived scores. Scores whose
+ * denominator is zero are NaN (e.g. recall on a frame with nothing moving);
+ * they are printed as "nan" and written as JSON null. */
+struct MaskMetrics
+{
+	uint64_t tp = 0;       ///< moving in GT and prediction
+	uint64_t fp = 0;       ///< predicted moving, static in GT
+	uint64_t fn = 0;       ///< moving in GT, predicted static
+	uint64_t tn = 0;       ///< static in both
+	uint64_t invalid = 0;  ///< pixels skipped (no valid depth)
+
+	/** Adds the counts of one frame. \a gt and \a pred are CV_8UC1 masks
+	 * (value >= 128 means moving; the contract writes 0/255); \a validDepth
+	 * is empty (all pixels count) or CV_8UC1 of the same size (non-zero =
+	 * valid). Throws std::invalid_argument on empty masks, other types or
+	 * different sizes. */
+	void accumulate(const cv::Mat& gt, const cv::Mat& pred,
+	                const cv::Mat& validDepth = cv::Mat());
+	/** The counts of one frame (see accumulate()). */
+	static MaskMetrics compute(const cv::Mat& gt, const cv::Mat& pred,
+	                           const cv::Mat& validDepth = cv::Mat());
+
+	MaskMetrics& operator+=(const MaskMetrics& o);
+
+	double precision() const;  ///< tp / (tp + fp)
+	double recall() const;     ///< tp / (tp + fn)
+	double f1() const;         ///< 2 tp / (2 tp + fp + fn)
+	double iou() const;        ///< tp / (tp + fp + fn)
+	uint64_t valid() const { return tp + fp + fn + tn; }
+
+	/** "precision P recall R F1 F IoU I" with 4 decimals ("nan" if
+	 * undefined). */
+	std::string scoresLine() const;
+	/** JSON object with counts and scores. */
+	std::string toJson() const;
+};
+
+/** Reads an 8-bit single-channel mask PNG; throws std::runtime_error naming
+ * the file if it is missing, unreadable or of another type. */
+cv::Mat loadMask(const std::string& path);
+
+/** Colour overlay of one frame (BGR): TP green, FP red, FN blue, invalid
+ * pixels dark grey, other pixels the dimmed \a background (CV_8UC1 or
+ * CV_8UC3 of the same size; black if empty). A caption line with the frame's
+ * scores is drawn at the top. */
+cv::Mat maskOverlay(const cv::Mat& gt, const cv::Mat& pred,
+                    const cv::Mat& validDepth, const cv::Mat& background,
+                    const std::string& caption);
+
+}  // namespace bims::eval

@@ -1,0 +1,196 @@
+#include <bims/eval/mask_metrics.h>
+
+#include <cmath>
+#include <limits>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "json.h"
+
+namespace bims::eval
+{
+using detail::fmt4;
+using detail::jnum;
+
+namespace
+{
+std::string sizeText(const cv::Mat& m)
+{
+	return std::to_string(m.cols) + "x" + std::to_string(m.rows);
+}
+void checkMask(const cv::Mat& m, const char* what)
+{
+	if (m.empty()) throw std::invalid_argument(std::string(what) + " is empty");
+	if (m.type() != CV_8UC1)
+		throw std::invalid_argument(std::string(what) +
+		                            " is not an 8-bit single-channel image");
+}
+double ratio(uint64_t num, uint64_t den)
+{
+	return den ? static_cast<double>(num) / static_cast<double>(den)
+	           : std::numeric_limits<double>::quiet_NaN();
+}
+}  // namespace
+
+void MaskMetrics::accumulate(const cv::Mat& gt, const cv::Mat& pred,
+                             const cv::Mat& validDepth)
+{
+	checkMask(gt, "ground-truth mask");
+	checkMask(pred, "predicted mask");
+	if (gt.size() != pred.size())
+		throw std::invalid_argument("mask sizes differ: ground truth " +
+		                            sizeText(gt) + ", prediction " +
+		                            sizeText(pred));
+	if (!validDepth.empty())
+	{
+		checkMask(validDepth, "valid-depth mask");
+		if (validDepth.size() != gt.size())
+			throw std::invalid_argument("valid-depth image is " +
+			                            sizeText(validDepth) +
+			                            " but the masks are " + sizeText(gt));
+	}
+	for (int v = 0; v < gt.rows; v++)
+	{
+		const uint8_t* g = gt.ptr<uint8_t>(v);
+		const uint8_t* p = pred.ptr<uint8_t>(v);
+		const uint8_t* d =
+		    validDepth.empty() ? nullptr : validDepth.ptr<uint8_t>(v);
+		for (int u = 0; u < gt.cols; u++)
+		{
+			if (d && !d[u])
+			{
+				invalid++;
+				continue;
+			}
+			const bool gm = g[u] >= 128, pm = p[u] >= 128;
+			if (gm && pm)
+				tp++;
+			else if (pm)
+				fp++;
+			else if (gm)
+				fn++;
+			else
+				tn++;
+		}
+	}
+}
+
+MaskMetrics MaskMetrics::compute(const cv::Mat& gt, const cv::Mat& pred,
+                                 const cv::Mat& validDepth)
+{
+	MaskMetrics m;
+	m.accumulate(gt, pred, validDepth);
+	return m;
+}
+
+MaskMetrics& MaskMetrics::operator+=(const MaskMetrics& o)
+{
+	tp += o.tp;
+	fp += o.fp;
+	fn += o.fn;
+	tn += o.tn;
+	invalid += o.invalid;
+	return *this;
+}
+
+double MaskMetrics::precision() const
+{
+	return ratio(tp, tp + fp);
+}
+double MaskMetrics::recall() const
+{
+	return ratio(tp, tp + fn);
+}
+double MaskMetrics::f1() const
+{
+	return ratio(2 * tp, 2 * tp + fp + fn);
+}
+double MaskMetrics::iou() const
+{
+	return ratio(tp, tp + fp + fn);
+}
+
+std::string MaskMetrics::scoresLine() const
+{
+	return "precision " + fmt4(precision()) + " recall " + fmt4(recall()) +
+	       " F1 " + fmt4(f1()) + " IoU " + fmt4(iou());
+}
+
+std::string MaskMetrics::toJson() const
+{
+	std::ostringstream o;
+	o << "{\"tp\": " << tp << ", \"fp\": " << fp << ", \"fn\": " << fn
+	  << ", \"tn\": " << tn << ", \"invalid\": " << invalid
+	  << ", \"precision\": " << jnum(precision())
+	  << ", \"recall\": " << jnum(recall()) << ", \"f1\": " << jnum(f1())
+	  << ", \"iou\": " << jnum(iou()) << "}";
+	return o.str();
+}
+
+cv::Mat loadMask(const std::string& path)
+{
+	const cv::Mat m = cv::imread(path, cv::IMREAD_UNCHANGED);
+	if (m.empty()) throw std::runtime_error(path + ": cannot read mask image");
+	if (m.type() != CV_8UC1)
+		throw std::runtime_error(
+		    path + ": mask must be an 8-bit single-channel PNG (got " +
+		    std::to_string(m.channels()) + " channel(s), " +
+		    std::to_string(8 * m.elemSize1()) + "-bit)");
+	return m;
+}
+
+cv::Mat maskOverlay(const cv::Mat& gt, const cv::Mat& pred,
+                    const cv::Mat& validDepth, const cv::Mat& background,
+                    const std::string& caption)
+{
+	checkMask(gt, "ground-truth mask");
+	checkMask(pred, "predicted mask");
+	cv::Mat out(gt.size(), CV_8UC3, cv::Scalar(0, 0, 0));
+	if (!background.empty())
+	{
+		if (background.size() != gt.size())
+			throw std::invalid_argument("overlay background is " +
+			                            sizeText(background) +
+			                            " but the masks are " + sizeText(gt));
+		cv::Mat grey;
+		if (background.channels() == 3)
+			cv::cvtColor(background, grey, cv::COLOR_BGR2GRAY);
+		else
+			grey = background;
+		cv::cvtColor(grey, out, cv::COLOR_GRAY2BGR);
+		out *= 0.6;
+	}
+	for (int v = 0; v < gt.rows; v++)
+		for (int u = 0; u < gt.cols; u++)
+		{
+			auto& px = out.at<cv::Vec3b>(v, u);
+			if (!validDepth.empty() && !validDepth.at<uint8_t>(v, u))
+			{
+				px = cv::Vec3b(40, 40, 40);
+				continue;
+			}
+			const bool gm = gt.at<uint8_t>(v, u) >= 128;
+			const bool pm = pred.at<uint8_t>(v, u) >= 128;
+			if (gm && pm)
+				px = cv::Vec3b(0, 200, 0);  // TP green (BGR)
+			else if (pm)
+				px = cv::Vec3b(0, 0, 230);  // FP red
+			else if (gm)
+				px = cv::Vec3b(230, 80, 0);  // FN blue
+		}
+	cv::rectangle(out, {0, 0}, {out.cols, 22}, cv::Scalar(0, 0, 0), cv::FILLED);
+	cv::putText(out, caption, {4, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
+	            cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+	const int y = out.rows - 8;
+	cv::putText(out, "TP", {4, y}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
+	            cv::Scalar(0, 200, 0), 1, cv::LINE_AA);
+	cv::putText(out, "FP", {30, y}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
+	            cv::Scalar(0, 0, 230), 1, cv::LINE_AA);
+	cv::putText(out, "FN", {56, y}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
+	            cv::Scalar(230, 80, 0), 1, cv::LINE_AA);
+	return out;
+}
+
+}  // namespace bims::eval

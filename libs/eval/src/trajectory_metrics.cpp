@@ -1,0 +1,205 @@
+#include <bims/eval/trajectory_metrics.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+
+#include "eigen_pose.h"
+#include "json.h"
+
+namespace bims::eval
+{
+using detail::fromIso;
+using detail::jnum;
+using detail::jstr;
+using detail::toIso;
+
+ErrorStats ErrorStats::of(std::vector<double> v)
+{
+	ErrorStats s;
+	s.count = v.size();
+	if (v.empty()) return s;
+	double sum = 0, sum2 = 0;
+	for (const double x : v)
+	{
+		sum += x;
+		sum2 += x * x;
+	}
+	const double n = static_cast<double>(v.size());
+	s.mean = sum / n;
+	s.rmse = std::sqrt(sum2 / n);
+	s.std = std::sqrt(std::max(0.0, sum2 / n - s.mean * s.mean));
+	std::sort(v.begin(), v.end());
+	s.min = v.front();
+	s.max = v.back();
+	// numpy.median: mean of the two middle values for even counts.
+	const size_t m = v.size() / 2;
+	s.median = (v.size() % 2) ? v[m] : 0.5 * (v[m - 1] + v[m]);
+	return s;
+}
+
+namespace
+{
+std::vector<double> stamps(const Trajectory& t)
+{
+	std::vector<double> s;
+	s.reserve(t.size());
+	for (const auto& p : t) s.push_back(p.t);
+	return s;
+}
+void requireSorted(const Trajectory& t, const char* what)
+{
+	for (size_t i = 1; i < t.size(); i++)
+		if (t[i].t < t[i - 1].t)
+			throw std::invalid_argument(std::string(what) +
+			                            " trajectory is not sorted by time");
+}
+std::string spanText(const Trajectory& t)
+{
+	std::ostringstream ss;
+	ss.precision(3);
+	ss << std::fixed << "[" << t.front().t << ", " << t.back().t << "] s";
+	return ss.str();
+}
+}  // namespace
+
+AteResult computeAte(const Trajectory& gt, const Trajectory& est,
+                     const AteOptions& opt)
+{
+	if (gt.empty())
+		throw std::invalid_argument("ground-truth trajectory is empty");
+	if (est.empty())
+		throw std::invalid_argument("estimated trajectory is empty");
+	requireSorted(gt, "ground-truth");
+	requireSorted(est, "estimated");
+	AteResult r;
+	r.pairs = associateGreedy(stamps(gt), stamps(est), opt.maxTimeDifference,
+	                          opt.timeOffset);
+	if (r.pairs.empty())
+		throw std::invalid_argument(
+		    "no time overlap between ground truth " + spanText(gt) +
+		    " and estimate " + spanText(est) + " within " +
+		    std::to_string(opt.maxTimeDifference) + " s");
+	if (r.pairs.size() < 3)
+		throw std::invalid_argument(
+		    "only " + std::to_string(r.pairs.size()) +
+		    " associated poses; at least 3 are needed for the alignment");
+	const auto n = static_cast<Eigen::Index>(r.pairs.size());
+	Eigen::Matrix3Xd src(3, n), dst(3, n);
+	for (Eigen::Index k = 0; k < n; k++)
+	{
+		const auto& g = gt[r.pairs[k].first].T_WC;
+		const auto& e = est[r.pairs[k].second].T_WC;
+		dst.col(k) << g.x(), g.y(), g.z();
+		src.col(k) << e.x(), e.y(), e.z();
+	}
+	// Closed-form least squares rigid alignment (Umeyama 1991 = Horn 1987
+	// without scale): dst ~ R src + t.
+	Eigen::Isometry3d T(Eigen::umeyama(src, dst, false));
+	r.T_alignment = fromIso(T);
+	r.errors.resize(r.pairs.size());
+	for (Eigen::Index k = 0; k < n; k++)
+		r.errors[k] = (T * Eigen::Vector3d(src.col(k)) - dst.col(k)).norm();
+	r.stats = ErrorStats::of(r.errors);
+	return r;
+}
+
+RpeResult computeRpe(const Trajectory& gt, const Trajectory& est,
+                     const RpeOptions& opt)
+{
+	if (gt.empty())
+		throw std::invalid_argument("ground-truth trajectory is empty");
+	if (est.empty())
+		throw std::invalid_argument("estimated trajectory is empty");
+	if (!(opt.delta > 0)) throw std::invalid_argument("RPE delta must be > 0");
+	requireSorted(gt, "ground-truth");
+	requireSorted(est, "estimated");
+	const auto sg = stamps(gt), se = stamps(est);
+
+	// Max GT time difference: twice the median GT period (evaluate_rpe.py).
+	double gtMaxDiff = 0;
+	if (sg.size() >= 2)
+	{
+		std::vector<double> d;
+		for (size_t i = 1; i < sg.size(); i++) d.push_back(sg[i] - sg[i - 1]);
+		gtMaxDiff = 2 * ErrorStats::of(d).median;
+	}
+
+	RpeResult r;
+	for (size_t i = 0; i < se.size(); i++)
+	{
+		const size_t j = closestIndex(se, se[i] + opt.delta);
+		if (j == se.size() - 1) continue;  // as evaluate_rpe.py
+		const double t0 = se[i] + opt.timeOffset, t1 = se[j] + opt.timeOffset;
+		const size_t g0 = closestIndex(sg, t0), g1 = closestIndex(sg, t1);
+		if (std::abs(sg[g0] - t0) > gtMaxDiff ||
+		    std::abs(sg[g1] - t1) > gtMaxDiff)
+			continue;
+		const Eigen::Isometry3d dE =
+		    toIso(est[i].T_WC).inverse() * toIso(est[j].T_WC);
+		const Eigen::Isometry3d dG =
+		    toIso(gt[g0].T_WC).inverse() * toIso(gt[g1].T_WC);
+		const Eigen::Isometry3d E = dG.inverse() * dE;
+		const double c = std::clamp((E.linear().trace() - 1) / 2, -1.0, 1.0);
+		r.pairs.emplace_back(i, j);
+		r.transErrors.push_back(E.translation().norm() / opt.delta);
+		r.rotErrors.push_back(std::acos(c) * 180.0 / M_PI / opt.delta);
+	}
+	if (r.pairs.size() < 2)
+	{
+		std::ostringstream ss;
+		ss << "only " << r.pairs.size() << " RPE pairs (delta " << opt.delta
+		   << " s) between ground truth " << spanText(gt) << " and estimate "
+		   << spanText(est)
+		   << ": no time overlap or the estimate is shorter than delta";
+		throw std::invalid_argument(ss.str());
+	}
+	r.trans = ErrorStats::of(r.transErrors);
+	r.rot = ErrorStats::of(r.rotErrors);
+	return r;
+}
+
+Trajectory alignTrajectory(const Trajectory& est, const mrpt::poses::CPose3D& T)
+{
+	Trajectory out = est;
+	for (auto& p : out) p.T_WC = T + p.T_WC;
+	return out;
+}
+
+namespace
+{
+std::string statsJson(const ErrorStats& s)
+{
+	std::ostringstream o;
+	o << "{\"count\": " << s.count << ", \"rmse\": " << jnum(s.rmse)
+	  << ", \"mean\": " << jnum(s.mean) << ", \"median\": " << jnum(s.median)
+	  << ", \"std\": " << jnum(s.std) << ", \"min\": " << jnum(s.min)
+	  << ", \"max\": " << jnum(s.max) << "}";
+	return o.str();
+}
+}  // namespace
+
+std::string TrajectoryReport::toJson() const
+{
+	std::ostringstream o;
+	const auto& T = ate.T_alignment;
+	o << "{\n  \"gt\": " << jstr(gtPath) << ",\n  \"est\": " << jstr(estPath)
+	  << ",\n  \"gt_poses\": " << gtPoses << ",\n  \"est_poses\": " << estPoses
+	  << ",\n  \"ate\": {\"max_time_difference_s\": "
+	  << jnum(ateOptions.maxTimeDifference)
+	  << ", \"pairs\": " << ate.pairs.size()
+	  << ", \"error_m\": " << statsJson(ate.stats)
+	  << ", \"alignment_T_WgWe\": [" << jnum(T.x()) << ", " << jnum(T.y())
+	  << ", " << jnum(T.z()) << ", " << jnum(T.yaw()) << ", " << jnum(T.pitch())
+	  << ", " << jnum(T.roll())
+	  << "]},\n  \"rpe\": {\"delta_s\": " << jnum(rpeOptions.delta)
+	  << ", \"pairs\": " << rpe.pairs.size()
+	  << ", \"trans_m_per_s\": " << statsJson(rpe.trans)
+	  << ", \"rot_deg_per_s\": " << statsJson(rpe.rot) << "}\n}\n";
+	return o.str();
+}
+
+}  // namespace bims::eval

@@ -1,0 +1,203 @@
+#include <bims/common/app.h>
+#include <bims/common/progress.h>
+#include <bims/common/rawlog.h>
+#include <bims/eval/pose_utils.h>
+#include <bims/eval/tum_import.h>
+#include <mrpt/obs/CObservationIMU.h>
+#include <mrpt/system/datetime.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <stdexcept>
+
+namespace bims::eval
+{
+namespace fs = std::filesystem;
+using mrpt::obs::CObservation3DRangeScan;
+
+mrpt::obs::CObservation3DRangeScan::Ptr loadFrame(const TumFrame& frame,
+                                                  const ImportParams& params)
+{
+	const auto& cam = params.camera;
+	const cv::Mat raw = cv::imread(frame.depthPath, cv::IMREAD_UNCHANGED);
+	if (raw.empty())
+		throw std::runtime_error(frame.depthPath + ": cannot read depth image");
+	if (raw.type() != CV_16UC1)
+		throw std::runtime_error(frame.depthPath +
+		                         ": depth must be a 16-bit single-channel PNG");
+	if (raw.cols != cam.width || raw.rows != cam.height)
+		throw std::runtime_error(
+		    frame.depthPath + ": depth image is " + std::to_string(raw.cols) +
+		    "x" + std::to_string(raw.rows) + " but [camera] says " +
+		    std::to_string(cam.width) + "x" + std::to_string(cam.height));
+	const cv::Mat rgb = cv::imread(frame.rgbPath, cv::IMREAD_COLOR);
+	if (rgb.empty())
+		throw std::runtime_error(frame.rgbPath + ": cannot read colour image");
+	if (rgb.cols != cam.width || rgb.rows != cam.height)
+		throw std::runtime_error(
+		    frame.rgbPath + ": colour image is " + std::to_string(rgb.cols) +
+		    "x" + std::to_string(rgb.rows) + " but [camera] says " +
+		    std::to_string(cam.width) + "x" + std::to_string(cam.height));
+
+	auto o = CObservation3DRangeScan::Create();
+	o->sensorLabel = params.rgbdLabel;
+	o->timestamp = mrpt::Clock::fromDouble(frame.t);
+	o->sensorPose = mrpt::poses::CPose3D();
+	o->hasRangeImage = true;
+	o->range_is_depth = true;
+	o->rangeUnits = static_cast<float>(params.rangeUnits);
+	o->maxRange = static_cast<float>(65535 * params.rangeUnits);
+	o->stdError = 0.01f;
+	o->rangeImage_setSize(cam.height, cam.width);
+	const double k = 1.0 / (cam.depthScale * params.rangeUnits);
+	for (int v = 0; v < cam.height; v++)
+	{
+		const uint16_t* r = raw.ptr<uint16_t>(v);
+		for (int u = 0; u < cam.width; u++)
+		{
+			const double units = std::round(r[u] * k);
+			o->rangeImage(v, u) =
+			    units > 65535 ? 0 : static_cast<uint16_t>(units);
+		}
+	}
+	o->cameraParams = cam.asTCamera();
+	o->cameraParamsIntensity = o->cameraParams;
+	o->relativePoseIntensityWRTDepth =
+	    mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+	o->hasIntensityImage = true;
+	o->intensityImageChannel = CObservation3DRangeScan::CH_VISIBLE;
+	o->intensityImage = mrpt::img::CImage(rgb, mrpt::img::DEEP_COPY);
+	return o;
+}
+
+std::string groundTruthDirFor(const std::string& rawlogPath)
+{
+	fs::path p(rawlogPath);
+	if (p.extension() == ".rawlog" || p.extension() == ".gz")
+	{
+		p.replace_extension();
+		if (p.extension() == ".rawlog") p.replace_extension();
+	}
+	return p.string() + "_gt";
+}
+
+namespace
+{
+void writeCalibration(const std::string& path, const ImportParams& params)
+{
+	std::ofstream f(path);
+	if (!f) throw std::runtime_error(path + ": cannot write");
+	const auto& c = params.camera;
+	char buf[512];
+	std::snprintf(
+	    buf, sizeof(buf),
+	    "# Written by bims-import-tum: the camera of the imported rawlog.\n"
+	    "[camera]\nfx = %.9g\nfy = %.9g\ncx = %.9g\ncy = %.9g\nwidth = %d\n"
+	    "height = %d\ndepth_scale = %.9g\n\n[sensors]\nrgbd_label = %s\n"
+	    "imu_label = %s\n",
+	    c.fx, c.fy, c.cx, c.cy, c.width, c.height, c.depthScale,
+	    params.rgbdLabel.c_str(), params.imuLabel.c_str());
+	f << buf;
+	if (!f) throw std::runtime_error(path + ": write failed");
+}
+}  // namespace
+
+ImportSummary importTum(const std::string& folder, const std::string& outRawlog,
+                        const ImportParams& params,
+                        const ImportOptions& options)
+{
+	TumFolder tum = readTumFolder(folder, params);
+	if (options.maxFrames > 0 && tum.frames.size() > options.maxFrames)
+		tum.frames.resize(options.maxFrames);
+	const double t0 = tum.frames.front().t, t1 = tum.frames.back().t;
+
+	ImportSummary sum;
+	sum.gtDir = groundTruthDirFor(outRawlog);
+	makeDirs(sum.gtDir);
+	writeCalibration(sum.gtDir + "/calibration.ini", params);
+
+	// Ground truth: T_WC of the optical frame at each frame's stamp.
+	if (tum.hasGroundTruth)
+	{
+		Trajectory gt = tum.groundTruth;
+		if (options.bonnGt || params.bonnGt)
+			for (auto& p : gt) p.T_WC = bonnMarkerToCamera(p.T_WC);
+		for (const auto& f : tum.frames)
+		{
+			const auto T = interpolatePose(gt, f.t, params.gtMaxGap);
+			if (T)
+				sum.groundTruth.push_back({f.t, *T});
+			else
+				sum.framesWithoutGt++;
+		}
+		sum.gtPoses = sum.groundTruth.size();
+		saveTumTrajectory(
+		    sum.gtDir + "/groundtruth.txt", sum.groundTruth,
+		    std::string("T_WC of the camera optical frame at each 3D scan's "
+		                "stamp, from ") +
+		        folder + "/groundtruth.txt" +
+		        ((options.bonnGt || params.bonnGt)
+		             ? " (Bonn marker-to-camera conversion applied)"
+		             : ""));
+	}
+
+	// Merge frames and IMU by time: (t, kind, index); kind 0 = IMU first at
+	// equal stamps.
+	struct Item
+	{
+		double t;
+		int kind;  // 0 accel file, 1 extra, 2 frame
+		size_t i;
+	};
+	std::vector<Item> items;
+	for (size_t i = 0; i < tum.accel.size(); i++)
+		if (tum.accel[i].t >= t0 && tum.accel[i].t <= t1)
+			items.push_back({tum.accel[i].t, 0, i});
+	for (size_t i = 0; i < options.extra.size(); i++)
+	{
+		const double t = mrpt::Clock::toDouble(options.extra[i]->timestamp);
+		if (t >= t0 && t <= t1) items.push_back({t, 1, i});
+	}
+	for (size_t i = 0; i < tum.frames.size(); i++)
+		items.push_back({tum.frames[i].t, 2, i});
+	std::stable_sort(items.begin(), items.end(),
+	                 [](const Item& a, const Item& b)
+	                 { return a.t < b.t || (a.t == b.t && a.kind < b.kind); });
+
+	RawlogWriter w(outRawlog, options.gzLevel);
+	ProgressBar bar("import", tum.frames.size(), options.progress);
+	for (const auto& it : items)
+	{
+		if (it.kind == 2)
+		{
+			w.write(*loadFrame(tum.frames[it.i], params));
+			bar.update(++sum.frames);
+		}
+		else if (it.kind == 1)
+		{
+			w.write(*options.extra[it.i]);
+			sum.imu++;
+		}
+		else
+		{
+			const auto& a = tum.accel[it.i];
+			auto m = mrpt::obs::CObservationIMU::Create();
+			m->sensorLabel = params.imuLabel;
+			m->timestamp = mrpt::Clock::fromDouble(a.t);
+			m->set(mrpt::obs::IMU_X_ACC, a.a[0]);
+			m->set(mrpt::obs::IMU_Y_ACC, a.a[1]);
+			m->set(mrpt::obs::IMU_Z_ACC, a.a[2]);
+			w.write(*m);
+			sum.imu++;
+		}
+	}
+	w.close();
+	bar.finish();
+	return sum;
+}
+
+}  // namespace bims::eval

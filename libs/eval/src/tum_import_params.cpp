@@ -1,0 +1,52 @@
+#include <bims/common/config.h>
+#include <bims/common/experiment.h>
+#include <bims/eval/tum_import.h>
+
+namespace bims::eval
+{
+void CameraIntrinsics::loadFromConfigFile(
+    const mrpt::config::CConfigFileBase& cfg, const std::string& section)
+{
+	ConfigSection s(cfg, section);
+	width = static_cast<int>(s.getInt("width", width, 1, 100000));
+	height = static_cast<int>(s.getInt("height", height, 1, 100000));
+	fx = s.getDouble("fx", fx, 1e-3, 1e6);
+	fy = s.getDouble("fy", fy, 1e-3, 1e6);
+	cx = s.getDouble("cx", cx, -1e6, 1e6);
+	cy = s.getDouble("cy", cy, -1e6, 1e6);
+	depthScale = s.getDouble("depth_scale", depthScale, 1e-6, 1e9);
+	s.finish();
+}
+
+mrpt::img::TCamera CameraIntrinsics::asTCamera() const
+{
+	mrpt::img::TCamera c;
+	c.ncols = static_cast<uint32_t>(width);
+	c.nrows = static_cast<uint32_t>(height);
+	c.setIntrinsicParamsFromValues(fx, fy, cx, cy);
+	c.distortion = mrpt::img::DistortionModel::none;
+	return c;
+}
+
+void ImportParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg)
+{
+	checkExperimentSections(cfg);
+	camera.loadFromConfigFile(cfg, "camera");
+
+	ConfigSection im(cfg, "import");
+	maxTimeGap = im.getDouble("max_time_gap_s", maxTimeGap, 0.0, 10.0);
+	bonnGt = im.getBool("bonn_gt", bonnGt);
+	timestampFrom = im.getEnum("timestamp", timestampFrom, {"depth", "rgb"});
+	gtMaxGap = im.getDouble("gt_max_gap_s", gtMaxGap, 0.0, 60.0);
+	rangeUnits = im.getDouble("range_units", rangeUnits, 1e-6, 0.1);
+	im.finish();
+
+	ConfigSection se(cfg, "sensors");
+	rgbdLabel = se.getString("rgbd_label", rgbdLabel);
+	imuLabel = se.getString("imu_label", imuLabel);
+	if (rgbdLabel.empty()) se.fail("rgbd_label", "must not be empty");
+	if (imuLabel.empty()) se.fail("imu_label", "must not be empty");
+	se.finish();
+}
+
+}  // namespace bims::eval

@@ -1,0 +1,112 @@
+// Mask metrics on a hand-computed 4x4 example.
+#include <bims/eval/mask_metrics.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/imgcodecs.hpp>
+
+namespace ev = bims::eval;
+
+namespace
+{
+cv::Mat mat4(const uint8_t v[16])
+{
+	return cv::Mat(4, 4, CV_8UC1, const_cast<uint8_t*>(v)).clone();
+}
+// gt:  X X . .    pred: X . . .
+//      X X . .          X X X .
+//      . . . .          . . . .
+//      . . . X          . . . .
+const uint8_t kGt[16] = {255, 255, 0, 0, 255, 255, 0, 0,
+                         0,   0,   0, 0, 0,   0,   0, 255};
+const uint8_t kPred[16] = {255, 0, 0, 0, 255, 255, 255, 0,
+                           0,   0, 0, 0, 0,   0,   0,   0};
+}  // namespace
+
+TEST(MaskMetrics, HandComputedAllPixelsValid)
+{
+	// TP (0,0),(1,0),(1,1) = 3; FP (1,2) = 1; FN (0,1),(3,3) = 2; TN 10.
+	const auto m = ev::MaskMetrics::compute(mat4(kGt), mat4(kPred));
+	EXPECT_EQ(m.tp, 3u);
+	EXPECT_EQ(m.fp, 1u);
+	EXPECT_EQ(m.fn, 2u);
+	EXPECT_EQ(m.tn, 10u);
+	EXPECT_DOUBLE_EQ(m.precision(), 0.75);
+	EXPECT_DOUBLE_EQ(m.recall(), 0.6);
+	EXPECT_DOUBLE_EQ(m.f1(), 6.0 / 9.0);
+	EXPECT_DOUBLE_EQ(m.iou(), 0.5);
+	EXPECT_EQ(m.scoresLine(),
+	          "precision 0.7500 recall 0.6000 F1 0.6667 IoU 0.5000");
+}
+
+TEST(MaskMetrics, InvalidDepthPixelsAreSkipped)
+{
+	// Pixel (3,3) (an FN) has no depth: FN = 1, recall 3/4, IoU 3/5.
+	cv::Mat valid(4, 4, CV_8UC1, cv::Scalar(1));
+	valid.at<uint8_t>(3, 3) = 0;
+	ev::MaskMetrics m;
+	m.accumulate(mat4(kGt), mat4(kPred), valid);
+	EXPECT_EQ(m.fn, 1u);
+	EXPECT_EQ(m.invalid, 1u);
+	EXPECT_DOUBLE_EQ(m.recall(), 0.75);
+	EXPECT_DOUBLE_EQ(m.f1(), 0.75);
+	EXPECT_DOUBLE_EQ(m.iou(), 0.6);
+	// Accumulating a second frame sums the counts (not the scores).
+	m.accumulate(mat4(kGt), mat4(kGt), valid);  // 4 TP more
+	EXPECT_EQ(m.tp, 7u);
+	EXPECT_DOUBLE_EQ(m.precision(), 7.0 / 8.0);
+}
+
+TEST(MaskMetrics, UndefinedScoresAreNan)
+{
+	const cv::Mat z = cv::Mat::zeros(4, 4, CV_8UC1);
+	const auto m = ev::MaskMetrics::compute(z, z);
+	EXPECT_EQ(m.tn, 16u);
+	EXPECT_TRUE(std::isnan(m.precision()));
+	EXPECT_TRUE(std::isnan(m.recall()));
+	EXPECT_EQ(m.scoresLine(), "precision nan recall nan F1 nan IoU nan");
+	EXPECT_NE(m.toJson().find("\"precision\": null"), std::string::npos);
+}
+
+TEST(MaskMetrics, MismatchedSizesAndTypesAreErrors)
+{
+	const cv::Mat a = cv::Mat::zeros(4, 4, CV_8UC1),
+	              b = cv::Mat::zeros(4, 5, CV_8UC1);
+	EXPECT_THROW(ev::MaskMetrics::compute(a, b), std::invalid_argument);
+	EXPECT_THROW(ev::MaskMetrics::compute(a, cv::Mat::zeros(4, 4, CV_16UC1)),
+	             std::invalid_argument);
+	EXPECT_THROW(ev::MaskMetrics::compute(a, a, b), std::invalid_argument);
+}
+
+TEST(MaskMetrics, LoadMaskNamesTheFile)
+{
+	try
+	{
+		ev::loadMask("/nonexistent/000001.png");
+		FAIL();
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("000001.png"), std::string::npos);
+	}
+}
+
+TEST(MaskMetrics, OverlayColours)
+{
+	// 100x100 masks with a TP, an FP and an FN block away from the caption
+	// (top 22 rows) and the legend (bottom rows); one pixel without depth.
+	cv::Mat g(100, 100, CV_8UC1, cv::Scalar(0)), p = g.clone();
+	cv::Mat valid(100, 100, CV_8UC1, cv::Scalar(255));
+	g(cv::Rect(40, 40, 10, 10)) = 255;
+	p(cv::Rect(40, 40, 10, 10)) = 255;  // TP
+	p(cv::Rect(60, 40, 10, 10)) = 255;  // FP
+	g(cv::Rect(40, 60, 10, 10)) = 255;  // FN
+	valid.at<uint8_t>(70, 70) = 0;
+	const cv::Mat ov = ev::maskOverlay(g, p, valid, cv::Mat(), "caption");
+	ASSERT_EQ(ov.type(), CV_8UC3);
+	EXPECT_EQ(ov.at<cv::Vec3b>(45, 45), cv::Vec3b(0, 200, 0));
+	EXPECT_EQ(ov.at<cv::Vec3b>(45, 65), cv::Vec3b(0, 0, 230));
+	EXPECT_EQ(ov.at<cv::Vec3b>(65, 45), cv::Vec3b(230, 80, 0));
+	EXPECT_EQ(ov.at<cv::Vec3b>(70, 70), cv::Vec3b(40, 40, 40));
+	EXPECT_EQ(ov.at<cv::Vec3b>(50, 90), cv::Vec3b(0, 0, 0));
+}
