@@ -18,6 +18,7 @@ ProgressBar::ProgressBar(std::string label, size_t total, bool enabled)
 void ProgressBar::update(size_t done, const std::string& extra)
 {
 	if (!enabled_) return;
+	lastDone_ = done;
 	const auto now = std::chrono::steady_clock::now();
 	if (tty_)
 	{
@@ -37,7 +38,7 @@ void ProgressBar::finish(const std::string& extra)
 {
 	if (!enabled_ || finished_) return;
 	finished_ = true;
-	draw(total_, extra, true);
+	draw(total_ ? total_ : lastDone_, extra, true);
 }
 
 void ProgressBar::draw(size_t done, const std::string& extra, bool final)

@@ -24,6 +24,7 @@ class ProgressBar
 	size_t total_;
 	bool enabled_, tty_;
 	size_t lastPct_ = 0;
+	size_t lastDone_ = 0;
 	std::chrono::steady_clock::time_point start_, last_;
 	bool finished_ = false;
 };

@@ -1,0 +1,80 @@
+// The whole experiment read from one .ini (see config/default.ini): the
+// egomotion sections, [flow], [grids], [pipeline] and [output]. Unknown
+// sections and keys are errors naming the file, the section and the key.
+#pragma once
+
+#include <bims/ego/params.h>
+#include <bims/flow/params.h>
+#include <bims/maps/grid_params.h>
+
+#include <mrpt/config/CConfigFileBase.h>
+
+#include <string>
+
+namespace bims::pipeline
+{
+/** Which decision the output mask (and the tracker's feedback) uses
+ * (docs/EVALUATION table). */
+enum class Variant
+{
+	BottomOnly,   ///< tier-1 MAP (background subtraction)
+	FlowOnly,     ///< the pixel's Diff label
+	Fused,        ///< tier-2 MAP (the paper)
+	FusedRaycast  ///< tier-2 MAP with decay = raycast
+};
+const char* toString(Variant v);
+/** "bottom-only", "flow-only", "fused", "fused-raycast"; throws
+ * std::invalid_argument listing the choices otherwise. */
+Variant variantFromString(const std::string& s);
+
+/** [pipeline] */
+struct PipelineParams
+{
+	Variant variant = Variant::Fused;
+	/** The first frames only build the map: their masks are written empty
+	 * (no background yet, no flow on frame 0). */
+	int warmup_frames = 1;
+	/** Feed the moving mask back to the tracker of the next frame. */
+	bool feedback_mask = true;
+	/** A camera frame waits at most this long (in data time) for IMU samples
+	 * at its timestamp before it is processed anyway [s]. */
+	double imu_wait_s = 0.1;
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+	                        const std::string& section = "pipeline");
+};
+
+/** [output]: what bims-run writes besides trajectory, masks and metrics. */
+struct OutputParams
+{
+	bool moving_ply = true;  ///< moving_voxels/NNNNNN.ply per frame
+	bool static_map = true;  ///< static_map.ply and static_map.bt at the end
+	bool labelled_rawlog = true;  ///< segmented.rawlog with pixel labels
+	bool flow_labels = false;     ///< flow_labels/NNNNNN.png (Diff red)
+	/** Occupancy probability above which a voxel is in the static map. */
+	double static_p_occupied = 0.7;
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+	                        const std::string& section = "output");
+};
+
+/** Everything one run reads. */
+struct ExperimentConfig
+{
+	std::string source;  ///< file name ("<memory>" / "<defaults>")
+	ego::EgoConfig ego;
+	flow::FlowParams flow;
+	maps::GridParams grids;
+	PipelineParams pipeline;
+	OutputParams output;
+
+	/** Reads every section (checkExperimentSections first). */
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
+	/** Opens and reads \a path; throws naming the file when missing. */
+	void loadFromFile(const std::string& path);
+	/** Applies a variant: sets pipeline.variant and, for fused-raycast,
+	 * grids.decay = raycast. */
+	void setVariant(Variant v);
+};
+
+}  // namespace bims::pipeline

@@ -1,0 +1,92 @@
+// Per-frame orchestration (docs/architecture.md):
+//   egomotion -> tier 1 reads O- -> tier 0 update -> flow labels -> tier 2
+//   -> MAP -> moving voxels -> moving-pixel mask (fed back to the tracker).
+// No threads, no I/O: the caller feeds observations in time order.
+#pragma once
+
+#include <bims/ego/odometry.h>
+#include <bims/flow/consistency.h>
+#include <bims/flow/observed_flow.h>
+#include <bims/maps/motion_grids.h>
+#include <bims/pipeline/config.h>
+
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationIMU.h>
+
+#include <opencv2/core.hpp>
+
+#include <vector>
+
+namespace bims::pipeline
+{
+/** Wall time of each stage of one frame [ms]. */
+struct StageTimes
+{
+	double input = 0;  ///< decoding images, depth conversion
+	double ego = 0;    ///< tracking + motion estimation
+	double flow = 0;   ///< observed + expected flow + labels
+	double grids = 0;  ///< cloud building + the three tiers
+	double total = 0;
+};
+
+/** Everything one frame produced. */
+struct FrameResult
+{
+	size_t index = 0;               ///< 3D-scan index in the input (from 0)
+	double t = 0;                   ///< camera timestamp [s]
+	mrpt::poses::CPose3D T_WC;      ///< estimated camera pose
+	mrpt::poses::CPose3D T_CprevC;  ///< relative to the previous frame
+	ego::FrameEgomotion ego;        ///< egomotion details (flags, inliers, ...)
+	bool warmup = false;            ///< mask forced empty (warm-up frame)
+	/** The variant's moving-pixel mask (CV_8UC1, 255 = moving). */
+	cv::Mat mask;
+	/** The three decisions side by side (CV_8UC1, 255 = moving). */
+	cv::Mat maskTier1, maskTier2, maskFlow;
+	/** Flow labels (CV_8SC1: -1 none, 0 notDiff, 1 Diff); empty on frame 0. */
+	cv::Mat labels;
+	flow::LabelStats labelStats;
+	size_t hitVoxels = 0, movingVoxels = 0;
+	/** Centres [m, {W}] of the voxels the variant labels moving. */
+	std::vector<mrpt::math::TPoint3D> movingVoxelCentres;
+	maps::FrameStats cloudStats;
+	StageTimes ms;
+};
+
+class Pipeline
+{
+ public:
+	explicit Pipeline(const ExperimentConfig& cfg);
+
+	/** Feeds an IMU observation (label filtered by [sensors] imu_label). */
+	void addImu(const mrpt::obs::CObservationIMU& imu);
+
+	/** Runs one RGB-D frame; \a index is its 3D-scan index. Throws
+	 * std::runtime_error naming the frame when the observation has no
+	 * usable intensity or depth image. */
+	const FrameResult& processFrame(
+	    const mrpt::obs::CObservation3DRangeScan& scan, size_t index);
+
+	const FrameResult& last() const { return res_; }
+	const ExperimentConfig& config() const { return cfg_; }
+	const maps::MotionGrids& grids() const { return grids_; }
+	const ego::Odometry& odometry() const { return odom_; }
+	size_t framesProcessed() const { return nFrames_; }
+
+ private:
+	ExperimentConfig cfg_;
+	ego::Odometry odom_;
+	flow::ObservedFlow observed_;
+	maps::MotionGrids grids_;
+	ego::RgbdFrame cur_, prev_;
+	bool havePrev_ = false;
+	cv::Mat feedback_;
+	FrameResult res_;
+	size_t nFrames_ = 0;
+};
+
+/** maps::PixelMask -> CV_8UC1 (a copy; 0x0 mask -> \a size of zeros). */
+cv::Mat toMat(const maps::PixelMask& m, cv::Size size);
+/** flow labels (CV_8SC1) -> maps::PixelLabels. */
+maps::PixelLabels toPixelLabels(const cv::Mat& labels);
+
+}  // namespace bims::pipeline

@@ -1,0 +1,74 @@
+// A whole run over rawlog files: reading, IMU/camera ordering, the frame
+// range, the outputs of bims-run and the summary. Shared by bims-run (batch)
+// and the viewer/grabber front ends.
+#pragma once
+
+#include <bims/pipeline/pipeline.h>
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace bims::pipeline
+{
+/** Inclusive range of 3D-scan indices ("A:B", "A:" or ":B"). */
+struct FrameRange
+{
+	size_t first = 0;
+	size_t last = static_cast<size_t>(-1);
+	bool contains(size_t i) const { return i >= first && i <= last; }
+	/** Parses "A:B"; throws std::invalid_argument on bad text or A > B. */
+	static FrameRange parse(const std::string& s);
+};
+
+/** Median and 95th percentile of a series. */
+struct Percentiles
+{
+	double median = 0, p95 = 0, mean = 0;
+	size_t n = 0;
+	static Percentiles of(std::vector<double> v);
+};
+
+/** What a run measured. */
+struct RunSummary
+{
+	size_t scansRead = 0, framesProcessed = 0, imuRead = 0, otherSkipped = 0;
+	size_t framesFlagged = 0;    ///< frames with an egomotion flag
+	size_t scansOutOfOrder = 0;  ///< dropped: timestamp not increasing
+	double seconds = 0;          ///< wall time of the whole run
+	double dataSeconds = 0;      ///< time span of the processed frames
+	std::map<std::string, Percentiles> stageMs;  ///< per stage [ms]
+	double meanMovingPixelFraction = 0;          ///< over labelled-depth pixels
+	size_t staticMapVoxels = 0;
+	std::string variant;
+	/** Error that stopped the run early (outputs so far stay valid). */
+	std::string error;
+	double fps() const { return seconds > 0 ? framesProcessed / seconds : 0; }
+};
+
+/** Called after each processed frame (e.g. a viewer). */
+using FrameCallback = std::function<void(
+    const FrameResult&, const mrpt::obs::CObservation3DRangeScan&)>;
+
+struct RunOptions
+{
+	std::vector<std::string> rawlogs;
+	std::string outDir;  ///< empty: write nothing
+	FrameRange frames;
+	bool progress = true;
+	FrameCallback onFrame;
+};
+
+/** Runs \a cfg over the rawlogs. Writes into outDir (when set):
+ * trajectory.txt, masks/NNNNNN.png, moving_voxels/NNNNNN.ply,
+ * static_map.{ply,bt}, segmented.rawlog, metrics.json, frames.csv.
+ * Bad input (truncated rawlog, missing images) stops the run with
+ * summary.error set; everything written so far stays valid. */
+RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt);
+
+/** The summary as an aligned text table. */
+std::string formatSummary(const RunSummary& s);
+
+}  // namespace bims::pipeline

@@ -1,0 +1,171 @@
+#include "outputs.h"
+
+#include <bims/common/app.h>
+#include <bims/common/trajectory.h>
+#include <bims/maps/export.h>
+#include <mrpt/obs/TPixelLabelInfo.h>
+
+#include <cstdio>
+#include <opencv2/imgcodecs.hpp>
+#include <stdexcept>
+
+namespace bims::pipeline
+{
+namespace
+{
+std::string frameName(size_t index, const char* ext)
+{
+	char buf[32];
+	std::snprintf(buf, sizeof(buf), "%06zu.%s", index, ext);
+	return buf;
+}
+}  // namespace
+
+void writePointsPly(const std::string& path,
+                    const std::vector<mrpt::math::TPoint3D>& pts)
+{
+	std::ofstream f(path);
+	if (!f) throw std::runtime_error(path + ": cannot write PLY file");
+	f << "ply\nformat ascii 1.0\nelement vertex " << pts.size()
+	  << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+	char buf[96];
+	for (const auto& p : pts)
+	{
+		std::snprintf(buf, sizeof(buf), "%.4f %.4f %.4f\n", p.x, p.y, p.z);
+		f << buf;
+	}
+	if (!f) throw std::runtime_error(path + ": write failed");
+}
+
+OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
+    : dir_(dir), p_(p)
+{
+	makeDirs(dir_ + "/masks");
+	if (p_.moving_ply) makeDirs(dir_ + "/moving_voxels");
+	if (p_.flow_labels) makeDirs(dir_ + "/flow_labels");
+	traj_.open(dir_ + "/trajectory.txt");
+	csv_.open(dir_ + "/frames.csv");
+	if (!traj_ || !csv_)
+		throw std::runtime_error(dir_ + ": cannot create output files");
+	traj_ << "# bims-run estimated camera trajectory T_WC (optical frame)\n# "
+	         "timestamp tx ty tz qx qy qz qw\n";
+	csv_ << "index,t,ego_flags,correspondences,inliers,residual_m,hit_voxels,"
+	        "moving_voxels,moving_px,diff_px,notdiff_px,"
+	        "ms_input,ms_ego,ms_flow,ms_grids,ms_total\n";
+	traj_.flush();
+	csv_.flush();
+	if (p_.labelled_rawlog)
+		rawlog_ = std::make_unique<RawlogWriter>(dir_ + "/segmented.rawlog", 1);
+}
+
+void OutputWriter::writeFrame(const FrameResult& r,
+                              const mrpt::obs::CObservation3DRangeScan& scan)
+{
+	const std::string mpath = dir_ + "/masks/" + frameName(r.index, "png");
+	if (!cv::imwrite(mpath, r.mask))
+		throw std::runtime_error(mpath + ": cannot write mask");
+	if (p_.moving_ply)
+		writePointsPly(dir_ + "/moving_voxels/" + frameName(r.index, "ply"),
+		               r.movingVoxelCentres);
+	if (p_.flow_labels && !r.labels.empty())
+	{
+		cv::Mat vis(r.labels.size(), CV_8UC1, cv::Scalar(0));
+		vis.setTo(128, r.labels == 0);
+		vis.setTo(255, r.labels == 1);
+		cv::imwrite(dir_ + "/flow_labels/" + frameName(r.index, "png"), vis);
+	}
+	traj_ << tumLine(r.t, r.T_WC) << "\n";
+	traj_.flush();
+	char buf[512];
+	std::snprintf(
+	    buf, sizeof(buf),
+	    "%zu,%.6f,%u,%d,%d,%.5f,%zu,%zu,%d,%zu,%zu,%.3f,%.3f,%.3f,%.3f,%.3f\n",
+	    r.index, r.t, r.ego.flags, r.ego.correspondences, r.ego.inliers,
+	    r.ego.residual_rms_m, r.hitVoxels, r.movingVoxels,
+	    cv::countNonZero(r.mask), r.labelStats.diff, r.labelStats.notDiff,
+	    r.ms.input, r.ms.ego, r.ms.flow, r.ms.grids, r.ms.total);
+	csv_ << buf;
+	csv_.flush();
+	if (rawlog_)
+	{
+		mrpt::obs::CObservation3DRangeScan o(scan);
+		auto labels = std::make_shared<mrpt::obs::TPixelLabelInfo<1>>();
+		labels->setSize(r.mask.rows, r.mask.cols);
+		labels->setLabelName(0, "moving");
+		for (int v = 0; v < r.mask.rows; v++)
+		{
+			const uint8_t* m = r.mask.ptr<uint8_t>(v);
+			for (int u = 0; u < r.mask.cols; u++)
+				if (m[u]) labels->setLabel(v, u, 0);
+		}
+		o.pixelLabels = labels;
+		rawlog_->write(o);
+	}
+}
+
+void OutputWriter::writeOther(const mrpt::obs::CObservation& obs)
+{
+	if (rawlog_) rawlog_->write(obs);
+}
+
+size_t OutputWriter::finish(const Pipeline& pipe, const RunSummary& sum)
+{
+	if (rawlog_) rawlog_->close();
+	size_t nStatic = 0;
+	const auto& g = pipe.grids();
+	const maps::CMotionGridBase* motion = nullptr;
+	if (pipe.config().pipeline.variant == Variant::BottomOnly)
+		motion = g.background().get();
+	else if (pipe.config().pipeline.variant != Variant::FlowOnly)
+		motion = g.flow().get();
+	if (p_.static_map && pipe.framesProcessed() > 0)
+	{
+		nStatic = maps::writeStaticPly(dir_ + "/static_map.ply", *g.occupancy(),
+		                               motion, p_.static_p_occupied);
+		maps::writeStaticOctomap(dir_ + "/static_map.bt", *g.occupancy(),
+		                         motion, p_.static_p_occupied);
+	}
+	std::ofstream j(dir_ + "/metrics.json");
+	if (!j) throw std::runtime_error(dir_ + "/metrics.json: cannot write");
+	char buf[256];
+	j << "{\n";
+	j << "  \"variant\": \"" << sum.variant << "\",\n";
+	j << "  \"config\": \"" << pipe.config().source << "\",\n";
+	std::snprintf(buf, sizeof(buf),
+	              "  \"frames_processed\": %zu,\n  \"frames_flagged\": %zu,\n  "
+	              "\"scans_read\": %zu,\n  \"imu_read\": %zu,\n"
+	              "  \"scans_out_of_order\": %zu,\n  \"wall_seconds\": %.3f,\n "
+	              " \"fps\": %.3f,\n  \"data_seconds\": %.3f,\n"
+	              "  \"mean_moving_pixel_fraction\": %.6f,\n  "
+	              "\"static_map_voxels\": %zu,\n",
+	              sum.framesProcessed, sum.framesFlagged, sum.scansRead,
+	              sum.imuRead, sum.scansOutOfOrder, sum.seconds, sum.fps(),
+	              sum.dataSeconds, sum.meanMovingPixelFraction, nStatic);
+	j << buf;
+	j << "  \"stage_ms\": {";
+	bool first = true;
+	for (const auto& [name, p] : sum.stageMs)
+	{
+		std::snprintf(buf, sizeof(buf),
+		              "%s\n    \"%s\": {\"median\": %.3f, \"p95\": %.3f, "
+		              "\"mean\": %.3f, \"n\": %zu}",
+		              first ? "" : ",", name.c_str(), p.median, p.p95, p.mean,
+		              p.n);
+		j << buf;
+		first = false;
+	}
+	j << "\n  },\n";
+	std::string err;
+	for (char c : sum.error)
+	{
+		if (c == '"' || c == '\\') err += '\\';
+		if (c == '\n')
+			err += "\\n";
+		else
+			err += c;
+	}
+	j << "  \"error\": \"" << err << "\"\n}\n";
+	return nStatic;
+}
+
+}  // namespace bims::pipeline

@@ -1,0 +1,256 @@
+#include <bims/common/app.h>
+#include <bims/common/progress.h>
+#include <bims/common/rawlog.h>
+#include <bims/common/trajectory.h>
+#include <bims/ego/flags.h>
+#include <bims/maps/export.h>
+#include <bims/pipeline/run.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationIMU.h>
+#include <mrpt/obs/TPixelLabelInfo.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <fstream>
+#include <limits>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "outputs.h"
+
+namespace bims::pipeline
+{
+FrameRange FrameRange::parse(const std::string& s)
+{
+	const auto colon = s.find(':');
+	if (colon == std::string::npos)
+		throw std::invalid_argument(
+		    "--frames '" + s + "': expected A:B (3D-scan indices, inclusive)");
+	auto num = [&](const std::string& t, size_t def) -> size_t
+	{
+		if (t.empty()) return def;
+		size_t pos = 0;
+		long long v = -1;
+		try
+		{
+			v = std::stoll(t, &pos);
+		}
+		catch (...)
+		{
+			pos = 0;
+		}
+		if (pos != t.size() || v < 0)
+			throw std::invalid_argument("--frames '" + s + "': '" + t +
+			                            "' is not a non-negative integer");
+		return static_cast<size_t>(v);
+	};
+	FrameRange r;
+	r.first = num(s.substr(0, colon), 0);
+	r.last = num(s.substr(colon + 1), static_cast<size_t>(-1));
+	if (r.first > r.last)
+		throw std::invalid_argument("--frames '" + s + "': A > B");
+	return r;
+}
+
+Percentiles Percentiles::of(std::vector<double> v)
+{
+	Percentiles p;
+	p.n = v.size();
+	if (v.empty()) return p;
+	std::sort(v.begin(), v.end());
+	p.median = v[v.size() / 2];
+	p.p95 = v[std::min(v.size() - 1,
+	                   static_cast<size_t>(std::ceil(0.95 * v.size())) - 1)];
+	double s = 0;
+	for (double x : v) s += x;
+	p.mean = s / v.size();
+	return p;
+}
+
+namespace
+{
+struct PendingScan
+{
+	mrpt::obs::CObservation3DRangeScan::Ptr scan;
+	size_t index;
+	double t;
+};
+}  // namespace
+
+RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
+{
+	const auto wall0 = std::chrono::steady_clock::now();
+	RunSummary sum;
+	sum.variant = toString(cfg.pipeline.variant);
+	if (opt.rawlogs.empty())
+		throw std::invalid_argument("no input rawlog given");
+
+	Pipeline pipe(cfg);
+	std::unique_ptr<OutputWriter> out;
+	if (!opt.outDir.empty())
+		out = std::make_unique<OutputWriter>(opt.outDir, cfg.output);
+
+	std::map<std::string, std::vector<double>> stage;
+	std::deque<PendingScan> pending;
+	double lastImuT = -std::numeric_limits<double>::infinity();
+	double newestT = lastImuT, lastScanT = lastImuT, firstT = NAN, lastT = NAN;
+	const double offset = cfg.ego.calibration.time_offset_s;
+	const std::string& rgbdLabel = cfg.ego.sensors.rgbd_label;
+	const std::string& imuLabel = cfg.ego.sensors.imu_label;
+	size_t scanIndex = 0;
+	bool pastRange = false;
+	double movingFracSum = 0;
+	ProgressBar bar("bims-run", 0, opt.progress);
+
+	auto process = [&](const PendingScan& p)
+	{
+		p.scan->load();  // external images, if any
+		const FrameResult& r = pipe.processFrame(*p.scan, p.index);
+		sum.framesProcessed++;
+		if (r.ego.flags & ~static_cast<uint32_t>(ego::kFlagFirstFrame))
+			sum.framesFlagged++;
+		stage["input"].push_back(r.ms.input);
+		stage["egomotion"].push_back(r.ms.ego);
+		stage["flow"].push_back(r.ms.flow);
+		stage["grids"].push_back(r.ms.grids);
+		stage["total"].push_back(r.ms.total);
+		const double validPx = static_cast<double>(r.cloudStats.valid);
+		if (validPx > 0) movingFracSum += cv::countNonZero(r.mask) / validPx;
+		if (std::isnan(firstT)) firstT = r.t;
+		lastT = r.t;
+		if (out) out->writeFrame(r, *p.scan);
+		if (opt.onFrame) opt.onFrame(r, *p.scan);
+		bar.update(sum.framesProcessed, "frame " + std::to_string(p.index));
+	};
+	auto flush = [&](bool all)
+	{
+		while (!pending.empty())
+		{
+			const auto& p = pending.front();
+			const bool imuReady = p.t + offset <= lastImuT;
+			const bool waitedEnough = newestT - p.t > cfg.pipeline.imu_wait_s;
+			if (!all && !imuReady && !waitedEnough) break;
+			process(p);
+			pending.pop_front();
+		}
+	};
+
+	try
+	{
+		for (const auto& path : opt.rawlogs)
+		{
+			if (pastRange) break;
+			RawlogReader reader(path);
+			while (auto o = reader.next())
+			{
+				const double t = mrpt::Clock::toDouble(o->timestamp);
+				if (auto imu =
+				        std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(
+				            o))
+				{
+					if (!imuLabel.empty() && imu->sensorLabel != imuLabel)
+					{
+						sum.otherSkipped++;
+						continue;
+					}
+					pipe.addImu(*imu);
+					sum.imuRead++;
+					lastImuT = std::max(lastImuT, t);
+					if (out) out->writeOther(*imu);
+				}
+				else if (auto scan = std::dynamic_pointer_cast<
+				             mrpt::obs::CObservation3DRangeScan>(o))
+				{
+					if (!rgbdLabel.empty() && scan->sensorLabel != rgbdLabel)
+					{
+						sum.otherSkipped++;
+						continue;
+					}
+					const size_t idx = scanIndex++;
+					sum.scansRead++;
+					if (idx > opt.frames.last)
+					{
+						pastRange = true;
+						break;
+					}
+					if (!opt.frames.contains(idx)) continue;
+					if (t <= lastScanT)
+					{
+						sum.scansOutOfOrder++;
+						std::fprintf(
+						    stderr,
+						    "bims-run: warning: %s: 3D scan #%zu has a "
+						    "timestamp not after the previous one; skipped\n",
+						    path.c_str(), idx);
+						continue;
+					}
+					lastScanT = t;
+					pending.push_back({scan, idx, t});
+				}
+				else
+					sum.otherSkipped++;
+				newestT = std::max(newestT, t);
+				flush(false);
+			}
+		}
+		flush(true);
+	}
+	catch (const std::exception& e)
+	{
+		sum.error = e.what();
+		pending.clear();
+	}
+	if (sum.scansRead == 0 && sum.error.empty())
+	{
+		std::string files;
+		for (const auto& f : opt.rawlogs)
+			files += (files.empty() ? "" : ", ") + f;
+		sum.error = files + ": no CObservation3DRangeScan (RGB-D) observation" +
+		            (rgbdLabel.empty() ? std::string()
+		                               : " with label '" + rgbdLabel + "'");
+	}
+	bar.finish();
+
+	for (auto& [name, v] : stage) sum.stageMs[name] = Percentiles::of(v);
+	sum.dataSeconds = std::isnan(firstT) ? 0 : lastT - firstT;
+	sum.meanMovingPixelFraction =
+	    sum.framesProcessed ? movingFracSum / sum.framesProcessed : 0;
+	sum.seconds =
+	    std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0)
+	        .count();
+	if (out) sum.staticMapVoxels = out->finish(pipe, sum);
+	return sum;
+}
+
+std::string formatSummary(const RunSummary& s)
+{
+	std::ostringstream o;
+	char buf[256];
+	std::snprintf(buf, sizeof(buf),
+	              "variant %s: %zu frames (%zu flagged) of %zu 3D scans, %zu "
+	              "IMU samples, %.1f s of data\n",
+	              s.variant.c_str(), s.framesProcessed, s.framesFlagged,
+	              s.scansRead, s.imuRead, s.dataSeconds);
+	o << buf;
+	std::snprintf(
+	    buf, sizeof(buf),
+	    "wall time %.1f s, %.1f frames/s; mean moving-pixel fraction %.2f %%\n",
+	    s.seconds, s.fps(), 100.0 * s.meanMovingPixelFraction);
+	o << buf;
+	o << "stage        median ms   p95 ms   mean ms\n";
+	for (const char* k : {"input", "egomotion", "flow", "grids", "total"})
+	{
+		const auto it = s.stageMs.find(k);
+		if (it == s.stageMs.end()) continue;
+		std::snprintf(buf, sizeof(buf), "%-12s %9.2f %8.2f %9.2f\n", k,
+		              it->second.median, it->second.p95, it->second.mean);
+		o << buf;
+	}
+	if (!s.error.empty()) o << "stopped early: " << s.error << "\n";
+	return o.str();
+}
+
+}  // namespace bims::pipeline
