@@ -105,7 +105,9 @@ void writeCalibration(const SimConfig& cfg, const std::string& path)
 	std::ofstream f(path);
 	if (!f) throw std::runtime_error(path + ": cannot write");
 	char buf[256];
-	f << "# bims-sim calibration of " << cfg.file << "\n"
+	const std::string sceneName =
+	    cfg.file.substr(cfg.file.find_last_of('/') + 1);
+	f << "# bims-sim calibration of scene " << sceneName << "\n"
 	  << "# Keys match the sections of a bims experiment .ini.\n"
 	  << "[camera]\n";
 	std::snprintf(buf, sizeof(buf),

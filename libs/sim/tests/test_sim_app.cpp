@@ -1,0 +1,391 @@
+// End-to-end tests of bims-sim and bims-info: rawlog round trip through MRPT,
+// rawlog-edit, determinism, bad input, the bundled sample.
+#include <bims/common/frames.h>
+#include <bims/common/rawlog.h>
+#include <bims/common/trajectory.h>
+#include <bims/sim/scene.h>
+#include <bims/sim/simulator.h>
+#include <gtest/gtest.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationIMU.h>
+#include <mrpt/obs/CRawlog.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+
+namespace
+{
+const std::string kBin = BIMS_BIN_DIR;
+const std::string kSrc = BIMS_SOURCE_DIR;
+
+std::string tmpDir(const std::string& name)
+{
+	const std::string d =
+	    std::string(BIMS_BINARY_DIR) + "/test_sim_tmp/" + name;
+	std::system(("rm -rf '" + d + "' && mkdir -p '" + d + "'").c_str());
+	return d;
+}
+/** Runs a shell command; returns the exit code, output (stdout+stderr) in out.
+ */
+int run(const std::string& cmd, std::string& out)
+{
+	FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+	if (!p) return -1;
+	char buf[4096];
+	out.clear();
+	size_t n;
+	while ((n = fread(buf, 1, sizeof(buf), p)) > 0) out.append(buf, n);
+	const int st = pclose(p);
+	return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+std::string readFile(const std::string& path)
+{
+	std::ifstream f(path, std::ios::binary);
+	std::stringstream ss;
+	ss << f.rdbuf();
+	return ss.str();
+}
+void writeFile(const std::string& path, const std::string& text)
+{
+	std::ofstream(path) << text;
+}
+
+const char* kSmallScene = R"([sim]
+frames=12
+fps=30
+
+[camera]
+resolution=320x240
+
+[pendulum]
+pivot=0.6 0 2.3
+length=1.3
+ball_radius=0.25
+
+[box]
+center=0.8 0
+)";
+
+/** Runs bims-sim on a small scene into dir/out.rawlog. */
+std::string simulate(const std::string& dir, const std::string& scene,
+                     const std::string& args)
+{
+	writeFile(dir + "/scene.ini", scene);
+	std::string out;
+	const int rc = run("'" + kBin + "/bims-sim' '" + dir + "/scene.ini' -o '" +
+	                       dir + "/out.rawlog' -q " + args,
+	                   out);
+	EXPECT_EQ(rc, 0) << out;
+	return dir + "/out.rawlog";
+}
+}  // namespace
+
+TEST(BimsSim, RawlogRoundTripsThroughMrptReader)
+{
+	const std::string d = tmpDir("roundtrip");
+	const std::string f = simulate(d, kSmallScene, "--seed 3");
+	mrpt::obs::CRawlog rl;
+	ASSERT_TRUE(rl.loadFromRawLogFile(f));
+	size_t n3d = 0, nImu = 0;
+	double lastT = 0;
+	for (size_t i = 0; i < rl.size(); i++)
+	{
+		ASSERT_EQ(rl.getType(i), mrpt::obs::CRawlog::etObservation);
+		const auto o = rl.getAsObservation(i);
+		const double t = mrpt::Clock::toDouble(o->timestamp);
+		EXPECT_GE(t, lastT) << "rawlog must be time-ordered";
+		lastT = t;
+		if (auto s =
+		        std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(
+		            o))
+		{
+			n3d++;
+			EXPECT_EQ(s->sensorLabel, "RGBD");
+			EXPECT_EQ(s->rangeImage.cols(), 320);
+			EXPECT_EQ(s->rangeImage.rows(), 240);
+			EXPECT_EQ(s->intensityImage.getWidth(), 320u);
+			EXPECT_TRUE(s->range_is_depth);
+			EXPECT_FLOAT_EQ(s->rangeUnits, 0.001f);
+			EXPECT_NEAR(s->cameraParams.fx(), 262.5, 1e-9);
+			EXPECT_TRUE(s->hasPixelLabels());
+		}
+		else if (std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(o))
+		{
+			nImu++;
+			EXPECT_EQ(o->sensorLabel, "IMU");
+		}
+	}
+	EXPECT_EQ(n3d, 12u);
+	EXPECT_EQ(nImu, 39u);  // 0 .. 11/30 s + half a frame, at 100 Hz
+	// Ground truth files exist, one pose and one mask per frame.
+	const std::string gt = d + "/out_gt";
+	EXPECT_EQ(bims::loadTumTrajectory(gt + "/groundtruth.txt").size(), 12u);
+	const cv::Mat m =
+	    cv::imread(gt + "/masks/000011.png", cv::IMREAD_UNCHANGED);
+	ASSERT_FALSE(m.empty());
+	EXPECT_EQ(m.type(), CV_8UC1);
+	EXPECT_EQ(m.cols, 320);
+	EXPECT_FALSE(readFile(gt + "/imu.txt").empty());
+	EXPECT_NE(readFile(gt + "/objects.txt").find(" pendulum "),
+	          std::string::npos);
+	EXPECT_NE(readFile(gt + "/calibration.ini").find("R_IC="),
+	          std::string::npos);
+}
+
+TEST(BimsSim, RawlogEditListsBothSensorsAtTheirRates)
+{
+	std::string out;
+	if (run("command -v rawlog-edit", out) != 0)
+		GTEST_SKIP() << "rawlog-edit not installed";
+	const std::string d = tmpDir("rawlogedit");
+	const std::string f = simulate(d, kSmallScene, "--frames 31");
+	ASSERT_EQ(run("rawlog-edit --info -i '" + f + "'", out), 0) << out;
+	std::map<std::string, double> rate;
+	const std::regex re(
+	    R"(Sensor \(Label/Occurs/Rate/Durat\.\)\s*:\s*(\S+)\s*/\s*(\d+)\s*/\s*([0-9.]+))");
+	for (std::sregex_iterator it(out.begin(), out.end(), re), end; it != end;
+	     ++it)
+		rate[(*it)[1]] = std::stod((*it)[3]);
+	ASSERT_EQ(rate.size(), 2u) << out;
+	EXPECT_NEAR(rate["RGBD"], 30.0, 0.01);
+	EXPECT_NEAR(rate["IMU"], 100.0, 0.01);
+}
+
+TEST(BimsSim, NoiselessDepthUnprojectedWithGroundTruthLiesOnSurfaces)
+{
+	// Through the whole chain: rawlog -> MRPT unprojection ({S}) -> T_WC from
+	// groundtruth.txt -> distance to the scene; masks checked against the
+	// surface each pixel's depth comes from.
+	const std::string d = tmpDir("geometry");
+	const std::string scene =
+	    std::string(kSmallScene) + "\n[depth]\nnoiseless=true\n";
+	const std::string f = simulate(d, scene, "--frames 3");
+	const auto cfg = bims::sim::SimConfig::load(d + "/scene.ini");
+	const auto world = cfg.buildScene();
+	const auto gt = bims::loadTumTrajectory(d + "/out_gt/groundtruth.txt");
+	bims::RawlogReader r(f);
+	size_t frame = 0, checked = 0, moving = 0;
+	while (auto o = r.next())
+	{
+		auto s =
+		    std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(o);
+		if (!s) continue;
+		const double t = frame / 30.0;
+		const auto prims = world.primitivesAt(t);
+		const cv::Mat mask = cv::imread(
+		    d + "/out_gt/masks/" + mrpt::format("%06zu", frame) + ".png",
+		    cv::IMREAD_UNCHANGED);
+		ASSERT_FALSE(mask.empty());
+		mrpt::poses::CPose3D T_CS = bims::T_SC();
+		T_CS.inverse();
+		const mrpt::poses::CPose3D T_WS = gt[frame].T_WC + T_CS;
+		for (int v = 0; v < 240; v += 2)
+			for (int u = 0; u < 320; u += 2)
+			{
+				const uint16_t z = s->rangeImage(v, u);
+				if (!z) continue;
+				// MRPT's unprojection of one pixel, in {S}
+				const double zc = z * 1e-3;
+				const mrpt::math::TPoint3D p_S(
+				    zc, -(u - s->cameraParams.cx()) / s->cameraParams.fx() * zc,
+				    -(v - s->cameraParams.cy()) / s->cameraParams.fy() * zc);
+				const auto p_W = T_WS.composePoint(p_S);
+				const Eigen::Vector3d x(p_W.x, p_W.y, p_W.z);
+				double dS = 1e9, dM = 1e9;
+				for (const auto& p : prims)
+				{
+					const double dist = bims::sim::distanceToSurface(p, x);
+					if (p.objectId)
+						dM = std::min(dM, dist);
+					else
+						dS = std::min(dS, dist);
+				}
+				ASSERT_LT(std::min(dS, dM), 1e-3)
+				    << "frame " << frame << " pixel " << u << "," << v;
+				if (mask.at<uint8_t>(v, u) == 255)
+				{
+					EXPECT_LT(dM, 1e-3);
+					moving++;
+				}
+				else
+				{
+					EXPECT_EQ(mask.at<uint8_t>(v, u), 0);
+					EXPECT_LT(dS, 1e-3);
+				}
+				checked++;
+			}
+		// Cross-check our pixel formula against MRPT's own unprojection.
+		if (frame == 0)
+		{
+			mrpt::maps::CSimplePointsMap pts;
+			mrpt::obs::T3DPointsProjectionParams pp;
+			pp.takeIntoAccountSensorPoseOnRobot = false;
+			s->unprojectInto(pts, pp);
+			ASSERT_GT(pts.size(), 1000u);
+			double worst = 0;
+			for (size_t i = 0; i < pts.size(); i += 97)
+			{
+				mrpt::math::TPoint3D q;
+				pts.getPoint(i, q);
+				const auto p_W = T_WS.composePoint(q);
+				worst = std::max(worst, world.distanceToNearestSurface(
+				                            {p_W.x, p_W.y, p_W.z}, t));
+			}
+			EXPECT_LT(worst, 1e-3);
+		}
+		frame++;
+	}
+	EXPECT_EQ(frame, 3u);
+	EXPECT_GT(checked, 30000u);
+	EXPECT_GT(moving, 200u);
+}
+
+TEST(BimsSim, SameSeedGivesIdenticalBytesOtherSeedDiffers)
+{
+	const std::string a = tmpDir("seedA"), b = tmpDir("seedB"),
+	                  c = tmpDir("seedC");
+	const std::string fa = simulate(a, kSmallScene, "--seed 5 --frames 4");
+	const std::string fb = simulate(b, kSmallScene, "--seed 5 --frames 4");
+	const std::string fc = simulate(c, kSmallScene, "--seed 6 --frames 4");
+	EXPECT_EQ(readFile(fa), readFile(fb));
+	for (const char* g : {"groundtruth.txt", "imu.txt", "objects.txt",
+	                      "calibration.ini", "masks/000003.png"})
+		EXPECT_EQ(readFile(a + "/out_gt/" + g), readFile(b + "/out_gt/" + g))
+		    << g;
+	EXPECT_NE(readFile(fa), readFile(fc));
+	EXPECT_NE(readFile(a + "/out_gt/imu.txt"), readFile(c + "/out_gt/imu.txt"));
+	// Geometry does not depend on the noise seed.
+	EXPECT_EQ(readFile(a + "/out_gt/groundtruth.txt"),
+	          readFile(c + "/out_gt/groundtruth.txt"));
+	EXPECT_EQ(readFile(a + "/out_gt/masks/000003.png"),
+	          readFile(c + "/out_gt/masks/000003.png"));
+}
+
+TEST(BimsSim, BadInputGivesClearErrorAndNonZeroExit)
+{
+	const std::string d = tmpDir("bad");
+	struct Case
+	{
+		std::string ini, expect;
+	};
+	const std::vector<Case> cases = {
+	    {std::string(kSmallScene) + "\n[depth]\nmax_rnage=4\n",
+	     "[depth] max_rnage"},
+	    {"[camera]\nresolution=320x240\n", "missing required section [sim]"},
+	    {std::string(kSmallScene) + "\n[imu]\nrate_hz=-5\n", "[imu] rate_hz"},
+	    {std::string(kSmallScene) + "\n[cmaera]\nfx=500\n", "cmaera"},
+	    {"[sim]\nframes=ten\n", "[sim] frames"},
+	    {std::string(kSmallScene) +
+	         "\n[pendulum2]\nlength=0.5\nball_radius=0.6\n",
+	     "[pendulum2] ball_radius"},
+	};
+	for (size_t i = 0; i < cases.size(); i++)
+	{
+		const std::string ini = d + "/bad" + std::to_string(i) + ".ini";
+		writeFile(ini, cases[i].ini);
+		std::string out;
+		const int rc = run(
+		    "'" + kBin + "/bims-sim' '" + ini + "' -o '" + d + "/x.rawlog' -q",
+		    out);
+		EXPECT_NE(rc, 0) << cases[i].ini;
+		EXPECT_NE(out.find(cases[i].expect), std::string::npos) << out;
+		EXPECT_NE(out.find("bad" + std::to_string(i) + ".ini"),
+		          std::string::npos)
+		    << out;
+	}
+	std::string out;
+	EXPECT_NE(run("'" + kBin + "/bims-sim' '" + d + "/nope.ini' -o '" + d +
+	                  "/x.rawlog'",
+	              out),
+	          0);
+	EXPECT_NE(out.find("nope.ini"), std::string::npos) << out;
+	EXPECT_EQ(run("'" + kBin + "/bims-sim' -o '" + d + "/x.rawlog'", out), 2)
+	    << out;
+	writeFile(d + "/good.ini", kSmallScene);
+	EXPECT_EQ(run("'" + kBin + "/bims-sim' '" + d +
+	                  "/good.ini' -o x.rawlog -r 800x600",
+	              out),
+	          2);
+	EXPECT_NE(out.find("640x480 or 320x240"), std::string::npos) << out;
+}
+
+TEST(BimsSim, ImuFromTumTrajectoryIsLabelledSynthetic)
+{
+	const std::string d = tmpDir("imufromtum");
+	const std::string scene =
+	    std::string(kSmallScene) + "\n[imu]\nnoiseless=true\n";
+	simulate(d, scene, "--frames 60");
+	std::string out;
+	ASSERT_EQ(
+	    run("'" + kBin + "/bims-sim' --imu-from-tum '" + d +
+	            "/out_gt/groundtruth.txt' -o '" + d + "/imu.rawlog' --seed 2",
+	        out),
+	    0)
+	    << out;
+	bims::RawlogReader r(d + "/imu.rawlog");
+	size_t n = 0;
+	while (auto o = r.next())
+	{
+		EXPECT_EQ(o->sensorLabel, "IMU_SYNTH");
+		n++;
+	}
+	EXPECT_EQ(n, 197u);  // 59/30 s at 100 Hz, both ends
+	EXPECT_FALSE(readFile(d + "/imu_gt/imu.txt").empty());
+	ASSERT_EQ(run("'" + kBin + "/bims-info' '" + d + "/imu.rawlog'", out), 0)
+	    << out;
+	EXPECT_NE(out.find("IMU_SYNTH"), std::string::npos) << out;
+}
+
+TEST(BimsInfo, SummarisesSensorsAndRejectsBadFiles)
+{
+	const std::string d = tmpDir("info");
+	const std::string f = simulate(d, kSmallScene, "--frames 31");
+	std::string out;
+	ASSERT_EQ(run("'" + kBin + "/bims-info' '" + f + "'", out), 0) << out;
+	EXPECT_NE(out.find("observations:  133"), std::string::npos) << out;
+	EXPECT_NE(out.find("30.000 Hz"), std::string::npos) << out;
+	EXPECT_NE(out.find("100.000 Hz"), std::string::npos) << out;
+	EXPECT_NE(out.find("duration:      1.010 s"), std::string::npos) << out;
+	EXPECT_NE(out.find("depth 320x240 rgb 320x240 x31"), std::string::npos)
+	    << out;
+	EXPECT_EQ(run("'" + kBin + "/bims-info' '" + d + "/missing.rawlog'", out),
+	          1);
+	EXPECT_NE(out.find("missing.rawlog"), std::string::npos) << out;
+	// Truncated file: an error naming the file, not a silent short summary.
+	const std::string bytes = readFile(f);
+	std::ofstream(d + "/trunc.rawlog", std::ios::binary)
+	    .write(bytes.data(), bytes.size() / 2);
+	EXPECT_EQ(run("'" + kBin + "/bims-info' '" + d + "/trunc.rawlog'", out), 1)
+	    << out;
+	EXPECT_NE(out.find("trunc.rawlog"), std::string::npos) << out;
+}
+
+TEST(BundledSample, RegeneratingGivesTheSameBytes)
+{
+	const std::string d = tmpDir("sample");
+	std::string out;
+	// The command of rawlogs/README.md, run from the source tree.
+	ASSERT_EQ(run("cd '" + kSrc + "' && '" + kBin +
+	                  "/bims-sim' rawlogs/pendulum_slow.ini -o '" + d +
+	                  "/pendulum_slow.rawlog' --seed 1 -q",
+	              out),
+	          0)
+	    << out;
+	const std::string ref = kSrc + "/rawlogs/pendulum_slow";
+	EXPECT_TRUE(readFile(d + "/pendulum_slow.rawlog") ==
+	            readFile(ref + ".rawlog"))
+	    << "rawlogs/pendulum_slow.rawlog differs from a fresh run: regenerate "
+	       "it (rawlogs/README.md)";
+	ASSERT_EQ(run("diff -r '" + d + "/pendulum_slow_gt' '" + ref + "_gt'", out),
+	          0)
+	    << out;
+}
