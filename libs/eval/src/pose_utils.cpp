@@ -75,7 +75,10 @@ Eigen::Isometry3d bonnTros()
 mrpt::poses::CPose3D bonnMarkerToCamera(const mrpt::poses::CPose3D& T_gt)
 {
 	static const Eigen::Isometry3d Tm = bonnTm(), Tros = bonnTros();
-	return fromIso(Tros * toIso(T_gt) * Tros * Tm);
+	// Bonn's T_ros * T_gt * T_ros * T_m, without the leftmost T_ros: that
+	// factor only re-expresses the world in a y-up basis; we keep the z-up
+	// motion-capture world (the project's {W} convention).
+	return fromIso(toIso(T_gt) * Tros * Tm);
 }
 
 }  // namespace bims::eval

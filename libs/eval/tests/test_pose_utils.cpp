@@ -24,21 +24,23 @@ TEST(PoseUtils, InterpolationMidpointAndLimits)
 
 TEST(PoseUtils, BonnConversionMatchesTheFormula)
 {
-	// T_cam = T_ros T_gt T_ros T_m: for T_gt = identity, T_ros^2 = I, so the
-	// result is T_m (orthonormalised): translation exactly T_m's, rotation
-	// within the non-orthonormality of the published matrix.
+	// T_WC = T_gt T_ros T_m: for T_gt = identity, the rotation is T_ros times
+	// T_m's (orthonormalised) and the translation T_ros t_m = (-tx, tz, ty).
 	const CPose3D T = ev::bonnMarkerToCamera(CPose3D());
 	const double* m = ev::bonnTm4x4();
-	EXPECT_NEAR(T.x(), m[3], 1e-12);
-	EXPECT_NEAR(T.y(), m[7], 1e-12);
-	EXPECT_NEAR(T.z(), m[11], 1e-12);
+	EXPECT_NEAR(T.x(), -m[3], 1e-12);
+	EXPECT_NEAR(T.y(), m[11], 1e-12);
+	EXPECT_NEAR(T.z(), m[7], 1e-12);
 	const auto R = T.getRotationMatrix();
 	EXPECT_NEAR(R.det(), 1.0, 1e-9);
+	const int rowOf[3] = {0, 2, 1};
+	const double sign[3] = {-1, 1, 1};
 	for (int r = 0; r < 3; r++)
-		for (int c = 0; c < 3; c++) EXPECT_NEAR(R(r, c), m[4 * r + c], 0.1);
-	// A pure translation of the marker along x_gt moves the camera along
-	// -x (T_ros flips x).
-	const CPose3D T2 = ev::bonnMarkerToCamera(CPose3D(1, 0, 0, 0, 0, 0));
-	EXPECT_NEAR(T2.x() - T.x(), -1.0, 1e-12);
-	EXPECT_NEAR(T2.y() - T.y(), 0.0, 1e-12);
+		for (int c = 0; c < 3; c++)
+			EXPECT_NEAR(R(r, c), sign[r] * m[4 * rowOf[r] + c], 0.1);
+	// The marker's translation passes through unchanged (world = mocap).
+	const CPose3D T2 = ev::bonnMarkerToCamera(CPose3D(1, 2, 3, 0, 0, 0));
+	EXPECT_NEAR(T2.x() - T.x(), 1.0, 1e-12);
+	EXPECT_NEAR(T2.y() - T.y(), 2.0, 1e-12);
+	EXPECT_NEAR(T2.z() - T.z(), 3.0, 1e-12);
 }

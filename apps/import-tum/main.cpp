@@ -1,0 +1,138 @@
+// bims-import-tum FOLDER -o OUT.rawlog [--config cam.ini] [--bonn-gt]
+//   [--max-frames N] [--synth-imu [--seed N]] [--gz L]
+// Converts a TUM RGB-D-layout folder into a bims rawlog plus OUT_gt/
+// (groundtruth.txt, calibration.ini). See docs/eval.md.
+#include <bims/common/app.h>
+#include <bims/eval/pose_utils.h>
+#include <bims/eval/tum_import.h>
+#include <mrpt/3rdparty/tclap/CmdLine.h>
+#include <mrpt/config/CConfigFile.h>
+
+#include <cstdio>
+#include <filesystem>
+
+#ifdef BIMS_HAVE_SIM
+#include <bims/sim/imu.h>
+#endif
+
+int main(int argc, char** argv)
+{
+	return bims::runApp(
+	    "bims-import-tum",
+	    [&]()
+	    {
+		    TCLAP::CmdLine cmd(
+		        "Import a TUM RGB-D-layout folder (rgb.txt, depth.txt, "
+		        "optional "
+		        "accelerometer.txt, groundtruth.txt) into a rawlog of "
+		        "registered "
+		        "RGB-D frames plus ground truth in OUT_gt/.",
+		        ' ', "0.1");
+		    TCLAP::UnlabeledValueArg<std::string> folder(
+		        "FOLDER", "TUM RGB-D folder", true, "", "FOLDER", cmd);
+		    TCLAP::ValueArg<std::string> out(
+		        "o", "output", "output rawlog (ground truth goes to OUT_gt/)",
+		        true, "", "OUT.rawlog", cmd);
+		    TCLAP::ValueArg<std::string> config(
+		        "", "config",
+		        "experiment .ini: [camera] intrinsics and depth_scale, "
+		        "[import], "
+		        "[sensors] (default: TUM 525/319.5/239.5, depth scale 5000)",
+		        false, "", "cam.ini", cmd);
+		    TCLAP::SwitchArg bonn(
+		        "", "bonn-gt",
+		        "ground truth is the Bonn RGB-D Dynamic marker pose: convert "
+		        "it to "
+		        "the camera (same as [import] bonn_gt = true)",
+		        cmd);
+		    TCLAP::ValueArg<size_t> maxFrames(
+		        "", "max-frames", "import only the first N frames (0 = all)",
+		        false, 0, "N", cmd);
+		    TCLAP::ValueArg<int> gz(
+		        "", "gz", "gzip level of the rawlog, 0 = plain (default 1)",
+		        false, 1, "L", cmd);
+		    TCLAP::SwitchArg synth(
+		        "", "synth-imu",
+		        "add SYNTHETIC IMU readings (label <imu_label>_SYNTH) "
+		        "synthesised "
+		        "from the ground truth with bims::sim::synthesizeImu (default "
+		        "Xsens MTi-like noise; [calibration] of --config)",
+		        cmd);
+		    TCLAP::ValueArg<uint64_t> seed(
+		        "", "seed", "random seed of --synth-imu (default 1)", false, 1,
+		        "N", cmd);
+		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
+		    cmd.parse(argc, argv);
+
+		    if (gz.getValue() < 0 || gz.getValue() > 9)
+			    throw bims::UsageError("--gz must be in 0..9");
+		    bims::eval::ImportParams params;
+		    std::unique_ptr<mrpt::config::CConfigFile> cfg;
+		    if (config.isSet())
+		    {
+			    if (!std::filesystem::exists(config.getValue()))
+				    throw std::runtime_error(config.getValue() +
+				                             ": config file not found");
+			    cfg = std::make_unique<mrpt::config::CConfigFile>(
+			        config.getValue());
+			    params.loadFromConfigFile(*cfg);
+		    }
+		    else
+			    std::fprintf(stderr,
+			                 "bims-import-tum: no --config: using the TUM "
+			                 "default camera "
+			                 "(fx=fy=525, cx=319.5, cy=239.5, 640x480, depth "
+			                 "scale 5000)\n");
+
+		    bims::eval::ImportOptions opt;
+		    opt.maxFrames = maxFrames.getValue();
+		    opt.bonnGt = bonn.getValue();
+		    opt.gzLevel = gz.getValue();
+		    opt.progress = !quiet.getValue();
+
+		    if (synth.getValue())
+		    {
+#ifdef BIMS_HAVE_SIM
+			    const auto tum =
+			        bims::eval::readTumFolder(folder.getValue(), params);
+			    if (!tum.hasGroundTruth)
+				    throw std::runtime_error(
+				        folder.getValue() +
+				        ": --synth-imu needs groundtruth.txt to synthesise "
+				        "from");
+			    bims::Trajectory gt = tum.groundTruth;
+			    if (opt.bonnGt || params.bonnGt)
+				    for (auto& p : gt)
+					    p.T_WC = bims::eval::bonnMarkerToCamera(p.T_WC);
+			    bims::sim::ImuParams imu;
+			    imu.label = params.imuLabel;
+			    if (cfg) imu.loadFromConfigFile(*cfg, "imu", "calibration");
+			    for (auto& o :
+			         bims::sim::synthesizeImu(gt, imu, seed.getValue()))
+				    opt.extra.push_back(o);
+#else
+			    throw bims::UsageError(
+			        "--synth-imu: this build has no simulator library "
+			        "(libs/sim)");
+#endif
+		    }
+
+		    const auto sum = bims::eval::importTum(folder.getValue(),
+		                                           out.getValue(), params, opt);
+		    std::printf("%s: %zu RGB-D frames, %zu IMU observations%s\n",
+		                out.getValue().c_str(), sum.frames, sum.imu,
+		                synth.getValue() ? " (synthetic)" : "");
+		    if (sum.gtPoses || sum.framesWithoutGt)
+			    std::printf(
+			        "%s/groundtruth.txt: %zu poses (T_WC at the frames' "
+			        "stamps%s), "
+			        "%zu frames outside the ground truth\n",
+			        sum.gtDir.c_str(), sum.gtPoses,
+			        (opt.bonnGt || params.bonnGt) ? ", Bonn-converted" : "",
+			        sum.framesWithoutGt);
+		    else
+			    std::printf("%s: no groundtruth.txt in the folder\n",
+			                sum.gtDir.c_str());
+		    return 0;
+	    });
+}
