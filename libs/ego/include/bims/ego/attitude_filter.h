@@ -1,0 +1,110 @@
+// AttitudeFilter: the IMU orientation R_WI ({I} in the world {W}: z up,
+// x magnetic north) from gyro, accelerometer and magnetometer.
+//
+// A nonlinear complementary filter on SO(3) (Mahony et al., IEEE TAC 2008)
+// with gyro-bias estimation: the gyro is integrated between samples and the
+// gravity direction (accelerometer) and the horizontal magnetic north
+// (magnetometer, yaw only) pull the estimate back. Each aiding sensor is gated
+// when it cannot be trusted: the accelerometer when | |f| - g | is large
+// (linear acceleration), the magnetometer when its norm or dip departs from
+// the reference field (magnetic disturbance). Derivation, gains and gating
+// rules: docs/attitude.md. The filter keeps a short history so the attitude
+// can be interpolated (slerp) at camera timestamps.
+#pragma once
+
+#include <bims/ego/params.h>
+
+#include <mrpt/obs/CObservationIMU.h>
+
+#include <Eigen/Geometry>
+
+#include <deque>
+#include <optional>
+
+namespace bims::ego
+{
+/** One IMU reading, in the IMU body frame {I}. */
+struct ImuSample
+{
+	double t = 0;  ///< IMU clock [s]
+	bool hasGyro = false, hasAcc = false, hasMag = false;
+	Eigen::Vector3d gyro = Eigen::Vector3d::Zero();  ///< omega_I [rad/s]
+	Eigen::Vector3d acc = Eigen::Vector3d::Zero();   ///< specific force [m/s^2]
+	Eigen::Vector3d mag = Eigen::Vector3d::Zero();   ///< field (sensor units)
+	/** The sensor's own orientation R_WI ({W} = NWU), if it gives one. */
+	std::optional<Eigen::Quaterniond> q_WI;
+};
+
+/** Converts an MRPT IMU observation (IMU_WX.., IMU_X_ACC.., IMU_MAG_X..,
+ * IMU_ORI_QUAT_*); t = timestamp in seconds (mrpt::Clock::toDouble). */
+ImuSample imuSampleFrom(const mrpt::obs::CObservationIMU& obs);
+
+class AttitudeFilter
+{
+ public:
+	explicit AttitudeFilter(const AttitudeParams& p = {});
+
+	/** Feeds one sample (must be later than the previous one: an older or
+	 * equal timestamp is dropped and reported as kFlagOutOfOrder). Until the
+	 * first sample with an accelerometer reading (and magnetometer, if
+	 * used) arrives, the filter is not initialised and nothing is stored.
+	 * \return kFlag* bits for this sample (gated sensors, gap, order). */
+	uint32_t add(const ImuSample& s);
+
+	/** Forces the state (e.g. a known or deliberately wrong start); the
+	 * fast-convergence phase restarts at \a t. */
+	void setState(const Eigen::Quaterniond& q_WI, double t);
+
+	bool initialized() const { return initialized_; }
+	/** Latest estimate of R_WI. */
+	Eigen::Quaterniond q_WI() const { return q_; }
+	/** Estimated gyro bias [rad/s] in {I}. */
+	Eigen::Vector3d gyroBias() const { return bias_; }
+	/** Time of the latest sample [s]. */
+	double lastTime() const { return tLast_; }
+
+	/** R_WI at IMU time \a t [s]: slerp between the stored samples around
+	 * t, or a short gyro extrapolation (<= max_gap_s) past the last one.
+	 * nullopt (and kFlagImuMissing in *flags) when t is outside the
+	 * history; kFlagImuGap when the samples around t are more than
+	 * max_gap_s apart. */
+	std::optional<Eigen::Quaterniond> attitudeAt(
+	    double t, uint32_t* flags = nullptr) const;
+
+	/** Counters since construction. */
+	struct Stats
+	{
+		size_t samples = 0, accelGated = 0, magGated = 0, gaps = 0,
+		       outOfOrder = 0;
+	};
+	const Stats& stats() const { return stats_; }
+	const AttitudeParams& params() const { return p_; }
+
+ private:
+	bool tryInitialize(const ImuSample& s);
+	bool magUsable(const Eigen::Vector3d& m, const Eigen::Vector3d& up_I);
+	void push(double t);
+
+	AttitudeParams p_;
+	bool initialized_ = false;
+	double tInit_ = 0, tLast_ = 0, tAccelOk_ = 0;
+	Eigen::Quaterniond q_ = Eigen::Quaterniond::Identity();
+	Eigen::Vector3d bias_ = Eigen::Vector3d::Zero();
+	Eigen::Vector3d lastGyro_ = Eigen::Vector3d::Zero();
+	bool haveGyro_ = false;
+	Eigen::Vector3d lastRate_ = Eigen::Vector3d::Zero();  // bias-corrected
+	// Magnetic reference (learned or fixed).
+	bool magRefReady_ = false;
+	double magNormRef_ = 0, magDipRef_ = 0;  // sensor units, rad
+	double magNormSum_ = 0, magDipSum_ = 0;
+	int magRefCount_ = 0;
+	struct Stamped
+	{
+		double t;
+		Eigen::Quaterniond q;
+	};
+	std::deque<Stamped> hist_;
+	Stats stats_;
+};
+
+}  // namespace bims::ego

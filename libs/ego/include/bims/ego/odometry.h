@@ -1,0 +1,108 @@
+// Odometry: the egomotion stage, one call per RGB-D frame.
+//
+//   addImu()       feeds the attitude filter (R_WI, docs/attitude.md).
+//   processFrame() gyro-aided KLT between the previous and this frame,
+//                  features with depth -> 3D correspondences, then either
+//                  mode = imu:    R_WC = R_WI(t + time_offset) R_IC and the
+//                                 translation from the rotation-compensated
+//                                 features (optionally refined with SE(3));
+//                  mode = vision: full SE(3) from the 3D features (RANSAC).
+// The moving-region mask of the previous frame (from the segmentation) keeps
+// features off independently moving objects. No threads, no I/O.
+#pragma once
+
+#include <bims/ego/attitude_filter.h>
+#include <bims/ego/gyro_klt.h>
+#include <bims/ego/params.h>
+#include <bims/ego/rgbd_input.h>
+#include <bims/ego/translation_estimator.h>
+
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationIMU.h>
+#include <mrpt/poses/CPose3D.h>
+
+#include <optional>
+#include <vector>
+
+namespace bims::ego
+{
+/** Where a frame's rotation came from. */
+enum class RotationSource
+{
+	None,        ///< first frame without IMU, or failure fallback
+	Imu,         ///< attitude filter (R_WI R_IC)
+	ImuRefined,  ///< IMU prior fused with the features (refine = se3)
+	Vision,      ///< tracked 3D features only
+};
+const char* toString(RotationSource s);
+
+/** The egomotion of one frame. */
+struct FrameEgomotion
+{
+	double t = 0;                   ///< camera timestamp [s]
+	mrpt::poses::CPose3D T_WC;      ///< camera in the world
+	mrpt::poses::CPose3D T_CprevC;  ///< this camera in the previous one
+	RotationSource R_source = RotationSource::None;
+	uint32_t flags = 0;         ///< kFlag* bits (flags.h); 0 = all good
+	int correspondences = 0;    ///< tracks with depth in both frames
+	int inliers = 0;            ///< of the robust fit
+	double residual_rms_m = 0;  ///< RMS 3D residual of the inliers [m]
+	std::vector<Track> tracks;  ///< KLT tracks previous -> this frame
+	/** Per track: 1 inlier, 0 outlier (candidate moving), -1 no depth. */
+	std::vector<int8_t> trackInlier;
+	double ms_input = 0, ms_track = 0, ms_motion = 0;  ///< stage times [ms]
+
+	/** true when the motion was measured (no failure flag). */
+	bool ok() const;
+};
+
+class Odometry
+{
+ public:
+	explicit Odometry(const EgoConfig& cfg);
+
+	/** Feeds an IMU observation (ignored when its label does not match
+	 * [sensors] imu_label). Returns kFlag* bits of the sample. */
+	uint32_t addImu(const mrpt::obs::CObservationIMU& obs);
+	/** Same, for an already converted sample (IMU clock). */
+	uint32_t addImu(const ImuSample& s);
+
+	/** Processes one RGB-D observation. \param movingMaskPrev CV_8UC1 of
+	 * the image size, non-zero = moving in the previous frame, or nullptr.
+	 * A frame whose images cannot be used is flagged kFlagBadImage. */
+	FrameEgomotion processFrame(const mrpt::obs::CObservation3DRangeScan& obs,
+	                            const cv::Mat* movingMaskPrev = nullptr);
+	/** Same, for an already converted frame. */
+	FrameEgomotion processFrame(const RgbdFrame& f,
+	                            const cv::Mat* movingMaskPrev = nullptr);
+
+	/** R_WC at camera time t from the IMU (nullopt without IMU data or
+	 * R_IC); *flags gets kFlagImuMissing / kFlagImuGap. */
+	std::optional<Eigen::Matrix3d> imuRotation(double tCam,
+	                                           uint32_t* flags = nullptr) const;
+
+	const AttitudeFilter& attitude() const { return att_; }
+	const EgoConfig& config() const { return cfg_; }
+	size_t framesProcessed() const { return nFrames_; }
+
+ private:
+	EgoConfig cfg_;
+	AttitudeFilter att_;
+	GyroAidedKLT klt_;
+	TranslationEstimator est_;
+	bool havePrev_ = false;
+	double tPrev_ = 0;
+	cv::Mat depthPrev_;
+	std::optional<Eigen::Matrix3d> R_WC_imuPrev_;
+	mrpt::poses::CPose3D T_WC_;  // latest pose
+	Eigen::Matrix3d R_WC_ = Eigen::Matrix3d::Identity();
+	Eigen::Vector3d t_WC_ = Eigen::Vector3d::Zero();
+	Eigen::Matrix3d lastR_rel_ = Eigen::Matrix3d::Identity();
+	Eigen::Vector3d lastT_rel_ = Eigen::Vector3d::Zero();
+	size_t nFrames_ = 0;
+};
+
+/** Eigen rotation + translation -> CPose3D. */
+mrpt::poses::CPose3D toPose(const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
+
+}  // namespace bims::ego

@@ -1,0 +1,176 @@
+// Parameters of the egomotion stage, one plain struct per .ini section of the
+// experiment file ([attitude], [tracker], [translation], [odometry],
+// [calibration], [camera], [sensors]; see bims/common/experiment.h).
+//
+// Each struct has defaults and loadFromConfigFile(cfg, section), which reads
+// through bims::ConfigSection: out-of-range values and unknown keys are
+// ConfigError naming the file, the section and the key. Derivations of the
+// filter and the gating rules: docs/attitude.md; the rest: docs/ego.md.
+#pragma once
+
+#include <mrpt/config/CConfigFileBase.h>
+
+#include <Eigen/Core>
+
+#include <optional>
+#include <string>
+
+namespace bims::ego
+{
+/** [attitude]: the accelerometer + magnetometer + gyro attitude filter. */
+struct AttitudeParams
+{
+	double kp = 1.0;   ///< proportional correction gain [1/s]
+	double ki = 0.25;  ///< gyro-bias integral gain [1/s^2] (critically damped
+	                   ///< with kp = 1)
+	double kp_init = 10.0;         ///< gain during the first init_time_s [1/s]
+	double init_time_s = 1.0;      ///< fast-convergence phase length [s]
+	bool use_magnetometer = true;  ///< false: heading from the gyro only
+	/** true: take R_WI from the sensor's own orientation quaternion
+	 * (IMU_ORI_QUAT_*, {W} = NWU) when present instead of filtering. */
+	bool use_sensor_orientation = false;
+	double gravity = 9.80665;  ///< local gravity magnitude [m/s^2]
+	/** Accelerometer used only if | |f| - gravity | below this [m/s^2]. */
+	double accel_gate = 0.8;
+	/** ... and if the measured and predicted gravity directions differ by
+	 * less than this [deg] (after the first init_time_s) ... */
+	double accel_angle_gate_deg = 3.0;
+	/** ... unless they have disagreed for longer than this [s]. */
+	double accel_gate_max_s = 3.0;
+	/** Magnetometer used only if | |m| / m_ref - 1 | below this [-]. */
+	double mag_norm_gate = 0.08;
+	/** ... and if |dip - dip_ref| below this [deg]. */
+	double mag_dip_gate_deg = 4.0;
+	/** Reference field: "auto" learns norm and dip from the first
+	 * mag_reference_samples undisturbed-looking samples; "fixed" uses
+	 * mag_norm / mag_dip_deg. */
+	std::string mag_reference = "auto";
+	int mag_reference_samples = 50;
+	double mag_norm = 1.0;      ///< reference |m| (sensor units), when fixed
+	double mag_dip_deg = 60.0;  ///< reference dip below horizontal [deg]
+	/** A gap between IMU samples longer than this is flagged [s]. */
+	double max_gap_s = 0.1;
+	double history_s = 10.0;  ///< attitude history kept for queries [s]
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+	                        const std::string& section = "attitude");
+};
+
+/** [tracker]: the gyro-aided pyramidal KLT tracker. */
+struct TrackerParams
+{
+	int max_features = 300;         ///< features kept per frame
+	int grid_cols = 8;              ///< replenishment grid (columns)
+	int grid_rows = 6;              ///< replenishment grid (rows)
+	double min_distance_px = 12;    ///< min spacing of new features [px]
+	std::string detector = "fast";  ///< "fast" or "gftt"
+	int fast_threshold = 15;        ///< FAST intensity threshold [grey levels]
+	double gftt_quality = 0.01;     ///< goodFeaturesToTrack quality level
+	int window = 21;                ///< LK window side [px] (odd)
+	int pyramid_levels = 3;         ///< LK max pyramid level (0 = no pyramid)
+	int max_iterations = 30;        ///< LK iterations per level
+	double epsilon = 0.01;          ///< LK convergence [px]
+	double fb_threshold_px = 1.0;   ///< forward-backward error limit [px]
+	double border_px = 8;    ///< tracks closer to the border are dropped [px]
+	int mask_dilate_px = 8;  ///< growth of the moving-region mask [px]
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+	                        const std::string& section = "tracker");
+};
+
+/** [translation]: robust translation (and optional SE(3) refinement). */
+struct TranslationParams
+{
+	std::string method = "ransac";  ///< "ransac" or "lmeds"
+	int iterations = 60;  ///< hypotheses for the 1-point translation model
+	int vision_iterations = 200;  ///< hypotheses for the 3-point SE(3) model
+	/** Inlier threshold on the 3D residual: a + b z^2 [m], z = depth [m]. */
+	double inlier_threshold_m = 0.02;
+	double inlier_threshold_z2 = 0.01;  ///< b above [1/m]
+	int min_inliers = 8;       ///< fewer inliers: frame flagged as failed
+	double min_depth_m = 0.3;  ///< depth readings outside [min,max] unused
+	double max_depth_m = 8.0;
+	/** "none": IMU rotation kept as is; "se3": Gauss-Newton refinement of
+	 * R and t over the inliers with the IMU rotation as a prior. */
+	std::string refine = "none";
+	double rotation_prior_sigma_deg = 0.3;  ///< IMU rotation std. dev. [deg]
+	double point_sigma_m = 0.01;  ///< 3D residual std. dev. at 1 m [m]
+	uint32_t seed = 1;  ///< RANSAC random seed (results are repeatable)
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+	                        const std::string& section = "translation");
+};
+
+/** [odometry]: where the rotation comes from and whether the gyro aids. */
+struct OdometryParams
+{
+	/** "imu": rotation from the attitude filter, translation from vision
+	 * (the paper); "vision": full SE(3) from the tracked 3D features. */
+	std::string mode = "imu";
+	/** Seed KLT with the gyro-predicted feature positions (when IMU data
+	 * exist; otherwise with the previous frame's rotation rate). */
+	bool gyro_aid = true;
+	int min_tracks = 12;  ///< fewer 3D matches: frame flagged
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+	                        const std::string& section = "odometry");
+};
+
+/** [calibration]: IMU-camera extrinsics. Convention (bims/common/frames.h):
+ * R_IC is the camera frame {C} (optical) expressed in the IMU frame {I}:
+ * p_I = R_IC p_C, so R_WC = R_WI R_IC. Time: the IMU sample stamped
+ * t_cam + time_offset_s was taken at the instant of the camera frame stamped
+ * t_cam. */
+struct CalibrationParams
+{
+	Eigen::Matrix3d R_IC = Eigen::Matrix3d::Identity();
+	bool has_R_IC = false;     ///< R_IC was given in the file
+	double time_offset_s = 0;  ///< t_imu = t_cam + time_offset_s [s]
+
+	/** Keys: R_IC = 9 reals, row major (checked orthonormal to 1e-3, then
+	 * re-orthonormalised); time_offset_s. \param requireR throws
+	 * ConfigError naming file/section/key when R_IC is missing. */
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+	                        const std::string& section = "calibration",
+	                        bool requireR = false);
+};
+
+/** [camera]: intrinsics; when the section has none, those of each
+ * observation (cameraParamsIntensity) are used. */
+struct CameraParams
+{
+	bool given = false;                     ///< fx..height present in the file
+	double fx = 0, fy = 0, cx = 0, cy = 0;  ///< [px]
+	int width = 0, height = 0;              ///< [px]
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+	                        const std::string& section = "camera");
+};
+
+/** [sensors]: sensor labels in the rawlog (empty = accept any). */
+struct SensorsParams
+{
+	std::string rgbd_label;
+	std::string imu_label;
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+	                        const std::string& section = "sensors");
+};
+
+/** Everything the egomotion stage reads from one experiment file. */
+struct EgoConfig
+{
+	AttitudeParams attitude;
+	TrackerParams tracker;
+	TranslationParams translation;
+	OdometryParams odometry;
+	CalibrationParams calibration;
+	CameraParams camera;
+	SensorsParams sensors;
+
+	/** Reads all sections above (each optional, defaults otherwise);
+	 * R_IC is required when odometry.mode = imu. */
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
+};
+
+}  // namespace bims::ego

@@ -1,0 +1,44 @@
+// Conversion of an RGB-D observation into what the egomotion stage uses: a
+// grey image, a metric depth image registered to it, and the intrinsics.
+#pragma once
+
+#include <bims/ego/params.h>
+
+#include <mrpt/obs/CObservation3DRangeScan.h>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include <string>
+
+namespace bims::ego
+{
+/** One RGB-D frame ready for tracking. Registered RGB-D is assumed: depth
+ * pixel (u, v) belongs to intensity pixel (u, v) (as in the simulator and in
+ * TUM/Bonn imports). */
+struct RgbdFrame
+{
+	double t = 0;   ///< camera timestamp [s]
+	cv::Mat grey;   ///< CV_8UC1
+	cv::Mat depth;  ///< CV_32FC1 optical-axis depth [m], 0 = no reading
+	Eigen::Matrix3d K = Eigen::Matrix3d::Identity();  ///< intrinsics [px]
+};
+
+/** Fills \a out from \a obs (intensity -> grey, rangeImage * rangeUnits ->
+ * depth, Euclidean ranges converted to depth when range_is_depth = false;
+ * K from \a cam when given, else from obs.cameraParams).
+ * \return empty string on success, else what is wrong (no image, sizes
+ * differ, camera size disagrees with [camera]). */
+std::string rgbdFrameFrom(const mrpt::obs::CObservation3DRangeScan& obs,
+                          const CameraParams& cam, RgbdFrame& out);
+
+/** Depth at a sub-pixel position [m]: bilinear over the 4 neighbours if all
+ * are valid and within 5 % of each other (no interpolation across depth
+ * edges), else 0. */
+float depthAt(const cv::Mat& depth, const cv::Point2f& x);
+
+/** Back-projection of pixel \a x at depth \a z [m] into the optical frame. */
+Eigen::Vector3d backProject(const Eigen::Matrix3d& K, const cv::Point2f& x,
+                            double z);
+
+}  // namespace bims::ego

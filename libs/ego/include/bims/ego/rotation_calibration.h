@@ -1,0 +1,42 @@
+// Estimation of the IMU-camera rotation R_IC ({C} in {I}, p_I = R_IC p_C)
+// from a sequence: the rotation the gyro measures between two frames,
+// R_IprevIcur, and the one vision measures, R_CprevCcur, are conjugate,
+// R_IprevIcur = R_IC R_CprevCcur R_IC^T, so their rotation vectors satisfy
+// Log(R_IprevIcur) = R_IC Log(R_CprevCcur) (the hand-eye rotation problem).
+// R_IC is the orthogonal Procrustes (Wahba) solution over all pairs, made
+// robust by 2-pair RANSAC (pairs with tracking failures are outliers).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace bims::ego
+{
+/** Relative rotations of one frame interval. */
+struct RotationPair
+{
+	Eigen::Matrix3d R_IprevIcur;  ///< integrated gyro
+	Eigen::Matrix3d R_CprevCcur;  ///< visual odometry
+};
+
+struct RotationCalibResult
+{
+	bool ok = false;  ///< enough informative inlier pairs, non-degenerate
+	Eigen::Matrix3d R_IC = Eigen::Matrix3d::Identity();
+	int informative = 0;  ///< pairs rotating more than minAngle
+	int inliers = 0;
+	double rms_deg = 0;  ///< RMS of |Log_I - R_IC Log_C| over inliers [deg]
+	/** Ratio of the 2nd to 1st singular value of the data: near 0 means the
+	 * motion rotated about one axis only and R_IC is not observable. */
+	double conditioning = 0;
+};
+
+/** \param minAngle_deg pairs rotating less (either sensor) are skipped.
+ * \param inlierThr_deg residual limit for a pair to count as inlier. */
+RotationCalibResult estimateRotationIC(const std::vector<RotationPair>& pairs,
+                                       double minAngle_deg = 0.5,
+                                       double inlierThr_deg = 0.5,
+                                       unsigned seed = 1);
+
+}  // namespace bims::ego

@@ -1,0 +1,296 @@
+#include <bims/ego/attitude_filter.h>
+#include <bims/ego/flags.h>
+#include <bims/ego/so3.h>
+
+#include <mrpt/core/Clock.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace bims::ego
+{
+using mrpt::obs::CObservationIMU;
+using namespace mrpt::obs;  // TIMUDataIndex values
+
+ImuSample imuSampleFrom(const CObservationIMU& o)
+{
+	ImuSample s;
+	s.t = mrpt::Clock::toDouble(o.timestamp);
+	if (o.has(IMU_WX) && o.has(IMU_WY) && o.has(IMU_WZ))
+	{
+		s.hasGyro = true;
+		s.gyro = {o.get(IMU_WX), o.get(IMU_WY), o.get(IMU_WZ)};
+	}
+	if (o.has(IMU_X_ACC) && o.has(IMU_Y_ACC) && o.has(IMU_Z_ACC))
+	{
+		s.hasAcc = true;
+		s.acc = {o.get(IMU_X_ACC), o.get(IMU_Y_ACC), o.get(IMU_Z_ACC)};
+	}
+	if (o.has(IMU_MAG_X) && o.has(IMU_MAG_Y) && o.has(IMU_MAG_Z))
+	{
+		s.hasMag = true;
+		s.mag = {o.get(IMU_MAG_X), o.get(IMU_MAG_Y), o.get(IMU_MAG_Z)};
+	}
+	if (o.has(IMU_ORI_QUAT_W) && o.has(IMU_ORI_QUAT_X) &&
+	    o.has(IMU_ORI_QUAT_Y) && o.has(IMU_ORI_QUAT_Z))
+	{
+		Eigen::Quaterniond q(o.get(IMU_ORI_QUAT_W), o.get(IMU_ORI_QUAT_X),
+		                     o.get(IMU_ORI_QUAT_Y), o.get(IMU_ORI_QUAT_Z));
+		if (std::abs(q.norm() - 1) < 1e-2) s.q_WI = q.normalized();
+	}
+	const auto finite = [](const Eigen::Vector3d& v) { return v.allFinite(); };
+	if (!finite(s.gyro)) s.hasGyro = false;
+	if (!finite(s.acc)) s.hasAcc = false;
+	if (!finite(s.mag)) s.hasMag = false;
+	return s;
+}
+
+AttitudeFilter::AttitudeFilter(const AttitudeParams& p) : p_(p)
+{
+	if (p_.mag_reference == "fixed")
+	{
+		magRefReady_ = true;
+		magNormRef_ = p_.mag_norm;
+		magDipRef_ = p_.mag_dip_deg * M_PI / 180;
+	}
+}
+
+void AttitudeFilter::setState(const Eigen::Quaterniond& q_WI, double t)
+{
+	q_ = q_WI.normalized();
+	initialized_ = true;
+	tInit_ = tLast_ = tAccelOk_ = t;
+	hist_.clear();
+	push(t);
+}
+
+void AttitudeFilter::push(double t)
+{
+	hist_.push_back({t, q_});
+	while (hist_.size() > 2 && hist_.back().t - hist_.front().t > p_.history_s)
+		hist_.pop_front();
+}
+
+bool AttitudeFilter::tryInitialize(const ImuSample& s)
+{
+	if (p_.use_sensor_orientation && s.q_WI)
+	{
+		setState(*s.q_WI, s.t);
+		return true;
+	}
+	if (!s.hasAcc || s.acc.norm() < 0.5 * p_.gravity) return false;
+	const bool useMag = p_.use_magnetometer;
+	if (useMag && !s.hasMag) return false;
+	// TRIAD: world axes expressed in {I} are the rows of R_WI.
+	const Eigen::Vector3d z = s.acc.normalized();  // up (specific force)
+	Eigen::Vector3d x;
+	if (useMag)
+	{
+		x = s.mag - s.mag.dot(z) * z;  // horizontal field = north
+		if (x.norm() < 1e-6 * s.mag.norm() || s.mag.norm() == 0) return false;
+	}
+	else
+	{
+		// No heading reference: keep the IMU's x as close to north as possible.
+		x = Eigen::Vector3d::UnitX() - z.x() * z;
+		if (x.norm() < 1e-3) x = Eigen::Vector3d::UnitY() - z.y() * z;
+	}
+	x.normalize();
+	const Eigen::Vector3d y = z.cross(x);
+	Eigen::Matrix3d R_WI;
+	R_WI.row(0) = x;
+	R_WI.row(1) = y;
+	R_WI.row(2) = z;
+	setState(Eigen::Quaterniond(orthonormalize(R_WI)), s.t);
+	haveGyro_ = s.hasGyro;
+	lastGyro_ = s.gyro;
+	return true;
+}
+
+bool AttitudeFilter::magUsable(const Eigen::Vector3d& m,
+                               const Eigen::Vector3d& up_I)
+{
+	const double n = m.norm();
+	if (n <= 0) return false;
+	const double dip = std::asin(std::clamp(-m.dot(up_I) / n, -1.0, 1.0));
+	if (!magRefReady_)
+	{
+		// Learn the reference from the first samples (assumed undisturbed).
+		magNormSum_ += n;
+		magDipSum_ += dip;
+		if (++magRefCount_ >= p_.mag_reference_samples)
+		{
+			magNormRef_ = magNormSum_ / magRefCount_;
+			magDipRef_ = magDipSum_ / magRefCount_;
+			magRefReady_ = true;
+		}
+		return true;
+	}
+	return std::abs(n / magNormRef_ - 1) <= p_.mag_norm_gate &&
+	       std::abs(dip - magDipRef_) <= p_.mag_dip_gate_deg * M_PI / 180;
+}
+
+uint32_t AttitudeFilter::add(const ImuSample& s)
+{
+	uint32_t flags = 0;
+	if (!std::isfinite(s.t)) return kFlagOutOfOrder;
+	if (initialized_ && s.t <= tLast_)
+	{
+		++stats_.outOfOrder;
+		return kFlagOutOfOrder;
+	}
+	++stats_.samples;
+	if (!initialized_)
+	{
+		tryInitialize(s);
+		return flags;
+	}
+	if (p_.use_sensor_orientation && s.q_WI)
+	{
+		q_ = *s.q_WI;
+		tLast_ = s.t;
+		push(s.t);
+		return flags;
+	}
+
+	double dt = s.t - tLast_;
+	if (dt > p_.max_gap_s)
+	{
+		flags |= kFlagImuGap;
+		++stats_.gaps;
+		dt = p_.max_gap_s;  // do not integrate a rate across a long gap
+	}
+	const Eigen::Matrix3d R_WI = q_.toRotationMatrix();
+	const Eigen::Vector3d up_I = R_WI.transpose().col(2);  // e_z in {I}
+
+	// Innovation: measured x predicted directions (Mahony's omega_mes).
+	Eigen::Vector3d e = Eigen::Vector3d::Zero();
+	bool corrected = false;
+	const bool fast = (s.t - tInit_) < p_.init_time_s;
+	if (s.hasAcc)
+	{
+		const double fn = s.acc.norm();
+		const Eigen::Vector3d ea =
+		    fn > 0 ? Eigen::Vector3d((s.acc / fn).cross(up_I))
+		           : Eigen::Vector3d::Zero();
+		// Norm gate, then innovation-angle gate (not while converging, and
+		// released when the disagreement persists: then the estimate, not
+		// the accelerometer, is wrong).
+		bool use = fn > 0 && std::abs(fn - p_.gravity) <= p_.accel_gate;
+		const double ang = std::asin(std::min(1.0, ea.norm()));
+		if (use && !fast && ang > p_.accel_angle_gate_deg * M_PI / 180 &&
+		    s.t - tAccelOk_ < p_.accel_gate_max_s)
+			use = false;
+		if (use)
+		{
+			e += ea;
+			corrected = true;
+			if (ang <= p_.accel_angle_gate_deg * M_PI / 180) tAccelOk_ = s.t;
+		}
+		else
+		{
+			flags |= kFlagAccelGated;
+			++stats_.accelGated;
+		}
+	}
+	if (p_.use_magnetometer && s.hasMag)
+	{
+		const Eigen::Vector3d h_W = R_WI * s.mag;
+		// Dip against the measured vertical when the accelerometer is
+		// plausible (independent of the estimate), else the estimated one.
+		const bool accOk =
+		    s.hasAcc && std::abs(s.acc.norm() - p_.gravity) <= p_.accel_gate;
+		const Eigen::Vector3d vert =
+		    accOk ? Eigen::Vector3d(s.acc.normalized()) : up_I;
+		if (magUsable(s.mag, vert) && std::hypot(h_W.x(), h_W.y()) > 0)
+		{
+			// Heading error: angle of the horizontal field from north (+x of
+			// {W}), corrected about the vertical only, so a tilted or
+			// disturbed field never tilts the estimate.
+			e += -std::atan2(h_W.y(), h_W.x()) * up_I;
+			corrected = true;
+		}
+		else
+		{
+			flags |= kFlagMagGated;
+			++stats_.magGated;
+		}
+	}
+
+	const double kp = fast ? std::max(p_.kp_init, p_.kp) : p_.kp;
+	// Bias integration only near convergence (no wind-up on large errors).
+	if (corrected && !fast && e.norm() < 0.05) bias_ -= p_.ki * e * dt;
+
+	// Trapezoidal gyro rate over the interval (zero-order hold if only one).
+	Eigen::Vector3d w = Eigen::Vector3d::Zero();
+	if (s.hasGyro)
+		w = (haveGyro_ && !(flags & kFlagImuGap)) ? 0.5 * (s.gyro + lastGyro_)
+		                                          : s.gyro;
+	else if (haveGyro_)
+		w = lastGyro_;
+	lastRate_ = w - bias_;
+	const Eigen::Vector3d omega = lastRate_ + kp * e;
+	q_ = Eigen::Quaterniond(R_WI * expSO3(omega * dt));
+	q_.normalize();
+	if (s.hasGyro)
+	{
+		lastGyro_ = s.gyro;
+		haveGyro_ = true;
+	}
+	tLast_ = s.t;
+	push(s.t);
+	return flags;
+}
+
+std::optional<Eigen::Quaterniond> AttitudeFilter::attitudeAt(
+    double t, uint32_t* flags) const
+{
+	uint32_t f = 0;
+	std::optional<Eigen::Quaterniond> out;
+	const double eps = 1e-9;
+	if (!initialized_ || hist_.empty() || t < hist_.front().t - eps)
+		f |= kFlagImuMissing;
+	else if (t >= hist_.back().t)
+	{
+		const double dt = t - hist_.back().t;
+		if (dt > p_.max_gap_s)
+			f |= kFlagImuMissing;
+		else
+			out = Eigen::Quaterniond(hist_.back().q.toRotationMatrix() *
+			                         expSO3(lastRate_ * dt));
+	}
+	else
+	{
+		auto it = std::upper_bound(hist_.begin(), hist_.end(), t,
+		                           [](double v, const Stamped& s)
+		                           { return v < s.t; });
+		const Stamped& b = *it;
+		const Stamped& a = *(it - 1);
+		if (b.t - a.t > p_.max_gap_s) f |= kFlagImuGap;
+		const double u = (t - a.t) / (b.t - a.t);
+		out = a.q.slerp(u, b.q);
+	}
+	if (flags) *flags |= f;
+	return out;
+}
+
+std::string flagsToString(uint32_t flags)
+{
+	static const std::pair<uint32_t, const char*> names[] = {
+	    {kFlagFirstFrame, "first_frame"},
+	    {kFlagImuMissing, "imu_missing"},
+	    {kFlagImuGap, "imu_gap"},
+	    {kFlagTooFewTracks, "too_few_tracks"},
+	    {kFlagTooFewInliers, "too_few_inliers"},
+	    {kFlagOutOfOrder, "out_of_order"},
+	    {kFlagConstVelPrediction, "const_vel_prediction"},
+	    {kFlagAccelGated, "accel_gated"},
+	    {kFlagMagGated, "mag_gated"},
+	    {kFlagBadImage, "bad_image"}};
+	std::string s;
+	for (const auto& [bit, name] : names)
+		if (flags & bit) s += (s.empty() ? "" : "|") + std::string(name);
+	return s.empty() ? "ok" : s;
+}
+
+}  // namespace bims::ego

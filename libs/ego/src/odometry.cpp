@@ -1,0 +1,239 @@
+#include <bims/ego/flags.h>
+#include <bims/ego/odometry.h>
+#include <bims/ego/so3.h>
+
+#include <mrpt/math/CMatrixFixed.h>
+
+#include <chrono>
+
+namespace bims::ego
+{
+namespace
+{
+double msSince(std::chrono::steady_clock::time_point t0)
+{
+	return std::chrono::duration<double, std::milli>(
+	           std::chrono::steady_clock::now() - t0)
+	    .count();
+}
+}  // namespace
+
+const char* toString(RotationSource s)
+{
+	switch (s)
+	{
+		case RotationSource::Imu:
+			return "imu";
+		case RotationSource::ImuRefined:
+			return "imu_refined";
+		case RotationSource::Vision:
+			return "vision";
+		default:
+			return "none";
+	}
+}
+
+bool FrameEgomotion::ok() const
+{
+	return !(flags & (kFlagTooFewTracks | kFlagTooFewInliers | kFlagOutOfOrder |
+	                  kFlagBadImage));
+}
+
+mrpt::poses::CPose3D toPose(const Eigen::Matrix3d& R, const Eigen::Vector3d& t)
+{
+	mrpt::math::CMatrixDouble33 Rm;
+	mrpt::math::CVectorFixedDouble<3> tv;
+	for (int i = 0; i < 3; i++)
+	{
+		tv[i] = t[i];
+		for (int j = 0; j < 3; j++) Rm(i, j) = R(i, j);
+	}
+	return mrpt::poses::CPose3D::FromRotationAndTranslation(Rm, tv);
+}
+
+Odometry::Odometry(const EgoConfig& cfg)
+    : cfg_(cfg), att_(cfg.attitude), klt_(cfg.tracker), est_(cfg.translation)
+{
+}
+
+uint32_t Odometry::addImu(const mrpt::obs::CObservationIMU& obs)
+{
+	if (!cfg_.sensors.imu_label.empty() &&
+	    obs.sensorLabel != cfg_.sensors.imu_label)
+		return 0;
+	return addImu(imuSampleFrom(obs));
+}
+
+uint32_t Odometry::addImu(const ImuSample& s)
+{
+	return att_.add(s);
+}
+
+std::optional<Eigen::Matrix3d> Odometry::imuRotation(double tCam,
+                                                     uint32_t* flags) const
+{
+	if (!cfg_.calibration.has_R_IC)
+	{
+		if (flags) *flags |= kFlagImuMissing;
+		return std::nullopt;
+	}
+	const auto q =
+	    att_.attitudeAt(tCam + cfg_.calibration.time_offset_s, flags);
+	if (!q) return std::nullopt;
+	return Eigen::Matrix3d(q->toRotationMatrix() * cfg_.calibration.R_IC);
+}
+
+FrameEgomotion Odometry::processFrame(
+    const mrpt::obs::CObservation3DRangeScan& obs, const cv::Mat* mask)
+{
+	const auto t0 = std::chrono::steady_clock::now();
+	RgbdFrame f;
+	const std::string err = rgbdFrameFrom(obs, cfg_.camera, f);
+	if (!err.empty())
+	{
+		FrameEgomotion r;
+		r.t = f.t;
+		r.T_WC = T_WC_;
+		r.flags = kFlagBadImage;
+		return r;
+	}
+	const double msIn = msSince(t0);
+	FrameEgomotion r = processFrame(f, mask);
+	r.ms_input = msIn;
+	return r;
+}
+
+FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
+{
+	FrameEgomotion r;
+	r.t = f.t;
+	if (havePrev_ && !(f.t > tPrev_))
+	{
+		r.T_WC = T_WC_;
+		r.flags = kFlagOutOfOrder;
+		return r;
+	}
+	++nFrames_;
+	const bool imuMode = cfg_.odometry.mode == "imu";
+	uint32_t imuFlags = 0;
+	const auto R_WC_imu = imuRotation(f.t, &imuFlags);
+
+	// First frame: the reference (IMU attitude when there is one).
+	if (!havePrev_)
+	{
+		if (R_WC_imu)
+		{
+			R_WC_ = *R_WC_imu;
+			r.R_source = RotationSource::Imu;
+		}
+		T_WC_ = toPose(R_WC_, t_WC_);
+		const auto t1 = std::chrono::steady_clock::now();
+		klt_.track(f.grey, f.K, nullptr, mask);
+		r.ms_track = msSince(t1);
+		r.T_WC = T_WC_;
+		r.flags = kFlagFirstFrame | (imuMode ? imuFlags : 0);
+		havePrev_ = true;
+		tPrev_ = f.t;
+		depthPrev_ = f.depth.clone();
+		R_WC_imuPrev_ = R_WC_imu;
+		return r;
+	}
+
+	// Rotation prediction for the tracker.
+	std::optional<Eigen::Matrix3d> R_pred;
+	if (cfg_.odometry.gyro_aid)
+	{
+		if (R_WC_imu && R_WC_imuPrev_)
+			R_pred = R_WC_imuPrev_->transpose() * *R_WC_imu;
+		else
+		{
+			R_pred = lastR_rel_;  // constant angular velocity
+			r.flags |= kFlagConstVelPrediction;
+		}
+	}
+	const auto t1 = std::chrono::steady_clock::now();
+	r.tracks = klt_.track(f.grey, f.K, R_pred ? &*R_pred : nullptr, mask);
+	r.ms_track = msSince(t1);
+
+	const auto t2 = std::chrono::steady_clock::now();
+	std::vector<Correspondence> corr;
+	std::vector<int> corrTrack;
+	r.trackInlier.assign(r.tracks.size(), -1);
+	const double zmin = cfg_.translation.min_depth_m,
+	             zmax = cfg_.translation.max_depth_m;
+	for (size_t i = 0; i < r.tracks.size(); i++)
+	{
+		const float z0 = depthAt(depthPrev_, r.tracks[i].prev);
+		const float z1 = depthAt(f.depth, r.tracks[i].cur);
+		if (z0 < zmin || z0 > zmax || z1 < zmin || z1 > zmax) continue;
+		corr.push_back({backProject(f.K, r.tracks[i].prev, z0),
+		                backProject(f.K, r.tracks[i].cur, z1)});
+		corrTrack.push_back(static_cast<int>(i));
+	}
+	r.correspondences = static_cast<int>(corr.size());
+
+	const bool useImu = imuMode && R_WC_imu.has_value();
+	if (imuMode) r.flags |= imuFlags;
+	MotionEstimate m;
+	if (useImu)
+	{
+		// Relative prior anchored on the absolute IMU attitude, so that the
+		// estimated R_WC never drifts from the filter's.
+		const Eigen::Matrix3d R_rel = R_WC_.transpose() * *R_WC_imu;
+		m = est_.estimateTranslation(corr, R_rel);
+		r.R_source = RotationSource::Imu;
+		if (m.ok && cfg_.translation.refine == "se3")
+		{
+			m = est_.refineSE3(
+			    corr, m, R_rel,
+			    cfg_.translation.rotation_prior_sigma_deg * M_PI / 180);
+			r.R_source = RotationSource::ImuRefined;
+		}
+	}
+	else
+	{
+		m = est_.estimateSE3(corr);
+		r.R_source = RotationSource::Vision;
+	}
+	if (r.correspondences < cfg_.odometry.min_tracks)
+		r.flags |= kFlagTooFewTracks;
+	else if (!m.ok)
+		r.flags |= kFlagTooFewInliers;
+
+	Eigen::Matrix3d R_rel;
+	Eigen::Vector3d t_rel;
+	if (!(r.flags & (kFlagTooFewTracks | kFlagTooFewInliers)))
+	{
+		R_rel = m.R_CprevCcur;
+		t_rel = m.t_CprevCcur;
+		r.inliers = m.inliers;
+		r.residual_rms_m = m.residual_rms_m;
+		for (size_t k = 0; k < corrTrack.size(); k++)
+			r.trackInlier[corrTrack[k]] = m.inlier.empty() ? 0 : m.inlier[k];
+	}
+	else
+	{
+		// Failure: keep going with the best guess (IMU rotation if any,
+		// else constant velocity); the flags say the motion is not measured.
+		R_rel = useImu ? Eigen::Matrix3d(R_WC_.transpose() * *R_WC_imu)
+		               : lastR_rel_;
+		t_rel = lastT_rel_;
+		r.R_source = useImu ? RotationSource::Imu : RotationSource::None;
+	}
+	R_rel = orthonormalize(R_rel);
+	t_WC_ += R_WC_ * t_rel;
+	R_WC_ = orthonormalize(R_WC_ * R_rel);
+	lastR_rel_ = R_rel;
+	lastT_rel_ = t_rel;
+	T_WC_ = toPose(R_WC_, t_WC_);
+	r.T_WC = T_WC_;
+	r.T_CprevC = toPose(R_rel, t_rel);
+	r.ms_motion = msSince(t2);
+
+	tPrev_ = f.t;
+	depthPrev_ = f.depth.clone();
+	R_WC_imuPrev_ = R_WC_imu;
+	return r;
+}
+
+}  // namespace bims::ego

@@ -1,0 +1,43 @@
+// R_IC estimation from gyro vs visual relative rotations.
+#include <bims/ego/rotation_calibration.h>
+#include <bims/ego/so3.h>
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace bims::ego;
+
+TEST(RotationCalibration, RecoversR_ICWithNoiseAndOutliers)
+{
+	const Eigen::Matrix3d R_IC = expSO3(Eigen::Vector3d(0.4, -2.0, 0.7));
+	std::mt19937 rng(11);
+	std::normal_distribution<double> N(0, 1);
+	std::vector<RotationPair> pairs;
+	for (int i = 0; i < 200; i++)
+	{
+		const Eigen::Vector3d w(0.05 * N(rng), 0.05 * N(rng), 0.05 * N(rng));
+		const Eigen::Matrix3d Rc = expSO3(w);
+		Eigen::Matrix3d Ri = R_IC * Rc * R_IC.transpose();
+		Ri = Ri * expSO3(0.001 * Eigen::Vector3d(N(rng), N(rng), N(rng)));
+		pairs.push_back(
+		    {Ri, i % 5 == 0 ? Eigen::Matrix3d(expSO3(-3 * w)) : Rc});
+	}
+	const RotationCalibResult r = estimateRotationIC(pairs);
+	ASSERT_TRUE(r.ok);
+	EXPECT_LT(angleSO3(r.R_IC.transpose() * R_IC) * 180 / M_PI, 0.2);
+	EXPECT_LE(r.inliers, 160);
+	EXPECT_GT(r.inliers, 120);
+}
+
+TEST(RotationCalibration, ReportsUnobservableSingleAxisMotion)
+{
+	std::vector<RotationPair> pairs;
+	for (int i = 0; i < 50; i++)
+	{
+		const Eigen::Matrix3d R =
+		    expSO3(Eigen::Vector3d(0, 0.05 * (i % 7 - 3), 0));
+		pairs.push_back({R, R});
+	}
+	EXPECT_FALSE(estimateRotationIC(pairs).ok);
+	EXPECT_FALSE(estimateRotationIC({}).ok);
+}

@@ -1,0 +1,178 @@
+// Odometry end to end on rendered frames of a textured room with exact IMU
+// data: both modes, with and without the gyro aid, and bad input.
+#include <bims/common/config.h>
+#include <bims/ego/flags.h>
+#include <bims/ego/odometry.h>
+#include <gtest/gtest.h>
+
+#include <mrpt/config/CConfigFileMemory.h>
+
+#include "synth_scene.h"
+
+using namespace bims::ego;
+
+namespace
+{
+Eigen::Matrix3d K320()
+{
+	Eigen::Matrix3d K;
+	K << 262.5, 0, 159.5, 0, 262.5, 119.5, 0, 0, 1;
+	return K;
+}
+const Eigen::Matrix3d kR_IC = expSO3(Eigen::Vector3d(0.3, -1.2, 0.4));
+
+Eigen::Matrix3d R_of(const mrpt::poses::CPose3D& T)
+{
+	Eigen::Matrix3d R;
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < 3; j++) R(i, j) = T.getRotationMatrix()(i, j);
+	return R;
+}
+
+struct RunResult
+{
+	double maxTransErr = 0, maxRotErr_deg = 0;
+	int failed = 0;
+};
+
+// 1.5 s at 20 Hz with IMU at 200 Hz; errors of T_C0C (relative to the first
+// frame, so independent of the world anchoring).
+RunResult run(EgoConfig cfg, bool withImu, int frames = 30)
+{
+	cfg.calibration.R_IC = kR_IC;
+	cfg.calibration.has_R_IC = true;
+	Odometry odo(cfg);
+	test::Motion m;
+	const double dtImu = 0.005, dtCam = 0.05;
+	double tImu = 0;
+	RunResult res;
+	mrpt::poses::CPose3D T0;
+	for (int k = 0; k < frames; k++)
+	{
+		const double t = k * dtCam;
+		if (withImu)
+			for (; tImu <= t + 0.03; tImu += dtImu)
+				odo.addImu(test::imuAt(m, kR_IC, tImu));
+		const RgbdFrame f = test::render(m.R(t), m.p(t), K320(), 320, 240, t);
+		const FrameEgomotion e = odo.processFrame(f);
+		if (k == 0)
+		{
+			T0 = e.T_WC;
+			continue;
+		}
+		if (!e.ok()) ++res.failed;
+		const mrpt::poses::CPose3D Test = e.T_WC - T0;  // T_C0C estimated
+		const Eigen::Matrix3d Rt = m.R(0).transpose() * m.R(t);
+		const Eigen::Vector3d tt = m.R(0).transpose() * (m.p(t) - m.p(0));
+		const Eigen::Vector3d te(Test.x(), Test.y(), Test.z());
+		res.maxTransErr = std::max(res.maxTransErr, (te - tt).norm());
+		res.maxRotErr_deg =
+		    std::max(res.maxRotErr_deg,
+		             angleSO3(R_of(Test).transpose() * Rt) * 180 / M_PI);
+	}
+	return res;
+}
+}  // namespace
+
+TEST(Odometry, ImuRotationPlusVisualTranslation)
+{
+	EgoConfig cfg;
+	cfg.odometry.mode = "imu";
+	const RunResult r = run(cfg, true);
+	EXPECT_EQ(r.failed, 0);
+	EXPECT_LT(r.maxRotErr_deg, 0.3);
+	EXPECT_LT(r.maxTransErr, 0.03);
+}
+
+TEST(Odometry, VisionOnlyWithoutImu)
+{
+	EgoConfig cfg;
+	cfg.odometry.mode = "vision";
+	const RunResult r = run(cfg, false);
+	EXPECT_EQ(r.failed, 0);
+	EXPECT_LT(r.maxRotErr_deg, 1.0);
+	EXPECT_LT(r.maxTransErr, 0.03);
+}
+
+TEST(Odometry, RefinedImuRotation)
+{
+	EgoConfig cfg;
+	cfg.odometry.mode = "imu";
+	cfg.translation.refine = "se3";
+	const RunResult r = run(cfg, true);
+	EXPECT_EQ(r.failed, 0);
+	EXPECT_LT(r.maxRotErr_deg, 0.3);
+	EXPECT_LT(r.maxTransErr, 0.03);
+}
+
+TEST(Odometry, ImuModeWithoutImuDataFallsBackToVisionAndFlags)
+{
+	EgoConfig cfg;
+	cfg.calibration.has_R_IC = true;
+	Odometry odo(cfg);
+	test::Motion m;
+	FrameEgomotion e;
+	for (int k = 0; k < 3; k++)
+		e = odo.processFrame(test::render(m.R(k * 0.05), m.p(k * 0.05), K320(),
+		                                  320, 240, k * 0.05));
+	EXPECT_TRUE(e.flags & kFlagImuMissing);
+	EXPECT_EQ(e.R_source, RotationSource::Vision);
+	EXPECT_TRUE(e.ok());
+}
+
+TEST(Odometry, FlagsBadInputAndKeepsGoing)
+{
+	EgoConfig cfg;
+	cfg.odometry.mode = "vision";
+	Odometry odo(cfg);
+	test::Motion m;
+	RgbdFrame f0 = test::render(m.R(0), m.p(0), K320(), 320, 240, 0);
+	EXPECT_TRUE(odo.processFrame(f0).flags & kFlagFirstFrame);
+	// Same timestamp again: out of order, pose unchanged, tracker untouched.
+	const FrameEgomotion dup = odo.processFrame(f0);
+	EXPECT_TRUE(dup.flags & kFlagOutOfOrder);
+	EXPECT_FALSE(dup.ok());
+	// No depth at all: too few tracks, flagged, pose stays finite.
+	RgbdFrame f1 = test::render(m.R(0.05), m.p(0.05), K320(), 320, 240, 0.05);
+	f1.depth.setTo(0);
+	const FrameEgomotion e1 = odo.processFrame(f1);
+	EXPECT_TRUE(e1.flags & kFlagTooFewTracks);
+	EXPECT_FALSE(e1.ok());
+	EXPECT_TRUE(std::isfinite(e1.T_WC.x()));
+	// Two good frames afterwards (the first still lacks the previous
+	// depth): back to normal.
+	odo.processFrame(test::render(m.R(0.1), m.p(0.1), K320(), 320, 240, 0.1));
+	const FrameEgomotion e3 = odo.processFrame(
+	    test::render(m.R(0.15), m.p(0.15), K320(), 320, 240, 0.15));
+	EXPECT_TRUE(e3.ok()) << flagsToString(e3.flags);
+}
+
+TEST(Odometry, MissingCalibrationKeyIsAClearError)
+{
+	mrpt::config::CConfigFileMemory cfg(
+	    std::string("[odometry]\nmode = imu\n"));
+	EgoConfig ec;
+	try
+	{
+		ec.loadFromConfigFile(cfg);
+		FAIL() << "expected ConfigError";
+	}
+	catch (const bims::ConfigError& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("R_IC"), std::string::npos)
+		    << e.what();
+		EXPECT_NE(std::string(e.what()).find("calibration"), std::string::npos);
+	}
+	mrpt::config::CConfigFileMemory bad(
+	    std::string("[odometry]\nmode = vision\n[tracker]\nwindw = 21\n"));
+	EXPECT_THROW(ec.loadFromConfigFile(bad), bims::ConfigError);
+	mrpt::config::CConfigFileMemory notRot(
+	    std::string("[calibration]\nR_IC = 1 0 0 0 1 0 0 0 2\n"));
+	EXPECT_THROW(ec.loadFromConfigFile(notRot), bims::ConfigError);
+	mrpt::config::CConfigFileMemory ok(std::string(
+	    "[calibration]\nR_IC = 0 0 1  -1 0 0  0 -1 0\ntime_offset_s = 0.01\n"));
+	ec.loadFromConfigFile(ok);
+	EXPECT_TRUE(ec.calibration.has_R_IC);
+	EXPECT_DOUBLE_EQ(ec.calibration.R_IC(1, 0), -1);
+	EXPECT_DOUBLE_EQ(ec.calibration.time_offset_s, 0.01);
+}
