@@ -10,11 +10,11 @@
 
 namespace bims::maps
 {
-IMPLEMENTS_VIRTUAL_SERIALIZABLE(
-	CBayesVoxelGridBase, mrpt::maps::CMetricMap, bims::maps)
+IMPLEMENTS_VIRTUAL_SERIALIZABLE(CBayesVoxelGridBase, mrpt::maps::CMetricMap,
+                                bims::maps)
 
 CBayesVoxelGridBase::CBayesVoxelGridBase(const GridParams& p)
-	: params_(p), builder_(p)
+    : params_(p), builder_(p)
 {
 	registerClasses();
 	params_.validate();
@@ -39,7 +39,7 @@ VoxelKey CBayesVoxelGridBase::keyOf(const mrpt::math::TPoint3D& p) const
 {
 	const double inv = 1 / params_.voxel_size;
 	return {coordToIndex(p.x, inv), coordToIndex(p.y, inv),
-			coordToIndex(p.z, inv)};
+	        coordToIndex(p.z, inv)};
 }
 
 mrpt::math::TPoint3D CBayesVoxelGridBase::centerOf(const VoxelKey& k) const
@@ -49,8 +49,8 @@ mrpt::math::TPoint3D CBayesVoxelGridBase::centerOf(const VoxelKey& k) const
 }
 
 bool CBayesVoxelGridBase::buildFrame(
-	const mrpt::obs::CObservation3DRangeScan& scan,
-	const mrpt::poses::CPose3D& robotPose, FrameCloud& out) const
+    const mrpt::obs::CObservation3DRangeScan& scan,
+    const mrpt::poses::CPose3D& robotPose, FrameCloud& out) const
 {
 	builder_.build(scan, robotPose + scan.sensorPose, out);
 	accountFrame(out.stats);
@@ -66,28 +66,29 @@ void CBayesVoxelGridBase::accountFrame(const FrameStats& s) const
 		size_t n;
 		const char* what;
 	} reasons[] = {
-		{s.badPose ? 1u : 0u, "a frame with a non-finite pose was skipped"},
-		{s.nonFinite, "readings with NaN/inf coordinates were skipped"},
-		{s.outsideExtent, "readings outside the configured extent were skipped"},
-		{s.overBudget,
-		 "cells beyond the memory budget (max_memory_mb) were not created"}};
+	    {s.badPose ? 1u : 0u, "a frame with a non-finite pose was skipped"},
+	    {s.nonFinite, "readings with NaN/inf coordinates were skipped"},
+	    {s.outsideExtent,
+	     "readings outside the configured extent were skipped"},
+	    {s.overBudget,
+	     "cells beyond the memory budget (max_memory_mb) were not created"}};
 	for (unsigned i = 0; i < 4; ++i)
 	{
 		if (reasons[i].n == 0 || (warned_ & (1u << i))) continue;
 		warned_ |= 1u << i;
 		std::cerr << "bims::maps warning (" << GetRuntimeClass()->className
-				  << "): " << reasons[i].what << " (" << reasons[i].n
-				  << " in this frame; totals in totalStats(), warned once)\n";
+		          << "): " << reasons[i].what << " (" << reasons[i].n
+		          << " in this frame; totals in totalStats(), warned once)\n";
 	}
 }
 
 double CBayesVoxelGridBase::internal_computeObservationLikelihood(
-	const mrpt::obs::CObservation&, const mrpt::poses::CPose3D&) const
+    const mrpt::obs::CObservation&, const mrpt::poses::CPose3D&) const
 {
 	return 0;
 }
 bool CBayesVoxelGridBase::internal_canComputeObservationLikelihood(
-	const mrpt::obs::CObservation&) const
+    const mrpt::obs::CObservation&) const
 {
 	return false;
 }
@@ -96,12 +97,11 @@ void CBayesVoxelGridBase::writeBase(mrpt::serialization::CArchive& out) const
 {
 	const auto& p = params_;
 	out << p.voxel_size << uint8_t(p.decay) << p.p_miss << p.reading_lambda
-		<< p.p_min << p.p_max << p.bg_transition_eps << p.flow_transition_tau
-		<< p.flow_lambda << uint8_t(p.flow_evidence) << p.max_range << p.extent
-		<< p.max_memory_mb << int32_t(p.raycast_decimation)
-		<< uint8_t(p.raycast_target);
-	out << frameCount_
-		<< int64_t(lastTimestamp_.time_since_epoch().count());
+	    << p.p_min << p.p_max << p.bg_transition_eps << p.flow_transition_tau
+	    << p.flow_lambda << uint8_t(p.flow_evidence) << p.max_range << p.extent
+	    << p.max_memory_mb << int32_t(p.raycast_decimation)
+	    << uint8_t(p.raycast_target);
+	out << frameCount_ << int64_t(lastTimestamp_.time_since_epoch().count());
 }
 
 void CBayesVoxelGridBase::readBase(mrpt::serialization::CArchive& in)
@@ -110,12 +110,12 @@ void CBayesVoxelGridBase::readBase(mrpt::serialization::CArchive& in)
 	uint8_t decay, ev, tgt;
 	int32_t dec;
 	in >> p.voxel_size >> decay >> p.p_miss >> p.reading_lambda >> p.p_min >>
-		p.p_max >> p.bg_transition_eps >> p.flow_transition_tau >>
-		p.flow_lambda >> ev >> p.max_range >> p.extent >> p.max_memory_mb >>
-		dec >> tgt;
+	    p.p_max >> p.bg_transition_eps >> p.flow_transition_tau >>
+	    p.flow_lambda >> ev >> p.max_range >> p.extent >> p.max_memory_mb >>
+	    dec >> tgt;
 	if (decay > 2 || ev > 1 || tgt > 1)
 		throw std::runtime_error(
-			"bims::maps: corrupt serialised grid (bad enum value)");
+		    "bims::maps: corrupt serialised grid (bad enum value)");
 	p.decay = DecayMode(decay);
 	p.flow_evidence = FlowEvidence(ev);
 	p.raycast_target = RayTarget(tgt);
@@ -123,16 +123,15 @@ void CBayesVoxelGridBase::readBase(mrpt::serialization::CArchive& in)
 	setParamsBase(p);  // validates
 	int64_t ts;
 	in >> frameCount_ >> ts;
-	lastTimestamp_ =
-		mrpt::Clock::time_point(mrpt::Clock::duration(ts));
+	lastTimestamp_ = mrpt::Clock::time_point(mrpt::Clock::duration(ts));
 	totalStats_ = {};
 	badPoseFrames_ = 0;
 }
 
 void CBayesVoxelGridBase::addVoxelsTo(
-	mrpt::opengl::CSetOfObjects& o,
-	const std::vector<mrpt::math::TPoint3D>& centers,
-	const mrpt::img::TColor& color, const std::string& name) const
+    mrpt::opengl::CSetOfObjects& o,
+    const std::vector<mrpt::math::TPoint3D>& centers,
+    const mrpt::img::TColor& color, const std::string& name) const
 {
 	auto vox = mrpt::opengl::COctoMapVoxels::Create();
 	vox->setName(name);
@@ -141,9 +140,8 @@ void CBayesVoxelGridBase::addVoxelsTo(
 	mrpt::math::TPoint3D lo(1e9, 1e9, 1e9), hi(-1e9, -1e9, -1e9);
 	for (const auto& c : centers)
 	{
-		vox->push_back_Voxel(
-			0, mrpt::opengl::COctoMapVoxels::TVoxel(
-				   c, params_.voxel_size, color));
+		vox->push_back_Voxel(0, mrpt::opengl::COctoMapVoxels::TVoxel(
+		                            c, params_.voxel_size, color));
 		lo.x = std::min(lo.x, c.x);
 		lo.y = std::min(lo.y, c.y);
 		lo.z = std::min(lo.z, c.z);

@@ -11,7 +11,8 @@
 
 namespace bims::maps
 {
-IMPLEMENTS_VIRTUAL_SERIALIZABLE(CMotionGridBase, CBayesVoxelGridBase, bims::maps)
+IMPLEMENTS_VIRTUAL_SERIALIZABLE(CMotionGridBase, CBayesVoxelGridBase,
+                                bims::maps)
 
 CMotionGridBase::CMotionGridBase(const GridParams& p) : CBayesVoxelGridBase(p)
 {
@@ -27,14 +28,14 @@ void CMotionGridBase::setParams(const GridParams& p)
 }
 
 void CMotionGridBase::linkOccupancy(
-	std::shared_ptr<const COccupancyBayesGrid> t0)
+    std::shared_ptr<const COccupancyBayesGrid> t0)
 {
 	if (t0 && t0->params().voxel_size != params_.voxel_size)
-		throw std::invalid_argument(
-			std::string(GetRuntimeClass()->className) +
-			"::linkOccupancy: tier-0 voxel size " +
-			std::to_string(t0->params().voxel_size) + " m differs from " +
-			std::to_string(params_.voxel_size) + " m");
+		throw std::invalid_argument(std::string(GetRuntimeClass()->className) +
+		                            "::linkOccupancy: tier-0 voxel size " +
+		                            std::to_string(t0->params().voxel_size) +
+		                            " m differs from " +
+		                            std::to_string(params_.voxel_size) + " m");
 	linked_ = std::move(t0);
 }
 
@@ -43,7 +44,7 @@ const COccupancyBayesGrid& CMotionGridBase::occupancySource() const
 	if (linked_) return *linked_;
 	if (!private_)
 		const_cast<CMotionGridBase*>(this)->private_ =
-			std::make_shared<COccupancyBayesGrid>(params_);
+		    std::make_shared<COccupancyBayesGrid>(params_);
 	return *private_;
 }
 
@@ -51,7 +52,7 @@ void CMotionGridBase::store(const FrameCloud& f, std::vector<float> post)
 {
 	if (post.size() != f.cells.size())
 		throw std::invalid_argument(
-			"CMotionGridBase::store: one posterior per frame cell expected");
+		    "CMotionGridBase::store: one posterior per frame cell expected");
 	const uint32_t F = frameCount_ + 1;
 	Storage::Accessor acc(grid_);
 	FrameStats st;
@@ -83,7 +84,7 @@ void CMotionGridBase::store(const FrameCloud& f, std::vector<float> post)
 }
 
 std::optional<double> CMotionGridBase::probabilityAt(
-	const mrpt::math::TPoint3D& p) const
+    const mrpt::math::TPoint3D& p) const
 {
 	const Cell* c = grid_.find(keyOf(p));
 	if (!c || c->stamp != frameCount_ || frameCount_ == 0) return std::nullopt;
@@ -105,11 +106,11 @@ std::vector<mrpt::math::TPoint3D> CMotionGridBase::movingCells() const
 }
 
 bool CMotionGridBase::internal_insertObservation(
-	const mrpt::obs::CObservation& obs,
-	const std::optional<const mrpt::poses::CPose3D>& robotPose)
+    const mrpt::obs::CObservation& obs,
+    const std::optional<const mrpt::poses::CPose3D>& robotPose)
 {
 	const auto* scan =
-		dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
+	    dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
 	if (!scan) return false;
 	FrameCloud f;
 	if (!buildFrame(*scan, robotPose ? *robotPose : mrpt::poses::CPose3D(), f))
@@ -157,7 +158,7 @@ void CMotionGridBase::writeMotion(mrpt::serialization::CArchive& out) const
 	out << uint64_t(lastCells_.size());
 	for (size_t i = 0; i < lastCells_.size(); ++i)
 		out << lastCells_[i].x << lastCells_[i].y << lastCells_[i].z
-			<< lastPost_[i];
+		    << lastPost_[i];
 	out << int32_t(lastMask_.width) << int32_t(lastMask_.height);
 	if (!lastMask_.data.empty())
 		out.WriteBuffer(lastMask_.data.data(), lastMask_.data.size());
@@ -186,7 +187,7 @@ void CMotionGridBase::readMotion(mrpt::serialization::CArchive& in)
 		const uint32_t id = grid_.findOrCreateBlock(key);
 		if (id == FlatHashMap::kNotFound)
 			throw std::runtime_error(
-				"bims::maps: serialised map exceeds max_memory_mb");
+			    "bims::maps: serialised map exceeds max_memory_mb");
 		auto& blk = grid_.block(id);
 		for (size_t c = 0; c < N; ++c) blk.cells[c] = {l[c], st[c]};
 	}
@@ -198,7 +199,7 @@ void CMotionGridBase::readMotion(mrpt::serialization::CArchive& in)
 	lastPost_.resize(nl);
 	for (size_t i = 0; i < nl; ++i)
 		in >> lastCells_[i].x >> lastCells_[i].y >> lastCells_[i].z >>
-			lastPost_[i];
+		    lastPost_[i];
 	int32_t w, h;
 	in >> w >> h;
 	if (w < 0 || h < 0 || int64_t(w) * h > (int64_t(1) << 28))
@@ -217,7 +218,7 @@ void CMotionGridBase::readMotion(mrpt::serialization::CArchive& in)
 }
 
 void CMotionGridBase::saveMetricMapRepresentationToFile(
-	const std::string& prefix) const
+    const std::string& prefix) const
 {
 	std::vector<float> probs;
 	std::vector<mrpt::math::TPoint3D> pts;
@@ -241,9 +242,9 @@ std::string CMotionGridBase::asString() const
 	return s.str();
 }
 
-void CMotionGridBase::visualize(
-	mrpt::opengl::CSetOfObjects& o, const mrpt::img::TColor& c,
-	const std::string& name) const
+void CMotionGridBase::visualize(mrpt::opengl::CSetOfObjects& o,
+                                const mrpt::img::TColor& c,
+                                const std::string& name) const
 {
 	if (!genericMapParams.enableSaveAs3DObject) return;
 	addVoxelsTo(o, movingCells(), c, name);

@@ -9,7 +9,7 @@
 namespace bims::maps
 {
 COccupancyBayesGrid::COccupancyBayesGrid(const GridParams& p)
-	: CBayesVoxelGridBase(p)
+    : CBayesVoxelGridBase(p)
 {
 	grid_.setMaxBytes(size_t(p.max_memory_mb * 1048576.0));
 	updateConstants();
@@ -32,7 +32,8 @@ void COccupancyBayesGrid::updateConstants()
 	lmax_ = toFixed(logit(p.p_max));
 	logLambda_ = std::log(p.reading_lambda);
 	hitTable_.clear();
-	for (uint32_t n = 0; n <= 1024; ++n) hitTable_.push_back(hitFixedCompute(n));
+	for (uint32_t n = 0; n <= 1024; ++n)
+		hitTable_.push_back(hitFixedCompute(n));
 }
 
 LogOddsFx COccupancyBayesGrid::hitFixed(uint32_t n) const
@@ -45,8 +46,7 @@ LogOddsFx COccupancyBayesGrid::hitFixedCompute(uint32_t n) const
 	if (n == 0) return 0;
 	// Increments beyond the clamping range are equivalent after clamping.
 	const double range = fromFixed(lmax_) - fromFixed(lmin_) + 1;
-	return toFixed(
-		std::min(hitLogOdds(params_.p_miss, logLambda_, n), range));
+	return toFixed(std::min(hitLogOdds(params_.p_miss, logLambda_, n), range));
 }
 
 LogOddsFx COccupancyBayesGrid::currentFixed(const Cell& c) const
@@ -86,7 +86,7 @@ std::vector<VoxelKey> COccupancyBayesGrid::keysAbove(double p) const
 }
 
 std::vector<mrpt::math::TPoint3D> COccupancyBayesGrid::cellsAbove(
-	double p) const
+    double p) const
 {
 	std::vector<mrpt::math::TPoint3D> out;
 	for (const auto& k : keysAbove(p)) out.push_back(centerOf(k));
@@ -101,14 +101,14 @@ void COccupancyBayesGrid::applyMiss(Cell& c, uint32_t F) const
 	c.stamp = F;
 }
 
-void COccupancyBayesGrid::integrate(
-	const FrameCloud& f, std::vector<float>* priorOut)
+void COccupancyBayesGrid::integrate(const FrameCloud& f,
+                                    std::vector<float>* priorOut)
 {
 	if (f.voxel_size != params_.voxel_size)
 		throw std::invalid_argument(
-			"COccupancyBayesGrid::integrate: frame keyed for voxel size " +
-			std::to_string(f.voxel_size) + " m, grid has " +
-			std::to_string(params_.voxel_size) + " m");
+		    "COccupancyBayesGrid::integrate: frame keyed for voxel size " +
+		    std::to_string(f.voxel_size) + " m, grid has " +
+		    std::to_string(params_.voxel_size) + " m");
 	const uint32_t F = frameCount_ + 1;
 	const bool lazy = params_.decay == DecayMode::All;
 	if (priorOut) priorOut->resize(f.cells.size());
@@ -122,15 +122,15 @@ void COccupancyBayesGrid::integrate(
 		{
 			st.overBudget += f.hits[i];
 			if (priorOut)
-				(*priorOut)[i] = float(fromFixed(
-					lazy ? decayFixed(0, F - 1, miss_, lmin_) : 0));
+				(*priorOut)[i] = float(
+				    fromFixed(lazy ? decayFixed(0, F - 1, miss_, lmin_) : 0));
 			continue;
 		}
 		const LogOddsFx prior =
-			lazy ? decayFixed(c->l, F - 1 - c->stamp, miss_, lmin_) : c->l;
+		    lazy ? decayFixed(c->l, F - 1 - c->stamp, miss_, lmin_) : c->l;
 		c->lPrev = prior;
-		c->l = LogOddsFx(std::min<int64_t>(
-			int64_t(prior) + hitFixed(f.hits[i]), lmax_));
+		c->l = LogOddsFx(
+		    std::min<int64_t>(int64_t(prior) + hitFixed(f.hits[i]), lmax_));
 		c->stamp = F;
 		if (priorOut) (*priorOut)[i] = float(fromFixed(prior));
 	}
@@ -141,16 +141,16 @@ void COccupancyBayesGrid::integrate(
 	if (st.overBudget) accountFrame(st);
 }
 
-void COccupancyBayesGrid::priorLogOdds(
-	const FrameCloud& f, std::vector<float>& out) const
+void COccupancyBayesGrid::priorLogOdds(const FrameCloud& f,
+                                       std::vector<float>& out) const
 {
 	if (f.voxel_size != params_.voxel_size)
 		throw std::invalid_argument(
-			"COccupancyBayesGrid::priorLogOdds: voxel size mismatch");
+		    "COccupancyBayesGrid::priorLogOdds: voxel size mismatch");
 	const bool lazy = params_.decay == DecayMode::All;
 	const bool already = frameCount_ > 0 &&
-		f.timestamp != mrpt::Clock::time_point() &&
-		f.timestamp == lastTimestamp_;
+	                     f.timestamp != mrpt::Clock::time_point() &&
+	                     f.timestamp == lastTimestamp_;
 	const uint32_t G = already ? frameCount_ : frameCount_ + 1;
 	out.resize(f.cells.size());
 	for (size_t i = 0; i < f.cells.size(); ++i)
@@ -162,17 +162,17 @@ void COccupancyBayesGrid::priorLogOdds(
 			v = cell.lPrev;
 		else
 			v = lazy ? decayFixed(cell.l, G - 1 - cell.stamp, miss_, lmin_)
-					 : cell.l;
+			         : cell.l;
 		out[i] = float(fromFixed(v));
 	}
 }
 
 bool COccupancyBayesGrid::internal_insertObservation(
-	const mrpt::obs::CObservation& obs,
-	const std::optional<const mrpt::poses::CPose3D>& robotPose)
+    const mrpt::obs::CObservation& obs,
+    const std::optional<const mrpt::poses::CPose3D>& robotPose)
 {
 	const auto* scan =
-		dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
+	    dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
 	if (!scan) return false;
 	FrameCloud f;
 	if (!buildFrame(*scan, robotPose ? *robotPose : mrpt::poses::CPose3D(), f))

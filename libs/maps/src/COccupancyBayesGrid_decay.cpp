@@ -44,7 +44,7 @@ void traverse(const double a[3], const double b[3], Visit&& visit)
 	{
 		visit(i[0], i[1], i[2]);
 		int k = tMax[0] < tMax[1] ? (tMax[0] < tMax[2] ? 0 : 2)
-								  : (tMax[1] < tMax[2] ? 1 : 2);
+		                          : (tMax[1] < tMax[2] ? 1 : 2);
 		// Never step past the end voxel on an axis (numerical safety).
 		if (i[k] == e[k])
 		{
@@ -71,7 +71,8 @@ void COccupancyBayesGrid::decayRaycast(const FrameCloud& f, uint32_t F)
 	const double a[3] = {o.x * inv, o.y * inv, o.z * inv};
 	Storage::Accessor acc(grid_);
 	size_t over = 0;
-	auto visit = [&](int32_t x, int32_t y, int32_t z) {
+	auto visit = [&](int32_t x, int32_t y, int32_t z)
+	{
 		Cell* c = acc.get(x, y, z);
 		if (c)
 			applyMiss(*c, F);
@@ -125,21 +126,22 @@ void COccupancyBayesGrid::decayFrustum(const FrameCloud& f, uint32_t F)
 	const auto& R = f.T_WC.getRotationMatrix();  // R_WC
 	const mrpt::math::TPoint3D t = f.T_WC.translation();
 	// Side planes of the frustum in {C} (through the origin), normalised.
-	double planes[4][3] = {
-		{1, 0, (K.cx + 0.5) / K.fx},
-		{-1, 0, (K.width - 0.5 - K.cx) / K.fx},
-		{0, 1, (K.cy + 0.5) / K.fy},
-		{0, -1, (K.height - 0.5 - K.cy) / K.fy}};
+	double planes[4][3] = {{1, 0, (K.cx + 0.5) / K.fx},
+	                       {-1, 0, (K.width - 0.5 - K.cx) / K.fx},
+	                       {0, 1, (K.cy + 0.5) / K.fy},
+	                       {0, -1, (K.height - 0.5 - K.cy) / K.fy}};
 	for (auto& pl : planes)
 	{
-		const double n = std::sqrt(pl[0] * pl[0] + pl[1] * pl[1] + pl[2] * pl[2]);
+		const double n =
+		    std::sqrt(pl[0] * pl[0] + pl[1] * pl[1] + pl[2] * pl[2]);
 		for (auto& v : pl) v /= n;
 	}
 	const int D = Storage::kDim;
 	const double blockRadius = D * s * std::sqrt(3.0) / 2;
 	const double cellHalfDiag = s * std::sqrt(3.0) / 2;
 	const double maxR = params_.max_range;
-	auto toCam = [&](double x, double y, double z, double c[3]) {
+	auto toCam = [&](double x, double y, double z, double c[3])
+	{
 		const double dx = x - t.x, dy = y - t.y, dz = z - t.z;
 		for (int r = 0; r < 3; ++r)
 			c[r] = R(0, r) * dx + R(1, r) * dy + R(2, r) * dz;  // R^T d
@@ -148,8 +150,8 @@ void COccupancyBayesGrid::decayFrustum(const FrameCloud& f, uint32_t F)
 	{
 		const VoxelKey o = grid_.blockOrigin(b);
 		double pc[3];
-		toCam(
-			(o.x + D / 2.0) * s, (o.y + D / 2.0) * s, (o.z + D / 2.0) * s, pc);
+		toCam((o.x + D / 2.0) * s, (o.y + D / 2.0) * s, (o.z + D / 2.0) * s,
+		      pc);
 		if (pc[2] < -blockRadius || pc[2] > maxR + blockRadius) continue;
 		bool outside = false;
 		for (const auto& pl : planes)

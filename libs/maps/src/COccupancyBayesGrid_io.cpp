@@ -12,44 +12,46 @@
 namespace bims::maps
 {
 // Names usable as "<name>_count" under [map]; must contain the RTTI name.
-MAP_DEFINITION_REGISTER(
-	"bims::maps::COccupancyBayesGrid,occupancyBayesGrid",
-	bims::maps::COccupancyBayesGrid)
+MAP_DEFINITION_REGISTER("bims::maps::COccupancyBayesGrid,occupancyBayesGrid",
+                        bims::maps::COccupancyBayesGrid)
 
 IMPLEMENTS_SERIALIZABLE(COccupancyBayesGrid, CBayesVoxelGridBase, bims::maps)
 
-
 const std::vector<std::string>& mrptGenericMapKeys()
 {
-	static const std::vector<std::string> k = {
-		"enableSaveAs3DObject", "enableObservationLikelihood",
-		"enableObservationInsertion"};
+	static const std::vector<std::string> k = {"enableSaveAs3DObject",
+	                                           "enableObservationLikelihood",
+	                                           "enableObservationInsertion"};
 	return k;
 }
 
 COccupancyBayesGrid::TMapDefinition::TMapDefinition() = default;
 
 void COccupancyBayesGrid::TMapDefinition::loadFromConfigFile_map_specific(
-	const mrpt::config::CConfigFileBase& source, const std::string& prefix)
+    const mrpt::config::CConfigFileBase& source, const std::string& prefix)
 {
-	params.loadFromConfigFile(
-		source, prefix + "_creationOpts", mrptGenericMapKeys());
+	params.loadFromConfigFile(source, prefix + "_creationOpts",
+	                          mrptGenericMapKeys());
 }
 
 void COccupancyBayesGrid::TMapDefinition::dumpToTextStream_map_specific(
-	std::ostream& out) const
+    std::ostream& out) const
 {
 	params.dump(out);
 }
 
 mrpt::maps::CMetricMap* COccupancyBayesGrid::internal_CreateFromMapDefinition(
-	const mrpt::maps::TMetricMapInitializer& def)
+    const mrpt::maps::TMetricMapInitializer& def)
 {
-	const auto& d = dynamic_cast<const COccupancyBayesGrid::TMapDefinition&>(def);
+	const auto& d =
+	    dynamic_cast<const COccupancyBayesGrid::TMapDefinition&>(def);
 	return new COccupancyBayesGrid(d.params);
 }
 
-uint8_t COccupancyBayesGrid::serializeGetVersion() const { return 0; }
+uint8_t COccupancyBayesGrid::serializeGetVersion() const
+{
+	return 0;
+}
 
 void COccupancyBayesGrid::serializeTo(mrpt::serialization::CArchive& out) const
 {
@@ -75,11 +77,10 @@ void COccupancyBayesGrid::serializeTo(mrpt::serialization::CArchive& out) const
 	}
 }
 
-void COccupancyBayesGrid::serializeFrom(
-	mrpt::serialization::CArchive& in, uint8_t version)
+void COccupancyBayesGrid::serializeFrom(mrpt::serialization::CArchive& in,
+                                        uint8_t version)
 {
-	if (version != 0)
-		MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
+	if (version != 0) MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
 	grid_.clear();
 	readBase(in);
 	grid_.setMaxBytes(size_t(params_.max_memory_mb * 1048576.0));
@@ -99,26 +100,26 @@ void COccupancyBayesGrid::serializeFrom(
 		const uint32_t id = grid_.findOrCreateBlock(key);
 		if (id == FlatHashMap::kNotFound)
 			throw std::runtime_error(
-				"COccupancyBayesGrid: serialised map exceeds max_memory_mb");
+			    "COccupancyBayesGrid: serialised map exceeds max_memory_mb");
 		auto& blk = grid_.block(id);
 		for (size_t c = 0; c < N; ++c)
 		{
 			if (st[c] > frameCount_)
 				throw std::runtime_error(
-					"COccupancyBayesGrid: corrupt serialised map (cell stamp "
-					"beyond frame count)");
+				    "COccupancyBayesGrid: corrupt serialised map (cell stamp "
+				    "beyond frame count)");
 			blk.cells[c] = {l[c], lp[c], st[c]};
 		}
 	}
 }
 
 void COccupancyBayesGrid::getVisualizationInto(
-	mrpt::opengl::CSetOfObjects& o) const
+    mrpt::opengl::CSetOfObjects& o) const
 {
 	if (!genericMapParams.enableSaveAs3DObject) return;
 	// Tier 0 in blue (the paper's Fig. 4): voxels with P(O) > 0.5.
 	addVoxelsTo(o, cellsAbove(0.5), mrpt::img::TColor(0, 0, 255, 255),
-				"tier0_occupancy");
+	            "tier0_occupancy");
 }
 
 std::string COccupancyBayesGrid::asString() const
@@ -132,7 +133,7 @@ std::string COccupancyBayesGrid::asString() const
 }
 
 void COccupancyBayesGrid::saveMetricMapRepresentationToFile(
-	const std::string& prefix) const
+    const std::string& prefix) const
 {
 	writeStaticPly(prefix + "_occupied.ply", *this, nullptr);
 }

@@ -13,7 +13,10 @@ double logAddExp(double a, double b)
 	return m + std::log1p(std::exp(std::min(a, b) - m));
 }
 
-double logit(double p) { return std::log(p) - std::log1p(-p); }
+double logit(double p)
+{
+	return std::log(p) - std::log1p(-p);
+}
 
 double sigmoid(double l)
 {
@@ -28,13 +31,16 @@ double hitLogOdds(double pMiss, double logLambda, uint32_t n)
 	return logAddExp(a, b) - b;
 }
 
-double missLogOdds(double pMiss) { return -std::log(2 - pMiss); }
+double missLogOdds(double pMiss)
+{
+	return -std::log(2 - pMiss);
+}
 
-double occupancyPosterior(
-	double lPrior, double pMiss, double logLambda, uint32_t n)
+double occupancyPosterior(double lPrior, double pMiss, double logLambda,
+                          uint32_t n)
 {
 	return lPrior +
-		(n > 0 ? hitLogOdds(pMiss, logLambda, n) : missLogOdds(pMiss));
+	       (n > 0 ? hitLogOdds(pMiss, logLambda, n) : missLogOdds(pMiss));
 }
 
 // q = (1-p)(1-eps) + p eps; 1-q = (1-p) eps + p (1-eps). In logs, with
@@ -47,24 +53,23 @@ double backgroundPriorLogOdds(double lOccPrev, double eps)
 	return logAddExp(l1p + l1e, lp + le) - logAddExp(l1p + le, lp + l1e);
 }
 
-double backgroundPosterior(
-	double lOccPrev, double eps, double pMiss, double logLambda, uint32_t n)
+double backgroundPosterior(double lOccPrev, double eps, double pMiss,
+                           double logLambda, uint32_t n)
 {
-	return occupancyPosterior(
-		backgroundPriorLogOdds(lOccPrev, eps), pMiss, logLambda, n);
+	return occupancyPosterior(backgroundPriorLogOdds(lOccPrev, eps), pMiss,
+	                          logLambda, n);
 }
 
-double flowPosterior(
-	double lI, double tau, double pMiss, double logFlowLambda, uint32_t k,
-	uint32_t l, bool veto)
+double flowPosterior(double lI, double tau, double pMiss, double logFlowLambda,
+                     uint32_t k, uint32_t l, bool veto)
 {
 	const double a = std::log1p(-pMiss), b = std::log(pMiss);
 	const double logL1 = logAddExp(a + double(k) * logFlowLambda, b);
 	const double logL0 =
-		logAddExp(a + double(veto ? k + l : l) * logFlowLambda, b);
+	    logAddExp(a + double(veto ? k + l : l) * logFlowLambda, b);
 	const double lt = std::log(tau), l1t = std::log1p(-tau);
 	return lI + logAddExp(l1t + logL1, lt + logL0) -
-		logAddExp(lt + logL1, l1t + logL0);
+	       logAddExp(lt + logL1, l1t + logL0);
 }
 
 }  // namespace bims::maps

@@ -9,9 +9,9 @@
 
 namespace bims::maps
 {
-size_t writeStaticOctomap(
-	const std::string& path, const COccupancyBayesGrid& occ,
-	const CMotionGridBase* motion, double p)
+size_t writeStaticOctomap(const std::string& path,
+                          const COccupancyBayesGrid& occ,
+                          const CMotionGridBase* motion, double p)
 {
 	const auto keys = staticOccupiedKeys(occ, motion, p);
 	octomap::OcTree tree(occ.params().voxel_size);
@@ -21,7 +21,7 @@ size_t writeStaticOctomap(
 		const auto c = occ.centerOf(k);
 		octomap::OcTreeKey ok;
 		if (!tree.coordToKeyChecked(
-				octomap::point3d(float(c.x), float(c.y), float(c.z)), ok))
+		        octomap::point3d(float(c.x), float(c.y), float(c.z)), ok))
 			continue;  // outside OctoMap's +-2^15 voxel range
 		tree.setNodeValue(ok, float(fromFixed(occ.logOddsFixed(k))), true);
 		++n;

@@ -7,21 +7,22 @@
 
 namespace bims::maps
 {
-std::vector<VoxelKey> staticOccupiedKeys(
-	const COccupancyBayesGrid& occ, const CMotionGridBase* motion, double p)
+std::vector<VoxelKey> staticOccupiedKeys(const COccupancyBayesGrid& occ,
+                                         const CMotionGridBase* motion,
+                                         double p)
 {
 	if (motion && motion->params().voxel_size != occ.params().voxel_size)
 		throw std::invalid_argument(
-			"staticOccupiedKeys: tier-0 and motion grids differ in voxel size");
+		    "staticOccupiedKeys: tier-0 and motion grids differ in voxel size");
 	std::vector<VoxelKey> out;
 	for (const auto& k : occ.keysAbove(p))
 		if (!motion || !motion->wasMovingAtLastHit(k)) out.push_back(k);
 	return out;
 }
 
-void writePointsPly(
-	const std::string& path, const std::vector<mrpt::math::TPoint3D>& pts,
-	const std::vector<float>& values)
+void writePointsPly(const std::string& path,
+                    const std::vector<mrpt::math::TPoint3D>& pts,
+                    const std::vector<float>& values)
 {
 	if (values.size() != pts.size())
 		throw std::invalid_argument("writePointsPly: one value per point");
@@ -35,8 +36,8 @@ void writePointsPly(
 	static_assert(sizeof(float) == 4);
 	for (size_t i = 0; i < pts.size(); ++i)
 	{
-		const float v[4] = {
-			float(pts[i].x), float(pts[i].y), float(pts[i].z), values[i]};
+		const float v[4] = {float(pts[i].x), float(pts[i].y), float(pts[i].z),
+		                    values[i]};
 		unsigned char b[16];
 		std::memcpy(b, v, 16);  // x86/ARM little endian hosts
 		f.write(reinterpret_cast<const char*>(b), 16);
@@ -44,9 +45,8 @@ void writePointsPly(
 	if (!f) throw std::runtime_error("error writing PLY file '" + path + "'");
 }
 
-size_t writeStaticPly(
-	const std::string& path, const COccupancyBayesGrid& occ,
-	const CMotionGridBase* motion, double p)
+size_t writeStaticPly(const std::string& path, const COccupancyBayesGrid& occ,
+                      const CMotionGridBase* motion, double p)
 {
 	const auto keys = staticOccupiedKeys(occ, motion, p);
 	std::vector<mrpt::math::TPoint3D> pts;

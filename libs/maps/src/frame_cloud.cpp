@@ -38,7 +38,10 @@ std::string FrameStats::asString() const
 	return s.str();
 }
 
-FrameCloudBuilder::FrameCloudBuilder(const GridParams& p) { setParams(p); }
+FrameCloudBuilder::FrameCloudBuilder(const GridParams& p)
+{
+	setParams(p);
+}
 
 void FrameCloudBuilder::setParams(const GridParams& p)
 {
@@ -77,29 +80,27 @@ void resetFrame(FrameCloud& out)
 }
 }  // namespace
 
-void FrameCloudBuilder::build(
-	const mrpt::obs::CObservation3DRangeScan& scan,
-	const mrpt::poses::CPose3D& T_WS, FrameCloud& out)
+void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
+                              const mrpt::poses::CPose3D& T_WS, FrameCloud& out)
 {
 	resetFrame(out);
 	out.voxel_size = p_.voxel_size;
 	out.timestamp = scan.timestamp;
 	if (!scan.hasRangeImage)
-		throw std::invalid_argument(
-			"bims::maps::FrameCloudBuilder: scan '" + scan.sensorLabel +
-			"' has no range image");
+		throw std::invalid_argument("bims::maps::FrameCloudBuilder: scan '" +
+		                            scan.sensorLabel + "' has no range image");
 	const int W = int(scan.rangeImage.cols()), H = int(scan.rangeImage.rows());
 	const auto& cam = scan.cameraParams;
 	if (int(cam.ncols) != W || int(cam.nrows) != H)
 		throw std::invalid_argument(
-			"bims::maps::FrameCloudBuilder: scan '" + scan.sensorLabel +
-			"': cameraParams size " + std::to_string(cam.ncols) + "x" +
-			std::to_string(cam.nrows) + " differs from the range image " +
-			std::to_string(W) + "x" + std::to_string(H));
+		    "bims::maps::FrameCloudBuilder: scan '" + scan.sensorLabel +
+		    "': cameraParams size " + std::to_string(cam.ncols) + "x" +
+		    std::to_string(cam.nrows) + " differs from the range image " +
+		    std::to_string(W) + "x" + std::to_string(H));
 	if (!(cam.fx() > 0 && cam.fy() > 0))
-		throw std::invalid_argument(
-			"bims::maps::FrameCloudBuilder: scan '" + scan.sensorLabel +
-			"': focal lengths must be > 0");
+		throw std::invalid_argument("bims::maps::FrameCloudBuilder: scan '" +
+		                            scan.sensorLabel +
+		                            "': focal lengths must be > 0");
 	out.K = {W, H, cam.fx(), cam.fy(), cam.cx(), cam.cy()};
 	if (!finitePose(T_WS))
 	{
@@ -124,7 +125,7 @@ void FrameCloudBuilder::build(
 		const double yn = (v - cy) * ify;
 		// Ray direction in {W} for depth 1: xn*R.col0 + yn*R.col1 + R.col2.
 		const double by = yn * R(0, 1) + R(0, 2), bz = yn * R(1, 1) + R(1, 2),
-					 bw = yn * R(2, 1) + R(2, 2);
+		             bw = yn * R(2, 1) + R(2, 2);
 		for (int u = 0; u < W; ++u)
 		{
 			const uint16_t raw = scan.rangeImage(v, u);
@@ -149,10 +150,9 @@ void FrameCloudBuilder::build(
 			}
 			const size_t pix = size_t(v) * W + u;
 			out.depth[pix] = float(d);
-			out.points_W.emplace_back(
-				float(t.x + d * (xn * R(0, 0) + by)),
-				float(t.y + d * (xn * R(1, 0) + bz)),
-				float(t.z + d * (xn * R(2, 0) + bw)));
+			out.points_W.emplace_back(float(t.x + d * (xn * R(0, 0) + by)),
+			                          float(t.y + d * (xn * R(1, 0) + bz)),
+			                          float(t.z + d * (xn * R(2, 0) + bw)));
 			out.pixel.push_back(uint32_t(pix));
 		}
 	}
@@ -160,22 +160,23 @@ void FrameCloudBuilder::build(
 }
 
 void FrameCloudBuilder::buildFromPoints(
-	const std::vector<mrpt::math::TPoint3Df>& points_W,
-	const std::vector<uint32_t>& pixels, const mrpt::math::TPoint3D& origin_W,
-	FrameCloud& out, const Intrinsics& K)
+    const std::vector<mrpt::math::TPoint3Df>& points_W,
+    const std::vector<uint32_t>& pixels, const mrpt::math::TPoint3D& origin_W,
+    FrameCloud& out, const Intrinsics& K)
 {
 	resetFrame(out);
 	out.voxel_size = p_.voxel_size;
 	out.K = K;
 	out.origin_W = origin_W;
-	out.T_WC = mrpt::poses::CPose3D(origin_W.x, origin_W.y, origin_W.z, 0, 0, 0);
+	out.T_WC =
+	    mrpt::poses::CPose3D(origin_W.x, origin_W.y, origin_W.z, 0, 0, 0);
 	if (!pixels.empty() && pixels.size() != points_W.size())
 		throw std::invalid_argument(
-			"bims::maps::FrameCloudBuilder::buildFromPoints: " +
-			std::to_string(pixels.size()) + " pixel indices for " +
-			std::to_string(points_W.size()) + " points");
+		    "bims::maps::FrameCloudBuilder::buildFromPoints: " +
+		    std::to_string(pixels.size()) + " pixel indices for " +
+		    std::to_string(points_W.size()) + " points");
 	if (!(std::isfinite(origin_W.x) && std::isfinite(origin_W.y) &&
-		  std::isfinite(origin_W.z)))
+	      std::isfinite(origin_W.z)))
 	{
 		out.stats.badPose = true;
 		return;
@@ -227,12 +228,12 @@ void FrameCloudBuilder::keyPoints(FrameCloud& out)
 			continue;
 		}
 		const int32_t kx = coordToIndex(p.x, inv), ky = coordToIndex(p.y, inv),
-					  kz = coordToIndex(p.z, inv);
+		              kz = coordToIndex(p.z, inv);
 		const uint64_t key = packKey(kx, ky, kz);
 		if (key != lastKey)
 		{
 			const auto [idx, inserted] =
-				dedup_.insert(key, uint32_t(out.cells.size()));
+			    dedup_.insert(key, uint32_t(out.cells.size()));
 			if (inserted)
 			{
 				out.cells.push_back({kx, ky, kz});

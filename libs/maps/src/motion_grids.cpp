@@ -6,11 +6,11 @@
 namespace bims::maps
 {
 MotionGrids::MotionGrids(const GridParams& p)
-	: p_(p),
-	  t0_(std::make_shared<COccupancyBayesGrid>(p)),
-	  t1_(std::make_shared<CBackgroundSubtractionGrid>(p)),
-	  t2_(std::make_shared<CFlowConsistencyGrid>(p)),
-	  builder_(p)
+    : p_(p),
+      t0_(std::make_shared<COccupancyBayesGrid>(p)),
+      t1_(std::make_shared<CBackgroundSubtractionGrid>(p)),
+      t2_(std::make_shared<CFlowConsistencyGrid>(p)),
+      builder_(p)
 {
 	t1_->linkOccupancy(t0_);
 	t2_->linkOccupancy(t0_);
@@ -24,19 +24,19 @@ void MotionGrids::clear()
 }
 
 const MotionFrameResult& MotionGrids::processFrame(
-	const mrpt::obs::CObservation3DRangeScan& scan,
-	const mrpt::poses::CPose3D& T_WS, const PixelLabels* labels)
+    const mrpt::obs::CObservation3DRangeScan& scan,
+    const mrpt::poses::CPose3D& T_WS, const PixelLabels* labels)
 {
 	builder_.build(scan, T_WS, frame_);
 	return processFrame(frame_, labels);
 }
 
-const MotionFrameResult& MotionGrids::processFrame(
-	const FrameCloud& f, const PixelLabels* labels)
+const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
+                                                   const PixelLabels* labels)
 {
 	if (f.voxel_size != p_.voxel_size)
 		throw std::invalid_argument(
-			"MotionGrids::processFrame: frame keyed for another voxel size");
+		    "MotionGrids::processFrame: frame keyed for another voxel size");
 	result_ = MotionFrameResult();
 	result_.stats = f.stats;
 	t0_->accountFrame(f.stats);
@@ -60,8 +60,8 @@ const MotionFrameResult& MotionGrids::processFrame(
 	result_.maskTier1 = t1_->lastMovingMask();
 	result_.maskTier2 = t2_->lastMovingMask();
 	result_.updateMs = std::chrono::duration<double, std::milli>(
-						   std::chrono::steady_clock::now() - t0)
-						   .count();
+	                       std::chrono::steady_clock::now() - t0)
+	                       .count();
 	return result_;
 }
 

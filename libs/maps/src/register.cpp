@@ -10,13 +10,16 @@ namespace bims::maps
 void registerClasses()
 {
 	static std::once_flag once;
-	std::call_once(once, [] {
-		mrpt::rtti::registerClass(CLASS_ID(CBayesVoxelGridBase));
-		mrpt::rtti::registerClass(CLASS_ID(CMotionGridBase));
-		mrpt::rtti::registerClass(CLASS_ID(COccupancyBayesGrid));
-		mrpt::rtti::registerClass(CLASS_ID(CBackgroundSubtractionGrid));
-		mrpt::rtti::registerClass(CLASS_ID(CFlowConsistencyGrid));
-	});
+	std::call_once(
+	    once,
+	    []
+	    {
+		    mrpt::rtti::registerClass(CLASS_ID(CBayesVoxelGridBase));
+		    mrpt::rtti::registerClass(CLASS_ID(CMotionGridBase));
+		    mrpt::rtti::registerClass(CLASS_ID(COccupancyBayesGrid));
+		    mrpt::rtti::registerClass(CLASS_ID(CBackgroundSubtractionGrid));
+		    mrpt::rtti::registerClass(CLASS_ID(CFlowConsistencyGrid));
+	    });
 }
 
 namespace

@@ -8,17 +8,17 @@
 namespace bims::maps
 {
 CBackgroundSubtractionGrid::CBackgroundSubtractionGrid(const GridParams& p)
-	: CMotionGridBase(p)
+    : CMotionGridBase(p)
 {
 }
 
-void CBackgroundSubtractionGrid::posterior(
-	const FrameCloud& f, const std::vector<float>& priorO,
-	std::vector<float>& post) const
+void CBackgroundSubtractionGrid::posterior(const FrameCloud& f,
+                                           const std::vector<float>& priorO,
+                                           std::vector<float>& post) const
 {
 	if (priorO.size() != f.cells.size())
 		throw std::invalid_argument(
-			"CBackgroundSubtractionGrid::posterior: one O- per cell expected");
+		    "CBackgroundSubtractionGrid::posterior: one O- per cell expected");
 	const auto& p = params_;
 	const double logLambda = std::log(p.reading_lambda);
 	post.resize(f.cells.size());
@@ -30,14 +30,14 @@ void CBackgroundSubtractionGrid::posterior(
 	{
 		const uint32_t n = f.hits[i];
 		const double hit =
-			n < 64 ? hitCache[n] : hitLogOdds(p.p_miss, logLambda, n);
-		post[i] = float(
-			backgroundPriorLogOdds(priorO[i], p.bg_transition_eps) + hit);
+		    n < 64 ? hitCache[n] : hitLogOdds(p.p_miss, logLambda, n);
+		post[i] =
+		    float(backgroundPriorLogOdds(priorO[i], p.bg_transition_eps) + hit);
 	}
 }
 
 CFlowConsistencyGrid::CFlowConsistencyGrid(const GridParams& p)
-	: CMotionGridBase(p)
+    : CMotionGridBase(p)
 {
 }
 
@@ -46,20 +46,20 @@ void CFlowConsistencyGrid::setPendingLabels(PixelLabels labels)
 	pending_ = std::move(labels);
 }
 
-void CFlowConsistencyGrid::countLabels(
-	const FrameCloud& f, const PixelLabels& labels, std::vector<uint32_t>& k,
-	std::vector<uint32_t>& l)
+void CFlowConsistencyGrid::countLabels(const FrameCloud& f,
+                                       const PixelLabels& labels,
+                                       std::vector<uint32_t>& k,
+                                       std::vector<uint32_t>& l)
 {
 	k.assign(f.cells.size(), 0);
 	l.assign(f.cells.size(), 0);
 	if (labels.label.empty()) return;  // no labels: no flow evidence
 	if (labels.width != f.K.width || labels.height != f.K.height ||
-		labels.label.size() != size_t(labels.width) * size_t(labels.height))
+	    labels.label.size() != size_t(labels.width) * size_t(labels.height))
 		throw std::invalid_argument(
-			"CFlowConsistencyGrid: labels are " +
-			std::to_string(labels.width) + "x" +
-			std::to_string(labels.height) + " but the frame is " +
-			std::to_string(f.K.width) + "x" + std::to_string(f.K.height));
+		    "CFlowConsistencyGrid: labels are " + std::to_string(labels.width) +
+		    "x" + std::to_string(labels.height) + " but the frame is " +
+		    std::to_string(f.K.width) + "x" + std::to_string(f.K.height));
 	for (size_t j = 0; j < f.pixel.size(); ++j)
 	{
 		const int8_t lab = labels.label[f.pixel[j]];
@@ -70,14 +70,15 @@ void CFlowConsistencyGrid::countLabels(
 	}
 }
 
-void CFlowConsistencyGrid::posterior(
-	const FrameCloud& f, const PixelLabels& labels,
-	const std::vector<float>& tier1, std::vector<float>& post) const
+void CFlowConsistencyGrid::posterior(const FrameCloud& f,
+                                     const PixelLabels& labels,
+                                     const std::vector<float>& tier1,
+                                     std::vector<float>& post) const
 {
 	if (tier1.size() != f.cells.size())
 		throw std::invalid_argument(
-			"CFlowConsistencyGrid::posterior: one tier-1 value per cell "
-			"expected");
+		    "CFlowConsistencyGrid::posterior: one tier-1 value per cell "
+		    "expected");
 	std::vector<uint32_t> k, l;
 	countLabels(f, labels, k, l);
 	const auto& p = params_;
@@ -85,16 +86,16 @@ void CFlowConsistencyGrid::posterior(
 	const bool veto = p.flow_evidence == FlowEvidence::Veto;
 	post.resize(f.cells.size());
 	for (size_t i = 0; i < f.cells.size(); ++i)
-		post[i] = (k[i] == 0 && l[i] == 0)
-			? tier1[i]
-			: float(flowPosterior(
-				  tier1[i], p.flow_transition_tau, p.p_miss, logLambda, k[i],
-				  l[i], veto));
+		post[i] =
+		    (k[i] == 0 && l[i] == 0)
+		        ? tier1[i]
+		        : float(flowPosterior(tier1[i], p.flow_transition_tau, p.p_miss,
+		                              logLambda, k[i], l[i], veto));
 }
 
-void CFlowConsistencyGrid::computePosterior(
-	const FrameCloud& f, const std::vector<float>& priorO,
-	std::vector<float>& post)
+void CFlowConsistencyGrid::computePosterior(const FrameCloud& f,
+                                            const std::vector<float>& priorO,
+                                            std::vector<float>& post)
 {
 	CBackgroundSubtractionGrid t1(params_);
 	t1.posterior(f, priorO, t1scratch_);

@@ -1,1 +1,129 @@
-// placeholder
+// Static (ghost-free) map export: PLY and OctoMap .bt, and the drawing.
+#include <bims/maps/export.h>
+#include <bims/maps/motion_grids.h>
+
+#include <mrpt/opengl/COctoMapVoxels.h>
+#include <mrpt/opengl/CSetOfObjects.h>
+#include <mrpt/system/filesystem.h>
+
+#include <gtest/gtest.h>
+#include <octomap/OcTree.h>
+
+#include <fstream>
+
+#include "scene_raycaster.h"
+
+using namespace bims::maps;
+using namespace bims::maps::test;
+
+namespace
+{
+// Static room seen for a few frames, then a box moving through it.
+MotionGrids& scenario()
+{
+	static MotionGrids mg(
+	    []
+	    {
+		    GridParams p;
+		    p.decay = DecayMode::Raycast;
+		    p.voxel_size = 0.1;
+		    return p;
+	    }());
+	if (mg.occupancy()->frameCount() > 0) return mg;
+	const auto scene = room();
+	const mrpt::poses::CPose3D T(-2, 0, 1.2, 0, 0, 0);
+	for (int f = 0; f < 10; ++f)
+	{
+		auto s = scene;
+		if (f >= 6)
+			s.push_back({{0.5, -1.0 + 0.3 * (f - 6), 0.5},
+			             {0.8, -0.6 + 0.3 * (f - 6), 1.6}});
+		mg.processFrame(*renderScan(s, T, 96, 72, 70, f), T, nullptr);
+	}
+	return mg;
+}
+
+std::string tmpPath(const std::string& name)
+{
+	return mrpt::system::getTempFileName() + "_" + name;
+}
+}  // namespace
+
+TEST(Export, StaticMapExcludesMovingVoxels)
+{
+	auto& mg = scenario();
+	const auto all = staticOccupiedKeys(*mg.occupancy(), nullptr);
+	const auto stat = staticOccupiedKeys(*mg.occupancy(), mg.flow().get());
+	ASSERT_GT(mg.flow()->movingCells().size(), 5u);
+	EXPECT_LT(stat.size(), all.size());
+	// No voxel of the box region in the static map.
+	for (const auto& k : stat)
+	{
+		const auto c = mg.occupancy()->centerOf(k);
+		const bool inBoxPath = c.x > 0.45 && c.x < 0.85 && c.z > 0.5 &&
+		                       c.z < 1.6 && c.y > -1.05 && c.y < 0.35;
+		EXPECT_FALSE(inBoxPath) << c.x << " " << c.y << " " << c.z;
+	}
+}
+
+TEST(Export, PlyHeaderAndSize)
+{
+	auto& mg = scenario();
+	const auto path = tmpPath("static.ply");
+	const size_t n = writeStaticPly(path, *mg.occupancy(), mg.flow().get());
+	std::ifstream f(path, std::ios::binary);
+	std::string line, header;
+	while (std::getline(f, line) && line != "end_header") header += line + "\n";
+	EXPECT_NE(header.find("format binary_little_endian 1.0"),
+	          std::string::npos);
+	EXPECT_NE(header.find("element vertex " + std::to_string(n)),
+	          std::string::npos);
+	const auto pos = f.tellg();
+	f.seekg(0, std::ios::end);
+	EXPECT_EQ(size_t(f.tellg() - pos), n * 16);
+	EXPECT_THROW(
+	    writeStaticPly("/nonexistent_dir/x.ply", *mg.occupancy(), nullptr),
+	    std::runtime_error);
+}
+
+TEST(Export, OctomapBtReadsBackWithTheSameOccupiedVoxels)
+{
+	auto& mg = scenario();
+	const auto path = tmpPath("static.bt");
+	const size_t n = writeStaticOctomap(path, *mg.occupancy(), mg.flow().get());
+	ASSERT_GT(n, 100u);
+	octomap::OcTree tree(0.1);
+	ASSERT_TRUE(tree.readBinary(path));
+	EXPECT_NEAR(tree.getResolution(), 0.1, 1e-9);
+	size_t occ = 0;
+	for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it)
+		if (tree.isNodeOccupied(*it))
+			occ += size_t(1) << (3 * (tree.getTreeDepth() - it.getDepth()));
+	EXPECT_EQ(occ, n);
+	for (const auto& k : staticOccupiedKeys(*mg.occupancy(), mg.flow().get()))
+	{
+		const auto c = mg.occupancy()->centerOf(k);
+		auto* node = tree.search(c.x, c.y, c.z);
+		ASSERT_NE(node, nullptr);
+		EXPECT_TRUE(tree.isNodeOccupied(node));
+	}
+}
+
+TEST(Export, VisualisationUsesThePaperColours)
+{
+	auto& mg = scenario();
+	mrpt::opengl::CSetOfObjects o0, o1, o2;
+	mg.occupancy()->getVisualizationInto(o0);
+	mg.background()->getVisualizationInto(o1);
+	mg.flow()->getVisualizationInto(o2);
+	auto colourOf = [](const mrpt::opengl::CSetOfObjects& o)
+	{
+		auto v = o.getByClass<mrpt::opengl::COctoMapVoxels>();
+		EXPECT_TRUE(v);
+		EXPECT_GT(v->getVoxelCount(0), 0u);
+		return v->getVoxel(0, 0).color;
+	};
+	EXPECT_EQ(colourOf(o0), mrpt::img::TColor(0, 0, 255, 255));
+	EXPECT_EQ(colourOf(o1), mrpt::img::TColor(255, 255, 0, 255));
+	EXPECT_EQ(colourOf(o2), mrpt::img::TColor(255, 0, 0, 255));
+}

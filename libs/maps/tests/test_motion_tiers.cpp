@@ -1,1 +1,117 @@
-// placeholder
+// Tiers 1 and 2 in the grids: closed forms applied with the right O-, order
+// independence of a linked tier-0 map, and MotionGrids == individual maps.
+#include <bims/maps/closed_form.h>
+#include <bims/maps/motion_grids.h>
+
+#include <gtest/gtest.h>
+
+#include "scene_raycaster.h"
+#include "test_util.h"
+
+using namespace bims::maps;
+using bims::maps::test::frameAt;
+
+TEST(BackgroundGrid, PosteriorUsesOccupancyBeforeThisFrame)
+{
+	GridParams p;
+	MotionGrids mg(p);
+	const VoxelKey k{1, 2, 3};
+	std::vector<double> expected;
+	double lOcc = 0;
+	for (int f = 1; f <= 4; ++f)
+	{
+		const auto fr = frameAt(p, {k}, {2}, {0, 0, 0}, f);
+		mg.processFrame(fr, nullptr);
+		const double want = backgroundPosterior(
+		    lOcc, p.bg_transition_eps, p.p_miss, std::log(p.reading_lambda), 2);
+		ASSERT_EQ(mg.background()->lastPosterior().size(), 1u);
+		EXPECT_NEAR(mg.background()->lastPosterior()[0], want, 1e-5) << f;
+		lOcc = fromFixed(mg.occupancy()->logOddsFixed(k));
+	}
+	// A voxel hit in every frame becomes background after a few frames.
+	EXPECT_LT(mg.background()->lastPosterior()[0], 0);
+	EXPECT_FALSE(mg.background()->wasMovingAtLastHit(k));
+}
+
+TEST(BackgroundGrid, LinkedTier0OrderDoesNotMatter)
+{
+	GridParams p;
+	auto t0a = std::make_shared<COccupancyBayesGrid>(p);
+	auto t0b = std::make_shared<COccupancyBayesGrid>(p);
+	CBackgroundSubtractionGrid before(p), after(p);
+	before.linkOccupancy(t0a);
+	after.linkOccupancy(t0b);
+	using namespace bims::maps::test;
+	const auto scene = room();
+	for (int f = 0; f < 4; ++f)
+	{
+		const mrpt::poses::CPose3D T(0.1 * f, 0, 1, 0.05 * f, 0, 0);
+		auto scan = renderScan(scene, T, 40, 30, 60, f);
+		before.insertObservation(*scan, T);  // tier 1 first
+		t0a->insertObservation(*scan, T);
+		t0b->insertObservation(*scan, T);  // tier 0 first
+		after.insertObservation(*scan, T);
+		ASSERT_EQ(before.lastPosterior(), after.lastPosterior()) << f;
+		ASSERT_EQ(before.lastMovingMask().data, after.lastMovingMask().data);
+	}
+}
+
+TEST(MotionGrids, SameResultAsIndividualMapsThroughInsertObservation)
+{
+	GridParams p;
+	MotionGrids mg(p);
+	CBackgroundSubtractionGrid t1(p);  // private tier-0 map
+	CFlowConsistencyGrid t2(p);
+	using namespace bims::maps::test;
+	auto scene = room();
+	for (int f = 0; f < 5; ++f)
+	{
+		scene.push_back({{2.0, -1.0 + 0.2 * f, 0}, {2.3, -0.7 + 0.2 * f, 1.5}});
+		const mrpt::poses::CPose3D T(0, 0, 1, 0, 0, 0);
+		auto scan = renderScan(scene, T, 64, 48, 60, f);
+		PixelLabels labels(64, 48, 0);
+		for (size_t i = 0; i < labels.label.size(); i += 3) labels.label[i] = 1;
+		const auto& res = mg.processFrame(*scan, T, &labels);
+		t1.insertObservation(*scan, T);
+		t2.setPendingLabels(labels);
+		t2.insertObservation(*scan, T);
+		ASSERT_EQ(res.maskTier1.data, t1.lastMovingMask().data);
+		ASSERT_EQ(res.maskTier2.data, t2.lastMovingMask().data);
+		ASSERT_EQ(mg.flow()->lastPosterior(), t2.lastPosterior());
+		scene.pop_back();
+	}
+}
+
+TEST(FlowGrid, LabelsMoveTheDecisionAsTheModelSays)
+{
+	GridParams p;
+	p.flow_transition_tau = 0.05;
+	MotionGrids mg(p);
+	const VoxelKey k{0, 0, 0};
+	// Build a background voxel (tier 1 negative) over a few frames.
+	for (int f = 1; f <= 4; ++f)
+		mg.processFrame(frameAt(p, {k}, {3}, {0, 0, 0}, f), nullptr);
+	const double l1 = mg.background()->lastPosterior()[0];
+	ASSERT_LT(l1, 0);
+	ASSERT_GT(l1, -std::log(0.95 / 0.05));  // within tau's reach
+	// All readings Diff: tier 2 overturns tier 1.
+	auto fr = frameAt(p, {k}, {3}, {0, 0, 0}, 5);
+	fr.K.width = 3;
+	fr.K.height = 1;
+	PixelLabels diff(3, 1, 1), same(3, 1, 0);
+	std::vector<float> post;
+	std::vector<float> t1 = {float(l1)};
+	mg.flow()->posterior(fr, diff, t1, post);
+	EXPECT_GT(post[0], 0);
+	mg.flow()->posterior(fr, same, t1, post);
+	EXPECT_LT(post[0], l1);
+	// Veto: Diff readings alone carry no evidence.
+	GridParams pv = p;
+	pv.flow_evidence = FlowEvidence::Veto;
+	CFlowConsistencyGrid veto(pv);
+	veto.posterior(fr, diff, t1, post);
+	EXPECT_NEAR(post[0], l1, 1e-6);
+	// Wrong label size is an error, not a silently wrong answer.
+	EXPECT_THROW(mg.flow()->posterior(fr, PixelLabels(4, 1, 1), t1, post),
+	             std::invalid_argument);
+}

@@ -1,1 +1,129 @@
-// placeholder
+// Versioned serialisation round trips (polymorphic, through CArchive).
+#include <bims/maps/motion_grids.h>
+
+#include <mrpt/io/CMemoryStream.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <gtest/gtest.h>
+
+#include "scene_raycaster.h"
+
+using namespace bims::maps;
+
+namespace
+{
+template <class T>
+std::shared_ptr<T> roundTrip(const T& m)
+{
+	mrpt::io::CMemoryStream buf;
+	auto arch = mrpt::serialization::archiveFrom(buf);
+	arch << m;
+	buf.Seek(0);
+	auto obj = arch.ReadObject();
+	auto out = std::dynamic_pointer_cast<T>(obj);
+	EXPECT_TRUE(out) << "ReadObject returned "
+	                 << (obj ? obj->GetRuntimeClass()->className : "null");
+	return out;
+}
+
+void feed(MotionGrids& mg, int frames, int first = 0)
+{
+	using namespace bims::maps::test;
+	auto scene = room();
+	for (int f = first; f < first + frames; ++f)
+	{
+		scene.push_back({{2.0, -1.0 + 0.2 * f, 0}, {2.3, -0.7 + 0.2 * f, 1.5}});
+		const mrpt::poses::CPose3D T(0.05 * f, 0, 1, 0.1 * f, 0, 0);
+		PixelLabels lab(48, 36, 1);
+		mg.processFrame(*renderScan(scene, T, 48, 36, 60, f), T, &lab);
+		scene.pop_back();
+	}
+}
+}  // namespace
+
+TEST(Serialization, OccupancyRoundTripIsExactAndKeepsWorking)
+{
+	for (auto mode : {DecayMode::All, DecayMode::Frustum, DecayMode::Raycast})
+	{
+		GridParams p;
+		p.decay = mode;
+		p.voxel_size = 0.1;
+		MotionGrids mg(p);
+		feed(mg, 3);
+		const auto& a = *mg.occupancy();
+		auto b = roundTrip(a);
+		ASSERT_TRUE(b);
+		EXPECT_EQ(b->params(), a.params());
+		EXPECT_EQ(b->frameCount(), a.frameCount());
+		size_t n = 0;
+		a.storage().forEachCell(
+		    [&](const VoxelKey& k, const auto& c)
+		    {
+			    const auto* d = b->storage().find(k);
+			    ASSERT_NE(d, nullptr);
+			    ASSERT_EQ(d->l, c.l);
+			    ASSERT_EQ(d->lPrev, c.lPrev);
+			    ASSERT_EQ(d->stamp, c.stamp);
+			    ++n;
+		    });
+		EXPECT_GT(n, 1000u);
+		EXPECT_EQ(b->storage().numBlocks(), a.storage().numBlocks());
+	}
+}
+
+TEST(Serialization, MotionTiersRoundTrip)
+{
+	GridParams p;
+	p.voxel_size = 0.1;
+	MotionGrids mg(p);
+	feed(mg, 4);
+	auto t1 = roundTrip(*mg.background());
+	auto t2 = roundTrip(*mg.flow());
+	ASSERT_TRUE(t1 && t2);
+	EXPECT_EQ(t1->lastPosterior(), mg.background()->lastPosterior());
+	EXPECT_EQ(t2->lastPosterior(), mg.flow()->lastPosterior());
+	EXPECT_EQ(t2->lastMovingMask().data, mg.flow()->lastMovingMask().data);
+	EXPECT_EQ(t2->lastMovingMask().width, 48);
+	EXPECT_EQ(t1->movingCells().size(), mg.background()->movingCells().size());
+	EXPECT_EQ(t1->frameCount(), 4u);
+}
+
+TEST(Serialization, StandaloneTier1KeepsItsPrivateTier0)
+{
+	using namespace bims::maps::test;
+	GridParams p;
+	p.voxel_size = 0.1;
+	CBackgroundSubtractionGrid a(p);
+	const auto scene = room();
+	const mrpt::poses::CPose3D T(0, 0, 1, 0, 0, 0);
+	for (int f = 0; f < 3; ++f)
+		a.insertObservation(*renderScan(scene, T, 40, 30, 60, f), T);
+	auto b = roundTrip(a);
+	ASSERT_TRUE(b);
+	// Both continue identically: the private tier 0 came along.
+	auto scan = renderScan(scene, T, 40, 30, 60, 3);
+	a.insertObservation(*scan, T);
+	b->insertObservation(*scan, T);
+	EXPECT_EQ(a.lastPosterior(), b->lastPosterior());
+	EXPECT_EQ(b->occupancySource().frameCount(), 4u);
+}
+
+TEST(Serialization, CorruptStreamThrows)
+{
+	GridParams p;
+	p.voxel_size = 0.1;
+	MotionGrids mg(p);
+	feed(mg, 1);
+	mrpt::io::CMemoryStream buf;
+	auto arch = mrpt::serialization::archiveFrom(buf);
+	arch << *mg.occupancy();
+	// Truncate the stream.
+	std::vector<uint8_t> bytes(
+	    static_cast<const uint8_t*>(buf.getRawBufferData()),
+	    static_cast<const uint8_t*>(buf.getRawBufferData()) +
+	        buf.getTotalBytesCount() / 2);
+	mrpt::io::CMemoryStream half;
+	half.assignMemoryNotOwn(bytes.data(), bytes.size());
+	auto a2 = mrpt::serialization::archiveFrom(half);
+	EXPECT_ANY_THROW(a2.ReadObject());
+}

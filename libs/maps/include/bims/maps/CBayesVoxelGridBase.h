@@ -20,7 +20,7 @@ class CBayesVoxelGridBase : public mrpt::maps::CMetricMap
 {
 	DEFINE_VIRTUAL_SERIALIZABLE(CBayesVoxelGridBase)
 
-   public:
+ public:
 	/** \throws std::invalid_argument if \a p is inconsistent. */
 	explicit CBayesVoxelGridBase(const GridParams& p = {});
 
@@ -42,9 +42,9 @@ class CBayesVoxelGridBase : public mrpt::maps::CMetricMap
 	/** Builds the FrameCloud of a 3D range scan taken from \a robotPose
 	 * (T_WS = robotPose + scan.sensorPose), accounting for bad input.
 	 * Returns false (frame skipped) for a non-finite pose. */
-	bool buildFrame(
-		const mrpt::obs::CObservation3DRangeScan& scan,
-		const mrpt::poses::CPose3D& robotPose, FrameCloud& out) const;
+	bool buildFrame(const mrpt::obs::CObservation3DRangeScan& scan,
+	                const mrpt::poses::CPose3D& robotPose,
+	                FrameCloud& out) const;
 
 	/** Adds a frame's statistics to the totals; warns once per reason on
 	 * stderr. Called by the update functions. */
@@ -52,12 +52,12 @@ class CBayesVoxelGridBase : public mrpt::maps::CMetricMap
 
 	bool isEmpty() const override { return frameCount_ == 0; }
 
-   protected:
+ protected:
 	double internal_computeObservationLikelihood(
-		const mrpt::obs::CObservation& obs,
-		const mrpt::poses::CPose3D& takenFrom) const override;
+	    const mrpt::obs::CObservation& obs,
+	    const mrpt::poses::CPose3D& takenFrom) const override;
 	bool internal_canComputeObservationLikelihood(
-		const mrpt::obs::CObservation& obs) const override;
+	    const mrpt::obs::CObservation& obs) const override;
 
 	/** Resets counters (called by derived internal_clear()). */
 	void clearBase();
@@ -68,10 +68,10 @@ class CBayesVoxelGridBase : public mrpt::maps::CMetricMap
 
 	/** Appends cubes of side voxel_size at \a centers with \a color to the
 	 * visualisation (an mrpt::opengl::COctoMapVoxels). */
-	void addVoxelsTo(
-		mrpt::opengl::CSetOfObjects& o,
-		const std::vector<mrpt::math::TPoint3D>& centers,
-		const mrpt::img::TColor& color, const std::string& name) const;
+	void addVoxelsTo(mrpt::opengl::CSetOfObjects& o,
+	                 const std::vector<mrpt::math::TPoint3D>& centers,
+	                 const mrpt::img::TColor& color,
+	                 const std::string& name) const;
 
 	GridParams params_;
 	uint32_t frameCount_ = 0;

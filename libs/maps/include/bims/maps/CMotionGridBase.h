@@ -23,7 +23,7 @@ class CMotionGridBase : public CBayesVoxelGridBase
 {
 	DEFINE_VIRTUAL_SERIALIZABLE(CMotionGridBase)
 
-   public:
+ public:
 	/** Stored posterior log-odds of I at the voxel's last hit frame. */
 	struct Cell
 	{
@@ -71,24 +71,23 @@ class CMotionGridBase : public CBayesVoxelGridBase
 	std::string asString() const override;
 	/** Writes <prefix>_moving.ply (the last frame's moving voxels). */
 	void saveMetricMapRepresentationToFile(
-		const std::string& prefix) const override;
+	    const std::string& prefix) const override;
 
-   protected:
+ protected:
 	/** Posterior log-odds per frame.cell from O- (tier specific). */
-	virtual void computePosterior(
-		const FrameCloud& frame, const std::vector<float>& priorO,
-		std::vector<float>& post) = 0;
+	virtual void computePosterior(const FrameCloud& frame,
+	                              const std::vector<float>& priorO,
+	                              std::vector<float>& post) = 0;
 
 	void internal_clear() override;
 	bool internal_insertObservation(
-		const mrpt::obs::CObservation& obs,
-		const std::optional<const mrpt::poses::CPose3D>& robotPose =
-			std::nullopt) override;
+	    const mrpt::obs::CObservation& obs,
+	    const std::optional<const mrpt::poses::CPose3D>& robotPose =
+	        std::nullopt) override;
 	void writeMotion(mrpt::serialization::CArchive& out) const;
 	void readMotion(mrpt::serialization::CArchive& in);
-	void visualize(
-		mrpt::opengl::CSetOfObjects& o, const mrpt::img::TColor& c,
-		const std::string& name) const;
+	void visualize(mrpt::opengl::CSetOfObjects& o, const mrpt::img::TColor& c,
+	               const std::string& name) const;
 
 	Storage grid_;
 	std::vector<float> lastPost_;
@@ -106,13 +105,12 @@ class CBackgroundSubtractionGrid : public CMotionGridBase
 {
 	DEFINE_SERIALIZABLE(CBackgroundSubtractionGrid, bims::maps)
 
-   public:
+ public:
 	explicit CBackgroundSubtractionGrid(const GridParams& p = {});
 
 	/** Tier-1 posterior log-odds for each of frame.cells from O-. */
-	void posterior(
-		const FrameCloud& frame, const std::vector<float>& priorO,
-		std::vector<float>& post) const;
+	void posterior(const FrameCloud& frame, const std::vector<float>& priorO,
+	               std::vector<float>& post) const;
 
 	void getVisualizationInto(mrpt::opengl::CSetOfObjects& o) const override;
 
@@ -120,10 +118,10 @@ class CBackgroundSubtractionGrid : public CMotionGridBase
 	GridParams params;
 	MAP_DEFINITION_END(CBackgroundSubtractionGrid)
 
-   protected:
-	void computePosterior(
-		const FrameCloud& frame, const std::vector<float>& priorO,
-		std::vector<float>& post) override
+ protected:
+	void computePosterior(const FrameCloud& frame,
+	                      const std::vector<float>& priorO,
+	                      std::vector<float>& post) override
 	{
 		posterior(frame, priorO, post);
 	}
@@ -139,7 +137,7 @@ class CFlowConsistencyGrid : public CMotionGridBase
 {
 	DEFINE_SERIALIZABLE(CFlowConsistencyGrid, bims::maps)
 
-   public:
+ public:
 	explicit CFlowConsistencyGrid(const GridParams& p = {});
 
 	/** Labels for the next insertObservation(). */
@@ -148,15 +146,14 @@ class CFlowConsistencyGrid : public CMotionGridBase
 	/** Counts the Diff (k) and notDiff (l) readings of each frame cell.
 	 * Throws std::invalid_argument if the label image size differs from
 	 * the frame's. */
-	static void countLabels(
-		const FrameCloud& frame, const PixelLabels& labels,
-		std::vector<uint32_t>& k, std::vector<uint32_t>& l);
+	static void countLabels(const FrameCloud& frame, const PixelLabels& labels,
+	                        std::vector<uint32_t>& k, std::vector<uint32_t>& l);
 
 	/** Tier-2 posterior log-odds for each of frame.cells from the tier-1
 	 * posterior log-odds \a tier1 and the labels. */
-	void posterior(
-		const FrameCloud& frame, const PixelLabels& labels,
-		const std::vector<float>& tier1, std::vector<float>& post) const;
+	void posterior(const FrameCloud& frame, const PixelLabels& labels,
+	               const std::vector<float>& tier1,
+	               std::vector<float>& post) const;
 
 	void getVisualizationInto(mrpt::opengl::CSetOfObjects& o) const override;
 
@@ -164,12 +161,12 @@ class CFlowConsistencyGrid : public CMotionGridBase
 	GridParams params;
 	MAP_DEFINITION_END(CFlowConsistencyGrid)
 
-   protected:
-	void computePosterior(
-		const FrameCloud& frame, const std::vector<float>& priorO,
-		std::vector<float>& post) override;
+ protected:
+	void computePosterior(const FrameCloud& frame,
+	                      const std::vector<float>& priorO,
+	                      std::vector<float>& post) override;
 
-   private:
+ private:
 	PixelLabels pending_;
 	std::vector<float> t1scratch_;
 };

@@ -23,7 +23,7 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 {
 	DEFINE_SERIALIZABLE(COccupancyBayesGrid, bims::maps)
 
-   public:
+ public:
 	/** Storage cell: fixed-point log-odds at frame `stamp`, and the value
 	 * O- it had just before that frame's update. Never-touched cells are
 	 * {0, 0, 0}: the prior 0.5 before frame 1. */
@@ -43,8 +43,8 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 	/** Folds one frame in (frame number frameCount()+1). If
 	 * \a priorLogOdds is given it receives O- (log-odds before this frame,
 	 * after lazy decay) for each of frame.cells, for tier 1. */
-	void integrate(
-		const FrameCloud& frame, std::vector<float>* priorLogOdds = nullptr);
+	void integrate(const FrameCloud& frame,
+	               std::vector<float>* priorLogOdds = nullptr);
 
 	/** O- for each of frame.cells, without modifying the map. Order
 	 * independent: if this frame (same non-zero timestamp) was already
@@ -76,20 +76,20 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 	std::string asString() const override;
 	/** Writes <prefix>_occupied.ply (voxels with p > 0.5). */
 	void saveMetricMapRepresentationToFile(
-		const std::string& prefix) const override;
+	    const std::string& prefix) const override;
 
 	MAP_DEFINITION_START(COccupancyBayesGrid)
 	GridParams params;
 	MAP_DEFINITION_END(COccupancyBayesGrid)
 
-   protected:
+ protected:
 	void internal_clear() override;
 	bool internal_insertObservation(
-		const mrpt::obs::CObservation& obs,
-		const std::optional<const mrpt::poses::CPose3D>& robotPose =
-			std::nullopt) override;
+	    const mrpt::obs::CObservation& obs,
+	    const std::optional<const mrpt::poses::CPose3D>& robotPose =
+	        std::nullopt) override;
 
-   private:
+ private:
 	void updateConstants();
 	LogOddsFx hitFixedCompute(uint32_t n) const;
 	LogOddsFx currentFixed(const Cell& c) const;

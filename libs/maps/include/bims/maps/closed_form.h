@@ -26,22 +26,21 @@ double missLogOdds(double pMiss);
 
 /** Tier 0 posterior log-odds (unclamped) from prior log-odds \a lPrior and n
  * readings (n = 0: miss). */
-double occupancyPosterior(
-	double lPrior, double pMiss, double logLambda, uint32_t n);
+double occupancyPosterior(double lPrior, double pMiss, double logLambda,
+                          uint32_t n);
 
 /** Tier 1 prior of I from the previous occupancy O- (log-odds):
  * q = (1 - p-) (1 - eps) + p- eps, returned as log-odds. */
 double backgroundPriorLogOdds(double lOccPrev, double eps);
 
 /** Tier 1 posterior log-odds of I for a hit cell with n readings. */
-double backgroundPosterior(
-	double lOccPrev, double eps, double pMiss, double logLambda, uint32_t n);
+double backgroundPosterior(double lOccPrev, double eps, double pMiss,
+                           double logLambda, uint32_t n);
 
 /** Tier 2 posterior log-odds of I for a hit cell with k Diff and l notDiff
  * readings, from the tier-1 posterior log-odds \a lI. \a veto selects the
  * literal reading of Diff readings (docs/model.md). */
-double flowPosterior(
-	double lI, double tau, double pMiss, double logFlowLambda, uint32_t k,
-	uint32_t l, bool veto);
+double flowPosterior(double lI, double tau, double pMiss, double logFlowLambda,
+                     uint32_t k, uint32_t l, bool veto);
 
 }  // namespace bims::maps

@@ -15,11 +15,14 @@ using std::size_t;
 
 class FlatHashMap
 {
-   public:
+ public:
 	static constexpr uint64_t kEmpty = ~uint64_t(0);
 	static constexpr uint32_t kNotFound = ~uint32_t(0);
 
-	explicit FlatHashMap(size_t initialCapacity = 64) { rehash(initialCapacity); }
+	explicit FlatHashMap(size_t initialCapacity = 64)
+	{
+		rehash(initialCapacity);
+	}
 
 	size_t size() const { return size_; }
 	size_t capacity() const { return keys_.size(); }
@@ -27,7 +30,7 @@ class FlatHashMap
 	size_t memoryBytes() const
 	{
 		return keys_.capacity() * sizeof(uint64_t) +
-			vals_.capacity() * sizeof(uint32_t);
+		       vals_.capacity() * sizeof(uint32_t);
 	}
 
 	/** Value of \a key, or kNotFound. */
@@ -79,7 +82,7 @@ class FlatHashMap
 			if (keys_[i] != kEmpty) f(keys_[i], vals_[i]);
 	}
 
-   private:
+ private:
 	size_t slot(uint64_t key) const
 	{
 		return size_t((key * 0x9E3779B97F4A7C15ull) >> shift_);

@@ -35,7 +35,7 @@ struct PixelLabels
 
 	PixelLabels() = default;
 	PixelLabels(int w, int h, int8_t fill = -1)
-		: width(w), height(h), label(size_t(w) * size_t(h), fill)
+	    : width(w), height(h), label(size_t(w) * size_t(h), fill)
 	{
 	}
 	int8_t at(int u, int v) const { return label[size_t(v) * width + u]; }
@@ -59,13 +59,13 @@ struct PixelMask
 /** Readings skipped while building a frame, by reason. */
 struct FrameStats
 {
-	size_t valid = 0;  //!< readings used
-	size_t noDepth = 0;  //!< zero depth (no reading)
-	size_t nonFinite = 0;  //!< NaN or inf coordinates
-	size_t beyondRange = 0;  //!< farther than max_range
+	size_t valid = 0;          //!< readings used
+	size_t noDepth = 0;        //!< zero depth (no reading)
+	size_t nonFinite = 0;      //!< NaN or inf coordinates
+	size_t beyondRange = 0;    //!< farther than max_range
 	size_t outsideExtent = 0;  //!< outside the configured extent
-	size_t overBudget = 0;  //!< cells not created: memory budget
-	bool badPose = false;  //!< the pose was not finite: frame skipped
+	size_t overBudget = 0;     //!< cells not created: memory budget
+	bool badPose = false;      //!< the pose was not finite: frame skipped
 	FrameStats& operator+=(const FrameStats& o);
 	size_t skipped() const
 	{
@@ -122,7 +122,7 @@ struct FrameCloud
  * Not thread-safe (one builder per thread). */
 class FrameCloudBuilder
 {
-   public:
+ public:
 	explicit FrameCloudBuilder(const GridParams& p = {});
 	void setParams(const GridParams& p);
 
@@ -131,23 +131,21 @@ class FrameCloudBuilder
 	 * robotPose + sensorPose yourself). A non-finite pose yields an empty
 	 * frame with stats.badPose = true. Throws std::invalid_argument if the
 	 * scan has no range image or its camera size differs from the image. */
-	void build(
-		const mrpt::obs::CObservation3DRangeScan& scan,
-		const mrpt::poses::CPose3D& T_WS, FrameCloud& out);
+	void build(const mrpt::obs::CObservation3DRangeScan& scan,
+	           const mrpt::poses::CPose3D& T_WS, FrameCloud& out);
 
 	/** From points already in {W}, with the sensor origin (e.g. a
 	 * simulator or a LiDAR). \a pixels may be empty (unorganised cloud). */
-	void buildFromPoints(
-		const std::vector<mrpt::math::TPoint3Df>& points_W,
-		const std::vector<uint32_t>& pixels,
-		const mrpt::math::TPoint3D& origin_W, FrameCloud& out,
-		const Intrinsics& K = {});
+	void buildFromPoints(const std::vector<mrpt::math::TPoint3Df>& points_W,
+	                     const std::vector<uint32_t>& pixels,
+	                     const mrpt::math::TPoint3D& origin_W, FrameCloud& out,
+	                     const Intrinsics& K = {});
 
 	/** Keys the points of \a out (points_W, pixel already filled):
 	 * fills cellOfPoint, cells, hits and the extent/range statistics. */
 	void keyPoints(FrameCloud& out);
 
-   private:
+ private:
 	GridParams p_;
 	FlatHashMap dedup_;  // packed voxel key -> index into cells
 };

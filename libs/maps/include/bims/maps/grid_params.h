@@ -94,9 +94,9 @@ struct GridParams
 	/** Reads the keys above from \a section (strict: unknown keys throw
 	 * bims::ConfigError naming file, section and key). Keys in
 	 * \a alsoAllowed are accepted without being read. */
-	void loadFromConfigFile(
-		const mrpt::config::CConfigFileBase& cfg, const std::string& section,
-		const std::vector<std::string>& alsoAllowed = {});
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+	                        const std::string& section,
+	                        const std::vector<std::string>& alsoAllowed = {});
 
 	/** Writes every key (for dumps, serialisation checks). */
 	void dump(std::ostream& out) const;

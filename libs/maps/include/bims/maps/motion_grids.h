@@ -26,19 +26,19 @@ struct MotionFrameResult
  * gives the moving voxels and the masks. */
 class MotionGrids
 {
-   public:
+ public:
 	explicit MotionGrids(const GridParams& p = {});
 
 	/** One frame from a scan and the pose T_WS of its scan frame {S} in
 	 * {W} (scan.sensorPose is NOT added). \a labels may be null (no flow:
 	 * tier 2 = tier 1). */
 	const MotionFrameResult& processFrame(
-		const mrpt::obs::CObservation3DRangeScan& scan,
-		const mrpt::poses::CPose3D& T_WS, const PixelLabels* labels);
+	    const mrpt::obs::CObservation3DRangeScan& scan,
+	    const mrpt::poses::CPose3D& T_WS, const PixelLabels* labels);
 	/** Same, for a FrameCloud built by the caller with the same voxel
 	 * size (throws std::invalid_argument otherwise). */
-	const MotionFrameResult& processFrame(
-		const FrameCloud& frame, const PixelLabels* labels);
+	const MotionFrameResult& processFrame(const FrameCloud& frame,
+	                                      const PixelLabels* labels);
 
 	/** The FrameCloud of the last processFrame(scan, ...). */
 	const FrameCloud& lastFrame() const { return frame_; }
@@ -53,7 +53,7 @@ class MotionGrids
 	const GridParams& params() const { return p_; }
 	void clear();
 
-   private:
+ private:
 	GridParams p_;
 	std::shared_ptr<COccupancyBayesGrid> t0_;
 	std::shared_ptr<CBackgroundSubtractionGrid> t1_;

@@ -17,7 +17,7 @@ namespace bims::maps
 template <class Cell, int Log2Dim = 3>
 class SparseVoxelGrid
 {
-   public:
+ public:
 	static constexpr int kDim = 1 << Log2Dim;
 	static constexpr int kMask = kDim - 1;
 	static constexpr size_t kCellsPerBlock = size_t(kDim) * kDim * kDim;
@@ -29,7 +29,7 @@ class SparseVoxelGrid
 	/** \param maxBytes budget for blocks + index; beyond it findOrCreate()
 	 * returns nullptr. */
 	explicit SparseVoxelGrid(size_t maxBytes = size_t(1) << 40)
-		: maxBytes_(maxBytes)
+	    : maxBytes_(maxBytes)
 	{
 	}
 	SparseVoxelGrid(const SparseVoxelGrid& o) { *this = o; }
@@ -40,7 +40,8 @@ class SparseVoxelGrid
 		index_ = o.index_;
 		blockKeys_ = o.blockKeys_;
 		blocks_.clear();
-		for (const auto& b : o.blocks_) blocks_.push_back(std::make_unique<Block>(*b));
+		for (const auto& b : o.blocks_)
+			blocks_.push_back(std::make_unique<Block>(*b));
 		return *this;
 	}
 
@@ -51,7 +52,7 @@ class SparseVoxelGrid
 	static size_t cellIndexOf(int32_t x, int32_t y, int32_t z)
 	{
 		return size_t(x & kMask) | (size_t(y & kMask) << Log2Dim) |
-			(size_t(z & kMask) << (2 * Log2Dim));
+		       (size_t(z & kMask) << (2 * Log2Dim));
 	}
 
 	/** Cell at \a k, or nullptr if its block does not exist. */
@@ -106,9 +107,8 @@ class SparseVoxelGrid
 	VoxelKey cellKey(size_t i, size_t c) const
 	{
 		const VoxelKey o = blockOrigin(i);
-		return {
-			o.x + int32_t(c & kMask), o.y + int32_t((c >> Log2Dim) & kMask),
-			o.z + int32_t(c >> (2 * Log2Dim))};
+		return {o.x + int32_t(c & kMask), o.y + int32_t((c >> Log2Dim) & kMask),
+		        o.z + int32_t(c >> (2 * Log2Dim))};
 	}
 
 	/** Calls f(key, cell) for every stored cell. */
@@ -131,7 +131,7 @@ class SparseVoxelGrid
 	size_t memoryBytes() const
 	{
 		return blocks_.size() * (sizeof(Block) + sizeof(void*) + 8) +
-			index_.memoryBytes();
+		       index_.memoryBytes();
 	}
 	size_t maxBytes() const { return maxBytes_; }
 	void setMaxBytes(size_t b) { maxBytes_ = b; }
@@ -139,7 +139,7 @@ class SparseVoxelGrid
 	/** Fast repeated access along a path (rays): caches the last block. */
 	class Accessor
 	{
-	   public:
+	 public:
 		explicit Accessor(SparseVoxelGrid& g) : g_(g) {}
 		/** Cell at voxel (x, y, z), created if needed; nullptr over budget. */
 		Cell* get(int32_t x, int32_t y, int32_t z)
@@ -148,20 +148,21 @@ class SparseVoxelGrid
 			if (bk != lastKey_ || !last_)
 			{
 				const uint32_t b = g_.findOrCreateBlock(bk);
-				last_ = (b == FlatHashMap::kNotFound) ? nullptr : g_.blocks_[b].get();
+				last_ = (b == FlatHashMap::kNotFound) ? nullptr
+				                                      : g_.blocks_[b].get();
 				lastKey_ = bk;
 				if (!last_) return nullptr;
 			}
 			return &last_->cells[cellIndexOf(x, y, z)];
 		}
 
-	   private:
+	 private:
 		SparseVoxelGrid& g_;
 		uint64_t lastKey_ = FlatHashMap::kEmpty;
 		Block* last_ = nullptr;
 	};
 
-   private:
+ private:
 	size_t maxBytes_;
 	FlatHashMap index_;
 	std::vector<uint64_t> blockKeys_;

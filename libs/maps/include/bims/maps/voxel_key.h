@@ -29,14 +29,16 @@ inline uint64_t packKey(int32_t x, int32_t y, int32_t z)
 	constexpr int64_t o = 1 << 20;
 	return (uint64_t(x + o) << 42) | (uint64_t(y + o) << 21) | uint64_t(z + o);
 }
-inline uint64_t packKey(const VoxelKey& k) { return packKey(k.x, k.y, k.z); }
+inline uint64_t packKey(const VoxelKey& k)
+{
+	return packKey(k.x, k.y, k.z);
+}
 inline VoxelKey unpackKey(uint64_t p)
 {
 	constexpr int64_t o = 1 << 20;
 	constexpr uint64_t m = (1u << 21) - 1;
-	return {
-		int32_t(int64_t((p >> 42) & m) - o), int32_t(int64_t((p >> 21) & m) - o),
-		int32_t(int64_t(p & m) - o)};
+	return {int32_t(int64_t((p >> 42) & m) - o),
+	        int32_t(int64_t((p >> 21) & m) - o), int32_t(int64_t(p & m) - o)};
 }
 
 /** Voxel index of a coordinate [m] for voxel size \a res: floor(v / res). */
