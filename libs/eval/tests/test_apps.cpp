@@ -1,0 +1,222 @@
+// End-to-end tests of bims-import-tum and bims-eval (run the built programs).
+#include <bims/common/rawlog.h>
+#include <bims/common/trajectory.h>
+#include <bims/eval/tum_import.h>
+#include <gtest/gtest.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+
+namespace fs = std::filesystem;
+namespace
+{
+const std::string kBin = BIMS_BIN_DIR;
+const std::string kBonn =
+    std::string(BIMS_SHARED_DATA_DIR) + "/bonn_crowd_f150_349";
+
+struct Run
+{
+	int code;
+	std::string out;
+};
+Run run(const std::string& args)
+{
+	const std::string c = args + " 2>&1";
+	FILE* p = popen(c.c_str(), "r");
+	Run r{-1, {}};
+	if (!p) return r;
+	std::array<char, 4096> buf;
+	while (fgets(buf.data(), buf.size(), p)) r.out += buf.data();
+	const int st = pclose(p);
+	r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+	return r;
+}
+std::string tmpDir(const std::string& name)
+{
+	const auto d = fs::temp_directory_path() / "bims_test_eval" / name;
+	fs::remove_all(d);
+	fs::create_directories(d);
+	return d.string();
+}
+std::string lastLine(const std::string& s)
+{
+	auto t = s;
+	while (!t.empty() && t.back() == '\n') t.pop_back();
+	return t.substr(t.rfind('\n') + 1);
+}
+}  // namespace
+
+TEST(ImportTum, BonnTwentyFramesWithConvertedGroundTruth)
+{
+	if (!fs::exists(kBonn + "/depth.txt")) GTEST_SKIP() << "no Bonn sample";
+	const auto d = tmpDir("import");
+	const auto r = run(kBin + "/bims-import-tum " + kBonn + " -o " + d +
+	                   "/b.rawlog --config " + BIMS_SOURCE_DIR +
+	                   "/config/bonn.ini --max-frames 20 -q");
+	ASSERT_EQ(r.code, 0) << r.out;
+	const auto gt = bims::loadTumTrajectory(d + "/b_gt/groundtruth.txt");
+	ASSERT_EQ(gt.size(), 20u);
+	ASSERT_TRUE(fs::exists(d + "/b_gt/calibration.ini"));
+
+	// The first scan: intrinsics, stamp, depth equal to the PNG (1 mm units).
+	bims::RawlogReader rd(d + "/b.rawlog");
+	size_t n = 0;
+	mrpt::obs::CObservation3DRangeScan::Ptr first;
+	while (auto o = rd.next())
+		if (auto s =
+		        std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(
+		            o))
+		{
+			if (!first) first = s;
+			n++;
+		}
+	ASSERT_EQ(n, 20u);
+	EXPECT_EQ(first->sensorLabel, "RGBD");
+	EXPECT_NEAR(first->cameraParams.fx(), 542.822841, 1e-6);
+	EXPECT_NEAR(first->cameraParams.cy(), 237.756098, 1e-6);
+	EXPECT_NEAR(mrpt::Clock::toDouble(first->timestamp), 1548339824.89375,
+	            1e-4);
+	EXPECT_NEAR(gt[0].t, 1548339824.89375, 1e-5);
+	const cv::Mat png =
+	    cv::imread(kBonn + "/depth/1548339824.89375.png", cv::IMREAD_UNCHANGED);
+	ASSERT_EQ(png.type(), CV_16UC1);
+	size_t checked = 0;
+	for (int v = 0; v < 480; v += 7)
+		for (int u = 0; u < 640; u += 7)
+		{
+			const double expect = png.at<uint16_t>(v, u) / 5000.0;
+			EXPECT_NEAR(first->rangeImage(v, u) * first->rangeUnits, expect,
+			            5.1e-4);
+			checked++;
+		}
+	EXPECT_GT(checked, 6000u);
+	EXPECT_TRUE(first->hasIntensityImage);
+	EXPECT_EQ(first->intensityImage.getWidth(), 640u);
+
+	// GT vs itself through bims-eval: zero error, JSON and plot written.
+	const auto e =
+	    run(kBin + "/bims-eval traj " + d + "/b_gt/groundtruth.txt " + d +
+	        "/b_gt/groundtruth.txt --delta 0.3 --json " + d + "/t.json -o " +
+	        d + "/t.png");
+	ASSERT_EQ(e.code, 0) << e.out;
+	EXPECT_NE(e.out.find("ate_rmse 0.0000 m"), std::string::npos) << e.out;
+	EXPECT_TRUE(fs::exists(d + "/t.png"));
+	EXPECT_TRUE(fs::exists(d + "/t.json"));
+
+	// Depth consistency of the converted poses on these frames (5 apart).
+	const auto c = run(kBin + "/bims-eval depth-consistency " + d +
+	                   "/b.rawlog " + d + "/b_gt/groundtruth.txt --gap 5");
+	ASSERT_EQ(c.code, 0) << c.out;
+	double med = 1, still = 0;
+	ASSERT_EQ(
+	    std::sscanf(
+	        c.out.substr(c.out.find("median_abs_dz")).c_str(),
+	        "median_abs_dz %lf m within_5cm %*f no_motion_median_abs_dz %lf",
+	        &med, &still),
+	    2)
+	    << c.out;
+	EXPECT_LT(med, 0.03) << c.out;
+	EXPECT_GT(still, 1.5 * med) << c.out;
+}
+
+TEST(ImportTum, BadInputIsAClearError)
+{
+	const auto d = tmpDir("import_bad");
+	auto r =
+	    run(kBin + "/bims-import-tum " + d + "/nothing -o " + d + "/x.rawlog");
+	EXPECT_EQ(r.code, 1);
+	EXPECT_NE(r.out.find("nothing: not a directory"), std::string::npos)
+	    << r.out;
+	// Malformed rgb.txt line.
+	{
+		std::ofstream(d + "/rgb.txt") << "# c\n1.0 rgb/a.png\nfoo\n";
+		std::ofstream(d + "/depth.txt") << "1.0 depth/a.png\n";
+	}
+	r = run(kBin + "/bims-import-tum " + d + " -o " + d + "/x.rawlog");
+	EXPECT_EQ(r.code, 1);
+	EXPECT_NE(r.out.find("rgb.txt:3: expected 'timestamp filename'"),
+	          std::string::npos)
+	    << r.out;
+	// Missing image.
+	std::ofstream(d + "/rgb.txt") << "1.0 rgb/a.png\n";
+	r = run(kBin + "/bims-import-tum " + d + " -o " + d + "/x.rawlog -q");
+	EXPECT_EQ(r.code, 1);
+	EXPECT_NE(r.out.find("depth/a.png: cannot read depth image"),
+	          std::string::npos)
+	    << r.out;
+	// Unknown key in the config.
+	std::ofstream(d + "/c.ini") << "[camera]\nfx = 500\nfxx = 3\n";
+	r = run(kBin + "/bims-import-tum " + d + " -o " + d +
+	        "/x.rawlog --config " + d + "/c.ini");
+	EXPECT_EQ(r.code, 1);
+	EXPECT_NE(r.out.find("fxx"), std::string::npos) << r.out;
+}
+
+TEST(EvalMasks, HandComputedTotalsAndErrors)
+{
+	const auto d = tmpDir("masks");
+	fs::create_directories(d + "/gt");
+	fs::create_directories(d + "/pred");
+	// Frame 0: gt left half moving, pred left quarter: TP 4x8=32... on 8x8:
+	// gt cols 0-3 (32 px), pred cols 0-1 (16 px): TP 16, FP 0, FN 16.
+	// Frame 1: gt nothing, pred one column (8 px): FP 8.
+	// Total: TP 16, FP 8, FN 16 -> P 16/24, R 0.5, F1 32/56, IoU 16/40.
+	cv::Mat g0(8, 8, CV_8UC1, cv::Scalar(0)), p0 = g0.clone(), g1 = g0.clone(),
+	                                          p1 = g0.clone();
+	g0(cv::Rect(0, 0, 4, 8)) = 255;
+	p0(cv::Rect(0, 0, 2, 8)) = 255;
+	p1(cv::Rect(7, 0, 1, 8)) = 255;
+	cv::imwrite(d + "/gt/000000.png", g0);
+	cv::imwrite(d + "/pred/000000.png", p0);
+	cv::imwrite(d + "/gt/000001.png", g1);
+	cv::imwrite(d + "/pred/000001.png", p1);
+	auto r = run(kBin + "/bims-eval masks " + d + "/gt " + d + "/pred");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_EQ(lastLine(r.out),
+	          "total precision 0.6667 recall 0.5000 F1 0.5714 IoU 0.4000")
+	    << r.out;
+	EXPECT_TRUE(fs::exists(d + "/pred_eval/000001.png"));
+	// A mask of another size is an error naming both files.
+	cv::imwrite(d + "/pred/000001.png", cv::Mat(4, 8, CV_8UC1, cv::Scalar(0)));
+	r = run(kBin + "/bims-eval masks " + d + "/gt " + d + "/pred --no-plots");
+	EXPECT_EQ(r.code, 1);
+	EXPECT_NE(r.out.find("000001.png: mask sizes differ"), std::string::npos)
+	    << r.out;
+	r = run(kBin + "/bims-eval masks " + d + "/gt " + d + "/missing");
+	EXPECT_EQ(r.code, 1);
+	EXPECT_NE(r.out.find("missing: mask directory not found"),
+	          std::string::npos)
+	    << r.out;
+}
+
+TEST(EvalTraj, BadInputIsAClearError)
+{
+	const auto d = tmpDir("traj");
+	std::ofstream(d + "/gt.txt")
+	    << "1 0 0 0 0 0 0 1\n2 1 0 0 0 0 0 1\n3 2 0 0 0 0 0 1\n";
+	std::ofstream(d + "/empty.txt") << "# nothing\n";
+	std::ofstream(d + "/bad.txt") << "1 0 0 0 0 0 0 1\n2 0 0\n";
+	std::ofstream(d + "/late.txt")
+	    << "101 0 0 0 0 0 0 1\n102 1 0 0 0 0 0 1\n103 2 0 0 0 0 0 1\n";
+	auto r = run(kBin + "/bims-eval traj " + d + "/gt.txt " + d + "/empty.txt");
+	EXPECT_EQ(r.code, 1);
+	EXPECT_NE(r.out.find("empty.txt: trajectory is empty"), std::string::npos)
+	    << r.out;
+	r = run(kBin + "/bims-eval traj " + d + "/gt.txt " + d + "/bad.txt");
+	EXPECT_EQ(r.code, 1);
+	EXPECT_NE(r.out.find("bad.txt:2:"), std::string::npos) << r.out;
+	r = run(kBin + "/bims-eval traj " + d + "/gt.txt " + d +
+	        "/late.txt --no-plot");
+	EXPECT_EQ(r.code, 1);
+	EXPECT_NE(r.out.find("no time overlap"), std::string::npos) << r.out;
+	r = run(kBin + "/bims-eval traj " + d + "/gt.txt " + d + "/nofile.txt");
+	EXPECT_EQ(r.code, 1);
+	EXPECT_NE(r.out.find("nofile.txt: file not found"), std::string::npos)
+	    << r.out;
+	r = run(kBin + "/bims-eval frobnicate");
+	EXPECT_EQ(r.code, 2);
+}
