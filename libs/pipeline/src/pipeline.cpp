@@ -95,6 +95,8 @@ const FrameResult& Pipeline::processFrame(
 		r.labels = flow::labelConsistency(obs, exp, cur_.depth, cam, r.T_CprevC,
 		                                  cfg_.flow, &r.labelStats);
 		r.maskFlow.setTo(255, r.labels == static_cast<int8_t>(flow::kDiff));
+		r.flowObserved = obs;
+		r.flowExpected = exp;
 		pixLabels = toPixelLabels(r.labels);
 	}
 	r.ms.flow = msSince(t);

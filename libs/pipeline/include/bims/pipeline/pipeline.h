@@ -44,6 +44,10 @@ struct FrameResult
 	cv::Mat maskTier1, maskTier2, maskFlow;
 	/** Flow labels (CV_8SC1: -1 none, 0 notDiff, 1 Diff); empty on frame 0. */
 	cv::Mat labels;
+	/** Observed and expected backward flow on the current frame's pixels
+	 * (CV_32FC2 [px], u_{t-1} - u_t, NaN = none; flow/expected_flow.h);
+	 * empty on frame 0. For viewers. */
+	cv::Mat flowObserved, flowExpected;
 	flow::LabelStats labelStats;
 	size_t hitVoxels = 0, movingVoxels = 0;
 	/** Centres [m, {W}] of the voxels the variant labels moving. */
