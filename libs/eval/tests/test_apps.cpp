@@ -4,8 +4,10 @@
 #include <bims/eval/tum_import.h>
 #include <gtest/gtest.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationIMU.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -219,4 +221,38 @@ TEST(EvalTraj, BadInputIsAClearError)
 	    << r.out;
 	r = run(kBin + "/bims-eval frobnicate");
 	EXPECT_EQ(r.code, 2);
+}
+
+TEST(ImportTum, SynthImuFromConvertedGroundTruthSeesGravityUp)
+{
+	// Synthetic IMU from the converted Bonn poses: the world must be z up
+	// for the accelerometer to read gravity on the IMU's up axis ({I} = MRPT
+	// scan frame by default: z up when the camera is level).
+	if (!fs::exists(kBonn + "/depth.txt")) GTEST_SKIP() << "no Bonn sample";
+	const auto d = tmpDir("synth");
+	const auto r = run(kBin + "/bims-import-tum " + kBonn + " -o " + d +
+	                   "/s.rawlog --config " + BIMS_SOURCE_DIR +
+	                   "/config/bonn.ini --max-frames 30 --synth-imu -q");
+	if (r.code == 2 && r.out.find("no simulator library") != std::string::npos)
+		GTEST_SKIP() << r.out;
+	ASSERT_EQ(r.code, 0) << r.out;
+	bims::RawlogReader rd(d + "/s.rawlog");
+	size_t n = 0;
+	double sumNorm = 0, sumZ = 0;
+	while (auto o = rd.next())
+		if (auto m = std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(o))
+		{
+			EXPECT_EQ(m->sensorLabel, "IMU_SYNTH");
+			const double ax = m->get(mrpt::obs::IMU_X_ACC),
+			             ay = m->get(mrpt::obs::IMU_Y_ACC),
+			             az = m->get(mrpt::obs::IMU_Z_ACC);
+			sumNorm += std::sqrt(ax * ax + ay * ay + az * az);
+			sumZ += az;
+			n++;
+		}
+	// 30 frames ~ 0.97 s at 100 Hz.
+	EXPECT_GT(n, 80u);
+	EXPECT_LT(n, 110u);
+	EXPECT_NEAR(sumNorm / n, 9.8, 0.6);
+	EXPECT_GT(sumZ / n, 8.5);
 }
