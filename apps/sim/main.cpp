@@ -125,11 +125,14 @@ int main(int argc, char** argv)
 		                                 !quiet.getValue(), preview.getValue());
 		    std::fprintf(stderr,
 		                 "bims-sim: %zu frames %dx%d + %zu IMU samples in %.2f "
-		                 "s (%.1f frames/s overall, "
-		                 "render %.1f frames/s); moving pixels %.1f %%; ground "
-		                 "truth in %s\n",
+		                 "s wall, %.2f s CPU "
+		                 "(%.1f frames/s wall, %.1f frames/s per CPU second, "
+		                 "render %.1f frames/s wall); "
+		                 "moving pixels %.1f %%; ground truth in %s\n",
 		                 st.frames, cfg.camera.width, cfg.camera.height,
-		                 st.imuSamples, st.seconds, st.frames / st.seconds,
+		                 st.imuSamples, st.seconds, st.cpuSeconds,
+		                 st.frames / st.seconds,
+		                 st.frames / std::max(1e-9, st.cpuSeconds),
 		                 st.frames / std::max(1e-9, st.renderSeconds),
 		                 100 * st.movingFraction, st.gtDir.c_str());
 		    return 0;

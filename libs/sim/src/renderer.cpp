@@ -211,7 +211,7 @@ void Renderer::render(const Scene& scene, double t, const Eigen::Matrix3d& R_WC,
 			for (int c = 0; c < 3; c++)
 			{
 				double val = col[c] * shade;
-				if (rgb_.noiseSigma > 0) val += rgb_.noiseSigma * rng.gauss();
+				if (rgb_.noiseSigma > 0) val += rgb_.noiseSigma * rng.gaussFast();
 				out.rgb[3 * size_t(k) + c] =
 				    uint8_t(std::clamp(std::lround(val), 0L, 255L));
 			}

@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <stdexcept>
 
@@ -162,6 +163,7 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
                        uint64_t seed, bool progress, int previewFrame)
 {
 	const auto tStart = std::chrono::steady_clock::now();
+	const std::clock_t cpuStart = std::clock();
 	SimStats st;
 	st.gtDir = groundTruthDirFor(outRawlog);
 	makeDirs(st.gtDir + "/masks");
@@ -253,6 +255,7 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	st.frames = size_t(cfg.seq.frames);
 	st.imuSamples = imuTruth.size();
 	st.movingFraction = movingSum / std::max(1, cfg.seq.frames);
+	st.cpuSeconds = double(std::clock() - cpuStart) / CLOCKS_PER_SEC;
 	st.seconds =
 	    std::chrono::duration<double>(std::chrono::steady_clock::now() - tStart)
 	        .count();

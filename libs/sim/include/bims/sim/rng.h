@@ -3,6 +3,7 @@
 // is implementation-defined).
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 
@@ -77,7 +78,41 @@ class Rng
 		return r * std::cos(a);
 	}
 
+	/** Approximate standard normal from one draw: inverse-CDF table (4096
+	 * intervals, linear interpolation; tails cut at 3.7 sigma). Several times
+	 * faster than gauss(); for image noise, not for statistics-critical use. */
+	double gaussFast()
+	{
+		const double* tab = normalQuantileTable();
+		const uint64_t r = next();
+		const unsigned i = unsigned(r >> 52);  // 12 bits
+		const double f = double((r >> 28) & 0xFFFFFF) * 0x1.0p-24;
+		return tab[i] + f * (tab[i + 1] - tab[i]);
+	}
+
  private:
+	/** Phi^-1 at (i + 0.5) / 4097, i = 0..4096 (computed once by bisection). */
+	static const double* normalQuantileTable()
+	{
+		static const auto table = []
+		{
+			std::array<double, 4097> t{};
+			for (size_t i = 0; i < t.size(); i++)
+			{
+				const double p = (double(i) + 0.5) / double(t.size());
+				double lo = -10, hi = 10;
+				for (int it = 0; it < 60; it++)
+				{
+					const double mid = 0.5 * (lo + hi);
+					(0.5 * std::erfc(-mid / std::sqrt(2.0)) < p ? lo : hi) =
+					    mid;
+				}
+				t[i] = 0.5 * (lo + hi);
+			}
+			return t;
+		}();
+		return table.data();
+	}
 	static uint64_t rotl(uint64_t x, int k)
 	{
 		return (x << k) | (x >> (64 - k));

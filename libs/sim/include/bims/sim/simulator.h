@@ -66,6 +66,8 @@ struct SimStats
 	size_t frames = 0, imuSamples = 0;
 	double seconds = 0;         ///< wall-clock time of the whole run [s]
 	double renderSeconds = 0;   ///< time spent rendering [s]
+	double cpuSeconds = 0;      ///< CPU time of the process during the run [s]
+	                            ///< (single-threaded: the work done)
 	double movingFraction = 0;  ///< mean fraction of pixels on moving objects
 	std::string gtDir;          ///< ground-truth folder
 };
