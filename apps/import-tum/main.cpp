@@ -12,7 +12,42 @@
 #include <filesystem>
 
 #ifdef BIMS_HAVE_SIM
+#include <bims/common/config.h>
 #include <bims/sim/imu.h>
+
+#include <Eigen/SVD>
+
+namespace
+{
+/** R_IC and time_offset_s of the synthetic IMU from [calibration]: either
+ * the egomotion module's key R_IC (9 reals, row major, p_I = R_IC p_C) or
+ * the simulator's R_IC_ypr_deg. Not strict about other keys: the section
+ * belongs to those modules, whose readers are. */
+void calibrationForSynth(const mrpt::config::CConfigFileBase& cfg,
+                         bims::sim::ImuParams& imu)
+{
+	if (!cfg.sectionExists("calibration")) return;
+	bims::ConfigSection s(cfg, "calibration");
+	if (s.has("R_IC"))
+	{
+		const auto v = s.getDoubles("R_IC", {}, 9, -1.0001, 1.0001);
+		Eigen::Matrix3d M;
+		M << v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8];
+		Eigen::JacobiSVD<Eigen::Matrix3d> svd(
+		    M, Eigen::ComputeFullU | Eigen::ComputeFullV);
+		const Eigen::Matrix3d R = svd.matrixU() * svd.matrixV().transpose();
+		if ((R - M).norm() > 1e-3 || R.determinant() < 0)
+			s.fail("R_IC", "not a rotation matrix");
+		imu.R_IC = R;
+	}
+	else if (s.has("R_IC_ypr_deg"))
+	{
+		const auto y = s.getDoubles("R_IC_ypr_deg", {}, 3, -360, 360);
+		imu.setR_IC_ypr(y[0], y[1], y[2]);
+	}
+	imu.timeOffsetS = s.getDouble("time_offset_s", 0.0, -10.0, 10.0);
+}
+}  // namespace
 #endif
 
 int main(int argc, char** argv)
@@ -56,7 +91,9 @@ int main(int argc, char** argv)
 		        "add SYNTHETIC IMU readings (label <imu_label>_SYNTH) "
 		        "synthesised "
 		        "from the ground truth with bims::sim::synthesizeImu (default "
-		        "Xsens MTi-like noise; [calibration] of --config)",
+		        "Xsens MTi-like noise; R_IC and time_offset_s from "
+		        "[calibration] of "
+		        "--config)",
 		        cmd);
 		    TCLAP::ValueArg<uint64_t> seed(
 		        "", "seed", "random seed of --synth-imu (default 1)", false, 1,
@@ -106,7 +143,7 @@ int main(int argc, char** argv)
 					    p.T_WC = bims::eval::bonnMarkerToCamera(p.T_WC);
 			    bims::sim::ImuParams imu;
 			    imu.label = params.imuLabel;
-			    if (cfg) imu.loadFromConfigFile(*cfg, "imu", "calibration");
+			    if (cfg) calibrationForSynth(*cfg, imu);
 			    for (auto& o :
 			         bims::sim::synthesizeImu(gt, imu, seed.getValue()))
 				    opt.extra.push_back(o);

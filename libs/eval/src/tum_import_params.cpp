@@ -15,6 +15,7 @@ void CameraIntrinsics::loadFromConfigFile(
 	cx = s.getDouble("cx", cx, -1e6, 1e6);
 	cy = s.getDouble("cy", cy, -1e6, 1e6);
 	depthScale = s.getDouble("depth_scale", depthScale, 1e-6, 1e9);
+	s.allow("max_range");  // read by other modules from the same section
 	s.finish();
 }
 
@@ -42,10 +43,12 @@ void ImportParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg)
 	im.finish();
 
 	ConfigSection se(cfg, "sensors");
-	rgbdLabel = se.getString("rgbd_label", rgbdLabel);
-	imuLabel = se.getString("imu_label", imuLabel);
-	if (rgbdLabel.empty()) se.fail("rgbd_label", "must not be empty");
-	if (imuLabel.empty()) se.fail("imu_label", "must not be empty");
+	// Empty means "any label" to the readers of a rawlog; the importer
+	// then writes the default label.
+	const std::string r = se.getString("rgbd_label", rgbdLabel);
+	const std::string i = se.getString("imu_label", imuLabel);
+	if (!r.empty()) rgbdLabel = r;
+	if (!i.empty()) imuLabel = i;
 	se.finish();
 }
 

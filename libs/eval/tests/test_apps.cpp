@@ -3,6 +3,8 @@
 #include <bims/common/trajectory.h>
 #include <bims/eval/tum_import.h>
 #include <gtest/gtest.h>
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
 
@@ -255,4 +257,34 @@ TEST(ImportTum, SynthImuFromConvertedGroundTruthSeesGravityUp)
 	EXPECT_LT(n, 110u);
 	EXPECT_NEAR(sumNorm / n, 9.8, 0.6);
 	EXPECT_GT(sumZ / n, 8.5);
+}
+
+TEST(ImportParams, BonnIniAndStrictKeys)
+{
+	mrpt::config::CConfigFile cfg(std::string(BIMS_SOURCE_DIR) +
+	                              "/config/bonn.ini");
+	bims::eval::ImportParams p;
+	p.loadFromConfigFile(cfg);
+	EXPECT_DOUBLE_EQ(p.camera.fx, 542.822841);
+	EXPECT_DOUBLE_EQ(p.camera.cy, 237.756098);
+	EXPECT_DOUBLE_EQ(p.camera.depthScale, 5000);
+	EXPECT_TRUE(p.bonnGt);
+	EXPECT_EQ(p.imuLabel, "IMU_SYNTH");
+	EXPECT_DOUBLE_EQ(p.rangeUnits, 0.001);
+
+	mrpt::config::CConfigFileMemory bad("[import]\nmax_time_gap = 0.02\n");
+	try
+	{
+		bims::eval::ImportParams q;
+		q.loadFromConfigFile(bad);
+		FAIL();
+	}
+	catch (const std::exception& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("max_time_gap"), std::string::npos)
+		    << e.what();
+	}
+	mrpt::config::CConfigFileMemory range("[import]\ntimestamp = both\n");
+	bims::eval::ImportParams q;
+	EXPECT_THROW(q.loadFromConfigFile(range), std::exception);
 }

@@ -55,7 +55,8 @@ struct ImportParams
 	 * rounding (<= 0.5 mm) is far below the sensor's noise. 1/depth_scale
 	 * keeps the PNG values exactly. */
 	double rangeUnits = 0.001;
-	/** [sensors] rgbd_label, imu_label: sensor labels in the rawlog. */
+	/** [sensors] rgbd_label, imu_label: sensor labels in the rawlog (an
+	 * empty value, "any" for rawlog readers, keeps the default). */
 	std::string rgbdLabel = "RGBD", imuLabel = "IMU";
 
 	/** Checks the file's sections (bims::checkExperimentSections) and reads
