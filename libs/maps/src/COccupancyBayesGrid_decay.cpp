@@ -1,60 +1,11 @@
 // Tier 0: the miss update for decay = frustum and decay = raycast.
 #include <bims/maps/COccupancyBayesGrid.h>
+#include <bims/maps/dda.h>
 
 #include <cmath>
 
 namespace bims::maps
 {
-namespace
-{
-/** Visits the voxels a segment crosses, from the voxel of \a a (in voxel
- * units) up to but excluding the voxel of \a b (Amanatides & Woo 3D DDA,
- * 6-connected, the same traversal as OctoMap's computeRayKeys). */
-template <class Visit>
-void traverse(const double a[3], const double b[3], Visit&& visit)
-{
-	int32_t i[3], e[3], step[3];
-	double tMax[3], tDelta[3];
-	uint32_t n = 0;
-	for (int k = 0; k < 3; ++k)
-	{
-		i[k] = int32_t(std::floor(a[k]));
-		e[k] = int32_t(std::floor(b[k]));
-		const double d = b[k] - a[k];
-		n += uint32_t(std::abs(e[k] - i[k]));
-		if (d > 0)
-		{
-			step[k] = 1;
-			tDelta[k] = 1 / d;
-			tMax[k] = (i[k] + 1 - a[k]) / d;
-		}
-		else if (d < 0)
-		{
-			step[k] = -1;
-			tDelta[k] = -1 / d;
-			tMax[k] = (i[k] - a[k]) / d;
-		}
-		else
-		{
-			step[k] = 0;
-			tDelta[k] = tMax[k] = INFINITY;
-		}
-	}
-	for (uint32_t s = 0; s < n; ++s)
-	{
-		visit(i[0], i[1], i[2]);
-		int k = tMax[0] < tMax[1] ? (tMax[0] < tMax[2] ? 0 : 2)
-		                          : (tMax[1] < tMax[2] ? 1 : 2);
-		// Never step past the end voxel on an axis (numerical safety).
-		if (i[k] == e[k])
-		{
-			k = i[0] != e[0] ? 0 : (i[1] != e[1] ? 1 : 2);
-		}
-		i[k] += step[k];
-		tMax[k] += tDelta[k];
-	}
-}
-}  // namespace
 
 void COccupancyBayesGrid::decayRaycast(const FrameCloud& f, uint32_t F)
 {
@@ -87,7 +38,7 @@ void COccupancyBayesGrid::decayRaycast(const FrameCloud& f, uint32_t F)
 			if (dec > 1 && i % size_t(dec * dec) != 0) continue;
 			const auto& k = f.cells[i];
 			const double b[3] = {k.x + 0.5, k.y + 0.5, k.z + 0.5};
-			traverse(a, b, visit);
+			traverseRay(a, b, visit);
 		}
 	}
 	else
@@ -107,7 +58,7 @@ void COccupancyBayesGrid::decayRaycast(const FrameCloud& f, uint32_t F)
 			}
 			const auto& p = f.points_W[i];
 			const double b[3] = {p.x * inv, p.y * inv, p.z * inv};
-			traverse(a, b, visit);
+			traverseRay(a, b, visit);
 		}
 	}
 	if (over)

@@ -3,6 +3,7 @@
 #include <bims/maps/CMotionGridBase.h>
 #include <bims/maps/closed_form.h>
 
+#include <cmath>
 #include <stdexcept>
 
 namespace bims::maps
@@ -26,13 +27,20 @@ void CBackgroundSubtractionGrid::posterior(const FrameCloud& f,
 	double hitCache[64];
 	for (uint32_t n = 0; n < 64; ++n)
 		hitCache[n] = n ? hitLogOdds(p.p_miss, logLambda, n) : 0;
+	// O- takes few distinct values (saturated cells): memoise its prior.
+	float lastO = std::nanf("");
+	double lastQ = 0;
 	for (size_t i = 0; i < f.cells.size(); ++i)
 	{
 		const uint32_t n = f.hits[i];
 		const double hit =
 		    n < 64 ? hitCache[n] : hitLogOdds(p.p_miss, logLambda, n);
-		post[i] =
-		    float(backgroundPriorLogOdds(priorO[i], p.bg_transition_eps) + hit);
+		if (!(priorO[i] == lastO))
+		{
+			lastO = priorO[i];
+			lastQ = backgroundPriorLogOdds(lastO, p.bg_transition_eps);
+		}
+		post[i] = float(lastQ + hit);
 	}
 }
 
@@ -84,13 +92,23 @@ void CFlowConsistencyGrid::posterior(const FrameCloud& f,
 	const auto& p = params_;
 	const double logLambda = std::log(p.flow_lambda);
 	const bool veto = p.flow_evidence == FlowEvidence::Veto;
+	// The update is additive in log-odds: flowPosterior(lI, k, l) - lI
+	// depends on (k, l) only. Tabulate small counts.
+	constexpr uint32_t T = 32;
+	double delta[T][T];
+	for (uint32_t a = 0; a < T; ++a)
+		for (uint32_t b = 0; b < T; ++b)
+			delta[a][b] = flowPosterior(0, p.flow_transition_tau, p.p_miss,
+			                            logLambda, a, b, veto);
 	post.resize(f.cells.size());
 	for (size_t i = 0; i < f.cells.size(); ++i)
-		post[i] =
-		    (k[i] == 0 && l[i] == 0)
-		        ? tier1[i]
-		        : float(flowPosterior(tier1[i], p.flow_transition_tau, p.p_miss,
-		                              logLambda, k[i], l[i], veto));
+	{
+		const double d = (k[i] < T && l[i] < T)
+		                     ? delta[k[i]][l[i]]
+		                     : flowPosterior(0, p.flow_transition_tau, p.p_miss,
+		                                     logLambda, k[i], l[i], veto);
+		post[i] = float(tier1[i] + d);
+	}
 }
 
 void CFlowConsistencyGrid::computePosterior(const FrameCloud& f,

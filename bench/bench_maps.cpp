@@ -1,0 +1,463 @@
+// Voxel grid benchmark: tier 0/1/2 update time per frame for each decay
+// mode, MRPT's COccupancyGridMap3D and COctoMap on the same clouds, memory
+// per million occupied cells, and the storage choice (hashed voxels vs
+// hashed blocks). One JSON object per measurement on stdout (see
+// json_reporter.h); run through scripts/bench.sh.
+//
+//   bench_maps [--bonn_depth=PNG] [--sim_rawlog=RAWLOG] [--sim_frame=N]
+//              [--voxels=0.02,0.05] [benchmark flags]
+#include <bims/common/rawlog.h>
+#include <bims/maps/dda.h>
+#include <bims/maps/motion_grids.h>
+
+#include <mrpt/maps/COccupancyGridMap3D.h>
+#include <mrpt/maps/COctoMap.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/system/filesystem.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+#include <random>
+#include <unordered_map>
+
+#include "json_reporter.h"
+
+using namespace bims::maps;
+namespace bm = benchmark;
+
+namespace
+{
+struct Cloud
+{
+	std::string name;
+	mrpt::obs::CObservation3DRangeScan::Ptr scan;
+	mrpt::poses::CPose3D T_WS;
+};
+
+// A Bonn RGB-D depth PNG (16 bit, metres = value / 5000).
+Cloud loadBonn(const std::string& path)
+{
+	const cv::Mat d = cv::imread(path, cv::IMREAD_UNCHANGED);
+	if (d.empty() || d.type() != CV_16UC1)
+		throw std::runtime_error("cannot read 16-bit depth PNG '" + path + "'");
+	auto o = mrpt::obs::CObservation3DRangeScan::Create();
+	o->hasRangeImage = true;
+	o->range_is_depth = true;
+	o->rangeUnits = 1.0f / 5000;
+	o->rangeImage_setSize(d.rows, d.cols);
+	for (int v = 0; v < d.rows; ++v)
+		for (int u = 0; u < d.cols; ++u)
+			o->rangeImage(v, u) = d.at<uint16_t>(v, u);
+	o->cameraParams.ncols = d.cols;
+	o->cameraParams.nrows = d.rows;
+	o->cameraParams.setIntrinsicParamsFromValues(542.822841, 542.576870,
+	                                             315.593520, 237.756098);
+	o->cameraParamsIntensity = o->cameraParams;
+	o->maxRange = 10;
+	return {"bonn", o, mrpt::poses::CPose3D(0, 0, 1.5, 0, 0, 0)};
+}
+
+Cloud loadSim(const std::string& path, int frame)
+{
+	bims::RawlogReader r(path);
+	int i = 0;
+	while (auto obs = r.next())
+		if (auto s =
+		        std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(
+		            obs))
+			if (i++ == frame)
+				return {"sim", s, mrpt::poses::CPose3D(0, 0, 1.3, 0, 0, 0)};
+	throw std::runtime_error("rawlog '" + path + "' has fewer range scans");
+}
+
+std::vector<Cloud> g_clouds;
+std::vector<double> g_voxels = {0.02, 0.05};
+
+GridParams paramsFor(double voxel, const std::string& decay)
+{
+	GridParams p;
+	p.voxel_size = voxel;
+	p.max_range = 8;
+	p.decay = decay == "all"       ? DecayMode::All
+	          : decay == "frustum" ? DecayMode::Frustum
+	                               : DecayMode::Raycast;
+	if (decay == "raycast_voxels") p.raycast_target = RayTarget::Voxels;
+	return p;
+}
+
+PixelLabels randomLabels(int w, int h)
+{
+	PixelLabels l(w, h, 0);
+	std::mt19937 r(1);
+	for (auto& x : l.label)
+	{
+		const int k = int(r() % 10);
+		x = k == 0 ? 1 : (k == 1 ? -1 : 0);
+	}
+	return l;
+}
+
+void setCounters(bm::State& st, const Cloud& c, double voxel,
+                 const FrameCloud& f)
+{
+	st.counters["voxel_m"] = voxel;
+	st.counters["points"] = double(f.numPoints());
+	st.counters["hit_voxels"] = double(f.numCells());
+	st.counters["width"] = c.scan->rangeImage.cols();
+}
+
+// ---- our grids -------------------------------------------------------------
+void benchBuild(bm::State& st, const Cloud& c, double voxel)
+{
+	FrameCloudBuilder b(paramsFor(voxel, "all"));
+	FrameCloud f;
+	for (auto _ : st) b.build(*c.scan, c.T_WS, f);
+	setCounters(st, c, voxel, f);
+}
+
+enum class Stage
+{
+	Tier0,
+	Tier1,
+	Tier2,
+	All3
+};
+
+void benchTier(bm::State& st, const Cloud& c, double voxel, std::string decay,
+               Stage s)
+{
+	const auto p = paramsFor(voxel, decay);
+	MotionGrids mg(p);
+	FrameCloudBuilder b(p);
+	FrameCloud f;
+	b.build(*c.scan, c.T_WS, f);
+	const auto labels = randomLabels(f.K.width, f.K.height);
+	for (int i = 0; i < 3; ++i) mg.processFrame(f, &labels);  // warm up
+	std::vector<float> prior, p1, p2;
+	mg.occupancy()->priorLogOdds(f, prior);
+	mg.background()->posterior(f, prior, p1);
+	for (auto _ : st)
+	{
+		switch (s)
+		{
+			case Stage::Tier0:
+				mg.occupancy()->integrate(f, &prior);
+				break;
+			case Stage::Tier1:
+				mg.background()->posterior(f, prior, p1);
+				mg.background()->store(f, p1);
+				break;
+			case Stage::Tier2:
+				mg.flow()->posterior(f, labels, p1, p2);
+				mg.flow()->store(f, p2);
+				break;
+			case Stage::All3:
+				mg.processFrame(f, &labels);
+				break;
+		}
+	}
+	setCounters(st, c, voxel, f);
+	if (s == Stage::Tier0 || s == Stage::All3)
+	{
+		const double occ = double(mg.occupancy()->keysAbove(0.5).size());
+		st.counters["occupied_voxels"] = occ;
+		st.counters["storage_MiB"] = mg.occupancy()->memoryBytes() / 1048576.0;
+		st.counters["MiB_per_million_occupied"] =
+		    occ > 0 ? mg.occupancy()->memoryBytes() / 1048576.0 / (occ / 1e6)
+		            : 0;
+		size_t stored = 0;
+		mg.occupancy()->storage().forEachCell(
+		    [&](const VoxelKey&, const auto& cell)
+		    { stored += cell.stamp != 0; });
+		st.counters["touched_voxels"] = double(stored);
+		st.counters["MiB_per_million_touched"] =
+		    mg.occupancy()->memoryBytes() / 1048576.0 / (stored / 1e6);
+	}
+}
+
+// ---- MRPT baselines --------------------------------------------------------
+void benchGrid3D(bm::State& st, const Cloud& c, double voxel, int decimation)
+{
+	// The grid must contain the sensor: bounds around cloud and origin.
+	FrameCloudBuilder b(paramsFor(voxel, "all"));
+	FrameCloud f;
+	b.build(*c.scan, c.T_WS, f);
+	mrpt::math::TPoint3D lo = f.origin_W, hi = f.origin_W;
+	for (const auto& q : f.points_W)
+	{
+		lo.x = std::min<double>(lo.x, q.x), lo.y = std::min<double>(lo.y, q.y),
+		lo.z = std::min<double>(lo.z, q.z);
+		hi.x = std::max<double>(hi.x, q.x), hi.y = std::max<double>(hi.y, q.y),
+		hi.z = std::max<double>(hi.z, q.z);
+	}
+	const mrpt::math::TPoint3D m(0.1, 0.1, 0.1);
+	mrpt::maps::COccupancyGridMap3D g(lo - m, hi + m, float(voxel));
+	g.insertionOptions.maxDistanceInsertion = 8;
+	if (decimation > 0) g.insertionOptions.decimation_3d_range = decimation;
+	st.counters["decimation_3d_range"] = g.insertionOptions.decimation_3d_range;
+	for (auto _ : st) g.insertObservation(*c.scan, c.T_WS);
+	setCounters(st, c, voxel, f);
+}
+
+void benchOctoMap(bm::State& st, const Cloud& c, double voxel)
+{
+	FrameCloudBuilder b(paramsFor(voxel, "all"));
+	FrameCloud f;
+	b.build(*c.scan, c.T_WS, f);
+	mrpt::maps::COctoMap m(voxel);
+	m.insertionOptions.maxrange = 8;
+	// COctoMap::insertObservation() of a range scan uses its embedded
+	// points3D (absent here); insert the same cloud as our grids, in {W}.
+	mrpt::maps::CSimplePointsMap pts;
+	for (const auto& q : f.points_W) pts.insertPoint(q.x, q.y, q.z);
+	const auto& o = f.origin_W;
+	for (auto _ : st)
+		m.insertPointCloud(pts, float(o.x), float(o.y), float(o.z));
+	setCounters(st, c, voxel, f);
+	// The octree behind COctoMap is private (pimpl): leaves (occupied + free)
+	// are what its API counts.
+	st.counters["leaf_voxels"] = double(m.getNumLeafNodes());
+	st.counters["storage_MiB"] = m.memoryUsage() / 1048576.0;
+	st.counters["MiB_per_million_leaves"] =
+	    m.memoryUsage() / 1048576.0 / (m.getNumLeafNodes() / 1e6);
+}
+
+// ---- storage choice: the same full-resolution ray casting workload ---------
+struct RayCell
+{
+	float l = 0;
+	uint32_t stamp = 0;
+};
+
+template <int L>
+void benchStorageBlocks(bm::State& st, const Cloud& c, double voxel)
+{
+	FrameCloudBuilder b(paramsFor(voxel, "all"));
+	FrameCloud f;
+	b.build(*c.scan, c.T_WS, f);
+	SparseVoxelGrid<RayCell, L> g;
+	const double inv = 1 / voxel;
+	const double a[3] = {f.origin_W.x * inv, f.origin_W.y * inv,
+	                     f.origin_W.z * inv};
+	uint32_t F = 0;
+	size_t steps = 0;
+	for (auto _ : st)
+	{
+		++F;
+		steps = 0;
+		typename SparseVoxelGrid<RayCell, L>::Accessor acc(g);
+		for (const auto& p : f.points_W)
+		{
+			const double e[3] = {p.x * inv, p.y * inv, p.z * inv};
+			traverseRay(a, e,
+			            [&](int32_t x, int32_t y, int32_t z)
+			            {
+				            RayCell* cell = acc.get(x, y, z);
+				            ++steps;
+				            if (cell->stamp != F)
+				            {
+					            cell->stamp = F;
+					            cell->l = std::max(cell->l - 0.64f, -2.f);
+				            }
+			            });
+		}
+	}
+	setCounters(st, c, voxel, f);
+	st.counters["storage_MiB"] = g.memoryBytes() / 1048576.0;
+	st.counters["ray_steps"] = double(steps);
+}
+
+void benchStorageUnordered(bm::State& st, const Cloud& c, double voxel)
+{
+	FrameCloudBuilder b(paramsFor(voxel, "all"));
+	FrameCloud f;
+	b.build(*c.scan, c.T_WS, f);
+	std::unordered_map<uint64_t, RayCell> g;
+	const double inv = 1 / voxel;
+	const double a[3] = {f.origin_W.x * inv, f.origin_W.y * inv,
+	                     f.origin_W.z * inv};
+	uint32_t F = 0;
+	for (auto _ : st)
+	{
+		++F;
+		for (const auto& p : f.points_W)
+		{
+			const double e[3] = {p.x * inv, p.y * inv, p.z * inv};
+			traverseRay(a, e,
+			            [&](int32_t x, int32_t y, int32_t z)
+			            {
+				            RayCell& cell = g[packKey(x, y, z)];
+				            if (cell.stamp != F)
+				            {
+					            cell.stamp = F;
+					            cell.l = std::max(cell.l - 0.64f, -2.f);
+				            }
+			            });
+		}
+	}
+	setCounters(st, c, voxel, f);
+	// node: key + value + next pointer + cached hash, plus the bucket array
+	st.counters["storage_MiB"] =
+	    (g.size() * (8 + sizeof(RayCell) + 16) + g.bucket_count() * 8) /
+	    1048576.0;
+}
+
+std::string findFirstPng(const std::string& dir)
+{
+	std::vector<std::string> f;
+	if (!std::filesystem::is_directory(dir)) return {};
+	for (const auto& e : std::filesystem::directory_iterator(dir))
+		if (e.path().extension() == ".png") f.push_back(e.path().string());
+	std::sort(f.begin(), f.end());
+	return f.empty() ? std::string() : f.front();
+}
+
+void registerAll()
+{
+	for (const auto& c : g_clouds)
+		for (double v : g_voxels)
+		{
+			const std::string sfx = "/" + c.name + "/" +
+			                        std::to_string(int(std::lround(v * 100))) +
+			                        "cm";
+			bm::RegisterBenchmark(("build" + sfx).c_str(), benchBuild, c, v)
+			    ->Unit(bm::kMillisecond)
+			    ->UseRealTime()
+			    ->Iterations(10)
+			    ->Repetitions(5)
+			    ->ReportAggregatesOnly();
+			for (std::string d :
+			     {"all", "frustum", "raycast", "raycast_voxels"})
+			{
+				const bool slow = d.rfind("raycast", 0) == 0;
+				const int it = slow ? 2 : 20;
+				const std::pair<const char*, Stage> stages[] = {
+				    {"tier0", Stage::Tier0},
+				    {"tier1", Stage::Tier1},
+				    {"tier2", Stage::Tier2},
+				    {"tiers012", Stage::All3}};
+				for (const auto& [sn, s] : stages)
+				{
+					if (slow && (s == Stage::Tier1 || s == Stage::Tier2))
+						continue;  // decay-independent
+					bm::RegisterBenchmark(
+					    (std::string(sn) + "/" + d + sfx).c_str(), benchTier, c,
+					    v, d, s)
+					    ->Unit(bm::kMillisecond)
+					    ->UseRealTime()
+					    ->Iterations(it)
+					    ->Repetitions(5)
+					    ->ReportAggregatesOnly();
+				}
+			}
+			bm::RegisterBenchmark(("mrpt_grid3d_dec1" + sfx).c_str(),
+			                      benchGrid3D, c, v, 1)
+			    ->Unit(bm::kMillisecond)
+			    ->UseRealTime()
+			    ->Iterations(1)
+			    ->Repetitions(3)
+			    ->ReportAggregatesOnly();
+			bm::RegisterBenchmark(("mrpt_grid3d_default" + sfx).c_str(),
+			                      benchGrid3D, c, v, 0)
+			    ->Unit(bm::kMillisecond)
+			    ->UseRealTime()
+			    ->Iterations(3)
+			    ->Repetitions(3)
+			    ->ReportAggregatesOnly();
+			bm::RegisterBenchmark(("mrpt_octomap" + sfx).c_str(), benchOctoMap,
+			                      c, v)
+			    ->Unit(bm::kMillisecond)
+			    ->UseRealTime()
+			    ->Iterations(1)
+			    ->Repetitions(3)
+			    ->ReportAggregatesOnly();
+			bm::RegisterBenchmark(
+			    ("storage_raycast_hash_voxels_std" + sfx).c_str(),
+			    benchStorageUnordered, c, v)
+			    ->Unit(bm::kMillisecond)
+			    ->UseRealTime()
+			    ->Iterations(1)
+			    ->Repetitions(3)
+			    ->ReportAggregatesOnly();
+			bm::RegisterBenchmark(
+			    ("storage_raycast_hash_voxels_flat" + sfx).c_str(),
+			    benchStorageBlocks<0>, c, v)
+			    ->Unit(bm::kMillisecond)
+			    ->UseRealTime()
+			    ->Iterations(1)
+			    ->Repetitions(3)
+			    ->ReportAggregatesOnly();
+			bm::RegisterBenchmark(("storage_raycast_blocks8" + sfx).c_str(),
+			                      benchStorageBlocks<3>, c, v)
+			    ->Unit(bm::kMillisecond)
+			    ->UseRealTime()
+			    ->Iterations(1)
+			    ->Repetitions(3)
+			    ->ReportAggregatesOnly();
+			bm::RegisterBenchmark(("storage_raycast_blocks16" + sfx).c_str(),
+			                      benchStorageBlocks<4>, c, v)
+			    ->Unit(bm::kMillisecond)
+			    ->UseRealTime()
+			    ->Iterations(1)
+			    ->Repetitions(3)
+			    ->ReportAggregatesOnly();
+		}
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+	try
+	{
+		std::string bonn = findFirstPng(std::string(BIMS_SHARED_DATA_DIR) +
+		                                "/bonn_crowd_f150_349/depth");
+		std::string sim;
+		int simFrame = 3;
+		std::vector<char*> rest = {argv[0]};
+		for (int i = 1; i < argc; ++i)
+		{
+			const std::string a = argv[i];
+			auto val = [&](const char* k) -> const char*
+			{
+				const std::string p = std::string(k) + "=";
+				return a.rfind(p, 0) == 0 ? argv[i] + p.size() : nullptr;
+			};
+			if (auto v = val("--bonn_depth"))
+				bonn = v;
+			else if (auto v = val("--sim_rawlog"))
+				sim = v;
+			else if (auto v = val("--sim_frame"))
+				simFrame = std::stoi(v);
+			else if (auto v = val("--voxels"))
+			{
+				g_voxels.clear();
+				std::stringstream ss(v);
+				std::string t;
+				while (std::getline(ss, t, ','))
+					g_voxels.push_back(std::stod(t));
+			}
+			else
+				rest.push_back(argv[i]);
+		}
+		if (!bonn.empty()) g_clouds.push_back(loadBonn(bonn));
+		if (!sim.empty()) g_clouds.push_back(loadSim(sim, simFrame));
+		if (g_clouds.empty())
+			throw std::runtime_error(
+			    "no cloud: give --bonn_depth and/or --sim_rawlog");
+		for (const auto& c : g_clouds)
+			std::cerr << "cloud " << c.name << ": " << c.scan->rangeImage.cols()
+			          << "x" << c.scan->rangeImage.rows() << "\n";
+		registerAll();
+		int n = int(rest.size());
+		return bims::bench::runWithJsonLines(n, rest.data());
+	}
+	catch (const std::exception& e)
+	{
+		std::cerr << "bench_maps: error: " << e.what() << "\n";
+		return 1;
+	}
+}

@@ -1,0 +1,39 @@
+// A Google Benchmark reporter printing one JSON object per measurement on
+// stdout, e.g. {"name":"tier0/all/bonn","voxel_m":0.02,"ms_median":1.9,...},
+// so that runs can be compared by script. Counters of the benchmark become
+// fields. With repetitions, only the median/mean/stddev aggregates are
+// printed ("ms_median", "ms_mean", "ms_stddev" in one object) plus
+// "cpu_ms_median" (process CPU time of the benchmark thread, the better
+// figure when other jobs share the machine).
+#pragma once
+
+#include <benchmark/benchmark.h>
+
+#include <map>
+#include <string>
+
+namespace bims::bench
+{
+class JsonLinesReporter : public benchmark::BenchmarkReporter
+{
+ public:
+	bool ReportContext(const Context& context) override;
+	void ReportRuns(const std::vector<Run>& runs) override;
+	void Finalize() override;
+
+ private:
+	struct Acc
+	{
+		std::map<std::string, double> fields;
+		std::string name;
+	};
+	std::map<std::string, Acc> pending_;
+	std::vector<std::string> order_;
+	void flush(const std::string& key);
+};
+
+/** Runs the registered benchmarks with JsonLinesReporter on stdout (and
+ * Google Benchmark's console table on stderr). */
+int runWithJsonLines(int argc, char** argv);
+
+}  // namespace bims::bench

@@ -1,0 +1,82 @@
+// 3D DDA voxel traversal of a segment (free-space ray casting).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+
+namespace bims::maps
+{
+/** Visits the voxels a segment crosses, from the voxel of \a a (in voxel
+ * units) up to but excluding the voxel of \a b (Amanatides & Woo 3D DDA,
+ * 6-connected, the same traversal as OctoMap's computeRayKeys). Exactly
+ * |dx|+|dy|+|dz| voxels are visited (the voxel differences of a and b). */
+template <class Visit>
+inline void traverseRay(const double a[3], const double b[3], Visit&& visit)
+{
+	int32_t x = int32_t(std::floor(a[0])), y = int32_t(std::floor(a[1])),
+	        z = int32_t(std::floor(a[2]));
+	const int32_t ex = int32_t(std::floor(b[0])),
+	              ey = int32_t(std::floor(b[1])),
+	              ez = int32_t(std::floor(b[2]));
+	uint32_t n =
+	    uint32_t(std::abs(ex - x) + std::abs(ey - y) + std::abs(ez - z));
+	if (n == 0) return;
+	// Per axis: step, parameter t of the next boundary, t per voxel.
+	auto setup = [](double a0, double b0, int32_t i, int32_t& s, double& tMax,
+	                double& tDelta)
+	{
+		const double d = b0 - a0;
+		if (d > 0)
+		{
+			s = 1;
+			tDelta = 1 / d;
+			tMax = (i + 1 - a0) * tDelta;
+		}
+		else if (d < 0)
+		{
+			s = -1;
+			tDelta = -1 / d;
+			tMax = (a0 - i) * tDelta;
+		}
+		else
+		{
+			s = 0;
+			tDelta = tMax = INFINITY;
+		}
+	};
+	int32_t sx, sy, sz;
+	double tx, ty, tz, dx, dy, dz;
+	setup(a[0], b[0], x, sx, tx, dx);
+	setup(a[1], b[1], y, sy, ty, dy);
+	setup(a[2], b[2], z, sz, tz, dz);
+	while (n--)
+	{
+		visit(x, y, z);
+		if (tx < ty)
+		{
+			if (tx < tz)
+			{
+				x += sx;
+				tx += dx;
+			}
+			else
+			{
+				z += sz;
+				tz += dz;
+			}
+		}
+		else if (ty < tz)
+		{
+			y += sy;
+			ty += dy;
+		}
+		else
+		{
+			z += sz;
+			tz += dz;
+		}
+	}
+}
+
+}  // namespace bims::maps
