@@ -189,7 +189,9 @@ int cmdMasks(int argc, char** argv)
 		if (!quiet.getValue()) std::printf("%s\n", line.c_str());
 		if (!outDir.empty())
 			ev::writePng(outDir + "/" + f.name,
-			             ev::maskOverlay(g, p, valid, background, line));
+			             ev::maskOverlay(g, p, valid, background,
+			                             "frame " + frameName(f.index) + "  " +
+			                                 m.scoresLine()));
 		if (!jsonFrames.empty()) jsonFrames += ",\n";
 		jsonFrames += "    {\"frame\": " + std::to_string(f.index) +
 		              ", \"metrics\": " + m.toJson() + "}";

@@ -173,12 +173,17 @@ cv::Mat maskOverlay(const cv::Mat& gt, const cv::Mat& pred,
 			}
 			const bool gm = gt.at<uint8_t>(v, u) >= 128;
 			const bool pm = pred.at<uint8_t>(v, u) >= 128;
+			cv::Vec3b c;
 			if (gm && pm)
-				px = cv::Vec3b(0, 200, 0);  // TP green (BGR)
+				c = cv::Vec3b(0, 200, 0);  // TP green (BGR)
 			else if (pm)
-				px = cv::Vec3b(0, 0, 230);  // FP red
+				c = cv::Vec3b(0, 0, 230);  // FP red
 			else if (gm)
-				px = cv::Vec3b(230, 80, 0);  // FN blue
+				c = cv::Vec3b(230, 80, 0);  // FN blue
+			else
+				continue;
+			// Over an image, blend so that the scene stays visible.
+			px = background.empty() ? c : 0.4 * px + 0.6 * c;
 		}
 	cv::rectangle(out, {0, 0}, {out.cols, 22}, cv::Scalar(0, 0, 0), cv::FILLED);
 	cv::putText(out, caption, {4, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45,

@@ -125,6 +125,41 @@ TEST(ImportTum, BonnTwentyFramesWithConvertedGroundTruth)
 	    << c.out;
 	EXPECT_LT(med, 0.03) << c.out;
 	EXPECT_GT(still, 1.5 * med) << c.out;
+
+	// Masks over valid depth only: scan 5 of the rawlog is frame 5 of the
+	// folder; GT = left half moving, prediction = everything moving.
+	bims::eval::ImportParams ip;
+	const auto folder = bims::eval::readTumFolder(kBonn, ip);
+	const cv::Mat d5 =
+	    cv::imread(folder.frames[5].depthPath, cv::IMREAD_UNCHANGED);
+	ASSERT_FALSE(d5.empty());
+	const cv::Mat valid5 = d5 > 0;
+	const cv::Mat left = valid5(cv::Rect(0, 0, 320, 480));
+	const long nValid = cv::countNonZero(valid5),
+	           nLeft = cv::countNonZero(left);
+	fs::create_directories(d + "/gtm");
+	fs::create_directories(d + "/predm");
+	cv::Mat g(480, 640, CV_8UC1, cv::Scalar(0));
+	g(cv::Rect(0, 0, 320, 480)) = 255;
+	cv::imwrite(d + "/gtm/000005.png", g);
+	cv::imwrite(d + "/predm/000005.png",
+	            cv::Mat(480, 640, CV_8UC1, cv::Scalar(255)));
+	const auto m = run(kBin + "/bims-eval masks " + d + "/gtm " + d +
+	                   "/predm --depth-valid " + d + "/b.rawlog");
+	ASSERT_EQ(m.code, 0) << m.out;
+	char expect[128];
+	std::snprintf(expect, sizeof(expect), "tp %ld fp %ld fn 0 tn 0 invalid %ld",
+	              nLeft, nValid - nLeft, 640L * 480L - nValid);
+	EXPECT_NE(m.out.find(expect), std::string::npos) << expect << "\n" << m.out;
+	EXPECT_TRUE(fs::exists(d + "/predm_eval/000005.png"));
+	// A mask index beyond the rawlog's scans is an error naming the rawlog.
+	cv::imwrite(d + "/gtm/000050.png", g);
+	cv::imwrite(d + "/predm/000050.png", g);
+	const auto m2 = run(kBin + "/bims-eval masks " + d + "/gtm " + d +
+	                    "/predm --no-plots --depth-valid " + d + "/b.rawlog");
+	EXPECT_EQ(m2.code, 1);
+	EXPECT_NE(m2.out.find("b.rawlog: has only 20 3D scans"), std::string::npos)
+	    << m2.out;
 }
 
 TEST(ImportTum, BadInputIsAClearError)

@@ -50,9 +50,10 @@ struct MaskMetrics
  * the file if it is missing, unreadable or of another type. */
 cv::Mat loadMask(const std::string& path);
 
-/** Colour overlay of one frame (BGR): TP green, FP red, FN blue, invalid
- * pixels dark grey, other pixels the dimmed \a background (CV_8UC1 or
- * CV_8UC3 of the same size; black if empty). A caption line with the frame's
+/** Colour overlay of one frame (BGR): TP green, FP red, FN blue (blended
+ * 60 % over the \a background when one is given), invalid pixels dark grey,
+ * other pixels the dimmed grey \a background (CV_8UC1 or CV_8UC3 of the same
+ * size; black if empty). A caption line with the frame's
  * scores is drawn at the top. */
 cv::Mat maskOverlay(const cv::Mat& gt, const cv::Mat& pred,
                     const cv::Mat& validDepth, const cv::Mat& background,
