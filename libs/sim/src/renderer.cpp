@@ -73,6 +73,8 @@ void DepthParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	dropout = s.getDouble("dropout", dropout, 0, 1);
 	holesPerMpx = s.getDouble("holes_per_mpx", holesPerMpx, 0, 10000);
 	holeRadiusPx = s.getDouble("hole_radius_px", holeRadiusPx, 0.5, 100);
+	projectorBaseline =
+	    s.getDouble("projector_baseline", projectorBaseline, 0, 1);
 	if (s.getBool("noiseless", false)) makeNoiseless();
 	s.finish();
 }
@@ -211,7 +213,8 @@ void Renderer::render(const Scene& scene, double t, const Eigen::Matrix3d& R_WC,
 			for (int c = 0; c < 3; c++)
 			{
 				double val = col[c] * shade;
-				if (rgb_.noiseSigma > 0) val += rgb_.noiseSigma * rng.gaussFast();
+				if (rgb_.noiseSigma > 0)
+					val += rgb_.noiseSigma * rng.gaussFast();
 				out.rgb[3 * size_t(k) + c] =
 				    uint8_t(std::clamp(std::lround(val), 0L, 255L));
 			}
@@ -228,6 +231,27 @@ void Renderer::render(const Scene& scene, double t, const Eigen::Matrix3d& R_WC,
 			if (depth_.noiseA > 0) zn += depth_.noiseA * z * z * rng.gauss();
 			const long mm = std::lround(zn * 1000.0);
 			out.depthMm[k] = uint16_t(std::clamp(mm, 0L, 65535L));
+		}
+	}
+	// Projector shadows: a pixel's projector column is x_p = u - fx b / z. A
+	// surface point is lit only if no point to its right (nearer to the
+	// projector's line of sight) maps to a smaller projector column.
+	if (depth_.projectorBaseline > 0)
+	{
+		const double fb = fx * depth_.projectorBaseline;
+		for (int v = 0; v < H; v++)
+		{
+			double minXp = std::numeric_limits<double>::infinity();
+			for (int u = W - 1; u >= 0; u--)
+			{
+				const int k = v * W + u;
+				if (ibuf[k] < 0) continue;
+				const double xp = u - fb / zbuf[k];
+				if (xp > minXp)
+					out.depthMm[k] = 0;
+				else
+					minXp = xp;
+			}
 		}
 	}
 	// Small round holes.

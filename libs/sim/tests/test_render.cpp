@@ -201,3 +201,51 @@ TEST(Renderer, SameSeedSameFrameOtherSeedDiffers)
 	EXPECT_NE(a.rgb, c.rgb);
 	EXPECT_EQ(a.mask, c.mask);
 }
+
+TEST(Renderer, ProjectorShadowLeftOfForegroundObjects)
+{
+	// A box 1.8 m away in front of a wall 4 m away: the band left of the box
+	// where the projector (7.5 cm to the right) cannot see the wall has width
+	// fx b (1/z_box - 1/z_wall) pixels; no shadow on the right.
+	Scene scene;
+	RoomParams rp;
+	rp.size = {6, 10, 3};
+	rp.furniture = 0;
+	buildRoom(rp, scene);
+	Primitive box;
+	box.shape = Shape::Box;
+	box.t_WP = {1, 0, 1.2};
+	box.half = {0.2, 0.2, 0.3};
+	scene.staticPrims.push_back(box);
+	CameraParams cam;
+	DepthParams dp;
+	dp.makeNoiseless();
+	HandheldMotionParams mp;
+	mp.position = {-1, 0, 1.2};
+	mp.yprDeg = {0, 0, 0};
+	const auto k = HandheldMotion(mp).at(0);
+	RenderedFrame f;
+	Renderer(cam, dp, RgbParams()).render(scene, 0, k.R_WC, k.p_WC, 1, 0, f);
+	const int v = int(cam.cyS());
+	int uL = -1, uR = -1;
+	for (int u = 0; u < f.width; u++)
+		if (std::abs(f.depthTrue[v * f.width + u] - 1.8) < 1e-6)
+		{
+			if (uL < 0) uL = u;
+			uR = u;
+		}
+	ASSERT_GT(uL, 20);
+	ASSERT_LT(uR, f.width - 20);
+	int shadow = 0;
+	for (int u = uL - 1; u >= 0 && f.depthMm[v * f.width + u] == 0; u--)
+		shadow++;
+	const double expected =
+	    cam.fxS() * dp.projectorBaseline * (1 / 1.8 - 1 / 4.0);
+	EXPECT_NEAR(shadow, expected, 1.5);
+	EXPECT_GT(f.depthMm[v * f.width + uR + 1], 0);  // right side lit
+	EXPECT_GT(f.depthMm[v * f.width + uL], 0);      // the box itself lit
+	// Without a projector baseline: no shadow.
+	dp.projectorBaseline = 0;
+	Renderer(cam, dp, RgbParams()).render(scene, 0, k.R_WC, k.p_WC, 1, 0, f);
+	EXPECT_GT(f.depthMm[v * f.width + uL - 1], 0);
+}

@@ -45,6 +45,10 @@ struct DepthParams
 	double dropout = 0.002;   ///< probability of a missing single pixel
 	double holesPerMpx = 50;  ///< small round holes per megapixel per frame
 	double holeRadiusPx = 3;  ///< maximum hole radius at 640x480 [px]
+	/** Structured-light projector to the right (+x of {C}) of the depth camera
+	 * [m]; surfaces it cannot see get no reading (the shadow band left of
+	 * foreground objects in Kinect images). 0 = no shadows. */
+	double projectorBaseline = 0.075;
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section);
 	/** No noise, no dropout, no holes (range and grazing limits kept). */
