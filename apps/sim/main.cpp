@@ -1,7 +1,8 @@
 // bims-sim: synthetic RGB-D + IMU sequences with ground truth.
-//   bims-sim SCENE.ini -o OUT.rawlog [--seed N] [--frames N] [--resolution
-//   320x240] bims-sim --imu-from-tum GT.txt -o IMU.rawlog [--seed N] [--config
-//   imu.ini]
+//   bims-sim SCENE.ini -o OUT.rawlog [--seed N] [--frames N]
+//            [--resolution 320x240] [--preview K] [-q]
+//   bims-sim --imu-from-tum GT.txt -o IMU.rawlog [--seed N]
+//            [--config imu.ini]
 // See docs/sim.md.
 #include <bims/common/app.h>
 #include <bims/common/config.h>

@@ -10,15 +10,15 @@
 //  - The IMU sits at the camera centre (no lever arm).
 //  - Time offset: an IMU sample stamped t_stamp measured the motion at the
 //    true time t_stamp - time_offset_s (positive = IMU stamps are late).
-//  - Accelerometer: specific force f_I = R_IW (a_W - g_W), g_W =
-//  (0,0,-9.80665);
-//    at rest and level it reads +9.81 on the {I} axis that points up.
+//  - Accelerometer: specific force f_I = R_IW (a_W - g_W) with
+//    g_W = (0, 0, -9.80665); at rest it reads +9.81 along the {I} axis that
+//    points up.
 //  - Gyroscope: angular velocity of {I} w.r.t. {W}, in {I} [rad/s].
 //  - Magnetometer: Earth field m_W (+ optional local disturbance) in {I}
 //    [gauss]; m_W = B (cos dip cos decl, -cos dip sin decl, -sin dip) in NWU.
 //  - Continuous-time noise densities; a sample at rate f gets white noise with
-//    sigma = density * sqrt(f); biases follow b += sigma_rw * sqrt(dt) *
-//    N(0,1).
+//    sigma = density * sqrt(f); biases random-walk,
+//    b += sigma_rw * sqrt(dt) * N(0, 1).
 #pragma once
 
 #include <bims/common/trajectory.h>
