@@ -1,6 +1,7 @@
 #include <bims/common/app.h>
 #include <bims/common/rawlog.h>
 #include <bims/eval/depth_consistency.h>
+#include <bims/eval/json.h>
 #include <bims/eval/mask_metrics.h>
 #include <bims/eval/plots.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
@@ -218,8 +219,9 @@ int cmdMasks(int argc, char** argv)
 	if (json.isSet())
 	{
 		std::ofstream jf(json.getValue());
-		jf << "{\n  \"gt\": \"" << gtDir << "\",\n  \"pred\": \"" << predDir
-		   << "\",\n  \"frames_compared\": " << compared
+		jf << "{\n  \"gt\": " << ev::jsonString(gtDir)
+		   << ",\n  \"pred\": " << ev::jsonString(predDir)
+		   << ",\n  \"frames_compared\": " << compared
 		   << ",\n  \"frames_missing\": " << missing
 		   << ",\n  \"depth_valid_only\": " << (scans ? "true" : "false")
 		   << ",\n  \"total\": " << total.toJson() << ",\n  \"frames\": [\n"

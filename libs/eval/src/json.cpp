@@ -1,8 +1,19 @@
-#include "json.h"
+#include <bims/eval/json.h>
 
-namespace bims::eval::detail
+#include <cmath>
+#include <cstdio>
+
+namespace bims::eval
 {
-std::string jstr(const std::string& s)
+std::string jsonNumber(double v)
+{
+	if (!std::isfinite(v)) return "null";
+	char b[64];
+	std::snprintf(b, sizeof(b), "%.9g", v);
+	return b;
+}
+
+std::string jsonString(const std::string& s)
 {
 	std::string o = "\"";
 	for (const char c : s)
@@ -34,4 +45,4 @@ std::string jstr(const std::string& s)
 	}
 	return o + "\"";
 }
-}  // namespace bims::eval::detail
+}  // namespace bims::eval
