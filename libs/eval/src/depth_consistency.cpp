@@ -7,6 +7,35 @@
 
 namespace bims::eval
 {
+namespace
+{
+/** Depth at sub-pixel (u, v): bilinear where the 4 neighbours are valid
+ * and within 5 cm of each other (one surface), else the nearest pixel.
+ * 0 outside the image or where there is no reading. */
+double sampleDepth(const cv::Mat& d, double u, double v)
+{
+	const long un = std::lround(u), vn = std::lround(v);
+	if (un < 0 || vn < 0 || un >= d.cols || vn >= d.rows) return 0;
+	const int u0 = static_cast<int>(std::floor(u)),
+	          v0 = static_cast<int>(std::floor(v));
+	if (u0 >= 0 && v0 >= 0 && u0 + 1 < d.cols && v0 + 1 < d.rows)
+	{
+		const float z00 = d.at<float>(v0, u0), z01 = d.at<float>(v0, u0 + 1),
+		            z10 = d.at<float>(v0 + 1, u0),
+		            z11 = d.at<float>(v0 + 1, u0 + 1);
+		const float lo = std::min({z00, z01, z10, z11}),
+		            hi = std::max({z00, z01, z10, z11});
+		if (lo > 0 && hi - lo < 0.05f)
+		{
+			const double a = u - u0, b = v - v0;
+			return (1 - b) * ((1 - a) * z00 + a * z01) +
+			       b * ((1 - a) * z10 + a * z11);
+		}
+	}
+	return d.at<float>(static_cast<int>(vn), static_cast<int>(un));
+}
+}  // namespace
+
 DepthAgreement depthAgreement(const cv::Mat& depth_i,
                               const mrpt::poses::CPose3D& T_WC_i,
                               const cv::Mat& depth_j,
@@ -34,12 +63,9 @@ DepthAgreement depthAgreement(const cv::Mat& depth_i,
 			const double Y = R(1, 0) * x + R(1, 1) * y + R(1, 2) * z + ty;
 			const double Z = R(2, 0) * x + R(2, 1) * y + R(2, 2) * z + tz;
 			if (Z <= 0.05) continue;
-			const long uj = std::lround(cam.fx * X / Z + cam.cx);
-			const long vj = std::lround(cam.fy * Y / Z + cam.cy);
-			if (uj < 0 || vj < 0 || uj >= depth_j.cols || vj >= depth_j.rows)
-				continue;
-			const double zj =
-			    depth_j.at<float>(static_cast<int>(vj), static_cast<int>(uj));
+			const double fu = cam.fx * X / Z + cam.cx,
+			             fv = cam.fy * Y / Z + cam.cy;
+			const double zj = sampleDepth(depth_j, fu, fv);
 			if (!(zj > 0)) continue;
 			res.push_back(std::abs(zj - Z));
 		}
