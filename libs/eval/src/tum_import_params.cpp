@@ -14,7 +14,13 @@ void CameraIntrinsics::loadFromConfigFile(
 	fy = s.getDouble("fy", fy, 1e-3, 1e6);
 	cx = s.getDouble("cx", cx, -1e6, 1e6);
 	cy = s.getDouble("cy", cy, -1e6, 1e6);
-	depthScale = s.getDouble("depth_scale", depthScale, 1e-6, 1e9);
+	depthScale = s.getDouble("depth_scale", depthScale, 1e-9, 1e9);
+	if (depthScale < 1)
+		s.fail(
+		    "depth_scale",
+		    "is the depth PNG value per metre (TUM, Bonn: 5000); a value below "
+		    "1 looks like metres per unit (bims-sim's calibration.ini writes "
+		    "that convention)");
 	s.allow("max_range");  // read by other modules from the same section
 	s.finish();
 }
@@ -47,6 +53,9 @@ void ImportParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg)
 	// then writes the default label.
 	const std::string r = se.getString("rgbd_label", rgbdLabel);
 	const std::string i = se.getString("imu_label", imuLabel);
+	// Informative keys of bims-sim's OUT_gt/calibration.ini.
+	se.allow("rgbd_rate_hz");
+	se.allow("imu_rate_hz");
 	if (!r.empty()) rgbdLabel = r;
 	if (!i.empty()) imuLabel = i;
 	se.finish();

@@ -319,6 +319,20 @@ TEST(ImportParams, BonnIniAndStrictKeys)
 		EXPECT_NE(std::string(e.what()).find("max_time_gap"), std::string::npos)
 		    << e.what();
 	}
+	// depth_scale in the other convention (metres per unit) is refused.
+	mrpt::config::CConfigFileMemory inv("[camera]\ndepth_scale = 0.001\n");
+	try
+	{
+		bims::eval::ImportParams q;
+		q.loadFromConfigFile(inv);
+		FAIL();
+	}
+	catch (const std::exception& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("value per metre"),
+		          std::string::npos)
+		    << e.what();
+	}
 	mrpt::config::CConfigFileMemory range("[import]\ntimestamp = both\n");
 	bims::eval::ImportParams q;
 	EXPECT_THROW(q.loadFromConfigFile(range), std::exception);
