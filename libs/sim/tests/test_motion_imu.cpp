@@ -295,3 +295,27 @@ TEST(SynthesizeImu, FromTumTrajectoryFollowsTheMotion)
 	bims::Trajectory tooShort(traj.begin(), traj.begin() + 3);
 	EXPECT_THROW(synthesizeImu(tooShort, p, 5), std::invalid_argument);
 }
+
+TEST(ImuSimulator, OrientationOutputIsTrueAttitudeWhenNoiseless)
+{
+	const HandheldMotion motion{HandheldMotionParams()};
+	ImuParams p;
+	p.makeNoiseless();
+	p.orientation = true;
+	ImuSimulator imu(p, 1);
+	for (double t : {0.0, 1.3, 4.2})
+	{
+		using namespace mrpt::obs;
+		const auto o = imu.sample(motion, t, 0);
+		ASSERT_TRUE(o->has(IMU_ORI_QUAT_W));
+		const Eigen::Quaterniond q(
+		    o->get(IMU_ORI_QUAT_W), o->get(IMU_ORI_QUAT_X),
+		    o->get(IMU_ORI_QUAT_Y), o->get(IMU_ORI_QUAT_Z));
+		const Eigen::Matrix3d R_WI = motion.at(t).R_WC * p.R_IC.transpose();
+		EXPECT_LT(angleDeg(q.toRotationMatrix().transpose() * R_WI), 1e-6);
+	}
+	ImuParams off;
+	EXPECT_FALSE(ImuSimulator(off, 1)
+	                 .sample(motion, 0, 0)
+	                 ->has(mrpt::obs::IMU_ORI_QUAT_W));
+}

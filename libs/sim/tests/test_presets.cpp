@@ -1,0 +1,86 @@
+// The scene presets of config/sim/: each loads, renders, and has the property
+// its name promises.
+#include <bims/sim/simulator.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace bims::sim;
+
+namespace
+{
+const std::string kPresets = std::string(BIMS_SOURCE_DIR) + "/config/sim/";
+
+/** Mean fraction of moving pixels over n frames spread over the sequence. */
+double movingFraction(const SimConfig& c, int n)
+{
+	const Scene scene = c.buildScene();
+	CameraParams cam = c.camera;
+	cam.setResolution("320x240");
+	const Renderer r(cam, c.depth, c.rgb);
+	const HandheldMotion motion(c.motion);
+	double sum = 0;
+	RenderedFrame f;
+	for (int i = 0; i < n; i++)
+	{
+		const double t =
+		    (c.seq.frames - 1) / c.seq.fps * i / std::max(1, n - 1);
+		const auto k = motion.at(t);
+		r.render(scene, t, k.R_WC, k.p_WC, 1, uint64_t(i), f);
+		size_t m = 0;
+		for (auto v : f.mask) m += v ? 1 : 0;
+		sum += double(m) / f.mask.size();
+	}
+	return sum / n;
+}
+double peakRateDegS(const SimConfig& c)
+{
+	const HandheldMotion m(c.motion);
+	double peak = 0;
+	for (double t = 0; t < c.seq.frames / c.seq.fps; t += 0.002)
+		peak = std::max(peak, m.at(t).omega_C.norm());
+	return peak * 180 / M_PI;
+}
+}  // namespace
+
+TEST(Presets, AllLoadAndShowMovingObjects)
+{
+	for (const char* p : {"pendulum_slow", "fast_rotation", "static_camera",
+	                      "crowded", "mag_disturbance"})
+	{
+		SCOPED_TRACE(p);
+		const SimConfig c = SimConfig::load(kPresets + p + ".ini");
+		EXPECT_GE(c.seq.frames, 150);
+		EXPECT_GE(c.imu.rateHz, 100.0);
+		EXPECT_GT(movingFraction(c, 4), 0.005);
+	}
+}
+
+TEST(Presets, EachHasItsPromisedProperty)
+{
+	const auto slow = SimConfig::load(kPresets + "pendulum_slow.ini");
+	EXPECT_LT(peakRateDegS(slow), 30.0);
+	EXPECT_EQ(slow.pendulums.size(), 1u);
+	EXPECT_GT(peakRateDegS(SimConfig::load(kPresets + "fast_rotation.ini")),
+	          180.0);
+	EXPECT_LT(peakRateDegS(SimConfig::load(kPresets + "static_camera.ini")),
+	          1e-12);
+	const double crowded =
+	    movingFraction(SimConfig::load(kPresets + "crowded.ini"), 12);
+	EXPECT_GT(crowded, 0.22);
+	EXPECT_LT(crowded, 0.42);
+	const auto mag = SimConfig::load(kPresets + "mag_disturbance.ini");
+	ASSERT_TRUE(mag.imu.disturbance);
+	// The camera passes through the disturbed region and out of it.
+	const HandheldMotion m(mag.motion);
+	double fmin = 1e9, fmax = 0;
+	for (double t = 0; t < mag.seq.frames / mag.seq.fps; t += 0.05)
+	{
+		const Eigen::Vector3d d =
+		    mag.imu.field_W(m.at(t).p_WC) - mag.imu.earthField_W();
+		fmin = std::min(fmin, d.norm());
+		fmax = std::max(fmax, d.norm());
+	}
+	EXPECT_LT(fmin, 0.02);
+	EXPECT_GT(fmax, 0.15);
+}
