@@ -1,0 +1,282 @@
+#include <bims/common/frames.h>
+#include <bims/viewer/controller.h>
+#include <bims/viewer/panels.h>
+
+#include <mrpt/system/filesystem.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <stdexcept>
+
+namespace bims::viewer
+{
+namespace
+{
+/** The pose of \a traj nearest in time to \a t (traj not empty). */
+const StampedPose& nearest(const Trajectory& traj, double t)
+{
+	auto it = std::lower_bound(traj.begin(), traj.end(), t,
+	                           [](const StampedPose& p, double v)
+	                           { return p.t < v; });
+	if (it == traj.end()) return traj.back();
+	if (it != traj.begin() && t - std::prev(it)->t < it->t - t)
+		return *std::prev(it);
+	return *it;
+}
+
+std::string defaultGroundTruth(const std::string& rawlog)
+{
+	std::string stem = rawlog;
+	const std::string ext = ".rawlog";
+	if (stem.size() > ext.size() &&
+	    stem.compare(stem.size() - ext.size(), ext.size(), ext) == 0)
+		stem.resize(stem.size() - ext.size());
+	const std::string gt = stem + "_gt/groundtruth.txt";
+	return mrpt::system::fileExists(gt) ? gt : std::string();
+}
+}  // namespace
+
+const char* toString(Panel p)
+{
+	switch (p)
+	{
+		case Panel::RgbMask:
+			return "RGB + moving mask";
+		case Panel::Depth:
+			return "Depth";
+		case Panel::FlowObserved:
+			return "Observed flow";
+		case Panel::FlowExpected:
+			return "Expected flow";
+		case Panel::Labels:
+			return "Diff labels";
+	}
+	return "?";
+}
+
+ReplayController::ReplayController(const ViewerOptions& opt) : opt_(opt)
+{
+	if (opt_.rawlog.empty()) throw std::invalid_argument("no rawlog given");
+	if (!opt_.configPath.empty())
+		cfg_.loadFromFile(opt_.configPath);
+	else
+		cfg_.source = "<defaults>";
+	if (opt_.cloudDecimation < 1) opt_.cloudDecimation = 1;
+
+	ReplaySourceParams sp;
+	sp.rgbdLabel = cfg_.ego.sensors.rgbd_label;
+	sp.imuLabel = cfg_.ego.sensors.imu_label;
+	sp.imuOffsetS = cfg_.ego.calibration.time_offset_s;
+	sp.imuWaitS = cfg_.pipeline.imu_wait_s;
+	src_ = std::make_unique<ReplaySource>(opt_.rawlog, sp);
+
+	if (!opt_.resultsDir.empty())
+	{
+		const std::string traj = opt_.resultsDir + "/trajectory.txt";
+		if (!mrpt::system::fileExists(traj))
+			throw std::runtime_error(opt_.resultsDir +
+			                         ": not a bims-run output folder (no "
+			                         "trajectory.txt)");
+		results_ = loadTumTrajectory(traj);
+	}
+	const std::string gt = opt_.groundTruth.empty()
+	                           ? defaultGroundTruth(opt_.rawlog)
+	                           : opt_.groundTruth;
+	if (!gt.empty()) gt_ = loadTumTrajectory(gt);
+	restart();
+}
+
+ReplayController::~ReplayController() = default;
+
+void ReplayController::restart()
+{
+	src_->rewind();
+	pipe_.reset();
+	if (opt_.runPipeline) pipe_ = std::make_unique<pipeline::Pipeline>(cfg_);
+	est_ = pipe_ ? Trajectory() : results_;
+	frame_.reset();
+	resultsMask_.release();
+	cur_ = -1;
+	clock_ = 0;
+}
+
+double ReplayController::frameTime(size_t i) const
+{
+	const auto& t = src_->frameTimes();
+	return t.at(i) - t.front();
+}
+
+bool ReplayController::step()
+{
+	auto f = src_->next();
+	if (!f) return false;
+	f->scan->load();  // external images, if any
+	if (pipe_)
+	{
+		for (const auto& m : f->imu) pipe_->addImu(*m);
+		const auto& r = pipe_->processFrame(*f->scan, f->index);
+		est_.push_back({f->t, r.T_WC});
+	}
+	cur_ = static_cast<long>(f->index);
+	frame_ = std::move(f);
+	loadResultsFrame();
+	return true;
+}
+
+void ReplayController::loadResultsFrame()
+{
+	resultsMask_.release();
+	if (opt_.resultsDir.empty() || cur_ < 0) return;
+	char name[32];
+	std::snprintf(name, sizeof(name), "/masks/%06ld.png", cur_);
+	const std::string p = opt_.resultsDir + name;
+	if (mrpt::system::fileExists(p))
+		resultsMask_ = cv::imread(p, cv::IMREAD_GRAYSCALE);
+}
+
+void ReplayController::seek(size_t i)
+{
+	if (i >= frameCount()) i = frameCount() - 1;
+	if (static_cast<long>(i) < cur_ ||
+	    (cur_ >= 0 && static_cast<long>(i) == cur_ && !frame_))
+		restart();
+	while (cur_ < static_cast<long>(i) && step())
+	{
+	}
+	clock_ = frameTime(static_cast<size_t>(std::max(0L, cur_)));
+}
+
+void ReplayController::setPlaying(bool on)
+{
+	if (on && atEnd()) restart();
+	playing_ = on;
+	clock_ = cur_ >= 0 ? frameTime(static_cast<size_t>(cur_)) : 0;
+}
+
+void ReplayController::setSpeed(double s)
+{
+	speed_ = std::clamp(s, 0.05, 20.0);
+}
+
+size_t ReplayController::advance(double wallSeconds, size_t maxSteps)
+{
+	if (!playing_) return 0;
+	clock_ += std::max(0.0, wallSeconds) * speed_;
+	size_t n = 0;
+	while (n < maxSteps && !atEnd())
+	{
+		const size_t next = static_cast<size_t>(cur_ + 1);
+		if (cur_ >= 0 && frameTime(next) > clock_) break;
+		if (!step()) break;
+		++n;
+	}
+	// A slow pipeline makes playback lag; don't let the clock run away.
+	if (cur_ >= 0 && clock_ > frameTime(static_cast<size_t>(cur_)) + 0.25)
+		clock_ = frameTime(static_cast<size_t>(cur_));
+	if (atEnd()) playing_ = false;
+	return n;
+}
+
+const pipeline::FrameResult* ReplayController::result() const
+{
+	return (pipe_ && cur_ >= 0) ? &pipe_->last() : nullptr;
+}
+
+mrpt::poses::CPose3D ReplayController::currentPose() const
+{
+	if (const auto* r = result()) return r->T_WC;
+	if (frame_ && !results_.empty()) return nearest(results_, frame_->t).T_WC;
+	if (frame_ && !gt_.empty()) return nearest(gt_, frame_->t).T_WC;
+	return {};
+}
+
+cv::Mat ReplayController::currentMask() const
+{
+	if (const auto* r = result()) return r->mask;
+	return resultsMask_;
+}
+
+cv::Mat ReplayController::panel(Panel p) const
+{
+	if (!frame_) return cv::Mat(240, 320, CV_8UC3, cv::Scalar(64, 64, 64));
+	const auto& scan = *frame_->scan;
+	cv::Mat bgr = intensityBgr(scan);
+	const cv::Size size =
+	    bgr.empty() ? cv::Size(static_cast<int>(scan.rangeImage.cols()),
+	                           static_cast<int>(scan.rangeImage.rows()))
+	                : bgr.size();
+	const auto* r = result();
+	switch (p)
+	{
+		case Panel::RgbMask:
+			if (bgr.empty()) break;
+			return overlayMask(bgr, currentMask());
+		case Panel::Depth:
+		{
+			cv::Mat d = depthColour(scan);
+			if (!d.empty()) return d;
+			break;
+		}
+		case Panel::FlowObserved:
+		case Panel::FlowExpected:
+		{
+			if (!r) break;
+			// One magnitude scale for both, so that they compare.
+			double maxMag = 0;
+			for (const cv::Mat* f : {&r->flowObserved, &r->flowExpected})
+			{
+				if (f->empty()) continue;
+				for (int v = 0; v < f->rows; ++v)
+					for (int u = 0; u < f->cols; ++u)
+					{
+						const auto x = f->at<cv::Vec2f>(v, u);
+						const double m = std::hypot(x[0], x[1]);
+						if (std::isfinite(m)) maxMag = std::max(maxMag, m);
+					}
+			}
+			return flowColour(
+			    p == Panel::FlowObserved ? r->flowObserved : r->flowExpected,
+			    std::max(1.0, 0.5 * maxMag), size);
+		}
+		case Panel::Labels:
+			if (!r) break;
+			return labelsColour(r->labels, bgr);
+	}
+	return cv::Mat(size, CV_8UC3, cv::Scalar(64, 64, 64));
+}
+
+std::string ReplayController::statusText() const
+{
+	std::ostringstream s;
+	s.setf(std::ios::fixed);
+	s.precision(3);
+	if (cur_ < 0)
+	{
+		s << frameCount() << " frames, " << src_->imuCount() << " IMU samples; "
+		  << (pipe_ ? "pipeline on" : "pipeline off");
+		return s.str();
+	}
+	s << "frame " << cur_ << "/" << frameCount() - 1
+	  << "  t=" << frameTime(cur_) << " s";
+	const auto T = currentPose();
+	s.precision(2);
+	s << "  pos=(" << T.x() << ", " << T.y() << ", " << T.z() << ")";
+	if (const auto* r = result())
+	{
+		const double valid = static_cast<double>(r->cloudStats.valid);
+		const double moving = r->mask.empty() ? 0 : cv::countNonZero(r->mask);
+		s.precision(1);
+		s << "  moving " << (valid > 0 ? 100.0 * moving / valid : 0.0)
+		  << "% px, " << r->movingVoxels << " voxels  [" << r->ms.total
+		  << " ms: ego " << r->ms.ego << ", flow " << r->ms.flow << ", grids "
+		  << r->ms.grids << "]";
+	}
+	s.precision(2);
+	s << "  x" << speed_;
+	return s.str();
+}
+
+}  // namespace bims::viewer

@@ -1,0 +1,245 @@
+// The viewer's controller, without any GUI: replay order, timeline, play
+// clock, pipeline while replaying, panels, results folders, and an offscreen
+// render of the 3D view in which the three tier colours must appear.
+#include <bims/common/app.h>
+#include <bims/common/trajectory.h>
+#include <bims/viewer/controller.h>
+#include <bims/viewer/panels.h>
+#include <gtest/gtest.h>
+
+#include <mrpt/system/filesystem.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+using namespace bims;
+using namespace bims::viewer;
+
+namespace
+{
+const std::string kRawlog =
+    std::string(BIMS_SOURCE_DIR) + "/rawlogs/pendulum_slow.rawlog";
+const std::string kConfig =
+    std::string(BIMS_SOURCE_DIR) + "/config/default.ini";
+
+ViewerOptions sampleOptions()
+{
+	ViewerOptions o;
+	o.rawlog = kRawlog;
+	o.configPath = kConfig;
+	return o;
+}
+}  // namespace
+
+TEST(ReplaySource, IndexesScansAndDeliversEveryImuSampleBeforeItsFrame)
+{
+	ReplaySourceParams p;
+	p.rgbdLabel = "RGBD";
+	p.imuLabel = "IMU";
+	ReplaySource src(kRawlog, p);
+	ASSERT_EQ(src.frameCount(), 150u);
+	EXPECT_EQ(src.imuCount(), 499u);
+	EXPECT_NEAR(src.frameTimes()[1] - src.frameTimes()[0], 1.0 / 30, 1e-3);
+
+	size_t n = 0, imu = 0;
+	while (auto f = src.next())
+	{
+		EXPECT_EQ(f->index, n);
+		EXPECT_NEAR(f->t, src.frameTimes()[n], 1e-9);
+		imu += f->imu.size();
+		// IMU samples come before (or up to imuWaitS after) their frame.
+		for (const auto& m : f->imu)
+			EXPECT_LE(mrpt::Clock::toDouble(m->timestamp), f->t + 0.1 + 1e-6);
+		++n;
+	}
+	EXPECT_EQ(n, 150u);
+	// Every sample up to the last frame (those after it feed no frame).
+	EXPECT_GE(imu, 496u);
+	EXPECT_LE(imu, 499u);
+
+	src.rewind();
+	auto f0 = src.next();
+	ASSERT_TRUE(f0.has_value());
+	EXPECT_EQ(f0->index, 0u);
+}
+
+TEST(ReplaySource, RejectsMissingFileAndUnknownLabel)
+{
+	EXPECT_THROW(ReplaySource("/nonexistent/x.rawlog", {}), std::exception);
+	ReplaySourceParams p;
+	p.rgbdLabel = "KINECT_NOPE";
+	try
+	{
+		ReplaySource s(kRawlog, p);
+		FAIL() << "no throw";
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("KINECT_NOPE"), std::string::npos);
+	}
+}
+
+TEST(ReplayController, StepsRunThePipelineAndSeekBackRestarts)
+{
+	ReplayController c(sampleOptions());
+	EXPECT_EQ(c.frameCount(), 150u);
+	EXPECT_EQ(c.currentFrame(), -1);
+	EXPECT_EQ(c.result(), nullptr);
+	for (int i = 0; i < 5; ++i) ASSERT_TRUE(c.step());
+	EXPECT_EQ(c.currentFrame(), 4);
+	ASSERT_NE(c.result(), nullptr);
+	EXPECT_EQ(c.result()->index, 4u);
+	EXPECT_EQ(c.estimated().size(), 5u);
+	EXPECT_EQ(c.pipelineObj()->framesProcessed(), 5u);
+
+	c.seek(2);  // back: restart and replay 0..2
+	EXPECT_EQ(c.currentFrame(), 2);
+	EXPECT_EQ(c.estimated().size(), 3u);
+	EXPECT_EQ(c.pipelineObj()->framesProcessed(), 3u);
+	c.seek(6);  // forward: continue
+	EXPECT_EQ(c.currentFrame(), 6);
+	EXPECT_EQ(c.pipelineObj()->framesProcessed(), 7u);
+}
+
+TEST(ReplayController, PlayClockFollowsDataTimeAndSpeed)
+{
+	auto o = sampleOptions();
+	o.runPipeline = false;  // timing logic only
+	ReplayController c(o);
+	EXPECT_EQ(c.advance(1.0), 0u);  // paused: nothing
+	c.setPlaying(true);
+	EXPECT_EQ(c.advance(0.0, 100), 1u);  // frame 0 at once
+	EXPECT_EQ(c.currentFrame(), 0);
+	// 0.51 s of data at 30 fps: frames 1..15
+	EXPECT_EQ(c.advance(0.51, 100), 15u);
+	EXPECT_EQ(c.currentFrame(), 15);
+	c.setSpeed(2.0);
+	EXPECT_EQ(c.advance(0.1, 100), 6u);  // 0.2 s of data
+	EXPECT_EQ(c.currentFrame(), 21);
+	c.setSpeed(100);  // clamped
+	EXPECT_DOUBLE_EQ(c.speed(), 20.0);
+	// maxSteps = 1: a slow consumer lags but never skips frames
+	EXPECT_EQ(c.advance(10.0, 1), 1u);
+	EXPECT_EQ(c.currentFrame(), 22);
+	c.seek(149);
+	EXPECT_TRUE(c.atEnd());
+	c.setPlaying(true);  // at the end: restart from frame 0
+	EXPECT_EQ(c.currentFrame(), -1);
+	EXPECT_TRUE(c.playing());
+}
+
+TEST(ReplayController, PanelsHaveTheFrameSizeAndShowTheMask)
+{
+	ReplayController c(sampleOptions());
+	const auto grey = c.panel(Panel::RgbMask);
+	EXPECT_EQ(grey.type(), CV_8UC3);  // before any frame: placeholder
+	c.seek(12);
+	for (Panel p : {Panel::RgbMask, Panel::Depth, Panel::FlowObserved,
+	                Panel::FlowExpected, Panel::Labels})
+	{
+		const cv::Mat m = c.panel(p);
+		EXPECT_EQ(m.cols, 320) << toString(p);
+		EXPECT_EQ(m.rows, 240) << toString(p);
+		EXPECT_EQ(m.type(), CV_8UC3) << toString(p);
+	}
+	ASSERT_NE(c.result(), nullptr);
+	EXPECT_FALSE(c.result()->flowObserved.empty());
+	EXPECT_FALSE(c.result()->flowExpected.empty());
+	// The pendulum moves: some pixels are masked, and they are red-tinted.
+	const cv::Mat mask = c.currentMask();
+	ASSERT_FALSE(mask.empty());
+	EXPECT_GT(cv::countNonZero(mask), 50);
+	const auto tc = tierColourFractions(c.panel(Panel::Labels));
+	EXPECT_GT(tc.red, 0.001);  // Diff labels on the pendulum
+	EXPECT_NE(c.statusText().find("frame 12/149"), std::string::npos);
+}
+
+TEST(Panels, OverlayTintsOnlyMaskedPixels)
+{
+	cv::Mat bgr(10, 10, CV_8UC3, cv::Scalar(200, 200, 200));
+	cv::Mat mask = cv::Mat::zeros(10, 10, CV_8UC1);
+	mask(cv::Rect(2, 2, 4, 4)).setTo(255);
+	const cv::Mat o = overlayMask(bgr, mask);
+	EXPECT_EQ(o.at<cv::Vec3b>(9, 9), cv::Vec3b(200, 200, 200));
+	const auto in = o.at<cv::Vec3b>(3, 3);
+	EXPECT_EQ(in, cv::Vec3b(100, 100, 228));                 // 50 % red tint
+	EXPECT_EQ(o.at<cv::Vec3b>(2, 2), cv::Vec3b(0, 0, 255));  // outline
+	const auto tc = tierColourFractions(o);
+	EXPECT_NEAR(tc.red, 16.0 / 100, 1e-9);
+	EXPECT_EQ(tc.blue, 0);
+	EXPECT_EQ(tc.yellow, 0);
+}
+
+TEST(Panels, FlowColourCodesDirectionAndMagnitude)
+{
+	cv::Mat f(2, 2, CV_32FC2, cv::Scalar(0, 0));
+	f.at<cv::Vec2f>(0, 0) = cv::Vec2f(4, 0);
+	f.at<cv::Vec2f>(0, 1) = cv::Vec2f(-4, 0);
+	f.at<cv::Vec2f>(1, 1) = cv::Vec2f(NAN, NAN);
+	const cv::Mat c = flowColour(f, 4, {2, 2});
+	EXPECT_EQ(c.at<cv::Vec3b>(1, 1), cv::Vec3b(0, 0, 0));     // none: black
+	EXPECT_EQ(c.at<cv::Vec3b>(1, 0), cv::Vec3b(0, 0, 0));     // zero flow
+	EXPECT_NE(c.at<cv::Vec3b>(0, 0), c.at<cv::Vec3b>(0, 1));  // direction
+	const auto a = c.at<cv::Vec3b>(0, 0);
+	EXPECT_EQ(std::max({a[0], a[1], a[2]}), 255);  // full magnitude
+	EXPECT_EQ(flowColour(cv::Mat(), 1, {3, 2}).size(), cv::Size(3, 2));
+}
+
+TEST(ReplayController, ResultsFolderGivesPosesAndMasks)
+{
+	const std::string dir =
+	    std::string(BIMS_BINARY_DIR) + "/test_viewer_results";
+	makeDirs(dir + "/masks");
+	ReplaySourceParams sp;
+	ReplaySource src(kRawlog, sp);
+	Trajectory traj;
+	for (size_t i = 0; i < 3; ++i)
+		traj.push_back({src.frameTimes()[i],
+		                mrpt::poses::CPose3D(0.1 * i, 0, 0, 0, 0, 0)});
+	saveTumTrajectory(dir + "/trajectory.txt", traj);
+	cv::Mat m = cv::Mat::zeros(240, 320, CV_8UC1);
+	m(cv::Rect(10, 10, 20, 20)).setTo(255);
+	cv::imwrite(dir + "/masks/000001.png", m);
+
+	ViewerOptions o;
+	o.rawlog = kRawlog;
+	o.resultsDir = dir;
+	o.runPipeline = false;
+	ReplayController c(o);
+	EXPECT_EQ(c.estimated().size(), 3u);
+	c.seek(1);
+	EXPECT_NEAR(c.currentPose().x(), 0.1, 1e-6);
+	EXPECT_EQ(cv::countNonZero(c.currentMask()), 400);
+	c.step();  // no mask file for frame 2
+	EXPECT_TRUE(c.currentMask().empty());
+
+	o.resultsDir = dir + "/masks";  // not a results folder
+	EXPECT_THROW(ReplayController bad(o), std::runtime_error);
+}
+
+TEST(ReplayController, OffscreenViewShowsTheThreeTierColours)
+{
+	auto o = sampleOptions();
+	ReplayController c(o);
+	c.seek(14);
+	ASSERT_NE(c.result(), nullptr);
+	ASSERT_GT(c.pipelineObj()->grids().background()->movingCells().size(), 0u);
+	ASSERT_GT(c.pipelineObj()->grids().flow()->movingCells().size(), 0u);
+	const auto img = c.renderOffscreen(c.suggestedCamera(), 640, 480);
+	ASSERT_EQ(img.getWidth(), 640u);
+	img.saveToFile(std::string(BIMS_BINARY_DIR) + "/test_viewer_offscreen.png");
+	const auto tc = tierColourFractions(img.asCvMatRef());
+	EXPECT_GT(tc.blue, 0.002);
+	EXPECT_GT(tc.yellow, 0.0002);
+	EXPECT_GT(tc.red, 0.0002);
+
+	// Each tier toggled off disappears from the picture.
+	c.layers().tier0 = false;
+	c.layers().tier1 = false;
+	c.layers().tier2 = false;
+	c.layers().cloud = false;
+	const auto none = tierColourFractions(
+	    c.renderOffscreen(c.suggestedCamera(), 320, 240).asCvMatRef());
+	EXPECT_LT(none.blue, 0.0005);
+	EXPECT_LT(none.yellow, 0.0005);
+	EXPECT_LT(none.red, 0.0005);
+}
