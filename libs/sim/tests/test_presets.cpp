@@ -83,4 +83,10 @@ TEST(Presets, EachHasItsPromisedProperty)
 	}
 	EXPECT_LT(fmin, 0.02);
 	EXPECT_GT(fmax, 0.15);
+	const auto mis = SimConfig::load(kPresets + "imu_misaligned.ini");
+	EXPECT_GT(
+	    Eigen::AngleAxisd(mis.imu.R_IC.transpose() * slow.imu.R_IC).angle() *
+	        180 / M_PI,
+	    3.0);
+	EXPECT_NE(mis.imu.timeOffsetS, 0.0);
 }
