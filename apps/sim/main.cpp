@@ -121,6 +121,11 @@ int main(int argc, char** argv)
 				    throw bims::UsageError(e.what());
 			    }
 		    }
+		    if (preview.isSet() && (preview.getValue() < 0 ||
+		                            preview.getValue() >= cfg.seq.frames))
+			    throw bims::UsageError(
+			        "--preview must be a frame index in [0, " +
+			        std::to_string(cfg.seq.frames - 1) + "]");
 		    const auto st =
 		        bims::sim::runSimulation(cfg, out.getValue(), seed.getValue(),
 		                                 !quiet.getValue(), preview.getValue());

@@ -316,6 +316,14 @@ TEST(BimsSim, BadInputGivesClearErrorAndNonZeroExit)
 	              out),
 	          2);
 	EXPECT_NE(out.find("640x480 or 320x240"), std::string::npos) << out;
+	EXPECT_EQ(run("'" + kBin + "/bims-sim' '" + d +
+	                  "/good.ini' -o x.rawlog --preview 12",
+	              out),
+	          2);
+	EXPECT_EQ(run("'" + kBin + "/bims-sim' '" + d +
+	                  "/good.ini' -o x.rawlog --frames 0",
+	              out),
+	          2);
 }
 
 TEST(BimsSim, ImuFromTumTrajectoryIsLabelledSynthetic)
