@@ -66,7 +66,7 @@ void ImuParams::makeNoiseless()
 {
 	gyroNoiseDensity = gyroBiasRw = gyroBiasInit = 0;
 	accNoiseDensity = accBiasRw = accBiasInit = 0;
-	magNoiseDensity = orientationNoiseDeg = 0;
+	magNoiseDensity = magBiasRw = magBiasInit = orientationNoiseDeg = 0;
 }
 
 void ImuParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
@@ -89,6 +89,8 @@ void ImuParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 		accBiasInit = s.getDouble("acc_bias_init", accBiasInit, 0, 10);
 		magNoiseDensity =
 		    s.getDouble("mag_noise_density", magNoiseDensity, 0, 1);
+		magBiasRw = s.getDouble("mag_bias_rw", magBiasRw, 0, 1);
+		magBiasInit = s.getDouble("mag_bias_init", magBiasInit, 0, 1);
 		magField = s.getDouble("mag_field_gauss", magField, 0, 10);
 		magDipDeg = s.getDouble("mag_dip_deg", magDipDeg, -90, 90);
 		magDeclinationDeg =
@@ -122,6 +124,9 @@ ImuSimulator::ImuSimulator(const ImuParams& p, uint64_t seed)
 	Rng r(seed, 0x1B1A5);
 	bg_ = p_.gyroBiasInit * gaussVec(r);
 	ba_ = p_.accBiasInit * gaussVec(r);
+	// Own streams for the magnetometer bias: the other channels do not change.
+	Rng rm(seed, 0x3A6B1A5);
+	bm_ = p_.magBiasInit * gaussVec(rm);
 }
 
 mrpt::obs::CObservationIMU::Ptr ImuSimulator::sample(const MotionModel& motion,
@@ -138,6 +143,12 @@ mrpt::obs::CObservationIMU::Ptr ImuSimulator::sample(const MotionModel& motion,
 		bg_ += p_.gyroBiasRw * std::sqrt(dt) * gaussVec(r);
 		ba_ += p_.accBiasRw * std::sqrt(dt) * gaussVec(r);
 	}
+	if (n_ > 0)
+	{
+		Rng rw(seed_, 0x3A6B00000000ULL + n_);
+		bm_ += p_.magBiasRw * std::sqrt(std::max(0.0, tStamp - lastT_)) *
+		       gaussVec(rw);
+	}
 	lastT_ = tStamp;
 	n_++;
 
@@ -153,7 +164,7 @@ mrpt::obs::CObservationIMU::Ptr ImuSimulator::sample(const MotionModel& motion,
 	const Eigen::Vector3d w =
 	    w_I + bg_ + p_.gyroNoiseDensity * sq * gaussVec(r);
 	const Eigen::Vector3d f = f_I + ba_ + p_.accNoiseDensity * sq * gaussVec(r);
-	const Eigen::Vector3d m = m_I + p_.magNoiseDensity * sq * gaussVec(r);
+	const Eigen::Vector3d m = m_I + bm_ + p_.magNoiseDensity * sq * gaussVec(r);
 
 	auto o = CObservationIMU::Create();
 	o->sensorLabel = p_.label;
@@ -190,6 +201,7 @@ mrpt::obs::CObservationIMU::Ptr ImuSimulator::sample(const MotionModel& motion,
 		truth->m_I = m_I;
 		truth->gyroBias = bg_;
 		truth->accBias = ba_;
+		truth->magBias = bm_;
 		truth->q_WI = q_WI;
 	}
 	return o;
@@ -230,20 +242,20 @@ void saveImuTruth(const std::string& path, const std::vector<ImuTruth>& truth)
 	     "fx fy fz[m/s^2, true specific force in {I}] mx my mz[gauss, true "
 	     "field in {I}] "
 	     "bgx bgy bgz[rad/s gyro bias] bax bay baz[m/s^2 accel bias] "
-	     "qx qy qz qw[true R_WI]\n";
-	char buf[512];
+	     "qx qy qz qw[true R_WI] bmx bmy bmz[gauss magnetometer bias]\n";
+	char buf[640];
 	for (const auto& t : truth)
 	{
 		std::snprintf(buf, sizeof(buf),
 		              "%.6f %.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f "
 		              "%.9e %.9e %.9e %.9e %.9e %.9e "
-		              "%.9f %.9f %.9f %.9f\n",
+		              "%.9f %.9f %.9f %.9f %.9e %.9e %.9e\n",
 		              t.tStamp, t.tTrue, t.omega_I.x(), t.omega_I.y(),
 		              t.omega_I.z(), t.f_I.x(), t.f_I.y(), t.f_I.z(), t.m_I.x(),
 		              t.m_I.y(), t.m_I.z(), t.gyroBias.x(), t.gyroBias.y(),
 		              t.gyroBias.z(), t.accBias.x(), t.accBias.y(),
 		              t.accBias.z(), t.q_WI.x(), t.q_WI.y(), t.q_WI.z(),
-		              t.q_WI.w());
+		              t.q_WI.w(), t.magBias.x(), t.magBias.y(), t.magBias.z());
 		f << buf;
 	}
 	if (!f) throw std::runtime_error(path + ": write failed");

@@ -224,17 +224,21 @@ TEST(ImuSimulator, BiasRandomWalkGrowsWithSqrtTime)
 	ImuParams p;
 	p.makeNoiseless();
 	p.gyroBiasRw = 1e-3;
+	p.magBiasRw = 2e-3;
 	const int seeds = 400;
-	double s2 = 0;
+	double s2 = 0, m2 = 0;
 	for (int s = 0; s < seeds; s++)
 	{
 		ImuSimulator imu(p, uint64_t(s));
 		ImuTruth tr;
 		for (int k = 0; k <= 400; k++) imu.sample(motion, k / 100.0, 0, &tr);
 		s2 += tr.gyroBias.squaredNorm();
+		m2 += tr.magBias.squaredNorm();
 	}
 	const double sigma = std::sqrt(s2 / (3 * seeds));
 	EXPECT_NEAR(sigma / (1e-3 * std::sqrt(4.0)), 1.0, 0.08);
+	EXPECT_NEAR(std::sqrt(m2 / (3 * seeds)) / (2e-3 * std::sqrt(4.0)), 1.0,
+	            0.08);
 }
 
 TEST(ImuSimulator, TimeOffsetShiftsTheMeasuredInstant)

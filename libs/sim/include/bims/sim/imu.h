@@ -51,7 +51,11 @@ struct ImuParams
 	double accBiasInit = 0.02;  ///< sigma of the initial bias per axis [m/s^2]
 	// Magnetometer
 	double magNoiseDensity = 5.0e-4;  ///< [gauss/sqrt(Hz)]
-	double magField = 0.48;           ///< Earth field magnitude [gauss]
+	double magBiasRw =
+	    1.0e-5;  ///< bias (residual hard-iron) random walk [gauss/sqrt(s)]
+	double magBiasInit =
+	    3.0e-3;              ///< sigma of the initial bias per axis [gauss]
+	double magField = 0.48;  ///< Earth field magnitude [gauss]
 	double magDipDeg = 60;  ///< inclination, positive = field points down [deg]
 	double magDeclinationDeg =
 	    0;  ///< angle of the field east of {W}'s x axis [deg]
@@ -95,7 +99,9 @@ struct ImuTruth
 	Eigen::Vector3d omega_I, f_I,
 	    m_I;  ///< noiseless gyro [rad/s], specific force [m/s^2], field [gauss]
 	Eigen::Vector3d gyroBias, accBias;  ///< biases added to this sample
-	Eigen::Quaterniond q_WI;            ///< true orientation of {I} in {W}
+	Eigen::Vector3d magBias =
+	    Eigen::Vector3d::Zero();  ///< magnetometer bias [gauss]
+	Eigen::Quaterniond q_WI;      ///< true orientation of {I} in {W}
 };
 
 /** Generates IMU samples along a motion, sample by sample, deterministic for
@@ -117,7 +123,7 @@ class ImuSimulator
 	uint64_t seed_;
 	uint64_t n_ = 0;
 	double lastT_ = 0;
-	Eigen::Vector3d bg_, ba_;
+	Eigen::Vector3d bg_, ba_, bm_;
 };
 
 /** IMU readings synthesised from a TUM ground-truth trajectory of poses T_WC
