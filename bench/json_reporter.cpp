@@ -48,7 +48,7 @@ void JsonLinesReporter::ReportRuns(const std::vector<Run>& runs)
 			          << "\",\"error\":\"" << r.error_message << "\"}\n";
 			continue;
 		}
-		const std::string key = r.run_name.str();
+		const std::string key = r.run_name.function_name;
 		if (!pending_.count(key)) order_.push_back(key);
 		auto& acc = pending_[key];
 		acc.name = key;

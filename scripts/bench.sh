@@ -24,3 +24,17 @@ if [[ -x "$BUILD/bin/bims-sim" ]]; then
 fi
 "$BUILD/bin/bench_maps" "${extra[@]}" "$@" | tee "$OUT/bench_maps.jsonl"
 echo "results: $OUT/bench_maps.jsonl" >&2
+
+# A markdown summary: per cloud and voxel size, median ms (CPU ms) per frame.
+python3 - "$OUT/bench_maps.jsonl" <<'PY' >&2
+import json, sys
+rows = [json.loads(l) for l in open(sys.argv[1]) if l.startswith("{")]
+print("| measurement | cloud | voxel | ms median (wall) | ms median (CPU) |")
+print("|---|---|---|---|---|")
+for d in rows:
+    n = d["name"].split("/")
+    name = "/".join(x for x in n if x not in ("bonn", "sim") and not x.endswith("cm"))
+    cloud = next((x for x in n if x in ("bonn", "sim")), "?")
+    print("| %s | %s | %.2f | %.2f | %.2f |" % (name, cloud, d.get("voxel_m", 0),
+          d.get("ms_median", float("nan")), d.get("cpu_ms_median", float("nan"))))
+PY

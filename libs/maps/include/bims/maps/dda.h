@@ -53,29 +53,17 @@ inline void traverseRay(const double a[3], const double b[3], Visit&& visit)
 	while (n--)
 	{
 		visit(x, y, z);
-		if (tx < ty)
-		{
-			if (tx < tz)
-			{
-				x += sx;
-				tx += dx;
-			}
-			else
-			{
-				z += sz;
-				tz += dz;
-			}
-		}
-		else if (ty < tz)
-		{
-			y += sy;
-			ty += dy;
-		}
-		else
-		{
-			z += sz;
-			tz += dz;
-		}
+		// Branch-free choice of the axis whose boundary comes first (the
+		// choice is data dependent and mispredicts often as a branch).
+		const bool bx = (tx < ty) & (tx < tz);
+		const bool by = !bx & (ty < tz);
+		const bool bz = !bx & !by;
+		x += bx ? sx : 0;
+		y += by ? sy : 0;
+		z += bz ? sz : 0;
+		tx += bx ? dx : 0.0;
+		ty += by ? dy : 0.0;
+		tz += bz ? dz : 0.0;
 	}
 }
 

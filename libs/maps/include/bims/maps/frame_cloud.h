@@ -107,7 +107,8 @@ struct FrameCloud
 	std::vector<uint32_t> pixel;
 	/** Index into cells of each reading's voxel. */
 	std::vector<uint32_t> cellOfPoint;
-	/** Distinct voxels hit this frame. */
+	/** Distinct voxels hit this frame, ordered by storage block (8^3) and
+	 * by cell inside a block. */
 	std::vector<VoxelKey> cells;
 	/** Number of readings in each of cells (n_C >= 1). */
 	std::vector<uint32_t> hits;
@@ -146,8 +147,13 @@ class FrameCloudBuilder
 	void keyPoints(FrameCloud& out);
 
  private:
+	void sortCellsByBlock(FrameCloud& out);
+
 	GridParams p_;
 	FlatHashMap dedup_;  // packed voxel key -> index into cells
+	std::vector<std::pair<uint64_t, uint32_t>> order_;
+	std::vector<uint32_t> newIndex_, hitsTmp_;
+	std::vector<VoxelKey> cellsTmp_;
 };
 
 }  // namespace bims::maps
