@@ -58,6 +58,7 @@ AttitudeFilter::AttitudeFilter(const AttitudeParams& p) : p_(p)
 void AttitudeFilter::setState(const Eigen::Quaterniond& q_WI, double t)
 {
 	q_ = q_WI.normalized();
+	qg_ = q_;
 	initialized_ = true;
 	tInit_ = tLast_ = tAccelOk_ = t;
 	hist_.clear();
@@ -66,7 +67,7 @@ void AttitudeFilter::setState(const Eigen::Quaterniond& q_WI, double t)
 
 void AttitudeFilter::push(double t)
 {
-	hist_.push_back({t, q_});
+	hist_.push_back({t, q_, qg_});
 	while (hist_.size() > 2 && hist_.back().t - hist_.front().t > p_.history_s)
 		hist_.pop_front();
 }
@@ -147,6 +148,21 @@ uint32_t AttitudeFilter::add(const ImuSample& s)
 	}
 	if (p_.use_sensor_orientation && s.q_WI)
 	{
+		// The sensor's attitude as is; the gyro-only chain still integrates
+		// the raw gyro (uncorrected bias) for inter-frame rotations.
+		const double dt = s.t - tLast_;
+		if (s.hasGyro && haveGyro_ && dt <= p_.max_gap_s)
+			qg_ = Eigen::Quaterniond(qg_.toRotationMatrix() *
+			                         expSO3(0.5 * (s.gyro + lastGyro_) * dt));
+		else
+			qg_ = *s.q_WI;
+		qg_.normalize();
+		if (s.hasGyro)
+		{
+			lastGyro_ = s.gyro;
+			lastRate_ = s.gyro;
+			haveGyro_ = true;
+		}
 		q_ = *s.q_WI;
 		tLast_ = s.t;
 		push(s.t);
@@ -232,6 +248,8 @@ uint32_t AttitudeFilter::add(const ImuSample& s)
 	const Eigen::Vector3d omega = lastRate_ + kp * e;
 	q_ = Eigen::Quaterniond(R_WI * expSO3(omega * dt));
 	q_.normalize();
+	qg_ = Eigen::Quaterniond(qg_.toRotationMatrix() * expSO3(lastRate_ * dt));
+	qg_.normalize();
 	if (s.hasGyro)
 	{
 		lastGyro_ = s.gyro;
@@ -245,6 +263,19 @@ uint32_t AttitudeFilter::add(const ImuSample& s)
 std::optional<Eigen::Quaterniond> AttitudeFilter::attitudeAt(
     double t, uint32_t* flags) const
 {
+	return lookup(t, flags, false);
+}
+
+std::optional<Eigen::Quaterniond> AttitudeFilter::gyroAttitudeAt(
+    double t, uint32_t* flags) const
+{
+	return lookup(t, flags, true);
+}
+
+std::optional<Eigen::Quaterniond> AttitudeFilter::lookup(double t,
+                                                         uint32_t* flags,
+                                                         bool gyroOnly) const
+{
 	uint32_t f = 0;
 	std::optional<Eigen::Quaterniond> out;
 	const double eps = 1e-9;
@@ -256,8 +287,10 @@ std::optional<Eigen::Quaterniond> AttitudeFilter::attitudeAt(
 		if (dt > p_.max_gap_s)
 			f |= kFlagImuMissing;
 		else
-			out = Eigen::Quaterniond(hist_.back().q.toRotationMatrix() *
-			                         expSO3(lastRate_ * dt));
+			out =
+			    Eigen::Quaterniond((gyroOnly ? hist_.back().qg : hist_.back().q)
+			                           .toRotationMatrix() *
+			                       expSO3(lastRate_ * dt));
 	}
 	else
 	{
@@ -268,7 +301,7 @@ std::optional<Eigen::Quaterniond> AttitudeFilter::attitudeAt(
 		const Stamped& a = *(it - 1);
 		if (b.t - a.t > p_.max_gap_s) f |= kFlagImuGap;
 		const double u = (t - a.t) / (b.t - a.t);
-		out = a.q.slerp(u, b.q);
+		out = gyroOnly ? a.qg.slerp(u, b.qg) : a.q.slerp(u, b.q);
 	}
 	if (flags) *flags |= f;
 	return out;

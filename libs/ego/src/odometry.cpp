@@ -70,15 +70,17 @@ uint32_t Odometry::addImu(const ImuSample& s)
 }
 
 std::optional<Eigen::Matrix3d> Odometry::imuRotation(double tCam,
-                                                     uint32_t* flags) const
+                                                     uint32_t* flags,
+                                                     bool gyroOnly) const
 {
 	if (!cfg_.calibration.has_R_IC)
 	{
 		if (flags) *flags |= kFlagImuMissing;
 		return std::nullopt;
 	}
+	const double t = tCam + cfg_.calibration.time_offset_s;
 	const auto q =
-	    att_.attitudeAt(tCam + cfg_.calibration.time_offset_s, flags);
+	    gyroOnly ? att_.gyroAttitudeAt(t, flags) : att_.attitudeAt(t, flags);
 	if (!q) return std::nullopt;
 	return Eigen::Matrix3d(q->toRotationMatrix() * cfg_.calibration.R_IC);
 }
@@ -117,6 +119,10 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	const bool imuMode = cfg_.odometry.mode == "imu";
 	uint32_t imuFlags = 0;
 	const auto R_WC_imu = imuRotation(f.t, &imuFlags);
+	const auto R_WC_gyro = imuRotation(f.t, nullptr, true);
+	std::optional<Eigen::Matrix3d> R_rel_gyro;
+	if (R_WC_gyro && R_WC_gyroPrev_)
+		R_rel_gyro = R_WC_gyroPrev_->transpose() * *R_WC_gyro;
 
 	// First frame: the reference (IMU attitude when there is one).
 	if (!havePrev_)
@@ -136,6 +142,7 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		tPrev_ = f.t;
 		depthPrev_ = f.depth.clone();
 		R_WC_imuPrev_ = R_WC_imu;
+		R_WC_gyroPrev_ = R_WC_gyro;
 		return r;
 	}
 
@@ -143,8 +150,8 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	std::optional<Eigen::Matrix3d> R_pred;
 	if (cfg_.odometry.gyro_aid)
 	{
-		if (R_WC_imu && R_WC_imuPrev_)
-			R_pred = R_WC_imuPrev_->transpose() * *R_WC_imu;
+		if (R_rel_gyro)
+			R_pred = R_rel_gyro;
 		else
 		{
 			R_pred = lastR_rel_;  // constant angular velocity
@@ -166,22 +173,41 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		const float z0 = depthAt(depthPrev_, r.tracks[i].prev);
 		const float z1 = depthAt(f.depth, r.tracks[i].cur);
 		if (z0 < zmin || z0 > zmax || z1 < zmin || z1 > zmax) continue;
-		corr.push_back({backProject(f.K, r.tracks[i].prev, z0),
-		                backProject(f.K, r.tracks[i].cur, z1)});
+		Correspondence c;
+		c.p_prev = backProject(f.K, r.tracks[i].prev, z0);
+		c.p_cur = backProject(f.K, r.tracks[i].cur, z1);
+		c.x_prev = {r.tracks[i].prev.x, r.tracks[i].prev.y};
+		c.x_cur = {r.tracks[i].cur.x, r.tracks[i].cur.y};
+		corr.push_back(c);
 		corrTrack.push_back(static_cast<int>(i));
 	}
 	r.correspondences = static_cast<int>(corr.size());
 
 	const bool useImu = imuMode && R_WC_imu.has_value();
+	Eigen::Matrix3d R_imuRel = Eigen::Matrix3d::Identity();
 	if (imuMode) r.flags |= imuFlags;
 	MotionEstimate m;
 	if (useImu)
 	{
 		// Relative prior anchored on the absolute IMU attitude, so that the
 		// estimated R_WC never drifts from the filter's.
-		const Eigen::Matrix3d R_rel = R_WC_.transpose() * *R_WC_imu;
+		// Inter-frame rotation from the gyro; the absolute attitude pulled
+		// towards the filter's by attitude_blend per frame (no drift, and
+		// no correction noise in the inter-frame rotations).
+		Eigen::Matrix3d R_new = *R_WC_imu;
+		if (R_rel_gyro)
+		{
+			const Eigen::Matrix3d R_pred = R_WC_ * *R_rel_gyro;
+			R_new = R_pred * expSO3(cfg_.odometry.attitude_blend *
+			                        logSO3(R_pred.transpose() * *R_WC_imu));
+		}
+		const Eigen::Matrix3d R_rel = R_WC_.transpose() * R_new;
+		R_imuRel = R_rel;
 		m = est_.estimateTranslation(corr, R_rel);
 		r.R_source = RotationSource::Imu;
+		if (m.ok && cfg_.translation.reprojection &&
+		    cfg_.translation.refine != "se3")
+			m = est_.refineReprojection(corr, m, f.K, false);
 		if (m.ok && cfg_.translation.refine == "se3")
 		{
 			m = est_.refineSE3(
@@ -193,6 +219,8 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	else
 	{
 		m = est_.estimateSE3(corr);
+		if (m.ok && cfg_.translation.reprojection)
+			m = est_.refineReprojection(corr, m, f.K, true);
 		r.R_source = RotationSource::Vision;
 	}
 	if (r.correspondences < cfg_.odometry.min_tracks)
@@ -233,6 +261,7 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	tPrev_ = f.t;
 	depthPrev_ = f.depth.clone();
 	R_WC_imuPrev_ = R_WC_imu;
+	R_WC_gyroPrev_ = R_WC_gyro;
 	return r;
 }
 

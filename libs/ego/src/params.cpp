@@ -104,6 +104,11 @@ void TranslationParams::loadFromConfigFile(
 	rotation_prior_sigma_deg = s.getDouble("rotation_prior_sigma_deg",
 	                                       rotation_prior_sigma_deg, 1e-4, 180);
 	point_sigma_m = s.getDouble("point_sigma_m", point_sigma_m, 1e-6, 10);
+	reprojection = s.getBool("reprojection", reprojection);
+	reprojection_sigma_px =
+	    s.getDouble("reprojection_sigma_px", reprojection_sigma_px, 1e-3, 100);
+	reprojection_threshold_px = s.getDouble(
+	    "reprojection_threshold_px", reprojection_threshold_px, 0.1, 1000);
 	seed = static_cast<uint32_t>(s.getInt("seed", seed, 0, 4294967295L));
 	s.finish();
 }
@@ -115,6 +120,7 @@ void OdometryParams::loadFromConfigFile(
 	mode = s.getEnum("mode", mode, {"imu", "vision"});
 	gyro_aid = s.getBool("gyro_aid", gyro_aid);
 	min_tracks = static_cast<int>(s.getInt("min_tracks", min_tracks, 3, 1e6));
+	attitude_blend = s.getDouble("attitude_blend", attitude_blend, 0, 1);
 	s.finish();
 }
 
@@ -173,6 +179,7 @@ void CameraParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	}
 	// Keys other modules read from the same section.
 	s.allow("depth_scale");
+	s.allow("max_range");
 	s.allow("depth_units");
 	s.allow("k1");
 	s.allow("k2");
@@ -188,16 +195,20 @@ void SensorsParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	ConfigSection s(cfg, section);
 	rgbd_label = s.getString("rgbd_label", rgbd_label);
 	imu_label = s.getString("imu_label", imu_label);
+	s.allow("rgbd_rate_hz");  // informative keys written by bims-sim
+	s.allow("imu_rate_hz");
 	s.finish();
 }
 
-void EgoConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg)
+void EgoConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+                                   bool requireCalibration)
 {
 	attitude.loadFromConfigFile(cfg);
 	tracker.loadFromConfigFile(cfg);
 	translation.loadFromConfigFile(cfg);
 	odometry.loadFromConfigFile(cfg);
-	calibration.loadFromConfigFile(cfg, "calibration", odometry.mode == "imu");
+	calibration.loadFromConfigFile(
+	    cfg, "calibration", requireCalibration && odometry.mode == "imu");
 	camera.loadFromConfigFile(cfg);
 	sensors.loadFromConfigFile(cfg);
 }

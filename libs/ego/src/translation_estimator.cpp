@@ -286,4 +286,104 @@ MotionEstimate TranslationEstimator::refineSE3(
 	return m;
 }
 
+void TranslationEstimator::reprojectionResidual(const Eigen::Matrix3d& R,
+                                                const Eigen::Vector3d& t,
+                                                const Eigen::Matrix3d& K,
+                                                const Correspondence& c,
+                                                Eigen::Vector4d& r,
+                                                Eigen::Matrix<double, 4, 6>* J)
+{
+	const auto proj = [&](const Eigen::Vector3d& q, Eigen::Vector2d& x,
+	                      Eigen::Matrix<double, 2, 3>& Jp)
+	{
+		const double iz = 1.0 / q.z();
+		x << K(0, 0) * q.x() * iz + K(0, 2), K(1, 1) * q.y() * iz + K(1, 2);
+		Jp << K(0, 0) * iz, 0, -K(0, 0) * q.x() * iz * iz, 0, K(1, 1) * iz,
+		    -K(1, 1) * q.y() * iz * iz;
+	};
+	// Forward: previous point seen from the current camera.
+	const Eigen::Vector3d q = R.transpose() * (c.p_prev - t);
+	// Backward: current point seen from the previous camera.
+	const Eigen::Vector3d sp = R * c.p_cur + t;
+	Eigen::Vector2d xf, xb;
+	Eigen::Matrix<double, 2, 3> Jf, Jb;
+	proj(q, xf, Jf);
+	proj(sp, xb, Jb);
+	r.head<2>() = xf - c.x_cur;
+	r.tail<2>() = xb - c.x_prev;
+	if (J)
+	{
+		J->block<2, 3>(0, 0) = Jf * skew(q);
+		J->block<2, 3>(0, 3) = -Jf * R.transpose();
+		J->block<2, 3>(2, 0) = -Jb * R * skew(c.p_cur);
+		J->block<2, 3>(2, 3) = Jb;
+	}
+}
+
+MotionEstimate TranslationEstimator::refineReprojection(
+    const std::vector<Correspondence>& c, const MotionEstimate& init,
+    const Eigen::Matrix3d& K, bool optimizeRotation) const
+{
+	MotionEstimate m = init;
+	if (init.inlier.size() != c.size() || init.inliers < 3) return m;
+	Eigen::Matrix3d R = init.R_CprevCcur;
+	Eigen::Vector3d t = init.t_CprevCcur;
+	const double sig = p_.reprojection_sigma_px, k = 1.345;
+	for (int it = 0; it < 5; it++)
+	{
+		Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
+		Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+		for (size_t i = 0; i < c.size(); i++)
+		{
+			if (!init.inlier[i]) continue;
+			Eigen::Vector4d r;
+			Eigen::Matrix<double, 4, 6> J;
+			reprojectionResidual(R, t, K, c[i], r, &J);
+			if (!r.allFinite()) continue;
+			for (int h = 0; h < 2; h++)
+			{
+				const auto rh = r.segment<2>(2 * h);
+				const auto Jh = J.block<2, 6>(2 * h, 0);
+				const double e = rh.norm() / sig;
+				const double w = (e < k ? 1.0 : k / e) / (sig * sig);
+				A += w * Jh.transpose() * Jh;
+				g += w * Jh.transpose() * rh;
+			}
+		}
+		Eigen::Matrix<double, 6, 1> dx = Eigen::Matrix<double, 6, 1>::Zero();
+		if (optimizeRotation)
+			dx = -A.ldlt().solve(g);
+		else
+			dx.tail<3>() =
+			    -A.bottomRightCorner<3, 3>().ldlt().solve(g.tail<3>());
+		if (!dx.allFinite()) return m;  // keep the 3D estimate
+		R = orthonormalize(R * expSO3(dx.head<3>()));
+		t += dx.tail<3>();
+		if (dx.norm() < 1e-9) break;
+	}
+	m.R_CprevCcur = R;
+	m.t_CprevCcur = t;
+	// Inliers: consistent in 3D (as before) and in both images.
+	m.inliers = 0;
+	double ss = 0;
+	const double thr = p_.reprojection_threshold_px;
+	for (size_t i = 0; i < c.size(); i++)
+	{
+		if (!init.inlier[i]) continue;
+		Eigen::Vector4d r;
+		reprojectionResidual(R, t, K, c[i], r);
+		const bool in = r.allFinite() && r.head<2>().norm() < thr &&
+		                r.tail<2>().norm() < thr;
+		m.inlier[i] = in ? 1 : 0;
+		if (in)
+		{
+			++m.inliers;
+			ss += (c[i].p_prev - R * c[i].p_cur - t).squaredNorm();
+		}
+	}
+	m.residual_rms_m = m.inliers ? std::sqrt(ss / m.inliers) : 0;
+	m.ok = m.inliers >= p_.min_inliers;
+	return m;
+}
+
 }  // namespace bims::ego

@@ -71,6 +71,14 @@ class AttitudeFilter
 	std::optional<Eigen::Quaterniond> attitudeAt(
 	    double t, uint32_t* flags = nullptr) const;
 
+	/** Same, on the gyro-only chain: the bias-corrected gyro integrated
+	 * without any accelerometer/magnetometer correction (started from the
+	 * filter's state). Its absolute value drifts, but the rotation between
+	 * two nearby times, R_a^T R_b, is free of the corrections' noise: use it
+	 * for inter-frame rotations. */
+	std::optional<Eigen::Quaterniond> gyroAttitudeAt(
+	    double t, uint32_t* flags = nullptr) const;
+
 	/** Counters since construction. */
 	struct Stats
 	{
@@ -101,8 +109,12 @@ class AttitudeFilter
 	struct Stamped
 	{
 		double t;
-		Eigen::Quaterniond q;
+		Eigen::Quaterniond q, qg;  // filtered, gyro-only
 	};
+
+	std::optional<Eigen::Quaterniond> lookup(double t, uint32_t* flags,
+	                                         bool gyroOnly) const;
+	Eigen::Quaterniond qg_ = Eigen::Quaterniond::Identity();
 	std::deque<Stamped> hist_;
 	Stats stats_;
 };

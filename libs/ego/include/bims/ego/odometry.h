@@ -77,9 +77,11 @@ class Odometry
 	                            const cv::Mat* movingMaskPrev = nullptr);
 
 	/** R_WC at camera time t from the IMU (nullopt without IMU data or
-	 * R_IC); *flags gets kFlagImuMissing / kFlagImuGap. */
+	 * R_IC); *flags gets kFlagImuMissing / kFlagImuGap. \param gyroOnly
+	 * use the gyro-only chain (for inter-frame rotations). */
 	std::optional<Eigen::Matrix3d> imuRotation(double tCam,
-	                                           uint32_t* flags = nullptr) const;
+	                                           uint32_t* flags = nullptr,
+	                                           bool gyroOnly = false) const;
 
 	const AttitudeFilter& attitude() const { return att_; }
 	const EgoConfig& config() const { return cfg_; }
@@ -93,7 +95,7 @@ class Odometry
 	bool havePrev_ = false;
 	double tPrev_ = 0;
 	cv::Mat depthPrev_;
-	std::optional<Eigen::Matrix3d> R_WC_imuPrev_;
+	std::optional<Eigen::Matrix3d> R_WC_imuPrev_, R_WC_gyroPrev_;
 	mrpt::poses::CPose3D T_WC_;  // latest pose
 	Eigen::Matrix3d R_WC_ = Eigen::Matrix3d::Identity();
 	Eigen::Vector3d t_WC_ = Eigen::Vector3d::Zero();

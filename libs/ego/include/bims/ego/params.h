@@ -95,6 +95,11 @@ struct TranslationParams
 	std::string refine = "none";
 	double rotation_prior_sigma_deg = 0.3;  ///< IMU rotation std. dev. [deg]
 	double point_sigma_m = 0.01;  ///< 3D residual std. dev. at 1 m [m]
+	/** Final reprojection refinement of the robust 3D estimate (t only in
+	 * mode = imu, R and t in mode = vision). */
+	bool reprojection = true;
+	double reprojection_sigma_px = 0.7;      ///< pixel noise (Huber scale) [px]
+	double reprojection_threshold_px = 3.0;  ///< inlier limit [px]
 	uint32_t seed = 1;  ///< RANSAC random seed (results are repeatable)
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
@@ -111,6 +116,11 @@ struct OdometryParams
 	 * exist; otherwise with the previous frame's rotation rate). */
 	bool gyro_aid = true;
 	int min_tracks = 12;  ///< fewer 3D matches: frame flagged
+	/** mode = imu: the inter-frame rotation comes from the gyro alone and
+	 * the absolute R_WC is pulled towards the attitude filter's by this
+	 * fraction of their difference per frame [0..1] (1 = R_WC is the
+	 * filter's, with its correction noise in every inter-frame rotation). */
+	double attitude_blend = 0.01;
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "odometry");
@@ -169,8 +179,10 @@ struct EgoConfig
 	SensorsParams sensors;
 
 	/** Reads all sections above (each optional, defaults otherwise);
-	 * R_IC is required when odometry.mode = imu. */
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
+	 * R_IC is required when odometry.mode = imu and \a requireCalibration
+	 * (false: the caller reads [calibration] from another file later). */
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+	                        bool requireCalibration = true);
 };
 
 }  // namespace bims::ego

@@ -28,6 +28,9 @@ struct Correspondence
 {
 	Eigen::Vector3d p_prev;  ///< point in {C_prev} [m]
 	Eigen::Vector3d p_cur;   ///< point in {C_cur} [m]
+	/** Pixels of the feature (needed by refineReprojection only) [px]. */
+	Eigen::Vector2d x_prev = Eigen::Vector2d::Zero();
+	Eigen::Vector2d x_cur = Eigen::Vector2d::Zero();
 };
 
 /** Result of one estimate. */
@@ -85,6 +88,27 @@ class TranslationEstimator
 	                   const std::vector<int>& idx,
 	                   const std::vector<double>& w, Eigen::Matrix3d& R,
 	                   Eigen::Vector3d& t);
+
+	/** Refines \a init by minimising robust (Huber) reprojection errors
+	 * of its inliers in both directions: p_prev into the current image and
+	 * p_cur into the previous one. Depth noise, which dominates the 3D
+	 * residuals, moves a point almost only along its ray, so it hardly
+	 * changes these pixel errors: the estimate is much less noisy than the
+	 * 3D fit. \param optimizeRotation false keeps R (the IMU's) fixed.
+	 * Inliers become those within reprojection_threshold_px both ways. */
+	MotionEstimate refineReprojection(const std::vector<Correspondence>& c,
+	                                  const MotionEstimate& init,
+	                                  const Eigen::Matrix3d& K,
+	                                  bool optimizeRotation) const;
+
+	/** Forward and backward reprojection residuals (4) and their Jacobian
+	 * w.r.t. (dtheta, dt) (4x6, right perturbation R <- R Exp(dtheta)). */
+	static void reprojectionResidual(const Eigen::Matrix3d& R,
+	                                 const Eigen::Vector3d& t,
+	                                 const Eigen::Matrix3d& K,
+	                                 const Correspondence& c,
+	                                 Eigen::Vector4d& r,
+	                                 Eigen::Matrix<double, 4, 6>* J = nullptr);
 
 	const TranslationParams& params() const { return p_; }
 

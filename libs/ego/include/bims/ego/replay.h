@@ -1,0 +1,41 @@
+// Replays a rawlog through an Odometry in time order (used by bims-odom and
+// bims-calib-imu). IMU observations are fed as they are read; each RGB-D
+// frame waits until the IMU stream has passed its time (+ time_offset_s), or
+// until data newer than imu_wait_s has been read (IMU late or absent), so
+// the attitude can be interpolated rather than extrapolated.
+#pragma once
+
+#include <bims/ego/odometry.h>
+
+#include <functional>
+#include <string>
+
+namespace bims::ego
+{
+struct ReplayOptions
+{
+	double imu_wait_s = 0.2;  ///< max wait for the IMU behind a frame [s]
+	size_t max_frames = 0;    ///< stop after this many frames (0 = all)
+	bool progress = true;     ///< progress line on stderr
+};
+
+struct ReplayStats
+{
+	size_t frames = 0;      ///< RGB-D frames processed
+	size_t imu = 0;         ///< IMU observations fed
+	size_t flagged = 0;     ///< frames with a failure flag (!ok())
+	size_t otherLabel = 0;  ///< observations skipped for their label
+};
+
+using FrameCallback = std::function<void(
+    const FrameEgomotion&, const mrpt::obs::CObservation3DRangeScan&)>;
+using ImuCallback = std::function<void(const ImuSample&)>;
+
+/** Runs \a odo over the rawlog at \a path. Throws RawlogError on a
+ * truncated or corrupt file (after the frames before it were processed). */
+ReplayStats replayRawlog(const std::string& path, Odometry& odo,
+                         const FrameCallback& onFrame,
+                         const ReplayOptions& opt = {},
+                         const ImuCallback& onImu = {});
+
+}  // namespace bims::ego
