@@ -10,6 +10,11 @@
 // --screenshot writes the 3D view as shown in the window and quits.
 #include <bims/common/app.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
+#include <mrpt/system/filesystem.h>
+
+#include <cstdio>
+#include <fstream>
+#include <iostream>
 
 #include "viewer_frame.h"
 
@@ -88,9 +93,25 @@ int main(int argc, char** argv)
 		    cmd.parse(argc, argv);
 
 		    auto& o = gOptions;
+		    if (aCfg.getValue().empty())
+		    {
+			    // "Default parameters": the project's config/default.ini,
+			    // found next to the build tree or the installed share dir.
+			    const std::string exeDir =
+			        mrpt::system::extractFileDirectory(argv[0]);
+			    for (const std::string& c :
+			         {exeDir + "/../../config/default.ini",
+			          exeDir + "/../share/bims/default.ini"})
+				    if (mrpt::system::fileExists(c))
+				    {
+					    o.viewer.configPath = c;
+					    break;
+				    }
+		    }
+		    else
+			    o.viewer.configPath = aCfg.getValue();
 		    o.viewer.rawlog = aIn.getValue();
 		    o.viewer.resultsDir = aRes.getValue();
-		    o.viewer.configPath = aCfg.getValue();
 		    o.viewer.groundTruth = aGt.getValue();
 		    o.viewer.runPipeline =
 		        !aNoPipe.getValue() &&
@@ -114,6 +135,10 @@ int main(int argc, char** argv)
 				                             o.viewer.rawlog + "'");
 		    }
 
+		    std::cerr << "bims-viewer: parameters from "
+		              << (o.viewer.configPath.empty() ? "built-in defaults"
+		                                              : o.viewer.configPath)
+		              << "\n";
 		    int wxArgc = 1;
 		    char* wxArgv[] = {argv[0], nullptr};
 		    const int rc = wxEntry(wxArgc, wxArgv);

@@ -150,11 +150,15 @@ void ViewerFrame::buildLayout()
 	split->SplitVertically(canvas_, right, opt_.width * 3 / 5);
 	split->SetSashGravity(0.6);
 	split->SetMinimumPaneSize(100);
+	// The frame gets its real size only once shown: place the sash then.
+	CallAfter([this, split]
+	          { split->SetSashPosition(GetClientSize().x * 3 / 5); });
 
 	// Timeline: play/pause, step, restart, speed, slider.
 	auto* bar = new wxPanel(this);
 	auto* hs = new wxBoxSizer(wxHORIZONTAL);
-	playBtn_ = new wxButton(bar, ID_PLAY, "Play");
+	playBtn_ =
+	    new wxButton(bar, ID_PLAY, "Pause", wxDefaultPosition, wxSize(90, -1));
 	hs->Add(playBtn_, 0, wxALL, 2);
 	hs->Add(new wxButton(bar, ID_STEP, "Step >|"), 0, wxALL, 2);
 	hs->Add(new wxButton(bar, ID_RESTART, "|< Restart"), 0, wxALL, 2);
@@ -166,7 +170,8 @@ void ViewerFrame::buildLayout()
 	hs->Add(speedChoice_, 0, wxALL | wxALIGN_CENTER_VERTICAL, 2);
 	slider_ = new wxSlider(bar, ID_SLIDER, 0, 0, 1);
 	hs->Add(slider_, 1, wxALL | wxEXPAND, 2);
-	frameLabel_ = new wxStaticText(bar, wxID_ANY, "  -/-  ");
+	frameLabel_ = new wxStaticText(bar, wxID_ANY, "  -/-  ", wxDefaultPosition,
+	                               wxSize(110, -1), wxST_NO_AUTORESIZE);
 	hs->Add(frameLabel_, 0, wxALL | wxALIGN_CENTER_VERTICAL, 4);
 	bar->SetSizer(hs);
 
@@ -232,7 +237,8 @@ void ViewerFrame::updateControls()
 	slider_->SetValue(std::max(0L, cur));
 	frameLabel_->SetLabel(
 	    wxString::Format("  %ld / %zu  ", cur, ctl_->frameCount() - 1));
-	playBtn_->SetLabel(ctl_->playing() ? "Pause" : "Play");
+	const wxString play = ctl_->playing() ? "Pause" : "Play";
+	if (playBtn_->GetLabel() != play) playBtn_->SetLabel(play);
 	SetStatusText(ctl_->statusText());
 }
 
