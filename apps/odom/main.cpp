@@ -9,12 +9,14 @@
 #include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/replay.h>
+#include <bims/ego/so3.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/system/filesystem.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <vector>
@@ -63,6 +65,12 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<std::string> csvArg(
 		        "", "csv", "per-frame details (flags, inliers, stage times)",
 		        false, "", "FRAMES.csv", cmd);
+		    TCLAP::ValueArg<std::string> gtArg(
+		        "", "gt",
+		        "ground-truth TUM trajectory: adds to --csv the true angular "
+		        "rate and the number of features tracked within 2 px of the "
+		        "truth",
+		        false, "", "GT.txt", cmd);
 		    TCLAP::ValueArg<size_t> maxArg(
 		        "", "max-frames", "stop after N frames", false, 0, "N", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
@@ -123,12 +131,30 @@ int main(int argc, char** argv)
 			           "tracks,"
 			           "ms_input,ms_track,ms_motion\n";
 		    }
+		    Trajectory gt;
+		    if (gtArg.isSet()) gt = loadTumTrajectory(gtArg.getValue());
+		    // Ground-truth pose nearest to t (within 5 ms), or nullptr.
+		    const auto gtAt = [&](double t) -> const StampedPose*
+		    {
+			    auto it = std::lower_bound(gt.begin(), gt.end(), t,
+			                               [](const StampedPose& p, double v)
+			                               { return p.t < v; });
+			    const StampedPose* best = nullptr;
+			    double bestDt = 5e-3;
+			    for (auto j : {it, it == gt.begin() ? it : it - 1})
+				    if (j != gt.end() && std::abs(j->t - t) < bestDt)
+					    best = &*j, bestDt = std::abs(j->t - t);
+			    return best;
+		    };
+		    ego::RgbdFrame prevFrame;
+		    double prevT = 0;
 		    ego::ReplayOptions ro;
 		    ro.max_frames = maxArg.getValue();
 		    ro.progress = !quiet.getValue();
 		    const auto st = ego::replayRawlog(
 		        inArg.getValue(), odo,
-		        [&](const ego::FrameEgomotion& r, const auto&)
+		        [&](const ego::FrameEgomotion& r,
+		            const mrpt::obs::CObservation3DRangeScan& scan)
 		        {
 			        if (r.flags & ego::kFlagOutOfOrder ||
 			            r.flags & ego::kFlagBadImage)
@@ -138,16 +164,63 @@ int main(int argc, char** argv)
 			        msTrack.push_back(r.ms_track);
 			        msMotion.push_back(r.ms_motion);
 			        msEgo.push_back(r.ms_track + r.ms_motion);
+			        // Tracker accuracy against the ground truth.
+			        double rate = NAN;
+			        int denom = 0, good = 0;
+			        ego::RgbdFrame cur;
+			        if (!gt.empty() &&
+			            ego::rgbdFrameFrom(scan, ec.camera, cur).empty())
+			        {
+				        const StampedPose* g1 = gtAt(r.t);
+				        const StampedPose* g0 = gtAt(prevT);
+				        if (g0 && g1 && !prevFrame.depth.empty())
+				        {
+					        const mrpt::poses::CPose3D T = g1->T_WC - g0->T_WC;
+					        Eigen::Matrix3d R;
+					        for (int i = 0; i < 3; i++)
+						        for (int j = 0; j < 3; j++)
+							        R(i, j) = T.getRotationMatrix()(i, j);
+					        const Eigen::Vector3d t(T.x(), T.y(), T.z());
+					        rate =
+					            ego::angleSO3(R) * 180 / M_PI / (r.t - prevT);
+					        // True position of a previous-image feature.
+					        const auto truth =
+					            [&](const cv::Point2f& x, Eigen::Vector2d& y)
+					        {
+						        const float z =
+						            ego::depthAt(prevFrame.depth, x);
+						        if (z <= 0) return false;
+						        const Eigen::Vector3d q =
+						            cur.K *
+						            (R.transpose() *
+						             (ego::backProject(cur.K, x, z) - t));
+						        y = q.head<2>() / q.z();
+						        return q.z() > 0;
+					        };
+					        Eigen::Vector2d y;
+					        for (const auto& x : r.attempted)
+						        denom += truth(x, y);
+					        for (const auto& tr : r.tracks)
+						        if (truth(tr.prev, y) &&
+						            std::hypot(y.x() - tr.cur.x,
+						                       y.y() - tr.cur.y) < 2.0)
+							        ++good;
+				        }
+				        prevFrame = cur;
+			        }
+			        prevT = r.t;
 			        if (csv.is_open())
 			        {
-				        char buf[256];
-				        std::snprintf(
-				            buf, sizeof(buf),
-				            "%.6f,%s,%s,%d,%d,%.5f,%zu,%.3f,%.3f,%.3f\n", r.t,
-				            ego::flagsToString(r.flags).c_str(),
-				            ego::toString(r.R_source), r.correspondences,
-				            r.inliers, r.residual_rms_m, r.tracks.size(),
-				            r.ms_input, r.ms_track, r.ms_motion);
+				        char buf[320];
+				        std::snprintf(buf, sizeof(buf),
+				                      "%.6f,%s,%s,%d,%d,%.5f,%zu,%.3f,%.3f,%."
+				                      "3f,%.3f,%d,%d\n",
+				                      r.t, ego::flagsToString(r.flags).c_str(),
+				                      ego::toString(r.R_source),
+				                      r.correspondences, r.inliers,
+				                      r.residual_rms_m, r.tracks.size(),
+				                      r.ms_input, r.ms_track, r.ms_motion, rate,
+				                      denom, good);
 				        csv << buf;
 			        }
 		        },

@@ -59,6 +59,7 @@ const std::vector<Track>& GyroAidedKLT::track(
 	}
 	stats_ = {};
 	tracks_.clear();
+	tried_.clear();
 	const cv::Size win(p_.window, p_.window);
 	std::vector<cv::Mat> pyr;
 	cv::buildOpticalFlowPyramid(grey, pyr, win, p_.pyramid_levels, true);
@@ -81,6 +82,7 @@ const std::vector<Track>& GyroAidedKLT::track(
 			idx.push_back(static_cast<int>(i));
 		}
 		stats_.attempted = static_cast<int>(p0.size());
+		tried_ = p0;
 		std::vector<cv::Point2f> p1(p0.size());
 		int flags = 0;
 		if (R_CprevCcur)

@@ -160,6 +160,8 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	}
 	const auto t1 = std::chrono::steady_clock::now();
 	r.tracks = klt_.track(f.grey, f.K, R_pred ? &*R_pred : nullptr, mask);
+	r.tracker = klt_.stats();
+	r.attempted = klt_.attemptedPoints();
 	r.ms_track = msSince(t1);
 
 	const auto t2 = std::chrono::steady_clock::now();

@@ -88,4 +88,29 @@ RotationCalibResult estimateRotationIC(const std::vector<RotationPair>& pairs,
 	return res;
 }
 
+std::optional<Eigen::Matrix3d> integrateGyro(const std::deque<ImuSample>& s,
+                                             double t0, double t1,
+                                             double maxGap_s)
+{
+	if (s.size() < 2 || !(t1 > t0) || s.front().t > t0 || s.back().t < t1)
+		return std::nullopt;
+	// Rate at time t, linear between samples.
+	const auto rate = [&](size_t i, double t)
+	{
+		const double u = (t - s[i].t) / (s[i + 1].t - s[i].t);
+		return Eigen::Vector3d((1 - u) * s[i].gyro + u * s[i + 1].gyro);
+	};
+	Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+	for (size_t i = 0; i + 1 < s.size(); i++)
+	{
+		const double a = std::max(t0, s[i].t), b = std::min(t1, s[i + 1].t);
+		if (b <= a) continue;
+		if (s[i + 1].t - s[i].t > maxGap_s || !s[i].hasGyro ||
+		    !s[i + 1].hasGyro)
+			return std::nullopt;
+		R = R * expSO3(0.5 * (rate(i, a) + rate(i, b)) * (b - a));
+	}
+	return orthonormalize(R);
+}
+
 }  // namespace bims::ego

@@ -41,3 +41,23 @@ TEST(RotationCalibration, ReportsUnobservableSingleAxisMotion)
 	EXPECT_FALSE(estimateRotationIC(pairs).ok);
 	EXPECT_FALSE(estimateRotationIC({}).ok);
 }
+
+TEST(RotationCalibration, IntegratesGyroExactlyForConstantRate)
+{
+	std::deque<ImuSample> s;
+	const Eigen::Vector3d w(0.3, -0.2, 0.5);
+	for (int i = 0; i <= 100; i++)
+	{
+		ImuSample x;
+		x.t = i * 0.01;
+		x.hasGyro = true;
+		x.gyro = w;
+		s.push_back(x);
+	}
+	const auto R = integrateGyro(s, 0.123, 0.456);
+	ASSERT_TRUE(R.has_value());
+	EXPECT_LT(angleSO3(R->transpose() * expSO3(w * (0.456 - 0.123))), 1e-9);
+	EXPECT_FALSE(integrateGyro(s, -0.1, 0.5).has_value());  // not covered
+	s.erase(s.begin() + 40, s.begin() + 60);                // 0.2 s gap
+	EXPECT_FALSE(integrateGyro(s, 0.3, 0.7).has_value());
+}

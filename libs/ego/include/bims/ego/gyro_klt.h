@@ -67,6 +67,9 @@ class GyroAidedKLT
 	static cv::Point2f warp(const Eigen::Matrix3d& H, const cv::Point2f& x);
 
 	const TrackerStats& stats() const { return stats_; }
+	/** Positions in the previous image of the features the last call tried
+	 * to track (tracked or lost) [px]. */
+	const std::vector<cv::Point2f>& attemptedPoints() const { return tried_; }
 	/** Number of features alive after the last call. */
 	size_t numFeatures() const { return pts_.size(); }
 	/** Forgets all features and the previous image. */
@@ -82,6 +85,7 @@ class GyroAidedKLT
 	std::vector<cv::Point2f> pts_;  // features in the previous image
 	std::vector<int> ids_, ages_;
 	std::vector<Track> tracks_;
+	std::vector<cv::Point2f> tried_;
 	TrackerStats stats_;
 	int nextId_ = 0;
 };

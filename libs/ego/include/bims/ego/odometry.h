@@ -51,6 +51,9 @@ struct FrameEgomotion
 	/** Per track: 1 inlier, 0 outlier (candidate moving), -1 no depth. */
 	std::vector<int8_t> trackInlier;
 	double ms_input = 0, ms_track = 0, ms_motion = 0;  ///< stage times [ms]
+	TrackerStats tracker;  ///< KLT counters of this frame
+	/** Previous-image positions of all features the KLT tried [px]. */
+	std::vector<cv::Point2f> attempted;
 
 	/** true when the motion was measured (no failure flag). */
 	bool ok() const;

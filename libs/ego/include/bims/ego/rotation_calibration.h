@@ -7,8 +7,12 @@
 // robust by 2-pair RANSAC (pairs with tracking failures are outliers).
 #pragma once
 
+#include <bims/ego/attitude_filter.h>
+
 #include <Eigen/Core>
 
+#include <deque>
+#include <optional>
 #include <vector>
 
 namespace bims::ego
@@ -38,5 +42,12 @@ RotationCalibResult estimateRotationIC(const std::vector<RotationPair>& pairs,
                                        double minAngle_deg = 0.5,
                                        double inlierThr_deg = 0.5,
                                        unsigned seed = 1);
+
+/** R_I(t0)I(t1): the raw gyro integrated (trapezoidal) from t0 to t1 [s, IMU
+ * clock] over \a samples (sorted by time). nullopt if the samples do not
+ * cover [t0, t1] or a gap exceeds maxGap_s. */
+std::optional<Eigen::Matrix3d> integrateGyro(
+    const std::deque<ImuSample>& samples, double t0, double t1,
+    double maxGap_s = 0.1);
 
 }  // namespace bims::ego
