@@ -248,6 +248,9 @@ void ViewerFrame::onTimer(wxTimerEvent&)
 	const double dt = std::chrono::duration<double>(now - lastTick_).count();
 	lastTick_ = now;
 	if (!ctl_ || !ctl_->playing()) return;
+	// Exporting a PNG sequence: every frame must be drawn (and written)
+	// before the next one; playback slows down to the drawing speed.
+	if (!pngDir_.empty() && !canvas_->captureDone()) return;
 	try
 	{
 		if (ctl_->advance(dt) > 0) refreshViews();

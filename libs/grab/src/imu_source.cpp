@@ -33,8 +33,16 @@ class XsensImuSource : public ImuSource
 		}
 		catch (const std::exception& e)
 		{
-			throw std::runtime_error(
-			    "[" + section + "] Xsens IMU: " + mrpt::exception_to_str(e));
+			// MRPT's text has a banner and a call stack: keep the message.
+			std::string msg = mrpt::exception_to_str(e);
+			const auto m = msg.find("Message:");
+			if (m != std::string::npos)
+			{
+				msg = msg.substr(m + 8);
+				msg = msg.substr(0, msg.find('\n'));
+				while (!msg.empty() && msg.front() == ' ') msg.erase(0, 1);
+			}
+			throw std::runtime_error("[" + section + "] Xsens IMU: " + msg);
 		}
 		label_ = sensor_->getSensorLabel();
 	}
