@@ -165,3 +165,22 @@ TEST(Grabber, WritesFramesAndImuInTimeOrder)
 	while (r.next()) ++n;
 	EXPECT_EQ(n, st.frames + st.imu);
 }
+
+TEST(Grabber, MissingXsensIsAOneLineErrorNotAnAbort)
+{
+	mrpt::config::CConfigFileMemory cfg(
+	    "[RGBD]\ndriver=OpenNI2\ndevice_uri=Dummy\n"
+	    "[IMU]\ndriver=CIMUXSens_MT4\nsensorLabel=IMU\n");
+	try
+	{
+		Grabber g(cfg);
+		GTEST_SKIP() << "an Xsens IMU is plugged in";
+	}
+	catch (const std::runtime_error& e)
+	{
+		const std::string m = e.what();
+		EXPECT_NE(m.find("[IMU] Xsens IMU: "), std::string::npos) << m;
+		EXPECT_EQ(m.find("Call stack"), std::string::npos) << m;
+		EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+	}
+}
