@@ -116,11 +116,17 @@ void ViewerFrame::buildMenus()
 	view->AppendCheckItem(ID_LAYER_EST, "&Estimated trajectory (cyan)")
 	    ->Check(true);
 	view->AppendCheckItem(ID_LAYER_GT, "&Ground truth (green)")->Check(true);
+	auto* play = new wxMenu;
+	// Plain keys (GTK accelerators need modifiers): see the char hook.
+	play->Append(ID_PLAY, "&Play / Pause (Space)");
+	play->Append(ID_STEP, "&Step one frame (Right)");
+	play->Append(ID_RESTART, "&Restart (Home)");
 	auto* help = new wxMenu;
 	help->Append(wxID_ABOUT, "&About");
 	auto* bar = new wxMenuBar;
 	bar->Append(file, "&File");
 	bar->Append(view, "&View");
+	bar->Append(play, "&Playback");
 	bar->Append(help, "&Help");
 	SetMenuBar(bar);
 
@@ -131,6 +137,28 @@ void ViewerFrame::buildMenus()
 	Bind(
 	    wxEVT_MENU, [this](wxCommandEvent&) { Close(true); }, wxID_EXIT);
 	Bind(wxEVT_MENU, &ViewerFrame::onAbout, this, wxID_ABOUT);
+	Bind(wxEVT_CHAR_HOOK,
+	     [this](wxKeyEvent& e)
+	     {
+		     wxCommandEvent c;
+		     switch (e.GetKeyCode())
+		     {
+			     case WXK_SPACE:
+				     onPlayPause(c);
+				     break;
+			     case WXK_RIGHT:
+				     onStep(c);
+				     break;
+			     case WXK_HOME:
+				     onRestart(c);
+				     break;
+			     default:
+				     e.Skip();
+		     }
+	     });
+	Bind(wxEVT_MENU, &ViewerFrame::onPlayPause, this, ID_PLAY);
+	Bind(wxEVT_MENU, &ViewerFrame::onStep, this, ID_STEP);
+	Bind(wxEVT_MENU, &ViewerFrame::onRestart, this, ID_RESTART);
 	Bind(wxEVT_MENU, &ViewerFrame::onLayer, this, ID_LAYER_CLOUD, ID_LAYER_GT);
 }
 
@@ -184,7 +212,13 @@ void ViewerFrame::buildLayout()
 	Bind(wxEVT_BUTTON, &ViewerFrame::onStep, this, ID_STEP);
 	Bind(wxEVT_BUTTON, &ViewerFrame::onRestart, this, ID_RESTART);
 	Bind(wxEVT_CHOICE, &ViewerFrame::onSpeed, this, ID_SPEED);
-	Bind(wxEVT_SLIDER, &ViewerFrame::onSlider, this, ID_SLIDER);
+	// On release only: going back re-runs the pipeline from frame 0.
+	slider_->Bind(wxEVT_SCROLL_CHANGED,
+	              [this](wxScrollEvent&)
+	              {
+		              wxCommandEvent e;
+		              onSlider(e);
+	              });
 }
 
 void ViewerFrame::open(const viewer::ViewerOptions& vo)
