@@ -150,8 +150,15 @@ std::unique_ptr<ImuSource> makeImuSource(
 			file = iniDir + "/" + file;
 		return std::make_unique<RawlogImuSource>(file, src, label, loop);
 	}
+#ifdef BIMS_GRAB_WITH_SIM
+	if (driver == "SimImu") return makeSimImuSource(cfg, section);
+#endif
 	throw ConfigError("[" + section + "] driver=" + driver +
-	                  ": not an IMU driver (CIMUXSens_MT4, RawlogImu)");
+	                  ": not an IMU driver (CIMUXSens_MT4, RawlogImu"
+#ifdef BIMS_GRAB_WITH_SIM
+	                  ", SimImu"
+#endif
+	                  ")");
 }
 
 }  // namespace bims::grab

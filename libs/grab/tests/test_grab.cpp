@@ -184,3 +184,34 @@ TEST(Grabber, MissingXsensIsAOneLineErrorNotAnAbort)
 		EXPECT_EQ(m.find('\n'), std::string::npos) << m;
 	}
 }
+
+#ifdef BIMS_GRAB_WITH_SIM
+TEST(SimImu, SamplesInRealTimeAndMeasuresGravityAtRest)
+{
+	mrpt::config::CConfigFileMemory cfg(
+	    "[IMU]\ndriver=SimImu\nsensorLabel=SIMU\nrate_hz=200\n");
+	auto src = makeImuSource(cfg, "IMU", "SimImu", "");
+	const double start = hostNow();
+	std::this_thread::sleep_for(std::chrono::milliseconds(250));
+	const auto a = src->poll();
+	const double now = hostNow();
+	// 200 Hz over ~0.25 s (+ the sample at t = 0)
+	EXPECT_GE(a.size(), static_cast<size_t>(200 * (now - start) * 0.8));
+	EXPECT_LE(a.size(), static_cast<size_t>(200 * (now - start) + 3));
+	ASSERT_FALSE(a.empty());
+	for (const auto& m : a)
+	{
+		EXPECT_EQ(m->sensorLabel, "SIMU");
+		const double g = std::sqrt(std::pow(m->get(mrpt::obs::IMU_X_ACC), 2) +
+		                           std::pow(m->get(mrpt::obs::IMU_Y_ACC), 2) +
+		                           std::pow(m->get(mrpt::obs::IMU_Z_ACC), 2));
+		EXPECT_NEAR(g, 9.81, 0.3);  // at rest: gravity (+ bias, noise)
+		EXPECT_LT(std::abs(m->get(mrpt::obs::IMU_WZ)), 0.1);
+		const double t = mrpt::Clock::toDouble(m->timestamp);
+		EXPECT_GE(t, start - 1e-3);
+		EXPECT_LE(t, now + 1e-3);
+	}
+	mrpt::config::CConfigFileMemory bad("[IMU]\ndriver=SimImu\nrate=5\n");
+	EXPECT_THROW(makeImuSource(bad, "IMU", "SimImu", ""), bims::ConfigError);
+}
+#endif

@@ -30,10 +30,17 @@ class ImuSource
  *  - RawlogImu: keys sensorLabel (default IMU), file (a rawlog; relative
  *    paths are relative to the .ini's folder), source_label (the IMU label
  *    in that file, "" = any), loop (default true).
+ *  - SimImu (when libs/sim is built): the simulator's noisy IMU sampled in
+ *    real time; keys sensorLabel (IMU), rate_hz (100), moving (false: the
+ *    camera at rest; true: libs/sim's default hand-held motion), seed (1).
  * \param iniDir folder of the .ini (for relative paths). */
 std::unique_ptr<ImuSource> makeImuSource(
     const mrpt::config::CConfigFileBase& cfg, const std::string& section,
     const std::string& driver, const std::string& iniDir);
+
+/** driver=SimImu (only when built with libs/sim). */
+std::unique_ptr<ImuSource> makeSimImuSource(
+    const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 
 /** Replays the IMU samples of a rawlog in real time from construction on:
  * a sample recorded dt after the first one is released dt after start,
