@@ -37,7 +37,8 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 
 	explicit COccupancyBayesGrid(const GridParams& p = {});
 
-	/** Replaces the parameters (clears the map if voxel_size changes). */
+	/** Replaces the parameters (clears the map if voxel_size or decay
+	 * changes). */
 	void setParams(const GridParams& p);
 
 	/** Folds one frame in (frame number frameCount()+1). If
