@@ -20,7 +20,7 @@ void COccupancyBayesGrid::setParams(const GridParams& p)
 	// Stored stamps mean "lazily decayed" only under decay = all: a change of
 	// voxel size or of decay mode invalidates the content.
 	const bool sizeChanged =
-		p.voxel_size != params_.voxel_size || p.decay != params_.decay;
+	    p.voxel_size != params_.voxel_size || p.decay != params_.decay;
 	setParamsBase(p);
 	grid_.setMaxBytes(size_t(p.max_memory_mb * 1048576.0));
 	updateConstants();

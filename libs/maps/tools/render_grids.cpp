@@ -26,101 +26,112 @@
 
 int main(int argc, char** argv)
 {
-	return bims::runApp("bims-maps-figure", [&] {
-		if (argc < 4)
-			throw bims::UsageError(
-				"usage: bims-maps-figure RAWLOG GT_DIR OUT.png [--frames N] "
-				"[--voxel M]");
-		int frames = 60;
-		double voxel = 0.05;
-		for (int i = 4; i + 1 < argc; i += 2)
-		{
-			const std::string a = argv[i];
-			if (a == "--frames") frames = std::stoi(argv[i + 1]);
-			else if (a == "--voxel") voxel = std::stod(argv[i + 1]);
-			else throw bims::UsageError("unknown option " + a);
-		}
-		const std::string gt = argv[2];
-		const auto traj = bims::loadTumTrajectory(gt + "/groundtruth.txt");
-		bims::maps::GridParams p;
-		p.voxel_size = voxel;
-		p.decay = bims::maps::DecayMode::Raycast;
-		p.raycast_target = bims::maps::RayTarget::Voxels;
-		bims::maps::MotionGrids grids(p);
-		bims::RawlogReader r(argv[1]);
-		int k = 0;
-		while (auto obs = r.next())
-		{
-			auto scan =
-				std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(obs);
-			if (!scan) continue;
-			if (k >= frames || k >= int(traj.size())) break;
-			const auto T_WS = traj[k].T_WC + (-bims::T_SC());
-			char name[32];
-			std::snprintf(name, sizeof name, "/masks/%06d.png", k);
-			const cv::Mat m = cv::imread(gt + name, cv::IMREAD_GRAYSCALE);
-			bims::maps::PixelLabels labels;
-			if (!m.empty())
-			{
-				labels = bims::maps::PixelLabels(m.cols, m.rows, 0);
-				for (int v = 0; v < m.rows; ++v)
-					for (int u = 0; u < m.cols; ++u)
-						if (m.at<uint8_t>(v, u)) labels.at(u, v) = 1;
-			}
-			grids.processFrame(*scan, T_WS, labels.label.empty() ? nullptr : &labels);
-			++k;
-		}
-		mrpt::opengl::COpenGLScene scene;
-		auto all = mrpt::opengl::CSetOfObjects::Create();
-		// Tier 0 without the voxels tier 1/2 flag (they coincide and would be
-		// hidden), drawn like COccupancyBayesGrid::getVisualizationInto.
-		auto vox = mrpt::opengl::COctoMapVoxels::Create();
-		vox->resizeVoxelSets(1);
-		for (const auto& key : bims::maps::staticOccupiedKeys(
-				 *grids.occupancy(), grids.background().get()))
-			vox->push_back_Voxel(
-				0, mrpt::opengl::COctoMapVoxels::TVoxel(
-					   grids.occupancy()->centerOf(key), voxel,
-					   mrpt::img::TColor(0, 0, 255, 255)));
-		vox->setVisualizationMode(mrpt::opengl::COctoMapVoxels::FIXED);
-		vox->showGridLines(false);
-		all->insert(vox);
-		// Tier 1 (yellow) where tier 2 does not agree, tier 2 (red) on top.
-		auto t12 = mrpt::opengl::COctoMapVoxels::Create();
-		t12->resizeVoxelSets(1);
-		const auto& c1 = grids.background()->lastCells();
-		const auto& l1 = grids.background()->lastPosterior();
-		const auto& l2 = grids.flow()->lastPosterior();
-		size_t n1 = 0, n2 = 0;
-		for (size_t i = 0; i < c1.size(); ++i)
-		{
-			if (!(l1[i] > 0 || l2[i] > 0)) continue;
-			const bool red = l2[i] > 0;
-			(red ? n2 : n1)++;
-			t12->push_back_Voxel(
-				0, mrpt::opengl::COctoMapVoxels::TVoxel(
-					   grids.occupancy()->centerOf(c1[i]), voxel,
-					   red ? mrpt::img::TColor(255, 0, 0, 255)
-						   : mrpt::img::TColor(255, 255, 0, 255)));
-		}
-		t12->setVisualizationMode(mrpt::opengl::COctoMapVoxels::FIXED);
-		t12->showGridLines(false);
-		all->insert(t12);
-		std::cout << "last frame: " << n2 << " voxels moving by tier 2 (red), "
-				  << n1 << " by tier 1 only (yellow)\n";
-		scene.insert(all);
-		mrpt::opengl::CFBORender fbo(1000, 750);
-		auto& cam = fbo.getCamera(scene);
-		const auto o = traj[std::max(0, k - 1)].T_WC.translation();
-		cam.setPointingAt(float(o.x + 2.0), float(o.y), float(o.z - 0.3));
-		cam.setZoomDistance(5);
-		cam.setAzimuthDegrees(180);
-		cam.setElevationDegrees(25);
-		mrpt::img::CImage img;
-		fbo.render_RGB(scene, img);
-		img.saveToFile(argv[3]);
-		std::cout << k << " frames; " << grids.occupancy()->asString() << "\n"
-				  << grids.flow()->asString() << "\nwrote " << argv[3] << "\n";
-		return 0;
-	});
+	return bims::runApp(
+	    "bims-maps-figure",
+	    [&]
+	    {
+		    if (argc < 4)
+			    throw bims::UsageError(
+			        "usage: bims-maps-figure RAWLOG GT_DIR OUT.png [--frames "
+			        "N] "
+			        "[--voxel M]");
+		    int frames = 60;
+		    double voxel = 0.05;
+		    for (int i = 4; i + 1 < argc; i += 2)
+		    {
+			    const std::string a = argv[i];
+			    if (a == "--frames")
+				    frames = std::stoi(argv[i + 1]);
+			    else if (a == "--voxel")
+				    voxel = std::stod(argv[i + 1]);
+			    else
+				    throw bims::UsageError("unknown option " + a);
+		    }
+		    const std::string gt = argv[2];
+		    const auto traj = bims::loadTumTrajectory(gt + "/groundtruth.txt");
+		    bims::maps::GridParams p;
+		    p.voxel_size = voxel;
+		    p.decay = bims::maps::DecayMode::Raycast;
+		    p.raycast_target = bims::maps::RayTarget::Voxels;
+		    bims::maps::MotionGrids grids(p);
+		    bims::RawlogReader r(argv[1]);
+		    int k = 0;
+		    while (auto obs = r.next())
+		    {
+			    auto scan = std::dynamic_pointer_cast<
+			        mrpt::obs::CObservation3DRangeScan>(obs);
+			    if (!scan) continue;
+			    if (k >= frames || k >= int(traj.size())) break;
+			    const auto T_WS = traj[k].T_WC + (-bims::T_SC());
+			    char name[32];
+			    std::snprintf(name, sizeof name, "/masks/%06d.png", k);
+			    const cv::Mat m = cv::imread(gt + name, cv::IMREAD_GRAYSCALE);
+			    bims::maps::PixelLabels labels;
+			    if (!m.empty())
+			    {
+				    labels = bims::maps::PixelLabels(m.cols, m.rows, 0);
+				    for (int v = 0; v < m.rows; ++v)
+					    for (int u = 0; u < m.cols; ++u)
+						    if (m.at<uint8_t>(v, u)) labels.at(u, v) = 1;
+			    }
+			    grids.processFrame(*scan, T_WS,
+			                       labels.label.empty() ? nullptr : &labels);
+			    ++k;
+		    }
+		    mrpt::opengl::COpenGLScene scene;
+		    auto all = mrpt::opengl::CSetOfObjects::Create();
+		    // Tier 0 without the voxels tier 1/2 flag (they coincide and would
+		    // be hidden), drawn like COccupancyBayesGrid::getVisualizationInto.
+		    auto vox = mrpt::opengl::COctoMapVoxels::Create();
+		    vox->resizeVoxelSets(1);
+		    for (const auto& key : bims::maps::staticOccupiedKeys(
+		             *grids.occupancy(), grids.background().get()))
+			    vox->push_back_Voxel(
+			        0, mrpt::opengl::COctoMapVoxels::TVoxel(
+			               grids.occupancy()->centerOf(key), voxel,
+			               mrpt::img::TColor(0, 0, 255, 255)));
+		    vox->setVisualizationMode(mrpt::opengl::COctoMapVoxels::FIXED);
+		    vox->showGridLines(false);
+		    all->insert(vox);
+		    // Tier 1 (yellow) where tier 2 does not agree, tier 2 (red) on top.
+		    auto t12 = mrpt::opengl::COctoMapVoxels::Create();
+		    t12->resizeVoxelSets(1);
+		    const auto& c1 = grids.background()->lastCells();
+		    const auto& l1 = grids.background()->lastPosterior();
+		    const auto& l2 = grids.flow()->lastPosterior();
+		    size_t n1 = 0, n2 = 0;
+		    for (size_t i = 0; i < c1.size(); ++i)
+		    {
+			    if (!(l1[i] > 0 || l2[i] > 0)) continue;
+			    const bool red = l2[i] > 0;
+			    (red ? n2 : n1)++;
+			    t12->push_back_Voxel(
+			        0, mrpt::opengl::COctoMapVoxels::TVoxel(
+			               grids.occupancy()->centerOf(c1[i]), voxel,
+			               red ? mrpt::img::TColor(255, 0, 0, 255)
+			                   : mrpt::img::TColor(255, 255, 0, 255)));
+		    }
+		    t12->setVisualizationMode(mrpt::opengl::COctoMapVoxels::FIXED);
+		    t12->showGridLines(false);
+		    all->insert(t12);
+		    std::cout << "last frame: " << n2
+		              << " voxels moving by tier 2 (red), " << n1
+		              << " by tier 1 only (yellow)\n";
+		    scene.insert(all);
+		    mrpt::opengl::CFBORender fbo(1000, 750);
+		    auto& cam = fbo.getCamera(scene);
+		    const auto o = traj[std::max(0, k - 1)].T_WC.translation();
+		    cam.setPointingAt(float(o.x + 2.0), float(o.y), float(o.z - 0.3));
+		    cam.setZoomDistance(5);
+		    cam.setAzimuthDegrees(180);
+		    cam.setElevationDegrees(25);
+		    mrpt::img::CImage img;
+		    fbo.render_RGB(scene, img);
+		    img.saveToFile(argv[3]);
+		    std::cout << k << " frames; " << grids.occupancy()->asString()
+		              << "\n"
+		              << grids.flow()->asString() << "\nwrote " << argv[3]
+		              << "\n";
+		    return 0;
+	    });
 }
