@@ -60,7 +60,8 @@ void AttitudeFilter::setState(const Eigen::Quaterniond& q_WI, double t)
 	q_ = q_WI.normalized();
 	qg_ = q_;
 	initialized_ = true;
-	tInit_ = tLast_ = tAccelOk_ = t;
+	tInit_ = tLast_ = tAccelOk_ = tMagOk_ = t;
+	headingConverged_ = false;
 	hist_.clear();
 	push(t);
 }
@@ -218,12 +219,28 @@ uint32_t AttitudeFilter::add(const ImuSample& s)
 		    s.hasAcc && std::abs(s.acc.norm() - p_.gravity) <= p_.accel_gate;
 		const Eigen::Vector3d vert =
 		    accOk ? Eigen::Vector3d(s.acc.normalized()) : up_I;
-		if (magUsable(s.mag, vert) && std::hypot(h_W.x(), h_W.y()) > 0)
+		// Heading innovation: angle of the horizontal field from north (+x
+		// of {W}). A disturbance that rotates the field horizontally barely
+		// changes its norm and dip, so large innovations are gated too
+		// (after convergence; released when they persist mag_gate_max_s).
+		const double psi = std::atan2(h_W.y(), h_W.x());
+		const double gate = p_.mag_heading_gate_deg * M_PI / 180;
+		const bool usable =
+		    magUsable(s.mag, vert) && std::hypot(h_W.x(), h_W.y()) > 0;
+		const bool fastNow = (s.t - tInit_) < p_.init_time_s;
+		if (usable && std::abs(psi) <= gate && !fastNow)
 		{
-			// Heading error: angle of the horizontal field from north (+x of
-			// {W}), corrected about the vertical only, so a tilted or
-			// disturbed field never tilts the estimate.
-			e += -std::atan2(h_W.y(), h_W.x()) * up_I;
+			tMagOk_ = s.t;
+			headingConverged_ = true;
+		}
+		if (usable && (fastNow || !headingConverged_ || std::abs(psi) <= gate ||
+		               s.t - tMagOk_ >= p_.mag_gate_max_s))
+		{
+			// About the vertical only, so a tilted or disturbed field never
+			// tilts the estimate; heading gain kp_mag (kp while converging).
+			const double ratio =
+			    fastNow ? 1.0 : (p_.kp > 0 ? p_.kp_mag / p_.kp : 0.0);
+			e += -psi * ratio * up_I;
 			corrected = true;
 		}
 		else

@@ -252,7 +252,13 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	}
 	R_rel = orthonormalize(R_rel);
 	t_WC_ += R_WC_ * t_rel;
-	R_WC_ = orthonormalize(R_WC_ * R_rel);
+	// While the attitude filter is still converging its absolute attitude
+	// moves fast: follow it for the absolute R_WC, but never feed that
+	// convergence into the inter-frame rotation used above.
+	if (useImu && att_.converging(f.t + cfg_.calibration.time_offset_s))
+		R_WC_ = *R_WC_imu;
+	else
+		R_WC_ = orthonormalize(R_WC_ * R_rel);
 	lastR_rel_ = R_rel;
 	lastT_rel_ = t_rel;
 	T_WC_ = toPose(R_WC_, t_WC_);

@@ -43,6 +43,10 @@ void AttitudeParams::loadFromConfigFile(
 	mag_norm_gate = s.getDouble("mag_norm_gate", mag_norm_gate, 0, 10);
 	mag_dip_gate_deg =
 	    s.getDouble("mag_dip_gate_deg", mag_dip_gate_deg, 0, 180);
+	mag_heading_gate_deg =
+	    s.getDouble("mag_heading_gate_deg", mag_heading_gate_deg, 0, 180);
+	mag_gate_max_s = s.getDouble("mag_gate_max_s", mag_gate_max_s, 0, 1e6);
+	kp_mag = s.getDouble("kp_mag", kp_mag, 0, 100);
 	mag_reference =
 	    s.getEnum("mag_reference", mag_reference, {"auto", "fixed"});
 	mag_reference_samples = static_cast<int>(

@@ -76,6 +76,7 @@ TEST(AttitudeFilter, RejectsMagneticDisturbance)
 		AttitudeParams p;
 		p.mag_norm_gate = normGate;
 		p.mag_dip_gate_deg = normGate > 1 ? 180 : 4;
+		p.mag_heading_gate_deg = normGate > 1 ? 180 : 3;
 		AttitudeFilter f(p);
 		double worst = 0;
 		size_t gated = 0;

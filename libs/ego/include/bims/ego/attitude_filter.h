@@ -56,6 +56,12 @@ class AttitudeFilter
 	void setState(const Eigen::Quaterniond& q_WI, double t);
 
 	bool initialized() const { return initialized_; }
+	/** true within init_time_s of the initialisation (fast-convergence
+	 * phase: the absolute attitude is not trustworthy yet). */
+	bool converging(double t) const
+	{
+		return !initialized_ || t - tInit_ < p_.init_time_s;
+	}
 	/** Latest estimate of R_WI. */
 	Eigen::Quaterniond q_WI() const { return q_; }
 	/** Estimated gyro bias [rad/s] in {I}. */
@@ -95,7 +101,8 @@ class AttitudeFilter
 
 	AttitudeParams p_;
 	bool initialized_ = false;
-	double tInit_ = 0, tLast_ = 0, tAccelOk_ = 0;
+	double tInit_ = 0, tLast_ = 0, tAccelOk_ = 0, tMagOk_ = 0;
+	bool headingConverged_ = false;
 	Eigen::Quaterniond q_ = Eigen::Quaterniond::Identity();
 	Eigen::Vector3d bias_ = Eigen::Vector3d::Zero();
 	Eigen::Vector3d lastGyro_ = Eigen::Vector3d::Zero();

@@ -41,6 +41,13 @@ struct AttitudeParams
 	double mag_norm_gate = 0.08;
 	/** ... and if |dip - dip_ref| below this [deg]. */
 	double mag_dip_gate_deg = 4.0;
+	/** ... and if its heading innovation is below this [deg] (after the
+	 * first init_time_s), unless that has lasted mag_gate_max_s [s]. */
+	double mag_heading_gate_deg = 10.0;
+	double mag_gate_max_s = 20.0;
+	/** Heading correction gain [1/s] (slower than tilt: the field is the
+	 * less trustworthy reference). */
+	double kp_mag = 0.5;
 	/** Reference field: "auto" learns norm and dip from the first
 	 * mag_reference_samples undisturbed-looking samples; "fixed" uses
 	 * mag_norm / mag_dip_deg. */
