@@ -140,9 +140,7 @@ void ReplayController::loadResultsFrame()
 void ReplayController::seek(size_t i)
 {
 	if (i >= frameCount()) i = frameCount() - 1;
-	if (static_cast<long>(i) < cur_ ||
-	    (cur_ >= 0 && static_cast<long>(i) == cur_ && !frame_))
-		restart();
+	if (static_cast<long>(i) < cur_) restart();
 	while (cur_ < static_cast<long>(i) && step())
 	{
 	}
