@@ -114,7 +114,9 @@ TEST(GyroAidedKLT, TracksSlowMotionAccurately)
 	const Eigen::Vector3d t_C0C1(0.01, 0.0, 0.02);
 	const RgbdFrame f0 = test::render(R0, {0, 0, 0}, K, 320, 240, 0);
 	const RgbdFrame f1 = test::render(R0 * R_C0C1, R0 * t_C0C1, K, 320, 240, 1);
-	GyroAidedKLT klt;
+	TrackerParams p;
+	p.max_features = 300;
+	GyroAidedKLT klt(p);
 	klt.track(f0.grey, K, nullptr, nullptr);
 	EXPECT_GT(klt.numFeatures(), 250u);
 	const Score s = scoreTracks(klt.track(f1.grey, K, &R_C0C1, nullptr), f0,

@@ -66,18 +66,19 @@ struct AttitudeParams
 /** [tracker]: the gyro-aided pyramidal KLT tracker. */
 struct TrackerParams
 {
-	int max_features = 300;         ///< features kept per frame
+	int max_features = 200;         ///< features kept per frame
 	int grid_cols = 8;              ///< replenishment grid (columns)
 	int grid_rows = 6;              ///< replenishment grid (rows)
 	double min_distance_px = 12;    ///< min spacing of new features [px]
 	std::string detector = "fast";  ///< "fast" or "gftt"
 	int fast_threshold = 15;        ///< FAST intensity threshold [grey levels]
 	double gftt_quality = 0.01;     ///< goodFeaturesToTrack quality level
-	int window = 21;                ///< LK window side [px] (odd)
-	int pyramid_levels = 3;         ///< LK max pyramid level (0 = no pyramid)
-	int max_iterations = 30;        ///< LK iterations per level
-	double epsilon = 0.01;          ///< LK convergence [px]
-	double fb_threshold_px = 1.0;   ///< forward-backward error limit [px]
+	int window = 15;                ///< LK window side [px] (odd)
+	int pyramid_levels = 2;         ///< LK max pyramid level (0 = none); small
+	                         ///< because the gyro aid gives a close guess
+	int max_iterations = 30;       ///< LK iterations per level
+	double epsilon = 0.01;         ///< LK convergence [px]
+	double fb_threshold_px = 1.0;  ///< forward-backward error limit [px]
 	double border_px = 8;    ///< tracks closer to the border are dropped [px]
 	int mask_dilate_px = 8;  ///< growth of the moving-region mask [px]
 
