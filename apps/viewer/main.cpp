@@ -4,7 +4,7 @@
 //   bims-viewer [IN.rawlog] [--results OUTDIR] [--config CONFIG.ini]
 //               [--gt groundtruth.txt] [--no-pipeline] [--paused]
 //               [--speed S] [--frames N --screenshot FILE.png]
-//               [--png-sequence DIR]
+//               [--keep-open] [--png-sequence DIR]
 //
 // Non-interactive use (tests, figures): --frames N steps N frames, then
 // --screenshot writes the 3D view as shown in the window and quits.
@@ -83,6 +83,11 @@ int main(int argc, char** argv)
 		        "", "screenshot",
 		        "after --frames, write the 3D view to FILE.png and quit", false,
 		        "", "FILE.png", cmd);
+		    TCLAP::SwitchArg aKeep(
+		        "", "keep-open",
+		        "stay open after --screenshot (e.g. for an X screenshot of "
+		        "the whole window)",
+		        cmd);
 		    TCLAP::ValueArg<std::string> aSeq(
 		        "", "png-sequence",
 		        "write the 3D view of every frame shown "
@@ -120,6 +125,7 @@ int main(int argc, char** argv)
 		    o.speed = aSpeed.getValue();
 		    o.frames = aFrames.getValue();
 		    o.screenshot = aShot.getValue();
+		    o.keepOpen = aKeep.getValue();
 		    o.pngDir = aSeq.getValue();
 		    if (std::sscanf(aSize.getValue().c_str(), "%dx%d", &o.width,
 		                    &o.height) != 2 ||

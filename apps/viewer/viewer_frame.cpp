@@ -486,8 +486,8 @@ void ViewerFrame::startBatchScreenshot()
 			exitCode = 1;
 		}
 		else
-			std::cout << "bims-viewer: wrote " << opt_.screenshot << "\n";
-		Close(true);
+			std::cout << "bims-viewer: wrote " << opt_.screenshot << std::endl;
+		if (!opt_.keepOpen || !err.empty()) Close(true);
 		return;
 	}
 	if (batchWaitTicks_ > 300)  // 30 s

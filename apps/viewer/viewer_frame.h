@@ -28,6 +28,7 @@ struct AppOptions
 	double speed = 1;        ///< replay speed
 	int frames = -1;         ///< step this many frames at start (-1: none)
 	std::string screenshot;  ///< write the 3D view there, then quit
+	bool keepOpen = false;   ///< stay open after --screenshot
 	std::string pngDir;      ///< write a PNG of the 3D view per frame
 	int width = 1280, height = 800;  ///< window size [px]
 };

@@ -59,6 +59,37 @@ TEST(GuiViewer, XvfbScreenshotShowsTheThreeTierColours)
 	EXPECT_GT(sd[0] + sd[1] + sd[2], 10.0);
 }
 
+TEST(GuiViewer, XScreenshotOfTheWholeWindowShowsTiersAndPanels)
+{
+	// An X screenshot (ImageMagick's import) of the window as the X server
+	// shows it, taken once the viewer has written its own screenshot.
+	ASSERT_EQ(run("mkdir -p '" + kOut + "'"), 0);
+	const std::string own = kOut + "/viewer_own.png";
+	const std::string xshot = kOut + "/viewer_x.png";
+	const std::string log = kOut + "/viewer_x.log";
+	std::remove(own.c_str());
+	std::remove(xshot.c_str());
+	const std::string cmd =
+	    std::string(BIMS_XVFB_RUN) +
+	    " -a -s '-screen 0 1200x800x24 +extension GLX' '" + BIMS_SOURCE_DIR +
+	    "/apps/viewer/tests/xshot.sh' '" + own + "' '" + xshot + "' '" +
+	    kViewer + "' '" + kRawlog + "' --config '" + BIMS_SOURCE_DIR +
+	    "/config/default.ini' --frames 15 --size 1200x800 > '" + log + "' 2>&1";
+	ASSERT_EQ(run(cmd), 0) << slurp(log);
+	const cv::Mat img = cv::imread(xshot, cv::IMREAD_COLOR);
+	ASSERT_FALSE(img.empty()) << slurp(log);
+	const auto c = bims::viewer::tierColourFractions(img);
+	EXPECT_GT(c.blue, 0.002) << "tier 0 (blue) missing";
+	EXPECT_GT(c.yellow, 0.0001) << "tier 1 (yellow) missing";
+	EXPECT_GT(c.red, 0.0002) << "tier 2 (red) missing";
+	// The 2D panels on the right: the Diff-labels panel is mostly green.
+	const cv::Mat right =
+	    img(cv::Rect(img.cols * 2 / 3, 0, img.cols / 3, img.rows));
+	cv::Mat green;
+	cv::inRange(right, cv::Scalar(0, 120, 0), cv::Scalar(60, 255, 60), green);
+	EXPECT_GT(cv::countNonZero(green), 2000);
+}
+
 TEST(GuiViewer, NoDisplayGivesAClearErrorAndNonZeroExit)
 {
 	const std::string log = kOut + "/viewer_nodisplay.log";
