@@ -15,14 +15,14 @@ int runApp(const std::string& program, const std::function<int()>& body)
 	}
 	catch (const TCLAP::ArgException& e)
 	{
-		std::fprintf(
-			stderr, "%s: usage error: %s (%s)\n", program.c_str(),
-			e.error().c_str(), e.argId().c_str());
+		std::fprintf(stderr, "%s: usage error: %s (%s)\n", program.c_str(),
+		             e.error().c_str(), e.argId().c_str());
 		return 2;
 	}
 	catch (const UsageError& e)
 	{
-		std::fprintf(stderr, "%s: usage error: %s\n", program.c_str(), e.what());
+		std::fprintf(stderr, "%s: usage error: %s\n", program.c_str(),
+		             e.what());
 		return 2;
 	}
 	catch (const std::exception& e)
@@ -37,8 +37,8 @@ void makeDirs(const std::string& path)
 	std::error_code ec;
 	std::filesystem::create_directories(path, ec);
 	if (ec)
-		throw std::runtime_error(
-			path + ": cannot create directory: " + ec.message());
+		throw std::runtime_error(path +
+		                         ": cannot create directory: " + ec.message());
 }
 
 }  // namespace bims

@@ -14,9 +14,9 @@ namespace
 {
 std::string lower(std::string s)
 {
-	std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) {
-		return static_cast<char>(std::tolower(c));
-	});
+	std::transform(s.begin(), s.end(), s.begin(),
+	               [](unsigned char c)
+	               { return static_cast<char>(std::tolower(c)); });
 	return s;
 }
 std::string trim(const std::string& s)
@@ -53,14 +53,14 @@ std::string configSourceName(const mrpt::config::CConfigFileBase& cfg)
 	return "<memory>";
 }
 
-ConfigSection::ConfigSection(
-	const mrpt::config::CConfigFileBase& cfg, std::string section, bool required)
-	: cfg_(cfg), section_(std::move(section)), file_(configSourceName(cfg))
+ConfigSection::ConfigSection(const mrpt::config::CConfigFileBase& cfg,
+                             std::string section, bool required)
+    : cfg_(cfg), section_(std::move(section)), file_(configSourceName(cfg))
 {
 	exists_ = cfg_.sectionExists(section_);
 	if (required && !exists_)
-		throw ConfigError(
-			file_ + ": missing required section [" + section_ + "]");
+		throw ConfigError(file_ + ": missing required section [" + section_ +
+		                  "]");
 }
 
 bool ConfigSection::has(const std::string& key) const
@@ -70,8 +70,7 @@ bool ConfigSection::has(const std::string& key) const
 
 void ConfigSection::fail(const std::string& key, const std::string& what) const
 {
-	throw ConfigError(
-		file_ + ": [" + section_ + "] " + key + ": " + what);
+	throw ConfigError(file_ + ": [" + section_ + "] " + key + ": " + what);
 }
 
 std::string ConfigSection::raw(const std::string& key) const
@@ -79,10 +78,13 @@ std::string ConfigSection::raw(const std::string& key) const
 	return trim(cfg_.read_string(section_, key, "", false));
 }
 
-void ConfigSection::allow(const std::string& key) { known_.insert(lower(key)); }
+void ConfigSection::allow(const std::string& key)
+{
+	known_.insert(lower(key));
+}
 
-double ConfigSection::getDouble(
-	const std::string& key, double def, double min, double max)
+double ConfigSection::getDouble(const std::string& key, double def, double min,
+                                double max)
 {
 	allow(key);
 	if (!has(key)) return def;
@@ -98,7 +100,8 @@ double ConfigSection::getDouble(
 	return v;
 }
 
-double ConfigSection::requireDouble(const std::string& key, double min, double max)
+double ConfigSection::requireDouble(const std::string& key, double min,
+                                    double max)
 {
 	if (!has(key)) fail(key, "required key is missing");
 	return getDouble(key, 0.0, min, max);
@@ -136,7 +139,8 @@ bool ConfigSection::getBool(const std::string& key, bool def)
 	fail(key, "'" + raw(key) + "' is not a boolean (true/false)");
 }
 
-std::string ConfigSection::getString(const std::string& key, const std::string& def)
+std::string ConfigSection::getString(const std::string& key,
+                                     const std::string& def)
 {
 	allow(key);
 	if (!has(key)) return def;
@@ -151,9 +155,9 @@ std::string ConfigSection::requireString(const std::string& key)
 	return v;
 }
 
-std::string ConfigSection::getEnum(
-	const std::string& key, const std::string& def,
-	const std::vector<std::string>& allowed)
+std::string ConfigSection::getEnum(const std::string& key,
+                                   const std::string& def,
+                                   const std::vector<std::string>& allowed)
 {
 	const std::string v = getString(key, def);
 	if (std::find(allowed.begin(), allowed.end(), v) == allowed.end())
@@ -165,9 +169,9 @@ std::string ConfigSection::getEnum(
 	return v;
 }
 
-std::vector<double> ConfigSection::getDoubles(
-	const std::string& key, const std::vector<double>& def, size_t n,
-	double min, double max)
+std::vector<double> ConfigSection::getDoubles(const std::string& key,
+                                              const std::vector<double>& def,
+                                              size_t n, double min, double max)
 {
 	allow(key);
 	if (!has(key)) return def;
@@ -180,18 +184,20 @@ std::vector<double> ConfigSection::getDoubles(
 	while (ss >> tok)
 	{
 		double v = 0;
-		if (!parseDouble(tok, v)) fail(key, "'" + tok + "' is not a finite number");
+		if (!parseDouble(tok, v))
+			fail(key, "'" + tok + "' is not a finite number");
 		if (v < min || v > max)
 		{
 			std::ostringstream m;
-			m << "value " << v << " out of range [" << min << ", " << max << "]";
+			m << "value " << v << " out of range [" << min << ", " << max
+			  << "]";
 			fail(key, m.str());
 		}
 		out.push_back(v);
 	}
 	if (out.size() != n)
 		fail(key, "expected " + std::to_string(n) + " numbers, got " +
-					  std::to_string(out.size()));
+		              std::to_string(out.size()));
 	return out;
 }
 
@@ -205,16 +211,14 @@ void ConfigSection::finish() const
 		if (known_.count(lower(k))) continue;
 		std::string list;
 		for (const auto& a : known_) list += (list.empty() ? "" : ", ") + a;
-		throw ConfigError(
-			file_ + ": [" + section_ + "] " + k +
-			": unknown key (known keys: " + list + ")");
+		throw ConfigError(file_ + ": [" + section_ + "] " + k +
+		                  ": unknown key (known keys: " + list + ")");
 	}
 }
 
-void checkSections(
-	const mrpt::config::CConfigFileBase& cfg,
-	const std::vector<std::string>& allowed,
-	const std::vector<std::string>& allowedPrefixes)
+void checkSections(const mrpt::config::CConfigFileBase& cfg,
+                   const std::vector<std::string>& allowed,
+                   const std::vector<std::string>& allowedPrefixes)
 {
 	std::vector<std::string> sections;
 	cfg.getAllSections(sections);
@@ -229,10 +233,11 @@ void checkSections(
 		if (!ok)
 		{
 			std::string list;
-			for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-			throw ConfigError(
-				configSourceName(cfg) + ": [" + s +
-				"]: unknown section (known sections: " + list + ")");
+			for (const auto& a : allowed)
+				list += (list.empty() ? "" : ", ") + a;
+			throw ConfigError(configSourceName(cfg) + ": [" + s +
+			                  "]: unknown section (known sections: " + list +
+			                  ")");
 		}
 	}
 }

@@ -1,8 +1,8 @@
 #include <bims/common/rawlog.h>
 #include <mrpt/img/CImage.h>
-#include <mrpt/serialization/archiveFrom_std_streams.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/serialization/archiveFrom_std_streams.h>
 #include <mrpt/system/filesystem.h>
 
 namespace bims
@@ -18,10 +18,10 @@ RawlogReader::RawlogReader(const std::string& path) : path_(path)
 {
 	if (!mrpt::system::fileExists(path))
 		throw RawlogError(path + ": no such rawlog file");
-	if (!in_.open(path))
-		throw RawlogError(path + ": cannot open rawlog file");
-	arch_ = std::make_unique<mrpt::serialization::CArchiveStreamBase<
-		mrpt::io::CFileGZInputStream>>(in_);
+	if (!in_.open(path)) throw RawlogError(path + ": cannot open rawlog file");
+	arch_ = std::make_unique<
+	    mrpt::serialization::CArchiveStreamBase<mrpt::io::CFileGZInputStream>>(
+	    in_);
 	const std::string imgDir = rawlogImagesDirectory(path);
 	if (mrpt::system::directoryExists(imgDir))
 		mrpt::img::CImage::setImagesPathBase(imgDir);
@@ -51,24 +51,25 @@ mrpt::obs::CObservation::Ptr RawlogReader::next()
 			std::string what = e.what();
 			if (what.size() > 300) what = what.substr(0, 300) + "...";
 			throw RawlogError(
-				path_ + ": truncated or corrupt rawlog at entry " +
-				std::to_string(entry_) + " (" +
-				std::to_string(nObs_) + " observations read before): " + what);
+			    path_ + ": truncated or corrupt rawlog at entry " +
+			    std::to_string(entry_) + " (" + std::to_string(nObs_) +
+			    " observations read before): " + what);
 		}
 		if (!obj)
-			throw RawlogError(
-				path_ + ": null object at entry " + std::to_string(entry_));
+			throw RawlogError(path_ + ": null object at entry " +
+			                  std::to_string(entry_));
 		if (auto o = std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj))
 			pending_.push_back(o);
-		else if (auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(obj))
+		else if (auto sf =
+		             std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(obj))
 			for (const auto& so : *sf) pending_.push_back(so);
 		else if (std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(obj))
 			continue;  // odometry actions are not used by bims
 		else
 			throw RawlogError(
-				path_ + ": entry " + std::to_string(entry_) +
-				" is a " + obj->GetRuntimeClass()->className +
-				", not an observation, sensory frame or action collection");
+			    path_ + ": entry " + std::to_string(entry_) + " is a " +
+			    obj->GetRuntimeClass()->className +
+			    ", not an observation, sensory frame or action collection");
 	}
 	auto o = pending_.front();
 	pending_.pop_front();
@@ -85,14 +86,15 @@ RawlogWriter::RawlogWriter(const std::string& path, int gzLevel) : path_(path)
 		plain_.open(path, std::ios::binary | std::ios::trunc);
 		if (!plain_) throw RawlogError(path + ": cannot create rawlog file");
 		arch_ = std::make_unique<
-			mrpt::serialization::CArchiveStreamBase<std::ostream>>(plain_);
+		    mrpt::serialization::CArchiveStreamBase<std::ostream>>(plain_);
 	}
 	else
 	{
-		if (!gz_.open(path, gzLevel, std::nullopt, mrpt::io::OpenMode::TRUNCATE))
+		if (!gz_.open(path, gzLevel, std::nullopt,
+		              mrpt::io::OpenMode::TRUNCATE))
 			throw RawlogError(path + ": cannot create rawlog file");
 		arch_ = std::make_unique<mrpt::serialization::CArchiveStreamBase<
-			mrpt::io::CFileGZOutputStream>>(gz_);
+		    mrpt::io::CFileGZOutputStream>>(gz_);
 	}
 	open_ = true;
 }

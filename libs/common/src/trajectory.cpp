@@ -25,22 +25,22 @@ Trajectory loadTumTrajectory(const std::string& path)
 		double v[8];
 		for (double& x : v)
 			if (!(ss >> x) || !std::isfinite(x))
-				throw std::runtime_error(
-					path + ":" + std::to_string(lineNo) +
-					": expected 8 finite numbers 'timestamp tx ty tz qx qy qz qw'");
+				throw std::runtime_error(path + ":" + std::to_string(lineNo) +
+				                         ": expected 8 finite numbers "
+				                         "'timestamp tx ty tz qx qy qz qw'");
 		const double qn =
-			std::sqrt(v[4] * v[4] + v[5] * v[5] + v[6] * v[6] + v[7] * v[7]);
+		    std::sqrt(v[4] * v[4] + v[5] * v[5] + v[6] * v[6] + v[7] * v[7]);
 		if (std::abs(qn - 1.0) > 1e-3)
-			throw std::runtime_error(
-				path + ":" + std::to_string(lineNo) +
-				": quaternion is not unit (norm " + std::to_string(qn) + ")");
+			throw std::runtime_error(path + ":" + std::to_string(lineNo) +
+			                         ": quaternion is not unit (norm " +
+			                         std::to_string(qn) + ")");
 		if (!out.empty() && v[0] < out.back().t)
-			throw std::runtime_error(
-				path + ":" + std::to_string(lineNo) + ": timestamp goes backwards");
-		mrpt::math::CQuaternionDouble q(
-			v[7] / qn, v[4] / qn, v[5] / qn, v[6] / qn);
-		out.push_back({v[0], mrpt::poses::CPose3D(
-								 mrpt::poses::CPose3DQuat(v[1], v[2], v[3], q))});
+			throw std::runtime_error(path + ":" + std::to_string(lineNo) +
+			                         ": timestamp goes backwards");
+		mrpt::math::CQuaternionDouble q(v[7] / qn, v[4] / qn, v[5] / qn,
+		                                v[6] / qn);
+		out.push_back({v[0], mrpt::poses::CPose3D(mrpt::poses::CPose3DQuat(
+		                         v[1], v[2], v[3], q))});
 	}
 	return out;
 }
@@ -49,15 +49,14 @@ std::string tumLine(double t, const mrpt::poses::CPose3D& T_WC)
 {
 	const mrpt::poses::CPose3DQuat q(T_WC);
 	char buf[256];
-	std::snprintf(
-		buf, sizeof(buf), "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f", t, q.x(),
-		q.y(), q.z(), q.quat().x(), q.quat().y(), q.quat().z(), q.quat().r());
+	std::snprintf(buf, sizeof(buf), "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f",
+	              t, q.x(), q.y(), q.z(), q.quat().x(), q.quat().y(),
+	              q.quat().z(), q.quat().r());
 	return buf;
 }
 
-void saveTumTrajectory(
-	const std::string& path, const Trajectory& traj,
-	const std::string& headerComment)
+void saveTumTrajectory(const std::string& path, const Trajectory& traj,
+                       const std::string& headerComment)
 {
 	std::ofstream f(path);
 	if (!f) throw std::runtime_error(path + ": cannot write trajectory file");

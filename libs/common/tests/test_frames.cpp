@@ -9,7 +9,7 @@ TEST(Frames, T_SCMatchesTheAxisPermutation)
 	EXPECT_NEAR(p_S.x, q_S.x, 1e-12);
 	EXPECT_NEAR(p_S.y, q_S.y, 1e-12);
 	EXPECT_NEAR(p_S.z, q_S.z, 1e-12);
-	EXPECT_NEAR(p_S.x, 2.0, 1e-12);  // forward
+	EXPECT_NEAR(p_S.x, 2.0, 1e-12);   // forward
 	EXPECT_NEAR(p_S.y, -0.3, 1e-12);  // optical right = scan -left
 	const auto back = bims::opticalFromScan(p_S);
 	EXPECT_NEAR(back.x, p_C.x, 1e-12);

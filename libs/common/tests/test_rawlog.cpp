@@ -10,7 +10,8 @@ namespace
 {
 std::string tmpPath(const std::string& name)
 {
-	const auto dir = std::filesystem::temp_directory_path() / "bims_test_common";
+	const auto dir =
+	    std::filesystem::temp_directory_path() / "bims_test_common";
 	std::filesystem::create_directories(dir);
 	return (dir / name).string();
 }
@@ -59,7 +60,7 @@ TEST(Rawlog, MissingFileIsAClearError)
 	catch (const bims::RawlogError& e)
 	{
 		EXPECT_NE(std::string(e.what()).find("does_not_exist.rawlog: no such"),
-				  std::string::npos);
+		          std::string::npos);
 	}
 }
 
@@ -79,9 +80,10 @@ TEST(Rawlog, TruncatedFileIsAnErrorNamingFileAndEntry)
 	catch (const bims::RawlogError& e)
 	{
 		const std::string msg = e.what();
-		EXPECT_NE(msg.find("trunc.rawlog: truncated or corrupt rawlog at entry 9"),
-				  std::string::npos)
-			<< msg;
+		EXPECT_NE(
+		    msg.find("trunc.rawlog: truncated or corrupt rawlog at entry 9"),
+		    std::string::npos)
+		    << msg;
 	}
 	EXPECT_EQ(n, 9);
 }
@@ -91,16 +93,17 @@ TEST(Rawlog, GarbageFileIsAnError)
 	const auto p = tmpPath("garbage.rawlog");
 	{
 		std::ofstream f(p, std::ios::binary);
-		for (int i = 0; i < 1000; i++) f.put(static_cast<char>((i * 37) & 0xff));
+		for (int i = 0; i < 1000; i++)
+			f.put(static_cast<char>((i * 37) & 0xff));
 	}
 	bims::RawlogReader r(p);
 	EXPECT_THROW(
-		{
-			while (r.next())
-			{
-			}
-		},
-		bims::RawlogError);
+	    {
+		    while (r.next())
+		    {
+		    }
+	    },
+	    bims::RawlogError);
 }
 
 TEST(Rawlog, ImagesDirectoryKeepsTheSlash)

@@ -8,7 +8,8 @@ namespace
 {
 std::string tmpPath(const std::string& name)
 {
-	const auto dir = std::filesystem::temp_directory_path() / "bims_test_common";
+	const auto dir =
+	    std::filesystem::temp_directory_path() / "bims_test_common";
 	std::filesystem::create_directories(dir);
 	return (dir / name).string();
 }
@@ -18,8 +19,9 @@ TEST(Trajectory, TumRoundTrip)
 {
 	bims::Trajectory t;
 	for (int i = 0; i < 5; i++)
-		t.push_back({1000.0 + i / 30.0,
-					 mrpt::poses::CPose3D(0.1 * i, -0.2 * i, 1.5, 0.3 * i, -0.1, 0.05 * i)});
+		t.push_back(
+		    {1000.0 + i / 30.0, mrpt::poses::CPose3D(0.1 * i, -0.2 * i, 1.5,
+		                                             0.3 * i, -0.1, 0.05 * i)});
 	const auto p = tmpPath("traj.txt");
 	bims::saveTumTrajectory(p, t, "test");
 	const auto r = bims::loadTumTrajectory(p);
@@ -29,7 +31,8 @@ TEST(Trajectory, TumRoundTrip)
 		EXPECT_NEAR(r[i].t, t[i].t, 1e-6);
 		const auto d = (r[i].T_WC - t[i].T_WC);
 		EXPECT_LT(d.translation().norm(), 1e-8);
-		EXPECT_LT(std::abs(d.yaw()) + std::abs(d.pitch()) + std::abs(d.roll()), 1e-8);
+		EXPECT_LT(std::abs(d.yaw()) + std::abs(d.pitch()) + std::abs(d.roll()),
+		          1e-8);
 	}
 }
 
@@ -47,8 +50,9 @@ TEST(Trajectory, MalformedLinesAreErrorsWithLineNumbers)
 	}
 	catch (const std::runtime_error& e)
 	{
-		EXPECT_NE(std::string(e.what()).find("bad_traj.txt:3:"), std::string::npos)
-			<< e.what();
+		EXPECT_NE(std::string(e.what()).find("bad_traj.txt:3:"),
+		          std::string::npos)
+		    << e.what();
 	}
 	{
 		std::ofstream f(p);

@@ -115,7 +115,9 @@ void writeCalibration(const SimConfig& cfg, const std::string& path)
 	              "width=%d\nheight=%d\nfx=%.6f\nfy=%.6f\ncx=%.6f\ncy=%.6f\n",
 	              cfg.camera.width, cfg.camera.height, cfg.camera.fxS(),
 	              cfg.camera.fyS(), cfg.camera.cxS(), cfg.camera.cyS());
-	f << buf << "; depth units per metre (TUM convention, as config/bonn.ini)\ndepth_scale=1000\n";
+	f << buf
+	  << "; depth units per metre (TUM convention, as "
+	     "config/bonn.ini)\ndepth_scale=1000\n";
 	std::snprintf(buf, sizeof(buf), "max_range=%.3f\n", cfg.depth.maxRange);
 	f << buf << "\n[calibration]\n"
 	  << "; R_IC: orientation of the camera optical frame {C} in the IMU frame "

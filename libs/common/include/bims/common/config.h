@@ -17,7 +17,7 @@ namespace bims
 /** Error in a configuration file; the message names file, section and key. */
 class ConfigError : public std::runtime_error
 {
-   public:
+ public:
 	using std::runtime_error::runtime_error;
 };
 
@@ -27,11 +27,11 @@ std::string configSourceName(const mrpt::config::CConfigFileBase& cfg);
 /** Typed, range-checked, unknown-key-rejecting access to one .ini section. */
 class ConfigSection
 {
-   public:
-	/** \param required if true and the section is absent, throws ConfigError. */
-	ConfigSection(
-		const mrpt::config::CConfigFileBase& cfg, std::string section,
-		bool required = false);
+ public:
+	/** \param required if true and the section is absent, throws ConfigError.
+	 */
+	ConfigSection(const mrpt::config::CConfigFileBase& cfg, std::string section,
+	              bool required = false);
 
 	bool exists() const { return exists_; }
 	bool has(const std::string& key) const;
@@ -39,8 +39,8 @@ class ConfigSection
 	const std::string& file() const { return file_; }
 
 	/** Reads a real number in [min, max] (inclusive); default if absent. */
-	double getDouble(
-		const std::string& key, double def, double min, double max);
+	double getDouble(const std::string& key, double def, double min,
+	                 double max);
 	/** Same, but the key must be present. */
 	double requireDouble(const std::string& key, double min, double max);
 	/** Reads an integer in [min, max]; default if absent. */
@@ -51,14 +51,13 @@ class ConfigSection
 	std::string getString(const std::string& key, const std::string& def);
 	std::string requireString(const std::string& key);
 	/** One of \a allowed (exact match); default if absent. */
-	std::string getEnum(
-		const std::string& key, const std::string& def,
-		const std::vector<std::string>& allowed);
+	std::string getEnum(const std::string& key, const std::string& def,
+	                    const std::vector<std::string>& allowed);
 	/** A whitespace/comma separated list of exactly \a n reals (or the
 	 * default if absent), each in [min, max]. */
-	std::vector<double> getDoubles(
-		const std::string& key, const std::vector<double>& def, size_t n,
-		double min, double max);
+	std::vector<double> getDoubles(const std::string& key,
+	                               const std::vector<double>& def, size_t n,
+	                               double min, double max);
 
 	/** Marks a key as known without reading it (e.g. read by MRPT code). */
 	void allow(const std::string& key);
@@ -68,9 +67,10 @@ class ConfigSection
 	void finish() const;
 
 	/** Throws ConfigError naming file, section and key. */
-	[[noreturn]] void fail(const std::string& key, const std::string& what) const;
+	[[noreturn]] void fail(const std::string& key,
+	                       const std::string& what) const;
 
-   private:
+ private:
 	std::string raw(const std::string& key) const;
 	const mrpt::config::CConfigFileBase& cfg_;
 	std::string section_;
@@ -81,9 +81,8 @@ class ConfigSection
 
 /** Throws ConfigError if the file has a section not in \a allowed and not
  * starting with one of \a allowedPrefixes. */
-void checkSections(
-	const mrpt::config::CConfigFileBase& cfg,
-	const std::vector<std::string>& allowed,
-	const std::vector<std::string>& allowedPrefixes = {});
+void checkSections(const mrpt::config::CConfigFileBase& cfg,
+                   const std::vector<std::string>& allowed,
+                   const std::vector<std::string>& allowedPrefixes = {});
 
 }  // namespace bims

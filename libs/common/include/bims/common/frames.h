@@ -20,8 +20,7 @@ namespace bims
  * (yaw -90 deg, roll -90 deg). */
 inline const mrpt::poses::CPose3D& T_SC()
 {
-	static const mrpt::poses::CPose3D T(
-		0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+	static const mrpt::poses::CPose3D T(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
 	return T;
 }
 

@@ -10,15 +10,16 @@ namespace bims
 {
 class ProgressBar
 {
-   public:
-	/** \param total number of steps (0 = unknown). \param enabled false = silent. */
+ public:
+	/** \param total number of steps (0 = unknown). \param enabled false =
+	 * silent. */
 	ProgressBar(std::string label, size_t total, bool enabled = true);
 	/** Sets the number of steps done; redraws at most every 0.2 s. */
 	void update(size_t done, const std::string& extra = {});
 	/** Final line with the total time. */
 	void finish(const std::string& extra = {});
 
-   private:
+ private:
 	void draw(size_t done, const std::string& extra, bool final);
 	std::string label_;
 	size_t total_;

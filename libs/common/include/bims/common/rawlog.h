@@ -21,7 +21,7 @@ namespace bims
 /** Error reading or writing a rawlog; the message names the file. */
 class RawlogError : public std::runtime_error
 {
-   public:
+ public:
 	using std::runtime_error::runtime_error;
 };
 
@@ -32,7 +32,7 @@ std::string rawlogImagesDirectory(const std::string& rawlogPath);
 
 class RawlogReader
 {
-   public:
+ public:
 	/** Opens the file (plain or gzip); throws RawlogError if it cannot. Sets
 	 * CImage's external images base path to rawlogImagesDirectory(path) when
 	 * that folder exists. */
@@ -48,7 +48,7 @@ class RawlogReader
 	size_t observationsRead() const { return nObs_; }
 	const std::string& path() const { return path_; }
 
-   private:
+ private:
 	std::string path_;
 	mrpt::io::CFileGZInputStream in_;
 	std::unique_ptr<mrpt::serialization::CArchive> arch_;
@@ -60,7 +60,7 @@ class RawlogReader
 
 class RawlogWriter
 {
-   public:
+ public:
 	/** Creates (truncates) \a path. gzLevel 1..9 writes a gzip-compressed
 	 * rawlog (flushed only on close); 0 writes a plain rawlog whose flush()
 	 * reaches the OS, for live grabbing. Throws RawlogError if the file
@@ -79,7 +79,7 @@ class RawlogWriter
 	size_t written() const { return n_; }
 	const std::string& path() const { return path_; }
 
-   private:
+ private:
 	std::string path_;
 	std::ofstream plain_;
 	mrpt::io::CFileGZOutputStream gz_;

@@ -12,7 +12,7 @@ namespace bims
 {
 struct StampedPose
 {
-	double t = 0;  ///< seconds (UNIX time or sequence time)
+	double t = 0;               ///< seconds (UNIX time or sequence time)
 	mrpt::poses::CPose3D T_WC;  ///< camera pose in the world frame
 };
 using Trajectory = std::vector<StampedPose>;
@@ -25,9 +25,8 @@ Trajectory loadTumTrajectory(const std::string& path);
 
 /** Writes a TUM trajectory (header comment, 6 decimals for time, 9 for
  * values). Throws std::runtime_error if the file cannot be written. */
-void saveTumTrajectory(
-	const std::string& path, const Trajectory& traj,
-	const std::string& headerComment = {});
+void saveTumTrajectory(const std::string& path, const Trajectory& traj,
+                       const std::string& headerComment = {});
 
 /** One TUM line for a pose (no newline). */
 std::string tumLine(double t, const mrpt::poses::CPose3D& T_WC);
