@@ -70,12 +70,7 @@ int main(int argc, char** argv)
 				    throw UsageError(calibArg.getValue() + ": no such file");
 			    mrpt::config::CConfigFile cal(calibArg.getValue());
 			    checkExperimentSections(cal);
-			    if (cal.sectionExists("calibration"))
-				    ec.calibration.loadFromConfigFile(cal);
-			    if (cal.sectionExists("camera"))
-				    ec.camera.loadFromConfigFile(cal);
-			    if (cal.sectionExists("sensors"))
-				    ec.sensors.loadFromConfigFile(cal);
+			    ec.overrideSensorSections(cal);
 		    }
 		    const bool haveRef = ec.calibration.has_R_IC;
 		    const Eigen::Matrix3d R_ref = ec.calibration.R_IC;

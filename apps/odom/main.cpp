@@ -90,12 +90,7 @@ int main(int argc, char** argv)
 				    throw UsageError(cp + ": no such calibration file");
 			    mrpt::config::CConfigFile cal(cp);
 			    checkExperimentSections(cal);
-			    if (cal.sectionExists("calibration"))
-				    ec.calibration.loadFromConfigFile(cal);
-			    if (cal.sectionExists("camera"))
-				    ec.camera.loadFromConfigFile(cal);
-			    if (cal.sectionExists("sensors"))
-				    ec.sensors.loadFromConfigFile(cal);
+			    ec.overrideSensorSections(cal);
 		    }
 		    if (modeArg.isSet())
 		    {

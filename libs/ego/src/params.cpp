@@ -217,4 +217,11 @@ void EgoConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	sensors.loadFromConfigFile(cfg);
 }
 
+void EgoConfig::overrideSensorSections(const mrpt::config::CConfigFileBase& cal)
+{
+	if (cal.sectionExists("calibration")) calibration.loadFromConfigFile(cal);
+	if (cal.sectionExists("camera")) camera.loadFromConfigFile(cal);
+	if (cal.sectionExists("sensors")) sensors.loadFromConfigFile(cal);
+}
+
 }  // namespace bims::ego

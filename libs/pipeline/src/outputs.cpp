@@ -59,7 +59,7 @@ OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
 }
 
 void OutputWriter::writeFrame(const FrameResult& r,
-                              const mrpt::obs::CObservation3DRangeScan& scan)
+                              mrpt::obs::CObservation3DRangeScan& scan)
 {
 	const std::string mpath = dir_ + "/masks/" + frameName(r.index, "png");
 	if (!cv::imwrite(mpath, r.mask))
@@ -88,7 +88,6 @@ void OutputWriter::writeFrame(const FrameResult& r,
 	csv_.flush();
 	if (rawlog_)
 	{
-		mrpt::obs::CObservation3DRangeScan o(scan);
 		auto labels = std::make_shared<mrpt::obs::TPixelLabelInfo<1>>();
 		labels->setSize(r.mask.rows, r.mask.cols);
 		labels->setLabelName(0, "moving");
@@ -98,8 +97,8 @@ void OutputWriter::writeFrame(const FrameResult& r,
 			for (int u = 0; u < r.mask.cols; u++)
 				if (m[u]) labels->setLabel(v, u, 0);
 		}
-		o.pixelLabels = labels;
-		rawlog_->write(o);
+		scan.pixelLabels = labels;  // no copy of the images
+		rawlog_->write(scan);
 	}
 }
 

@@ -17,9 +17,10 @@ class OutputWriter
  public:
 	OutputWriter(const std::string& dir, const OutputParams& p);
 	/** Mask PNG, moving-voxel PLY, trajectory and CSV lines (flushed), and
-	 * the labelled copy of the scan. */
+	 * the scan into the labelled rawlog: the mask is attached to \a scan as
+	 * its pixel labels (in place, so the images are not copied). */
 	void writeFrame(const FrameResult& r,
-	                const mrpt::obs::CObservation3DRangeScan& scan);
+	                mrpt::obs::CObservation3DRangeScan& scan);
 	/** Passes a non-scan observation (IMU) into the labelled rawlog. */
 	void writeOther(const mrpt::obs::CObservation& obs);
 	/** Static map and metrics.json; returns the static map's voxel count. */

@@ -191,6 +191,11 @@ struct EgoConfig
 	 * (false: the caller reads [calibration] from another file later). */
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        bool requireCalibration = true);
+
+	/** Overrides [calibration], [camera] and [sensors] with those present
+	 * in \a cal (e.g. bims-sim's OUT_gt/calibration.ini); sections absent
+	 * from \a cal are left as they are. */
+	void overrideSensorSections(const mrpt::config::CConfigFileBase& cal);
 };
 
 }  // namespace bims::ego
