@@ -101,10 +101,13 @@ void CBayesVoxelGridBase::writeBase(mrpt::serialization::CArchive& out) const
 	    << p.flow_lambda << uint8_t(p.flow_evidence) << p.max_range << p.extent
 	    << p.max_memory_mb << int32_t(p.raycast_decimation)
 	    << uint8_t(p.raycast_target);
+	// version 1
+	out << p.p_unknown << uint8_t(p.bg_neighbourhood) << p.exclude_moving;
 	out << frameCount_ << int64_t(lastTimestamp_.time_since_epoch().count());
 }
 
-void CBayesVoxelGridBase::readBase(mrpt::serialization::CArchive& in)
+void CBayesVoxelGridBase::readBase(mrpt::serialization::CArchive& in,
+                                   uint8_t version)
 {
 	GridParams p;
 	uint8_t decay, ev, tgt;
@@ -120,6 +123,15 @@ void CBayesVoxelGridBase::readBase(mrpt::serialization::CArchive& in)
 	p.flow_evidence = FlowEvidence(ev);
 	p.raycast_target = RayTarget(tgt);
 	p.raycast_decimation = dec;
+	if (version >= 1)
+	{
+		uint8_t nb;
+		in >> p.p_unknown >> nb >> p.exclude_moving;
+		if (nb > 3)
+			throw std::runtime_error(
+			    "bims::maps: corrupt serialised grid (bad enum value)");
+		p.bg_neighbourhood = BgNeighbourhood(nb);
+	}
 	setParamsBase(p);  // validates
 	int64_t ts;
 	in >> frameCount_ >> ts;

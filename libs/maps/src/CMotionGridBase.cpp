@@ -168,10 +168,11 @@ void CMotionGridBase::writeMotion(mrpt::serialization::CArchive& out) const
 	if (hasPrivate) out << *private_;
 }
 
-void CMotionGridBase::readMotion(mrpt::serialization::CArchive& in)
+void CMotionGridBase::readMotion(mrpt::serialization::CArchive& in,
+                                 uint8_t version)
 {
 	grid_.clear();
-	readBase(in);
+	readBase(in, version);
 	grid_.setMaxBytes(size_t(params_.max_memory_mb * 1048576.0));
 	uint64_t nb;
 	in >> nb;

@@ -4,6 +4,9 @@
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace bims::maps
@@ -34,6 +37,9 @@ void COccupancyBayesGrid::updateConstants()
 	lmin_ = toFixed(logit(p.p_min));
 	lmax_ = toFixed(logit(p.p_max));
 	logLambda_ = std::log(p.reading_lambda);
+	hasUnknown_ = p.p_unknown > 0;
+	unknown_ =
+	    hasUnknown_ ? std::clamp(toFixed(logit(p.p_unknown)), lmin_, lmax_) : 0;
 	hitTable_.clear();
 	for (uint32_t n = 0; n <= 1024; ++n)
 		hitTable_.push_back(hitFixedCompute(n));
@@ -52,10 +58,16 @@ LogOddsFx COccupancyBayesGrid::hitFixedCompute(uint32_t n) const
 	return toFixed(std::min(hitLogOdds(params_.p_miss, logLambda_, n), range));
 }
 
+LogOddsFx COccupancyBayesGrid::priorFixed(const Cell& c, uint32_t G) const
+{
+	if (c.stamp == 0 && hasUnknown_) return unknown_;
+	if (params_.decay != DecayMode::All) return c.l;
+	return decayFixed(c.l, G - 1 - c.stamp, miss_, lmin_);
+}
+
 LogOddsFx COccupancyBayesGrid::currentFixed(const Cell& c) const
 {
-	if (params_.decay != DecayMode::All) return c.l;
-	return decayFixed(c.l, frameCount_ - c.stamp, miss_, lmin_);
+	return priorFixed(c, frameCount_ + 1);
 }
 
 LogOddsFx COccupancyBayesGrid::logOddsFixed(const VoxelKey& k) const
@@ -99,21 +111,25 @@ std::vector<mrpt::math::TPoint3D> COccupancyBayesGrid::cellsAbove(
 void COccupancyBayesGrid::applyMiss(Cell& c, uint32_t F) const
 {
 	if (c.stamp == F) return;  // hit (or already missed) in this frame
+	if (c.stamp == 0 && hasUnknown_) c.l = unknown_;
 	c.lPrev = c.l;
 	c.l = std::max<LogOddsFx>(c.l - miss_, lmin_);
 	c.stamp = F;
 }
 
 void COccupancyBayesGrid::integrate(const FrameCloud& f,
-                                    std::vector<float>* priorOut)
+                                    std::vector<float>* priorOut,
+                                    const std::vector<float>* weight)
 {
+	if (weight && weight->size() != f.cells.size())
+		throw std::invalid_argument(
+		    "COccupancyBayesGrid::integrate: one weight per cell expected");
 	if (f.voxel_size != params_.voxel_size)
 		throw std::invalid_argument(
 		    "COccupancyBayesGrid::integrate: frame keyed for voxel size " +
 		    std::to_string(f.voxel_size) + " m, grid has " +
 		    std::to_string(params_.voxel_size) + " m");
 	const uint32_t F = frameCount_ + 1;
-	const bool lazy = params_.decay == DecayMode::All;
 	if (priorOut) priorOut->resize(f.cells.size());
 	FrameStats st;
 	Storage::Accessor acc(grid_);
@@ -125,15 +141,16 @@ void COccupancyBayesGrid::integrate(const FrameCloud& f,
 		{
 			st.overBudget += f.hits[i];
 			if (priorOut)
-				(*priorOut)[i] = float(
-				    fromFixed(lazy ? decayFixed(0, F - 1, miss_, lmin_) : 0));
+				(*priorOut)[i] = float(fromFixed(priorFixed(Cell(), F)));
 			continue;
 		}
-		const LogOddsFx prior =
-		    lazy ? decayFixed(c->l, F - 1 - c->stamp, miss_, lmin_) : c->l;
+		const LogOddsFx prior = priorFixed(*c, F);
 		c->lPrev = prior;
-		c->l = LogOddsFx(
-		    std::min<int64_t>(int64_t(prior) + hitFixed(f.hits[i]), lmax_));
+		LogOddsFx hit = hitFixed(f.hits[i]);
+		if (weight && (*weight)[i] < 1)
+			hit = LogOddsFx(
+			    std::lround(double(hit) * std::max(0.f, (*weight)[i])));
+		c->l = LogOddsFx(std::min<int64_t>(int64_t(prior) + hit, lmax_));
 		c->stamp = F;
 		if (priorOut) (*priorOut)[i] = float(fromFixed(prior));
 	}
@@ -150,7 +167,6 @@ void COccupancyBayesGrid::priorLogOdds(const FrameCloud& f,
 	if (f.voxel_size != params_.voxel_size)
 		throw std::invalid_argument(
 		    "COccupancyBayesGrid::priorLogOdds: voxel size mismatch");
-	const bool lazy = params_.decay == DecayMode::All;
 	const bool already = frameCount_ > 0 &&
 	                     f.timestamp != mrpt::Clock::time_point() &&
 	                     f.timestamp == lastTimestamp_;
@@ -164,9 +180,66 @@ void COccupancyBayesGrid::priorLogOdds(const FrameCloud& f,
 		if (already && cell.stamp == G)
 			v = cell.lPrev;
 		else
-			v = lazy ? decayFixed(cell.l, G - 1 - cell.stamp, miss_, lmin_)
-			         : cell.l;
+			v = priorFixed(cell, G);
 		out[i] = float(fromFixed(v));
+	}
+}
+
+void COccupancyBayesGrid::neighbourhoodMaxPrior(const FrameCloud& f,
+                                                const std::vector<float>& prior,
+                                                BgNeighbourhood nb,
+                                                std::vector<float>& out) const
+{
+	if (prior.size() != f.cells.size())
+		throw std::invalid_argument(
+		    "COccupancyBayesGrid::neighbourhoodMaxPrior: one prior per cell "
+		    "expected");
+	out = prior;
+	if (nb == BgNeighbourhood::None) return;
+	const uint32_t G = frameCount_ + 1;
+	const double s = params_.voxel_size;
+	const auto& o = f.origin_W;
+	for (size_t i = 0; i < f.cells.size(); ++i)
+	{
+		const VoxelKey& k = f.cells[i];
+		LogOddsFx best = std::numeric_limits<LogOddsFx>::min();
+		auto consider = [&](const VoxelKey& n)
+		{
+			const Cell* c = grid_.find(n);
+			if (c && c->stamp != 0) best = std::max(best, priorFixed(*c, G));
+		};
+		if (nb == BgNeighbourhood::Ray)
+		{
+			// The voxels one edge in front of and behind the centre, along
+			// the sensor ray (where depth noise moves a reading).
+			const double cx = (k.x + 0.5) * s, cy = (k.y + 0.5) * s,
+			             cz = (k.z + 0.5) * s;
+			double dx = cx - o.x, dy = cy - o.y, dz = cz - o.z;
+			const double n = std::sqrt(dx * dx + dy * dy + dz * dz);
+			if (n > 0)
+			{
+				dx *= s / n, dy *= s / n, dz *= s / n;
+				for (int sg : {-1, 1})
+				{
+					const VoxelKey nk =
+					    keyOf({cx + sg * dx, cy + sg * dy, cz + sg * dz});
+					if (!(nk == k)) consider(nk);
+				}
+			}
+		}
+		else
+			for (int dz = -1; dz <= 1; ++dz)
+				for (int dy = -1; dy <= 1; ++dy)
+					for (int dx = -1; dx <= 1; ++dx)
+					{
+						const int m =
+						    std::abs(dx) + std::abs(dy) + std::abs(dz);
+						if (m == 0 || (nb == BgNeighbourhood::Faces && m > 1))
+							continue;
+						consider({k.x + dx, k.y + dy, k.z + dz});
+					}
+		if (best != std::numeric_limits<LogOddsFx>::min())
+			out[i] = std::max(out[i], float(fromFixed(best)));
 	}
 }
 

@@ -28,6 +28,21 @@ const char* toString(RayTarget t)
 {
 	return t == RayTarget::Voxels ? "voxels" : "points";
 }
+const char* toString(BgNeighbourhood n)
+{
+	switch (n)
+	{
+		case BgNeighbourhood::None:
+			return "none";
+		case BgNeighbourhood::Ray:
+			return "ray";
+		case BgNeighbourhood::Faces:
+			return "faces";
+		case BgNeighbourhood::Block:
+			return "block";
+	}
+	return "?";
+}
 
 namespace
 {
@@ -50,6 +65,8 @@ void GridParams::validate() const
 	      "must satisfy 0 < p_min < 0.5 < p_max < 1");
 	check(bg_transition_eps > 0 && bg_transition_eps < 0.5, "bg_transition_eps",
 	      "must be in (0, 0.5)");
+	check(p_unknown >= 0 && p_unknown < 1, "p_unknown",
+	      "must be in [0, 1) (0 = the paper's prior)");
 	check(flow_transition_tau > 0 && flow_transition_tau < 0.5,
 	      "flow_transition_tau", "must be in (0, 0.5)");
 	check(std::isfinite(flow_lambda) && flow_lambda > 1, "flow_lambda",
@@ -82,6 +99,13 @@ void GridParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	p_max = s.getDouble("p_max", p_max, 0.5 + 1e-9, 1 - 1e-9);
 	bg_transition_eps =
 	    s.getDouble("bg_transition_eps", bg_transition_eps, 1e-12, 0.5 - 1e-9);
+	p_unknown = s.getDouble("p_unknown", p_unknown, 0, 1 - 1e-9);
+	const auto nb = s.getEnum("bg_neighbourhood", toString(bg_neighbourhood),
+	                          {"none", "ray", "faces", "block"});
+	bg_neighbourhood = nb == "ray"     ? BgNeighbourhood::Ray
+	                   : nb == "faces" ? BgNeighbourhood::Faces
+	                   : nb == "block" ? BgNeighbourhood::Block
+	                                   : BgNeighbourhood::None;
 	flow_transition_tau = s.getDouble("flow_transition_tau",
 	                                  flow_transition_tau, 1e-12, 0.5 - 1e-9);
 	flow_lambda = s.getDouble("flow_lambda", flow_lambda, 1 + 1e-9, 1e300);
@@ -96,6 +120,7 @@ void GridParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	const auto t = s.getEnum("raycast_target", toString(raycast_target),
 	                         {"points", "voxels"});
 	raycast_target = t == "voxels" ? RayTarget::Voxels : RayTarget::Points;
+	exclude_moving = s.getBool("exclude_moving", exclude_moving);
 	s.finish();
 	try
 	{
@@ -113,13 +138,16 @@ void GridParams::dump(std::ostream& o) const
 	  << "\np_miss=" << p_miss << "\nreading_lambda=" << reading_lambda
 	  << "\np_min=" << p_min << "\np_max=" << p_max
 	  << "\nbg_transition_eps=" << bg_transition_eps
+	  << "\np_unknown=" << p_unknown
+	  << "\nbg_neighbourhood=" << toString(bg_neighbourhood)
 	  << "\nflow_transition_tau=" << flow_transition_tau
 	  << "\nflow_lambda=" << flow_lambda
 	  << "\nflow_evidence=" << toString(flow_evidence)
 	  << "\nmax_range=" << max_range << "\nextent=" << extent
 	  << "\nmax_memory_mb=" << max_memory_mb
 	  << "\nraycast_decimation=" << raycast_decimation
-	  << "\nraycast_target=" << toString(raycast_target) << "\n";
+	  << "\nraycast_target=" << toString(raycast_target)
+	  << "\nexclude_moving=" << (exclude_moving ? "true" : "false") << "\n";
 }
 
 bool GridParams::operator==(const GridParams& o) const
@@ -128,12 +156,14 @@ bool GridParams::operator==(const GridParams& o) const
 	       p_miss == o.p_miss && reading_lambda == o.reading_lambda &&
 	       p_min == o.p_min && p_max == o.p_max &&
 	       bg_transition_eps == o.bg_transition_eps &&
+	       p_unknown == o.p_unknown && bg_neighbourhood == o.bg_neighbourhood &&
 	       flow_transition_tau == o.flow_transition_tau &&
 	       flow_lambda == o.flow_lambda && flow_evidence == o.flow_evidence &&
 	       max_range == o.max_range && extent == o.extent &&
 	       max_memory_mb == o.max_memory_mb &&
 	       raycast_decimation == o.raycast_decimation &&
-	       raycast_target == o.raycast_target;
+	       raycast_target == o.raycast_target &&
+	       exclude_moving == o.exclude_moving;
 }
 
 }  // namespace bims::maps

@@ -16,6 +16,14 @@ MotionGrids::MotionGrids(const GridParams& p)
 	t2_->linkOccupancy(t0_);
 }
 
+void MotionGrids::setDecisionTier(int tier)
+{
+	if (tier != 1 && tier != 2)
+		throw std::invalid_argument(
+		    "MotionGrids::setDecisionTier: tier must be 1 or 2");
+	decisionTier_ = tier;
+}
+
 void MotionGrids::clear()
 {
 	t0_->clear();
@@ -42,12 +50,44 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 	t0_->accountFrame(f.stats);
 	if (f.stats.badPose) return result_;
 	const auto t0 = std::chrono::steady_clock::now();
-	// (1)+(2): tier 0 hands out O- of the hit voxels, then folds the frame.
-	t0_->integrate(f, &prior_);
-	// (3) tier 1 from O-, tier 2 from tier 1 and the flow labels.
-	t1_->posterior(f, prior_, post1_);
 	static const PixelLabels none;
-	t2_->posterior(f, labels ? *labels : none, post1_, post2_);
+	// Without flow labels (first frame) there is no decision to exclude by.
+	const bool exclude = p_.exclude_moving && labels;
+	const bool neighbours = p_.bg_neighbourhood != BgNeighbourhood::None;
+	if (!exclude && !neighbours)
+	{
+		// (1)+(2): tier 0 hands out O- of the hit voxels, then folds the
+		// frame in.
+		t0_->integrate(f, &prior_);
+		// (3) tier 1 from O-, tier 2 from tier 1 and the flow labels.
+		t1_->posterior(f, prior_, post1_);
+		t2_->posterior(f, labels ? *labels : none, post1_, post2_);
+	}
+	else
+	{
+		// O- first (with its neighbourhood), both posteriors, then tier 0
+		// folds the frame in: with exclude_moving only the voxels the
+		// decision tier calls static (the moving ones keep their belief).
+		t0_->priorLogOdds(f, prior_);
+		const std::vector<float>* o = &prior_;
+		if (neighbours)
+		{
+			t0_->neighbourhoodMaxPrior(f, prior_, p_.bg_neighbourhood, priorN_);
+			o = &priorN_;
+		}
+		t1_->posterior(f, *o, post1_);
+		t2_->posterior(f, labels ? *labels : none, post1_, post2_);
+		if (exclude)
+		{
+			const auto& dec = decisionTier_ == 1 ? post1_ : post2_;
+			weight_.resize(f.cells.size());
+			for (size_t i = 0; i < f.cells.size(); ++i)
+				weight_[i] = dec[i] > 0 ? 0.f : 1.f;
+			t0_->integrate(f, nullptr, &weight_);
+		}
+		else
+			t0_->integrate(f);
+	}
 	// (4) MAP per voxel; masks.
 	result_.hitVoxels = f.cells.size();
 	for (size_t i = 0; i < f.cells.size(); ++i)

@@ -61,7 +61,7 @@ mrpt::maps::CMetricMap* CFlowConsistencyGrid::internal_CreateFromMapDefinition(
 
 uint8_t CBackgroundSubtractionGrid::serializeGetVersion() const
 {
-	return 0;
+	return 1;
 }
 void CBackgroundSubtractionGrid::serializeTo(
     mrpt::serialization::CArchive& out) const
@@ -71,13 +71,13 @@ void CBackgroundSubtractionGrid::serializeTo(
 void CBackgroundSubtractionGrid::serializeFrom(
     mrpt::serialization::CArchive& in, uint8_t version)
 {
-	if (version != 0) MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
-	readMotion(in);
+	if (version > 1) MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
+	readMotion(in, version);
 }
 
 uint8_t CFlowConsistencyGrid::serializeGetVersion() const
 {
-	return 0;
+	return 1;
 }
 void CFlowConsistencyGrid::serializeTo(mrpt::serialization::CArchive& out) const
 {
@@ -86,8 +86,8 @@ void CFlowConsistencyGrid::serializeTo(mrpt::serialization::CArchive& out) const
 void CFlowConsistencyGrid::serializeFrom(mrpt::serialization::CArchive& in,
                                          uint8_t version)
 {
-	if (version != 0) MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
-	readMotion(in);
+	if (version > 1) MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
+	readMotion(in, version);
 }
 
 // Colours of the paper's Fig. 4: tier 1 yellow, tier 2 red.

@@ -45,6 +45,8 @@ maps::PixelLabels toPixelLabels(const cv::Mat& labels)
 Pipeline::Pipeline(const ExperimentConfig& cfg)
     : cfg_(cfg), odom_(cfg.ego), observed_(cfg.flow), grids_(cfg.grids)
 {
+	// exclude_moving: the variant's own tier decides what is moving.
+	grids_.setDecisionTier(cfg.pipeline.variant == Variant::BottomOnly ? 1 : 2);
 }
 
 void Pipeline::addImu(const mrpt::obs::CObservationIMU& imu)

@@ -64,7 +64,9 @@ class CBayesVoxelGridBase : public mrpt::maps::CMetricMap
 	void setParamsBase(const GridParams& p);
 	/** Serialises params and counters. */
 	void writeBase(mrpt::serialization::CArchive& out) const;
-	void readBase(mrpt::serialization::CArchive& in);
+	/** \a version: of the derived class's serialisation (0: without
+	 * p_unknown, bg_neighbourhood, exclude_moving). */
+	void readBase(mrpt::serialization::CArchive& in, uint8_t version);
 
 	/** Appends cubes of side voxel_size at \a centers with \a color to the
 	 * visualisation (an mrpt::opengl::COctoMapVoxels). */

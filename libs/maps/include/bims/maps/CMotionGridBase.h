@@ -85,7 +85,7 @@ class CMotionGridBase : public CBayesVoxelGridBase
 	    const std::optional<const mrpt::poses::CPose3D>& robotPose =
 	        std::nullopt) override;
 	void writeMotion(mrpt::serialization::CArchive& out) const;
-	void readMotion(mrpt::serialization::CArchive& in);
+	void readMotion(mrpt::serialization::CArchive& in, uint8_t version);
 	void visualize(mrpt::opengl::CSetOfObjects& o, const mrpt::img::TColor& c,
 	               const std::string& name) const;
 

@@ -43,14 +43,29 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 
 	/** Folds one frame in (frame number frameCount()+1). If
 	 * \a priorLogOdds is given it receives O- (log-odds before this frame,
-	 * after lazy decay) for each of frame.cells, for tier 1. */
+	 * after lazy decay) for each of frame.cells, for tier 1. If \a weight
+	 * is given (one value in [0, 1] per frame cell, the probability that
+	 * the cell's readings are of the static scene), a cell's hit evidence is
+	 * scaled by its weight, and a cell with weight < 1 gets no miss and no
+	 * free-space evidence in this frame (weight 0: it keeps its belief, as
+	 * for the readings of a moving object). */
 	void integrate(const FrameCloud& frame,
-	               std::vector<float>* priorLogOdds = nullptr);
+	               std::vector<float>* priorLogOdds = nullptr,
+	               const std::vector<float>* weight = nullptr);
 
 	/** O- for each of frame.cells, without modifying the map. Order
 	 * independent: if this frame (same non-zero timestamp) was already
-	 * integrated, returns the values from before it. */
+	 * integrated, returns the values from before it.*/
 	void priorLogOdds(const FrameCloud& frame, std::vector<float>& out) const;
+
+	/** For each of frame.cells, the largest of \a prior (its O-) and the
+	 * priors of the neighbours in \a n that tier 0 has observed, all before
+	 * this frame is integrated: a reading next to a known surface is
+	 * explained by it (GridParams::bg_neighbourhood). */
+	void neighbourhoodMaxPrior(const FrameCloud& frame,
+	                           const std::vector<float>& prior,
+	                           BgNeighbourhood n,
+	                           std::vector<float>& out) const;
 
 	/** Current log-odds of the voxel containing \a p_W (after all decay up
 	 * to frameCount()); the prior 0 decayed for never-touched space. */
@@ -100,6 +115,12 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 
 	Storage grid_;
 	LogOddsFx miss_ = 0, lmin_ = 0, lmax_ = 0;
+	/** p_unknown > 0: the log-odds of a never-observed cell. */
+	bool hasUnknown_ = false;
+	LogOddsFx unknown_ = 0;
+	/** Prior (before frame G) of a cell, lazily decayed under decay = all;
+	 * a never-observed cell has the unknown prior. */
+	LogOddsFx priorFixed(const Cell& c, uint32_t G) const;
 	double logLambda_ = 0;
 	std::vector<LogOddsFx> hitTable_;
 };

@@ -35,6 +35,21 @@ enum class FlowEvidence
 	Veto
 };
 
+/** Which observed tier-0 voxels next to a hit voxel can explain its
+ * readings as background (tier 1's O- is their largest prior). */
+enum class BgNeighbourhood
+{
+	/** The voxel alone (the paper). */
+	None,
+	/** The voxels one edge in front of and behind the voxel centre along
+	 * the sensor ray, where depth noise and grazing rays put readings. */
+	Ray,
+	/** The 6 face neighbours. */
+	Faces,
+	/** The 26 neighbours of the 3x3x3 block. */
+	Block
+};
+
 /** Which end point a free-space ray goes to (decay = raycast). */
 enum class RayTarget
 {
@@ -48,6 +63,7 @@ enum class RayTarget
 const char* toString(DecayMode m);
 const char* toString(FlowEvidence e);
 const char* toString(RayTarget t);
+const char* toString(BgNeighbourhood n);
 
 /** All parameters of the grids. Probabilities are in (0, 1); log-odds are
  * natural logarithms. Defaults are explained in docs/model.md. */
@@ -68,6 +84,16 @@ struct GridParams
 	double p_max = 0.97;
 	/** Tier 1: eps = P(I=1 | O-=1) = 1 - P(I=1 | O-=0). */
 	double bg_transition_eps = 0.01;
+	/** Tier 0: occupancy prior of a voxel never observed (its value when
+	 * its first hit or miss arrives, O- for tier 1 and the query value of
+	 * unseen space). 0 = the paper: 0.5, decayed by every frame so far
+	 * under decay = all. A value near 1 reads unseen space as static scene,
+	 * so that tier 1 does not flag every newly seen surface and the flow
+	 * decides there (docs/model.md). */
+	double p_unknown = 0;
+	/** Tier 1: O- of a hit voxel is the largest tier-0 prior over the voxel
+	 * and these observed neighbours (docs/model.md). */
+	BgNeighbourhood bg_neighbourhood = BgNeighbourhood::None;
 	/** Tier 2: tau = P(Diff_C != I). */
 	double flow_transition_tau = 0.1;
 	/** Tier 2 per-reading likelihood ratio (must be > 1). */
@@ -87,6 +113,11 @@ struct GridParams
 	int raycast_decimation = 1;
 	/** decay = raycast: rays to each reading or to each hit voxel. */
 	RayTarget raycast_target = RayTarget::Points;
+	/** MotionGrids: tier 0 (the background of tier 1) integrates only the
+	 * voxels that the motion decision of this frame calls static; a voxel
+	 * labelled moving keeps its belief (no hit, no miss). false = the
+	 * paper: every reading is folded into tier 0. */
+	bool exclude_moving = false;
 
 	/** Throws std::invalid_argument naming the parameter if inconsistent. */
 	void validate() const;

@@ -53,6 +53,11 @@ class MotionGrids
 	const GridParams& params() const { return p_; }
 	void clear();
 
+	/** Which tier's MAP decides "moving" for exclude_moving (1 or 2;
+	 * default 2). */
+	void setDecisionTier(int tier);
+	int decisionTier() const { return decisionTier_; }
+
  private:
 	GridParams p_;
 	std::shared_ptr<COccupancyBayesGrid> t0_;
@@ -62,6 +67,8 @@ class MotionGrids
 	FrameCloud frame_;
 	MotionFrameResult result_;
 	std::vector<float> prior_, post1_, post2_;
+	std::vector<float> weight_, priorN_;
+	int decisionTier_ = 2;
 };
 
 }  // namespace bims::maps
