@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# The segmentation table of docs/EVALUATION (docs/results.md) on every simulator
+# preset: bottom tier only, flow only, fused (decay = all, the paper's literal
+# model), fused (the config's decay), fused + ray cast, side by side on the same
+# frames. Not part of CTest (minutes).
+#
+# Usage, from the repository root after building:
+#   scripts/segmentation_table.sh [BUILD_DIR] [DATA_DIR] [RES] [FRAMES] [PRESET...]
+# Defaults: build, a temporary folder, 320x240, 150 frames, every preset of
+# config/sim/. Each preset is simulated once (seed 1) into DATA_DIR (kept if
+# given); the experiment is config/default.ini with the preset's own
+# [calibration] (R_IC, time offset) from its ground truth.
+set -euo pipefail
+BUILD_DIR=${1:-build}
+DATA=${2:-}
+RES=${3:-320x240}
+FRAMES=${4:-150}
+shift $(($# < 4 ? $# : 4))
+cd "$(dirname "$0")/.."
+BIN="$BUILD_DIR/bin"
+PRESETS=${*:-$(ls config/sim/*.ini | xargs -n1 basename | sed 's/\.ini$//')}
+if [ -z "$DATA" ]; then
+	DATA=$(mktemp -d)
+	trap 'rm -rf "$DATA"' EXIT
+fi
+mkdir -p "$DATA"
+
+# default.ini with [calibration] taken from CALIB.ini and [grids] decay=$3
+make_config() {
+	local calib=$1 out=$2 decay=$3
+	local ric off
+	ric=$(awk -F= '/^R_IC=/{print $2}' "$calib")
+	off=$(awk -F= '/^time_offset_s=/{print $2}' "$calib")
+	awk -v ric="$ric" -v off="$off" -v decay="$decay" '
+		/^\[/ {sec=$0}
+		sec=="[calibration]" && /^R_IC=/ {print "R_IC=" ric; next}
+		sec=="[calibration]" && /^time_offset_s=/ {print "time_offset_s=" off; next}
+		sec=="[grids]" && /^decay=/ && decay!="" {print "decay=" decay; next}
+		sec=="[output]" && /^(moving_ply|static_map|labelled_rawlog)=/ {sub(/=.*/, "=false")}
+		{print}' config/default.ini > "$out"
+}
+
+echo "| preset | variant | precision | recall | F1 | IoU | ATE RMSE [m] | ms/frame (pipeline, median) |"
+echo "|---|---|---|---|---|---|---|---|"
+for p in $PRESETS; do
+	rl="$DATA/$p.rawlog"
+	gt="$DATA/${p}_gt"
+	if [ ! -f "$rl" ]; then
+		"$BIN/bims-sim" "config/sim/$p.ini" -o "$rl" -r "$RES" --frames "$FRAMES" --seed 1 -q >&2
+	fi
+	make_config "$gt/calibration.ini" "$DATA/$p.ini" ""
+	make_config "$gt/calibration.ini" "$DATA/${p}_all.ini" all
+	for row in "bottom-only bottom-only $p" "flow-only flow-only $p" \
+		"fused,decay=all fused ${p}_all" "fused fused $p" \
+		"fused+raycast fused-raycast $p"; do
+		read -r name variant cfg <<< "$row"
+		out="$DATA/out_${p}_${name//[,=+]/_}"
+		"$BIN/bims-run" "$DATA/$cfg.ini" "$rl" -o "$out" --variant "$variant" -q > "$out.log" 2>&1 ||
+			{ echo "| $p | $name | run failed: see $out.log | | | | | |"; continue; }
+		read -r _ _ pr _ re _ f1 _ iou <<< "$("$BIN/bims-eval" masks "$gt/masks" "$out/masks" \
+			--depth-valid "$rl" -q 2>/dev/null | tail -n 1)"
+		ate=$("$BIN/bims-eval" traj "$gt/groundtruth.txt" "$out/trajectory.txt" --no-plot 2>/dev/null |
+			awk '/^ate_rmse/ {print $2}')
+		ms=$(sed -n 's/.*"total": *{[^}]*"median": *\([0-9.]*\).*/\1/p' "$out/metrics.json" | head -n 1)
+		echo "| $p | $name | $pr | $re | $f1 | $iou | $ate | ${ms:--} |"
+	done
+done
