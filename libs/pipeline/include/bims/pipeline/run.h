@@ -37,9 +37,18 @@ struct RunSummary
 	size_t scansRead = 0, framesProcessed = 0, imuRead = 0, otherSkipped = 0;
 	size_t framesFlagged = 0;    ///< frames with an egomotion flag
 	size_t scansOutOfOrder = 0;  ///< dropped: timestamp not increasing
-	double seconds = 0;          ///< wall time of the whole run
+	/** Wall time of the whole run: reading, every frame, every output
+	 * (static map included; metrics.json excepted). */
+	double seconds = 0;
+	double cpuSeconds = 0;  ///< CPU time of the process over the run
 	double dataSeconds = 0;      ///< time span of the processed frames
-	std::map<std::string, Percentiles> stageMs;  ///< per stage [ms]
+	/** Per stage [ms]: the pipeline's input, egomotion, flow, grids, total
+	 * (wall); read (reading and decoding the observations up to the frame,
+	 * on the reading thread), outputs (writing the frame, on the writing
+	 * thread); *_cpu: CPU time of the same (total_cpu: the run's thread
+	 * only, not OpenCV's workers); wait_input / wait_output: the run
+	 * blocked on the reader / on a full write queue. */
+	std::map<std::string, Percentiles> stageMs;
 	double meanMovingPixelFraction = 0;          ///< over labelled-depth pixels
 	size_t staticMapVoxels = 0;
 	std::string variant;
