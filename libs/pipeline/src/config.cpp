@@ -56,8 +56,8 @@ void OutputParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	moving_ply = s.getBool("moving_ply", moving_ply);
 	static_map = s.getBool("static_map", static_map);
 	labelled_rawlog = s.getBool("labelled_rawlog", labelled_rawlog);
-	labelled_rawlog_gz_level = static_cast<int>(s.getInt(
-	    "labelled_rawlog_gz_level", labelled_rawlog_gz_level, 0, 9));
+	labelled_rawlog_gz_level = static_cast<int>(
+	    s.getInt("labelled_rawlog_gz_level", labelled_rawlog_gz_level, 0, 9));
 	flow_labels = s.getBool("flow_labels", flow_labels);
 	static_p_occupied =
 	    s.getDouble("static_p_occupied", static_p_occupied, 0.5, 0.999);

@@ -12,7 +12,13 @@ inline double cpuMs(clockid_t clock)
 	clock_gettime(clock, &ts);
 	return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * ts.tv_nsec;
 }
-inline double threadCpuMs() { return cpuMs(CLOCK_THREAD_CPUTIME_ID); }
-inline double processCpuMs() { return cpuMs(CLOCK_PROCESS_CPUTIME_ID); }
+inline double threadCpuMs()
+{
+	return cpuMs(CLOCK_THREAD_CPUTIME_ID);
+}
+inline double processCpuMs()
+{
+	return cpuMs(CLOCK_PROCESS_CPUTIME_ID);
+}
 
 }  // namespace bims::pipeline

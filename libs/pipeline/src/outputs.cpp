@@ -207,8 +207,8 @@ void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
 	              "\"static_map_voxels\": %zu,\n",
 	              sum.framesProcessed, sum.framesFlagged, sum.scansRead,
 	              sum.imuRead, sum.scansOutOfOrder, sum.seconds, sum.cpuSeconds,
-	              sum.fps(),
-	              sum.dataSeconds, sum.meanMovingPixelFraction, nStatic);
+	              sum.fps(), sum.dataSeconds, sum.meanMovingPixelFraction,
+	              nStatic);
 	j << buf;
 	j << "  \"stage_ms\": {";
 	bool first = true;

@@ -2,6 +2,8 @@
 
 #include "cpu_time.h"
 
+#include <pthread.h>
+
 #include <chrono>
 #include <exception>
 
@@ -61,9 +63,10 @@ ReadAhead::Item ReadAhead::readOne(std::string& error)
 			}
 			catch (const std::exception& e)
 			{
-				throw RawlogError(paths_[it.file] + ": observation " +
-				                  std::to_string(reader_->observationsRead()) +
-				                  ": cannot load its external data: " + e.what());
+				throw RawlogError(
+				    paths_[it.file] + ": observation " +
+				    std::to_string(reader_->observationsRead()) +
+				    ": cannot load its external data: " + e.what());
 			}
 		}
 	}
@@ -83,6 +86,7 @@ ReadAhead::Item ReadAhead::readOne(std::string& error)
 
 void ReadAhead::loop()
 {
+	pthread_setname_np(pthread_self(), "bims-read");  // for top, perf
 	for (;;)
 	{
 		Entry e;

@@ -270,17 +270,16 @@ std::string formatSummary(const RunSummary& s)
 	              s.variant.c_str(), s.framesProcessed, s.framesFlagged,
 	              s.scansRead, s.imuRead, s.dataSeconds);
 	o << buf;
-	std::snprintf(
-	    buf, sizeof(buf),
-	    "wall time %.1f s, %.1f frames/s end to end (CPU %.1f s, all "
-	    "threads); mean moving-pixel fraction %.2f %%\n",
-	    s.seconds, s.fps(), s.cpuSeconds, 100.0 * s.meanMovingPixelFraction);
+	std::snprintf(buf, sizeof(buf),
+	              "wall time %.1f s, %.1f frames/s end to end (CPU %.1f s, all "
+	              "threads); mean moving-pixel fraction %.2f %%\n",
+	              s.seconds, s.fps(), s.cpuSeconds,
+	              100.0 * s.meanMovingPixelFraction);
 	o << buf;
 	o << "stage        median ms   p95 ms   mean ms\n";
-	for (const char* k :
-	     {"read", "read_cpu", "wait_input", "input", "egomotion", "flow",
-	      "grids", "total", "total_cpu", "outputs", "outputs_cpu",
-	      "wait_output"})
+	for (const char* k : {"read", "read_cpu", "wait_input", "input",
+	                      "egomotion", "flow", "grids", "total", "total_cpu",
+	                      "outputs", "outputs_cpu", "wait_output"})
 	{
 		const auto it = s.stageMs.find(k);
 		if (it == s.stageMs.end()) continue;

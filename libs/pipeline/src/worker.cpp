@@ -1,5 +1,7 @@
 #include "worker.h"
 
+#include <pthread.h>
+
 #include <chrono>
 #include <exception>
 #include <stdexcept>
@@ -65,6 +67,7 @@ void SerialWorker::drain()
 
 void SerialWorker::loop()
 {
+	pthread_setname_np(pthread_self(), "bims-write");  // for top, perf
 	std::unique_lock<std::mutex> lk(mu_);
 	for (;;)
 	{

@@ -55,7 +55,7 @@ struct OutputParams
 	/** gzip level of segmented.rawlog: 0 = plain (default: gzip costs more
 	 * than the whole pipeline at 640x480), 1..9 = gzip. */
 	int labelled_rawlog_gz_level = 0;
-	bool flow_labels = false;     ///< flow_labels/NNNNNN.png (Diff red)
+	bool flow_labels = false;  ///< flow_labels/NNNNNN.png (Diff red)
 	/** Occupancy probability above which a voxel is in the static map. */
 	double static_p_occupied = 0.7;
 	/** Write the per-frame outputs on a background thread (in order; the

@@ -40,8 +40,8 @@ struct RunSummary
 	/** Wall time of the whole run: reading, every frame, every output
 	 * (static map included; metrics.json excepted). */
 	double seconds = 0;
-	double cpuSeconds = 0;  ///< CPU time of the process over the run
-	double dataSeconds = 0;      ///< time span of the processed frames
+	double cpuSeconds = 0;   ///< CPU time of the process over the run
+	double dataSeconds = 0;  ///< time span of the processed frames
 	/** Per stage [ms]: the pipeline's input, egomotion, flow, grids, total
 	 * (wall); read (reading and decoding the observations up to the frame,
 	 * on the reading thread), outputs (writing the frame, on the writing
@@ -49,7 +49,7 @@ struct RunSummary
 	 * only, not OpenCV's workers); wait_input / wait_output: the run
 	 * blocked on the reader / on a full write queue. */
 	std::map<std::string, Percentiles> stageMs;
-	double meanMovingPixelFraction = 0;          ///< over labelled-depth pixels
+	double meanMovingPixelFraction = 0;  ///< over labelled-depth pixels
 	size_t staticMapVoxels = 0;
 	std::string variant;
 	/** Error that stopped the run early (outputs so far stay valid). */
