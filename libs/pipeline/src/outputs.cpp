@@ -100,8 +100,16 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
                                 mrpt::obs::CObservation3DRangeScan& scan)
 {
 	const std::string mpath = dir_ + "/masks/" + frameName(r.index, "png");
-	if (!cv::imwrite(mpath, r.mask))
-		throw std::runtime_error(mpath + ": cannot write mask");
+	bool ok = false;
+	try
+	{
+		ok = cv::imwrite(mpath, r.mask);
+	}
+	catch (const cv::Exception& e)
+	{
+		throw std::runtime_error(mpath + ": cannot write mask: " + e.what());
+	}
+	if (!ok) throw std::runtime_error(mpath + ": cannot write mask");
 	if (p_.moving_ply)
 		writePointsPly(dir_ + "/moving_voxels/" + frameName(r.index, "ply"),
 		               r.movingVoxelCentres);

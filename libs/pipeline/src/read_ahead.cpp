@@ -32,6 +32,11 @@ ReadAhead::Item ReadAhead::readOne(std::string& error)
 	const auto t0 = std::chrono::steady_clock::now();
 	const double cpu0 = threadCpuMs();
 	Item it;
+	if (!error_.empty())
+	{
+		error = error_;  // the stream stopped there
+		return it;
+	}
 	try
 	{
 		while (!done_ && !it.obs)
@@ -74,6 +79,7 @@ ReadAhead::Item ReadAhead::readOne(std::string& error)
 	{
 		error = e.what();
 		if (error.empty()) error = "rawlog reading failed";
+		error_ = error;
 		it.obs.reset();
 		done_ = true;
 	}
@@ -112,10 +118,15 @@ ReadAhead::Item ReadAhead::next(double* waitMs)
 	{
 		std::unique_lock<std::mutex> lk(mu_);
 		cv_.wait(lk, [&] { return !queue_.empty(); });
-		e = std::move(queue_.front());
 		// the end marker and an error stay: the thread has stopped, and
 		// further calls return them again
-		if (e.item.obs) queue_.pop_front();
+		if (queue_.front().item.obs)
+		{
+			e = std::move(queue_.front());
+			queue_.pop_front();
+		}
+		else
+			e = queue_.front();
 		lk.unlock();
 		cv_.notify_all();
 	}

@@ -52,6 +52,7 @@ class ReadAhead
 	size_t file_ = 0;
 	std::unique_ptr<RawlogReader> reader_;
 	bool done_ = false;
+	std::string error_;  ///< the reading error, once met
 	// queue
 	struct Entry
 	{
