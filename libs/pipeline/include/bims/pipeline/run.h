@@ -57,7 +57,9 @@ struct RunSummary
 	double fps() const { return seconds > 0 ? framesProcessed / seconds : 0; }
 };
 
-/** Called after each processed frame (e.g. a viewer). */
+/** Called after each processed frame (e.g. a viewer), on the run's thread,
+ * before the frame is queued for writing (the scan's pixelLabels are still
+ * the input's). */
 using FrameCallback = std::function<void(
     const FrameResult&, const mrpt::obs::CObservation3DRangeScan&)>;
 
@@ -70,7 +72,9 @@ struct RunOptions
 	FrameCallback onFrame;
 };
 
-/** Runs \a cfg over the rawlogs. Writes into outDir (when set):
+/** Runs \a cfg over the rawlogs, reading ahead on a thread ([pipeline]
+ * read_ahead) and writing on another ([output] writer_thread); returns when
+ * every output is complete. Writes into outDir (when set):
  * trajectory.txt, masks/NNNNNN.png, moving_voxels/NNNNNN.ply,
  * static_map.{ply,bt}, segmented.rawlog, metrics.json, frames.csv.
  * Bad input (truncated rawlog, missing images) stops the run with
