@@ -11,7 +11,8 @@
 # end to end (bims-run's own figure: reading, every frame, every output) and
 # of the whole process (start to exit), CPU time per frame (all threads), and
 # the load average before the run. BIMS_RUN=/path/to/bims-run measures
-# another binary (stages it does not report print as "-").
+# another binary (stages it does not report print as "-"), BIMS_CONFIG=X.ini
+# another experiment file (e.g. the one of that binary's version).
 set -euo pipefail
 BUILD_DIR=${1:-build}
 FRAMES=${2:-120}
@@ -20,6 +21,7 @@ VARIANTS=${4:-fused fused-raycast}
 cd "$(dirname "$0")/.."
 BIN="$BUILD_DIR/bin"
 RUN=${BIMS_RUN:-$BIN/bims-run}
+CONFIG=${BIMS_CONFIG:-config/default.ini}
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 
@@ -31,7 +33,7 @@ stage() {
 field() { sed -n "s/.*\"$1\": \([0-9.]*\).*/\1/p" "$2"; }
 load() { cut -d' ' -f1 /proc/loadavg; }
 
-echo "bims-run: $RUN; $(nproc) cores; $(date -u '+%Y-%m-%d %H:%M UTC')"
+echo "bims-run: $RUN, $CONFIG; $(nproc) cores; $(date -u '+%Y-%m-%d %H:%M UTC')"
 echo
 echo "| resolution, variant | read | egomotion | flow | grids | pipeline total | outputs | frames/s end to end | frames/s process | CPU ms/frame | load |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|"
@@ -44,7 +46,7 @@ for res in 640x480 320x240; do
       rm -rf "$out"
       l=$(load)
       t0=$(date +%s.%N)
-      "$RUN" config/default.ini "$TMP/$res.rawlog" -o "$out" --variant "$v" \
+      "$RUN" "$CONFIG" "$TMP/$res.rawlog" -o "$out" --variant "$v" \
         -q > "$TMP/log" 2>&1 || { cat "$TMP/log"; exit 1; }
       t1=$(date +%s.%N)
       m="$out/metrics.json"
