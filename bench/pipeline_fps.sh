@@ -1,21 +1,64 @@
 #!/usr/bin/env bash
 # End-to-end speed of bims-run at 640x480 and 320x240 on simulator data
-# (not part of CTest). Usage: bench/pipeline_fps.sh [BUILD_DIR] [FRAMES]
-# Prints, per resolution and variant, frames/s and per-stage median/p95 ms
-# from bims-run's metrics.json.
+# (not part of CTest).
+#
+#   bench/pipeline_fps.sh [BUILD_DIR] [FRAMES] [REPEATS] [VARIANTS]
+#
+# Defaults: build, 120 frames, 1 run, "fused fused-raycast". Simulates
+# config/sim/pendulum_slow.ini (--seed 1) at both resolutions, runs bims-run
+# with config/default.ini and all its default outputs, and prints one
+# markdown row per run: per-stage median / p95 ms from metrics.json, frames/s
+# end to end (bims-run's own figure: reading, every frame, every output) and
+# of the whole process (start to exit), CPU time per frame (all threads), and
+# the load average before the run. BIMS_RUN=/path/to/bims-run measures
+# another binary (stages it does not report print as "-"), BIMS_CONFIG=X.ini
+# another experiment file (e.g. the one of that binary's version).
 set -euo pipefail
 BUILD_DIR=${1:-build}
 FRAMES=${2:-120}
+REPEATS=${3:-1}
+VARIANTS=${4:-fused fused-raycast}
 cd "$(dirname "$0")/.."
 BIN="$BUILD_DIR/bin"
+RUN=${BIMS_RUN:-$BIN/bims-run}
+CONFIG=${BIMS_CONFIG:-config/default.ini}
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 
+# "median / p95" of a stage in metrics.json, "-" when absent
+stage() {
+  sed -n "s/.*\"$1\": {\"median\": \([0-9.]*\), \"p95\": \([0-9.]*\).*/\1 \/ \2/p" "$2" |
+    awk '{printf "%.2f / %.2f", $1, $3} END {if (NR == 0) printf "-"}'
+}
+field() { sed -n "s/.*\"$1\": \([0-9.]*\).*/\1/p" "$2"; }
+load() { cut -d' ' -f1 /proc/loadavg; }
+
+echo "bims-run: $RUN, $CONFIG; $(nproc) cores; $(date -u '+%Y-%m-%d %H:%M UTC')"
+echo
+echo "| resolution, variant | read | egomotion | flow | grids | pipeline total | outputs | frames/s end to end | frames/s process | CPU ms/frame | load |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for res in 640x480 320x240; do
-  "$BIN/bims-sim" config/sim/pendulum_slow.ini -o "$TMP/$res.rawlog" --frames "$FRAMES" --resolution "$res" --seed 1 -q
-  for v in fused fused-raycast; do
-    "$BIN/bims-run" config/default.ini "$TMP/$res.rawlog" -o "$TMP/out_${res}_$v" --variant "$v" -q > "$TMP/log" 2>&1
-    echo "== $res $v ($FRAMES frames)"
-    grep -E "frames/s|median|input|egomotion|flow|grids|total" "$TMP/log" | grep -v "^outputs"
+  "$BIN/bims-sim" config/sim/pendulum_slow.ini -o "$TMP/$res.rawlog" \
+    --frames "$FRAMES" --resolution "$res" --seed 1 -q > /dev/null 2>&1
+  for v in $VARIANTS; do
+    for ((k = 0; k < REPEATS; k++)); do
+      out="$TMP/out_${res}_$v"
+      rm -rf "$out"
+      l=$(load)
+      t0=$(date +%s.%N)
+      "$RUN" "$CONFIG" "$TMP/$res.rawlog" -o "$out" --variant "$v" \
+        -q > "$TMP/log" 2>&1 || { cat "$TMP/log"; exit 1; }
+      t1=$(date +%s.%N)
+      m="$out/metrics.json"
+      n=$(field frames_processed "$m")
+      cpu=$(field cpu_seconds "$m")
+      printf "| %s %s | %s | %s | %s | %s | %s | %s | %.1f | %.1f | %s | %s |\n" \
+        "$res" "$v" "$(stage read "$m")" "$(stage egomotion "$m")" \
+        "$(stage flow "$m")" "$(stage grids "$m")" "$(stage total "$m")" \
+        "$(stage outputs "$m")" "$(field fps "$m")" \
+        "$(echo "$n $t0 $t1" | awk '{print $1 / ($3 - $2)}')" \
+        "$(if [ -n "$cpu" ]; then echo "$cpu $n" | awk '{printf "%.1f", 1000 * $1 / $2}'; else echo -; fi)" \
+        "$l"
+    done
   done
 done

@@ -8,9 +8,13 @@
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
 
 namespace fs = std::filesystem;
 using namespace bims::pipeline;
@@ -204,4 +208,186 @@ TEST(EndToEnd, UnknownSensorLabelIsAnErrorNamingTheFile)
 	    << sum.error;
 	EXPECT_NE(sum.error.find("'KINECT'"), std::string::npos) << sum.error;
 	EXPECT_EQ(sum.framesProcessed, 0u);
+}
+
+namespace
+{
+std::string readAll(const std::string& path)
+{
+	std::ifstream f(path, std::ios::binary);
+	return std::string((std::istreambuf_iterator<char>(f)),
+	                   std::istreambuf_iterator<char>());
+}
+
+/** frames.csv without its timing columns (ms_*, the last five). */
+std::string csvWithoutTimes(const std::string& path)
+{
+	std::istringstream in(readAll(path));
+	std::string line, out;
+	while (std::getline(in, line))
+	{
+		for (int k = 0; k < 5; k++) line = line.substr(0, line.rfind(','));
+		out += line + "\n";
+	}
+	return out;
+}
+
+/** The labelled rawlog's scans: index -> "moving" pixel-label mask. */
+std::vector<cv::Mat> labelMasks(const std::string& rawlog)
+{
+	std::vector<cv::Mat> masks;
+	bims::RawlogReader r(rawlog);
+	while (auto o = r.next())
+		if (auto s =
+		        std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(
+		            o))
+		{
+			EXPECT_TRUE(s->hasPixelLabels());
+			if (!s->hasPixelLabels()) continue;
+			const auto& L = *s->pixelLabels;
+			EXPECT_EQ(L.getLabelName(0), "moving");
+			cv::Mat m(static_cast<int>(s->rangeImage.rows()),
+			          static_cast<int>(s->rangeImage.cols()), CV_8UC1,
+			          cv::Scalar(0));
+			for (int v = 0; v < m.rows; v++)
+				for (int u = 0; u < m.cols; u++)
+					if (L.checkLabel(v, u, 0)) m.at<uint8_t>(v, u) = 255;
+			masks.push_back(m);
+		}
+	return masks;
+}
+}  // namespace
+
+TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
+{
+	// Reading ahead and writing on threads must not change a single byte of
+	// the outputs (nor the order of the labelled rawlog).
+	ExperimentConfig cfg;
+	cfg.loadFromFile(kConfig);
+	auto runWith = [&](bool threads, const std::string& name)
+	{
+		ExperimentConfig c = cfg;
+		c.pipeline.read_ahead = threads;
+		c.output.writer_thread = threads;
+		RunOptions opt;
+		opt.rawlogs = {kSample};
+		opt.frames = FrameRange{0, 19};
+		opt.outDir = tmpDir(name);
+		opt.progress = false;
+		const auto sum = runExperiment(c, opt);
+		EXPECT_TRUE(sum.error.empty()) << sum.error;
+		EXPECT_EQ(sum.framesProcessed, 20u);
+		return opt.outDir;
+	};
+	const std::string a = runWith(false, "sequential");
+	const std::string b = runWith(true, "threaded");
+	// (booleans: gtest's diff of two large strings would not end)
+	for (const char* f : {"trajectory.txt", "segmented.rawlog",
+	                      "static_map.ply", "moving_voxels/000015.ply"})
+		EXPECT_TRUE(readAll(a + "/" + f) == readAll(b + "/" + f))
+		    << f << " differs";
+	EXPECT_TRUE(csvWithoutTimes(a + "/frames.csv") ==
+	            csvWithoutTimes(b + "/frames.csv"))
+	    << "frames.csv differs";
+	for (int i = 0; i < 20; i++)
+	{
+		char name[32];
+		std::snprintf(name, sizeof(name), "/masks/%06d.png", i);
+		EXPECT_TRUE(readAll(a + name) == readAll(b + name))
+		    << name << " differs";
+	}
+	// the pixel labels are the masks
+	const auto labels = labelMasks(b + "/segmented.rawlog");
+	ASSERT_EQ(labels.size(), 20u);
+	for (int i : {0, 10, 19})
+	{
+		char name[32];
+		std::snprintf(name, sizeof(name), "/masks/%06d.png", i);
+		const cv::Mat m = cv::imread(b + name, cv::IMREAD_UNCHANGED);
+		ASSERT_EQ(m.size(), labels[i].size());
+		EXPECT_EQ(cv::countNonZero(m != labels[i]), 0) << name;
+	}
+}
+
+TEST(EndToEnd, LabelledRawlogIsPlainByDefaultAndGzipOnRequest)
+{
+	ExperimentConfig cfg;
+	cfg.loadFromFile(kConfig);
+	for (int level : {0, 1})
+	{
+		ExperimentConfig c = cfg;
+		c.output.labelled_rawlog_gz_level = level;
+		RunOptions opt;
+		opt.rawlogs = {kSample};
+		opt.frames = FrameRange{3, 6};
+		opt.outDir = tmpDir("gz" + std::to_string(level));
+		opt.progress = false;
+		const auto sum = runExperiment(c, opt);
+		ASSERT_TRUE(sum.error.empty()) << sum.error;
+		const std::string f = opt.outDir + "/segmented.rawlog";
+		const std::string head = readAll(f).substr(0, 2);
+		EXPECT_EQ(head == "\x1f\x8b", level > 0) << "level " << level;
+		EXPECT_EQ(labelMasks(f).size(), 4u);
+		// metrics.json reports reading and writing with the pipeline stages
+		const std::string j = readAll(opt.outDir + "/metrics.json");
+		for (const char* k : {"\"read\"", "\"outputs\"", "\"egomotion\"",
+		                      "\"cpu_seconds\"", "\"fps\""})
+			EXPECT_NE(j.find(k), std::string::npos) << k;
+	}
+}
+
+TEST(EndToEnd, RawlogEditOpensTheLabelledRawlog)
+{
+	if (std::system("command -v rawlog-edit > /dev/null 2>&1") != 0)
+		GTEST_SKIP() << "rawlog-edit not installed";
+	ExperimentConfig cfg;
+	cfg.loadFromFile(kConfig);
+	RunOptions opt;
+	opt.rawlogs = {kSample};
+	opt.frames = FrameRange{0, 4};
+	opt.outDir = tmpDir("rawlogedit");
+	opt.progress = false;
+	ASSERT_TRUE(runExperiment(cfg, opt).error.empty());
+	const std::string log = opt.outDir + "/info.txt";
+	ASSERT_EQ(std::system(("rawlog-edit --info -i '" + opt.outDir +
+	                       "/segmented.rawlog' > '" + log + "' 2>&1")
+	                          .c_str()),
+	          0)
+	    << readAll(log);
+	EXPECT_NE(readAll(log).find("Observations format               : Yes"),
+	          std::string::npos)
+	    << readAll(log);
+}
+
+TEST(EndToEnd, WriteErrorStopsTheRunNamingTheFileAndKeepsEarlierFrames)
+{
+	// masks/000003.png cannot be written (a folder is in the way): the run
+	// stops with that file named; frames 0-2 are complete in every output.
+	for (bool threads : {true, false})
+	{
+		ExperimentConfig cfg;
+		cfg.loadFromFile(kConfig);
+		cfg.output.writer_thread = threads;
+		RunOptions opt;
+		opt.rawlogs = {kSample};
+		opt.frames = FrameRange{0, 29};
+		opt.outDir = tmpDir(threads ? "writeerr_t" : "writeerr_s");
+		fs::create_directories(opt.outDir + "/masks/000003.png/x");
+		opt.progress = false;
+		const auto sum = runExperiment(cfg, opt);
+		EXPECT_NE(sum.error.find("masks/000003.png: cannot write mask"),
+		          std::string::npos)
+		    << sum.error;
+		EXPECT_LT(sum.framesProcessed, 30u);
+		for (const char* f : {"masks/000000.png", "masks/000002.png",
+		                      "moving_voxels/000002.ply", "metrics.json"})
+			EXPECT_TRUE(fs::exists(opt.outDir + "/" + f)) << f;
+		EXPECT_FALSE(fs::exists(opt.outDir + "/masks/000004.png"));
+		EXPECT_NE(readAll(opt.outDir + "/metrics.json").find("000003.png"),
+		          std::string::npos);
+		// frames.csv: header + frames 0-2; the labelled rawlog reads cleanly
+		const std::string csv = readAll(opt.outDir + "/frames.csv");
+		EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4) << csv;
+		EXPECT_EQ(labelMasks(opt.outDir + "/segmented.rawlog").size(), 3u);
+	}
 }

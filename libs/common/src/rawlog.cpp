@@ -5,8 +5,109 @@
 #include <mrpt/serialization/archiveFrom_std_streams.h>
 #include <mrpt/system/filesystem.h>
 
+#include <algorithm>
+#include <cstring>
+
 namespace bims
 {
+namespace
+{
+/** A CArchive appending to a byte vector. MRPT serializes a matrix element
+ * by element: buffering the object in memory makes that one file write per
+ * object instead of one per element, and a failed serialization writes
+ * nothing. */
+class VectorArchive : public mrpt::serialization::CArchive
+{
+ public:
+	explicit VectorArchive(std::vector<uint8_t>& buf) : buf_(buf) {}
+
+ protected:
+	size_t write(const void* d, size_t n) override
+	{
+		const auto* p = static_cast<const uint8_t*>(d);
+		buf_.insert(buf_.end(), p, p + n);
+		return n;
+	}
+	size_t read(void*, size_t) override
+	{
+		throw std::logic_error("VectorArchive is write-only");
+	}
+
+ private:
+	std::vector<uint8_t>& buf_;
+};
+
+/** A CArchive reading a (gzip or plain) file through a buffer of its own,
+ * for the same reason: one gzread per 256 KB instead of one per matrix
+ * element. */
+class BufferedInArchive : public mrpt::serialization::CArchive
+{
+ public:
+	explicit BufferedInArchive(mrpt::io::CFileGZInputStream& in) : in_(in) {}
+	/** Bytes handed out so far. */
+	uint64_t position() const { return pos_; }
+	/** Nothing left, in the buffer or in the file (false on a read error:
+	 * that is no clean end). */
+	bool atEof()
+	{
+		if (next_ < buf_.size()) return false;
+		if (eof_) return true;
+		try
+		{
+			fill();
+		}
+		catch (const std::exception&)
+		{
+			return false;
+		}
+		return next_ == buf_.size();
+	}
+
+ protected:
+	size_t write(const void*, size_t) override
+	{
+		throw std::logic_error("BufferedInArchive is read-only");
+	}
+	size_t read(void* d, size_t n) override
+	{
+		auto* out = static_cast<uint8_t*>(d);
+		size_t got = 0;
+		while (got < n)
+		{
+			if (next_ == buf_.size())
+			{
+				if (eof_) break;
+				fill();
+				if (next_ == buf_.size()) break;
+			}
+			const size_t k = std::min(n - got, buf_.size() - next_);
+			std::memcpy(out + got, buf_.data() + next_, k);
+			next_ += k;
+			got += k;
+		}
+		pos_ += got;
+		return got;
+	}
+
+ private:
+	void fill()
+	{
+		buf_.resize(kChunk);
+		const size_t k = in_.Read(buf_.data(), kChunk);
+		buf_.resize(k);
+		next_ = 0;
+		if (k == 0) eof_ = true;
+	}
+
+	static constexpr size_t kChunk = 256 * 1024;
+	mrpt::io::CFileGZInputStream& in_;
+	std::vector<uint8_t> buf_;
+	size_t next_ = 0;
+	uint64_t pos_ = 0;
+	bool eof_ = false;
+};
+}  // namespace
+
 std::string rawlogImagesDirectory(const std::string& rawlogPath)
 {
 	std::string dir = mrpt::system::extractFileDirectory(rawlogPath);
@@ -19,9 +120,7 @@ RawlogReader::RawlogReader(const std::string& path) : path_(path)
 	if (!mrpt::system::fileExists(path))
 		throw RawlogError(path + ": no such rawlog file");
 	if (!in_.open(path)) throw RawlogError(path + ": cannot open rawlog file");
-	arch_ = std::make_unique<
-	    mrpt::serialization::CArchiveStreamBase<mrpt::io::CFileGZInputStream>>(
-	    in_);
+	arch_ = std::make_unique<BufferedInArchive>(in_);
 	const std::string imgDir = rawlogImagesDirectory(path);
 	if (mrpt::system::directoryExists(imgDir))
 		mrpt::img::CImage::setImagesPathBase(imgDir);
@@ -33,7 +132,8 @@ mrpt::obs::CObservation::Ptr RawlogReader::next()
 	{
 		if (atEnd_) return nullptr;
 		mrpt::serialization::CSerializable::Ptr obj;
-		const uint64_t pos0 = in_.getPosition();
+		auto& arch = static_cast<BufferedInArchive&>(*arch_);
+		const uint64_t pos0 = arch.position();
 		try
 		{
 			obj = arch_->ReadObject();
@@ -42,7 +142,7 @@ mrpt::obs::CObservation::Ptr RawlogReader::next()
 		catch (const std::exception& e)
 		{
 			// EOF before the first byte of an object is the clean end.
-			if (in_.getPosition() == pos0 && in_.checkEOF())
+			if (arch.position() == pos0 && arch.atEof())
 			{
 				atEnd_ = true;
 				return nullptr;
@@ -85,17 +185,14 @@ RawlogWriter::RawlogWriter(const std::string& path, int gzLevel) : path_(path)
 	{
 		plain_.open(path, std::ios::binary | std::ios::trunc);
 		if (!plain_) throw RawlogError(path + ": cannot create rawlog file");
-		arch_ = std::make_unique<
-		    mrpt::serialization::CArchiveStreamBase<std::ostream>>(plain_);
 	}
 	else
 	{
 		if (!gz_.open(path, gzLevel, std::nullopt,
 		              mrpt::io::OpenMode::TRUNCATE))
 			throw RawlogError(path + ": cannot create rawlog file");
-		arch_ = std::make_unique<mrpt::serialization::CArchiveStreamBase<
-		    mrpt::io::CFileGZOutputStream>>(gz_);
 	}
+	arch_ = std::make_unique<VectorArchive>(buf_);
 	open_ = true;
 }
 
@@ -113,6 +210,7 @@ RawlogWriter::~RawlogWriter()
 void RawlogWriter::write(const mrpt::obs::CObservation& obs)
 {
 	if (!open_) throw RawlogError(path_ + ": write after close");
+	buf_.clear();
 	try
 	{
 		*arch_ << obs;
@@ -121,7 +219,14 @@ void RawlogWriter::write(const mrpt::obs::CObservation& obs)
 	{
 		throw RawlogError(path_ + ": write failed: " + e.what());
 	}
-	if (plain_.is_open() && !plain_)
+	const auto n = buf_.size();
+	if (plain_.is_open())
+	{
+		plain_.write(reinterpret_cast<const char*>(buf_.data()),
+		             static_cast<std::streamsize>(n));
+		if (!plain_) throw RawlogError(path_ + ": write failed (disk full?)");
+	}
+	else if (gz_.Write(buf_.data(), n) != n)
 		throw RawlogError(path_ + ": write failed (disk full?)");
 	++n_;
 }

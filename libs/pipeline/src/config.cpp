@@ -45,6 +45,7 @@ void PipelineParams::loadFromConfigFile(
 	    static_cast<int>(s.getInt("warmup_frames", warmup_frames, 0, 100000));
 	feedback_mask = s.getBool("feedback_mask", feedback_mask);
 	imu_wait_s = s.getDouble("imu_wait_s", imu_wait_s, 0.0, 10.0);
+	read_ahead = s.getBool("read_ahead", read_ahead);
 	s.finish();
 }
 
@@ -55,9 +56,12 @@ void OutputParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	moving_ply = s.getBool("moving_ply", moving_ply);
 	static_map = s.getBool("static_map", static_map);
 	labelled_rawlog = s.getBool("labelled_rawlog", labelled_rawlog);
+	labelled_rawlog_gz_level = static_cast<int>(
+	    s.getInt("labelled_rawlog_gz_level", labelled_rawlog_gz_level, 0, 9));
 	flow_labels = s.getBool("flow_labels", flow_labels);
 	static_p_occupied =
 	    s.getDouble("static_p_occupied", static_p_occupied, 0.5, 0.999);
+	writer_thread = s.getBool("writer_thread", writer_thread);
 	s.finish();
 }
 

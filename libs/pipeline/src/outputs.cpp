@@ -1,10 +1,13 @@
 #include "outputs.h"
 
+#include "cpu_time.h"
+
 #include <bims/common/app.h>
 #include <bims/common/trajectory.h>
 #include <bims/maps/export.h>
 #include <mrpt/obs/TPixelLabelInfo.h>
 
+#include <chrono>
 #include <cstdio>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
@@ -37,8 +40,20 @@ void writePointsPly(const std::string& path,
 	if (!f) throw std::runtime_error(path + ": write failed");
 }
 
+namespace
+{
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0)
+{
+	return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+/** Queue length of the writer: a few frames, so a slow disk slows the run
+ * down instead of filling the memory (about 2 MB per VGA frame). */
+constexpr size_t kQueuedWrites = 16;
+}  // namespace
+
 OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
-    : dir_(dir), p_(p)
+    : dir_(dir), p_(p), worker_(kQueuedWrites, p.writer_thread)
 {
 	makeDirs(dir_ + "/masks");
 	if (p_.moving_ply) makeDirs(dir_ + "/moving_voxels");
@@ -55,15 +70,46 @@ OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
 	traj_.flush();
 	csv_.flush();
 	if (p_.labelled_rawlog)
-		rawlog_ = std::make_unique<RawlogWriter>(dir_ + "/segmented.rawlog", 1);
+		rawlog_ = std::make_unique<RawlogWriter>(dir_ + "/segmented.rawlog",
+		                                         p_.labelled_rawlog_gz_level);
 }
 
-void OutputWriter::writeFrame(const FrameResult& r,
-                              mrpt::obs::CObservation3DRangeScan& scan)
+double OutputWriter::writeFrame(const FrameResult& r,
+                                mrpt::obs::CObservation3DRangeScan::Ptr scan)
+{
+	// What the writer needs, in buffers of its own (the pipeline keeps the
+	// mask as its feedback).
+	auto c = std::make_shared<FrameResult>(r);
+	c->maskTier1 = c->maskTier2 = c->maskFlow = cv::Mat();
+	c->flowObserved = c->flowExpected = cv::Mat();
+	c->mask = r.mask.clone();
+	c->labels = p_.flow_labels ? r.labels.clone() : cv::Mat();
+	return worker_.post(
+	    [this, c, scan]
+	    {
+		    const auto t0 = Clock::now();
+		    const double cpu0 = threadCpuMs();
+		    doWriteFrame(*c, *scan);
+		    frameCpuMs_.push_back(otherCpuMs_ + threadCpuMs() - cpu0);
+		    frameMs_.push_back(otherMs_ + msSince(t0));
+		    otherMs_ = otherCpuMs_ = 0;
+	    });
+}
+
+void OutputWriter::doWriteFrame(const FrameResult& r,
+                                mrpt::obs::CObservation3DRangeScan& scan)
 {
 	const std::string mpath = dir_ + "/masks/" + frameName(r.index, "png");
-	if (!cv::imwrite(mpath, r.mask))
-		throw std::runtime_error(mpath + ": cannot write mask");
+	bool ok = false;
+	try
+	{
+		ok = cv::imwrite(mpath, r.mask);
+	}
+	catch (const cv::Exception& e)
+	{
+		throw std::runtime_error(mpath + ": cannot write mask: " + e.what());
+	}
+	if (!ok) throw std::runtime_error(mpath + ": cannot write mask");
 	if (p_.moving_ply)
 		writePointsPly(dir_ + "/moving_voxels/" + frameName(r.index, "ply"),
 		               r.movingVoxelCentres);
@@ -99,16 +145,37 @@ void OutputWriter::writeFrame(const FrameResult& r,
 		}
 		scan.pixelLabels = labels;  // no copy of the images
 		rawlog_->write(scan);
+		// a plain rawlog reaches the OS frame by frame: a killed run leaves
+		// it readable up to the last whole frame
+		rawlog_->flush();
 	}
 }
 
-void OutputWriter::writeOther(const mrpt::obs::CObservation& obs)
+double OutputWriter::writeOther(mrpt::obs::CObservation::Ptr obs)
 {
-	if (rawlog_) rawlog_->write(obs);
+	if (!rawlog_) return 0;
+	return worker_.post(
+	    [this, obs]
+	    {
+		    const auto t0 = Clock::now();
+		    const double cpu0 = threadCpuMs();
+		    rawlog_->write(*obs);
+		    otherCpuMs_ += threadCpuMs() - cpu0;
+		    otherMs_ += msSince(t0);
+	    });
 }
 
-size_t OutputWriter::finish(const Pipeline& pipe, const RunSummary& sum)
+size_t OutputWriter::close(const Pipeline& pipe)
 {
+	std::string err;
+	try
+	{
+		worker_.drain();
+	}
+	catch (const std::exception& e)
+	{
+		err = e.what();
+	}
 	if (rawlog_) rawlog_->close();
 	size_t nStatic = 0;
 	const auto& g = pipe.grids();
@@ -124,9 +191,17 @@ size_t OutputWriter::finish(const Pipeline& pipe, const RunSummary& sum)
 		maps::writeStaticOctomap(dir_ + "/static_map.bt", *g.occupancy(),
 		                         motion, p_.static_p_occupied);
 	}
+	staticVoxels_ = nStatic;
+	if (!err.empty()) throw std::runtime_error(err);
+	return nStatic;
+}
+
+void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
+{
+	const size_t nStatic = staticVoxels_;
 	std::ofstream j(dir_ + "/metrics.json");
 	if (!j) throw std::runtime_error(dir_ + "/metrics.json: cannot write");
-	char buf[256];
+	char buf[1024];
 	j << "{\n";
 	j << "  \"variant\": \"" << sum.variant << "\",\n";
 	j << "  \"config\": \"" << pipe.config().source << "\",\n";
@@ -134,12 +209,14 @@ size_t OutputWriter::finish(const Pipeline& pipe, const RunSummary& sum)
 	              "  \"frames_processed\": %zu,\n  \"frames_flagged\": %zu,\n  "
 	              "\"scans_read\": %zu,\n  \"imu_read\": %zu,\n"
 	              "  \"scans_out_of_order\": %zu,\n  \"wall_seconds\": %.3f,\n "
-	              " \"fps\": %.3f,\n  \"data_seconds\": %.3f,\n"
+	              " \"cpu_seconds\": %.3f,\n"
+	              "  \"fps\": %.3f,\n  \"data_seconds\": %.3f,\n"
 	              "  \"mean_moving_pixel_fraction\": %.6f,\n  "
 	              "\"static_map_voxels\": %zu,\n",
 	              sum.framesProcessed, sum.framesFlagged, sum.scansRead,
-	              sum.imuRead, sum.scansOutOfOrder, sum.seconds, sum.fps(),
-	              sum.dataSeconds, sum.meanMovingPixelFraction, nStatic);
+	              sum.imuRead, sum.scansOutOfOrder, sum.seconds, sum.cpuSeconds,
+	              sum.fps(), sum.dataSeconds, sum.meanMovingPixelFraction,
+	              nStatic);
 	j << buf;
 	j << "  \"stage_ms\": {";
 	bool first = true;
@@ -164,7 +241,6 @@ size_t OutputWriter::finish(const Pipeline& pipe, const RunSummary& sum)
 			err += c;
 	}
 	j << "  \"error\": \"" << err << "\"\n}\n";
-	return nStatic;
 }
 
 }  // namespace bims::pipeline

@@ -1,5 +1,6 @@
 // Internal: the files bims-run writes, frame by frame, so that a run stopped
-// early leaves valid partial outputs.
+// early leaves valid partial outputs. The writing runs on a background
+// thread ([output] writer_thread), in the order the frames were given.
 #pragma once
 
 #include <bims/common/rawlog.h>
@@ -9,6 +10,9 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <vector>
+
+#include "worker.h"
 
 namespace bims::pipeline
 {
@@ -16,21 +20,42 @@ class OutputWriter
 {
  public:
 	OutputWriter(const std::string& dir, const OutputParams& p);
-	/** Mask PNG, moving-voxel PLY, trajectory and CSV lines (flushed), and
-	 * the scan into the labelled rawlog: the mask is attached to \a scan as
-	 * its pixel labels (in place, so the images are not copied). */
-	void writeFrame(const FrameResult& r,
-	                mrpt::obs::CObservation3DRangeScan& scan);
-	/** Passes a non-scan observation (IMU) into the labelled rawlog. */
-	void writeOther(const mrpt::obs::CObservation& obs);
-	/** Static map and metrics.json; returns the static map's voxel count. */
-	size_t finish(const Pipeline& pipe, const RunSummary& sum);
+	/** Queues the frame's outputs: mask PNG, moving-voxel PLY, trajectory and
+	 * CSV lines (flushed), and the scan into the labelled rawlog with the
+	 * mask as its pixel labels (set on \a scan itself, so the images are not
+	 * copied: the caller must not touch \a scan any more). Returns the time
+	 * spent waiting for room in the queue [ms]. Throws the error of an
+	 * earlier write that failed. */
+	double writeFrame(const FrameResult& r,
+	                  mrpt::obs::CObservation3DRangeScan::Ptr scan);
+	/** Queues a non-scan observation (IMU) for the labelled rawlog. */
+	double writeOther(mrpt::obs::CObservation::Ptr obs);
+	/** Waits for the queued writes, closes the labelled rawlog, writes the
+	 * static map; returns its voxel count. Throws the first write error
+	 * (after closing what is open). */
+	size_t close(const Pipeline& pipe);
+	/** metrics.json. */
+	void writeMetrics(const Pipeline& pipe, const RunSummary& sum);
+	/** Writing time of each frame [ms] (with the observations queued
+	 * before it); complete after close(). */
+	const std::vector<double>& frameMs() const { return frameMs_; }
+	/** The same in CPU time of the writing thread [ms]. */
+	const std::vector<double>& frameCpuMs() const { return frameCpuMs_; }
 
  private:
+	void doWriteFrame(const FrameResult& r,
+	                  mrpt::obs::CObservation3DRangeScan& scan);
+
 	std::string dir_;
 	OutputParams p_;
 	std::ofstream traj_, csv_;
 	std::unique_ptr<RawlogWriter> rawlog_;
+	size_t staticVoxels_ = 0;
+	// written by the worker thread, read after close()
+	std::vector<double> frameMs_, frameCpuMs_;
+	double otherMs_ = 0, otherCpuMs_ = 0;
+	// last member: its thread stops before the rest is destroyed
+	SerialWorker worker_;
 };
 
 /** Writes points as an ASCII PLY (x y z float). Throws naming the file. */

@@ -19,7 +19,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "cpu_time.h"
 #include "outputs.h"
+#include "read_ahead.h"
 
 namespace bims::pipeline
 {
@@ -77,12 +79,25 @@ struct PendingScan
 	mrpt::obs::CObservation3DRangeScan::Ptr scan;
 	size_t index;
 	double t;
+	double readMs;     ///< reading the observations up to this scan
+	double readCpuMs;  ///< the same in CPU time
+	double inWaitMs;   ///< the run waiting for them
 };
+
+/** Observations read ahead: a few frames of a VGA rawlog with its IMU. */
+constexpr size_t kReadAhead = 24;
+
+void addError(RunSummary& sum, const std::string& e)
+{
+	if (sum.error.find(e) != std::string::npos) return;  // reported already
+	sum.error += (sum.error.empty() ? "" : "; then: ") + e;
+}
 }  // namespace
 
 RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 {
 	const auto wall0 = std::chrono::steady_clock::now();
+	const double cpu0 = processCpuMs();
 	RunSummary sum;
 	sum.variant = toString(cfg.pipeline.variant);
 	if (opt.rawlogs.empty())
@@ -101,17 +116,20 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	const std::string& rgbdLabel = cfg.ego.sensors.rgbd_label;
 	const std::string& imuLabel = cfg.ego.sensors.imu_label;
 	size_t scanIndex = 0;
-	bool pastRange = false;
-	double movingFracSum = 0;
+	double movingFracSum = 0, readMs = 0, readCpuMs = 0, inWaitMs = 0;
 	ProgressBar bar("bims-run", 0, opt.progress);
 
 	auto process = [&](const PendingScan& p)
 	{
-		p.scan->load();  // external images, if any
+		const double frameCpu0 = threadCpuMs();
 		const FrameResult& r = pipe.processFrame(*p.scan, p.index);
+		stage["total_cpu"].push_back(threadCpuMs() - frameCpu0);
 		sum.framesProcessed++;
 		if (r.ego.flags & ~static_cast<uint32_t>(ego::kFlagFirstFrame))
 			sum.framesFlagged++;
+		stage["read"].push_back(p.readMs);
+		stage["read_cpu"].push_back(p.readCpuMs);
+		stage["wait_input"].push_back(p.inWaitMs);
 		stage["input"].push_back(r.ms.input);
 		stage["egomotion"].push_back(r.ms.ego);
 		stage["flow"].push_back(r.ms.flow);
@@ -121,8 +139,9 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		if (validPx > 0) movingFracSum += cv::countNonZero(r.mask) / validPx;
 		if (std::isnan(firstT)) firstT = r.t;
 		lastT = r.t;
-		if (out) out->writeFrame(r, *p.scan);
+		// the callback first: the writer then owns the scan
 		if (opt.onFrame) opt.onFrame(r, *p.scan);
+		if (out) stage["wait_output"].push_back(out->writeFrame(r, p.scan));
 		bar.update(sum.framesProcessed, "frame " + std::to_string(p.index));
 	};
 	auto flush = [&](bool all)
@@ -140,61 +159,61 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 
 	try
 	{
-		for (const auto& path : opt.rawlogs)
+		ReadAhead input(opt.rawlogs, kReadAhead, cfg.pipeline.read_ahead);
+		for (;;)
 		{
-			if (pastRange) break;
-			RawlogReader reader(path);
-			while (auto o = reader.next())
+			double wait = 0;
+			const auto item = input.next(&wait);
+			const auto& o = item.obs;
+			if (!o) break;
+			readMs += item.readMs;
+			readCpuMs += item.readCpuMs;
+			inWaitMs += wait;
+			const std::string& path = input.path(item.file);
+			const double t = mrpt::Clock::toDouble(o->timestamp);
+			if (auto imu =
+			        std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(o))
 			{
-				const double t = mrpt::Clock::toDouble(o->timestamp);
-				if (auto imu =
-				        std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(
-				            o))
+				if (!imuLabel.empty() && imu->sensorLabel != imuLabel)
 				{
-					if (!imuLabel.empty() && imu->sensorLabel != imuLabel)
-					{
-						sum.otherSkipped++;
-						continue;
-					}
-					pipe.addImu(*imu);
-					sum.imuRead++;
-					lastImuT = std::max(lastImuT, t);
-					if (out) out->writeOther(*imu);
-				}
-				else if (auto scan = std::dynamic_pointer_cast<
-				             mrpt::obs::CObservation3DRangeScan>(o))
-				{
-					if (!rgbdLabel.empty() && scan->sensorLabel != rgbdLabel)
-					{
-						sum.otherSkipped++;
-						continue;
-					}
-					const size_t idx = scanIndex++;
-					sum.scansRead++;
-					if (idx > opt.frames.last)
-					{
-						pastRange = true;
-						break;
-					}
-					if (!opt.frames.contains(idx)) continue;
-					if (t <= lastScanT)
-					{
-						sum.scansOutOfOrder++;
-						std::fprintf(
-						    stderr,
-						    "bims-run: warning: %s: 3D scan #%zu has a "
-						    "timestamp not after the previous one; skipped\n",
-						    path.c_str(), idx);
-						continue;
-					}
-					lastScanT = t;
-					pending.push_back({scan, idx, t});
-				}
-				else
 					sum.otherSkipped++;
-				newestT = std::max(newestT, t);
-				flush(false);
+					continue;
+				}
+				pipe.addImu(*imu);
+				sum.imuRead++;
+				lastImuT = std::max(lastImuT, t);
+				if (out) out->writeOther(imu);
 			}
+			else if (auto scan = std::dynamic_pointer_cast<
+			             mrpt::obs::CObservation3DRangeScan>(o))
+			{
+				if (!rgbdLabel.empty() && scan->sensorLabel != rgbdLabel)
+				{
+					sum.otherSkipped++;
+					continue;
+				}
+				const size_t idx = scanIndex++;
+				sum.scansRead++;
+				if (idx > opt.frames.last) break;  // stops reading
+				if (!opt.frames.contains(idx)) continue;
+				if (t <= lastScanT)
+				{
+					sum.scansOutOfOrder++;
+					std::fprintf(
+					    stderr,
+					    "bims-run: warning: %s: 3D scan #%zu has a "
+					    "timestamp not after the previous one; skipped\n",
+					    path.c_str(), idx);
+					continue;
+				}
+				lastScanT = t;
+				pending.push_back({scan, idx, t, readMs, readCpuMs, inWaitMs});
+				readMs = readCpuMs = inWaitMs = 0;
+			}
+			else
+				sum.otherSkipped++;
+			newestT = std::max(newestT, t);
+			flush(false);
 		}
 		flush(true);
 	}
@@ -214,6 +233,21 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	}
 	bar.finish();
 
+	// Every output complete (queued frames, static map) before the clock
+	// stops: the frames/s are end to end.
+	if (out)
+	{
+		try
+		{
+			sum.staticMapVoxels = out->close(pipe);
+		}
+		catch (const std::exception& e)
+		{
+			addError(sum, e.what());
+		}
+		stage["outputs"] = out->frameMs();
+		stage["outputs_cpu"] = out->frameCpuMs();
+	}
 	for (auto& [name, v] : stage) sum.stageMs[name] = Percentiles::of(v);
 	sum.dataSeconds = std::isnan(firstT) ? 0 : lastT - firstT;
 	sum.meanMovingPixelFraction =
@@ -221,7 +255,8 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	sum.seconds =
 	    std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0)
 	        .count();
-	if (out) sum.staticMapVoxels = out->finish(pipe, sum);
+	sum.cpuSeconds = 1e-3 * (processCpuMs() - cpu0);
+	if (out) out->writeMetrics(pipe, sum);
 	return sum;
 }
 
@@ -235,13 +270,16 @@ std::string formatSummary(const RunSummary& s)
 	              s.variant.c_str(), s.framesProcessed, s.framesFlagged,
 	              s.scansRead, s.imuRead, s.dataSeconds);
 	o << buf;
-	std::snprintf(
-	    buf, sizeof(buf),
-	    "wall time %.1f s, %.1f frames/s; mean moving-pixel fraction %.2f %%\n",
-	    s.seconds, s.fps(), 100.0 * s.meanMovingPixelFraction);
+	std::snprintf(buf, sizeof(buf),
+	              "wall time %.1f s, %.1f frames/s end to end (CPU %.1f s, all "
+	              "threads); mean moving-pixel fraction %.2f %%\n",
+	              s.seconds, s.fps(), s.cpuSeconds,
+	              100.0 * s.meanMovingPixelFraction);
 	o << buf;
 	o << "stage        median ms   p95 ms   mean ms\n";
-	for (const char* k : {"input", "egomotion", "flow", "grids", "total"})
+	for (const char* k : {"read", "read_cpu", "wait_input", "input",
+	                      "egomotion", "flow", "grids", "total", "total_cpu",
+	                      "outputs", "outputs_cpu", "wait_output"})
 	{
 		const auto it = s.stageMs.find(k);
 		if (it == s.stageMs.end()) continue;

@@ -52,6 +52,34 @@ TEST(PipelineConfig, ReadsEverySectionAndRejectsTypos)
 	EXPECT_THROW(c.loadFromFile("no/such/file.ini"), bims::ConfigError);
 }
 
+TEST(PipelineConfig, ThreadsAndLabelledRawlogCompression)
+{
+	ExperimentConfig c;
+	EXPECT_TRUE(c.pipeline.read_ahead);
+	EXPECT_TRUE(c.output.writer_thread);
+	EXPECT_EQ(c.output.labelled_rawlog_gz_level, 0);
+	mrpt::config::CConfigFileMemory ini(
+	    "[odometry]\nmode = vision\n[pipeline]\nread_ahead = false\n"
+	    "[output]\nwriter_thread = false\nlabelled_rawlog_gz_level = 6\n");
+	c.loadFromConfigFile(ini);
+	EXPECT_FALSE(c.pipeline.read_ahead);
+	EXPECT_FALSE(c.output.writer_thread);
+	EXPECT_EQ(c.output.labelled_rawlog_gz_level, 6);
+	mrpt::config::CConfigFileMemory bad(
+	    "[odometry]\nmode = vision\n[output]\nlabelled_rawlog_gz_level = 10\n");
+	try
+	{
+		c.loadFromConfigFile(bad);
+		ADD_FAILURE() << "level 10 accepted";
+	}
+	catch (const bims::ConfigError& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("labelled_rawlog_gz_level"),
+		          std::string::npos)
+		    << e.what();
+	}
+}
+
 TEST(FrameRange, ParsesInclusiveRanges)
 {
 	auto r = FrameRange::parse("3:7");

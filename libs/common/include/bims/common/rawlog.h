@@ -15,6 +15,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace bims
 {
@@ -83,6 +84,7 @@ class RawlogWriter
 	std::string path_;
 	std::ofstream plain_;
 	mrpt::io::CFileGZOutputStream gz_;
+	std::vector<uint8_t> buf_;  ///< the object being written
 	std::unique_ptr<mrpt::serialization::CArchive> arch_;
 	bool open_ = false;
 	size_t n_ = 0;

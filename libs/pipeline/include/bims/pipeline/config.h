@@ -39,6 +39,8 @@ struct PipelineParams
 	/** A camera frame waits at most this long (in data time) for IMU samples
 	 * at its timestamp before it is processed anyway [s]. */
 	double imu_wait_s = 0.1;
+	/** bims-run reads and decodes the rawlogs ahead on a thread. */
+	bool read_ahead = true;
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "pipeline");
@@ -50,9 +52,15 @@ struct OutputParams
 	bool moving_ply = true;  ///< moving_voxels/NNNNNN.ply per frame
 	bool static_map = true;  ///< static_map.ply and static_map.bt at the end
 	bool labelled_rawlog = true;  ///< segmented.rawlog with pixel labels
-	bool flow_labels = false;     ///< flow_labels/NNNNNN.png (Diff red)
+	/** gzip level of segmented.rawlog: 0 = plain (default: gzip costs more
+	 * than the whole pipeline at 640x480), 1..9 = gzip. */
+	int labelled_rawlog_gz_level = 0;
+	bool flow_labels = false;  ///< flow_labels/NNNNNN.png (Diff red)
 	/** Occupancy probability above which a voxel is in the static map. */
 	double static_p_occupied = 0.7;
+	/** Write the per-frame outputs on a background thread (in order; the
+	 * run waits for them before it ends). */
+	bool writer_thread = true;
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "output");

@@ -37,10 +37,19 @@ struct RunSummary
 	size_t scansRead = 0, framesProcessed = 0, imuRead = 0, otherSkipped = 0;
 	size_t framesFlagged = 0;    ///< frames with an egomotion flag
 	size_t scansOutOfOrder = 0;  ///< dropped: timestamp not increasing
-	double seconds = 0;          ///< wall time of the whole run
-	double dataSeconds = 0;      ///< time span of the processed frames
-	std::map<std::string, Percentiles> stageMs;  ///< per stage [ms]
-	double meanMovingPixelFraction = 0;          ///< over labelled-depth pixels
+	/** Wall time of the whole run: reading, every frame, every output
+	 * (static map included; metrics.json excepted). */
+	double seconds = 0;
+	double cpuSeconds = 0;   ///< CPU time of the process over the run
+	double dataSeconds = 0;  ///< time span of the processed frames
+	/** Per stage [ms]: the pipeline's input, egomotion, flow, grids, total
+	 * (wall); read (reading and decoding the observations up to the frame,
+	 * on the reading thread), outputs (writing the frame, on the writing
+	 * thread); *_cpu: CPU time of the same (total_cpu: the run's thread
+	 * only, not OpenCV's workers); wait_input / wait_output: the run
+	 * blocked on the reader / on a full write queue. */
+	std::map<std::string, Percentiles> stageMs;
+	double meanMovingPixelFraction = 0;  ///< over labelled-depth pixels
 	size_t staticMapVoxels = 0;
 	std::string variant;
 	/** Error that stopped the run early (outputs so far stay valid). */
@@ -48,7 +57,9 @@ struct RunSummary
 	double fps() const { return seconds > 0 ? framesProcessed / seconds : 0; }
 };
 
-/** Called after each processed frame (e.g. a viewer). */
+/** Called after each processed frame (e.g. a viewer), on the run's thread,
+ * before the frame is queued for writing (the scan's pixelLabels are still
+ * the input's). */
 using FrameCallback = std::function<void(
     const FrameResult&, const mrpt::obs::CObservation3DRangeScan&)>;
 
@@ -61,7 +72,9 @@ struct RunOptions
 	FrameCallback onFrame;
 };
 
-/** Runs \a cfg over the rawlogs. Writes into outDir (when set):
+/** Runs \a cfg over the rawlogs, reading ahead on a thread ([pipeline]
+ * read_ahead) and writing on another ([output] writer_thread); returns when
+ * every output is complete. Writes into outDir (when set):
  * trajectory.txt, masks/NNNNNN.png, moving_voxels/NNNNNN.ply,
  * static_map.{ply,bt}, segmented.rawlog, metrics.json, frames.csv.
  * Bad input (truncated rawlog, missing images) stops the run with
