@@ -3,7 +3,11 @@
 #include <bims/maps/dda.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <mutex>
+#include <thread>
+#include <type_traits>
 
 namespace bims::maps
 {
@@ -138,30 +142,94 @@ void COccupancyBayesGrid::decayRaycast(const FrameCloud& f, uint32_t F)
 		tab.assign(cells, nullptr);
 		static Cell overBudget;  // marks blocks the budget forbids
 		Cell* const kOver = &overBudget;
-		for (const auto& e : ends)
-			cast(e,
-			     [&](int32_t x, int32_t y, int32_t z)
-			     {
-				     const size_t bi = (size_t((x >> 3) - lo[0]) * n[1] +
-				                        size_t((y >> 3) - lo[1])) *
-				                           n[2] +
-				                       size_t((z >> 3) - lo[2]);
-				     Cell* blk = tab[bi];
-				     if (!blk)
+		std::mutex creating;  // with threads: the hash index, tab writes
+		auto create = [&](int32_t x, int32_t y, int32_t z)
+		{
+			const uint32_t b =
+			    grid_.findOrCreateBlock(packKey(x >> 3, y >> 3, z >> 3));
+			return b == FlatHashMap::kNotFound ? kOver : grid_.block(b).cells;
+		};
+		// Casts rays [r0, r1). Shared: other threads cast at the same time;
+		// a cell's miss is then claimed by a compare-and-swap of its stamp
+		// (hits were stamped before), so that it is applied once.
+		auto castRange = [&](auto sharedTag, size_t r0, size_t r1, size_t& ov)
+		{
+			constexpr bool kShared = decltype(sharedTag)::value;
+			for (size_t r = r0; r < r1; ++r)
+				cast(ends[r],
+				     [&](int32_t x, int32_t y, int32_t z)
 				     {
-					     const uint32_t b = grid_.findOrCreateBlock(
-					         packKey(x >> 3, y >> 3, z >> 3));
-					     blk = tab[bi] = b == FlatHashMap::kNotFound
-					                         ? kOver
-					                         : grid_.block(b).cells;
-				     }
-				     if (blk == kOver)
-				     {
-					     ++over;
-					     return;
-				     }
-				     missCell(blk[Storage::cellIndexOf(x, y, z)]);
-			     });
+					     const size_t bi = (size_t((x >> 3) - lo[0]) * n[1] +
+					                        size_t((y >> 3) - lo[1])) *
+					                           n[2] +
+					                       size_t((z >> 3) - lo[2]);
+					     Cell* blk;
+					     if constexpr (kShared)
+					     {
+						     blk = __atomic_load_n(&tab[bi], __ATOMIC_ACQUIRE);
+						     if (!blk)
+						     {
+							     std::lock_guard<std::mutex> lock(creating);
+							     blk = tab[bi];
+							     if (!blk)
+								     __atomic_store_n(&tab[bi],
+								                      blk = create(x, y, z),
+								                      __ATOMIC_RELEASE);
+						     }
+					     }
+					     else
+					     {
+						     blk = tab[bi];
+						     if (!blk) blk = tab[bi] = create(x, y, z);
+					     }
+					     if (blk == kOver)
+					     {
+						     ++ov;
+						     return;
+					     }
+					     Cell& c = blk[Storage::cellIndexOf(x, y, z)];
+					     if constexpr (kShared)
+					     {
+						     uint32_t s =
+						         __atomic_load_n(&c.stamp, __ATOMIC_RELAXED);
+						     if (s == F ||
+						         !__atomic_compare_exchange_n(
+						             &c.stamp, &s, F, false, __ATOMIC_RELAXED,
+						             __ATOMIC_RELAXED))
+							     return;  // hit, or missed by another ray
+						     c.lPrev = c.l;
+						     c.l = std::max<LogOddsFx>(c.l - miss, lmin);
+					     }
+					     else
+						     missCell(c);
+				     });
+		};
+		constexpr size_t kChunk = 2048;  // rays per work item (32 tiles)
+		const size_t threads =
+		    std::min<size_t>(size_t(params_.raycast_threads),
+		                     (ends.size() + kChunk - 1) / kChunk);
+		if (threads <= 1)
+			castRange(std::false_type(), 0, ends.size(), over);
+		else
+		{
+			std::atomic<size_t> next{0};
+			std::vector<size_t> overs(threads, 0);
+			auto worker = [&](size_t t)
+			{
+				for (;;)
+				{
+					const size_t r0 = next.fetch_add(kChunk);
+					if (r0 >= ends.size()) break;
+					castRange(std::true_type(), r0,
+					          std::min(ends.size(), r0 + kChunk), overs[t]);
+				}
+			};
+			std::vector<std::thread> pool;
+			for (size_t t = 1; t < threads; ++t) pool.emplace_back(worker, t);
+			worker(0);
+			for (auto& th : pool) th.join();
+			for (size_t v : overs) over += v;
+		}
 	}
 	if (over)
 	{

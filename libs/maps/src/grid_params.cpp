@@ -62,6 +62,8 @@ void GridParams::validate() const
 	check(max_memory_mb >= 1, "max_memory_mb", "must be >= 1");
 	check(raycast_decimation >= 1 && raycast_decimation <= 64,
 	      "raycast_decimation", "must be in [1, 64]");
+	check(raycast_threads >= 1 && raycast_threads <= 64, "raycast_threads",
+	      "must be in [1, 64]");
 }
 
 void GridParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
@@ -96,6 +98,7 @@ void GridParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	const auto t = s.getEnum("raycast_target", toString(raycast_target),
 	                         {"points", "voxels"});
 	raycast_target = t == "voxels" ? RayTarget::Voxels : RayTarget::Points;
+	raycast_threads = int(s.getInt("raycast_threads", raycast_threads, 1, 64));
 	s.finish();
 	try
 	{
@@ -119,7 +122,8 @@ void GridParams::dump(std::ostream& o) const
 	  << "\nmax_range=" << max_range << "\nextent=" << extent
 	  << "\nmax_memory_mb=" << max_memory_mb
 	  << "\nraycast_decimation=" << raycast_decimation
-	  << "\nraycast_target=" << toString(raycast_target) << "\n";
+	  << "\nraycast_target=" << toString(raycast_target)
+	  << "\nraycast_threads=" << raycast_threads << "\n";
 }
 
 bool GridParams::operator==(const GridParams& o) const
@@ -133,7 +137,8 @@ bool GridParams::operator==(const GridParams& o) const
 	       max_range == o.max_range && extent == o.extent &&
 	       max_memory_mb == o.max_memory_mb &&
 	       raycast_decimation == o.raycast_decimation &&
-	       raycast_target == o.raycast_target;
+	       raycast_target == o.raycast_target &&
+	       raycast_threads == o.raycast_threads;
 }
 
 }  // namespace bims::maps

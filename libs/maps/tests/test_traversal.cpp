@@ -1,11 +1,17 @@
 // The fast paths of the grids against their plain definitions: a
-// FrameCloud's cells are the distinct voxels of its readings in block order.
+// FrameCloud's cells are the distinct voxels of its readings in block order;
+// the raycast decay equals a per-voxel DDA on a std::map.
+#include <bims/maps/COccupancyBayesGrid.h>
+#include <bims/maps/dda.h>
 #include <bims/maps/frame_cloud.h>
 
 #include <gtest/gtest.h>
 
+#include "scene_raycaster.h"
+
 #include <map>
 #include <random>
+#include <set>
 #include <tuple>
 #include <vector>
 
@@ -65,4 +71,76 @@ TEST(FrameCloud, CellsAreTheDistinctVoxelsOfTheReadingsInBlockOrder)
 			++c;
 		}
 	}
+}
+
+// decay = raycast (ray ends in tile order, the per-frame block table, with
+// 1 or 2 threads) against a plain per-voxel reference: a std::map updated
+// along traverseRay() from the sensor origin to each reading.
+TEST(Raycast, SameResultAsAPlainDdaOnAMapWithAnyThreadCount)
+{
+	auto scene = bims::maps::test::room();
+	scene.push_back({{1.0, -0.6, 0}, {1.6, 0.4, 1.4}});
+	const mrpt::poses::CPose3D poses[] = {{-1, 0.3, 1.2, 0.2, 0.1, 0},
+	                                      {-0.5, -0.4, 1.0, -0.6, 0.0, 0.1},
+	                                      {-1, 0.3, 1.2, 2.0, -0.2, 0}};
+	GridParams p;
+	p.decay = DecayMode::Raycast;
+	p.voxel_size = 0.04;
+	COccupancyBayesGrid g1(p);
+	p.raycast_threads = 2;
+	COccupancyBayesGrid g2(p);
+	FrameCloudBuilder b(p);
+	std::map<std::tuple<int, int, int>, LogOddsFx> ref;
+	for (int f = 0; f < 3; ++f)
+	{
+		const auto scan =
+		    bims::maps::test::renderScan(scene, poses[f], 100, 75, 70, f);
+		FrameCloud fc;
+		b.build(*scan, poses[f], fc);
+		ASSERT_GT(fc.numPoints(), 5000u);  // > 2 work items of rays
+		g1.integrate(fc);
+		g2.integrate(fc);
+		// Reference: hits first, then one miss per voxel crossed.
+		std::set<std::tuple<int, int, int>> touched;
+		for (size_t i = 0; i < fc.numCells(); ++i)
+		{
+			const auto& k = fc.cells[i];
+			auto& l = ref[{k.x, k.y, k.z}];
+			l = LogOddsFx(std::min<int64_t>(
+			    int64_t(l) + g1.hitFixed(fc.hits[i]), g1.maxFixed()));
+			touched.insert({k.x, k.y, k.z});
+		}
+		const double inv = 1 / p.voxel_size;
+		const double a[3] = {fc.origin_W.x * inv, fc.origin_W.y * inv,
+		                     fc.origin_W.z * inv};
+		for (const auto& q : fc.points_W)
+		{
+			const double e[3] = {q.x * inv, q.y * inv, q.z * inv};
+			traverseRay(a, e,
+			            [&](int32_t x, int32_t y, int32_t z)
+			            {
+				            if (!touched.insert({x, y, z}).second) return;
+				            auto& l = ref[{x, y, z}];
+				            l = std::max<LogOddsFx>(l - g1.missFixed(),
+				                                    g1.minFixed());
+			            });
+		}
+	}
+	size_t compared = 0;
+	for (const auto& [k, l] : ref)
+	{
+		const VoxelKey key{std::get<0>(k), std::get<1>(k), std::get<2>(k)};
+		ASSERT_EQ(g1.logOddsFixed(key), l);
+		ASSERT_EQ(g2.logOddsFixed(key), l);
+		++compared;
+	}
+	// Nothing else was touched: as many stored cells with a stamp.
+	for (const auto* g : {&g1, &g2})
+	{
+		size_t stamped = 0;
+		g->storage().forEachCell([&](const VoxelKey&, const auto& c)
+		                         { stamped += c.stamp != 0; });
+		EXPECT_EQ(stamped, compared);
+	}
+	EXPECT_GT(compared, 20000u);
 }

@@ -87,6 +87,10 @@ struct GridParams
 	int raycast_decimation = 1;
 	/** decay = raycast: rays to each reading or to each hit voxel. */
 	RayTarget raycast_target = RayTarget::Points;
+	/** decay = raycast: threads casting the free-space rays of a frame
+	 * (the result does not depend on it). A setting of the process, not of
+	 * the map: not serialised (a loaded map has 1). */
+	int raycast_threads = 1;
 
 	/** Throws std::invalid_argument naming the parameter if inconsistent. */
 	void validate() const;
