@@ -86,6 +86,7 @@ GridParams paramsFor(double voxel, const std::string& decay)
 	          : decay == "frustum" ? DecayMode::Frustum
 	                               : DecayMode::Raycast;
 	if (decay == "raycast_voxels") p.raycast_target = RayTarget::Voxels;
+	if (decay == "raycast_mt2") p.raycast_threads = 2;
 	return p;
 }
 
@@ -331,7 +332,7 @@ void registerAll()
 			    ->Repetitions(5)
 			    ->ReportAggregatesOnly();
 			for (std::string d :
-			     {"all", "frustum", "raycast", "raycast_voxels"})
+			     {"all", "frustum", "raycast", "raycast_mt2", "raycast_voxels"})
 			{
 				const bool slow = d.rfind("raycast", 0) == 0;
 				const int it = slow ? 2 : 20;
@@ -344,14 +345,16 @@ void registerAll()
 				{
 					if (slow && (s == Stage::Tier1 || s == Stage::Tier2))
 						continue;  // decay-independent
-					bm::RegisterBenchmark(
+					auto* b = bm::RegisterBenchmark(
 					    (std::string(sn) + "/" + d + sfx).c_str(), benchTier, c,
-					    v, d, s)
-					    ->Unit(bm::kMillisecond)
+					    v, d, s);
+					b->Unit(bm::kMillisecond)
 					    ->UseRealTime()
 					    ->Iterations(it)
 					    ->Repetitions(5)
 					    ->ReportAggregatesOnly();
+					// CPU time of all threads, not only the calling one.
+					if (d == "raycast_mt2") b->MeasureProcessCPUTime();
 				}
 			}
 			bm::RegisterBenchmark(("mrpt_grid3d_dec1" + sfx).c_str(),

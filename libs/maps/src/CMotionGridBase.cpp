@@ -3,6 +3,8 @@
 #include <bims/maps/closed_form.h>
 #include <bims/maps/export.h>
 
+#include "internal.h"
+
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/serialization/CArchive.h>
 
@@ -56,8 +58,14 @@ void CMotionGridBase::store(const FrameCloud& f, std::vector<float> post)
 	const uint32_t F = frameCount_ + 1;
 	Storage::Accessor acc(grid_);
 	FrameStats st;
-	for (size_t i = 0; i < f.cells.size(); ++i)
+	const size_t m = f.cells.size();
+	for (size_t i = 0; i < m; ++i)
 	{
+		if (i + kPrefetchAhead < m)
+		{
+			const VoxelKey& q = f.cells[i + kPrefetchAhead];
+			acc.prefetch(q.x, q.y, q.z);
+		}
 		const auto& k = f.cells[i];
 		Cell* c = acc.get(k.x, k.y, k.z);
 		if (!c)

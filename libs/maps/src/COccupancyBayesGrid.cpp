@@ -2,6 +2,8 @@
 #include <bims/maps/COccupancyBayesGrid.h>
 #include <bims/maps/closed_form.h>
 
+#include "internal.h"
+
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
 #include <algorithm>
@@ -133,8 +135,14 @@ void COccupancyBayesGrid::integrate(const FrameCloud& f,
 	if (priorOut) priorOut->resize(f.cells.size());
 	FrameStats st;
 	Storage::Accessor acc(grid_);
-	for (size_t i = 0; i < f.cells.size(); ++i)
+	const size_t m = f.cells.size();
+	for (size_t i = 0; i < m; ++i)
 	{
+		if (i + kPrefetchAhead < m)
+		{
+			const VoxelKey& q = f.cells[i + kPrefetchAhead];
+			acc.prefetch(q.x, q.y, q.z);
+		}
 		const VoxelKey& k = f.cells[i];
 		Cell* c = acc.get(k.x, k.y, k.z);
 		if (!c)

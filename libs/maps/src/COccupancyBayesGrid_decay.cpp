@@ -2,10 +2,25 @@
 #include <bims/maps/COccupancyBayesGrid.h>
 #include <bims/maps/dda.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <mutex>
+#include <thread>
+#include <type_traits>
 
 namespace bims::maps
 {
+
+namespace
+{
+// Rays are cast tile by tile of the image (kTile x kTile pixels): the rays
+// of a tile cross nearly the same voxels, which then stay in cache.
+constexpr int kTile = 8;
+// Largest per-frame table of block pointers (entries); beyond it (huge
+// extents at fine voxels) blocks are found through the hash index.
+constexpr size_t kMaxTable = size_t(1) << 22;
+}  // namespace
 
 void COccupancyBayesGrid::decayRaycast(const FrameCloud& f, uint32_t F)
 {
@@ -20,16 +35,10 @@ void COccupancyBayesGrid::decayRaycast(const FrameCloud& f, uint32_t F)
 		return;  // keys along the rays could leave the key range
 	}
 	const double a[3] = {o.x * inv, o.y * inv, o.z * inv};
-	Storage::Accessor acc(grid_);
-	size_t over = 0;
-	auto visit = [&](int32_t x, int32_t y, int32_t z)
-	{
-		Cell* c = acc.get(x, y, z);
-		if (c)
-			applyMiss(*c, F);
-		else
-			++over;
-	};
+
+	// The rays' end points in voxel units, in tile order.
+	auto& ends = rayEnds_;
+	ends.clear();
 	const int dec = params_.raycast_decimation;
 	if (params_.raycast_target == RayTarget::Voxels)
 	{
@@ -37,28 +46,193 @@ void COccupancyBayesGrid::decayRaycast(const FrameCloud& f, uint32_t F)
 		{
 			if (dec > 1 && i % size_t(dec * dec) != 0) continue;
 			const auto& k = f.cells[i];
-			const double b[3] = {k.x + 0.5, k.y + 0.5, k.z + 0.5};
-			traverseRay(a, b, visit);
+			ends.push_back({{k.x + 0.5, k.y + 0.5, k.z + 0.5}});
 		}
 	}
 	else
 	{
-		const int W = f.K.width;
-		for (size_t i = 0; i < f.points_W.size(); ++i)
+		const int W = f.K.width, H = f.K.height;
+		const bool organised = W > 0 && H > 0;
+		auto keep = [&](size_t i)
 		{
-			if (dec > 1)
-			{
-				if (W > 0)
-				{
-					const uint32_t px = f.pixel[i];
-					if ((px % W) % dec != 0 || (px / W) % dec != 0) continue;
-				}
-				else if (i % size_t(dec) != 0)
-					continue;
-			}
+			if (dec <= 1) return true;
+			if (!organised) return i % size_t(dec) == 0;
+			const uint32_t px = f.pixel[i];
+			return (px % W) % dec == 0 && (px / W) % dec == 0;
+		};
+		auto end = [&](size_t i)
+		{
 			const auto& p = f.points_W[i];
-			const double b[3] = {p.x * inv, p.y * inv, p.z * inv};
-			traverseRay(a, b, visit);
+			return RayEnd{{p.x * inv, p.y * inv, p.z * inv}};
+		};
+		if (!organised)
+		{
+			for (size_t i = 0; i < f.points_W.size(); ++i)
+				if (keep(i)) ends.push_back(end(i));
+		}
+		else
+		{
+			// Counting sort of the readings by tile.
+			const int tw = (W + kTile - 1) / kTile,
+			          th = (H + kTile - 1) / kTile;
+			auto& start = tileStart_;
+			start.assign(size_t(tw) * th + 1, 0);
+			auto tileOf = [&](uint32_t px)
+			{ return (px / W / kTile) * tw + (px % W) / kTile; };
+			for (size_t i = 0; i < f.points_W.size(); ++i)
+				if (keep(i)) start[tileOf(f.pixel[i]) + 1]++;
+			for (size_t t = 1; t < start.size(); ++t) start[t] += start[t - 1];
+			ends.resize(start.back());
+			for (size_t i = 0; i < f.points_W.size(); ++i)
+				if (keep(i)) ends[start[tileOf(f.pixel[i])]++] = end(i);
+		}
+	}
+	if (ends.empty()) return;
+
+	// Bounding box of the rays in blocks (one block of margin: a DDA may
+	// round one voxel past its end on an axis).
+	int32_t lo[3], hi[3];
+	for (int k = 0; k < 3; ++k) lo[k] = hi[k] = int32_t(std::floor(a[k]));
+	for (const auto& e : ends)
+		for (int k = 0; k < 3; ++k)
+		{
+			const int32_t v = int32_t(std::floor(e.p[k]));
+			lo[k] = std::min(lo[k], v);
+			hi[k] = std::max(hi[k], v);
+		}
+	size_t n[3], cells = 1;
+	for (int k = 0; k < 3; ++k)
+	{
+		lo[k] = (lo[k] >> 3) - 1;
+		hi[k] = (hi[k] >> 3) + 1;
+		n[k] = size_t(hi[k] - lo[k] + 1);
+		cells *= n[k];
+	}
+
+	size_t over = 0;
+	const LogOddsFx miss = miss_, lmin = lmin_;
+	const bool hasUnknown = hasUnknown_;
+	const LogOddsFx unknown = unknown_;
+	auto missCell = [&](Cell& c)
+	{
+		if (c.stamp == F) return;  // hit (or already missed) in this frame
+		if (c.stamp == 0 && hasUnknown) c.l = unknown;  // first observation
+		c.lPrev = c.l;
+		c.l = std::max<LogOddsFx>(c.l - miss, lmin);
+		c.stamp = F;
+	};
+	auto cast = [&](const RayEnd& e, auto&& visit)
+	{ traverseRay(a, e.p, visit); };
+	if (cells > kMaxTable)
+	{
+		Storage::Accessor acc(grid_);
+		for (const auto& e : ends)
+			cast(e,
+			     [&](int32_t x, int32_t y, int32_t z)
+			     {
+				     Cell* c = acc.get(x, y, z);
+				     if (c)
+					     missCell(*c);
+				     else
+					     ++over;
+			     });
+	}
+	else
+	{
+		// A per-frame table of the blocks in the rays' bounding box: one
+		// array read per voxel instead of a hash lookup per block entered.
+		auto& tab = blockTable_;
+		tab.assign(cells, nullptr);
+		static Cell overBudget;  // marks blocks the budget forbids
+		Cell* const kOver = &overBudget;
+		std::mutex creating;  // with threads: the hash index, tab writes
+		auto create = [&](int32_t x, int32_t y, int32_t z)
+		{
+			const uint32_t b =
+			    grid_.findOrCreateBlock(packKey(x >> 3, y >> 3, z >> 3));
+			return b == FlatHashMap::kNotFound ? kOver : grid_.block(b).cells;
+		};
+		// Casts rays [r0, r1). Shared: other threads cast at the same time;
+		// a cell's miss is then claimed by a compare-and-swap of its stamp
+		// (hits were stamped before), so that it is applied once.
+		auto castRange = [&](auto sharedTag, size_t r0, size_t r1, size_t& ov)
+		{
+			constexpr bool kShared = decltype(sharedTag)::value;
+			for (size_t r = r0; r < r1; ++r)
+				cast(ends[r],
+				     [&](int32_t x, int32_t y, int32_t z)
+				     {
+					     const size_t bi = (size_t((x >> 3) - lo[0]) * n[1] +
+					                        size_t((y >> 3) - lo[1])) *
+					                           n[2] +
+					                       size_t((z >> 3) - lo[2]);
+					     Cell* blk;
+					     if constexpr (kShared)
+					     {
+						     blk = __atomic_load_n(&tab[bi], __ATOMIC_ACQUIRE);
+						     if (!blk)
+						     {
+							     std::lock_guard<std::mutex> lock(creating);
+							     blk = tab[bi];
+							     if (!blk)
+								     __atomic_store_n(&tab[bi],
+								                      blk = create(x, y, z),
+								                      __ATOMIC_RELEASE);
+						     }
+					     }
+					     else
+					     {
+						     blk = tab[bi];
+						     if (!blk) blk = tab[bi] = create(x, y, z);
+					     }
+					     if (blk == kOver)
+					     {
+						     ++ov;
+						     return;
+					     }
+					     Cell& c = blk[Storage::cellIndexOf(x, y, z)];
+					     if constexpr (kShared)
+					     {
+						     uint32_t s =
+						         __atomic_load_n(&c.stamp, __ATOMIC_RELAXED);
+						     if (s == F ||
+						         !__atomic_compare_exchange_n(
+						             &c.stamp, &s, F, false, __ATOMIC_RELAXED,
+						             __ATOMIC_RELAXED))
+							     return;  // hit, or missed by another ray
+						     if (s == 0 && hasUnknown) c.l = unknown;
+						     c.lPrev = c.l;
+						     c.l = std::max<LogOddsFx>(c.l - miss, lmin);
+					     }
+					     else
+						     missCell(c);
+				     });
+		};
+		constexpr size_t kChunk = 2048;  // rays per work item (32 tiles)
+		const size_t threads =
+		    std::min<size_t>(size_t(params_.raycast_threads),
+		                     (ends.size() + kChunk - 1) / kChunk);
+		if (threads <= 1)
+			castRange(std::false_type(), 0, ends.size(), over);
+		else
+		{
+			std::atomic<size_t> next{0};
+			std::vector<size_t> overs(threads, 0);
+			auto worker = [&](size_t t)
+			{
+				for (;;)
+				{
+					const size_t r0 = next.fetch_add(kChunk);
+					if (r0 >= ends.size()) break;
+					castRange(std::true_type(), r0,
+					          std::min(ends.size(), r0 + kChunk), overs[t]);
+				}
+			};
+			std::vector<std::thread> pool;
+			for (size_t t = 1; t < threads; ++t) pool.emplace_back(worker, t);
+			worker(0);
+			for (auto& th : pool) th.join();
+			for (size_t v : overs) over += v;
 		}
 	}
 	if (over)

@@ -194,52 +194,71 @@ void FrameCloudBuilder::buildFromPoints(
 	keyPoints(out);
 }
 
-// Orders the distinct cells by 8^3 block, then by cell inside the block, so
-// that the grids visit each storage block once per frame (one hash lookup
-// per block instead of per cell, and cache-friendly writes).
-void FrameCloudBuilder::sortCellsByBlock(FrameCloud& out)
+namespace
 {
-	const size_t m = out.cells.size();
-	order_.resize(m);
-	constexpr int64_t o = int64_t(1) << 17;
-	for (size_t i = 0; i < m; ++i)
+// LSD radix sort of (key, value) pairs on the low \a bits bits of the keys
+// (stable), with digits of at most 12 bits.
+void radixSortPairs(std::vector<uint64_t>& keys, std::vector<uint32_t>& vals,
+                    std::vector<uint64_t>& keysTmp,
+                    std::vector<uint32_t>& valsTmp, unsigned bits)
+{
+	const size_t n = keys.size();
+	keysTmp.resize(n);
+	valsTmp.resize(n);
+	const unsigned passes = std::max(1u, (bits + 11) / 12);
+	const unsigned digit = (bits + passes - 1) / passes;
+	const size_t buckets = size_t(1) << digit;
+	const uint64_t mask = buckets - 1;
+	std::vector<uint32_t> count(buckets);
+	for (unsigned p = 0, shift = 0; p < passes; ++p, shift += digit)
 	{
-		const auto& k = out.cells[i];
-		const uint64_t key =
-		    (uint64_t((k.x >> 3) + o) << 45) |
-		    (uint64_t((k.y >> 3) + o) << 27) | (uint64_t((k.z >> 3) + o) << 9) |
-		    uint64_t((k.x & 7) | ((k.y & 7) << 3) | ((k.z & 7) << 6));
-		order_[i] = {key, uint32_t(i)};
+		std::fill(count.begin(), count.end(), 0u);
+		for (size_t i = 0; i < n; ++i) count[(keys[i] >> shift) & mask]++;
+		uint32_t sum = 0;
+		for (auto& c : count)
+		{
+			const uint32_t t = c;
+			c = sum;
+			sum += t;
+		}
+		for (size_t i = 0; i < n; ++i)
+		{
+			const uint32_t d = count[(keys[i] >> shift) & mask]++;
+			keysTmp[d] = keys[i];
+			valsTmp[d] = vals[i];
+		}
+		keys.swap(keysTmp);
+		vals.swap(valsTmp);
 	}
-	std::sort(order_.begin(), order_.end());
-	newIndex_.resize(m);
-	cellsTmp_.resize(m);
-	hitsTmp_.resize(m);
-	for (size_t j = 0; j < m; ++j)
-	{
-		const uint32_t i = order_[j].second;
-		newIndex_[i] = uint32_t(j);
-		cellsTmp_[j] = out.cells[i];
-		hitsTmp_[j] = out.hits[i];
-	}
-	out.cells.swap(cellsTmp_);
-	out.hits.swap(hitsTmp_);
-	for (auto& c : out.cellOfPoint) c = newIndex_[c];
 }
 
+unsigned bitWidth(uint64_t v)
+{
+	unsigned b = 0;
+	while (v >> b) ++b;
+	return b;
+}
+}  // namespace
+
+// Keys every valid reading, then orders the readings by 8^3 block (blocks in
+// (x, y, z) lexicographic order) and by cell inside a block with a radix
+// sort of compact keys: runs of equal keys are the frame's distinct cells,
+// already in block order, so that the grids visit each storage block once
+// per frame (one hash lookup per block instead of per cell, and
+// cache-friendly writes). No hashing per reading.
 void FrameCloudBuilder::keyPoints(FrameCloud& out)
 {
 	const double inv = 1.0 / p_.voxel_size;
 	const double ext = p_.extent, maxR2 = p_.max_range * p_.max_range;
 	const auto& o = out.origin_W;
-	dedup_.clear();
 	out.cells.clear();
 	out.hits.clear();
-	out.cellOfPoint.resize(out.points_W.size());
+	const size_t n = out.points_W.size();
+	keys_.resize(n);
 	size_t w = 0;
-	uint64_t lastKey = FlatHashMap::kEmpty;
-	uint32_t lastCell = 0;
-	for (size_t i = 0; i < out.points_W.size(); ++i)
+	int32_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX};
+	int32_t hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+	for (size_t i = 0; i < n; ++i)
 	{
 		const auto& p = out.points_W[i];
 		if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)))
@@ -261,32 +280,63 @@ void FrameCloudBuilder::keyPoints(FrameCloud& out)
 			dropDepth(out, i);
 			continue;
 		}
-		const int32_t kx = coordToIndex(p.x, inv), ky = coordToIndex(p.y, inv),
-		              kz = coordToIndex(p.z, inv);
-		const uint64_t key = packKey(kx, ky, kz);
-		if (key != lastKey)
+		const int32_t k[3] = {coordToIndex(p.x, inv) >> 3,
+		                      coordToIndex(p.y, inv) >> 3,
+		                      coordToIndex(p.z, inv) >> 3};
+		for (int a = 0; a < 3; ++a)
 		{
-			const auto [idx, inserted] =
-			    dedup_.insert(key, uint32_t(out.cells.size()));
-			if (inserted)
-			{
-				out.cells.push_back({kx, ky, kz});
-				out.hits.push_back(0);
-			}
-			lastKey = key;
-			lastCell = idx;
+			lo[a] = std::min(lo[a], k[a]);
+			hi[a] = std::max(hi[a], k[a]);
 		}
-		out.hits[lastCell]++;
 		out.points_W[w] = p;
 		out.pixel[w] = out.pixel[i];
-		out.cellOfPoint[w] = lastCell;
 		++w;
 	}
 	out.points_W.resize(w);
 	out.pixel.resize(w);
 	out.cellOfPoint.resize(w);
 	out.stats.valid = w;
-	sortCellsByBlock(out);
+	if (w == 0) return;
+	// Compact key: block coordinates relative to the frame's lowest block,
+	// then the cell index inside the block (x fastest), as in the storage.
+	unsigned bits[3];
+	for (int a = 0; a < 3; ++a) bits[a] = bitWidth(uint64_t(hi[a] - lo[a]));
+	const unsigned sz = 9, sy = sz + bits[2], sx = sy + bits[1];
+	const unsigned total = sx + bits[0];
+	order_.resize(w);
+	for (size_t i = 0; i < w; ++i)
+	{
+		const auto& p = out.points_W[i];
+		const int32_t kx = coordToIndex(p.x, inv), ky = coordToIndex(p.y, inv),
+		              kz = coordToIndex(p.z, inv);
+		keys_[i] = (uint64_t((kx >> 3) - lo[0]) << sx) |
+		           (uint64_t((ky >> 3) - lo[1]) << sy) |
+		           (uint64_t((kz >> 3) - lo[2]) << sz) |
+		           uint64_t((kx & 7) | ((ky & 7) << 3) | ((kz & 7) << 6));
+		order_[i] = uint32_t(i);
+	}
+	keys_.resize(w);
+	radixSortPairs(keys_, order_, keysTmp_, orderTmp_, total);
+	const uint64_t mx = (uint64_t(1) << bits[0]) - 1,
+	               my = (uint64_t(1) << bits[1]) - 1,
+	               mz = (uint64_t(1) << bits[2]) - 1;
+	uint64_t last = ~uint64_t(0);
+	for (size_t j = 0; j < w; ++j)
+	{
+		const uint64_t key = keys_[j];
+		if (key != last)
+		{
+			const int32_t c = int32_t(key & 511);
+			out.cells.push_back(
+			    {(int32_t((key >> sx) & mx) + lo[0]) * 8 + (c & 7),
+			     (int32_t((key >> sy) & my) + lo[1]) * 8 + ((c >> 3) & 7),
+			     (int32_t((key >> sz) & mz) + lo[2]) * 8 + (c >> 6)});
+			out.hits.push_back(0);
+			last = key;
+		}
+		out.hits.back()++;
+		out.cellOfPoint[order_[j]] = uint32_t(out.cells.size() - 1);
+	}
 }
 
 }  // namespace bims::maps

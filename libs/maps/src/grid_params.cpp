@@ -79,6 +79,8 @@ void GridParams::validate() const
 	check(max_memory_mb >= 1, "max_memory_mb", "must be >= 1");
 	check(raycast_decimation >= 1 && raycast_decimation <= 64,
 	      "raycast_decimation", "must be in [1, 64]");
+	check(raycast_threads >= 1 && raycast_threads <= 64, "raycast_threads",
+	      "must be in [1, 64]");
 }
 
 void GridParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
@@ -121,6 +123,7 @@ void GridParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                         {"points", "voxels"});
 	raycast_target = t == "voxels" ? RayTarget::Voxels : RayTarget::Points;
 	exclude_moving = s.getBool("exclude_moving", exclude_moving);
+	raycast_threads = int(s.getInt("raycast_threads", raycast_threads, 1, 64));
 	s.finish();
 	try
 	{
@@ -147,7 +150,8 @@ void GridParams::dump(std::ostream& o) const
 	  << "\nmax_memory_mb=" << max_memory_mb
 	  << "\nraycast_decimation=" << raycast_decimation
 	  << "\nraycast_target=" << toString(raycast_target)
-	  << "\nexclude_moving=" << (exclude_moving ? "true" : "false") << "\n";
+	  << "\nexclude_moving=" << (exclude_moving ? "true" : "false")
+	  << "\nraycast_threads=" << raycast_threads << "\n";
 }
 
 bool GridParams::operator==(const GridParams& o) const
@@ -163,7 +167,8 @@ bool GridParams::operator==(const GridParams& o) const
 	       max_memory_mb == o.max_memory_mb &&
 	       raycast_decimation == o.raycast_decimation &&
 	       raycast_target == o.raycast_target &&
-	       exclude_moving == o.exclude_moving;
+	       exclude_moving == o.exclude_moving &&
+	       raycast_threads == o.raycast_threads;
 }
 
 }  // namespace bims::maps

@@ -114,6 +114,14 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 	void applyMiss(Cell& c, uint32_t F) const;
 
 	Storage grid_;
+	// Scratch of decayRaycast(), reused across frames.
+	struct RayEnd
+	{
+		double p[3];  // end point in voxel units
+	};
+	std::vector<RayEnd> rayEnds_;
+	std::vector<uint32_t> tileStart_;
+	std::vector<Cell*> blockTable_;
 	LogOddsFx miss_ = 0, lmin_ = 0, lmax_ = 0;
 	/** p_unknown > 0: the log-odds of a never-observed cell. */
 	bool hasUnknown_ = false;

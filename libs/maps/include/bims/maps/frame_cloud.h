@@ -147,13 +147,10 @@ class FrameCloudBuilder
 	void keyPoints(FrameCloud& out);
 
  private:
-	void sortCellsByBlock(FrameCloud& out);
-
 	GridParams p_;
-	FlatHashMap dedup_;  // packed voxel key -> index into cells
-	std::vector<std::pair<uint64_t, uint32_t>> order_;
-	std::vector<uint32_t> newIndex_, hitsTmp_;
-	std::vector<VoxelKey> cellsTmp_;
+	// Scratch of keyPoints(): compact keys of the readings and their order.
+	std::vector<uint64_t> keys_, keysTmp_;
+	std::vector<uint32_t> order_, orderTmp_;
 };
 
 }  // namespace bims::maps

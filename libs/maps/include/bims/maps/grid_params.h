@@ -118,6 +118,10 @@ struct GridParams
 	 * labelled moving keeps its belief (no hit, no miss). false = the
 	 * paper: every reading is folded into tier 0. */
 	bool exclude_moving = false;
+	/** decay = raycast: threads casting the free-space rays of a frame
+	 * (the result does not depend on it). A setting of the process, not of
+	 * the map: not serialised (a loaded map has 1). */
+	int raycast_threads = 1;
 
 	/** Throws std::invalid_argument naming the parameter if inconsistent. */
 	void validate() const;

@@ -156,10 +156,32 @@ class SparseVoxelGrid
 			return &last_->cells[cellIndexOf(x, y, z)];
 		}
 
+		/** Hints the CPU to fetch the cell at (x, y, z) for writing, if its
+		 * block exists (never creates one): call it some cells ahead of
+		 * get() when walking a long list of cells whose blocks are out of
+		 * cache. */
+		void prefetch(int32_t x, int32_t y, int32_t z)
+		{
+			const uint64_t bk = blockKeyOf(x, y, z);
+			if (bk != peekKey_)
+			{
+				const uint32_t b = g_.index_.find(bk);
+				peek_ =
+				    b == FlatHashMap::kNotFound ? nullptr : g_.blocks_[b].get();
+				peekKey_ = bk;
+			}
+#if defined(__GNUC__)
+			if (peek_)
+				__builtin_prefetch(&peek_->cells[cellIndexOf(x, y, z)], 1);
+#endif
+		}
+
 	 private:
 		SparseVoxelGrid& g_;
 		uint64_t lastKey_ = FlatHashMap::kEmpty;
 		Block* last_ = nullptr;
+		uint64_t peekKey_ = FlatHashMap::kEmpty;
+		Block* peek_ = nullptr;
 	};
 
  private:
