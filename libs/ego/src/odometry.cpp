@@ -97,6 +97,7 @@ FrameEgomotion Odometry::processFrame(
 		r.t = f.t;
 		r.T_WC = T_WC_;
 		r.flags = kFlagBadImage;
+		haveMotion_ = false;
 		return r;
 	}
 	const double msIn = msSince(t0);
@@ -109,6 +110,7 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 {
 	FrameEgomotion r;
 	r.t = f.t;
+	haveMotion_ = false;
 	if (havePrev_ && !(f.t > tPrev_))
 	{
 		r.T_WC = T_WC_;
@@ -251,11 +253,16 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		r.R_source = useImu ? RotationSource::Imu : RotationSource::None;
 	}
 	R_rel = orthonormalize(R_rel);
+	R_WCprev_ = R_WC_;
+	t_WCprev_ = t_WC_;
+	haveMotion_ = true;
 	t_WC_ += R_WC_ * t_rel;
 	// While the attitude filter is still converging its absolute attitude
 	// moves fast: follow it for the absolute R_WC, but never feed that
 	// convergence into the inter-frame rotation used above.
-	if (useImu && att_.converging(f.t + cfg_.calibration.time_offset_s))
+	followedFilter_ =
+	    useImu && att_.converging(f.t + cfg_.calibration.time_offset_s);
+	if (followedFilter_)
 		R_WC_ = *R_WC_imu;
 	else
 		R_WC_ = orthonormalize(R_WC_ * R_rel);
@@ -271,6 +278,24 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	R_WC_imuPrev_ = R_WC_imu;
 	R_WC_gyroPrev_ = R_WC_gyro;
 	return r;
+}
+
+mrpt::poses::CPose3D Odometry::correctLastMotion(
+    const mrpt::poses::CPose3D& T_CprevC)
+{
+	if (!haveMotion_) return T_WC_;
+	Eigen::Matrix3d R;
+	const auto& Rm = T_CprevC.getRotationMatrix();
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < 3; j++) R(i, j) = Rm(i, j);
+	R = orthonormalize(R);
+	const Eigen::Vector3d t(T_CprevC.x(), T_CprevC.y(), T_CprevC.z());
+	t_WC_ = t_WCprev_ + R_WCprev_ * t;
+	if (!followedFilter_) R_WC_ = orthonormalize(R_WCprev_ * R);
+	lastR_rel_ = R;
+	lastT_rel_ = t;
+	T_WC_ = toPose(R_WC_, t_WC_);
+	return T_WC_;
 }
 
 }  // namespace bims::ego
