@@ -185,12 +185,16 @@ FlowPoseResult refinePoseWithFlow(const cv::Mat& observed, const cv::Mat& depth,
 	residuals(R, t);
 	res.median_px_before = median(err);
 
+	auto tukeyCut = [&](const std::vector<double>& e)
+	{
+		return std::clamp(p.tukey_sigmas * 1.4826 * median(e), p.tukey_min_px,
+		                  std::max(p.tukey_min_px, p.tukey_max_px));
+	};
 	double cut = 0;
 	for (int it = 0; it < p.iterations; it++)
 	{
 		const bool tukey = it >= p.iterations / 3;
-		if (tukey)
-			cut = std::max(p.tukey_min_px, p.tukey_sigmas * 1.4826 * median(err));
+		if (tukey) cut = tukeyCut(err);
 		Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
 		Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
 		size_t nIn = 0;
@@ -241,7 +245,7 @@ FlowPoseResult refinePoseWithFlow(const cv::Mat& observed, const cv::Mat& depth,
 		if (xi.head<3>().norm() < 1e-7 && xi.tail<3>().norm() < 1e-6 && tukey)
 			break;
 	}
-	if (cut <= 0) cut = std::max(p.tukey_min_px, p.tukey_sigmas * 1.4826 * median(err));
+	if (cut <= 0) cut = tukeyCut(err);
 	size_t nIn = 0;
 	for (double e : err) nIn += e < cut;
 	res.inlier_fraction = static_cast<double>(nIn) / S.size();

@@ -81,7 +81,10 @@ class Odometry
 
 	/** Replaces the motion of the frame processed last by \a T_CprevC
 	 * (e.g. refined against the dense optical flow): its T_WC and the motion
-	 * the next frame falls back on follow. Returns the new T_WC. Does
+	 * the next frame falls back on follow (also while the attitude filter
+	 * converges, when processFrame() takes the filter's absolute attitude;
+	 * attitude_blend pulls R_WC back towards the filter's in later frames).
+	 * Returns the new T_WC. Does
 	 * nothing (returns the current T_WC) when the last frame estimated no
 	 * motion (first frame, out-of-order or unusable frame). */
 	mrpt::poses::CPose3D correctLastMotion(
@@ -113,7 +116,6 @@ class Odometry
 	// pose of the previous frame, for correctLastMotion()
 	Eigen::Matrix3d R_WCprev_ = Eigen::Matrix3d::Identity();
 	Eigen::Vector3d t_WCprev_ = Eigen::Vector3d::Zero();
-	bool followedFilter_ = false;  // last R_WC was the filter's (converging)
 	bool haveMotion_ = false;
 	Eigen::Matrix3d lastR_rel_ = Eigen::Matrix3d::Identity();
 	Eigen::Vector3d lastT_rel_ = Eigen::Vector3d::Zero();

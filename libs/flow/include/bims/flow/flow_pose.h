@@ -31,9 +31,11 @@ struct FlowPoseParams
 	int iterations = 12;    ///< Gauss-Newton iterations
 	double huber_px = 1.0;  ///< Huber scale of the first iterations [px]
 	/** Tukey cut-off in robust standard deviations (MAD) of the residuals,
-	 * never below tukey_min_px [px]. */
+	 * clamped to [tukey_min_px, tukey_max_px] [px]: the upper limit keeps a
+	 * large coherent mover from inflating the scale until it fits. */
 	double tukey_sigmas = 4.0;
 	double tukey_min_px = 1.5;
+	double tukey_max_px = 3.0;
 	double min_depth_m = 0.3, max_depth_m = 6.0;  ///< depth readings used
 	/** Samples whose depth differs from a neighbour's by more than this
 	 * fraction of their depth lie on an occlusion edge: not used. */
