@@ -43,7 +43,8 @@ using mrpt::poses::CPose3D;
 double rotDeg(const CPose3D& a, const CPose3D& b)
 {
 	const auto R = (b - a).getRotationMatrix();  // a^-1 b
-	const double c = std::clamp((R(0, 0) + R(1, 1) + R(2, 2) - 1) / 2, -1.0, 1.0);
+	const double c =
+	    std::clamp((R(0, 0) + R(1, 1) + R(2, 2) - 1) / 2, -1.0, 1.0);
 	return std::acos(c) * 180.0 / M_PI;
 }
 
@@ -77,7 +78,8 @@ PoseScore score(const cv::Mat& obs, const cv::Mat& depth,
 		for (int u = 0; u < lab.cols; u++)
 			if (lab.at<int8_t>(v, u) >= 0)
 			{
-				const cv::Vec2f e = exp.at<cv::Vec2f>(v, u) - obs.at<cv::Vec2f>(v, u);
+				const cv::Vec2f e =
+				    exp.at<cv::Vec2f>(v, u) - obs.at<cv::Vec2f>(v, u);
 				d.push_back(std::hypot(e[0], e[1]));
 			}
 	PoseScore s;
@@ -118,8 +120,8 @@ int main(int argc, char** argv)
 	    [&]()
 	    {
 		    TCLAP::CmdLine cmd(
-		        "bims: flow-label false positives per relative pose source", ' ',
-		        "0.1");
+		        "bims: flow-label false positives per relative pose source",
+		        ' ', "0.1");
 		    TCLAP::UnlabeledValueArg<std::string> aCfg(
 		        "config", "experiment .ini", true, "", "CONFIG.ini", cmd);
 		    TCLAP::UnlabeledValueArg<std::string> aIn(
@@ -163,7 +165,8 @@ int main(int argc, char** argv)
 		    opt.rawlogs = {aIn.getValue()};
 		    opt.progress = false;
 		    if (aFrames.isSet())
-			    opt.frames = bims::pipeline::FrameRange::parse(aFrames.getValue());
+			    opt.frames =
+			        bims::pipeline::FrameRange::parse(aFrames.getValue());
 		    std::ofstream csv;
 		    if (aCsv.isSet())
 		    {
@@ -202,8 +205,8 @@ int main(int argc, char** argv)
 			    mrpt::img::TCamera cam;
 			    cam.ncols = static_cast<uint32_t>(f.depth.cols);
 			    cam.nrows = static_cast<uint32_t>(f.depth.rows);
-			    cam.setIntrinsicParamsFromValues(f.K(0, 0), f.K(1, 1), f.K(0, 2),
-			                                     f.K(1, 2));
+			    cam.setIntrinsicParamsFromValues(f.K(0, 0), f.K(1, 1),
+			                                     f.K(0, 2), f.K(1, 2));
 			    const double validPx = cv::countNonZero(f.depth > 0);
 			    const CPose3D G = *gtCur - *gtP;  // T_{C(t-1) C(t)}
 			    const CPose3D E = r.ego.T_CprevC, U = r.T_CprevC;
@@ -213,37 +216,52 @@ int main(int argc, char** argv)
 			        r.flowObserved, f.depth, cam, E, refineP, nullptr, &S);
 			    const CPose3D V = ref.T_prev_cur;
 			    cv::Mat labU;
-			    const auto sE = score(r.flowObserved, f.depth, cam, E, fp, validPx, S);
-			    const auto sU =
-			        score(r.flowObserved, f.depth, cam, U, fp, validPx, S, &labU);
-			    const auto sG = score(r.flowObserved, f.depth, cam, G, fp, validPx, S);
-			    const auto sV = score(r.flowObserved, f.depth, cam, V, fp, validPx, S);
-			    const cv::Mat edges = bims::flow::depthEdgeMask(f.depth, 0.05, 2);
+			    const auto sE =
+			        score(r.flowObserved, f.depth, cam, E, fp, validPx, S);
+			    const auto sU = score(r.flowObserved, f.depth, cam, U, fp,
+			                          validPx, S, &labU);
+			    const auto sG =
+			        score(r.flowObserved, f.depth, cam, G, fp, validPx, S);
+			    const auto sV =
+			        score(r.flowObserved, f.depth, cam, V, fp, validPx, S);
+			    const cv::Mat edges =
+			        bims::flow::depthEdgeMask(f.depth, 0.05, 2);
 			    const double nDiff = cv::countNonZero(labU == 1);
 			    const double nDiffEdge =
 			        cv::countNonZero((labU == 1) & (edges > 0));
 			    const double edgeShare = nDiff > 0 ? nDiffEdge / nDiff : 0;
-			    const std::vector<double> row = {
-			        sE.diffFraction * 100, sU.diffFraction * 100,
-			        sG.diffFraction * 100, sV.diffFraction * 100,
-			        sE.medianPx,           sU.medianPx,
-			        sG.medianPx,           sV.medianPx,
-			        rotDeg(E, G),          rotDeg(E, V),
-			        rotDeg(G, V),          rotDeg(U, V),
-			        transMm(E, G),         transMm(E, V),
-			        transMm(G, V),         transMm(U, V),
-			        rotDeg(CPose3D(), G),  transMm(CPose3D(), G),
-			        edgeShare};
+			    const std::vector<double> row = {sE.diffFraction * 100,
+			                                     sU.diffFraction * 100,
+			                                     sG.diffFraction * 100,
+			                                     sV.diffFraction * 100,
+			                                     sE.medianPx,
+			                                     sU.medianPx,
+			                                     sG.medianPx,
+			                                     sV.medianPx,
+			                                     rotDeg(E, G),
+			                                     rotDeg(E, V),
+			                                     rotDeg(G, V),
+			                                     rotDeg(U, V),
+			                                     transMm(E, G),
+			                                     transMm(E, V),
+			                                     transMm(G, V),
+			                                     transMm(U, V),
+			                                     rotDeg(CPose3D(), G),
+			                                     transMm(CPose3D(), G),
+			                                     edgeShare};
 			    if (cols.empty()) cols.resize(row.size());
-			    for (size_t k = 0; k < row.size(); k++) cols[k].push_back(row[k]);
+			    for (size_t k = 0; k < row.size(); k++)
+				    cols[k].push_back(row[k]);
 			    std::printf(
-			        "%4zu %4u | %5.1f %5.1f %5.1f %5.1f | %5.2f %5.2f %5.2f %5.2f "
-			        "| %5.2f %5.2f %5.2f %5.2f | %5.1f %5.1f %5.1f %5.1f | %5.2f "
+			        "%4zu %4u | %5.1f %5.1f %5.1f %5.1f | %5.2f %5.2f %5.2f "
+			        "%5.2f "
+			        "| %5.2f %5.2f %5.2f %5.2f | %5.1f %5.1f %5.1f %5.1f | "
+			        "%5.2f "
 			        "%5.1f | %4.2f\n",
-			        r.index, r.ego.flags, row[0], row[1], row[2], row[3], row[4],
-			        row[5], row[6], row[7], row[8], row[9], row[10], row[11],
-			        row[12], row[13], row[14], row[15], row[16], row[17],
-			        row[18]);
+			        r.index, r.ego.flags, row[0], row[1], row[2], row[3],
+			        row[4], row[5], row[6], row[7], row[8], row[9], row[10],
+			        row[11], row[12], row[13], row[14], row[15], row[16],
+			        row[17], row[18]);
 			    if (csv)
 			    {
 				    csv << r.index << "," << r.ego.flags << "," << validPx;
@@ -277,12 +295,12 @@ int main(int argc, char** argv)
 			        "no frame with flow and ground truth on both sides");
 		    std::printf("# mean over %zu frames:\n", cols[0].size());
 		    const char* names[] = {
-		        "diff_%_ego",     "diff_%_used",     "diff_%_gt",
-		        "diff_%_flow",    "median_px_ego",   "median_px_used",
-		        "median_px_gt",   "median_px_flow",  "rot_ego_gt_deg",
+		        "diff_%_ego",       "diff_%_used",     "diff_%_gt",
+		        "diff_%_flow",      "median_px_ego",   "median_px_used",
+		        "median_px_gt",     "median_px_flow",  "rot_ego_gt_deg",
 		        "rot_ego_flow_deg", "rot_gt_flow_deg", "rot_used_flow_deg",
-		        "t_ego_gt_mm",    "t_ego_flow_mm",   "t_gt_flow_mm",
-		        "t_used_flow_mm", "gt_rot_deg",      "gt_t_mm",
+		        "t_ego_gt_mm",      "t_ego_flow_mm",   "t_gt_flow_mm",
+		        "t_used_flow_mm",   "gt_rot_deg",      "gt_t_mm",
 		        "edge_share_used"};
 		    for (size_t k = 0; k < cols.size(); k++)
 		    {
@@ -293,10 +311,11 @@ int main(int argc, char** argv)
 			    std::printf("%-18s mean %8.3f median %8.3f\n", names[k],
 			                m / v.size(), v[v.size() / 2]);
 		    }
-		    std::printf("run: mean moving-pixel fraction %.2f %% (%s), %zu of "
-		                "%zu frames flagged by egomotion\n",
-		                100 * sum.meanMovingPixelFraction, sum.variant.c_str(),
-		                sum.framesFlagged, sum.framesProcessed);
+		    std::printf(
+		        "run: mean moving-pixel fraction %.2f %% (%s), %zu of "
+		        "%zu frames flagged by egomotion\n",
+		        100 * sum.meanMovingPixelFraction, sum.variant.c_str(),
+		        sum.framesFlagged, sum.framesProcessed);
 		    if (aStrip.isSet())
 		    {
 			    if (tiles.empty())
@@ -313,8 +332,8 @@ int main(int argc, char** argv)
 			    if (!cv::imwrite(aStrip.getValue(), out))
 				    throw std::runtime_error(aStrip.getValue() +
 				                             ": cannot write");
-			    std::printf("strip: %s (%zu frames)\n", aStrip.getValue().c_str(),
-			                tiles.size());
+			    std::printf("strip: %s (%zu frames)\n",
+			                aStrip.getValue().c_str(), tiles.size());
 		    }
 		    return 0;
 	    });

@@ -18,8 +18,7 @@ namespace
 {
 const std::string kBonn =
     std::string(BIMS_SHARED_DATA_DIR) + "/bonn_crowd_f150_349";
-const std::string kConfig =
-    std::string(BIMS_SOURCE_DIR) + "/config/bonn.ini";
+const std::string kConfig = std::string(BIMS_SOURCE_DIR) + "/config/bonn.ini";
 
 /** Mean over the non-warm-up frames [first, last] of the moving share of the
  * valid-depth pixels. */

@@ -71,7 +71,7 @@ void AttitudeFilter::push(double t)
 {
 	hist_.push_back({t, q_, qg_});
 	while (hist_.size() > 2 && hist_.back().t - hist_.front().t > p_.history_s)
-		{
+	{
 		hist_.pop_front();
 		trimmed_ = true;
 	}

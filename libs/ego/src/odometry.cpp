@@ -193,7 +193,8 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	// the jump from the unanchored start to the filter's attitude, not a
 	// motion. Such a frame takes the vision estimate.
 	const bool anchorNow = imuMode && R_WC_imu.has_value() &&
-	                       !R_rel_gyro.has_value() && !R_WC_imuPrev_.has_value();
+	                       !R_rel_gyro.has_value() &&
+	                       !R_WC_imuPrev_.has_value();
 	const bool useImu = imuMode && R_WC_imu.has_value() && !anchorNow;
 	Eigen::Matrix3d R_imuRel = Eigen::Matrix3d::Identity();
 	if (imuMode) r.flags |= imuFlags;

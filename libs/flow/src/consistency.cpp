@@ -50,9 +50,9 @@ cv::Mat labelConsistency(const cv::Mat& observed, const cv::Mat& expected,
 			const float z = zr[u];
 			int8_t lab = kNoLabel;
 			if (std::isfinite(z) && z > 0.0f && z <= p.max_depth_m &&
-			    !(ed && ed[u]) &&
-			    std::isfinite(e[u][0]) && std::isfinite(e[u][1]) &&
-			    std::isfinite(o[u][0]) && std::isfinite(o[u][1]))
+			    !(ed && ed[u]) && std::isfinite(e[u][0]) &&
+			    std::isfinite(e[u][1]) && std::isfinite(o[u][0]) &&
+			    std::isfinite(o[u][1]))
 			{
 				const float eu = u + e[u][0], ev = v + e[u][1];
 				const float ou = u + o[u][0], ov = v + o[u][1];

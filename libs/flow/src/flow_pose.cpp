@@ -96,8 +96,7 @@ FlowPoseResult refinePoseWithFlow(const cv::Mat& observed, const cv::Mat& depth,
                                   const mrpt::img::TCamera& cam,
                                   const mrpt::poses::CPose3D& init,
                                   const FlowPoseParams& p,
-                                  const cv::Mat* exclude,
-                                  const cv::Mat* tensor)
+                                  const cv::Mat* exclude, const cv::Mat* tensor)
 {
 	if (observed.type() != CV_32FC2 || depth.type() != CV_32FC1 ||
 	    observed.size() != depth.size())
@@ -221,9 +220,8 @@ FlowPoseResult refinePoseWithFlow(const cv::Mat& observed, const cv::Mat& depth,
 			    -q.z(), 0, q.x(), 0, 1, 0,    //
 			    q.y(), -q.x(), 0, 0, 0, 1;    // d(q + w x q + d)/d(w, d)
 			const Eigen::Matrix<double, 2, 6> A = Jp * Jq;
-			const Eigen::Vector2d rr(
-			    S[i].x.x() - (fx * q.x() * iz + cx),
-			    S[i].x.y() - (fy * q.y() * iz + cy));
+			const Eigen::Vector2d rr(S[i].x.x() - (fx * q.x() * iz + cx),
+			                         S[i].x.y() - (fy * q.y() * iz + cy));
 			H.noalias() += w * A.transpose() * A;
 			g.noalias() += w * A.transpose() * rr;
 			nIn++;
@@ -236,7 +234,8 @@ FlowPoseResult refinePoseWithFlow(const cv::Mat& observed, const cv::Mat& depth,
 		if (se3)
 			xi = H.ldlt().solve(g);
 		else
-			xi.tail<3>() = H.bottomRightCorner<3, 3>().ldlt().solve(g.tail<3>());
+			xi.tail<3>() =
+			    H.bottomRightCorner<3, 3>().ldlt().solve(g.tail<3>());
 		if (!xi.allFinite()) return res;
 		const Eigen::Matrix3d dR = expSO3(xi.head<3>());
 		R = dR * R;

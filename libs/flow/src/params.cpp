@@ -29,6 +29,7 @@ void FlowParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	    s.getDouble("refine_min_texture", refine_min_texture, 0.0, 1e6);
 	refine_pose =
 	    s.getEnum("refine_pose", refine_pose, {"none", "translation", "se3"});
+	refine_to_ego = s.getBool("refine_to_ego", refine_to_ego);
 	refine_step_px =
 	    static_cast<int>(s.getInt("refine_step_px", refine_step_px, 1, 64));
 	refine_iterations = static_cast<int>(

@@ -20,7 +20,8 @@ cv::Mat roomDepth(int W, int H)
 	cv::Mat d(H, W, CV_32FC1);
 	for (int v = 0; v < H; v++)
 		for (int u = 0; u < W; u++)
-			d.at<float>(v, u) = static_cast<float>(2.5 + 1.5 * u / W + 0.5 * v / H);
+			d.at<float>(v, u) =
+			    static_cast<float>(2.5 + 1.5 * u / W + 0.5 * v / H);
 	d(cv::Rect(W / 3, H / 3, W / 4, H / 4)).setTo(1.2f);
 	return d;
 }
@@ -28,7 +29,8 @@ cv::Mat roomDepth(int W, int H)
 double rotDeg(const CPose3D& a, const CPose3D& b)
 {
 	const auto R = (b - a).getRotationMatrix();
-	const double c = std::clamp((R(0, 0) + R(1, 1) + R(2, 2) - 1) / 2, -1.0, 1.0);
+	const double c =
+	    std::clamp((R(0, 0) + R(1, 1) + R(2, 2) - 1) / 2, -1.0, 1.0);
 	return std::acos(c) * 180 / M_PI;
 }
 
@@ -179,7 +181,8 @@ TEST(Consistency, VisibilityGateIgnoresFlowDifferencesOnBlankSurfaces)
 	const cv::Mat S = structureTensor(grey, 9);
 	FlowParams p;
 	p.visible_change_grey = 8;
-	const cv::Mat lab = labelConsistency(obs, exp, depth, cam, T, p, nullptr, &S);
+	const cv::Mat lab =
+	    labelConsistency(obs, exp, depth, cam, T, p, nullptr, &S);
 	EXPECT_EQ(lab.at<int8_t>(H / 2, W / 4), kNotDiff);
 	EXPECT_EQ(lab.at<int8_t>(H / 2, 3 * W / 4), kDiff);
 	// without the gate both are Diff; the gate needs the tensor

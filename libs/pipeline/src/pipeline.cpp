@@ -90,14 +90,15 @@ const FrameResult& Pipeline::processFrame(
 		const auto cam = cameraOf(cur_);
 		if (cfg_.flow.refine_pose != "none")
 		{
-			r.flowPose = flow::refinePoseWithFlow(
-			    obs, cur_.depth, cam, r.T_CprevC,
-			    flow::flowPoseParamsFrom(cfg_.flow), nullptr,
-			    &observed_.tensor());
+			r.flowPose =
+			    flow::refinePoseWithFlow(obs, cur_.depth, cam, r.T_CprevC,
+			                             flow::flowPoseParamsFrom(cfg_.flow),
+			                             nullptr, &observed_.tensor());
 			if (r.flowPose.ok)
 			{
 				r.T_CprevC = r.flowPose.T_prev_cur;
-				r.T_WC = odom_.correctLastMotion(r.T_CprevC);
+				if (cfg_.flow.refine_to_ego)
+					r.T_WC = odom_.correctLastMotion(r.T_CprevC);
 			}
 		}
 		const cv::Mat exp =

@@ -47,6 +47,9 @@ struct FlowParams
 	 * translation fitted to the dense observed flow) or "se3" (rotation and
 	 * translation fitted to the observed flow, vision only); flow_pose.h. */
 	std::string refine_pose = "none";
+	/** Hand the refined motion back to the egomotion (T_WC, the grids'
+	 * pose, follows it) or use it for the expected flow only. */
+	bool refine_to_ego = true;
 	int refine_step_px = 4;      ///< grid step of the samples [px]
 	int refine_iterations = 12;  ///< robust Gauss-Newton iterations
 	/** Samples of the refinement need a structure-tensor minimum eigenvalue
