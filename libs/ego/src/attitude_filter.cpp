@@ -63,6 +63,7 @@ void AttitudeFilter::setState(const Eigen::Quaterniond& q_WI, double t)
 	tInit_ = tLast_ = tAccelOk_ = tMagOk_ = t;
 	headingConverged_ = false;
 	hist_.clear();
+	trimmed_ = false;
 	push(t);
 }
 
@@ -70,7 +71,10 @@ void AttitudeFilter::push(double t)
 {
 	hist_.push_back({t, q_, qg_});
 	while (hist_.size() > 2 && hist_.back().t - hist_.front().t > p_.history_s)
+	{
 		hist_.pop_front();
+		trimmed_ = true;
+	}
 }
 
 bool AttitudeFilter::tryInitialize(const ImuSample& s)
@@ -296,8 +300,18 @@ std::optional<Eigen::Quaterniond> AttitudeFilter::lookup(double t,
 	uint32_t f = 0;
 	std::optional<Eigen::Quaterniond> out;
 	const double eps = 1e-9;
-	if (!initialized_ || hist_.empty() || t < hist_.front().t - eps)
+	if (!initialized_ || hist_.empty())
 		f |= kFlagImuMissing;
+	else if (t < hist_.front().t - eps)
+	{
+		// Just before the first kept sample (e.g. a recording whose IMU
+		// starts right after the first camera frame): hold that sample's
+		// attitude within max_gap_s, as after the last one.
+		if (hist_.front().t - t <= p_.max_gap_s && !trimmed_)
+			out = gyroOnly ? hist_.front().qg : hist_.front().q;
+		else
+			f |= kFlagImuMissing;
+	}
 	else if (t >= hist_.back().t)
 	{
 		const double dt = t - hist_.back().t;
@@ -336,7 +350,8 @@ std::string flagsToString(uint32_t flags)
 	    {kFlagConstVelPrediction, "const_vel_prediction"},
 	    {kFlagAccelGated, "accel_gated"},
 	    {kFlagMagGated, "mag_gated"},
-	    {kFlagBadImage, "bad_image"}};
+	    {kFlagBadImage, "bad_image"},
+	    {kFlagWorldReanchored, "world_reanchored"}};
 	std::string s;
 	for (const auto& [bit, name] : names)
 		if (flags & bit) s += (s.empty() ? "" : "|") + std::string(name);

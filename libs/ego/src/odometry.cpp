@@ -97,6 +97,7 @@ FrameEgomotion Odometry::processFrame(
 		r.t = f.t;
 		r.T_WC = T_WC_;
 		r.flags = kFlagBadImage;
+		haveMotion_ = false;
 		return r;
 	}
 	const double msIn = msSince(t0);
@@ -109,6 +110,7 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 {
 	FrameEgomotion r;
 	r.t = f.t;
+	haveMotion_ = false;
 	if (havePrev_ && !(f.t > tPrev_))
 	{
 		r.T_WC = T_WC_;
@@ -185,7 +187,15 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	}
 	r.correspondences = static_cast<int>(corr.size());
 
-	const bool useImu = imuMode && R_WC_imu.has_value();
+	// The IMU gives the inter-frame rotation only with a gyro chain over
+	// the interval or an IMU attitude at the previous frame: otherwise
+	// (e.g. the IMU starts after the first frame) R_WC_^T R_WC_imu would be
+	// the jump from the unanchored start to the filter's attitude, not a
+	// motion. Such a frame takes the vision estimate.
+	const bool anchorNow = imuMode && R_WC_imu.has_value() &&
+	                       !R_rel_gyro.has_value() &&
+	                       !R_WC_imuPrev_.has_value();
+	const bool useImu = imuMode && R_WC_imu.has_value() && !anchorNow;
 	Eigen::Matrix3d R_imuRel = Eigen::Matrix3d::Identity();
 	if (imuMode) r.flags |= imuFlags;
 	MotionEstimate m;
@@ -245,12 +255,14 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	{
 		// Failure: keep going with the best guess (IMU rotation if any,
 		// else constant velocity); the flags say the motion is not measured.
-		R_rel = useImu ? Eigen::Matrix3d(R_WC_.transpose() * *R_WC_imu)
-		               : lastR_rel_;
+		R_rel = useImu ? R_imuRel : lastR_rel_;
 		t_rel = lastT_rel_;
 		r.R_source = useImu ? RotationSource::Imu : RotationSource::None;
 	}
 	R_rel = orthonormalize(R_rel);
+	R_WCprev_ = R_WC_;
+	t_WCprev_ = t_WC_;
+	haveMotion_ = true;
 	t_WC_ += R_WC_ * t_rel;
 	// While the attitude filter is still converging its absolute attitude
 	// moves fast: follow it for the absolute R_WC, but never feed that
@@ -259,6 +271,16 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		R_WC_ = *R_WC_imu;
 	else
 		R_WC_ = orthonormalize(R_WC_ * R_rel);
+	if (anchorNow)
+	{
+		// Rotate the world so that R_WC is the filter's from now on.
+		const Eigen::Matrix3d R_fix = *R_WC_imu * R_WC_.transpose();
+		R_WC_ = *R_WC_imu;
+		t_WC_ = R_fix * t_WC_;
+		R_WCprev_ = R_fix * R_WCprev_;
+		t_WCprev_ = R_fix * t_WCprev_;
+		r.flags |= kFlagWorldReanchored;
+	}
 	lastR_rel_ = R_rel;
 	lastT_rel_ = t_rel;
 	T_WC_ = toPose(R_WC_, t_WC_);
@@ -271,6 +293,28 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	R_WC_imuPrev_ = R_WC_imu;
 	R_WC_gyroPrev_ = R_WC_gyro;
 	return r;
+}
+
+mrpt::poses::CPose3D Odometry::correctLastMotion(
+    const mrpt::poses::CPose3D& T_CprevC)
+{
+	if (!haveMotion_) return T_WC_;
+	Eigen::Matrix3d R;
+	const auto& Rm = T_CprevC.getRotationMatrix();
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < 3; j++) R(i, j) = Rm(i, j);
+	R = orthonormalize(R);
+	const Eigen::Vector3d t(T_CprevC.x(), T_CprevC.y(), T_CprevC.z());
+	t_WC_ = t_WCprev_ + R_WCprev_ * t;
+	// Also while the attitude filter converges (processFrame then follows
+	// the filter's absolute attitude): the corrected motion is the better
+	// inter-frame rotation, and the attitude blend pulls R_WC towards the
+	// filter's afterwards.
+	R_WC_ = orthonormalize(R_WCprev_ * R);
+	lastR_rel_ = R;
+	lastT_rel_ = t;
+	T_WC_ = toPose(R_WC_, t_WC_);
+	return T_WC_;
 }
 
 }  // namespace bims::ego

@@ -176,3 +176,34 @@ TEST(Odometry, MissingCalibrationKeyIsAClearError)
 	EXPECT_DOUBLE_EQ(ec.calibration.R_IC(1, 0), -1);
 	EXPECT_DOUBLE_EQ(ec.calibration.time_offset_s, 0.01);
 }
+
+TEST(Odometry, CorrectLastMotionReplacesThePoseAndTheFallback)
+{
+	EgoConfig cfg;
+	cfg.odometry.mode = "vision";
+	Odometry odo(cfg);
+	test::Motion m;
+	const auto f0 = test::render(m.R(0), m.p(0), K320(), 320, 240, 0);
+	const FrameEgomotion e0 = odo.processFrame(f0);
+	// nothing to correct after the first frame
+	EXPECT_EQ(odo.correctLastMotion(mrpt::poses::CPose3D(1, 0, 0, 0, 0, 0))
+	              .asString(),
+	          e0.T_WC.asString());
+	const auto f1 = test::render(m.R(0.05), m.p(0.05), K320(), 320, 240, 0.05);
+	const FrameEgomotion e1 = odo.processFrame(f1);
+	ASSERT_TRUE(e1.ok());
+	const mrpt::poses::CPose3D T(0.01, -0.02, 0.03, 0.02, -0.01, 0.015);
+	const mrpt::poses::CPose3D T_WC = odo.correctLastMotion(T);
+	const mrpt::poses::CPose3D expect = e0.T_WC + T;
+	EXPECT_LT((T_WC - expect).norm(), 1e-9);
+	EXPECT_LT(std::abs(T_WC.yaw() - expect.yaw()), 1e-9);
+	EXPECT_LT(std::abs(T_WC.pitch() - expect.pitch()), 1e-9);
+	EXPECT_LT(std::abs(T_WC.roll() - expect.roll()), 1e-9);
+	// an unusable next frame falls back on the corrected motion
+	RgbdFrame bad = test::render(m.R(0.1), m.p(0.1), K320(), 320, 240, 0.1);
+	bad.depth.setTo(0.0f);
+	const FrameEgomotion e2 = odo.processFrame(bad);
+	EXPECT_FALSE(e2.ok());
+	EXPECT_LT((e2.T_CprevC - T).norm(), 1e-9);
+	EXPECT_LT(std::abs(e2.T_CprevC.yaw() - T.yaw()), 1e-9);
+}

@@ -1,4 +1,5 @@
 #include <bims/flow/consistency.h>
+#include <bims/flow/flow_pose.h>
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
@@ -9,7 +10,8 @@ namespace bims::flow
 cv::Mat labelConsistency(const cv::Mat& observed, const cv::Mat& expected,
                          const cv::Mat& depth, const mrpt::img::TCamera& cam,
                          const mrpt::poses::CPose3D& T_prev_cur,
-                         const FlowParams& p, LabelStats* stats)
+                         const FlowParams& p, LabelStats* stats,
+                         const cv::Mat* tensor)
 {
 	if (observed.type() != CV_32FC2 || expected.type() != CV_32FC2 ||
 	    depth.type() != CV_32FC1 || observed.size() != expected.size() ||
@@ -17,12 +19,22 @@ cv::Mat labelConsistency(const cv::Mat& observed, const cv::Mat& expected,
 		throw std::invalid_argument(
 		    "labelConsistency: need CV_32FC2 flows and CV_32FC1 depth of one "
 		    "size");
+	const bool visible = p.visible_change_grey > 0;
+	if (visible && (!tensor || tensor->type() != CV_32FC3 ||
+	                tensor->size() != depth.size()))
+		throw std::invalid_argument(
+		    "labelConsistency: visible_change_grey needs the current image's "
+		    "structure tensor (CV_32FC3 of the depth's size)");
+	const double minChange2 = p.visible_change_grey * p.visible_change_grey;
 	const double tx = T_prev_cur.x(), ty = T_prev_cur.y();
 	const double f = 0.5 * (cam.fx() + cam.fy());
 	const double noiseGain = p.depth_noise_sigmas * f *
 	                         std::sqrt(tx * tx + ty * ty) * p.depth_noise_a;
 	const float W = static_cast<float>(depth.cols - 1);
 	const float H = static_cast<float>(depth.rows - 1);
+	cv::Mat edges;
+	if (p.depth_edge_rel > 0)
+		edges = depthEdgeMask(depth, p.depth_edge_rel, p.depth_edge_px);
 	cv::Mat labels(depth.size(), CV_8SC1);
 	LabelStats st;
 	for (int v = 0; v < depth.rows; v++)
@@ -31,13 +43,16 @@ cv::Mat labelConsistency(const cv::Mat& observed, const cv::Mat& expected,
 		const auto* o = observed.ptr<cv::Vec2f>(v);
 		const auto* e = expected.ptr<cv::Vec2f>(v);
 		auto* l = labels.ptr<int8_t>(v);
+		const uint8_t* ed = edges.empty() ? nullptr : edges.ptr<uint8_t>(v);
+		const cv::Vec3f* S = visible ? tensor->ptr<cv::Vec3f>(v) : nullptr;
 		for (int u = 0; u < depth.cols; u++)
 		{
 			const float z = zr[u];
 			int8_t lab = kNoLabel;
 			if (std::isfinite(z) && z > 0.0f && z <= p.max_depth_m &&
-			    std::isfinite(e[u][0]) && std::isfinite(e[u][1]) &&
-			    std::isfinite(o[u][0]) && std::isfinite(o[u][1]))
+			    !(ed && ed[u]) && std::isfinite(e[u][0]) &&
+			    std::isfinite(e[u][1]) && std::isfinite(o[u][0]) &&
+			    std::isfinite(o[u][1]))
 			{
 				const float eu = u + e[u][0], ev = v + e[u][1];
 				const float ou = u + o[u][0], ov = v + o[u][1];
@@ -49,6 +64,12 @@ cv::Mat labelConsistency(const cv::Mat& observed, const cv::Mat& expected,
 					const double thr = p.diff_threshold_px + noiseGain;
 					const double du = o[u][0] - e[u][0], dv = o[u][1] - e[u][1];
 					lab = (du * du + dv * dv > thr * thr) ? kDiff : kNotDiff;
+					// d^T S d: squared RMS intensity change d would cause
+					if (lab == kDiff && S &&
+					    du * du * S[u][0] + 2 * du * dv * S[u][1] +
+					            dv * dv * S[u][2] <
+					        minChange2)
+						lab = kNotDiff;
 				}
 			}
 			l[u] = lab;

@@ -29,6 +29,9 @@ cv::Mat ObservedFlow::compute(const cv::Mat& prev, const cv::Mat& cur)
 	    prev.type() != CV_8UC1 || cur.type() != CV_8UC1)
 		throw std::invalid_argument(
 		    "observed flow: need two non-empty CV_8UC1 images of one size");
+	tensor_.release();
+	if (p_.visible_change_grey > 0 || p_.refine_pose != "none")
+		tensor_ = structureTensor(cur, p_.texture_window_px);
 	cv::Mat a = cur, b = prev;
 	if (p_.downscale > 1)
 	{
@@ -49,6 +52,25 @@ cv::Mat ObservedFlow::compute(const cv::Mat& prev, const cv::Mat& cur)
 		flow = up;
 	}
 	return flow;
+}
+
+cv::Mat structureTensor(const cv::Mat& grey, int window)
+{
+	if (grey.empty() || grey.type() != CV_8UC1)
+		throw std::invalid_argument("structureTensor: need a CV_8UC1 image");
+	if (window < 1)
+		throw std::invalid_argument("structureTensor: window must be >= 1");
+	cv::Mat gx, gy;
+	// Sobel 3x3 sums 8x the gradient: scale to grey levels per pixel.
+	cv::Sobel(grey, gx, CV_32F, 1, 0, 3, 1.0 / 8);
+	cv::Sobel(grey, gy, CV_32F, 0, 1, 3, 1.0 / 8);
+	cv::Mat prods[3] = {gx.mul(gx), gx.mul(gy), gy.mul(gy)};
+	for (auto& m : prods)
+		cv::boxFilter(m, m, CV_32F, {window, window}, {-1, -1}, true,
+		              cv::BORDER_REFLECT);
+	cv::Mat out;
+	cv::merge(prods, 3, out);
+	return out;
 }
 
 }  // namespace bims::flow

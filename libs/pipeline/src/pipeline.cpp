@@ -90,12 +90,26 @@ const FrameResult& Pipeline::processFrame(
 	{
 		const cv::Mat obs = observed_.compute(prev_.grey, cur_.grey);
 		const auto cam = cameraOf(cur_);
+		if (cfg_.flow.refine_pose != "none")
+		{
+			r.flowPose =
+			    flow::refinePoseWithFlow(obs, cur_.depth, cam, r.T_CprevC,
+			                             flow::flowPoseParamsFrom(cfg_.flow),
+			                             nullptr, &observed_.tensor());
+			if (r.flowPose.ok)
+			{
+				r.T_CprevC = r.flowPose.T_prev_cur;
+				if (cfg_.flow.refine_to_ego)
+					r.T_WC = odom_.correctLastMotion(r.T_CprevC);
+			}
+		}
 		const cv::Mat exp =
 		    cfg_.flow.expected == "linear"
 		        ? flow::expectedFlowLinear(cur_.depth, cam, r.T_CprevC)
 		        : flow::expectedFlowExact(cur_.depth, cam, r.T_CprevC);
 		r.labels = flow::labelConsistency(obs, exp, cur_.depth, cam, r.T_CprevC,
-		                                  cfg_.flow, &r.labelStats);
+		                                  cfg_.flow, &r.labelStats,
+		                                  &observed_.tensor());
 		r.maskFlow.setTo(255, r.labels == static_cast<int8_t>(flow::kDiff));
 		r.flowObserved = obs;
 		r.flowExpected = exp;

@@ -123,6 +123,7 @@ class AttitudeFilter
 	                                         bool gyroOnly) const;
 	Eigen::Quaterniond qg_ = Eigen::Quaterniond::Identity();
 	std::deque<Stamped> hist_;
+	bool trimmed_ = false;  // hist_ lost its first samples (history_s)
 	Stats stats_;
 };
 

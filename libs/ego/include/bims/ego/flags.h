@@ -21,6 +21,10 @@ enum EgoFlag : uint32_t
 	kFlagAccelGated = 1u << 7,  ///< accelerometer rejected (linear accel.)
 	kFlagMagGated = 1u << 8,    ///< magnetometer rejected (disturbance)
 	kFlagBadImage = 1u << 9,    ///< no usable intensity or depth image
+	/** mode = imu: the first IMU attitude came after the first frame; the
+	 * world's rotation was re-anchored on it (T_WC jumps, T_CprevC is the
+	 * vision estimate). */
+	kFlagWorldReanchored = 1u << 10,
 };
 
 /** "imu_gap|too_few_tracks" style text ("ok" for none). */

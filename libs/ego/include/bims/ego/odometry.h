@@ -79,6 +79,17 @@ class Odometry
 	FrameEgomotion processFrame(const RgbdFrame& f,
 	                            const cv::Mat* movingMaskPrev = nullptr);
 
+	/** Replaces the motion of the frame processed last by \a T_CprevC
+	 * (e.g. refined against the dense optical flow): its T_WC and the motion
+	 * the next frame falls back on follow (also while the attitude filter
+	 * converges, when processFrame() takes the filter's absolute attitude;
+	 * attitude_blend pulls R_WC back towards the filter's in later frames).
+	 * Returns the new T_WC. Does
+	 * nothing (returns the current T_WC) when the last frame estimated no
+	 * motion (first frame, out-of-order or unusable frame). */
+	mrpt::poses::CPose3D correctLastMotion(
+	    const mrpt::poses::CPose3D& T_CprevC);
+
 	/** R_WC at camera time t from the IMU (nullopt without IMU data or
 	 * R_IC); *flags gets kFlagImuMissing / kFlagImuGap. \param gyroOnly
 	 * use the gyro-only chain (for inter-frame rotations). */
@@ -102,6 +113,10 @@ class Odometry
 	mrpt::poses::CPose3D T_WC_;  // latest pose
 	Eigen::Matrix3d R_WC_ = Eigen::Matrix3d::Identity();
 	Eigen::Vector3d t_WC_ = Eigen::Vector3d::Zero();
+	// pose of the previous frame, for correctLastMotion()
+	Eigen::Matrix3d R_WCprev_ = Eigen::Matrix3d::Identity();
+	Eigen::Vector3d t_WCprev_ = Eigen::Vector3d::Zero();
+	bool haveMotion_ = false;
 	Eigen::Matrix3d lastR_rel_ = Eigen::Matrix3d::Identity();
 	Eigen::Vector3d lastT_rel_ = Eigen::Vector3d::Zero();
 	size_t nFrames_ = 0;

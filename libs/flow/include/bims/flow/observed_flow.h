@@ -6,6 +6,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include <cmath>
+
 namespace bims::flow
 {
 class ObservedFlow
@@ -18,9 +20,30 @@ class ObservedFlow
 	 * std::invalid_argument on empty or mismatched images. */
 	cv::Mat compute(const cv::Mat& prev, const cv::Mat& cur);
 
+	/** Structure tensor of the last \a cur (structureTensor()), computed by
+	 * compute() when [flow] visible_change_grey > 0 or refine_pose is
+	 * enabled; empty otherwise. */
+	const cv::Mat& tensor() const { return tensor_; }
+
  private:
 	FlowParams p_;
+	cv::Mat tensor_;
 	cv::Ptr<cv::DISOpticalFlow> dis_;
 };
+
+/** Local structure tensor of a grey image (CV_8UC1): per pixel the window
+ * means of Ix^2, Ix Iy, Iy^2 (gradients in grey levels per pixel, Sobel),
+ * over a \a window x \a window box. CV_32FC3. For a flow difference d,
+ * sqrt(d^T S d) is the RMS intensity change d would cause in the window:
+ * whether the observed flow can tell d at all (aperture, textureless
+ * surfaces). */
+cv::Mat structureTensor(const cv::Mat& grey, int window);
+
+/** Smaller eigenvalue of a structure tensor pixel (Sxx, Sxy, Syy). */
+inline float minEigen(const cv::Vec3f& s)
+{
+	const float h = 0.5f * (s[0] - s[2]);
+	return 0.5f * (s[0] + s[2]) - std::sqrt(h * h + s[1] * s[1]);
+}
 
 }  // namespace bims::flow

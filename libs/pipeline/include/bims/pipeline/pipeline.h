@@ -6,6 +6,7 @@
 
 #include <bims/ego/odometry.h>
 #include <bims/flow/consistency.h>
+#include <bims/flow/flow_pose.h>
 #include <bims/flow/observed_flow.h>
 #include <bims/maps/motion_grids.h>
 #include <bims/pipeline/config.h>
@@ -32,11 +33,15 @@ struct StageTimes
 /** Everything one frame produced. */
 struct FrameResult
 {
-	size_t index = 0;               ///< 3D-scan index in the input (from 0)
-	double t = 0;                   ///< camera timestamp [s]
-	mrpt::poses::CPose3D T_WC;      ///< estimated camera pose
-	mrpt::poses::CPose3D T_CprevC;  ///< relative to the previous frame
+	size_t index = 0;           ///< 3D-scan index in the input (from 0)
+	double t = 0;               ///< camera timestamp [s]
+	mrpt::poses::CPose3D T_WC;  ///< estimated camera pose
+	/** Relative to the previous frame: the egomotion's, or its refinement
+	 * against the dense flow ([flow] refine_pose; then ego.T_CprevC and
+	 * ego.T_WC keep the feature-based estimate). */
+	mrpt::poses::CPose3D T_CprevC;
 	ego::FrameEgomotion ego;        ///< egomotion details (flags, inliers, ...)
+	flow::FlowPoseResult flowPose;  ///< the dense-flow refinement, if any
 	bool warmup = false;            ///< mask forced empty (warm-up frame)
 	/** The variant's moving-pixel mask (CV_8UC1, 255 = moving). */
 	cv::Mat mask;

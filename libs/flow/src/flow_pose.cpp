@@ -1,0 +1,268 @@
+#include <bims/flow/flow_pose.h>
+#include <bims/flow/observed_flow.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+namespace bims::flow
+{
+namespace
+{
+inline bool usable(float z, double zmin, double zmax)
+{
+	return std::isfinite(z) && z >= zmin && z <= zmax;
+}
+
+Eigen::Matrix3d expSO3(const Eigen::Vector3d& w)
+{
+	const double th = w.norm();
+	if (th < 1e-12) return Eigen::Matrix3d::Identity();
+	return Eigen::AngleAxisd(th, w / th).toRotationMatrix();
+}
+
+double median(std::vector<double> v)
+{
+	if (v.empty()) return 0;
+	const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+	std::nth_element(v.begin(), mid, v.end());
+	return *mid;
+}
+
+struct Sample
+{
+	Eigen::Vector3d p;  // current camera frame [m]
+	Eigen::Vector2d x;  // observed position in the previous image [px]
+};
+}  // namespace
+
+FlowPoseMode flowPoseModeFromString(const std::string& s)
+{
+	if (s == "translation") return FlowPoseMode::Translation;
+	if (s == "se3") return FlowPoseMode::SE3;
+	throw std::invalid_argument("unknown flow pose mode '" + s +
+	                            "' (translation|se3)");
+}
+
+FlowPoseParams flowPoseParamsFrom(const FlowParams& f)
+{
+	FlowPoseParams p;
+	p.mode = flowPoseModeFromString(f.refine_pose);
+	p.step_px = f.refine_step_px;
+	p.iterations = f.refine_iterations;
+	p.max_depth_m = f.max_depth_m;
+	p.min_texture = f.refine_min_texture;
+	return p;
+}
+
+cv::Mat depthEdgeMask(const cv::Mat& depth, double rel, int radius)
+{
+	if (depth.type() != CV_32FC1)
+		throw std::invalid_argument("depthEdgeMask: depth must be CV_32FC1");
+	if (radius < 1) throw std::invalid_argument("depthEdgeMask: radius < 1");
+	cv::Mat out(depth.size(), CV_8UC1, cv::Scalar(0));
+	const int offs[8][2] = {{-1, -1}, {0, -1}, {1, -1}, {-1, 0},
+	                        {1, 0},   {-1, 1}, {0, 1},  {1, 1}};
+	for (int v = 0; v < depth.rows; v++)
+	{
+		const float* zr = depth.ptr<float>(v);
+		auto* o = out.ptr<uint8_t>(v);
+		for (int u = 0; u < depth.cols; u++)
+		{
+			const float z = zr[u];
+			if (!(std::isfinite(z) && z > 0)) continue;
+			for (const auto& d : offs)
+			{
+				const int uu = u + d[0] * radius, vv = v + d[1] * radius;
+				if (uu < 0 || vv < 0 || uu >= depth.cols || vv >= depth.rows)
+					continue;
+				const float zn = depth.at<float>(vv, uu);
+				if (!(std::isfinite(zn) && zn > 0) ||
+				    std::abs(zn - z) > rel * std::min(z, zn))
+				{
+					o[u] = 255;
+					break;
+				}
+			}
+		}
+	}
+	return out;
+}
+
+FlowPoseResult refinePoseWithFlow(const cv::Mat& observed, const cv::Mat& depth,
+                                  const mrpt::img::TCamera& cam,
+                                  const mrpt::poses::CPose3D& init,
+                                  const FlowPoseParams& p,
+                                  const cv::Mat* exclude, const cv::Mat* tensor)
+{
+	if (observed.type() != CV_32FC2 || depth.type() != CV_32FC1 ||
+	    observed.size() != depth.size())
+		throw std::invalid_argument(
+		    "refinePoseWithFlow: need a CV_32FC2 flow and a CV_32FC1 depth of "
+		    "one size");
+	if (exclude && !exclude->empty() &&
+	    (exclude->type() != CV_8UC1 || exclude->size() != depth.size()))
+		throw std::invalid_argument(
+		    "refinePoseWithFlow: exclusion mask must be CV_8UC1 of the "
+		    "depth's size");
+	const bool useT = tensor && !tensor->empty();
+	if (useT && (tensor->type() != CV_32FC3 || tensor->size() != depth.size()))
+		throw std::invalid_argument(
+		    "refinePoseWithFlow: structure tensor must be CV_32FC3 of the "
+		    "depth's size");
+	if (p.step_px < 1 || p.iterations < 1)
+		throw std::invalid_argument(
+		    "refinePoseWithFlow: step_px and iterations must be >= 1");
+
+	FlowPoseResult res;
+	res.T_prev_cur = init;
+	const double fx = cam.fx(), fy = cam.fy(), cx = cam.cx(), cy = cam.cy();
+	const bool useEx = exclude && !exclude->empty();
+
+	// Samples: grid pixels with depth, off depth edges, finite flow.
+	std::vector<Sample> S;
+	S.reserve(static_cast<size_t>((depth.rows / p.step_px + 1) *
+	                              (depth.cols / p.step_px + 1)));
+	const int r = std::max(1, p.step_px / 2);
+	for (int v = r; v + r < depth.rows; v += p.step_px)
+		for (int u = r; u + r < depth.cols; u += p.step_px)
+		{
+			const float z = depth.at<float>(v, u);
+			if (!usable(z, p.min_depth_m, p.max_depth_m)) continue;
+			if (useEx && exclude->at<uint8_t>(v, u)) continue;
+			if (useT && minEigen(tensor->at<cv::Vec3f>(v, u)) < p.min_texture)
+				continue;
+			const cv::Vec2f f = observed.at<cv::Vec2f>(v, u);
+			if (!std::isfinite(f[0]) || !std::isfinite(f[1])) continue;
+			bool edge = false;
+			for (const auto& d : {cv::Point(-r, 0), cv::Point(r, 0),
+			                      cv::Point(0, -r), cv::Point(0, r)})
+			{
+				const float zn = depth.at<float>(v + d.y, u + d.x);
+				if (!(std::isfinite(zn) && zn > 0) ||
+				    std::abs(zn - z) > p.edge_rel * std::min(z, zn))
+				{
+					edge = true;
+					break;
+				}
+			}
+			if (edge) continue;
+			Sample s;
+			s.p = {(u - cx) / fx * z, (v - cy) / fy * z, z};
+			s.x = {u + f[0], v + f[1]};
+			S.push_back(s);
+		}
+	res.samples = static_cast<int>(S.size());
+	if (res.samples < p.min_samples) return res;
+
+	Eigen::Matrix3d R;
+	const auto& Rm = init.getRotationMatrix();
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < 3; j++) R(i, j) = Rm(i, j);
+	Eigen::Vector3d t(init.x(), init.y(), init.z());
+	const bool se3 = p.mode == FlowPoseMode::SE3;
+
+	std::vector<double> err(S.size());
+	auto residuals = [&](const Eigen::Matrix3d& Rc, const Eigen::Vector3d& tc)
+	{
+		for (size_t i = 0; i < S.size(); i++)
+		{
+			const Eigen::Vector3d q = Rc * S[i].p + tc;
+			if (q.z() <= 1e-6)
+			{
+				err[i] = 1e9;
+				continue;
+			}
+			const Eigen::Vector2d pr(fx * q.x() / q.z() + cx,
+			                         fy * q.y() / q.z() + cy);
+			err[i] = (S[i].x - pr).norm();
+		}
+	};
+	residuals(R, t);
+	res.median_px_before = median(err);
+
+	auto tukeyCut = [&](const std::vector<double>& e)
+	{
+		return std::clamp(p.tukey_sigmas * 1.4826 * median(e), p.tukey_min_px,
+		                  std::max(p.tukey_min_px, p.tukey_max_px));
+	};
+	double cut = 0;
+	for (int it = 0; it < p.iterations; it++)
+	{
+		const bool tukey = it >= p.iterations / 3;
+		if (tukey) cut = tukeyCut(err);
+		Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+		Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+		size_t nIn = 0;
+		for (size_t i = 0; i < S.size(); i++)
+		{
+			const double e = err[i];
+			double w;
+			if (tukey)
+			{
+				if (e >= cut) continue;
+				const double a = 1 - (e / cut) * (e / cut);
+				w = a * a;
+			}
+			else
+				w = e <= p.huber_px ? 1.0 : p.huber_px / e;
+			const Eigen::Vector3d q = R * S[i].p + t;
+			if (q.z() <= 1e-6) continue;
+			const double iz = 1.0 / q.z();
+			Eigen::Matrix<double, 2, 3> Jp;
+			Jp << fx * iz, 0, -fx * q.x() * iz * iz, 0, fy * iz,
+			    -fy * q.y() * iz * iz;
+			Eigen::Matrix<double, 3, 6> Jq;
+			Jq << 0, q.z(), -q.y(), 1, 0, 0,  //
+			    -q.z(), 0, q.x(), 0, 1, 0,    //
+			    q.y(), -q.x(), 0, 0, 0, 1;    // d(q + w x q + d)/d(w, d)
+			const Eigen::Matrix<double, 2, 6> A = Jp * Jq;
+			const Eigen::Vector2d rr(S[i].x.x() - (fx * q.x() * iz + cx),
+			                         S[i].x.y() - (fy * q.y() * iz + cy));
+			H.noalias() += w * A.transpose() * A;
+			g.noalias() += w * A.transpose() * rr;
+			nIn++;
+		}
+		if (nIn < static_cast<size_t>(p.min_samples)) return res;
+		Eigen::Matrix<double, 6, 1> xi = Eigen::Matrix<double, 6, 1>::Zero();
+		// Levenberg damping keeps the weakly observed directions (e.g. the
+		// translation along the optical axis of a far scene) in place.
+		for (int k = 0; k < 6; k++) H(k, k) *= 1.0 + 1e-6;
+		if (se3)
+			xi = H.ldlt().solve(g);
+		else
+			xi.tail<3>() =
+			    H.bottomRightCorner<3, 3>().ldlt().solve(g.tail<3>());
+		if (!xi.allFinite()) return res;
+		const Eigen::Matrix3d dR = expSO3(xi.head<3>());
+		R = dR * R;
+		t = dR * t + xi.tail<3>();
+		residuals(R, t);
+		if (xi.head<3>().norm() < 1e-7 && xi.tail<3>().norm() < 1e-6 && tukey)
+			break;
+	}
+	if (cut <= 0) cut = tukeyCut(err);
+	size_t nIn = 0;
+	for (double e : err) nIn += e < cut;
+	res.inlier_fraction = static_cast<double>(nIn) / S.size();
+	res.median_px_after = median(err);
+	// Orthonormalise and build the pose.
+	Eigen::JacobiSVD<Eigen::Matrix3d> svd(
+	    R, Eigen::ComputeFullU | Eigen::ComputeFullV);
+	R = svd.matrixU() * svd.matrixV().transpose();
+	mrpt::math::CMatrixDouble33 Ro;
+	mrpt::math::CVectorFixedDouble<3> to;
+	for (int i = 0; i < 3; i++)
+	{
+		to[i] = t[i];
+		for (int j = 0; j < 3; j++) Ro(i, j) = R(i, j);
+	}
+	res.T_prev_cur = mrpt::poses::CPose3D::FromRotationAndTranslation(Ro, to);
+	res.ok = true;
+	return res;
+}
+
+}  // namespace bims::flow
