@@ -22,18 +22,20 @@ echo "== the bundled sample"
 
 mkdir -p "$OUT"
 table="$OUT/summary.txt"
-printf '%-14s %9s %9s %9s %9s %9s %12s\n' variant precision recall F1 IoU frames/s "ATE RMSE m" > "$table"
+printf '%-14s %9s %9s %9s %9s %9s %9s %12s\n' variant precision recall F1 IoU "voxel F1" frames/s "ATE RMSE m" > "$table"
 for v in bottom-only flow-only fused fused-raycast; do
   echo
   echo "== bims-run --variant $v"
   "$BIN/bims-run" "$CONFIG" "$SAMPLE" -o "$OUT/$v" --variant "$v" -q | tee "$OUT/$v.log"
-  total=$("$BIN/bims-eval" masks "$GT/masks" "$OUT/$v/masks" --depth-valid "$SAMPLE" -q | tail -n 1)
+  ev=$("$BIN/bims-eval" masks "$GT/masks" "$OUT/$v/masks" --depth-valid "$SAMPLE" -q)
+  total=$(echo "$ev" | tail -n 1)
+  vf1=$(echo "$ev" | sed -n 's/^voxel_total.* F1 \([0-9.na]*\) .*/\1/p')
   ate=$("$BIN/bims-eval" traj "$GT/groundtruth.txt" "$OUT/$v/trajectory.txt" -o "$OUT/$v/trajectory.png" 2>/dev/null |
         awk '/^ate_rmse/ {print $2}')
   fps=$(awk '/frames\/s/ {for (i = 1; i <= NF; i++) if ($i == "frames/s;") print $(i-1)}' "$OUT/$v.log")
   # total precision P recall R F1 F IoU I
   read -r _ _ p _ r _ f _ i <<< "$total"
-  printf '%-14s %9s %9s %9s %9s %9s %12s\n' "$v" "$p" "$r" "$f" "$i" "$fps" "$ate" >> "$table"
+  printf '%-14s %9s %9s %9s %9s %9s %9s %12s\n' "$v" "$p" "$r" "$f" "$i" "$vf1" "$fps" "$ate" >> "$table"
 done
 
 echo

@@ -2,7 +2,8 @@
 # The segmentation table of docs/EVALUATION (docs/results.md) on every simulator
 # preset: bottom tier only, flow only, fused (decay = all, the paper's literal
 # model), fused (the config's decay), fused + ray cast, side by side on the same
-# frames. Not part of CTest (minutes).
+# frames, pixel level and voxel level (bims-eval masks --voxel-size 0.05). Not
+# part of CTest (minutes).
 #
 # Usage, from the repository root after building:
 #   scripts/segmentation_table.sh [BUILD_DIR] [DATA_DIR] [RES] [FRAMES] [PRESET...]
@@ -40,8 +41,8 @@ make_config() {
 		{print}' config/default.ini > "$out"
 }
 
-echo "| preset | variant | precision | recall | F1 | IoU | ATE RMSE [m] | ms/frame (pipeline, median) |"
-echo "|---|---|---|---|---|---|---|---|"
+echo "| preset | variant | precision | recall | F1 | IoU | voxel F1 | ATE RMSE [m] | ms/frame (pipeline, median) |"
+echo "|---|---|---|---|---|---|---|---|---|"
 for p in $PRESETS; do
 	rl="$DATA/$p.rawlog"
 	gt="$DATA/${p}_gt"
@@ -56,12 +57,13 @@ for p in $PRESETS; do
 		read -r name variant cfg <<< "$row"
 		out="$DATA/out_${p}_${name//[,=+]/_}"
 		"$BIN/bims-run" "$DATA/$cfg.ini" "$rl" -o "$out" --variant "$variant" -q > "$out.log" 2>&1 ||
-			{ echo "| $p | $name | run failed: see $out.log | | | | | |"; continue; }
-		read -r _ _ pr _ re _ f1 _ iou <<< "$("$BIN/bims-eval" masks "$gt/masks" "$out/masks" \
-			--depth-valid "$rl" -q 2>/dev/null | tail -n 1)"
+			{ echo "| $p | $name | run failed: see $out.log | | | | | | |"; continue; }
+		ev=$("$BIN/bims-eval" masks "$gt/masks" "$out/masks" --depth-valid "$rl" -q --no-plots 2>/dev/null)
+		read -r _ _ pr _ re _ f1 _ iou <<< "$(echo "$ev" | tail -n 1)"
+		vf1=$(echo "$ev" | sed -n 's/^voxel_total.* F1 \([0-9.na]*\) .*/\1/p')
 		ate=$("$BIN/bims-eval" traj "$gt/groundtruth.txt" "$out/trajectory.txt" --no-plot 2>/dev/null |
 			awk '/^ate_rmse/ {print $2}')
 		ms=$(sed -n 's/.*"total": *{[^}]*"median": *\([0-9.]*\).*/\1/p' "$out/metrics.json" | head -n 1)
-		echo "| $p | $name | $pr | $re | $f1 | $iou | $ate | ${ms:--} |"
+		echo "| $p | $name | $pr | $re | $f1 | $iou | ${vf1:--} | $ate | ${ms:--} |"
 	done
 done

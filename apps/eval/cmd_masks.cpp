@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -115,6 +116,11 @@ int cmdMasks(int argc, char** argv)
 	TCLAP::ValueArg<std::string> json(
 	    "", "json", "also write per-frame and total figures as JSON", false, "",
 	    "FILE", cmd);
+	TCLAP::ValueArg<double> voxel(
+	    "", "voxel-size",
+	    "with --depth-valid: edge of the cubes of the voxel-level figures "
+	    "[m] (0 = none)",
+	    false, 0.05, "M", cmd);
 	TCLAP::SwitchArg quiet("q", "quiet", "no per-frame lines", cmd);
 	cmd.parse(argc, argv);
 
@@ -140,7 +146,9 @@ int cmdMasks(int argc, char** argv)
 	std::unique_ptr<ScanStream> scans;
 	if (depth.isSet()) scans = std::make_unique<ScanStream>(depth.getValue());
 
-	ev::MaskMetrics total;
+	if (voxel.getValue() < 0 || !std::isfinite(voxel.getValue()))
+		throw bims::UsageError("--voxel-size must be >= 0");
+	ev::MaskMetrics total, totalVoxels;
 	size_t compared = 0, missing = 0;
 	std::string jsonFrames;
 	for (const auto& f : gtFiles)
@@ -153,12 +161,15 @@ int cmdMasks(int argc, char** argv)
 		}
 		const std::string gtPath = gtDir + "/" + f.name;
 		const cv::Mat g = ev::loadMask(gtPath), p = ev::loadMask(predPath);
-		cv::Mat valid, background;
+		cv::Mat valid, background, depthM;
+		mrpt::img::TCamera cam;
 		if (scans)
 		{
 			auto s = scans->get(f.index);
 			s->load();
 			const cv::Mat d = ev::depthFromObservation(*s);
+			depthM = d;
+			cam = s->cameraParams;
 			valid = d > 0;
 			if (s->hasIntensityImage && !s->intensityImage.isEmpty())
 				background =
@@ -175,6 +186,10 @@ int cmdMasks(int argc, char** argv)
 		try
 		{
 			m.accumulate(g, p, valid);
+			if (!depthM.empty() && voxel.getValue() > 0)
+				totalVoxels +=
+				    ev::voxelMaskMetrics(g, p, depthM, cam.fx(), cam.fy(),
+				                         cam.cx(), cam.cy(), voxel.getValue());
 		}
 		catch (const std::invalid_argument& e)
 		{
@@ -212,10 +227,16 @@ int cmdMasks(int argc, char** argv)
 		    stderr,
 		    "bims-eval masks: overlays (TP green, FP red, FN blue) in %s\n",
 		    outDir.c_str());
-	std::fprintf(
-	    stderr,
-	    "bims-eval masks: voxel-level figures not computed (the ground truth "
-	    "has no voxel labels)\n");
+	const bool voxels = scans && voxel.getValue() > 0;
+	if (voxels)
+		std::printf(
+		    "voxel_total voxel %.3f m (camera-frame cubes, majority "
+		    "of their pixels): %s\n",
+		    voxel.getValue(), totalVoxels.scoresLine().c_str());
+	else
+		std::fprintf(stderr,
+		             "bims-eval masks: voxel-level figures need --depth-valid "
+		             "and --voxel-size > 0\n");
 	if (json.isSet())
 	{
 		std::ofstream jf(json.getValue());
@@ -224,8 +245,11 @@ int cmdMasks(int argc, char** argv)
 		   << ",\n  \"frames_compared\": " << compared
 		   << ",\n  \"frames_missing\": " << missing
 		   << ",\n  \"depth_valid_only\": " << (scans ? "true" : "false")
-		   << ",\n  \"total\": " << total.toJson() << ",\n  \"frames\": [\n"
-		   << jsonFrames << "\n  ]\n}\n";
+		   << ",\n  \"total\": " << total.toJson();
+		if (voxels)
+			jf << ",\n  \"voxel_size_m\": " << voxel.getValue()
+			   << ",\n  \"total_voxels\": " << totalVoxels.toJson();
+		jf << ",\n  \"frames\": [\n" << jsonFrames << "\n  ]\n}\n";
 		if (!jf) throw std::runtime_error(json.getValue() + ": cannot write");
 	}
 	std::printf(

@@ -1,4 +1,6 @@
 #include <bims/eval/mask_metrics.h>
+#include <map>
+#include <tuple>
 
 #include <cmath>
 #include <limits>
@@ -127,6 +129,62 @@ std::string MaskMetrics::toJson() const
 	  << ", \"recall\": " << jnum(recall()) << ", \"f1\": " << jnum(f1())
 	  << ", \"iou\": " << jnum(iou()) << "}";
 	return o.str();
+}
+
+MaskMetrics voxelMaskMetrics(const cv::Mat& gt, const cv::Mat& pred,
+                             const cv::Mat& depthM, double fx, double fy,
+                             double cx, double cy, double voxelM)
+{
+	if (gt.type() != CV_8UC1 || pred.type() != CV_8UC1 ||
+	    depthM.type() != CV_32FC1 || gt.size() != pred.size() ||
+	    gt.size() != depthM.size())
+		throw std::invalid_argument(
+		    "voxelMaskMetrics: need CV_8UC1 masks and CV_32FC1 depth of one "
+		    "size");
+	if (!(voxelM > 0) || !(fx > 0) || !(fy > 0))
+		throw std::invalid_argument(
+		    "voxelMaskMetrics: voxel size and focal lengths must be > 0");
+	struct Count
+	{
+		uint32_t n = 0, g = 0, p = 0;
+	};
+	std::map<std::tuple<int64_t, int64_t, int64_t>, Count> cells;
+	MaskMetrics m;
+	for (int v = 0; v < gt.rows; ++v)
+	{
+		const float* d = depthM.ptr<float>(v);
+		const uint8_t* g = gt.ptr<uint8_t>(v);
+		const uint8_t* p = pred.ptr<uint8_t>(v);
+		for (int u = 0; u < gt.cols; ++u)
+		{
+			const double z = d[u];
+			if (!(z > 0) || !std::isfinite(z))
+			{
+				m.invalid++;
+				continue;
+			}
+			const double x = (u - cx) * z / fx, y = (v - cy) * z / fy;
+			auto& c = cells[{int64_t(std::floor(x / voxelM)),
+			                 int64_t(std::floor(y / voxelM)),
+			                 int64_t(std::floor(z / voxelM))}];
+			c.n++;
+			c.g += g[u] >= 128;
+			c.p += p[u] >= 128;
+		}
+	}
+	for (const auto& [k, c] : cells)
+	{
+		const bool g = 2 * c.g > c.n, p = 2 * c.p > c.n;
+		if (g && p)
+			m.tp++;
+		else if (p)
+			m.fp++;
+		else if (g)
+			m.fn++;
+		else
+			m.tn++;
+	}
+	return m;
 }
 
 cv::Mat loadMask(const std::string& path)

@@ -110,3 +110,37 @@ TEST(MaskMetrics, OverlayColours)
 	EXPECT_EQ(ov.at<cv::Vec3b>(70, 70), cv::Vec3b(40, 40, 40));
 	EXPECT_EQ(ov.at<cv::Vec3b>(50, 90), cv::Vec3b(0, 0, 0));
 }
+
+TEST(VoxelMaskMetrics, EachCellCountsOnceHoweverManyPixelsSeeIt)
+{
+	// 64x64 px, f = 64 px: a near object (0.5 m, left 32 columns) and a far
+	// one (4 m, right 32 columns), both moving in the ground truth; the
+	// prediction finds only the far one. At 5 cm a far pixel (6.25 cm) is a
+	// cell of its own, near pixels share cells (0.78 cm each).
+	const int W = 64, H = 64;
+	cv::Mat depth(H, W, CV_32FC1), gt(H, W, CV_8UC1, cv::Scalar(255)),
+	    pred = cv::Mat::zeros(H, W, CV_8UC1);
+	depth.colRange(0, 32).setTo(0.5f);
+	depth.colRange(32, 64).setTo(4.0f);
+	pred.colRange(32, 64).setTo(255);
+	const auto px = bims::eval::MaskMetrics::compute(gt, pred);
+	EXPECT_DOUBLE_EQ(px.recall(), 0.5);
+	const auto vx =
+	    bims::eval::voxelMaskMetrics(gt, pred, depth, 64, 64, 32, 32, 0.05);
+	EXPECT_EQ(vx.fp, 0u);
+	EXPECT_EQ(vx.tp, 32u * 64u);  // one far cell per pixel
+	EXPECT_GT(vx.fn, 0u);
+	EXPECT_GT(vx.recall(), 0.9);
+	// Identical masks score 1; holes in depth are counted as invalid.
+	depth.at<float>(0, 0) = 0;
+	depth.at<float>(1, 1) = std::nanf("");
+	const auto same =
+	    bims::eval::voxelMaskMetrics(gt, gt, depth, 64, 64, 32, 32, 0.05);
+	EXPECT_DOUBLE_EQ(same.f1(), 1.0);
+	EXPECT_EQ(same.invalid, 2u);
+	EXPECT_THROW(bims::eval::voxelMaskMetrics(gt, gt, depth, 64, 64, 32, 32, 0),
+	             std::invalid_argument);
+	EXPECT_THROW(bims::eval::voxelMaskMetrics(gt, gt.colRange(0, 8).clone(),
+	                                          depth, 64, 64, 32, 32, 0.05),
+	             std::invalid_argument);
+}

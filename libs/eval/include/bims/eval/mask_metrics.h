@@ -46,6 +46,18 @@ struct MaskMetrics
 	std::string toJson() const;
 };
 
+/** Voxel-level counts of one frame: the pixels with valid \a depthM
+ * (CV_32FC1 metres along the optical axis, 0/NaN = none) are back-projected
+ * with the pinhole (fx, fy, cx, cy) into the camera frame and binned into
+ * cubes of edge \a voxelM; a cube is moving in the ground truth (in the
+ * prediction) when more than half of its pixels are. Each 3D cell counts
+ * once, however many pixels see it, so near surfaces do not outweigh far
+ * ones as they do at pixel level. Throws std::invalid_argument on
+ * inconsistent sizes or a non-positive voxel or focal length. */
+MaskMetrics voxelMaskMetrics(const cv::Mat& gt, const cv::Mat& pred,
+                             const cv::Mat& depthM, double fx, double fy,
+                             double cx, double cy, double voxelM);
+
 /** Reads an 8-bit single-channel mask PNG; throws std::runtime_error naming
  * the file if it is missing, unreadable or of another type. */
 cv::Mat loadMask(const std::string& path);
