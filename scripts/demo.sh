@@ -32,7 +32,7 @@ for v in bottom-only flow-only fused fused-raycast; do
   vf1=$(echo "$ev" | sed -n 's/^voxel_total.* F1 \([0-9.na]*\) .*/\1/p')
   ate=$("$BIN/bims-eval" traj "$GT/groundtruth.txt" "$OUT/$v/trajectory.txt" -o "$OUT/$v/trajectory.png" 2>/dev/null |
         awk '/^ate_rmse/ {print $2}')
-  fps=$(awk '/frames\/s/ {for (i = 1; i <= NF; i++) if ($i == "frames/s;") print $(i-1)}' "$OUT/$v.log")
+  fps=$(sed -n 's/^ *"fps": *\([0-9.]*\).*/\1/p' "$OUT/$v/metrics.json" | head -n 1)
   # total precision P recall R F1 F IoU I
   read -r _ _ p _ r _ f _ i <<< "$total"
   printf '%-14s %9s %9s %9s %9s %9s %9s %12s\n' "$v" "$p" "$r" "$f" "$i" "$vf1" "$fps" "$ate" >> "$table"
