@@ -303,25 +303,44 @@ void FrameCloudBuilder::keyPoints(FrameCloud& out)
 	for (int a = 0; a < 3; ++a) bits[a] = bitWidth(uint64_t(hi[a] - lo[a]));
 	const unsigned sz = 9, sy = sz + bits[2], sx = sy + bits[1];
 	const unsigned total = sx + bits[0];
+	// Neighbouring pixels often fall in one cell: runs of equal keys among
+	// consecutive readings are sorted once, with their length.
+	keys_.resize(w);
 	order_.resize(w);
+	runOf_.resize(w);
+	runLen_.resize(w);
+	size_t r = 0;
+	uint64_t prev = ~uint64_t(0);
 	for (size_t i = 0; i < w; ++i)
 	{
 		const auto& p = out.points_W[i];
 		const int32_t kx = coordToIndex(p.x, inv), ky = coordToIndex(p.y, inv),
 		              kz = coordToIndex(p.z, inv);
-		keys_[i] = (uint64_t((kx >> 3) - lo[0]) << sx) |
-		           (uint64_t((ky >> 3) - lo[1]) << sy) |
-		           (uint64_t((kz >> 3) - lo[2]) << sz) |
-		           uint64_t((kx & 7) | ((ky & 7) << 3) | ((kz & 7) << 6));
-		order_[i] = uint32_t(i);
+		const uint64_t key =
+		    (uint64_t((kx >> 3) - lo[0]) << sx) |
+		    (uint64_t((ky >> 3) - lo[1]) << sy) |
+		    (uint64_t((kz >> 3) - lo[2]) << sz) |
+		    uint64_t((kx & 7) | ((ky & 7) << 3) | ((kz & 7) << 6));
+		if (i == 0 || key != prev)
+		{
+			keys_[r] = key;
+			order_[r] = uint32_t(r);
+			runLen_[r] = 0;
+			++r;
+			prev = key;
+		}
+		runOf_[i] = uint32_t(r - 1);
+		runLen_[r - 1]++;
 	}
-	keys_.resize(w);
+	keys_.resize(r);
+	order_.resize(r);
 	radixSortPairs(keys_, order_, keysTmp_, orderTmp_, total);
 	const uint64_t mx = (uint64_t(1) << bits[0]) - 1,
 	               my = (uint64_t(1) << bits[1]) - 1,
 	               mz = (uint64_t(1) << bits[2]) - 1;
+	runCell_.resize(r);
 	uint64_t last = ~uint64_t(0);
-	for (size_t j = 0; j < w; ++j)
+	for (size_t j = 0; j < r; ++j)
 	{
 		const uint64_t key = keys_[j];
 		if (key != last)
@@ -334,9 +353,10 @@ void FrameCloudBuilder::keyPoints(FrameCloud& out)
 			out.hits.push_back(0);
 			last = key;
 		}
-		out.hits.back()++;
-		out.cellOfPoint[order_[j]] = uint32_t(out.cells.size() - 1);
+		out.hits.back() += runLen_[order_[j]];
+		runCell_[order_[j]] = uint32_t(out.cells.size() - 1);
 	}
+	for (size_t i = 0; i < w; ++i) out.cellOfPoint[i] = runCell_[runOf_[i]];
 }
 
 }  // namespace bims::maps

@@ -151,6 +151,7 @@ class FrameCloudBuilder
 	// Scratch of keyPoints(): compact keys of the readings and their order.
 	std::vector<uint64_t> keys_, keysTmp_;
 	std::vector<uint32_t> order_, orderTmp_;
+	std::vector<uint32_t> runOf_, runLen_, runCell_;
 };
 
 }  // namespace bims::maps
