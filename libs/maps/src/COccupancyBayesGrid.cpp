@@ -113,7 +113,7 @@ std::vector<mrpt::math::TPoint3D> COccupancyBayesGrid::cellsAbove(
 void COccupancyBayesGrid::applyMiss(Cell& c, uint32_t F) const
 {
 	if (c.stamp == F) return;  // hit (or already missed) in this frame
-	if (c.stamp == 0 && hasUnknown_) c.l = unknown_;
+	startIfUnobserved(c, c.stamp);
 	c.lPrev = c.l;
 	c.l = std::max<LogOddsFx>(c.l - miss_, lmin_);
 	c.stamp = F;
@@ -121,11 +121,11 @@ void COccupancyBayesGrid::applyMiss(Cell& c, uint32_t F) const
 
 void COccupancyBayesGrid::integrate(const FrameCloud& f,
                                     std::vector<float>* priorOut,
-                                    const std::vector<float>* weight)
+                                    const std::vector<uint8_t>* hold)
 {
-	if (weight && weight->size() != f.cells.size())
+	if (hold && hold->size() != f.cells.size())
 		throw std::invalid_argument(
-		    "COccupancyBayesGrid::integrate: one weight per cell expected");
+		    "COccupancyBayesGrid::integrate: one hold flag per cell expected");
 	if (f.voxel_size != params_.voxel_size)
 		throw std::invalid_argument(
 		    "COccupancyBayesGrid::integrate: frame keyed for voxel size " +
@@ -154,10 +154,7 @@ void COccupancyBayesGrid::integrate(const FrameCloud& f,
 		}
 		const LogOddsFx prior = priorFixed(*c, F);
 		c->lPrev = prior;
-		LogOddsFx hit = hitFixed(f.hits[i]);
-		if (weight && (*weight)[i] < 1)
-			hit = LogOddsFx(
-			    std::lround(double(hit) * std::max(0.f, (*weight)[i])));
+		const LogOddsFx hit = (hold && (*hold)[i]) ? 0 : hitFixed(f.hits[i]);
 		c->l = LogOddsFx(std::min<int64_t>(int64_t(prior) + hit, lmax_));
 		c->stamp = F;
 		if (priorOut) (*priorOut)[i] = float(fromFixed(prior));

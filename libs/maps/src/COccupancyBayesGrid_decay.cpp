@@ -111,16 +111,7 @@ void COccupancyBayesGrid::decayRaycast(const FrameCloud& f, uint32_t F)
 
 	size_t over = 0;
 	const LogOddsFx miss = miss_, lmin = lmin_;
-	const bool hasUnknown = hasUnknown_;
-	const LogOddsFx unknown = unknown_;
-	auto missCell = [&](Cell& c)
-	{
-		if (c.stamp == F) return;  // hit (or already missed) in this frame
-		if (c.stamp == 0 && hasUnknown) c.l = unknown;  // first observation
-		c.lPrev = c.l;
-		c.l = std::max<LogOddsFx>(c.l - miss, lmin);
-		c.stamp = F;
-	};
+	auto missCell = [&](Cell& c) { applyMiss(c, F); };
 	auto cast = [&](const RayEnd& e, auto&& visit)
 	{ traverseRay(a, e.p, visit); };
 	if (cells > kMaxTable)
@@ -200,7 +191,8 @@ void COccupancyBayesGrid::decayRaycast(const FrameCloud& f, uint32_t F)
 						             &c.stamp, &s, F, false, __ATOMIC_RELAXED,
 						             __ATOMIC_RELAXED))
 							     return;  // hit, or missed by another ray
-						     if (s == 0 && hasUnknown) c.l = unknown;
+						     startIfUnobserved(
+						         c, s);  // s: the stamp before the claim
 						     c.lPrev = c.l;
 						     c.l = std::max<LogOddsFx>(c.l - miss, lmin);
 					     }

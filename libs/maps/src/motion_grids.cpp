@@ -80,10 +80,9 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 		if (exclude)
 		{
 			const auto& dec = decisionTier_ == 1 ? post1_ : post2_;
-			weight_.resize(f.cells.size());
-			for (size_t i = 0; i < f.cells.size(); ++i)
-				weight_[i] = dec[i] > 0 ? 0.f : 1.f;
-			t0_->integrate(f, nullptr, &weight_);
+			hold_.resize(f.cells.size());
+			for (size_t i = 0; i < f.cells.size(); ++i) hold_[i] = dec[i] > 0;
+			t0_->integrate(f, nullptr, &hold_);
 		}
 		else
 			t0_->integrate(f);

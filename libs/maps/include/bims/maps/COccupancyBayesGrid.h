@@ -43,15 +43,13 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 
 	/** Folds one frame in (frame number frameCount()+1). If
 	 * \a priorLogOdds is given it receives O- (log-odds before this frame,
-	 * after lazy decay) for each of frame.cells, for tier 1. If \a weight
-	 * is given (one value in [0, 1] per frame cell, the probability that
-	 * the cell's readings are of the static scene), a cell's hit evidence is
-	 * scaled by its weight, and a cell with weight < 1 gets no miss and no
-	 * free-space evidence in this frame (weight 0: it keeps its belief, as
-	 * for the readings of a moving object). */
+	 * after lazy decay) for each of frame.cells, for tier 1. If \a hold is
+	 * given (one flag per frame cell), a cell with a non-zero flag keeps its
+	 * belief: no hit, no miss and no free-space evidence in this frame, as
+	 * for the readings of a moving object (GridParams::exclude_moving). */
 	void integrate(const FrameCloud& frame,
 	               std::vector<float>* priorLogOdds = nullptr,
-	               const std::vector<float>* weight = nullptr);
+	               const std::vector<uint8_t>* hold = nullptr);
 
 	/** O- for each of frame.cells, without modifying the map. Order
 	 * independent: if this frame (same non-zero timestamp) was already
@@ -129,6 +127,12 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 	/** Prior (before frame G) of a cell, lazily decayed under decay = all;
 	 * a never-observed cell has the unknown prior. */
 	LogOddsFx priorFixed(const Cell& c, uint32_t G) const;
+	/** A never-observed cell (\a stamp, its stamp before this update, is
+	 * 0) starts from the unknown prior (p_unknown > 0) at its first miss. */
+	void startIfUnobserved(Cell& c, uint32_t stamp) const
+	{
+		if (stamp == 0 && hasUnknown_) c.l = unknown_;
+	}
 	double logLambda_ = 0;
 	std::vector<LogOddsFx> hitTable_;
 };

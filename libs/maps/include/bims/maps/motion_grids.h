@@ -67,7 +67,8 @@ class MotionGrids
 	FrameCloud frame_;
 	MotionFrameResult result_;
 	std::vector<float> prior_, post1_, post2_;
-	std::vector<float> weight_, priorN_;
+	std::vector<float> priorN_;
+	std::vector<uint8_t> hold_;
 	int decisionTier_ = 2;
 };
 
