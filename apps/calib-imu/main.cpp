@@ -55,7 +55,7 @@ int main(int argc, char** argv)
 		        "inlier limit on the rotation-vector residual (0.3)", false,
 		        0.3, "DEG", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
-		    cmd.parse(argc, argv);
+		    bims::parseCommandLine(cmd, argc, argv);
 
 		    const std::string cfgPath = cfgArg.getValue();
 		    if (!mrpt::system::fileExists(cfgPath))

@@ -1,3 +1,4 @@
+#include <bims/common/app.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/eval/depth_consistency.h>
@@ -35,7 +36,7 @@ int cmdDepthConsistency(int argc, char** argv)
 	TCLAP::ValueArg<int> maxFrames("", "max-frames",
 	                               "use only the first N scans (0 = all)",
 	                               false, 0, "N", cmd);
-	cmd.parse(argc, argv);
+	bims::parseCommandLine(cmd, argc, argv);
 	if (gap.getValue() < 1) throw std::runtime_error("--gap must be >= 1");
 
 	const auto gt = bims::loadTumTrajectory(gtArg.getValue());

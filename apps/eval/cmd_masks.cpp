@@ -122,7 +122,7 @@ int cmdMasks(int argc, char** argv)
 	    "[m] (0 = none)",
 	    false, 0.05, "M", cmd);
 	TCLAP::SwitchArg quiet("q", "quiet", "no per-frame lines", cmd);
-	cmd.parse(argc, argv);
+	bims::parseCommandLine(cmd, argc, argv);
 
 	const std::string gtDir = gtArg.getValue(), predDir = predArg.getValue();
 	const auto gtFiles = listMasks(gtDir);

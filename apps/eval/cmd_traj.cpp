@@ -1,3 +1,4 @@
+#include <bims/common/app.h>
 #include <bims/common/trajectory.h>
 #include <bims/eval/plots.h>
 #include <bims/eval/trajectory_metrics.h>
@@ -49,7 +50,7 @@ int cmdTraj(int argc, char** argv)
 	TCLAP::ValueArg<double> offset("", "offset",
 	                               "time offset added to EST stamps [s] (0)",
 	                               false, 0.0, "S", cmd);
-	cmd.parse(argc, argv);
+	bims::parseCommandLine(cmd, argc, argv);
 
 	ev::TrajectoryReport rep;
 	rep.gtPath = gtArg.getValue();

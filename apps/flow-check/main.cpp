@@ -142,7 +142,7 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<std::string> aVariant(
 		        "", "variant", "pipeline variant (default flow-only)", false,
 		        "flow-only", "VARIANT", cmd);
-		    cmd.parse(argc, argv);
+		    bims::parseCommandLine(cmd, argc, argv);
 
 		    bims::pipeline::ExperimentConfig cfg;
 		    cfg.loadFromFile(aCfg.getValue());

@@ -80,7 +80,7 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<std::string> aPose(
 		        "", "pose", "T_C0C1 as 'x y z yaw pitch roll' (m, deg)", false,
 		        "0 0 0 0 0 0", "POSE", cmd);
-		    cmd.parse(argc, argv);
+		    bims::parseCommandLine(cmd, argc, argv);
 
 		    bims::flow::FlowParams params;
 		    if (aCfg.isSet())

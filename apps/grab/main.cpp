@@ -82,7 +82,7 @@ int main(int argc, char** argv)
 		                             "show the RGB frames (with the moving "
 		                             "mask) in a window",
 		                             cmd);
-		    cmd.parse(argc, argv);
+		    bims::parseCommandLine(cmd, argc, argv);
 		    std::signal(SIGINT, onSignal);  // Ctrl-C from now on: clean stop
 		    std::signal(SIGTERM, onSignal);
 		    if (aFrames.getValue() < 0)

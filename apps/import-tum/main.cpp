@@ -99,7 +99,7 @@ int main(int argc, char** argv)
 		        "", "seed", "random seed of --synth-imu (default 1)", false, 1,
 		        "N", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
-		    cmd.parse(argc, argv);
+		    bims::parseCommandLine(cmd, argc, argv);
 
 		    if (gz.getValue() < 0 || gz.getValue() > 9)
 			    throw bims::UsageError("--gz must be in 0..9");

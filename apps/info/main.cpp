@@ -16,7 +16,7 @@ int main(int argc, char** argv)
 		    TCLAP::CmdLine cmd("Summary of an MRPT rawlog.", ' ', "0.1");
 		    TCLAP::UnlabeledValueArg<std::string> in(
 		        "rawlog", "Input rawlog", true, "", "IN.rawlog", cmd);
-		    cmd.parse(argc, argv);
+		    bims::parseCommandLine(cmd, argc, argv);
 		    const auto s = bims::info::summarizeRawlog(in.getValue());
 		    bims::info::printSummary(s, std::cout);
 		    return 0;

@@ -74,7 +74,7 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<size_t> maxArg(
 		        "", "max-frames", "stop after N frames", false, 0, "N", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
-		    cmd.parse(argc, argv);
+		    bims::parseCommandLine(cmd, argc, argv);
 
 		    const std::string cfgPath = cfgArg.getValue();
 		    if (!mrpt::system::fileExists(cfgPath))

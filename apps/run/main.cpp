@@ -40,7 +40,7 @@ int main(int argc, char** argv)
 		        "[pipeline] variant)",
 		        false, "", "VARIANT", cmd);
 		    TCLAP::SwitchArg aQuiet("q", "quiet", "no progress line", cmd);
-		    cmd.parse(argc, argv);
+		    bims::parseCommandLine(cmd, argc, argv);
 
 		    bims::pipeline::ExperimentConfig cfg;
 		    cfg.loadFromFile(aCfg.getValue());

@@ -88,7 +88,7 @@ int main(int argc, char** argv)
 		        "Also write OUT_gt/preview.png (RGB | depth | mask) of frame N",
 		        false, -1, "N", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "No progress bar", cmd);
-		    cmd.parse(argc, argv);
+		    bims::parseCommandLine(cmd, argc, argv);
 
 		    if (tum.isSet())
 		    {

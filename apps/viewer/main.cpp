@@ -95,7 +95,7 @@ int main(int argc, char** argv)
 		        false, "", "DIR", cmd);
 		    TCLAP::ValueArg<std::string> aSize("", "size", "window size WxH",
 		                                       false, "1280x800", "WxH", cmd);
-		    cmd.parse(argc, argv);
+		    bims::parseCommandLine(cmd, argc, argv);
 
 		    auto& o = gOptions;
 		    if (aCfg.getValue().empty())

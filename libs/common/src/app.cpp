@@ -13,6 +13,10 @@ int runApp(const std::string& program, const std::function<int()>& body)
 	{
 		return body();
 	}
+	catch (const ExitRequest& e)
+	{
+		return e.code;
+	}
 	catch (const TCLAP::ArgException& e)
 	{
 		std::fprintf(stderr, "%s: usage error: %s (%s)\n", program.c_str(),

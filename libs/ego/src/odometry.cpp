@@ -196,6 +196,8 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	                       !R_rel_gyro.has_value() &&
 	                       !R_WC_imuPrev_.has_value();
 	const bool useImu = imuMode && R_WC_imu.has_value() && !anchorNow;
+	const bool filterConverging =
+	    att_.converging(f.t + cfg_.calibration.time_offset_s);
 	Eigen::Matrix3d R_imuRel = Eigen::Matrix3d::Identity();
 	if (imuMode) r.flags |= imuFlags;
 	MotionEstimate m;
@@ -210,8 +212,12 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		if (R_rel_gyro)
 		{
 			const Eigen::Matrix3d R_pred = R_WC_ * *R_rel_gyro;
-			R_new = R_pred * expSO3(cfg_.odometry.attitude_blend *
-			                        logSO3(R_pred.transpose() * *R_WC_imu));
+			const double blend =
+			    filterConverging && !cfg_.odometry.follow_converging_attitude
+			        ? 0.0
+			        : cfg_.odometry.attitude_blend;
+			R_new =
+			    R_pred * expSO3(blend * logSO3(R_pred.transpose() * *R_WC_imu));
 		}
 		const Eigen::Matrix3d R_rel = R_WC_.transpose() * R_new;
 		R_imuRel = R_rel;
@@ -267,7 +273,7 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	// While the attitude filter is still converging its absolute attitude
 	// moves fast: follow it for the absolute R_WC, but never feed that
 	// convergence into the inter-frame rotation used above.
-	if (useImu && att_.converging(f.t + cfg_.calibration.time_offset_s))
+	if (useImu && filterConverging && cfg_.odometry.follow_converging_attitude)
 		R_WC_ = *R_WC_imu;
 	else
 		R_WC_ = orthonormalize(R_WC_ * R_rel);

@@ -125,6 +125,8 @@ void OdometryParams::loadFromConfigFile(
 	gyro_aid = s.getBool("gyro_aid", gyro_aid);
 	min_tracks = static_cast<int>(s.getInt("min_tracks", min_tracks, 3, 1e6));
 	attitude_blend = s.getDouble("attitude_blend", attitude_blend, 0, 1);
+	follow_converging_attitude =
+	    s.getBool("follow_converging_attitude", follow_converging_attitude);
 	s.finish();
 }
 

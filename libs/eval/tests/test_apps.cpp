@@ -337,3 +337,25 @@ TEST(ImportParams, BonnIniAndStrictKeys)
 	bims::eval::ImportParams q;
 	EXPECT_THROW(q.loadFromConfigFile(range), std::exception);
 }
+
+TEST(Apps, HelpExitsCleanlyAndBadOptionsAreUsageErrors)
+{
+	// MRPT's TCLAP prints --help and parse errors and returns instead of
+	// exiting: no program may go on with empty arguments after them.
+	for (const std::string app :
+	     {"bims-run", "bims-odom", "bims-sim", "bims-import-tum",
+	      "bims-flow-check", "bims-flow-labels", "bims-calib-imu",
+	      "bims-eval masks", "bims-eval traj", "bims-eval depth-consistency"})
+	{
+		const ::Run h = run(kBin + "/" + app + " --help");
+		EXPECT_EQ(h.code, 0) << app << "\n" << h.out;
+		EXPECT_NE(h.out.find("USAGE"), std::string::npos) << app;
+		EXPECT_EQ(h.out.find("error"), std::string::npos) << app << "\n"
+		                                                  << h.out;
+		const ::Run b = run(kBin + "/" + app + " --no-such-option");
+		EXPECT_EQ(b.code, 2) << app << "\n" << b.out;
+		EXPECT_NE(b.out.find("PARSE ERROR"), std::string::npos) << app;
+		EXPECT_EQ(b.out.find("no such"), std::string::npos) << app << "\n"
+		                                                    << b.out;
+	}
+}

@@ -166,4 +166,13 @@ cv::Mat homographyFlow(const mrpt::img::TCamera& cam,
 	return flow;
 }
 
+cv::Matx33d rotationHomography(const mrpt::img::TCamera& cam,
+                               const mrpt::poses::CPose3D& T_prev_cur)
+{
+	const Rt T = rotTrans(T_prev_cur);
+	const cv::Matx33d K(cam.fx(), 0, cam.cx(), 0, cam.fy(), cam.cy(), 0, 0, 1);
+	const cv::Matx33d R(T.R);
+	return K * R * K.inv();
+}
+
 }  // namespace bims::flow

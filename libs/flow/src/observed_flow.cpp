@@ -1,6 +1,7 @@
 #include <bims/flow/observed_flow.h>
 #include <opencv2/imgproc.hpp>
 
+#include <limits>
 #include <stdexcept>
 
 namespace bims::flow
@@ -50,6 +51,40 @@ cv::Mat ObservedFlow::compute(const cv::Mat& prev, const cv::Mat& cur)
 		cv::resize(flow, up, cur.size(), 0, 0, cv::INTER_LINEAR);
 		up *= static_cast<double>(p_.downscale);
 		flow = up;
+	}
+	return flow;
+}
+
+cv::Mat ObservedFlow::computeDerotated(const cv::Mat& prev, const cv::Mat& cur,
+                                       const cv::Matx33d& H)
+{
+	if (prev.empty() || prev.size() != cur.size())
+		throw std::invalid_argument(
+		    "observed flow: need two non-empty CV_8UC1 images of one size");
+	cv::Mat warped;
+	// dst(u) = prev(H u)
+	cv::warpPerspective(prev, warped, H, prev.size(),
+	                    cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
+	                    cv::BORDER_REPLICATE);
+	cv::Mat flow = compute(warped, cur);
+	for (int v = 0; v < flow.rows; v++)
+	{
+		auto* f = flow.ptr<cv::Vec2f>(v);
+		for (int u = 0; u < flow.cols; u++)
+		{
+			const double x = u + f[u][0], y = v + f[u][1];
+			const double X = H(0, 0) * x + H(0, 1) * y + H(0, 2);
+			const double Y = H(1, 0) * x + H(1, 1) * y + H(1, 2);
+			const double Z = H(2, 0) * x + H(2, 1) * y + H(2, 2);
+			if (!(Z > 1e-12))
+			{
+				f[u] = {std::numeric_limits<float>::quiet_NaN(),
+				        std::numeric_limits<float>::quiet_NaN()};
+				continue;
+			}
+			f[u] = {static_cast<float>(X / Z - u),
+			        static_cast<float>(Y / Z - v)};
+		}
 	}
 	return flow;
 }

@@ -11,6 +11,7 @@ void FlowParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	dis_preset =
 	    s.getEnum("dis_preset", dis_preset, {"ultrafast", "fast", "medium"});
 	downscale = static_cast<int>(s.getInt("downscale", downscale, 1, 8));
+	derotate = s.getBool("derotate", derotate);
 	expected = s.getEnum("expected", expected, {"exact", "linear"});
 	diff_threshold_px =
 	    s.getDouble("diff_threshold_px", diff_threshold_px, 0.01, 100.0);

@@ -88,8 +88,12 @@ const FrameResult& Pipeline::processFrame(
 	const bool haveFlow = havePrev_ && prev_.grey.size() == size;
 	if (haveFlow)
 	{
-		const cv::Mat obs = observed_.compute(prev_.grey, cur_.grey);
 		const auto cam = cameraOf(cur_);
+		const cv::Mat obs = cfg_.flow.derotate
+		                        ? observed_.computeDerotated(
+		                              prev_.grey, cur_.grey,
+		                              flow::rotationHomography(cam, r.T_CprevC))
+		                        : observed_.compute(prev_.grey, cur_.grey);
 		if (cfg_.flow.refine_pose != "none")
 		{
 			r.flowPose =

@@ -18,6 +18,31 @@ struct UsageError : std::runtime_error
 	using std::runtime_error::runtime_error;
 };
 
+/** Thrown to end a program early with this exit code and no further
+ * message (runApp returns it), e.g. after --help. */
+struct ExitRequest
+{
+	int code = 0;
+};
+
+/** Parses the command line with MRPT's TCLAP (CmdLine in
+ * mrpt/3rdparty/tclap/CmdLine.h), which prints --help, --version and parse
+ * errors itself and then returns false instead of exiting: throws
+ * ExitRequest{0} after --help or --version, ExitRequest{2} after a parse
+ * error, so that no program goes on with empty arguments. */
+template <class CmdLine>
+void parseCommandLine(CmdLine& cmd, int argc, char** argv)
+{
+	if (cmd.parse(argc, argv)) return;
+	for (int i = 1; i < argc; ++i)
+	{
+		const std::string a = argv[i];
+		if (a == "-h" || a == "--help" || a == "--version")
+			throw ExitRequest{0};
+	}
+	throw ExitRequest{2};
+}
+
 /** Creates a directory and its parents; throws naming it on failure. */
 void makeDirs(const std::string& path);
 

@@ -129,6 +129,14 @@ struct OdometryParams
 	 * fraction of their difference per frame [0..1] (1 = R_WC is the
 	 * filter's, with its correction noise in every inter-frame rotation). */
 	double attitude_blend = 0.01;
+	/** mode = imu, while the attitude filter converges (its first
+	 * init_time_s): true, the absolute R_WC follows the filter (gravity and
+	 * north from the start, but every frame of that phase registers the
+	 * scene with the filter's convergence in it); false, R_WC keeps
+	 * integrating the gyro from the filter's first attitude and the blend
+	 * waits for the convergence, so the map stays consistent under fast
+	 * rotation (docs/ego.md). */
+	bool follow_converging_attitude = false;
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "odometry");

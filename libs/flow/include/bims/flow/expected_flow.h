@@ -52,4 +52,10 @@ cv::Mat expectedFlowLinear(const cv::Mat& depth, const mrpt::img::TCamera& cam,
 cv::Mat homographyFlow(const mrpt::img::TCamera& cam,
                        const mrpt::poses::CPose3D& R_prev_cur);
 
+/** The infinite homography H = K R K^-1 of the rotation of \a T_prev_cur
+ * (its translation is ignored): maps a current pixel (u, v, 1) to where a
+ * point at infinity seen there was seen in the previous frame. */
+cv::Matx33d rotationHomography(const mrpt::img::TCamera& cam,
+                               const mrpt::poses::CPose3D& T_prev_cur);
+
 }  // namespace bims::flow

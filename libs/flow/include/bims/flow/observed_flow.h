@@ -20,6 +20,18 @@ class ObservedFlow
 	 * std::invalid_argument on empty or mismatched images. */
 	cv::Mat compute(const cv::Mat& prev, const cv::Mat& cur);
 
+	/** The same flow, measured after derotation: \a prev is first warped
+	 * by the homography \a H_prev_cur (a current pixel u maps to H u in
+	 * \a prev; rotationHomography() of the egomotion's rotation), so that
+	 * DIS only has to find the residual r of the translation and of the
+	 * rotation's error; the result is composed back, flow(u) =
+	 * H (u + r(u)) - u. Large camera rotations (tens of pixels per frame)
+	 * otherwise exceed what the coarse-to-fine search recovers. Pixels whose
+	 * H u leaves \a prev see a replicated border there: their flow leaves
+	 * the image and the labels skip them. */
+	cv::Mat computeDerotated(const cv::Mat& prev, const cv::Mat& cur,
+	                         const cv::Matx33d& H_prev_cur);
+
 	/** Structure tensor of the last \a cur (structureTensor()), computed by
 	 * compute() when [flow] visible_change_grey > 0 or refine_pose is
 	 * enabled; empty otherwise. */

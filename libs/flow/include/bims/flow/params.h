@@ -17,6 +17,11 @@ struct FlowParams
 	/** Observed flow is computed on images downscaled by this integer
 	 * factor (1 = full resolution) and upsampled (vectors scaled back). */
 	int downscale = 1;
+	/** Measure the observed flow after warping frame t-1 by the rotation
+	 * of the egomotion (ObservedFlow::computeDerotated): DIS then only
+	 * searches the residual motion, which keeps it right under fast camera
+	 * rotation. */
+	bool derotate = false;
 	/** Expected flow: "exact" reprojection, or "linear" (first-order
 	 * Jacobian, the paper's eq. 8). */
 	std::string expected = "exact";
