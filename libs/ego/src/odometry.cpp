@@ -85,6 +85,15 @@ std::optional<Eigen::Matrix3d> Odometry::imuRotation(double tCam,
 	return Eigen::Matrix3d(q->toRotationMatrix() * cfg_.calibration.R_IC);
 }
 
+Eigen::Matrix3d Odometry::predictRotation(double tCam) const
+{
+	if (!havePrev_) return Eigen::Matrix3d::Identity();
+	if (R_WC_gyroPrev_)
+		if (const auto R = imuRotation(tCam, nullptr, true))
+			return R_WC_gyroPrev_->transpose() * *R;
+	return lastR_rel_;
+}
+
 FrameEgomotion Odometry::processFrame(
     const mrpt::obs::CObservation3DRangeScan& obs, const cv::Mat* mask)
 {

@@ -258,3 +258,32 @@ TEST(Odometry, WorldRotationIntegratesTheGyroWhileTheFilterConverges)
 	// option avoids; fast_rotation lost 0.6 of F1 to it).
 	EXPECT_GT(maxChainInconsistencyDeg(true), 0.05);
 }
+
+TEST(Odometry, PredictedRotationIsTheGyroRotationOfTheNextFrame)
+{
+	EgoConfig cfg;
+	cfg.odometry.mode = "imu";
+	cfg.calibration.R_IC = kR_IC;
+	cfg.calibration.has_R_IC = true;
+	Odometry odo(cfg);
+	test::Motion m;
+	double tImu = 0;
+	EXPECT_LT(angleSO3(odo.predictRotation(0.0)), 1e-12);  // no frame yet
+	for (int k = 0; k < 8; k++)
+	{
+		const double t = k * 0.05;
+		for (; tImu <= t + 0.03; tImu += 0.005)
+			odo.addImu(test::imuAt(m, kR_IC, tImu));
+		const Eigen::Matrix3d pred = odo.predictRotation(t);
+		const FrameEgomotion e =
+		    odo.processFrame(test::render(m.R(t), m.p(t), K320(), 320, 240, t));
+		if (k == 0) continue;
+		// The motion measured (IMU rotation, pulled by the blend) and the
+		// true one, against the prediction made before it.
+		EXPECT_LT(angleSO3(pred.transpose() * R_of(e.T_CprevC)) * 180 / M_PI,
+		          0.05);
+		const Eigen::Matrix3d Rtrue = m.R(t - 0.05).transpose() * m.R(t);
+		EXPECT_LT(angleSO3(pred.transpose() * Rtrue) * 180 / M_PI, 0.1);
+		EXPECT_GT(angleSO3(Rtrue) * 180 / M_PI, 0.2);  // it does rotate
+	}
+}

@@ -71,6 +71,9 @@ const FrameResult& Pipeline::processFrame(
 	r.ms.input = msSince(t);
 
 	// Egomotion, with the previous moving mask keeping features off movers.
+	// The rotation the observed flow is derotated with is predicted first
+	// (gyro), so that the flow does not depend on the tracker.
+	const Eigen::Matrix3d R_derot = odom_.predictRotation(cur_.t);
 	t = Clock::now();
 	const cv::Mat* fb = (cfg_.pipeline.feedback_mask && !feedback_.empty())
 	                        ? &feedback_
@@ -89,11 +92,13 @@ const FrameResult& Pipeline::processFrame(
 	if (haveFlow)
 	{
 		const auto cam = cameraOf(cur_);
-		const cv::Mat obs = cfg_.flow.derotate
-		                        ? observed_.computeDerotated(
-		                              prev_.grey, cur_.grey,
-		                              flow::rotationHomography(cam, r.T_CprevC))
-		                        : observed_.compute(prev_.grey, cur_.grey);
+		const cv::Mat obs =
+		    cfg_.flow.derotate
+		        ? observed_.computeDerotated(
+		              prev_.grey, cur_.grey,
+		              flow::rotationHomography(
+		                  cam, ego::toPose(R_derot, Eigen::Vector3d::Zero())))
+		        : observed_.compute(prev_.grey, cur_.grey);
 		if (cfg_.flow.refine_pose != "none")
 		{
 			r.flowPose =

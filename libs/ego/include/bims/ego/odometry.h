@@ -97,6 +97,14 @@ class Odometry
 	                                           uint32_t* flags = nullptr,
 	                                           bool gyroOnly = false) const;
 
+	/** The rotation R_{C(t-1)C(t)} expected for the next frame, stamped
+	 * \a tCam, before processFrame() measures it: the gyro chain's rotation
+	 * over the interval when IMU data cover it, else the last frame's
+	 * rotation (constant velocity); identity before the first frame. Changes
+	 * nothing: the pipeline derotates the observed flow with it while the
+	 * egomotion runs. */
+	Eigen::Matrix3d predictRotation(double tCam) const;
+
 	const AttitudeFilter& attitude() const { return att_; }
 	const EgoConfig& config() const { return cfg_; }
 	size_t framesProcessed() const { return nFrames_; }
