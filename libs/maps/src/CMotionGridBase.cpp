@@ -50,30 +50,50 @@ const COccupancyBayesGrid& CMotionGridBase::occupancySource() const
 	return *private_;
 }
 
-void CMotionGridBase::store(const FrameCloud& f, std::vector<float> post)
+void CMotionGridBase::store(const FrameCloud& f, const std::vector<float>& post)
 {
 	if (post.size() != f.cells.size())
 		throw std::invalid_argument(
 		    "CMotionGridBase::store: one posterior per frame cell expected");
 	const uint32_t F = frameCount_ + 1;
-	Storage::Accessor acc(grid_);
 	FrameStats st;
 	const size_t m = f.cells.size();
-	for (size_t i = 0; i < m; ++i)
+	// The cells' storage is found kPrefetchAhead cells ahead of the writes
+	// (one index lookup per block; blocks created in the order of the
+	// cells) and prefetched.
+	constexpr size_t kRing = 2 * kPrefetchAhead;
+	static_assert((kRing & (kRing - 1)) == 0, "ring size: a power of two");
+	Cell* ring[kRing];
+	uint64_t lastKey = FlatHashMap::kEmpty;
+	Storage::Block* last = nullptr;
+	for (size_t i = 0; i < m + kPrefetchAhead; ++i)
 	{
-		if (i + kPrefetchAhead < m)
+		if (i < m)
 		{
-			const VoxelKey& q = f.cells[i + kPrefetchAhead];
-			acc.prefetch(q.x, q.y, q.z);
+			const VoxelKey& k = f.cells[i];
+			const uint64_t bk = Storage::blockKeyOf(k.x, k.y, k.z);
+			if (bk != lastKey)
+			{
+				const uint32_t b = grid_.findOrCreateBlock(bk);
+				last = b == FlatHashMap::kNotFound ? nullptr : &grid_.block(b);
+				lastKey = bk;
+			}
+			Cell* c = last ? &last->cells[Storage::cellIndexOf(k.x, k.y, k.z)]
+			               : nullptr;
+#if defined(__GNUC__)
+			if (c) __builtin_prefetch(c, 1);
+#endif
+			ring[i % kRing] = c;
 		}
-		const auto& k = f.cells[i];
-		Cell* c = acc.get(k.x, k.y, k.z);
+		if (i < kPrefetchAhead) continue;
+		const size_t j = i - kPrefetchAhead;
+		Cell* c = ring[j % kRing];
 		if (!c)
 		{
-			st.overBudget += f.hits[i];
+			st.overBudget += f.hits[j];
 			continue;
 		}
-		c->l = post[i];
+		c->l = post[j];
 		c->stamp = F;
 	}
 	if (f.K.width > 0 && f.K.height > 0)
@@ -85,7 +105,7 @@ void CMotionGridBase::store(const FrameCloud& f, std::vector<float> post)
 	else
 		lastMask_.reset(0, 0);
 	lastCells_ = f.cells;
-	lastPost_ = std::move(post);
+	lastPost_ = post;
 	frameCount_ = F;
 	lastTimestamp_ = f.timestamp;
 	if (st.overBudget) accountFrame(st);
@@ -127,7 +147,7 @@ bool CMotionGridBase::internal_insertObservation(
 	occupancySource().priorLogOdds(f, prior);
 	if (!linked_) private_->integrate(f);
 	computePosterior(f, prior, post);
-	store(f, std::move(post));
+	store(f, post);
 	return true;
 }
 

@@ -119,6 +119,16 @@ void COccupancyBayesGrid::applyMiss(Cell& c, uint32_t F) const
 	c.stamp = F;
 }
 
+void COccupancyBayesGrid::checkFrame(const FrameCloud& f,
+                                     const char* what) const
+{
+	if (f.voxel_size != params_.voxel_size)
+		throw std::invalid_argument(
+		    std::string("COccupancyBayesGrid::") + what +
+		    ": frame keyed for voxel size " + std::to_string(f.voxel_size) +
+		    " m, grid has " + std::to_string(params_.voxel_size) + " m");
+}
+
 void COccupancyBayesGrid::integrate(const FrameCloud& f,
                                     std::vector<float>* priorOut,
                                     const std::vector<uint8_t>* hold)
@@ -126,25 +136,66 @@ void COccupancyBayesGrid::integrate(const FrameCloud& f,
 	if (hold && hold->size() != f.cells.size())
 		throw std::invalid_argument(
 		    "COccupancyBayesGrid::integrate: one hold flag per cell expected");
-	if (f.voxel_size != params_.voxel_size)
+	checkFrame(f, "integrate");
+	pending_ = nullptr;
+	grid_.resolve(f.cells, cellPtr_);
+	applyFrame(f, priorOut, hold);
+}
+
+void COccupancyBayesGrid::beginFrame(const FrameCloud& f,
+                                     std::vector<float>& out)
+{
+	checkFrame(f, "beginFrame");
+	grid_.resolve(f.cells, cellPtr_);
+	pending_ = &f;
+	pendingFrame_ = frameCount_;
+	// As priorLogOdds().
+	const bool already = frameCount_ > 0 &&
+	                     f.timestamp != mrpt::Clock::time_point() &&
+	                     f.timestamp == lastTimestamp_;
+	const uint32_t G = already ? frameCount_ : frameCount_ + 1;
+	out.resize(f.cells.size());
+	for (size_t i = 0; i < f.cells.size(); ++i)
+	{
+		const Cell cell = cellPtr_[i] ? *cellPtr_[i] : Cell();
+		const LogOddsFx v =
+		    (already && cell.stamp == G) ? cell.lPrev : priorFixed(cell, G);
+		out[i] = float(fromFixed(v));
+	}
+}
+
+void COccupancyBayesGrid::integratePending(const FrameCloud& f,
+                                           const std::vector<uint8_t>* hold)
+{
+	if (pending_ != &f || pendingFrame_ != frameCount_ ||
+	    cellPtr_.size() != f.cells.size())
+		throw std::logic_error(
+		    "COccupancyBayesGrid::integratePending: not the frame of the last "
+		    "beginFrame(), or the map changed in between");
+	if (hold && hold->size() != f.cells.size())
 		throw std::invalid_argument(
-		    "COccupancyBayesGrid::integrate: frame keyed for voxel size " +
-		    std::to_string(f.voxel_size) + " m, grid has " +
-		    std::to_string(params_.voxel_size) + " m");
+		    "COccupancyBayesGrid::integratePending: one hold flag per cell "
+		    "expected");
+	pending_ = nullptr;
+	applyFrame(f, nullptr, hold);
+}
+
+void COccupancyBayesGrid::applyFrame(const FrameCloud& f,
+                                     std::vector<float>* priorOut,
+                                     const std::vector<uint8_t>* hold)
+{
 	const uint32_t F = frameCount_ + 1;
 	if (priorOut) priorOut->resize(f.cells.size());
 	FrameStats st;
-	Storage::Accessor acc(grid_);
 	const size_t m = f.cells.size();
+	Cell* const* cells = cellPtr_.data();
 	for (size_t i = 0; i < m; ++i)
 	{
-		if (i + kPrefetchAhead < m)
-		{
-			const VoxelKey& q = f.cells[i + kPrefetchAhead];
-			acc.prefetch(q.x, q.y, q.z);
-		}
-		const VoxelKey& k = f.cells[i];
-		Cell* c = acc.get(k.x, k.y, k.z);
+#if defined(__GNUC__)
+		if (i + kPrefetchAhead < m && cells[i + kPrefetchAhead])
+			__builtin_prefetch(cells[i + kPrefetchAhead], 1);
+#endif
+		Cell* c = cells[i];
 		if (!c)
 		{
 			st.overBudget += f.hits[i];
@@ -199,18 +250,45 @@ void COccupancyBayesGrid::neighbourhoodMaxPrior(const FrameCloud& f,
 		throw std::invalid_argument(
 		    "COccupancyBayesGrid::neighbourhoodMaxPrior: one prior per cell "
 		    "expected");
-	out = prior;
-	if (nb == BgNeighbourhood::None) return;
+	if (nb == BgNeighbourhood::None)
+	{
+		out = prior;
+		return;
+	}
+	out.resize(prior.size());
 	const uint32_t G = frameCount_ + 1;
 	const double s = params_.voxel_size;
 	const auto& o = f.origin_W;
+	// Neighbours are mostly in the block of the cell or of the previous
+	// neighbour: the last blocks looked up are kept.
+	uint64_t lastKey[2] = {FlatHashMap::kEmpty, FlatHashMap::kEmpty};
+	const Storage::Block* lastBlk[2] = {nullptr, nullptr};
+	unsigned next = 0;
+	auto findCell = [&](const VoxelKey& n) -> const Cell*
+	{
+		const uint64_t bk = Storage::blockKeyOf(n.x, n.y, n.z);
+		const Storage::Block* b;
+		if (bk == lastKey[0])
+			b = lastBlk[0];
+		else if (bk == lastKey[1])
+			b = lastBlk[1];
+		else
+		{
+			b = grid_.findBlock(bk);
+			lastKey[next] = bk;
+			lastBlk[next] = b;
+			next ^= 1;
+		}
+		return b ? &b->cells[Storage::cellIndexOf(n.x, n.y, n.z)] : nullptr;
+	};
 	for (size_t i = 0; i < f.cells.size(); ++i)
 	{
+		out[i] = prior[i];
 		const VoxelKey& k = f.cells[i];
 		LogOddsFx best = std::numeric_limits<LogOddsFx>::min();
 		auto consider = [&](const VoxelKey& n)
 		{
-			const Cell* c = grid_.find(n);
+			const Cell* c = findCell(n);
 			if (c && c->stamp != 0) best = std::max(best, priorFixed(*c, G));
 		};
 		if (nb == BgNeighbourhood::Ray)

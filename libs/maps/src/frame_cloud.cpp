@@ -63,12 +63,6 @@ bool finitePose(const mrpt::poses::CPose3D& T)
 	return true;
 }
 
-// A reading dropped while keying must not count as measured depth.
-void dropDepth(FrameCloud& out, size_t i)
-{
-	if (!out.depth.empty()) out.depth[out.pixel[i]] = 0;
-}
-
 void resetFrame(FrameCloud& out)
 {
 	out.points_W.clear();
@@ -79,7 +73,56 @@ void resetFrame(FrameCloud& out)
 	out.depth.clear();
 	out.stats = FrameStats();
 }
+
+// floor(v) for |v| < 2^31 (the keys of readings within the extent), with
+// fewer instructions than std::floor on any double.
+inline int32_t floorSmall(double v)
+{
+	const int32_t i = static_cast<int32_t>(v);
+	return i - int32_t(v < double(i));
+}
+
+// Grows a vector to at least n elements without touching the elements it
+// already has (a resize() after clear() would value-initialise all n).
+template <class T>
+T* growTo(std::vector<T>& v, size_t n)
+{
+	if (v.size() < n) v.resize(n);
+	return v.data();
+}
 }  // namespace
+
+// The checks of one reading in {W} and its voxel key: the reading is kept
+// (returns true) or counted by the first reason that rejects it.
+struct FrameCloudBuilder::Keyer
+{
+	double inv, ext, maxR2;
+	mrpt::math::TPoint3D o;
+	FrameStats& st;
+
+	bool operator()(const mrpt::math::TPoint3Df& p, VoxelKey& k) const
+	{
+		if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)))
+		{
+			st.nonFinite++;
+			return false;
+		}
+		if (std::abs(p.x) > ext || std::abs(p.y) > ext || std::abs(p.z) > ext)
+		{
+			st.outsideExtent++;
+			return false;
+		}
+		const double dx = p.x - o.x, dy = p.y - o.y, dz = p.z - o.z;
+		if (dx * dx + dy * dy + dz * dz > maxR2)
+		{
+			st.beyondRange++;
+			return false;
+		}
+		k = {coordToIndex(p.x, inv), coordToIndex(p.y, inv),
+		     coordToIndex(p.z, inv)};
+		return true;
+	}
+};
 
 void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
                               const mrpt::poses::CPose3D& T_WS, FrameCloud& out)
@@ -113,51 +156,114 @@ void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
 	const auto& R = out.T_WC.getRotationMatrix();
 	const mrpt::math::TPoint3D t = out.T_WC.translation();
 	out.origin_W = t;
-	out.depth.assign(size_t(W) * H, 0.f);
-	out.points_W.reserve(size_t(W) * H);
-	out.pixel.reserve(size_t(W) * H);
+	const size_t N = size_t(W) * H;
+	// Every pixel's depth is written below (0 where no reading is kept).
+	out.depth.resize(N);
+	float* depth = out.depth.data();
+	mrpt::math::TPoint3Df* pts = growTo(out.points_W, N);
+	uint32_t* pix = growTo(out.pixel, N);
 
 	const double units = scan.rangeUnits;
 	const double maxR = p_.max_range;
 	const double ifx = 1 / cam.fx(), ify = 1 / cam.fy();
 	const double cx = cam.cx(), cy = cam.cy();
+	const bool isDepth = scan.range_is_depth;
+	// Per column: xn, 1 + xn^2 and xn * R.col0 (the terms of the
+	// unprojection that depend on u only, computed as per pixel before).
+	col_.resize(size_t(W));
+	for (int u = 0; u < W; ++u)
+	{
+		auto& c = col_[size_t(u)];
+		const double xn = (u - cx) * ifx;
+		c.a = 1 + xn * xn;
+		c.r[0] = xn * R(0, 0);
+		c.r[1] = xn * R(1, 0);
+		c.r[2] = xn * R(2, 0);
+	}
+	double maxA = 1;
+	for (const auto& c : col_) maxA = std::max(maxA, c.a);
+	const double inv = 1.0 / p_.voxel_size;
+	Keyer keyer{inv, p_.extent, p_.max_range * p_.max_range, t, out.stats};
+	// Fast path, exact: a reading whose distance d * norm is safely below
+	// max_range (with the largest norm of its row, fl() being monotonic) is
+	// kept by every check of the plain path (range in double, then in float;
+	// finite and within the extent when the whole sensor range is), so these
+	// checks and the square root (depth images) are skipped for it.
+	const double tMax = std::max({std::abs(t.x), std::abs(t.y), std::abs(t.z)});
+	const double rSafe =
+	    maxR - (4 * (tMax + maxR) * std::ldexp(1.0, -24) + 1e-9 * maxR);
+	const bool fast = isDepth && std::isfinite(units) && units >= 1e-300 &&
+	                  std::isfinite(units * 65535.0) &&
+	                  (tMax + maxR) * (1 + 1e-6) + 1 < p_.extent && rSafe > 0;
+	runKey_.clear();
+	runStart_.clear();
+	VoxelKey prev{INT32_MIN, INT32_MIN, INT32_MIN};
+	size_t w = 0;
 	for (int v = 0; v < H; ++v)
 	{
 		const double yn = (v - cy) * ify;
+		const double yn2 = yn * yn;
+		const double normMax = std::sqrt(maxA + yn2);
 		// Ray direction in {W} for depth 1: xn*R.col0 + yn*R.col1 + R.col2.
 		const double by = yn * R(0, 1) + R(0, 2), bz = yn * R(1, 1) + R(1, 2),
 		             bw = yn * R(2, 1) + R(2, 2);
+		const uint32_t rowPix = uint32_t(size_t(v) * W);
 		for (int u = 0; u < W; ++u)
 		{
+			float& dOut = depth[rowPix + u];
+			dOut = 0;
 			const uint16_t raw = scan.rangeImage(v, u);
 			if (raw == 0)
 			{
 				out.stats.noDepth++;
 				continue;
 			}
-			const double xn = (u - cx) * ifx;
-			const double norm = std::sqrt(1 + xn * xn + yn * yn);
+			const Column& c = col_[size_t(u)];
 			double d = raw * units;
-			if (!scan.range_is_depth) d /= norm;
-			if (!(d > 0) || !std::isfinite(d))
+			mrpt::math::TPoint3Df p;
+			VoxelKey k;
+			if (fast && d * normMax <= rSafe)
 			{
-				out.stats.nonFinite++;
-				continue;
+				p = {float(t.x + d * (c.r[0] + by)),
+				     float(t.y + d * (c.r[1] + bz)),
+				     float(t.z + d * (c.r[2] + bw))};
+				k = {floorSmall(p.x * inv), floorSmall(p.y * inv),
+				     floorSmall(p.z * inv)};
 			}
-			if (d * norm > maxR)
+			else
 			{
-				out.stats.beyondRange++;
-				continue;
+				const double norm = std::sqrt(c.a + yn2);
+				if (!isDepth) d /= norm;
+				if (!(d > 0) || !std::isfinite(d))
+				{
+					out.stats.nonFinite++;
+					continue;
+				}
+				if (d * norm > maxR)
+				{
+					out.stats.beyondRange++;
+					continue;
+				}
+				p = {float(t.x + d * (c.r[0] + by)),
+				     float(t.y + d * (c.r[1] + bz)),
+				     float(t.z + d * (c.r[2] + bw))};
+				if (!keyer(p, k)) continue;
 			}
-			const size_t pix = size_t(v) * W + u;
-			out.depth[pix] = float(d);
-			out.points_W.emplace_back(float(t.x + d * (xn * R(0, 0) + by)),
-			                          float(t.y + d * (xn * R(1, 0) + bz)),
-			                          float(t.z + d * (xn * R(2, 0) + bw)));
-			out.pixel.push_back(uint32_t(pix));
+			dOut = float(d);
+			if (k != prev)
+			{
+				runKey_.push_back(k);
+				runStart_.push_back(uint32_t(w));
+				prev = k;
+			}
+			pts[w] = p;
+			pix[w] = rowPix + uint32_t(u);
+			++w;
 		}
 	}
-	keyPoints(out);
+	out.points_W.resize(w);
+	out.pixel.resize(w);
+	finishCells(out);
 }
 
 void FrameCloudBuilder::buildFromPoints(
@@ -194,99 +300,35 @@ void FrameCloudBuilder::buildFromPoints(
 	keyPoints(out);
 }
 
-namespace
-{
-// LSD radix sort of (key, value) pairs on the low \a bits bits of the keys
-// (stable), with digits of at most 12 bits.
-void radixSortPairs(std::vector<uint64_t>& keys, std::vector<uint32_t>& vals,
-                    std::vector<uint64_t>& keysTmp,
-                    std::vector<uint32_t>& valsTmp, unsigned bits)
-{
-	const size_t n = keys.size();
-	keysTmp.resize(n);
-	valsTmp.resize(n);
-	const unsigned passes = std::max(1u, (bits + 11) / 12);
-	const unsigned digit = (bits + passes - 1) / passes;
-	const size_t buckets = size_t(1) << digit;
-	const uint64_t mask = buckets - 1;
-	std::vector<uint32_t> count(buckets);
-	for (unsigned p = 0, shift = 0; p < passes; ++p, shift += digit)
-	{
-		std::fill(count.begin(), count.end(), 0u);
-		for (size_t i = 0; i < n; ++i) count[(keys[i] >> shift) & mask]++;
-		uint32_t sum = 0;
-		for (auto& c : count)
-		{
-			const uint32_t t = c;
-			c = sum;
-			sum += t;
-		}
-		for (size_t i = 0; i < n; ++i)
-		{
-			const uint32_t d = count[(keys[i] >> shift) & mask]++;
-			keysTmp[d] = keys[i];
-			valsTmp[d] = vals[i];
-		}
-		keys.swap(keysTmp);
-		vals.swap(valsTmp);
-	}
-}
-
-unsigned bitWidth(uint64_t v)
-{
-	unsigned b = 0;
-	while (v >> b) ++b;
-	return b;
-}
-}  // namespace
-
-// Keys every valid reading, then orders the readings by 8^3 block (blocks in
-// (x, y, z) lexicographic order) and by cell inside a block with a radix
-// sort of compact keys: runs of equal keys are the frame's distinct cells,
-// already in block order, so that the grids visit each storage block once
-// per frame (one hash lookup per block instead of per cell, and
-// cache-friendly writes). No hashing per reading.
+// Keeps the readings of out.points_W that pass the checks (in place) and
+// splits them into runs of consecutive readings in one voxel.
 void FrameCloudBuilder::keyPoints(FrameCloud& out)
 {
-	const double inv = 1.0 / p_.voxel_size;
-	const double ext = p_.extent, maxR2 = p_.max_range * p_.max_range;
-	const auto& o = out.origin_W;
+	Keyer keyer{1.0 / p_.voxel_size, p_.extent, p_.max_range * p_.max_range,
+	            out.origin_W, out.stats};
+	runKey_.clear();
+	runStart_.clear();
 	out.cells.clear();
 	out.hits.clear();
+	VoxelKey prev{INT32_MIN, INT32_MIN, INT32_MIN};
 	const size_t n = out.points_W.size();
-	keys_.resize(n);
 	size_t w = 0;
-	int32_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX};
-	int32_t hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
 	for (size_t i = 0; i < n; ++i)
 	{
-		const auto& p = out.points_W[i];
-		if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)))
+		const mrpt::math::TPoint3Df p = out.points_W[i];
+		VoxelKey k;
+		if (!keyer(p, k))
 		{
-			out.stats.nonFinite++;
-			dropDepth(out, i);
+			// A reading dropped while keying must not count as measured
+			// depth.
+			if (!out.depth.empty()) out.depth[out.pixel[i]] = 0;
 			continue;
 		}
-		if (std::abs(p.x) > ext || std::abs(p.y) > ext || std::abs(p.z) > ext)
+		if (k != prev)
 		{
-			out.stats.outsideExtent++;
-			dropDepth(out, i);
-			continue;
-		}
-		const double dx = p.x - o.x, dy = p.y - o.y, dz = p.z - o.z;
-		if (dx * dx + dy * dy + dz * dz > maxR2)
-		{
-			out.stats.beyondRange++;
-			dropDepth(out, i);
-			continue;
-		}
-		const int32_t k[3] = {coordToIndex(p.x, inv) >> 3,
-		                      coordToIndex(p.y, inv) >> 3,
-		                      coordToIndex(p.z, inv) >> 3};
-		for (int a = 0; a < 3; ++a)
-		{
-			lo[a] = std::min(lo[a], k[a]);
-			hi[a] = std::max(hi[a], k[a]);
+			runKey_.push_back(k);
+			runStart_.push_back(uint32_t(w));
+			prev = k;
 		}
 		out.points_W[w] = p;
 		out.pixel[w] = out.pixel[i];
@@ -294,69 +336,219 @@ void FrameCloudBuilder::keyPoints(FrameCloud& out)
 	}
 	out.points_W.resize(w);
 	out.pixel.resize(w);
-	out.cellOfPoint.resize(w);
+	finishCells(out);
+}
+
+namespace
+{
+unsigned bitWidth(uint64_t v)
+{
+	unsigned b = 0;
+	while (v >> b) ++b;
+	return b;
+}
+
+// LSD radix sort of 64-bit values on their bits [lowBit, lowBit + bits)
+// (stable), digits of at most 11 bits; the histograms of all digits are
+// counted in one pass.
+void radixSort(std::vector<uint64_t>& v, std::vector<uint64_t>& tmp,
+               unsigned lowBit, unsigned bits)
+{
+	const size_t n = v.size();
+	if (n < 2 || bits == 0) return;
+	tmp.resize(n);
+	const unsigned passes = std::max(1u, (bits + 10) / 11);
+	const unsigned digit = (bits + passes - 1) / passes;
+	const size_t buckets = size_t(1) << digit;
+	const uint64_t mask = buckets - 1;
+	std::vector<uint32_t> count(buckets * passes, 0u);
+	for (size_t i = 0; i < n; ++i)
+	{
+		const uint64_t x = v[i] >> lowBit;
+		for (unsigned p = 0; p < passes; ++p)
+			count[p * buckets + ((x >> (p * digit)) & mask)]++;
+	}
+	for (unsigned p = 0; p < passes; ++p)
+	{
+		uint32_t* c = &count[p * buckets];
+		// A digit that is equal for all values needs no pass.
+		if (c[(v[0] >> (lowBit + p * digit)) & mask] == n) continue;
+		uint32_t sum = 0;
+		for (size_t b = 0; b < buckets; ++b)
+		{
+			const uint32_t t = c[b];
+			c[b] = sum;
+			sum += t;
+		}
+		const unsigned shift = lowBit + p * digit;
+		for (size_t i = 0; i < n; ++i) tmp[c[(v[i] >> shift) & mask]++] = v[i];
+		v.swap(tmp);
+	}
+}
+}  // namespace
+
+// Orders the runs by 8^3 block (blocks in (x, y, z) lexicographic order) and
+// by cell inside a block with a radix sort of compact keys (block relative
+// to the frame's lowest block, then the cell index in the block, x fastest,
+// as in the storage) packed with the run index: equal keys are the frame's
+// distinct cells, already in block order, so that the grids visit each
+// storage block once per frame (one hash lookup per block instead of per
+// cell, and cache-friendly writes). No hashing per reading.
+void FrameCloudBuilder::finishCells(FrameCloud& out)
+{
+	const size_t w = out.points_W.size();
 	out.stats.valid = w;
+	out.cellOfPoint.resize(w);
+	out.cells.clear();
+	out.hits.clear();
 	if (w == 0) return;
-	// Compact key: block coordinates relative to the frame's lowest block,
-	// then the cell index inside the block (x fastest), as in the storage.
+	const size_t r = runKey_.size();
+	runStart_.push_back(uint32_t(w));
+	int32_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX};
+	int32_t hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+	for (const auto& k : runKey_)
+	{
+		const int32_t b[3] = {k.x >> 3, k.y >> 3, k.z >> 3};
+		for (int a = 0; a < 3; ++a)
+		{
+			lo[a] = std::min(lo[a], b[a]);
+			hi[a] = std::max(hi[a], b[a]);
+		}
+	}
+	runCell_.resize(r);
+	out.cells.reserve(r);
+	out.hits.reserve(r);
+	const size_t nb[3] = {size_t(hi[0] - lo[0]) + 1, size_t(hi[1] - lo[1]) + 1,
+	                      size_t(hi[2] - lo[2]) + 1};
+	const double nBlocks = double(nb[0]) * double(nb[1]) * double(nb[2]);
+	if (nBlocks <= double(std::min<size_t>(4 * r + 65536, size_t(1) << 24)))
+		bucketCells(out, lo, nb);
+	else
+		radixCells(out, lo, hi);
+	uint32_t* cop = out.cellOfPoint.data();
+	for (size_t j = 0; j < r; ++j)
+		std::fill(cop + runStart_[j], cop + runStart_[j + 1], runCell_[j]);
+}
+
+// finishCells() for frames whose bounding box has too many blocks for a
+// bucket per block: one radix sort of compact keys (block relative to the
+// frame's lowest block, then the cell index in the block, x fastest, as in
+// the storage) packed with the run index.
+void FrameCloudBuilder::radixCells(FrameCloud& out, const int32_t lo[3],
+                                   const int32_t hi[3])
+{
+	const size_t r = runKey_.size();
 	unsigned bits[3];
 	for (int a = 0; a < 3; ++a) bits[a] = bitWidth(uint64_t(hi[a] - lo[a]));
+	const unsigned idxBits = bitWidth(uint64_t(r - 1));
+	// Key fields above the run index: cell (9 bits), z, y, x blocks.
 	const unsigned sz = 9, sy = sz + bits[2], sx = sy + bits[1];
 	const unsigned total = sx + bits[0];
-	// Neighbouring pixels often fall in one cell: runs of equal keys among
-	// consecutive readings are sorted once, with their length.
-	keys_.resize(w);
-	order_.resize(w);
-	runOf_.resize(w);
-	runLen_.resize(w);
-	size_t r = 0;
-	uint64_t prev = ~uint64_t(0);
-	for (size_t i = 0; i < w; ++i)
+	auto compact = [&](const VoxelKey& k)
 	{
-		const auto& p = out.points_W[i];
-		const int32_t kx = coordToIndex(p.x, inv), ky = coordToIndex(p.y, inv),
-		              kz = coordToIndex(p.z, inv);
-		const uint64_t key =
-		    (uint64_t((kx >> 3) - lo[0]) << sx) |
-		    (uint64_t((ky >> 3) - lo[1]) << sy) |
-		    (uint64_t((kz >> 3) - lo[2]) << sz) |
-		    uint64_t((kx & 7) | ((ky & 7) << 3) | ((kz & 7) << 6));
-		if (i == 0 || key != prev)
-		{
-			keys_[r] = key;
-			order_[r] = uint32_t(r);
-			runLen_[r] = 0;
-			++r;
-			prev = key;
-		}
-		runOf_[i] = uint32_t(r - 1);
-		runLen_[r - 1]++;
+		return (uint64_t((k.x >> 3) - lo[0]) << sx) |
+		       (uint64_t((k.y >> 3) - lo[1]) << sy) |
+		       (uint64_t((k.z >> 3) - lo[2]) << sz) |
+		       uint64_t((k.x & 7) | ((k.y & 7) << 3) | ((k.z & 7) << 6));
+	};
+	// Sorted (compact key, run) pairs: packed in one 64-bit value and radix
+	// sorted when both fit, else sorted as pairs.
+	auto& keys = packed_;
+	keys.resize(r);
+	const bool packed = total + idxBits <= 64;
+	if (packed)
+	{
+		for (size_t j = 0; j < r; ++j)
+			keys[j] = (compact(runKey_[j]) << idxBits) | j;
+		radixSort(keys, packedTmp_, idxBits, total);
 	}
-	keys_.resize(r);
-	order_.resize(r);
-	radixSortPairs(keys_, order_, keysTmp_, orderTmp_, total);
-	const uint64_t mx = (uint64_t(1) << bits[0]) - 1,
-	               my = (uint64_t(1) << bits[1]) - 1,
-	               mz = (uint64_t(1) << bits[2]) - 1;
-	runCell_.resize(r);
+	else
+	{
+		pairs_.resize(r);
+		for (size_t j = 0; j < r; ++j)
+			pairs_[j] = {compact(runKey_[j]), uint32_t(j)};
+		std::sort(pairs_.begin(), pairs_.end());
+	}
+	const uint64_t idxMask = (uint64_t(1) << idxBits) - 1;
 	uint64_t last = ~uint64_t(0);
 	for (size_t j = 0; j < r; ++j)
 	{
-		const uint64_t key = keys_[j];
+		const uint64_t key = packed ? keys[j] >> idxBits : pairs_[j].first;
+		const uint32_t run =
+		    packed ? uint32_t(keys[j] & idxMask) : pairs_[j].second;
 		if (key != last)
 		{
-			const int32_t c = int32_t(key & 511);
-			out.cells.push_back(
-			    {(int32_t((key >> sx) & mx) + lo[0]) * 8 + (c & 7),
-			     (int32_t((key >> sy) & my) + lo[1]) * 8 + ((c >> 3) & 7),
-			     (int32_t((key >> sz) & mz) + lo[2]) * 8 + (c >> 6)});
+			out.cells.push_back(runKey_[run]);
 			out.hits.push_back(0);
 			last = key;
 		}
-		out.hits.back() += runLen_[order_[j]];
-		runCell_[order_[j]] = uint32_t(out.cells.size() - 1);
+		out.hits.back() += runStart_[run + 1] - runStart_[run];
+		runCell_[run] = uint32_t(out.cells.size() - 1);
 	}
-	for (size_t i = 0; i < w; ++i) out.cellOfPoint[i] = runCell_[runOf_[i]];
+}
+
+// finishCells() with a bucket per block of the frame's bounding box: a
+// counting sort of the runs by block (blocks in (x, y, z) lexicographic
+// order), then, per block, the cells present in a 512-bit mask, numbered
+// in cell-index order (x fastest, as in the storage).
+void FrameCloudBuilder::bucketCells(FrameCloud& out, const int32_t lo[3],
+                                    const size_t nb[3])
+{
+	const size_t r = runKey_.size();
+	const size_t n = nb[0] * nb[1] * nb[2];
+	auto blockOf = [&](const VoxelKey& k)
+	{
+		return (size_t((k.x >> 3) - lo[0]) * nb[1] +
+		        size_t((k.y >> 3) - lo[1])) *
+		           nb[2] +
+		       size_t((k.z >> 3) - lo[2]);
+	};
+	auto cellOf = [](const VoxelKey& k)
+	{ return uint32_t((k.x & 7) | ((k.y & 7) << 3) | ((k.z & 7) << 6)); };
+	bucketStart_.assign(n + 1, 0);
+	uint32_t* start = bucketStart_.data();
+	for (const auto& k : runKey_) start[blockOf(k) + 1]++;
+	for (size_t b = 0; b < n; ++b) start[b + 1] += start[b];
+	// (run << 9) | cell, grouped by block, runs in increasing order.
+	packed_.resize(r);
+	uint64_t* byBlock = packed_.data();
+	bucketFill_.assign(start, start + n);
+	for (size_t j = 0; j < r; ++j)
+	{
+		const VoxelKey& k = runKey_[j];
+		byBlock[bucketFill_[blockOf(k)]++] = (uint64_t(j) << 9) | cellOf(k);
+	}
+	uint32_t cellId[512];
+	for (size_t b = 0; b < n; ++b)
+	{
+		const uint32_t b0 = start[b], b1 = start[b + 1];
+		if (b0 == b1) continue;
+		uint64_t present[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+		for (uint32_t j = b0; j < b1; ++j)
+		{
+			const uint32_t c = uint32_t(byBlock[j] & 511);
+			present[c >> 6] |= uint64_t(1) << (c & 63);
+		}
+		const VoxelKey o = runKey_[byBlock[b0] >> 9];
+		const int32_t ox = o.x & ~7, oy = o.y & ~7, oz = o.z & ~7;
+		for (uint32_t wd = 0; wd < 8; ++wd)
+			for (uint64_t m = present[wd]; m; m &= m - 1)
+			{
+				const uint32_t c = wd * 64 + uint32_t(__builtin_ctzll(m));
+				cellId[c] = uint32_t(out.cells.size());
+				out.cells.push_back({ox + int32_t(c & 7),
+				                     oy + int32_t((c >> 3) & 7),
+				                     oz + int32_t(c >> 6)});
+				out.hits.push_back(0);
+			}
+		for (uint32_t j = b0; j < b1; ++j)
+		{
+			const uint32_t run = uint32_t(byBlock[j] >> 9);
+			const uint32_t id = cellId[byBlock[j] & 511];
+			out.hits[id] += runStart_[run + 1] - runStart_[run];
+			runCell_[run] = id;
+		}
+	}
 }
 
 }  // namespace bims::maps

@@ -45,7 +45,14 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 	if (f.voxel_size != p_.voxel_size)
 		throw std::invalid_argument(
 		    "MotionGrids::processFrame: frame keyed for another voxel size");
+	// A fresh result, keeping the masks' memory.
+	PixelMask m1 = std::move(result_.maskTier1),
+	          m2 = std::move(result_.maskTier2);
+	m1.reset(0, 0);
+	m2.reset(0, 0);
 	result_ = MotionFrameResult();
+	result_.maskTier1 = std::move(m1);
+	result_.maskTier2 = std::move(m2);
 	result_.stats = f.stats;
 	t0_->accountFrame(f.stats);
 	if (f.stats.badPose) return result_;
@@ -68,7 +75,7 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 		// O- first (with its neighbourhood), both posteriors, then tier 0
 		// folds the frame in: with exclude_moving only the voxels the
 		// decision tier calls static (the moving ones keep their belief).
-		t0_->priorLogOdds(f, prior_);
+		t0_->beginFrame(f, prior_);
 		const std::vector<float>* o = &prior_;
 		if (neighbours)
 		{
@@ -82,10 +89,10 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 			const auto& dec = decisionTier_ == 1 ? post1_ : post2_;
 			hold_.resize(f.cells.size());
 			for (size_t i = 0; i < f.cells.size(); ++i) hold_[i] = dec[i] > 0;
-			t0_->integrate(f, nullptr, &hold_);
+			t0_->integratePending(f, &hold_);
 		}
 		else
-			t0_->integrate(f);
+			t0_->integratePending(f, nullptr);
 	}
 	// (4) MAP per voxel; masks.
 	result_.hitVoxels = f.cells.size();

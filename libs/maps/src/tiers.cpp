@@ -87,26 +87,57 @@ void CFlowConsistencyGrid::posterior(const FrameCloud& f,
 		throw std::invalid_argument(
 		    "CFlowConsistencyGrid::posterior: one tier-1 value per cell "
 		    "expected");
-	std::vector<uint32_t> k, l;
-	countLabels(f, labels, k, l);
 	const auto& p = params_;
 	const double logLambda = std::log(p.flow_lambda);
 	const bool veto = p.flow_evidence == FlowEvidence::Veto;
 	// The update is additive in log-odds: flowPosterior(lI, k, l) - lI
-	// depends on (k, l) only. Tabulate small counts.
-	constexpr uint32_t T = 32;
-	double delta[T][T];
-	for (uint32_t a = 0; a < T; ++a)
-		for (uint32_t b = 0; b < T; ++b)
-			delta[a][b] = flowPosterior(0, p.flow_transition_tau, p.p_miss,
-			                            logLambda, a, b, veto);
-	post.resize(f.cells.size());
-	for (size_t i = 0; i < f.cells.size(); ++i)
+	// depends on (k, l) only. Small counts are tabulated (once per
+	// parameter set).
+	constexpr uint32_t T = kTable;
+	auto& tab = delta_;
+	if (tab.d.empty() || tab.tau != p.flow_transition_tau ||
+	    tab.pMiss != p.p_miss || tab.logLambda != logLambda || tab.veto != veto)
 	{
-		const double d = (k[i] < T && l[i] < T)
-		                     ? delta[k[i]][l[i]]
+		tab.tau = p.flow_transition_tau;
+		tab.pMiss = p.p_miss;
+		tab.logLambda = logLambda;
+		tab.veto = veto;
+		tab.d.resize(T * T);
+		for (uint32_t a = 0; a < T; ++a)
+			for (uint32_t b = 0; b < T; ++b)
+				tab.d[a * T + b] = flowPosterior(
+				    0, p.flow_transition_tau, p.p_miss, logLambda, a, b, veto);
+	}
+	// Diff (k) and notDiff (l) counts per cell, interleaved, as
+	// countLabels().
+	const size_t m = f.cells.size();
+	counts_.assign(2 * m, 0);
+	if (!labels.label.empty())
+	{
+		if (labels.width != f.K.width || labels.height != f.K.height ||
+		    labels.label.size() != size_t(labels.width) * size_t(labels.height))
+			throw std::invalid_argument(
+			    "CFlowConsistencyGrid: labels are " +
+			    std::to_string(labels.width) + "x" +
+			    std::to_string(labels.height) + " but the frame is " +
+			    std::to_string(f.K.width) + "x" + std::to_string(f.K.height));
+		uint32_t* kl = counts_.data();
+		const int8_t* lab = labels.label.data();
+		for (size_t j = 0; j < f.pixel.size(); ++j)
+		{
+			const int8_t v = lab[f.pixel[j]];
+			if (v == 1 || v == 0) kl[2 * f.cellOfPoint[j] + (v == 0)]++;
+		}
+	}
+	post.resize(m);
+	const uint32_t* kl = counts_.data();
+	for (size_t i = 0; i < m; ++i)
+	{
+		const uint32_t k = kl[2 * i], l = kl[2 * i + 1];
+		const double d = (k < T && l < T)
+		                     ? tab.d[k * T + l]
 		                     : flowPosterior(0, p.flow_transition_tau, p.p_miss,
-		                                     logLambda, k[i], l[i], veto);
+		                                     logLambda, k, l, veto);
 		post[i] = float(tier1[i] + d);
 	}
 }

@@ -144,3 +144,188 @@ TEST(Raycast, SameResultAsAPlainDdaOnAMapWithAnyThreadCount)
 	}
 	EXPECT_GT(compared, 20000u);
 }
+
+// decay = frustum (boxes of cells decided at once where the rule provably
+// gives one answer) against the plain rule applied to every stored cell:
+// hits first, then each stored cell not hit whose centre projects onto a
+// measured depth d with z + half diagonal < d gets one miss. Random rooms
+// with boxes that come and go (cells in front of the depth, behind it, out
+// of view, behind the camera), depth holes, several voxel sizes.
+TEST(Frustum, SameResultAsThePlainRuleOnEveryStoredCell)
+{
+	using bims::maps::test::Box;
+	std::mt19937 rng(7);
+	std::uniform_real_distribution<double> U(-1, 1);
+	size_t decayed = 0, kept = 0;
+	for (double voxel : {0.03, 0.05, 0.1})
+	{
+		GridParams p;
+		p.decay = DecayMode::Frustum;
+		p.voxel_size = voxel;
+		p.max_range = 7;
+		COccupancyBayesGrid g(p);
+		FrameCloudBuilder b(p);
+		using Cell = COccupancyBayesGrid::Cell;
+		std::map<std::tuple<int, int, int>, Cell> ref;
+		const auto room = bims::maps::test::room();
+		for (int fr = 1; fr <= 8; ++fr)
+		{
+			auto scene = room;
+			// Boxes that exist in some frames only.
+			std::mt19937 boxes(uint32_t(fr / 3));
+			std::uniform_real_distribution<double> B(-3, 3);
+			for (int i = 0; i < 6; ++i)
+			{
+				const double x = B(boxes), y = B(boxes), z = 1.5 + B(boxes) / 3;
+				scene.push_back({{x, y, z - 0.3}, {x + 0.4, y + 0.5, z + 0.3}});
+			}
+			const mrpt::poses::CPose3D T_WS(2 * U(rng), 2 * U(rng),
+			                                1.5 + 0.5 * U(rng), 3.2 * U(rng),
+			                                0.5 * U(rng), 0.3 * U(rng));
+			const auto scan =
+			    bims::maps::test::renderScan(scene, T_WS, 80, 60, 70, fr);
+			// Holes in the depth image.
+			for (int v = 0; v < 60; ++v)
+				for (int u = 0; u < 80; ++u)
+					if (rng() % 17 == 0) scan->rangeImage(v, u) = 0;
+			FrameCloud f;
+			b.build(*scan, T_WS, f);
+			ASSERT_GT(f.numPoints(), 1000u);
+			g.integrate(f);
+			const uint32_t F = uint32_t(fr);
+			// Reference: the hits (their blocks are stored whole).
+			for (size_t i = 0; i < f.numCells(); ++i)
+			{
+				const VoxelKey& k = f.cells[i];
+				const int bx = k.x >> 3, by = k.y >> 3, bz = k.z >> 3;
+				if (!ref.count({bx * 8, by * 8, bz * 8}))
+					for (int z = 0; z < 8; ++z)
+						for (int y = 0; y < 8; ++y)
+							for (int x = 0; x < 8; ++x)
+								ref[{bx * 8 + x, by * 8 + y, bz * 8 + z}] =
+								    Cell();
+				Cell& c = ref[{k.x, k.y, k.z}];
+				c.lPrev = c.l;
+				c.l = LogOddsFx(std::min<int64_t>(
+				    int64_t(c.l) + g.hitFixed(f.hits[i]), g.maxFixed()));
+				c.stamp = F;
+			}
+			// Reference: the plain rule on every stored cell.
+			const auto& R = f.T_WC.getRotationMatrix();
+			const auto t = f.T_WC.translation();
+			const auto& K = f.K;
+			for (auto& [key, c] : ref)
+			{
+				if (c.stamp == F) continue;
+				const double x = (std::get<0>(key) + 0.5) * voxel - t.x,
+				             y = (std::get<1>(key) + 0.5) * voxel - t.y,
+				             z = (std::get<2>(key) + 0.5) * voxel - t.z;
+				double pc[3];
+				for (int r = 0; r < 3; ++r)
+					pc[r] = R(0, r) * x + R(1, r) * y + R(2, r) * z;
+				if (pc[2] <= 1e-6) continue;
+				const long u = std::lround(K.fx * pc[0] / pc[2] + K.cx),
+				           v = std::lround(K.fy * pc[1] / pc[2] + K.cy);
+				if (u < 0 || v < 0 || u >= K.width || v >= K.height) continue;
+				const float d = f.depth[size_t(v) * K.width + size_t(u)];
+				if (d > 0 && pc[2] + voxel * std::sqrt(3.0) / 2 < d)
+				{
+					c.lPrev = c.l;
+					c.l =
+					    std::max<LogOddsFx>(c.l - g.missFixed(), g.minFixed());
+					c.stamp = F;
+					++decayed;
+				}
+				else
+					++kept;
+			}
+			// Every stored cell equals the reference, and nothing else is
+			// stored.
+			size_t stored = 0;
+			g.storage().forEachCell(
+			    [&](const VoxelKey& k, const Cell& c)
+			    {
+				    ++stored;
+				    auto it = ref.find({k.x, k.y, k.z});
+				    ASSERT_TRUE(it != ref.end());
+				    ASSERT_EQ(c.l, it->second.l) << "frame " << fr;
+				    ASSERT_EQ(c.lPrev, it->second.lPrev) << "frame " << fr;
+				    ASSERT_EQ(c.stamp, it->second.stamp) << "frame " << fr;
+			    });
+			ASSERT_EQ(stored, ref.size());
+		}
+	}
+	EXPECT_GT(decayed, 10000u);
+	EXPECT_GT(kept, 10000u);
+}
+
+// beginFrame() + integratePending() (one storage lookup per voxel for O-
+// and the update) against priorLogOdds() + integrate(): the same O-, the
+// same cells, also for a repeated timestamp, held voxels, p_unknown and a
+// memory budget that stops block creation; a changed map in between is an
+// error.
+TEST(OccupancyGrid, BeginFrameThenIntegratePendingEqualsPriorThenIntegrate)
+{
+	for (int variant = 0; variant < 3; ++variant)
+	{
+		GridParams p;
+		p.voxel_size = 0.05;
+		p.reading_lambda = 1.5;
+		if (variant == 1) p.p_unknown = 0.9;
+		if (variant == 2) p.max_memory_mb = 1;  // ~170 blocks of 6 KiB
+		COccupancyBayesGrid a(p), b(p);
+		FrameCloudBuilder fb(p);
+		std::mt19937 rng(21 + variant);
+		std::normal_distribution<float> N(0, 1.5f);
+		size_t over = 0;
+		for (int fr = 0; fr < 12; ++fr)
+		{
+			std::vector<mrpt::math::TPoint3Df> pts;
+			for (int i = 0; i < 3000; ++i)
+				pts.emplace_back(N(rng), N(rng), N(rng));
+			FrameCloud f;
+			fb.buildFromPoints(pts, {}, {0, 0, 0}, f);
+			// Frames 4 and 5 share a timestamp (the second is "already
+			// integrated" for priorLogOdds()).
+			f.timestamp = mrpt::Clock::time_point(
+			    mrpt::Clock::duration(fr == 5 ? 4 : fr));
+			std::vector<uint8_t> hold(f.numCells());
+			for (auto& h : hold) h = rng() % 4 == 0;
+			std::vector<float> pa, pb;
+			a.priorLogOdds(f, pa);
+			a.integrate(f, nullptr, &hold);
+			b.beginFrame(f, pb);
+			b.integratePending(f, &hold);
+			ASSERT_EQ(pa.size(), pb.size());
+			for (size_t i = 0; i < pa.size(); ++i)
+				ASSERT_EQ(pa[i], pb[i]) << "frame " << fr << " cell " << i;
+			over = a.totalStats().overBudget;
+			ASSERT_EQ(a.totalStats().overBudget, b.totalStats().overBudget);
+		}
+		ASSERT_EQ(a.storage().numBlocks(), b.storage().numBlocks());
+		for (size_t k = 0; k < a.storage().numBlocks(); ++k)
+		{
+			ASSERT_EQ(a.storage().blockKey(k), b.storage().blockKey(k));
+			for (size_t c = 0; c < COccupancyBayesGrid::Storage::kCellsPerBlock;
+			     ++c)
+			{
+				const auto& x = a.storage().block(k).cells[c];
+				const auto& y = b.storage().block(k).cells[c];
+				ASSERT_EQ(x.l, y.l);
+				ASSERT_EQ(x.lPrev, y.lPrev);
+				ASSERT_EQ(x.stamp, y.stamp);
+			}
+		}
+		if (variant == 2)
+		{
+			EXPECT_GT(over, 0u);
+		}
+		// A map updated between the halves.
+		FrameCloud f;
+		fb.buildFromPoints({{0.1f, 0.2f, 0.3f}}, {}, {0, 0, 0}, f);
+		std::vector<float> pr;
+		b.beginFrame(f, pr);
+		b.integrate(f);
+		EXPECT_THROW(b.integratePending(f, nullptr), std::logic_error);
+	}
+}

@@ -47,7 +47,8 @@ class CMotionGridBase : public CBayesVoxelGridBase
 
 	/** Stores the posterior log-odds (one per frame.cells) of a frame as
 	 * this map's frame frameCount()+1 and computes the mask. */
-	void store(const FrameCloud& frame, std::vector<float> posteriorLogOdds);
+	void store(const FrameCloud& frame,
+	           const std::vector<float>& posteriorLogOdds);
 
 	/** Posterior log-odds of I of each of the last frame's cells. */
 	const std::vector<float>& lastPosterior() const { return lastPost_; }
@@ -169,6 +170,17 @@ class CFlowConsistencyGrid : public CMotionGridBase
  private:
 	PixelLabels pending_;
 	std::vector<float> t1scratch_;
+	// posterior(): the evidence of small label counts, for the parameters
+	// it was tabulated with, and the per-cell counts (scratch).
+	static constexpr uint32_t kTable = 32;
+	struct DeltaTable
+	{
+		double tau = -1, pMiss = -1, logLambda = 0;
+		bool veto = false;
+		std::vector<double> d;  // kTable x kTable, [k][l]
+	};
+	mutable DeltaTable delta_;
+	mutable std::vector<uint32_t> counts_;
 };
 
 }  // namespace bims::maps

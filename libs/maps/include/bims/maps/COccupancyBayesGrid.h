@@ -51,6 +51,16 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 	               std::vector<float>* priorLogOdds = nullptr,
 	               const std::vector<uint8_t>* hold = nullptr);
 
+	/** integrate() in two halves, for MotionGrids with exclude_moving, with
+	 * one storage lookup per voxel for both: beginFrame() gives O- of each
+	 * of frame.cells exactly as priorLogOdds() would (and creates the
+	 * voxels' blocks, as integrate() would); integratePending(frame, hold)
+	 * then equals integrate(frame, nullptr, hold). Nothing else may update
+	 * this map in between (std::logic_error otherwise). */
+	void beginFrame(const FrameCloud& frame, std::vector<float>& priorLogOdds);
+	void integratePending(const FrameCloud& frame,
+	                      const std::vector<uint8_t>* hold);
+
 	/** O- for each of frame.cells, without modifying the map. Order
 	 * independent: if this frame (same non-zero timestamp) was already
 	 * integrated, returns the values from before it.*/
@@ -110,6 +120,16 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 	void decayFrustum(const FrameCloud& f, uint32_t F);
 	void decayRaycast(const FrameCloud& f, uint32_t F);
 	void applyMiss(Cell& c, uint32_t F) const;
+	/** The update of integrate() once cellPtr_ holds the frame's cells. */
+	void applyFrame(const FrameCloud& f, std::vector<float>* priorOut,
+	                const std::vector<uint8_t>* hold);
+	void checkFrame(const FrameCloud& f, const char* what) const;
+
+	// The cells of the frame being integrated (nullptr: over budget) and,
+	// between beginFrame() and integratePending(), which frame they are.
+	std::vector<Cell*> cellPtr_;
+	const FrameCloud* pending_ = nullptr;
+	uint32_t pendingFrame_ = 0;
 
 	Storage grid_;
 	// Scratch of decayRaycast(), reused across frames.
@@ -120,6 +140,9 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 	std::vector<RayEnd> rayEnds_;
 	std::vector<uint32_t> tileStart_;
 	std::vector<Cell*> blockTable_;
+	// Scratch of decayFrustum(): per-tile depth bounds.
+	std::vector<float> tileMax_, tileMinPos_;
+	std::vector<uint8_t> tileZero_;
 	LogOddsFx miss_ = 0, lmin_ = 0, lmax_ = 0;
 	/** p_unknown > 0: the log-odds of a never-observed cell. */
 	bool hasUnknown_ = false;

@@ -17,6 +17,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mrpt::obs
@@ -147,11 +148,28 @@ class FrameCloudBuilder
 	void keyPoints(FrameCloud& out);
 
  private:
+	struct Keyer;
+	/** Sorts the runs of runKey_/runStart_ into out.cells, out.hits and
+	 * out.cellOfPoint (out.points_W holds the kept readings). */
+	void finishCells(FrameCloud& out);
+	void bucketCells(FrameCloud& out, const int32_t lo[3], const size_t nb[3]);
+	void radixCells(FrameCloud& out, const int32_t lo[3], const int32_t hi[3]);
+
 	GridParams p_;
-	// Scratch of keyPoints(): compact keys of the readings and their order.
-	std::vector<uint64_t> keys_, keysTmp_;
-	std::vector<uint32_t> order_, orderTmp_;
-	std::vector<uint32_t> runOf_, runLen_, runCell_;
+	// Per-column terms of the unprojection.
+	struct Column
+	{
+		double a;     // 1 + xn^2
+		double r[3];  // xn * R_WC.col(0)
+	};
+	std::vector<Column> col_;
+	// Runs of consecutive kept readings in one voxel: key and first reading.
+	std::vector<VoxelKey> runKey_;
+	std::vector<uint32_t> runStart_, runCell_;
+	// Sort scratch: (compact key << run bits) | run, or (key, run) pairs.
+	std::vector<uint64_t> packed_, packedTmp_;
+	std::vector<std::pair<uint64_t, uint32_t>> pairs_;
+	std::vector<uint32_t> bucketStart_, bucketFill_;
 };
 
 }  // namespace bims::maps

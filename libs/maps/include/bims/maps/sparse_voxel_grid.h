@@ -91,6 +91,36 @@ class SparseVoxelGrid
 		return &blocks_[b]->cells[cellIndexOf(k.x, k.y, k.z)];
 	}
 
+	/** The cell of each of \a keys, created if needed (nullptr where the
+	 * memory budget forbids its block), with one index lookup per run of
+	 * keys in one block (FrameCloud::cells are sorted by block). Blocks are
+	 * created in the order of the keys, as by an Accessor. */
+	void resolve(const std::vector<VoxelKey>& keys, std::vector<Cell*>& out)
+	{
+		out.resize(keys.size());
+		uint64_t lastKey = FlatHashMap::kEmpty;
+		Block* last = nullptr;
+		for (size_t i = 0; i < keys.size(); ++i)
+		{
+			const VoxelKey& k = keys[i];
+			const uint64_t bk = blockKeyOf(k.x, k.y, k.z);
+			if (bk != lastKey)
+			{
+				const uint32_t b = findOrCreateBlock(bk);
+				last = b == FlatHashMap::kNotFound ? nullptr : blocks_[b].get();
+				lastKey = bk;
+			}
+			out[i] = last ? &last->cells[cellIndexOf(k.x, k.y, k.z)] : nullptr;
+		}
+	}
+
+	/** Block with packed key \a blockKey, or nullptr (never creates). */
+	const Block* findBlock(uint64_t blockKey) const
+	{
+		const uint32_t b = index_.find(blockKey);
+		return b == FlatHashMap::kNotFound ? nullptr : blocks_[b].get();
+	}
+
 	size_t numBlocks() const { return blocks_.size(); }
 	size_t numCells() const { return blocks_.size() * kCellsPerBlock; }
 	Block& block(size_t i) { return *blocks_[i]; }
