@@ -178,9 +178,26 @@ void ViewerFrame::buildLayout()
 	split->SplitVertically(canvas_, right, opt_.width * 3 / 5);
 	split->SetSashGravity(0.6);
 	split->SetMinimumPaneSize(100);
-	// The frame gets its real size only once shown: place the sash then.
+	// The frame gets its real size only once shown, and under load the
+	// window manager may resize it after the first events: keep the sash at
+	// 3/5 of the width on every resize until the user drags it.
 	CallAfter([this, split]
 	          { split->SetSashPosition(GetClientSize().x * 3 / 5); });
+	split->Bind(wxEVT_SPLITTER_SASH_POS_CHANGED,
+	            [this](wxSplitterEvent& e)
+	            {
+		            sashMovedByUser_ = true;
+		            e.Skip();
+	            });
+	Bind(wxEVT_SIZE,
+	     [this, split](wxSizeEvent& e)
+	     {
+		     e.Skip();
+		     if (!sashMovedByUser_)
+			     CallAfter(
+			         [this, split]
+			         { split->SetSashPosition(GetClientSize().x * 3 / 5); });
+	     });
 
 	// Timeline: play/pause, step, restart, speed, slider.
 	auto* bar = new wxPanel(this);

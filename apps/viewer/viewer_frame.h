@@ -75,6 +75,7 @@ class ViewerFrame : public wxFrame
 	std::string pngDir_;
 	int batchWaitTicks_ = 0;
 	bool batchCaptureRequested_ = false;
+	bool sashMovedByUser_ = false;  ///< the sash no longer follows resizes
 };
 
 }  // namespace bims::viewer_app
