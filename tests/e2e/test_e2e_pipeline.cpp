@@ -94,19 +94,18 @@ TEST(EndToEnd, SegmentsThePendulumOnTheBundledSample)
 TEST(EndToEnd, FusionBeatsEachIsolatedVariantOnTheWholeSample)
 {
 	// The paper's claim, on all 150 frames of the bundled sample. Measured
-	// first (docs/results.md): bottom-only 0.843, flow-only 0.668, fused
-	// 0.869, fused + ray cast 0.899 (session 2, before derotation and the
-	// gyro-integrated world: 0.819, 0.696, 0.875, 0.904; the bottom tier
-	// gained most, so the margin is 0.02 where it was 0.03).
+	// first (docs/results.md): bottom-only 0.843, flow-only 0.710, fused
+	// 0.901, fused + ray cast 0.901 (session 2, before derotation, the
+	// gyro-integrated world and exclude_by: 0.819, 0.696, 0.875, 0.904).
 	ExperimentConfig cfg;
 	cfg.loadFromFile(kConfig);
 	const double bottom = score(cfg, Variant::BottomOnly, 149).f1();
 	const double flow = score(cfg, Variant::FlowOnly, 149).f1();
 	const double fused = score(cfg, Variant::Fused, 149).f1();
 	const double raycast = score(cfg, Variant::FusedRaycast, 149).f1();
-	EXPECT_GT(fused, std::max(bottom, flow) + 0.02);
+	EXPECT_GT(fused, std::max(bottom, flow) + 0.03);
 	EXPECT_GT(raycast, std::max(bottom, flow) + 0.03);
-	EXPECT_GT(fused, 0.85);
+	EXPECT_GT(fused, 0.88);
 	EXPECT_GT(raycast, 0.88);
 }
 

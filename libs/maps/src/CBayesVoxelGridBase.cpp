@@ -103,6 +103,8 @@ void CBayesVoxelGridBase::writeBase(mrpt::serialization::CArchive& out) const
 	    << uint8_t(p.raycast_target);
 	// version 1
 	out << p.p_unknown << uint8_t(p.bg_neighbourhood) << p.exclude_moving;
+	// version 2
+	out << uint8_t(p.exclude_by);
 	out << frameCount_ << int64_t(lastTimestamp_.time_since_epoch().count());
 }
 
@@ -131,6 +133,15 @@ void CBayesVoxelGridBase::readBase(mrpt::serialization::CArchive& in,
 			throw std::runtime_error(
 			    "bims::maps: corrupt serialised grid (bad enum value)");
 		p.bg_neighbourhood = BgNeighbourhood(nb);
+	}
+	if (version >= 2)
+	{
+		uint8_t xb;
+		in >> xb;
+		if (xb > 2)
+			throw std::runtime_error(
+			    "bims::maps: corrupt serialised grid (bad enum value)");
+		p.exclude_by = ExcludeBy(xb);
 	}
 	setParamsBase(p);  // validates
 	int64_t ts;

@@ -28,6 +28,20 @@ const char* toString(RayTarget t)
 {
 	return t == RayTarget::Voxels ? "voxels" : "points";
 }
+const char* toString(ExcludeBy e)
+{
+	switch (e)
+	{
+		case ExcludeBy::Decision:
+			return "decision";
+		case ExcludeBy::Either:
+			return "either";
+		case ExcludeBy::Auto:
+			return "auto";
+	}
+	return "?";
+}
+
 const char* toString(BgNeighbourhood n)
 {
 	switch (n)
@@ -123,6 +137,11 @@ void GridParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                         {"points", "voxels"});
 	raycast_target = t == "voxels" ? RayTarget::Voxels : RayTarget::Points;
 	exclude_moving = s.getBool("exclude_moving", exclude_moving);
+	const auto xb = s.getEnum("exclude_by", toString(exclude_by),
+	                          {"decision", "either", "auto"});
+	exclude_by = xb == "either" ? ExcludeBy::Either
+	             : xb == "auto" ? ExcludeBy::Auto
+	                            : ExcludeBy::Decision;
 	raycast_threads = int(s.getInt("raycast_threads", raycast_threads, 1, 64));
 	s.finish();
 	try
@@ -151,6 +170,7 @@ void GridParams::dump(std::ostream& o) const
 	  << "\nraycast_decimation=" << raycast_decimation
 	  << "\nraycast_target=" << toString(raycast_target)
 	  << "\nexclude_moving=" << (exclude_moving ? "true" : "false")
+	  << "\nexclude_by=" << toString(exclude_by)
 	  << "\nraycast_threads=" << raycast_threads << "\n";
 }
 
@@ -167,7 +187,7 @@ bool GridParams::operator==(const GridParams& o) const
 	       max_memory_mb == o.max_memory_mb &&
 	       raycast_decimation == o.raycast_decimation &&
 	       raycast_target == o.raycast_target &&
-	       exclude_moving == o.exclude_moving &&
+	       exclude_moving == o.exclude_moving && exclude_by == o.exclude_by &&
 	       raycast_threads == o.raycast_threads;
 }
 

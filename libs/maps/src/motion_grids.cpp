@@ -87,8 +87,12 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 		if (exclude)
 		{
 			const auto& dec = decisionTier_ == 1 ? post1_ : post2_;
+			const bool either = p_.exclude_by == ExcludeBy::Either ||
+			                    (p_.exclude_by == ExcludeBy::Auto &&
+			                     p_.decay != DecayMode::Raycast);
 			hold_.resize(f.cells.size());
-			for (size_t i = 0; i < f.cells.size(); ++i) hold_[i] = dec[i] > 0;
+			for (size_t i = 0; i < f.cells.size(); ++i)
+				hold_[i] = dec[i] > 0 || (either && post1_[i] > 0);
 			t0_->integratePending(f, &hold_);
 		}
 		else

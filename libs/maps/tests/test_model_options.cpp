@@ -213,6 +213,7 @@ TEST(ModelOptions, NewParametersSurviveSerialisationAndIni)
 	p.p_unknown = 0.9;
 	p.bg_neighbourhood = BgNeighbourhood::Ray;
 	p.exclude_moving = true;
+	p.exclude_by = ExcludeBy::Either;
 	CFlowConsistencyGrid m(p);
 	mrpt::io::CMemoryStream buf;
 	auto arch = mrpt::serialization::archiveFrom(buf);
@@ -224,12 +225,60 @@ TEST(ModelOptions, NewParametersSurviveSerialisationAndIni)
 	EXPECT_EQ(back->params(), p);
 
 	mrpt::config::CConfigFileMemory ini(
-	    "[grids]\np_unknown=0.9\nbg_neighbourhood=ray\nexclude_moving=true\n");
+	    "[grids]\np_unknown=0.9\nbg_neighbourhood=ray\nexclude_moving=true\n"
+	    "exclude_by=either\n");
 	GridParams q;
 	q.loadFromConfigFile(ini, "grids");
 	EXPECT_EQ(q, p);
 	mrpt::config::CConfigFileMemory bad("[grids]\nbg_neighbourhood=sphere\n");
 	EXPECT_THROW(q.loadFromConfigFile(bad, "grids"), bims::ConfigError);
+	mrpt::config::CConfigFileMemory badBy("[grids]\nexclude_by=tier3\n");
+	EXPECT_THROW(q.loadFromConfigFile(badBy, "grids"), bims::ConfigError);
 	mrpt::config::CConfigFileMemory range("[grids]\np_unknown=1.5\n");
 	EXPECT_THROW(q.loadFromConfigFile(range, "grids"), bims::ConfigError);
+}
+
+TEST(ModelOptions, ExcludeByEitherHoldsWhatTier1CallsMovingAgainstTheFlow)
+{
+	// A voxel seen occupied (frames 1-3), then empty (4-14: decayed to
+	// p_min); at frame 15 an object is in it whose flow looks consistent
+	// (notDiff: a pendulum at its turning point). Tier 2 then calls it
+	// static; with exclude_by = decision tier 0 folds it in, with either
+	// (tier 1 calls it moving) it is held.
+	const VoxelKey wall{0, 0, 40}, obj{0, 0, 20};
+	for (const ExcludeBy by :
+	     {ExcludeBy::Decision, ExcludeBy::Either, ExcludeBy::Auto})
+	{
+		GridParams p;
+		p.decay = DecayMode::All;
+		p.p_unknown = 0.97;
+		p.exclude_moving = true;
+		p.exclude_by = by;
+		p.flow_transition_tau = 0.001;  // the flow can overrule tier 1
+		MotionGrids mg(p);
+		for (int f = 1; f <= 14; ++f)
+			mg.processFrame(f <= 3
+			                    ? frameAt(p, {wall, obj}, {5, 5}, {0, 0, 0}, f)
+			                    : frameAt(p, {wall}, {5}, {0, 0, 0}, f),
+			                nullptr);
+		const LogOddsFx before = mg.occupancy()->logOddsFixed(obj);
+		FrameCloud fr = frameAt(p, {wall, obj}, {5, 5}, {0, 0, 0}, 15);
+		fr.K.width = 10;
+		fr.K.height = 1;
+		for (uint32_t j = 0; j < 10; ++j) fr.pixel[j] = j;
+		const PixelLabels notDiff(10, 1, 0);
+		mg.processFrame(fr, &notDiff);
+		const auto& cells = mg.background()->lastCells();
+		size_t io = cells.size();
+		for (size_t i = 0; i < cells.size(); ++i)
+			if (cells[i] == obj) io = i;
+		ASSERT_LT(io, cells.size());
+		EXPECT_GT(mg.background()->lastPosterior()[io], 0) << toString(by);
+		EXPECT_LT(mg.flow()->lastPosterior()[io], 0) << toString(by);
+		if (by == ExcludeBy::Decision)
+			EXPECT_GT(mg.occupancy()->logOddsFixed(obj), before);
+		else  // either, and auto without ray casting
+			EXPECT_EQ(mg.occupancy()->logOddsFixed(obj), before)
+			    << toString(by);
+	}
 }

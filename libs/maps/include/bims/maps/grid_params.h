@@ -60,10 +60,20 @@ enum class RayTarget
 	Voxels
 };
 
+/** MotionGrids with exclude_moving: which voxels tier 0 leaves out. */
+enum class ExcludeBy
+{
+	Decision,  ///< those the decision tier (2, or 1 for bottom-only) calls
+	           ///< moving
+	Either,    ///< those tier 1 or the decision tier calls moving
+	Auto       ///< Either, but Decision with decay = raycast (docs/model.md)
+};
+
 const char* toString(DecayMode m);
 const char* toString(FlowEvidence e);
 const char* toString(RayTarget t);
 const char* toString(BgNeighbourhood n);
+const char* toString(ExcludeBy e);
 
 /** All parameters of the grids. Probabilities are in (0, 1); log-odds are
  * natural logarithms. Defaults are explained in docs/model.md. */
@@ -118,6 +128,8 @@ struct GridParams
 	 * labelled moving keeps its belief (no hit, no miss). false = the
 	 * paper: every reading is folded into tier 0. */
 	bool exclude_moving = false;
+	/** exclude_moving: the voxels left out (see ExcludeBy). */
+	ExcludeBy exclude_by = ExcludeBy::Decision;
 	/** decay = raycast: threads casting the free-space rays of a frame
 	 * (the result does not depend on it). A setting of the process, not of
 	 * the map: not serialised (a loaded map has 1). */
