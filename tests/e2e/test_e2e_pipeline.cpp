@@ -280,14 +280,16 @@ std::vector<cv::Mat> labelMasks(const std::string& rawlog)
 
 TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 {
-	// Reading ahead and writing on threads must not change a single byte of
-	// the outputs (nor the order of the labelled rawlog).
+	// Reading ahead, the observed flow on its own thread and writing on
+	// threads must not change a single byte of the outputs (nor the order of
+	// the labelled rawlog).
 	ExperimentConfig cfg;
 	cfg.loadFromFile(kConfig);
 	auto runWith = [&](bool threads, const std::string& name)
 	{
 		ExperimentConfig c = cfg;
 		c.pipeline.read_ahead = threads;
+		c.pipeline.flow_thread = threads;
 		c.output.writer_thread = threads;
 		RunOptions opt;
 		opt.rawlogs = {kSample};

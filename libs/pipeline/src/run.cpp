@@ -133,6 +133,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		stage["input"].push_back(r.ms.input);
 		stage["egomotion"].push_back(r.ms.ego);
 		stage["flow"].push_back(r.ms.flow);
+		if (r.ms.observed > 0) stage["flow_observed"].push_back(r.ms.observed);
 		stage["grids"].push_back(r.ms.grids);
 		stage["total"].push_back(r.ms.total);
 		const double validPx = static_cast<double>(r.cloudStats.valid);
@@ -277,9 +278,10 @@ std::string formatSummary(const RunSummary& s)
 	              100.0 * s.meanMovingPixelFraction);
 	o << buf;
 	o << "stage        median ms   p95 ms   mean ms\n";
-	for (const char* k : {"read", "read_cpu", "wait_input", "input",
-	                      "egomotion", "flow", "grids", "total", "total_cpu",
-	                      "outputs", "outputs_cpu", "wait_output"})
+	for (const char* k :
+	     {"read", "read_cpu", "wait_input", "input", "egomotion", "flow",
+	      "flow_observed", "grids", "total", "total_cpu", "outputs",
+	      "outputs_cpu", "wait_output"})
 	{
 		const auto it = s.stageMs.find(k);
 		if (it == s.stageMs.end()) continue;
