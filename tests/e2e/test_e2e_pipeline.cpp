@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
@@ -279,15 +280,20 @@ std::vector<cv::Mat> labelMasks(const std::string& rawlog)
 
 TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 {
-	// Reading ahead and writing on threads must not change a single byte of
-	// the outputs (nor the order of the labelled rawlog).
+	// Reading ahead, the observed flow on its own thread, writing on threads
+	// and OpenCV's pool must not change a single byte of the outputs (nor the
+	// order of the labelled rawlog).
 	ExperimentConfig cfg;
 	cfg.loadFromFile(kConfig);
 	auto runWith = [&](bool threads, const std::string& name)
 	{
 		ExperimentConfig c = cfg;
 		c.pipeline.read_ahead = threads;
+		c.pipeline.flow_thread = threads;
 		c.output.writer_thread = threads;
+		// and OpenCV's pool off in sequence (the setting is restored)
+		c.pipeline.opencv_threads = threads ? 0 : 1;
+		const int cvThreads = cv::getNumThreads();
 		RunOptions opt;
 		opt.rawlogs = {kSample};
 		opt.frames = FrameRange{0, 19};
@@ -296,6 +302,7 @@ TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 		const auto sum = runExperiment(c, opt);
 		EXPECT_TRUE(sum.error.empty()) << sum.error;
 		EXPECT_EQ(sum.framesProcessed, 20u);
+		EXPECT_EQ(cv::getNumThreads(), cvThreads);
 		return opt.outDir;
 	};
 	const std::string a = runWith(false, "sequential");

@@ -25,7 +25,10 @@ class VectorArchive : public mrpt::serialization::CArchive
 	size_t write(const void* d, size_t n) override
 	{
 		const auto* p = static_cast<const uint8_t*>(d);
-		buf_.insert(buf_.end(), p, p + n);
+		if (n == 1)
+			buf_.push_back(*p);  // e.g. pixel labels, one byte per call
+		else
+			buf_.insert(buf_.end(), p, p + n);
 		return n;
 	}
 	size_t read(void*, size_t) override
@@ -71,6 +74,18 @@ class BufferedInArchive : public mrpt::serialization::CArchive
 	size_t read(void* d, size_t n) override
 	{
 		auto* out = static_cast<uint8_t*>(d);
+		if (n <= buf_.size() - next_)
+		{
+			// in the buffer: most calls (MRPT reads matrices element by
+			// element, pixel labels one byte at a time)
+			if (n == 1)
+				*out = buf_[next_];
+			else
+				std::memcpy(out, buf_.data() + next_, n);
+			next_ += n;
+			pos_ += n;
+			return n;
+		}
 		size_t got = 0;
 		while (got < n)
 		{

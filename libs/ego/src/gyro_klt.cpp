@@ -11,6 +11,25 @@
 
 namespace bims::ego
 {
+cv::Mat dilateMask(const cv::Mat& mask, int px)
+{
+	CV_Assert(mask.type() == CV_8UC1 && px >= 0);
+	cv::Mat out(mask.size(), CV_8UC1, cv::Scalar(0));
+	// Nothing outside the non-zero pixels' box grown by px can be set; inside
+	// it, cv::dilate of the ROI sees the (zero) pixels around it as the whole
+	// image's dilation does.
+	const cv::Rect box = cv::boundingRect(mask);
+	if (box.empty()) return out;
+	const cv::Rect roi = cv::Rect(box.x - px, box.y - px, box.width + 2 * px,
+	                              box.height + 2 * px) &
+	                     cv::Rect(0, 0, mask.cols, mask.rows);
+	cv::Mat dst = out(roi);
+	cv::dilate(mask(roi), dst,
+	           cv::getStructuringElement(cv::MORPH_ELLIPSE,
+	                                     cv::Size(2 * px + 1, 2 * px + 1)));
+	return out;
+}
+
 GyroAidedKLT::GyroAidedKLT(const TrackerParams& p) : p_(p)
 {
 }
@@ -162,16 +181,9 @@ void GyroAidedKLT::replenish(const cv::Mat& grey, const cv::Mat* movingMask)
 	if (grey.cols > 2 * b && grey.rows > 2 * b)
 		allow(cv::Rect(b, b, grey.cols - 2 * b, grey.rows - 2 * b)).setTo(255);
 	if (movingMask)
-	{
-		cv::Mat m = *movingMask;
-		if (p_.mask_dilate_px > 0)
-			cv::dilate(
-			    *movingMask, m,
-			    cv::getStructuringElement(cv::MORPH_ELLIPSE,
-			                              cv::Size(2 * p_.mask_dilate_px + 1,
-			                                       2 * p_.mask_dilate_px + 1)));
-		allow.setTo(0, m);
-	}
+		allow.setTo(0, p_.mask_dilate_px > 0
+		                   ? dilateMask(*movingMask, p_.mask_dilate_px)
+		                   : *movingMask);
 	const int r = static_cast<int>(std::lround(p_.min_distance_px));
 	for (const auto& q : pts_)
 		cv::circle(allow, q, r, cv::Scalar(0), cv::FILLED);

@@ -4,6 +4,7 @@
 #include <bims/ego/so3.h>
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
 #include <random>
 
 #include "synth_scene.h"
@@ -164,6 +165,33 @@ TEST(GyroAidedKLT, MovingMaskExcludesFeatures)
 	// New features are not detected in the (dilated) masked region either.
 	const auto& tr2 = klt.track(f0.grey, K, nullptr, nullptr);
 	for (const auto& t : tr2) EXPECT_GE(t.prev.x, 160.f);
+}
+
+TEST(GyroAidedKLT, MaskDilationAroundTheMoversEqualsTheWholeImages)
+{
+	const cv::Mat kernel =
+	    cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(17, 17));
+	std::mt19937 rng(3);
+	std::uniform_int_distribution<int> x(0, 319), y(0, 239), r(1, 30);
+	for (int k = 0; k < 12; k++)
+	{
+		cv::Mat mask(240, 320, CV_8UC1, cv::Scalar(0));
+		// blobs anywhere, at the borders and corners too; k = 0: empty
+		for (int b = 0; b < k % 4; b++)
+			cv::circle(mask, {x(rng), y(rng)}, r(rng), 255, cv::FILLED);
+		if (k == 5) mask.at<uint8_t>(0, 319) = 255;
+		if (k == 6) mask.at<uint8_t>(239, 0) = 7;
+		cv::Mat whole;
+		cv::dilate(mask, whole, kernel);
+		const cv::Mat ours = dilateMask(mask, 8);
+		ASSERT_EQ(ours.size(), mask.size());
+		ASSERT_EQ(ours.type(), CV_8UC1);
+		EXPECT_EQ(cv::countNonZero(ours != whole), 0) << "mask " << k;
+		if (k == 0)
+		{
+			EXPECT_EQ(cv::countNonZero(ours), 0);
+		}
+	}
 }
 
 TEST(GyroAidedKLT, RejectsBadImages)

@@ -4,12 +4,14 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <vector>
 
 namespace bims::flow
 {
 namespace
 {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 void checkDepth(const cv::Mat& depth, const mrpt::img::TCamera& cam)
 {
@@ -64,31 +66,30 @@ cv::Mat expectedFlowExact(const cv::Mat& depth, const mrpt::img::TCamera& cam,
 	checkDepth(depth, cam);
 	const Rt T = rotTrans(T_prev_cur);
 	const double fx = cam.fx(), fy = cam.fy(), cx = cam.cx(), cy = cam.cy();
+	// (u - cx) / fx once per column: the same doubles as per pixel
+	std::vector<double> xn(depth.cols);
+	for (int u = 0; u < depth.cols; u++) xn[u] = (u - cx) / fx;
 	cv::Mat flow(depth.size(), CV_32FC2);
 	for (int v = 0; v < depth.rows; v++)
 	{
 		const float* zr = depth.ptr<float>(v);
-		auto* fr = flow.ptr<cv::Vec2f>(v);
+		float* fr = flow.ptr<float>(v);
 		const double yn = (v - cy) / fy;
+		// No branch in the loop (it vectorises): every pixel is computed,
+		// the invalid ones then take NaN.
 		for (int u = 0; u < depth.cols; u++)
 		{
-			const float z = zr[u];
-			if (!validDepth(z))
-			{
-				fr[u] = {kNaN, kNaN};
-				continue;
-			}
-			const double x = (u - cx) / fx * z, y = yn * z;
+			const double z = zr[u];
+			const double x = xn[u] * z, y = yn * z;
 			const double X = T.R[0] * x + T.R[1] * y + T.R[2] * z + T.t[0];
 			const double Y = T.R[3] * x + T.R[4] * y + T.R[5] * z + T.t[1];
 			const double Z = T.R[6] * x + T.R[7] * y + T.R[8] * z + T.t[2];
-			if (Z <= 1e-6)
-			{
-				fr[u] = {kNaN, kNaN};
-				continue;
-			}
-			fr[u] = {static_cast<float>(fx * X / Z + cx - u),
-			         static_cast<float>(fy * Y / Z + cy - v)};
+			const bool ok = z > 0.0 && z < kInf && Z > 1e-6;
+			const double iZ = ok ? Z : 1.0;
+			const float fu = static_cast<float>(fx * X / iZ + cx - u);
+			const float fv = static_cast<float>(fy * Y / iZ + cy - v);
+			fr[2 * u] = ok ? fu : kNaN;
+			fr[2 * u + 1] = ok ? fv : kNaN;
 		}
 	}
 	return flow;

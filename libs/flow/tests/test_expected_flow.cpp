@@ -116,10 +116,22 @@ TEST(ExpectedFlow, NoDepthGivesNoFlow)
 	cv::Mat z(48, 64, CV_32FC1, cv::Scalar(2.0f));
 	z.at<float>(10, 10) = 0.0f;
 	z.at<float>(11, 11) = std::numeric_limits<float>::quiet_NaN();
+	z.at<float>(12, 12) = std::numeric_limits<float>::infinity();
+	z.at<float>(13, 13) = -1.0f;
+	z.at<float>(14, 14) = 4.0f;
 	const cv::Mat e = expectedFlowExact(z, cam, CPose3D(0.1, 0, 0, 0, 0, 0));
-	EXPECT_TRUE(std::isnan(e.at<cv::Vec2f>(10, 10)[0]));
-	EXPECT_TRUE(std::isnan(e.at<cv::Vec2f>(11, 11)[0]));
+	for (int k : {10, 11, 12, 13})
+	{
+		EXPECT_TRUE(std::isnan(e.at<cv::Vec2f>(k, k)[0])) << k;
+		EXPECT_TRUE(std::isnan(e.at<cv::Vec2f>(k, k)[1])) << k;
+	}
 	EXPECT_NEAR(e.at<cv::Vec2f>(20, 20)[0], cam.fx() * 0.1 / 2.0, 1e-3);
+	EXPECT_NEAR(e.at<cv::Vec2f>(20, 20)[1], 0.0, 1e-6);
+	// behind the previous camera (z = 2 m, 3 m back): no flow; 4 m: flow
+	const cv::Mat b = expectedFlowExact(z, cam, CPose3D(0, 0, -3, 0, 0, 0));
+	EXPECT_TRUE(std::isnan(b.at<cv::Vec2f>(20, 20)[0]));
+	EXPECT_TRUE(std::isnan(b.at<cv::Vec2f>(20, 20)[1]));
+	EXPECT_TRUE(std::isfinite(b.at<cv::Vec2f>(14, 14)[0]));
 	EXPECT_THROW(expectedFlowExact(cv::Mat(10, 10, CV_32FC1), cam, CPose3D()),
 	             std::invalid_argument);
 }

@@ -46,6 +46,9 @@ void PipelineParams::loadFromConfigFile(
 	feedback_mask = s.getBool("feedback_mask", feedback_mask);
 	imu_wait_s = s.getDouble("imu_wait_s", imu_wait_s, 0.0, 10.0);
 	read_ahead = s.getBool("read_ahead", read_ahead);
+	flow_thread = s.getBool("flow_thread", flow_thread);
+	opencv_threads =
+	    static_cast<int>(s.getInt("opencv_threads", opencv_threads, 0, 64));
 	s.finish();
 }
 

@@ -3,7 +3,10 @@
 #include <bims/pipeline/pipeline.h>
 
 #include <chrono>
+#include <future>
 #include <stdexcept>
+
+#include "worker.h"
 
 namespace bims::pipeline
 {
@@ -47,7 +50,11 @@ Pipeline::Pipeline(const ExperimentConfig& cfg)
 {
 	// exclude_moving: the variant's own tier decides what is moving.
 	grids_.setDecisionTier(cfg.pipeline.variant == Variant::BottomOnly ? 1 : 2);
+	if (cfg.pipeline.flow_thread)
+		flowThread_ = std::make_unique<SerialWorker>(1, true, "bims-flow");
 }
+
+Pipeline::~Pipeline() = default;
 
 void Pipeline::addImu(const mrpt::obs::CObservationIMU& imu)
 {
@@ -70,10 +77,48 @@ const FrameResult& Pipeline::processFrame(
 	r.t = cur_.t;
 	r.ms.input = msSince(t);
 
-	// Egomotion, with the previous moving mask keeping features off movers.
 	// The rotation the observed flow is derotated with is predicted first
 	// (gyro), so that the flow does not depend on the tracker.
 	const Eigen::Matrix3d R_derot = odom_.predictRotation(cur_.t);
+	const auto cam = cameraOf(cur_);
+
+	// The observed flow needs only the two images (and that prediction):
+	// with flow_thread it runs on the flow thread while the egomotion runs
+	// here. Nothing touches the images (nor observed_) meanwhile; the result
+	// is the same as in sequence.
+	const cv::Size size = cur_.grey.size();
+	const bool haveFlow = havePrev_ && prev_.grey.size() == size;
+	auto observe = [this, &r, &R_derot, &cam]
+	{
+		const auto t = Clock::now();
+		cv::Mat f =
+		    cfg_.flow.derotate
+		        ? observed_.computeDerotated(
+		              prev_.grey, cur_.grey,
+		              flow::rotationHomography(
+		                  cam, ego::toPose(R_derot, Eigen::Vector3d::Zero())))
+		        : observed_.compute(prev_.grey, cur_.grey);
+		r.ms.observed = msSince(t);
+		return f;
+	};
+	std::future<cv::Mat> observing;
+	// the flow job uses this frame's locals: never leave before it ends
+	struct WaitFor
+	{
+		std::future<cv::Mat>& f;
+		~WaitFor()
+		{
+			if (f.valid()) f.wait();
+		}
+	} waitForObserving{observing};
+	if (haveFlow && flowThread_)
+	{
+		auto job = std::make_shared<std::packaged_task<cv::Mat()>>(observe);
+		observing = job->get_future();
+		flowThread_->post([job] { (*job)(); });
+	}
+
+	// Egomotion, with the previous moving mask keeping features off movers.
 	t = Clock::now();
 	const cv::Mat* fb = (cfg_.pipeline.feedback_mask && !feedback_.empty())
 	                        ? &feedback_
@@ -85,20 +130,12 @@ const FrameResult& Pipeline::processFrame(
 
 	// Flow labels on the current frame's pixels.
 	t = Clock::now();
-	const cv::Size size = cur_.grey.size();
 	r.maskFlow = cv::Mat::zeros(size, CV_8UC1);
 	maps::PixelLabels pixLabels;
-	const bool haveFlow = havePrev_ && prev_.grey.size() == size;
 	if (haveFlow)
 	{
-		const auto cam = cameraOf(cur_);
-		const cv::Mat obs =
-		    cfg_.flow.derotate
-		        ? observed_.computeDerotated(
-		              prev_.grey, cur_.grey,
-		              flow::rotationHomography(
-		                  cam, ego::toPose(R_derot, Eigen::Vector3d::Zero())))
-		        : observed_.compute(prev_.grey, cur_.grey);
+		// (get() rethrows what the flow job threw)
+		const cv::Mat obs = observing.valid() ? observing.get() : observe();
 		if (cfg_.flow.refine_pose != "none")
 		{
 			r.flowPose =

@@ -16,6 +16,7 @@
 #include <deque>
 #include <fstream>
 #include <limits>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
@@ -87,6 +88,28 @@ struct PendingScan
 /** Observations read ahead: a few frames of a VGA rawlog with its IMU. */
 constexpr size_t kReadAhead = 24;
 
+/** cv::setNumThreads(n) for the lifetime of the object (n > 0), then the
+ * previous setting again. */
+class OpenCvThreads
+{
+ public:
+	explicit OpenCvThreads(int n) : before_(cv::getNumThreads())
+	{
+		if (n > 0) cv::setNumThreads(n);
+		set_ = n > 0;
+	}
+	~OpenCvThreads()
+	{
+		if (set_) cv::setNumThreads(before_);
+	}
+	OpenCvThreads(const OpenCvThreads&) = delete;
+	OpenCvThreads& operator=(const OpenCvThreads&) = delete;
+
+ private:
+	int before_;
+	bool set_ = false;
+};
+
 void addError(RunSummary& sum, const std::string& e)
 {
 	if (sum.error.find(e) != std::string::npos) return;  // reported already
@@ -103,6 +126,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	if (opt.rawlogs.empty())
 		throw std::invalid_argument("no input rawlog given");
 
+	const OpenCvThreads cvThreads(cfg.pipeline.opencv_threads);
 	Pipeline pipe(cfg);
 	std::unique_ptr<OutputWriter> out;
 	if (!opt.outDir.empty())
@@ -133,6 +157,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		stage["input"].push_back(r.ms.input);
 		stage["egomotion"].push_back(r.ms.ego);
 		stage["flow"].push_back(r.ms.flow);
+		if (r.ms.observed > 0) stage["flow_observed"].push_back(r.ms.observed);
 		stage["grids"].push_back(r.ms.grids);
 		stage["total"].push_back(r.ms.total);
 		const double validPx = static_cast<double>(r.cloudStats.valid);
@@ -277,9 +302,10 @@ std::string formatSummary(const RunSummary& s)
 	              100.0 * s.meanMovingPixelFraction);
 	o << buf;
 	o << "stage        median ms   p95 ms   mean ms\n";
-	for (const char* k : {"read", "read_cpu", "wait_input", "input",
-	                      "egomotion", "flow", "grids", "total", "total_cpu",
-	                      "outputs", "outputs_cpu", "wait_output"})
+	for (const char* k :
+	     {"read", "read_cpu", "wait_input", "input", "egomotion", "flow",
+	      "flow_observed", "grids", "total", "total_cpu", "outputs",
+	      "outputs_cpu", "wait_output"})
 	{
 		const auto it = s.stageMs.find(k);
 		if (it == s.stageMs.end()) continue;

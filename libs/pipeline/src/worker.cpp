@@ -8,8 +8,8 @@
 
 namespace bims::pipeline
 {
-SerialWorker::SerialWorker(size_t capacity, bool threaded)
-    : capacity_(capacity < 1 ? 1 : capacity)
+SerialWorker::SerialWorker(size_t capacity, bool threaded, const char* name)
+    : capacity_(capacity < 1 ? 1 : capacity), name_(name)
 {
 	if (threaded) thread_ = std::thread([this] { loop(); });
 }
@@ -67,7 +67,7 @@ void SerialWorker::drain()
 
 void SerialWorker::loop()
 {
-	pthread_setname_np(pthread_self(), "bims-write");  // for top, perf
+	pthread_setname_np(pthread_self(), name_.substr(0, 15).c_str());
 	std::unique_lock<std::mutex> lk(mu_);
 	for (;;)
 	{

@@ -1,9 +1,9 @@
 // Internal: one background thread that runs jobs in the order they were
-// posted (bims-run's output writing). The queue is bounded: post() blocks
-// while `capacity` jobs wait, so a slow disk slows the run down instead of
-// filling the memory. The first job that throws stops the worker: later jobs
-// are dropped, and post() and drain() throw its message. Without a thread
-// (threaded = false) post() runs the job at once.
+// posted (bims-run's output writing, the pipeline's flow thread). The queue is
+// bounded: post() blocks while `capacity` jobs wait, so a slow disk slows the
+// run down instead of filling the memory. The first job that throws stops the
+// worker: later jobs are dropped, and post() and drain() throw its message.
+// Without a thread (threaded = false) post() runs the job at once.
 #pragma once
 
 #include <condition_variable>
@@ -19,7 +19,9 @@ namespace bims::pipeline
 class SerialWorker
 {
  public:
-	SerialWorker(size_t capacity, bool threaded);
+	/** \a name: the thread's name (for top, perf; at most 15 characters). */
+	SerialWorker(size_t capacity, bool threaded,
+	             const char* name = "bims-write");
 	/** Runs what is still queued, then joins (errors are dropped: call
 	 * drain() first to see them). */
 	~SerialWorker();
@@ -38,6 +40,7 @@ class SerialWorker
 	void throwIfFailed();  // with mu_ held
 
 	size_t capacity_;
+	std::string name_;
 	std::mutex mu_;
 	std::condition_variable cv_;
 	std::deque<std::function<void()>> jobs_;

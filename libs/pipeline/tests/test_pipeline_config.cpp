@@ -56,13 +56,24 @@ TEST(PipelineConfig, ThreadsAndLabelledRawlogCompression)
 {
 	ExperimentConfig c;
 	EXPECT_TRUE(c.pipeline.read_ahead);
+	EXPECT_TRUE(c.pipeline.flow_thread);
 	EXPECT_TRUE(c.output.writer_thread);
 	EXPECT_EQ(c.output.labelled_rawlog_gz_level, 0);
 	mrpt::config::CConfigFileMemory ini(
 	    "[odometry]\nmode = vision\n[pipeline]\nread_ahead = false\n"
+	    "flow_thread = false\n"
 	    "[output]\nwriter_thread = false\nlabelled_rawlog_gz_level = 6\n");
 	c.loadFromConfigFile(ini);
 	EXPECT_FALSE(c.pipeline.read_ahead);
+	EXPECT_FALSE(c.pipeline.flow_thread);
+	EXPECT_EQ(c.pipeline.opencv_threads, 0);
+	mrpt::config::CConfigFileMemory cv1(
+	    "[odometry]\nmode = vision\n[pipeline]\nopencv_threads = 1\n");
+	c.loadFromConfigFile(cv1);
+	EXPECT_EQ(c.pipeline.opencv_threads, 1);
+	mrpt::config::CConfigFileMemory cvBad(
+	    "[odometry]\nmode = vision\n[pipeline]\nopencv_threads = -1\n");
+	EXPECT_THROW(c.loadFromConfigFile(cvBad), bims::ConfigError);
 	EXPECT_FALSE(c.output.writer_thread);
 	EXPECT_EQ(c.output.labelled_rawlog_gz_level, 6);
 	mrpt::config::CConfigFileMemory bad(

@@ -39,6 +39,11 @@ struct TrackerStats
 	int detected = 0;     ///< new features added on the current frame
 };
 
+/** \a mask (CV_8UC1) dilated by an ellipse of radius \a px: the same as
+ * cv::dilate over the whole image, computed around the non-zero pixels only
+ * (an empty mask costs nothing). */
+cv::Mat dilateMask(const cv::Mat& mask, int px);
+
 class GyroAidedKLT
 {
  public:

@@ -41,6 +41,14 @@ struct PipelineParams
 	double imu_wait_s = 0.1;
 	/** bims-run reads and decodes the rawlogs ahead on a thread. */
 	bool read_ahead = true;
+	/** The observed flow (it needs only the images of t-1 and t) runs on a
+	 * thread of its own while the egomotion runs; same results as in
+	 * sequence. */
+	bool flow_thread = true;
+	/** Threads of OpenCV's own pool during a run (cv::setNumThreads; 1 = no
+	 * pool, each call runs on the thread that makes it); 0 = OpenCV's
+	 * default (one per core). */
+	int opencv_threads = 0;
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "pipeline");

@@ -1,7 +1,9 @@
 // Per-frame orchestration (docs/architecture.md):
 //   egomotion -> tier 1 reads O- -> tier 0 update -> flow labels -> tier 2
 //   -> MAP -> moving voxels -> moving-pixel mask (fed back to the tracker).
-// No threads, no I/O: the caller feeds observations in time order.
+// No I/O: the caller feeds observations in time order. One thread of its own
+// ([pipeline] flow_thread): the observed flow of a frame runs there while the
+// egomotion runs on the caller's thread.
 #pragma once
 
 #include <bims/ego/odometry.h>
@@ -16,17 +18,23 @@
 
 #include <opencv2/core.hpp>
 
+#include <memory>
 #include <vector>
 
 namespace bims::pipeline
 {
+class SerialWorker;
+
 /** Wall time of each stage of one frame [ms]. */
 struct StageTimes
 {
 	double input = 0;  ///< decoding images, depth conversion
 	double ego = 0;    ///< tracking + motion estimation
-	double flow = 0;   ///< observed + expected flow + labels
-	double grids = 0;  ///< cloud building + the three tiers
+	/** observed + expected flow + labels, on the caller's thread (with
+	 * flow_thread: what is left of the observed flow after the egomotion) */
+	double flow = 0;
+	double observed = 0;  ///< the observed flow alone, on whichever thread
+	double grids = 0;     ///< cloud building + the three tiers
 	double total = 0;
 };
 
@@ -65,6 +73,9 @@ class Pipeline
 {
  public:
 	explicit Pipeline(const ExperimentConfig& cfg);
+	~Pipeline();
+	Pipeline(const Pipeline&) = delete;
+	Pipeline& operator=(const Pipeline&) = delete;
 
 	/** Feeds an IMU observation (label filtered by [sensors] imu_label). */
 	void addImu(const mrpt::obs::CObservationIMU& imu);
@@ -91,6 +102,7 @@ class Pipeline
 	cv::Mat feedback_;
 	FrameResult res_;
 	size_t nFrames_ = 0;
+	std::unique_ptr<SerialWorker> flowThread_;  ///< null: flow in sequence
 };
 
 /** maps::PixelMask -> CV_8UC1 (a copy; 0x0 mask -> \a size of zeros). */
