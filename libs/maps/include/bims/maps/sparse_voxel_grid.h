@@ -120,6 +120,10 @@ class SparseVoxelGrid
 		const uint32_t b = index_.find(blockKey);
 		return b == FlatHashMap::kNotFound ? nullptr : blocks_[b].get();
 	}
+	Block* findBlock(uint64_t blockKey)
+	{
+		return const_cast<Block*>(std::as_const(*this).findBlock(blockKey));
+	}
 
 	size_t numBlocks() const { return blocks_.size(); }
 	size_t numCells() const { return blocks_.size() * kCellsPerBlock; }
