@@ -142,6 +142,14 @@ void COccupancyBayesGrid::integrate(const FrameCloud& f,
 	applyFrame(f, priorOut, hold);
 }
 
+uint32_t COccupancyBayesGrid::priorFrameOf(const FrameCloud& f) const
+{
+	const bool already = frameCount_ > 0 &&
+	                     f.timestamp != mrpt::Clock::time_point() &&
+	                     f.timestamp == lastTimestamp_;
+	return already ? frameCount_ : frameCount_ + 1;
+}
+
 void COccupancyBayesGrid::beginFrame(const FrameCloud& f,
                                      std::vector<float>& out)
 {
@@ -149,11 +157,8 @@ void COccupancyBayesGrid::beginFrame(const FrameCloud& f,
 	grid_.resolve(f.cells, cellPtr_);
 	pending_ = &f;
 	pendingFrame_ = frameCount_;
-	// As priorLogOdds().
-	const bool already = frameCount_ > 0 &&
-	                     f.timestamp != mrpt::Clock::time_point() &&
-	                     f.timestamp == lastTimestamp_;
-	const uint32_t G = already ? frameCount_ : frameCount_ + 1;
+	const uint32_t G = priorFrameOf(f);  // as priorLogOdds()
+	const bool already = G == frameCount_;
 	out.resize(f.cells.size());
 	for (size_t i = 0; i < f.cells.size(); ++i)
 	{
@@ -223,10 +228,8 @@ void COccupancyBayesGrid::priorLogOdds(const FrameCloud& f,
 	if (f.voxel_size != params_.voxel_size)
 		throw std::invalid_argument(
 		    "COccupancyBayesGrid::priorLogOdds: voxel size mismatch");
-	const bool already = frameCount_ > 0 &&
-	                     f.timestamp != mrpt::Clock::time_point() &&
-	                     f.timestamp == lastTimestamp_;
-	const uint32_t G = already ? frameCount_ : frameCount_ + 1;
+	const uint32_t G = priorFrameOf(f);
+	const bool already = G == frameCount_;
 	out.resize(f.cells.size());
 	for (size_t i = 0; i < f.cells.size(); ++i)
 	{

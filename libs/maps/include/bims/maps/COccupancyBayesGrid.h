@@ -115,6 +115,10 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 
  private:
 	void updateConstants();
+	/** The frame O- is read for: the frame being integrated, or the last
+	 * one again if \a f repeats its timestamp (tier 1 reading O- of a frame
+	 * tier 0 already holds). */
+	uint32_t priorFrameOf(const FrameCloud& f) const;
 	LogOddsFx hitFixedCompute(uint32_t n) const;
 	LogOddsFx currentFixed(const Cell& c) const;
 	void decayFrustum(const FrameCloud& f, uint32_t F);
