@@ -423,12 +423,8 @@ int main(int argc, char** argv)
 		std::vector<char*> rest = {argv[0]};
 		for (int i = 1; i < argc; ++i)
 		{
-			const std::string a = argv[i];
-			auto val = [&](const char* k) -> const char*
-			{
-				const std::string p = std::string(k) + "=";
-				return a.rfind(p, 0) == 0 ? argv[i] + p.size() : nullptr;
-			};
+			auto val = [&](const char* k)
+			{ return bims::bench::flagValue(argv[i], k); };
 			if (auto v = val("--bonn_depth"))
 				bonn = v;
 			else if (auto v = val("--sim_rawlog"))

@@ -36,4 +36,13 @@ class JsonLinesReporter : public benchmark::BenchmarkReporter
  * Google Benchmark's console table on stderr). */
 int runWithJsonLines(int argc, char** argv);
 
+/** The value of a "--key=value" argument: a pointer into \a arg after
+ * "key=", or nullptr if \a arg is not that option. The benchmarks' own
+ * options; the others go on to Google Benchmark. */
+inline const char* flagValue(const char* arg, const char* key)
+{
+	const std::string a = arg, p = std::string(key) + "=";
+	return a.rfind(p, 0) == 0 ? arg + p.size() : nullptr;
+}
+
 }  // namespace bims::bench
