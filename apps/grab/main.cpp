@@ -53,6 +53,7 @@ mrpt::img::CImage preview(const mrpt::obs::CObservation3DRangeScan& scan,
 
 int main(int argc, char** argv)
 {
+	bims::keepFreedMemoryForReuse();
 	return bims::runApp(
 	    "bims-grab",
 	    [&]()

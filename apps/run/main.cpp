@@ -15,6 +15,7 @@
 
 int main(int argc, char** argv)
 {
+	bims::keepFreedMemoryForReuse();
 	return bims::runApp(
 	    "bims-run",
 	    [&]()

@@ -40,6 +40,7 @@ wxIMPLEMENT_APP_NO_MAIN(ViewerApp);
 
 int main(int argc, char** argv)
 {
+	bims::keepFreedMemoryForReuse();
 	return bims::runApp(
 	    "bims-viewer",
 	    [&]()

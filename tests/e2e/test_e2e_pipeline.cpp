@@ -276,20 +276,40 @@ std::vector<cv::Mat> labelMasks(const std::string& rawlog)
 		}
 	return masks;
 }
+
+/** (class, timestamp) of every observation of a rawlog, in file order,
+ * up to (without) the 3D scan number \a stopAtScan. */
+std::vector<std::pair<std::string, mrpt::Clock::time_point>> observationOrder(
+    const std::string& rawlog, size_t stopAtScan)
+{
+	std::vector<std::pair<std::string, mrpt::Clock::time_point>> out;
+	bims::RawlogReader r(rawlog);
+	size_t scans = 0;
+	while (auto o = r.next())
+	{
+		if (IS_CLASS(*o, mrpt::obs::CObservation3DRangeScan) &&
+		    scans++ == stopAtScan)
+			break;
+		out.emplace_back(o->GetRuntimeClass()->className, o->timestamp);
+	}
+	return out;
+}
 }  // namespace
 
 TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 {
-	// Reading ahead, the observed flow on its own thread, writing on threads
-	// and OpenCV's pool must not change a single byte of the outputs (nor the
-	// order of the labelled rawlog).
+	// Reading ahead, the observed flow on its own thread (and of the next
+	// frame during this frame's grids), writing on threads and OpenCV's pool
+	// must not change a single byte of the outputs (nor the order of the
+	// labelled rawlog, which is the input's).
 	ExperimentConfig cfg;
 	cfg.loadFromFile(kConfig);
-	auto runWith = [&](bool threads, const std::string& name)
+	auto runWith = [&](bool threads, bool lookahead, const std::string& name)
 	{
 		ExperimentConfig c = cfg;
 		c.pipeline.read_ahead = threads;
 		c.pipeline.flow_thread = threads;
+		c.pipeline.flow_lookahead = lookahead;
 		c.output.writer_thread = threads;
 		// and OpenCV's pool off in sequence (the setting is restored)
 		c.pipeline.opencv_threads = threads ? 0 : 1;
@@ -303,25 +323,36 @@ TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 		EXPECT_TRUE(sum.error.empty()) << sum.error;
 		EXPECT_EQ(sum.framesProcessed, 20u);
 		EXPECT_EQ(cv::getNumThreads(), cvThreads);
+		// every frame after the first pairs with the one before it
+		EXPECT_EQ(sum.framesFlowAhead, threads && lookahead ? 19u : 0u) << name;
 		return opt.outDir;
 	};
-	const std::string a = runWith(false, "sequential");
-	const std::string b = runWith(true, "threaded");
-	// (booleans: gtest's diff of two large strings would not end)
-	for (const char* f : {"trajectory.txt", "segmented.rawlog",
-	                      "static_map.ply", "moving_voxels/000015.ply"})
-		EXPECT_TRUE(readAll(a + "/" + f) == readAll(b + "/" + f))
-		    << f << " differs";
-	EXPECT_TRUE(csvWithoutTimes(a + "/frames.csv") ==
-	            csvWithoutTimes(b + "/frames.csv"))
-	    << "frames.csv differs";
-	for (int i = 0; i < 20; i++)
+	const std::string a = runWith(false, false, "sequential");
+	std::string b;  // the look-ahead run's
+	for (const auto& [lookahead, name] :
+	     {std::pair{false, "threaded"}, std::pair{true, "lookahead"}})
 	{
-		char name[32];
-		std::snprintf(name, sizeof(name), "/masks/%06d.png", i);
-		EXPECT_TRUE(readAll(a + name) == readAll(b + name))
-		    << name << " differs";
+		b = runWith(true, lookahead, name);
+		// (booleans: gtest's diff of two large strings would not end)
+		for (const char* f : {"trajectory.txt", "segmented.rawlog",
+		                      "static_map.ply", "moving_voxels/000015.ply"})
+			EXPECT_TRUE(readAll(a + "/" + f) == readAll(b + "/" + f))
+			    << f << " differs (" << name << ")";
+		EXPECT_TRUE(csvWithoutTimes(a + "/frames.csv") ==
+		            csvWithoutTimes(b + "/frames.csv"))
+		    << "frames.csv differs (" << name << ")";
+		for (int i = 0; i < 20; i++)
+		{
+			char f[32];
+			std::snprintf(f, sizeof(f), "/masks/%06d.png", i);
+			EXPECT_TRUE(readAll(a + f) == readAll(b + f))
+			    << f << " differs (" << name << ")";
+		}
 	}
+	// the labelled rawlog: the input's observations up to the last frame and
+	// the IMU samples after it, in the input's order
+	EXPECT_TRUE(observationOrder(b + "/segmented.rawlog", 100) ==
+	            observationOrder(kSample, 20));
 	// the pixel labels are the masks
 	const auto labels = labelMasks(b + "/segmented.rawlog");
 	ASSERT_EQ(labels.size(), 20u);

@@ -47,6 +47,7 @@ void PipelineParams::loadFromConfigFile(
 	imu_wait_s = s.getDouble("imu_wait_s", imu_wait_s, 0.0, 10.0);
 	read_ahead = s.getBool("read_ahead", read_ahead);
 	flow_thread = s.getBool("flow_thread", flow_thread);
+	flow_lookahead = s.getBool("flow_lookahead", flow_lookahead);
 	opencv_threads =
 	    static_cast<int>(s.getInt("opencv_threads", opencv_threads, 0, 64));
 	s.finish();

@@ -61,61 +61,122 @@ void Pipeline::addImu(const mrpt::obs::CObservationIMU& imu)
 	odom_.addImu(imu);
 }
 
+Pipeline::Observed Pipeline::observe(const cv::Mat& prevGrey,
+                                     const cv::Mat& curGrey,
+                                     const mrpt::img::TCamera& cam,
+                                     const Eigen::Matrix3d& R_derot)
+{
+	const auto t = Clock::now();
+	Observed o;
+	o.flow = cfg_.flow.derotate
+	             ? observed_.computeDerotated(
+	                   prevGrey, curGrey,
+	                   flow::rotationHomography(
+	                       cam, ego::toPose(R_derot, Eigen::Vector3d::Zero())))
+	             : observed_.compute(prevGrey, curGrey);
+	// a header of the tensor's own buffer: the next compute() allocates anew
+	o.tensor = observed_.tensor();
+	o.ms = msSince(t);
+	return o;
+}
+
+void Pipeline::dropLookahead()
+{
+	if (nextObserved_.valid()) nextObserved_.wait();
+	nextObserved_ = {};
+	nextIndex_ = kNoNext;
+}
+
+void Pipeline::startLookahead(const Next& next)
+{
+	dropLookahead();
+	if (!next.scan || !flowThread_ || !cfg_.pipeline.flow_lookahead) return;
+	const auto t = Clock::now();
+	// A frame that cannot be decoded, or that the next call would not pair
+	// with this one, is left to that call (which reports it).
+	if (!ego::rgbdFrameFrom(*next.scan, cfg_.ego.camera, next_).empty() ||
+	    next_.grey.size() != cur_.grey.size() || !(next_.t > cur_.t))
+		return;
+	nextInputMs_ = msSince(t);
+	// What the next call would predict at its start: the egomotion of this
+	// frame is final, and the caller has added the IMU samples already.
+	const Eigen::Matrix3d R = odom_.predictRotation(next_.t);
+	auto job = std::make_shared<std::packaged_task<Observed()>>(
+	    [this, prevGrey = cur_.grey, curGrey = next_.grey,
+	     cam = cameraOf(next_), R]
+	    { return observe(prevGrey, curGrey, cam, R); });
+	nextObserved_ = job->get_future();
+	nextIndex_ = next.index;
+	nextAfter_ = nFrames_;
+	flowThread_->post([job] { (*job)(); });
+}
+
 const FrameResult& Pipeline::processFrame(
-    const mrpt::obs::CObservation3DRangeScan& scan, size_t index)
+    const mrpt::obs::CObservation3DRangeScan& scan, size_t index, Next next)
 {
 	const auto t0 = Clock::now();
 	FrameResult r;
 	r.index = index;
 
-	// Input: grey image + metric depth + intrinsics, once for all stages.
-	auto t = Clock::now();
-	const std::string why = ego::rgbdFrameFrom(scan, cfg_.ego.camera, cur_);
-	if (!why.empty())
-		throw std::runtime_error("3D scan #" + std::to_string(index) + " ('" +
-		                         scan.sensorLabel + "'): " + why);
-	r.t = cur_.t;
-	r.ms.input = msSince(t);
-
-	// The rotation the observed flow is derotated with is predicted first
-	// (gyro), so that the flow does not depend on the tracker.
-	const Eigen::Matrix3d R_derot = odom_.predictRotation(cur_.t);
-	const auto cam = cameraOf(cur_);
-
-	// The observed flow needs only the two images (and that prediction):
-	// with flow_thread it runs on the flow thread while the egomotion runs
-	// here. Nothing touches the images (nor observed_) meanwhile; the result
-	// is the same as in sequence.
-	const cv::Size size = cur_.grey.size();
-	const bool haveFlow = havePrev_ && prev_.grey.size() == size;
-	auto observe = [this, &r, &R_derot, &cam]
-	{
-		const auto t = Clock::now();
-		cv::Mat f =
-		    cfg_.flow.derotate
-		        ? observed_.computeDerotated(
-		              prev_.grey, cur_.grey,
-		              flow::rotationHomography(
-		                  cam, ego::toPose(R_derot, Eigen::Vector3d::Zero())))
-		        : observed_.compute(prev_.grey, cur_.grey);
-		r.ms.observed = msSince(t);
-		return f;
-	};
-	std::future<cv::Mat> observing;
-	// the flow job uses this frame's locals: never leave before it ends
+	// The observed flow of this frame: started by the previous call (look
+	// ahead), on the flow thread now, or in sequence below.
+	std::future<Observed> observing;
+	// the flow jobs use members: never leave before they end
 	struct WaitFor
 	{
-		std::future<cv::Mat>& f;
+		std::future<Observed>& f;
 		~WaitFor()
 		{
 			if (f.valid()) f.wait();
 		}
 	} waitForObserving{observing};
-	if (haveFlow && flowThread_)
+
+	// Input: grey image + metric depth + intrinsics, once for all stages.
+	auto t = Clock::now();
+	// (only if the frame that queued it completed: prev_ is its frame)
+	if (havePrev_ && nextIndex_ == index && nextAfter_ + 1 == nFrames_ &&
+	    nextObserved_.valid())
 	{
-		auto job = std::make_shared<std::packaged_task<cv::Mat()>>(observe);
-		observing = job->get_future();
-		flowThread_->post([job] { (*job)(); });
+		std::swap(cur_, next_);
+		observing = std::move(nextObserved_);
+		nextIndex_ = kNoNext;
+		r.flowAhead = true;
+		r.ms.input = nextInputMs_;
+	}
+	else
+	{
+		dropLookahead();
+		const std::string why = ego::rgbdFrameFrom(scan, cfg_.ego.camera, cur_);
+		if (!why.empty())
+			throw std::runtime_error("3D scan #" + std::to_string(index) +
+			                         " ('" + scan.sensorLabel + "'): " + why);
+		r.ms.input = msSince(t);
+	}
+	r.t = cur_.t;
+	const auto cam = cameraOf(cur_);
+
+	// The observed flow needs only the two images and the rotation it is
+	// derotated with, predicted first (gyro) so that it does not depend on
+	// the tracker: with flow_thread it runs on the flow thread while the
+	// egomotion runs here. Nothing writes the images meanwhile; the result
+	// is the same as in sequence.
+	const cv::Size size = cur_.grey.size();
+	const bool haveFlow = havePrev_ && prev_.grey.size() == size;
+	std::function<Observed()> observeHere;
+	if (haveFlow && !observing.valid())
+	{
+		const Eigen::Matrix3d R_derot = odom_.predictRotation(cur_.t);
+		auto job =
+		    [this, prevGrey = prev_.grey, curGrey = cur_.grey, cam, R_derot]
+		{ return observe(prevGrey, curGrey, cam, R_derot); };
+		if (flowThread_)
+		{
+			auto task = std::make_shared<std::packaged_task<Observed()>>(job);
+			observing = task->get_future();
+			flowThread_->post([task] { (*task)(); });
+		}
+		else
+			observeHere = job;
 	}
 
 	// Egomotion, with the previous moving mask keeping features off movers.
@@ -127,6 +188,11 @@ const FrameResult& Pipeline::processFrame(
 	r.T_WC = r.ego.T_WC;
 	r.T_CprevC = r.ego.T_CprevC;
 	r.ms.ego = msSince(t);
+	// A refinement may still correct the egomotion (and so the next
+	// prediction): then the look-ahead starts after it.
+	const bool mayCorrect =
+	    cfg_.flow.refine_pose != "none" && cfg_.flow.refine_to_ego;
+	if (!mayCorrect) startLookahead(next);
 
 	// Flow labels on the current frame's pixels.
 	t = Clock::now();
@@ -135,13 +201,14 @@ const FrameResult& Pipeline::processFrame(
 	if (haveFlow)
 	{
 		// (get() rethrows what the flow job threw)
-		const cv::Mat obs = observing.valid() ? observing.get() : observe();
+		const Observed o = observing.valid() ? observing.get() : observeHere();
+		r.ms.observed = o.ms;
+		const cv::Mat& obs = o.flow;
 		if (cfg_.flow.refine_pose != "none")
 		{
-			r.flowPose =
-			    flow::refinePoseWithFlow(obs, cur_.depth, cam, r.T_CprevC,
-			                             flow::flowPoseParamsFrom(cfg_.flow),
-			                             nullptr, &observed_.tensor());
+			r.flowPose = flow::refinePoseWithFlow(
+			    obs, cur_.depth, cam, r.T_CprevC,
+			    flow::flowPoseParamsFrom(cfg_.flow), nullptr, &o.tensor);
 			if (r.flowPose.ok)
 			{
 				r.T_CprevC = r.flowPose.T_prev_cur;
@@ -154,14 +221,14 @@ const FrameResult& Pipeline::processFrame(
 		        ? flow::expectedFlowLinear(cur_.depth, cam, r.T_CprevC)
 		        : flow::expectedFlowExact(cur_.depth, cam, r.T_CprevC);
 		r.labels = flow::labelConsistency(obs, exp, cur_.depth, cam, r.T_CprevC,
-		                                  cfg_.flow, &r.labelStats,
-		                                  &observed_.tensor());
+		                                  cfg_.flow, &r.labelStats, &o.tensor);
 		r.maskFlow.setTo(255, r.labels == static_cast<int8_t>(flow::kDiff));
 		r.flowObserved = obs;
 		r.flowExpected = exp;
 		pixLabels = toPixelLabels(r.labels);
 	}
 	r.ms.flow = msSince(t);
+	if (mayCorrect) startLookahead(next);
 
 	// The three tiers. The grids take MRPT's scan frame {S} in {W}.
 	t = Clock::now();

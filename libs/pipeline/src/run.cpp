@@ -83,6 +83,9 @@ struct PendingScan
 	double readMs;     ///< reading the observations up to this scan
 	double readCpuMs;  ///< the same in CPU time
 	double inWaitMs;   ///< the run waiting for them
+	/** The IMU observations read after it (before the next scan), written
+	 * after it: the labelled rawlog keeps the input's order. */
+	std::vector<mrpt::obs::CObservation::Ptr> after;
 };
 
 /** Observations read ahead: a few frames of a VGA rawlog with its IMU. */
@@ -143,12 +146,15 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	double movingFracSum = 0, readMs = 0, readCpuMs = 0, inWaitMs = 0;
 	ProgressBar bar("bims-run", 0, opt.progress);
 
-	auto process = [&](const PendingScan& p)
+	auto process = [&](const PendingScan& p, const PendingScan* next)
 	{
 		const double frameCpu0 = threadCpuMs();
-		const FrameResult& r = pipe.processFrame(*p.scan, p.index);
+		Pipeline::Next ahead;
+		if (next) ahead = {next->scan.get(), next->index};
+		const FrameResult& r = pipe.processFrame(*p.scan, p.index, ahead);
 		stage["total_cpu"].push_back(threadCpuMs() - frameCpu0);
 		sum.framesProcessed++;
+		if (r.flowAhead) sum.framesFlowAhead++;
 		if (r.ego.flags & ~static_cast<uint32_t>(ego::kFlagFirstFrame))
 			sum.framesFlagged++;
 		stage["read"].push_back(p.readMs);
@@ -166,18 +172,32 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		lastT = r.t;
 		// the callback first: the writer then owns the scan
 		if (opt.onFrame) opt.onFrame(r, *p.scan);
-		if (out) stage["wait_output"].push_back(out->writeFrame(r, p.scan));
+		if (out)
+		{
+			stage["wait_output"].push_back(out->writeFrame(r, p.scan));
+			for (const auto& o : p.after) out->writeOther(o);
+		}
 		bar.update(sum.framesProcessed, "frame " + std::to_string(p.index));
+	};
+	// A frame is processed once the IMU samples at its time are in (or it
+	// waited long enough for them). Looking ahead, it also waits for the next
+	// frame to be ready, which the pipeline then pairs with it (one frame of
+	// latency; the same results).
+	const bool lookahead =
+	    cfg.pipeline.flow_thread && cfg.pipeline.flow_lookahead;
+	auto ready = [&](const PendingScan& p) {
+		return p.t + offset <= lastImuT ||
+		       newestT - p.t > cfg.pipeline.imu_wait_s;
 	};
 	auto flush = [&](bool all)
 	{
 		while (!pending.empty())
 		{
-			const auto& p = pending.front();
-			const bool imuReady = p.t + offset <= lastImuT;
-			const bool waitedEnough = newestT - p.t > cfg.pipeline.imu_wait_s;
-			if (!all && !imuReady && !waitedEnough) break;
-			process(p);
+			if (!all && !ready(pending.front())) break;
+			const bool nextReady =
+			    pending.size() > 1 && (all || ready(pending[1]));
+			if (lookahead && !all && !nextReady) break;
+			process(pending.front(), nextReady ? &pending[1] : nullptr);
 			pending.pop_front();
 		}
 	};
@@ -207,7 +227,13 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 				pipe.addImu(*imu);
 				sum.imuRead++;
 				lastImuT = std::max(lastImuT, t);
-				if (out) out->writeOther(imu);
+				if (out)
+				{
+					if (pending.empty())
+						out->writeOther(imu);
+					else
+						pending.back().after.push_back(imu);
+				}
 			}
 			else if (auto scan = std::dynamic_pointer_cast<
 			             mrpt::obs::CObservation3DRangeScan>(o))
@@ -232,7 +258,8 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 					continue;
 				}
 				lastScanT = t;
-				pending.push_back({scan, idx, t, readMs, readCpuMs, inWaitMs});
+				pending.push_back(
+				    {scan, idx, t, readMs, readCpuMs, inWaitMs, {}});
 				readMs = readCpuMs = inWaitMs = 0;
 			}
 			else

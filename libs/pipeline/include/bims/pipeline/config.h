@@ -45,6 +45,11 @@ struct PipelineParams
 	 * thread of its own while the egomotion runs; same results as in
 	 * sequence. */
 	bool flow_thread = true;
+	/** With flow_thread: bims-run hands the pipeline the next frame when it
+	 * is already read (and its IMU samples added), and that frame's observed
+	 * flow runs on the flow thread while this frame's grids run; same
+	 * results as without. */
+	bool flow_lookahead = true;
 	/** Threads of OpenCV's own pool during a run (cv::setNumThreads; 1 = no
 	 * pool, each call runs on the thread that makes it); 0 = OpenCV's
 	 * default (one per core). */

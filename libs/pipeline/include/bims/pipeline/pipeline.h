@@ -3,7 +3,9 @@
 //   -> MAP -> moving voxels -> moving-pixel mask (fed back to the tracker).
 // No I/O: the caller feeds observations in time order. One thread of its own
 // ([pipeline] flow_thread): the observed flow of a frame runs there while the
-// egomotion runs on the caller's thread.
+// egomotion runs on the caller's thread; told the next frame ([pipeline]
+// flow_lookahead), the observed flow of that frame starts there while this
+// frame's grids run (docs/pipeline.md, "Threads").
 #pragma once
 
 #include <bims/ego/odometry.h>
@@ -18,6 +20,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <future>
 #include <memory>
 #include <vector>
 
@@ -51,6 +54,8 @@ struct FrameResult
 	ego::FrameEgomotion ego;        ///< egomotion details (flags, inliers, ...)
 	flow::FlowPoseResult flowPose;  ///< the dense-flow refinement, if any
 	bool warmup = false;            ///< mask forced empty (warm-up frame)
+	/** its observed flow ran during the previous frame (flow_lookahead) */
+	bool flowAhead = false;
 	/** The variant's moving-pixel mask (CV_8UC1, 255 = moving). */
 	cv::Mat mask;
 	/** The three decisions side by side (CV_8UC1, 255 = moving). */
@@ -69,6 +74,13 @@ struct FrameResult
 	StageTimes ms;
 };
 
+/** The frame after the one Pipeline::processFrame() runs, already at hand. */
+struct NextFrame
+{
+	const mrpt::obs::CObservation3DRangeScan* scan = nullptr;
+	size_t index = 0;
+};
+
 class Pipeline
 {
  public:
@@ -80,11 +92,21 @@ class Pipeline
 	/** Feeds an IMU observation (label filtered by [sensors] imu_label). */
 	void addImu(const mrpt::obs::CObservationIMU& imu);
 
+	using Next = NextFrame;
+
 	/** Runs one RGB-D frame; \a index is its 3D-scan index. Throws
 	 * std::runtime_error naming the frame when the observation has no
-	 * usable intensity or depth image. */
+	 * usable intensity or depth image.
+	 *
+	 * \a next (optional): the frame the next call will run, given only when
+	 * every IMU sample that call would see has been added already (results
+	 * are then the same as without it). With flow_thread and flow_lookahead
+	 * its observed flow starts on the flow thread during this frame's grids;
+	 * the next call takes it if it runs that frame (same index), and drops
+	 * it otherwise. The observation must stay alive until that call. */
 	const FrameResult& processFrame(
-	    const mrpt::obs::CObservation3DRangeScan& scan, size_t index);
+	    const mrpt::obs::CObservation3DRangeScan& scan, size_t index,
+	    Next next = {});
 
 	const FrameResult& last() const { return res_; }
 	const ExperimentConfig& config() const { return cfg_; }
@@ -102,6 +124,27 @@ class Pipeline
 	cv::Mat feedback_;
 	FrameResult res_;
 	size_t nFrames_ = 0;
+	/** The observed flow of a frame with the structure tensor of its image
+	 * (both owned: the flow thread does not touch them afterwards). */
+	struct Observed
+	{
+		cv::Mat flow, tensor;
+		double ms = 0;
+	};
+	Observed observe(const cv::Mat& prevGrey, const cv::Mat& curGrey,
+	                 const mrpt::img::TCamera& cam,
+	                 const Eigen::Matrix3d& R_derot);
+	/** Decodes \a next into next_ and queues its observed flow. */
+	void startLookahead(const Next& next);
+	/** Waits for a queued look-ahead flow and forgets it. */
+	void dropLookahead();
+
+	ego::RgbdFrame next_;  ///< the frame of the queued look-ahead flow
+	static constexpr size_t kNoNext = static_cast<size_t>(-1);
+	size_t nextIndex_ = kNoNext;
+	size_t nextAfter_ = 0;  ///< nFrames_ when it was queued
+	double nextInputMs_ = 0;
+	std::future<Observed> nextObserved_;
 	std::unique_ptr<SerialWorker> flowThread_;  ///< null: flow in sequence
 };
 

@@ -37,6 +37,9 @@ struct RunSummary
 	size_t scansRead = 0, framesProcessed = 0, imuRead = 0, otherSkipped = 0;
 	size_t framesFlagged = 0;    ///< frames with an egomotion flag
 	size_t scansOutOfOrder = 0;  ///< dropped: timestamp not increasing
+	/** frames whose observed flow ran during the previous frame's grids
+	 * ([pipeline] flow_lookahead) */
+	size_t framesFlowAhead = 0;
 	/** Wall time of the whole run: reading, every frame, every output
 	 * (static map included; metrics.json excepted). */
 	double seconds = 0;
