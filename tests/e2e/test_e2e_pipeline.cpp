@@ -299,7 +299,8 @@ std::vector<std::pair<std::string, mrpt::Clock::time_point>> observationOrder(
 TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 {
 	// Reading ahead, the observed flow on its own thread (and of the next
-	// frame during this frame's grids), writing on threads and OpenCV's pool
+	// frame during this frame's grids), the cloud built beside the labels,
+	// writing on threads and OpenCV's pool
 	// must not change a single byte of the outputs (nor the order of the
 	// labelled rawlog, which is the input's).
 	ExperimentConfig cfg;
@@ -310,6 +311,7 @@ TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 		c.pipeline.read_ahead = threads;
 		c.pipeline.flow_thread = threads;
 		c.pipeline.flow_lookahead = lookahead;
+		c.pipeline.cloud_thread = threads;
 		c.output.writer_thread = threads;
 		// and OpenCV's pool off in sequence (the setting is restored)
 		c.pipeline.opencv_threads = threads ? 0 : 1;

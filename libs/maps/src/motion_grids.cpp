@@ -31,12 +31,19 @@ void MotionGrids::clear()
 	t2_->clear();
 }
 
+const FrameCloud& MotionGrids::buildFrame(
+    const mrpt::obs::CObservation3DRangeScan& scan,
+    const mrpt::poses::CPose3D& T_WS)
+{
+	builder_.build(scan, T_WS, frame_);
+	return frame_;
+}
+
 const MotionFrameResult& MotionGrids::processFrame(
     const mrpt::obs::CObservation3DRangeScan& scan,
     const mrpt::poses::CPose3D& T_WS, const PixelLabels* labels)
 {
-	builder_.build(scan, T_WS, frame_);
-	return processFrame(frame_, labels);
+	return processFrame(buildFrame(scan, T_WS), labels);
 }
 
 const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,

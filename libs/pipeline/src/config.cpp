@@ -48,6 +48,7 @@ void PipelineParams::loadFromConfigFile(
 	read_ahead = s.getBool("read_ahead", read_ahead);
 	flow_thread = s.getBool("flow_thread", flow_thread);
 	flow_lookahead = s.getBool("flow_lookahead", flow_lookahead);
+	cloud_thread = s.getBool("cloud_thread", cloud_thread);
 	opencv_threads =
 	    static_cast<int>(s.getInt("opencv_threads", opencv_threads, 0, 64));
 	s.finish();

@@ -18,6 +18,17 @@ double msSince(Clock::time_point t0)
 	return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+/** Waits for a job's future when leaving a scope (also by an exception). */
+template <class T>
+struct WaitFor
+{
+	std::future<T>& f;
+	~WaitFor()
+	{
+		if (f.valid()) f.wait();
+	}
+};
+
 mrpt::img::TCamera cameraOf(const ego::RgbdFrame& f)
 {
 	mrpt::img::TCamera c;
@@ -52,6 +63,8 @@ Pipeline::Pipeline(const ExperimentConfig& cfg)
 	grids_.setDecisionTier(cfg.pipeline.variant == Variant::BottomOnly ? 1 : 2);
 	if (cfg.pipeline.flow_thread)
 		flowThread_ = std::make_unique<SerialWorker>(1, true, "bims-flow");
+	if (cfg.pipeline.cloud_thread)
+		cloudThread_ = std::make_unique<SerialWorker>(1, true, "bims-cloud");
 }
 
 Pipeline::~Pipeline() = default;
@@ -121,15 +134,11 @@ const FrameResult& Pipeline::processFrame(
 	// The observed flow of this frame: started by the previous call (look
 	// ahead), on the flow thread now, or in sequence below.
 	std::future<Observed> observing;
-	// the flow jobs use members: never leave before they end
-	struct WaitFor
-	{
-		std::future<Observed>& f;
-		~WaitFor()
-		{
-			if (f.valid()) f.wait();
-		}
-	} waitForObserving{observing};
+	// The FrameCloud, built on the cloud thread during the labels.
+	std::future<void> building;
+	// the jobs use members and locals: never leave before they end
+	const WaitFor<Observed> waitForObserving{observing};
+	const WaitFor<void> waitForBuilding{building};
 
 	// Input: grey image + metric depth + intrinsics, once for all stages.
 	auto t = Clock::now();
@@ -192,7 +201,28 @@ const FrameResult& Pipeline::processFrame(
 	// prediction): then the look-ahead starts after it.
 	const bool mayCorrect =
 	    cfg_.flow.refine_pose != "none" && cfg_.flow.refine_to_ego;
-	if (!mayCorrect) startLookahead(next);
+	// The grids take MRPT's scan frame {S} in {W}; the cloud needs nothing
+	// else (its build touches nothing the labels use).
+	mrpt::poses::CPose3D T_WS;
+	auto buildCloud = [this, &scan, &T_WS, &r]
+	{
+		const auto t = Clock::now();
+		grids_.buildFrame(scan, T_WS);
+		r.ms.cloud = msSince(t);
+	};
+	auto startCloud = [&]
+	{
+		T_WS = r.T_WC + (mrpt::poses::CPose3D() - T_SC());
+		if (!cloudThread_) return;
+		auto task = std::make_shared<std::packaged_task<void()>>(buildCloud);
+		building = task->get_future();
+		cloudThread_->post([task] { (*task)(); });
+	};
+	if (!mayCorrect)
+	{
+		startLookahead(next);
+		startCloud();
+	}
 
 	// Flow labels on the current frame's pixels.
 	t = Clock::now();
@@ -228,14 +258,20 @@ const FrameResult& Pipeline::processFrame(
 		pixLabels = toPixelLabels(r.labels);
 	}
 	r.ms.flow = msSince(t);
-	if (mayCorrect) startLookahead(next);
+	if (mayCorrect)
+	{
+		startLookahead(next);
+		startCloud();
+	}
 
-	// The three tiers. The grids take MRPT's scan frame {S} in {W}.
+	// The three tiers.
 	t = Clock::now();
-	const mrpt::poses::CPose3D T_WS =
-	    r.T_WC + (mrpt::poses::CPose3D() - T_SC());
-	const auto& g =
-	    grids_.processFrame(scan, T_WS, haveFlow ? &pixLabels : nullptr);
+	if (building.valid())
+		building.get();  // (rethrows what the build threw)
+	else
+		buildCloud();
+	const auto& g = grids_.processFrame(grids_.lastFrame(),
+	                                    haveFlow ? &pixLabels : nullptr);
 	r.maskTier1 = toMat(g.maskTier1, size);
 	r.maskTier2 = toMat(g.maskTier2, size);
 	r.hitVoxels = g.hitVoxels;

@@ -40,7 +40,13 @@ class MotionGrids
 	const MotionFrameResult& processFrame(const FrameCloud& frame,
 	                                      const PixelLabels* labels);
 
-	/** The FrameCloud of the last processFrame(scan, ...). */
+	/** Builds the FrameCloud of a scan (as processFrame(scan, ...) does)
+	 * into lastFrame(), for processFrame(lastFrame(), labels) later: the
+	 * build touches nothing else, so it may run on another thread while
+	 * the caller prepares the labels. */
+	const FrameCloud& buildFrame(const mrpt::obs::CObservation3DRangeScan& scan,
+	                             const mrpt::poses::CPose3D& T_WS);
+	/** The FrameCloud of the last processFrame(scan, ...) / buildFrame. */
 	const FrameCloud& lastFrame() const { return frame_; }
 	const MotionFrameResult& lastResult() const { return result_; }
 

@@ -50,6 +50,10 @@ struct PipelineParams
 	 * flow runs on the flow thread while this frame's grids run; same
 	 * results as without. */
 	bool flow_lookahead = true;
+	/** The FrameCloud of a frame (unprojection and voxel keys) is built on
+	 * a thread of its own while the expected flow and the labels run; same
+	 * results as without. */
+	bool cloud_thread = true;
 	/** Threads of OpenCV's own pool during a run (cv::setNumThreads; 1 = no
 	 * pool, each call runs on the thread that makes it); 0 = OpenCV's
 	 * default (one per core). */

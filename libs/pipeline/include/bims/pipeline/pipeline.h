@@ -5,7 +5,8 @@
 // ([pipeline] flow_thread): the observed flow of a frame runs there while the
 // egomotion runs on the caller's thread; told the next frame ([pipeline]
 // flow_lookahead), the observed flow of that frame starts there while this
-// frame's grids run (docs/pipeline.md, "Threads").
+// frame's grids run; the FrameCloud of a frame is built on a thread of its
+// own ([pipeline] cloud_thread) while the labels run (docs/pipeline.md).
 #pragma once
 
 #include <bims/ego/odometry.h>
@@ -37,7 +38,8 @@ struct StageTimes
 	 * flow_thread: what is left of the observed flow after the egomotion) */
 	double flow = 0;
 	double observed = 0;  ///< the observed flow alone, on whichever thread
-	double grids = 0;     ///< cloud building + the three tiers
+	double grids = 0;     ///< cloud building (or waiting for it) + the tiers
+	double cloud = 0;     ///< building the FrameCloud, on whichever thread
 	double total = 0;
 };
 
@@ -145,7 +147,8 @@ class Pipeline
 	size_t nextAfter_ = 0;  ///< nFrames_ when it was queued
 	double nextInputMs_ = 0;
 	std::future<Observed> nextObserved_;
-	std::unique_ptr<SerialWorker> flowThread_;  ///< null: flow in sequence
+	std::unique_ptr<SerialWorker> flowThread_;   ///< null: flow in sequence
+	std::unique_ptr<SerialWorker> cloudThread_;  ///< null: cloud in sequence
 };
 
 /** maps::PixelMask -> CV_8UC1 (a copy; 0x0 mask -> \a size of zeros). */
