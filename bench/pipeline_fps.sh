@@ -12,8 +12,8 @@
 # thread, waiting for the cloud build and the tiers; cloud build: on the
 # cloud thread), frames/s
 # end to end (bims-run's own figure: reading, every frame, every output) and
-# of the whole process (start to exit), CPU time per frame (all threads), and
-# the load average before the run. BIMS_RUN=/path/to/bims-run measures
+# of the whole process (start to exit), CPU time per frame (all threads), peak
+# resident memory (MiB), and the load average before the run. BIMS_RUN=/path/to/bims-run measures
 # another binary (stages it does not report print as "-"), BIMS_CONFIG=X.ini
 # another experiment file (e.g. the one of that binary's version).
 # BIMS_INPUT_GZ=N writes the simulated input with gzip level N (default 0:
@@ -48,8 +48,8 @@ load() { cut -d' ' -f1 /proc/loadavg; }
 
 echo "bims-run: $RUN, $CONFIG; input gzip level $GZ, pixel labels $LABELS; $(nproc) cores; $(date -u '+%Y-%m-%d %H:%M UTC')"
 echo
-echo "| resolution, variant | read | egomotion | flow | observed flow | grids | cloud build | pipeline total | outputs | frames/s end to end | frames/s process | CPU ms/frame | load |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| resolution, variant | read | egomotion | flow | observed flow | grids | cloud build | pipeline total | outputs | frames/s end to end | frames/s process | CPU ms/frame | peak MiB | load |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 for res in 640x480 320x240; do
   "$BIN/bims-sim" "$TMP/scene.ini" -o "$TMP/$res.rawlog" \
     --frames "$FRAMES" --resolution "$res" --seed 1 -q > /dev/null 2>&1
@@ -65,13 +65,14 @@ for res in 640x480 320x240; do
       m="$out/metrics.json"
       n=$(field frames_processed "$m")
       cpu=$(field cpu_seconds "$m")
-      printf "| %s %s | %s | %s | %s | %s | %s | %s | %s | %s | %.1f | %.1f | %s | %s |\n" \
+      printf "| %s %s | %s | %s | %s | %s | %s | %s | %s | %s | %.1f | %.1f | %s | %s | %s |\n" \
         "$res" "$v" "$(stage read "$m")" "$(stage egomotion "$m")" \
         "$(stage flow "$m")" "$(stage flow_observed "$m")" \
         "$(stage grids "$m")" "$(stage grids_cloud "$m")" "$(stage total "$m")" \
         "$(stage outputs "$m")" "$(field fps "$m")" \
         "$(echo "$n $t0 $t1" | awk '{print $1 / ($3 - $2)}')" \
         "$(if [ -n "$cpu" ]; then echo "$cpu $n" | awk '{printf "%.1f", 1000 * $1 / $2}'; else echo -; fi)" \
+        "$(field peak_resident_mib "$m" | awk '{printf "%.0f", $1} END {if (NR == 0) printf "-"}')" \
         "$l"
     done
   done

@@ -389,9 +389,13 @@ TEST(EndToEnd, LabelledRawlogIsPlainByDefaultAndGzipOnRequest)
 		EXPECT_EQ(labelMasks(f).size(), 4u);
 		// metrics.json reports reading and writing with the pipeline stages
 		const std::string j = readAll(opt.outDir + "/metrics.json");
-		for (const char* k : {"\"read\"", "\"outputs\"", "\"egomotion\"",
-		                      "\"cpu_seconds\"", "\"fps\""})
+		for (const char* k :
+		     {"\"read\"", "\"outputs\"", "\"egomotion\"", "\"grids_cloud\"",
+		      "\"cpu_seconds\"", "\"fps\"", "\"peak_resident_mib\""})
 			EXPECT_NE(j.find(k), std::string::npos) << k;
+		// (MRPT, OpenCV and a map: tens of MiB at least, far from a TiB)
+		EXPECT_GT(sum.peakResidentMiB, 10.0);
+		EXPECT_LT(sum.peakResidentMiB, 1e6);
 	}
 }
 

@@ -1,6 +1,9 @@
 // Internal: CPU time of the calling thread and of the process [ms], the
-// cross-check of wall-clock stage times on a loaded machine.
+// cross-check of wall-clock stage times on a loaded machine; the process's
+// peak resident memory.
 #pragma once
+
+#include <sys/resource.h>
 
 #include <ctime>
 
@@ -19,6 +22,14 @@ inline double threadCpuMs()
 inline double processCpuMs()
 {
 	return cpuMs(CLOCK_PROCESS_CPUTIME_ID);
+}
+/** Peak resident set size of the process so far [MiB] (Linux: ru_maxrss
+ * is in KiB). */
+inline double peakResidentMiB()
+{
+	rusage u{};
+	getrusage(RUSAGE_SELF, &u);
+	return static_cast<double>(u.ru_maxrss) / 1024.0;
 }
 
 }  // namespace bims::pipeline

@@ -210,13 +210,13 @@ void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
 	    "  \"frames_processed\": %zu,\n  \"frames_flagged\": %zu,\n  "
 	    "\"scans_read\": %zu,\n  \"imu_read\": %zu,\n"
 	    "  \"scans_out_of_order\": %zu,\n  \"wall_seconds\": %.3f,\n "
-	    " \"cpu_seconds\": %.3f,\n"
+	    " \"cpu_seconds\": %.3f,\n  \"peak_resident_mib\": %.1f,\n"
 	    "  \"fps\": %.3f,\n  \"data_seconds\": %.3f,\n"
 	    "  \"mean_moving_pixel_fraction\": %.6f,\n  "
 	    "\"static_map_voxels\": %zu,\n  \"frames_flow_ahead\": %zu,\n",
 	    sum.framesProcessed, sum.framesFlagged, sum.scansRead, sum.imuRead,
-	    sum.scansOutOfOrder, sum.seconds, sum.cpuSeconds, sum.fps(),
-	    sum.dataSeconds, sum.meanMovingPixelFraction, nStatic,
+	    sum.scansOutOfOrder, sum.seconds, sum.cpuSeconds, sum.peakResidentMiB,
+	    sum.fps(), sum.dataSeconds, sum.meanMovingPixelFraction, nStatic,
 	    sum.framesFlowAhead);
 	j << buf;
 	j << "  \"stage_ms\": {";

@@ -309,6 +309,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	    std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0)
 	        .count();
 	sum.cpuSeconds = 1e-3 * (processCpuMs() - cpu0);
+	sum.peakResidentMiB = peakResidentMiB();
 	if (out) out->writeMetrics(pipe, sum);
 	return sum;
 }
@@ -325,8 +326,9 @@ std::string formatSummary(const RunSummary& s)
 	o << buf;
 	std::snprintf(buf, sizeof(buf),
 	              "wall time %.1f s, %.1f frames/s end to end (CPU %.1f s, all "
-	              "threads); mean moving-pixel fraction %.2f %%\n",
-	              s.seconds, s.fps(), s.cpuSeconds,
+	              "threads; peak memory %.0f MiB); mean moving-pixel fraction "
+	              "%.2f %%\n",
+	              s.seconds, s.fps(), s.cpuSeconds, s.peakResidentMiB,
 	              100.0 * s.meanMovingPixelFraction);
 	o << buf;
 	o << "stage        median ms   p95 ms   mean ms\n";

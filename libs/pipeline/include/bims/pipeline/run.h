@@ -43,7 +43,9 @@ struct RunSummary
 	/** Wall time of the whole run: reading, every frame, every output
 	 * (static map included; metrics.json excepted). */
 	double seconds = 0;
-	double cpuSeconds = 0;   ///< CPU time of the process over the run
+	double cpuSeconds = 0;  ///< CPU time of the process over the run
+	/** Peak resident memory of the process at the end of the run [MiB]. */
+	double peakResidentMiB = 0;
 	double dataSeconds = 0;  ///< time span of the processed frames
 	/** Per stage [ms]: the pipeline's input, egomotion, flow, grids, total
 	 * (wall); read (reading and decoding the observations up to the frame,
