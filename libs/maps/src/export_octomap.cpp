@@ -5,16 +5,45 @@
 
 #include <octomap/OcTree.h>
 
+#include <fstream>
 #include <stdexcept>
 
 namespace bims::maps
 {
+namespace
+{
+/** An OcTree written as OcTree::writeBinary writes it (pruned maximum
+ * likelihood tree: the .bt header lines, then the binary data), without the
+ * " done." line Debian's liboctomap prints on stderr after each write. */
+class QuietOcTree : public octomap::OcTree
+{
+ public:
+	using octomap::OcTree::OcTree;
+	bool writeBinaryQuietly(const std::string& path)
+	{
+		toMaxLikelihood();
+		prune();
+		std::ofstream f(path, std::ios::binary);
+		if (!f) return false;
+		f << binaryFileHeader
+		  << "\n# static map without moving objects, bims\n#\n"
+		  << "id " << getTreeType() << "\n"
+		  << "size " << size() << "\n"
+		  << "res " << getResolution() << "\n"
+		  << "data\n";
+		writeBinaryData(f);
+		f.close();
+		return !f.fail();
+	}
+};
+}  // namespace
+
 size_t writeStaticOctomap(const std::string& path,
                           const COccupancyBayesGrid& occ,
                           const CMotionGridBase* motion, double p)
 {
 	const auto keys = staticOccupiedKeys(occ, motion, p);
-	octomap::OcTree tree(occ.params().voxel_size);
+	QuietOcTree tree(occ.params().voxel_size);
 	size_t n = 0;
 	for (const auto& k : keys)
 	{
@@ -27,7 +56,7 @@ size_t writeStaticOctomap(const std::string& path,
 		++n;
 	}
 	tree.updateInnerOccupancy();
-	if (!tree.writeBinary(path))
+	if (!tree.writeBinaryQuietly(path))
 		throw std::runtime_error("cannot write OctoMap file '" + path + "'");
 	return n;
 }

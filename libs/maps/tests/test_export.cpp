@@ -90,7 +90,10 @@ TEST(Export, OctomapBtReadsBackWithTheSameOccupiedVoxels)
 {
 	auto& mg = scenario();
 	const auto path = tmpPath("static.bt");
+	testing::internal::CaptureStderr();
 	const size_t n = writeStaticOctomap(path, *mg.occupancy(), mg.flow().get());
+	// (liboctomap's own writer prints " done." there)
+	EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
 	ASSERT_GT(n, 100u);
 	octomap::OcTree tree(0.1);
 	ASSERT_TRUE(tree.readBinary(path));
