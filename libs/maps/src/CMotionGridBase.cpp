@@ -50,7 +50,33 @@ const COccupancyBayesGrid& CMotionGridBase::occupancySource() const
 	return *private_;
 }
 
+std::vector<VoxelKey>& CMotionGridBase::ownCells()
+{
+	if (lastCells_.use_count() != 1)
+		lastCells_ = std::make_shared<std::vector<VoxelKey>>();
+	return *lastCells_;
+}
+
 void CMotionGridBase::store(const FrameCloud& f, const std::vector<float>& post)
+{
+	storeCells(f, post);
+	ownCells() = f.cells;
+	lastPost_ = post;
+}
+
+void CMotionGridBase::store(const FrameCloud& f, std::vector<float>&& post,
+                            std::shared_ptr<std::vector<VoxelKey>> cells)
+{
+	if (!cells || cells->size() != f.cells.size())
+		throw std::invalid_argument(
+		    "CMotionGridBase::store: the shared cells are not the frame's");
+	storeCells(f, post);
+	lastCells_ = std::move(cells);
+	lastPost_.swap(post);
+}
+
+void CMotionGridBase::storeCells(const FrameCloud& f,
+                                 const std::vector<float>& post)
 {
 	if (post.size() != f.cells.size())
 		throw std::invalid_argument(
@@ -98,14 +124,18 @@ void CMotionGridBase::store(const FrameCloud& f, const std::vector<float>& post)
 	}
 	if (f.K.width > 0 && f.K.height > 0)
 	{
+		// Every reading has its own pixel: written without a branch on the
+		// (unpredictable) decision.
 		lastMask_.reset(f.K.width, f.K.height);
+		uint8_t* mask = lastMask_.data.data();
+		const float* pp = post.data();
+		const uint32_t* cop = f.cellOfPoint.data();
+		const uint32_t* pix = f.pixel.data();
 		for (size_t j = 0; j < f.pixel.size(); ++j)
-			if (post[f.cellOfPoint[j]] > 0) lastMask_.data[f.pixel[j]] = 255;
+			mask[pix[j]] = uint8_t(-uint8_t(pp[cop[j]] > 0));
 	}
 	else
 		lastMask_.reset(0, 0);
-	lastCells_ = f.cells;
-	lastPost_ = post;
 	frameCount_ = F;
 	lastTimestamp_ = f.timestamp;
 	if (st.overBudget) accountFrame(st);
@@ -128,8 +158,9 @@ bool CMotionGridBase::wasMovingAtLastHit(const VoxelKey& k) const
 std::vector<mrpt::math::TPoint3D> CMotionGridBase::movingCells() const
 {
 	std::vector<mrpt::math::TPoint3D> out;
-	for (size_t i = 0; i < lastCells_.size(); ++i)
-		if (lastPost_[i] > 0) out.push_back(centerOf(lastCells_[i]));
+	const auto& cells = *lastCells_;
+	for (size_t i = 0; i < cells.size(); ++i)
+		if (lastPost_[i] > 0) out.push_back(centerOf(cells[i]));
 	return out;
 }
 
@@ -155,7 +186,7 @@ void CMotionGridBase::internal_clear()
 {
 	grid_.clear();
 	lastPost_.clear();
-	lastCells_.clear();
+	ownCells().clear();
 	lastMask_.reset(0, 0);
 	if (private_) private_->clear();
 	clearBase();
@@ -183,10 +214,10 @@ void CMotionGridBase::writeMotion(mrpt::serialization::CArchive& out) const
 	}
 	// Last frame (masks can be recomputed only with the frame; keep the
 	// posteriors and keys, and the mask itself).
-	out << uint64_t(lastCells_.size());
-	for (size_t i = 0; i < lastCells_.size(); ++i)
-		out << lastCells_[i].x << lastCells_[i].y << lastCells_[i].z
-		    << lastPost_[i];
+	const auto& cells = *lastCells_;
+	out << uint64_t(cells.size());
+	for (size_t i = 0; i < cells.size(); ++i)
+		out << cells[i].x << cells[i].y << cells[i].z << lastPost_[i];
 	out << int32_t(lastMask_.width) << int32_t(lastMask_.height);
 	if (!lastMask_.data.empty())
 		out.WriteBuffer(lastMask_.data.data(), lastMask_.data.size());
@@ -224,11 +255,11 @@ void CMotionGridBase::readMotion(mrpt::serialization::CArchive& in,
 	in >> nl;
 	if (nl > (uint64_t(1) << 32))
 		throw std::runtime_error("bims::maps: corrupt serialised grid");
-	lastCells_.resize(nl);
+	auto& cells = ownCells();
+	cells.resize(nl);
 	lastPost_.resize(nl);
 	for (size_t i = 0; i < nl; ++i)
-		in >> lastCells_[i].x >> lastCells_[i].y >> lastCells_[i].z >>
-		    lastPost_[i];
+		in >> cells[i].x >> cells[i].y >> cells[i].z >> lastPost_[i];
 	int32_t w, h;
 	in >> w >> h;
 	if (w < 0 || h < 0 || int64_t(w) * h > (int64_t(1) << 28))
@@ -251,10 +282,11 @@ void CMotionGridBase::saveMetricMapRepresentationToFile(
 {
 	std::vector<float> probs;
 	std::vector<mrpt::math::TPoint3D> pts;
-	for (size_t i = 0; i < lastCells_.size(); ++i)
+	const auto& cells = *lastCells_;
+	for (size_t i = 0; i < cells.size(); ++i)
 		if (lastPost_[i] > 0)
 		{
-			pts.push_back(centerOf(lastCells_[i]));
+			pts.push_back(centerOf(cells[i]));
 			probs.push_back(float(sigmoid(lastPost_[i])));
 		}
 	writePointsPly(prefix + "_moving.ply", pts, probs);
@@ -265,7 +297,7 @@ std::string CMotionGridBase::asString() const
 	std::ostringstream s;
 	s << GetRuntimeClass()->className << ": voxel " << params_.voxel_size
 	  << " m, " << frameCount_ << " frames, " << grid_.numBlocks()
-	  << " blocks, last frame " << lastCells_.size() << " voxels, "
+	  << " blocks, last frame " << lastCells_->size() << " voxels, "
 	  << movingCells().size() << " moving, O- from "
 	  << (linked_ ? "a linked" : "a private") << " tier-0 map";
 	return s.str();

@@ -194,6 +194,17 @@ void COccupancyBayesGrid::applyFrame(const FrameCloud& f,
 	FrameStats st;
 	const size_t m = f.cells.size();
 	Cell* const* cells = cellPtr_.data();
+	// priorFixed() and hitFixed() with the constants in locals: the cell
+	// writes (int32 fields) could alias the members for the compiler.
+	const bool lazy = params_.decay == DecayMode::All;
+	const bool hasUnknown = hasUnknown_;
+	const LogOddsFx unknown = unknown_, miss = miss_, lmin = lmin_,
+	                lmax = lmax_;
+	const LogOddsFx* hitTab = hitTable_.data();
+	const uint32_t nTab = uint32_t(hitTable_.size());
+	const uint32_t* hits = f.hits.data();
+	const uint8_t* held = hold ? hold->data() : nullptr;
+	float* pOut = priorOut ? priorOut->data() : nullptr;
 	for (size_t i = 0; i < m; ++i)
 	{
 #if defined(__GNUC__)
@@ -203,17 +214,22 @@ void COccupancyBayesGrid::applyFrame(const FrameCloud& f,
 		Cell* c = cells[i];
 		if (!c)
 		{
-			st.overBudget += f.hits[i];
-			if (priorOut)
-				(*priorOut)[i] = float(fromFixed(priorFixed(Cell(), F)));
+			st.overBudget += hits[i];
+			if (pOut) pOut[i] = float(fromFixed(priorFixed(Cell(), F)));
 			continue;
 		}
-		const LogOddsFx prior = priorFixed(*c, F);
-		c->lPrev = prior;
-		const LogOddsFx hit = (hold && (*hold)[i]) ? 0 : hitFixed(f.hits[i]);
-		c->l = LogOddsFx(std::min<int64_t>(int64_t(prior) + hit, lmax_));
-		c->stamp = F;
-		if (priorOut) (*priorOut)[i] = float(fromFixed(prior));
+		const Cell old = *c;
+		const LogOddsFx prior =
+		    (old.stamp == 0 && hasUnknown)
+		        ? unknown
+		        : (lazy ? decayFixed(old.l, F - 1 - old.stamp, miss, lmin)
+		                : old.l);
+		const uint32_t n = hits[i];
+		const LogOddsFx hit =
+		    (held && held[i]) ? 0 : (n < nTab ? hitTab[n] : hitFixedCompute(n));
+		*c = {LogOddsFx(std::min<int64_t>(int64_t(prior) + hit, lmax)), prior,
+		      F};
+		if (pOut) pOut[i] = float(fromFixed(prior));
 	}
 	if (params_.decay == DecayMode::Raycast) decayRaycast(f, F);
 	if (params_.decay == DecayMode::Frustum) decayFrustum(f, F);

@@ -82,6 +82,13 @@ inline int32_t floorSmall(double v)
 	return i - int32_t(v < double(i));
 }
 
+// Whether a reading in voxel k starts a new run after one in voxel prev
+// (without the branches of operator!=: the outcome is unpredictable).
+inline bool newRun(const VoxelKey& k, const VoxelKey& prev)
+{
+	return ((k.x ^ prev.x) | (k.y ^ prev.y) | (k.z ^ prev.z)) != 0;
+}
+
 // Grows a vector to at least n elements without touching the elements it
 // already has (a resize() after clear() would value-initialise all n).
 template <class T>
@@ -195,8 +202,12 @@ void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
 	const bool fast = isDepth && std::isfinite(units) && units >= 1e-300 &&
 	                  std::isfinite(units * 65535.0) &&
 	                  (tMax + maxR) * (1 + 1e-6) + 1 < p_.extent && rSafe > 0;
-	runKey_.clear();
-	runStart_.clear();
+	// Runs: a slot is written for every kept reading and kept (r advanced)
+	// only where the voxel changes, without a branch on it.
+	VoxelKey* runKey = growTo(runKey_, N + 1);
+	uint32_t* runStart = growTo(runStart_, N + 1);
+	size_t r = 0;
+	size_t noDepth = 0;
 	VoxelKey prev{INT32_MIN, INT32_MIN, INT32_MIN};
 	size_t w = 0;
 	for (int v = 0; v < H; ++v)
@@ -215,7 +226,7 @@ void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
 			const uint16_t raw = scan.rangeImage(v, u);
 			if (raw == 0)
 			{
-				out.stats.noDepth++;
+				noDepth++;
 				continue;
 			}
 			const Column& c = col_[size_t(u)];
@@ -250,17 +261,17 @@ void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
 				if (!keyer(p, k)) continue;
 			}
 			dOut = float(d);
-			if (k != prev)
-			{
-				runKey_.push_back(k);
-				runStart_.push_back(uint32_t(w));
-				prev = k;
-			}
+			runKey[r] = k;
+			runStart[r] = uint32_t(w);
+			r += newRun(k, prev);
+			prev = k;
 			pts[w] = p;
 			pix[w] = rowPix + uint32_t(u);
 			++w;
 		}
 	}
+	out.stats.noDepth += noDepth;
+	nRuns_ = r;
 	out.points_W.resize(w);
 	out.pixel.resize(w);
 	finishCells(out);
@@ -306,12 +317,13 @@ void FrameCloudBuilder::keyPoints(FrameCloud& out)
 {
 	Keyer keyer{1.0 / p_.voxel_size, p_.extent, p_.max_range * p_.max_range,
 	            out.origin_W, out.stats};
-	runKey_.clear();
-	runStart_.clear();
 	out.cells.clear();
 	out.hits.clear();
 	VoxelKey prev{INT32_MIN, INT32_MIN, INT32_MIN};
 	const size_t n = out.points_W.size();
+	VoxelKey* runKey = growTo(runKey_, n + 1);
+	uint32_t* runStart = growTo(runStart_, n + 1);
+	size_t r = 0;
 	size_t w = 0;
 	for (size_t i = 0; i < n; ++i)
 	{
@@ -324,16 +336,15 @@ void FrameCloudBuilder::keyPoints(FrameCloud& out)
 			if (!out.depth.empty()) out.depth[out.pixel[i]] = 0;
 			continue;
 		}
-		if (k != prev)
-		{
-			runKey_.push_back(k);
-			runStart_.push_back(uint32_t(w));
-			prev = k;
-		}
+		runKey[r] = k;
+		runStart[r] = uint32_t(w);
+		r += newRun(k, prev);
+		prev = k;
 		out.points_W[w] = p;
 		out.pixel[w] = out.pixel[i];
 		++w;
 	}
+	nRuns_ = r;
 	out.points_W.resize(w);
 	out.pixel.resize(w);
 	finishCells(out);
@@ -388,12 +399,11 @@ void radixSort(std::vector<uint64_t>& v, std::vector<uint64_t>& tmp,
 }  // namespace
 
 // Orders the runs by 8^3 block (blocks in (x, y, z) lexicographic order) and
-// by cell inside a block with a radix sort of compact keys (block relative
-// to the frame's lowest block, then the cell index in the block, x fastest,
-// as in the storage) packed with the run index: equal keys are the frame's
-// distinct cells, already in block order, so that the grids visit each
-// storage block once per frame (one hash lookup per block instead of per
-// cell, and cache-friendly writes). No hashing per reading.
+// by cell inside a block (the cell index in the block, x fastest, as in the
+// storage): equal keys are the frame's distinct cells, already in block
+// order, so that the grids visit each storage block once per frame (one hash
+// lookup per block instead of per cell, and cache-friendly writes). No
+// hashing per reading.
 void FrameCloudBuilder::finishCells(FrameCloud& out)
 {
 	const size_t w = out.points_W.size();
@@ -402,12 +412,13 @@ void FrameCloudBuilder::finishCells(FrameCloud& out)
 	out.cells.clear();
 	out.hits.clear();
 	if (w == 0) return;
-	const size_t r = runKey_.size();
-	runStart_.push_back(uint32_t(w));
+	const size_t r = nRuns_;
+	runStart_[r] = uint32_t(w);  // the end of the last run
 	int32_t lo[3] = {INT32_MAX, INT32_MAX, INT32_MAX};
 	int32_t hi[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
-	for (const auto& k : runKey_)
+	for (size_t j = 0; j < r; ++j)
 	{
+		const VoxelKey& k = runKey_[j];
 		const int32_t b[3] = {k.x >> 3, k.y >> 3, k.z >> 3};
 		for (int a = 0; a < 3; ++a)
 		{
@@ -415,19 +426,16 @@ void FrameCloudBuilder::finishCells(FrameCloud& out)
 			hi[a] = std::max(hi[a], b[a]);
 		}
 	}
-	runCell_.resize(r);
 	out.cells.reserve(r);
 	out.hits.reserve(r);
 	const size_t nb[3] = {size_t(hi[0] - lo[0]) + 1, size_t(hi[1] - lo[1]) + 1,
 	                      size_t(hi[2] - lo[2]) + 1};
 	const double nBlocks = double(nb[0]) * double(nb[1]) * double(nb[2]);
-	if (nBlocks <= double(std::min<size_t>(4 * r + 65536, size_t(1) << 24)))
+	if (w < kMaxBucketReadings &&
+	    nBlocks <= double(std::min<size_t>(4 * r + 65536, size_t(1) << 24)))
 		bucketCells(out, lo, nb);
 	else
 		radixCells(out, lo, hi);
-	uint32_t* cop = out.cellOfPoint.data();
-	for (size_t j = 0; j < r; ++j)
-		std::fill(cop + runStart_[j], cop + runStart_[j + 1], runCell_[j]);
 }
 
 // finishCells() for frames whose bounding box has too many blocks for a
@@ -437,7 +445,8 @@ void FrameCloudBuilder::finishCells(FrameCloud& out)
 void FrameCloudBuilder::radixCells(FrameCloud& out, const int32_t lo[3],
                                    const int32_t hi[3])
 {
-	const size_t r = runKey_.size();
+	const size_t r = nRuns_;
+	runCell_.resize(r);
 	unsigned bits[3];
 	for (int a = 0; a < 3; ++a) bits[a] = bitWidth(uint64_t(hi[a] - lo[a]));
 	const unsigned idxBits = bitWidth(uint64_t(r - 1));
@@ -485,16 +494,21 @@ void FrameCloudBuilder::radixCells(FrameCloud& out, const int32_t lo[3],
 		out.hits.back() += runStart_[run + 1] - runStart_[run];
 		runCell_[run] = uint32_t(out.cells.size() - 1);
 	}
+	uint32_t* cop = out.cellOfPoint.data();
+	for (size_t j = 0; j < r; ++j)
+		std::fill(cop + runStart_[j], cop + runStart_[j + 1], runCell_[j]);
 }
 
 // finishCells() with a bucket per block of the frame's bounding box: a
 // counting sort of the runs by block (blocks in (x, y, z) lexicographic
 // order), then, per block, the cells present in a 512-bit mask, numbered
-// in cell-index order (x fastest, as in the storage).
+// in cell-index order (x fastest, as in the storage). A run is bucketed as
+// (first reading << 32) | (length << 9) | cell, so that its readings get
+// their cell without a second pass over the runs.
 void FrameCloudBuilder::bucketCells(FrameCloud& out, const int32_t lo[3],
                                     const size_t nb[3])
 {
-	const size_t r = runKey_.size();
+	const size_t r = nRuns_;
 	const size_t n = nb[0] * nb[1] * nb[2];
 	auto blockOf = [&](const VoxelKey& k)
 	{
@@ -505,50 +519,71 @@ void FrameCloudBuilder::bucketCells(FrameCloud& out, const int32_t lo[3],
 	};
 	auto cellOf = [](const VoxelKey& k)
 	{ return uint32_t((k.x & 7) | ((k.y & 7) << 3) | ((k.z & 7) << 6)); };
-	bucketStart_.assign(n + 1, 0);
+	// Runs per block, then the first slot of each block; the scatter below
+	// advances start[b] to the end of block b.
+	bucketStart_.assign(n, 0);
 	uint32_t* start = bucketStart_.data();
-	for (const auto& k : runKey_) start[blockOf(k) + 1]++;
-	for (size_t b = 0; b < n; ++b) start[b + 1] += start[b];
-	// (run << 9) | cell, grouped by block, runs in increasing order.
-	packed_.resize(r);
-	uint64_t* byBlock = packed_.data();
-	bucketFill_.assign(start, start + n);
-	for (size_t j = 0; j < r; ++j)
-	{
-		const VoxelKey& k = runKey_[j];
-		byBlock[bucketFill_[blockOf(k)]++] = (uint64_t(j) << 9) | cellOf(k);
-	}
-	uint32_t cellId[512];
+	const VoxelKey* runKey = runKey_.data();
+	const uint32_t* runStart = runStart_.data();
+	for (size_t j = 0; j < r; ++j) start[blockOf(runKey[j])]++;
+	uint32_t sum = 0;
 	for (size_t b = 0; b < n; ++b)
 	{
-		const uint32_t b0 = start[b], b1 = start[b + 1];
-		if (b0 == b1) continue;
-		uint64_t present[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-		for (uint32_t j = b0; j < b1; ++j)
-		{
-			const uint32_t c = uint32_t(byBlock[j] & 511);
-			present[c >> 6] |= uint64_t(1) << (c & 63);
-		}
-		const VoxelKey o = runKey_[byBlock[b0] >> 9];
-		const int32_t ox = o.x & ~7, oy = o.y & ~7, oz = o.z & ~7;
-		for (uint32_t wd = 0; wd < 8; ++wd)
-			for (uint64_t m = present[wd]; m; m &= m - 1)
-			{
-				const uint32_t c = wd * 64 + uint32_t(__builtin_ctzll(m));
-				cellId[c] = uint32_t(out.cells.size());
-				out.cells.push_back({ox + int32_t(c & 7),
-				                     oy + int32_t((c >> 3) & 7),
-				                     oz + int32_t(c >> 6)});
-				out.hits.push_back(0);
-			}
-		for (uint32_t j = b0; j < b1; ++j)
-		{
-			const uint32_t run = uint32_t(byBlock[j] >> 9);
-			const uint32_t id = cellId[byBlock[j] & 511];
-			out.hits[id] += runStart_[run + 1] - runStart_[run];
-			runCell_[run] = id;
-		}
+		const uint32_t t = start[b];
+		start[b] = sum;
+		sum += t;
 	}
+	uint64_t* byBlock = growTo(packed_, r);
+	for (size_t j = 0; j < r; ++j)
+	{
+		const VoxelKey& k = runKey[j];
+		const uint64_t len = runStart[j + 1] - runStart[j];
+		byBlock[start[blockOf(k)]++] =
+		    (uint64_t(runStart[j]) << 32) | (len << 9) | cellOf(k);
+	}
+	uint32_t cellId[512];
+	uint32_t* cop = out.cellOfPoint.data();
+	uint32_t b0 = 0;
+	size_t b = 0;
+	for (size_t bx = 0; bx < nb[0]; ++bx)
+		for (size_t by = 0; by < nb[1]; ++by)
+			for (size_t bz = 0; bz < nb[2]; ++bz, ++b)
+			{
+				const uint32_t b1 = start[b];
+				if (b0 == b1) continue;
+				uint64_t present[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+				for (uint32_t j = b0; j < b1; ++j)
+				{
+					const uint32_t c = uint32_t(byBlock[j] & 511);
+					present[c >> 6] |= uint64_t(1) << (c & 63);
+				}
+				const int32_t ox = (lo[0] + int32_t(bx)) * 8,
+				              oy = (lo[1] + int32_t(by)) * 8,
+				              oz = (lo[2] + int32_t(bz)) * 8;
+				for (uint32_t wd = 0; wd < 8; ++wd)
+					for (uint64_t m = present[wd]; m; m &= m - 1)
+					{
+						const uint32_t c =
+						    wd * 64 + uint32_t(__builtin_ctzll(m));
+						cellId[c] = uint32_t(out.cells.size());
+						out.cells.push_back({ox + int32_t(c & 7),
+						                     oy + int32_t((c >> 3) & 7),
+						                     oz + int32_t(c >> 6)});
+						out.hits.push_back(0);
+					}
+				uint32_t* hits = out.hits.data();
+				for (uint32_t j = b0; j < b1; ++j)
+				{
+					const uint64_t e = byBlock[j];
+					const uint32_t id = cellId[e & 511];
+					const uint32_t first = uint32_t(e >> 32);
+					const uint32_t len =
+					    uint32_t(e >> 9) & (kMaxBucketReadings - 1);
+					hits[id] += len;
+					for (uint32_t q = first; q < first + len; ++q) cop[q] = id;
+				}
+				b0 = b1;
+			}
 }
 
 }  // namespace bims::maps

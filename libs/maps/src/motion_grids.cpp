@@ -112,8 +112,14 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 		result_.movingTier1 += post1_[i] > 0;
 		result_.movingTier2 += post2_[i] > 0;
 	}
-	t1_->store(f, post1_);
-	t2_->store(f, post2_);
+	// Tiers 1 and 2 keep one copy of the cells, and the posteriors without
+	// a copy (post1_, post2_ are recomputed every frame).
+	auto& cells = cellsBuf_[0].use_count() <= 1 ? cellsBuf_[0] : cellsBuf_[1];
+	if (cells.use_count() != 1)
+		cells = std::make_shared<std::vector<VoxelKey>>();
+	*cells = f.cells;
+	t1_->store(f, std::move(post1_), cells);
+	t2_->store(f, std::move(post2_), cells);
 	result_.maskTier1 = t1_->lastMovingMask();
 	result_.maskTier2 = t2_->lastMovingMask();
 	result_.updateMs = std::chrono::duration<double, std::milli>(

@@ -121,12 +121,15 @@ void CFlowConsistencyGrid::posterior(const FrameCloud& f,
 			    std::to_string(labels.width) + "x" +
 			    std::to_string(labels.height) + " but the frame is " +
 			    std::to_string(f.K.width) + "x" + std::to_string(f.K.height));
+		// Without a branch on the label: an unlabelled reading (-1) adds 0.
 		uint32_t* kl = counts_.data();
 		const int8_t* lab = labels.label.data();
+		const uint32_t* cop = f.cellOfPoint.data();
+		const uint32_t* pix = f.pixel.data();
 		for (size_t j = 0; j < f.pixel.size(); ++j)
 		{
-			const int8_t v = lab[f.pixel[j]];
-			if (v == 1 || v == 0) kl[2 * f.cellOfPoint[j] + (v == 0)]++;
+			const int8_t v = lab[pix[j]];
+			kl[2 * size_t(cop[j]) + (v == 0)] += uint32_t(v == 0 || v == 1);
 		}
 	}
 	post.resize(m);

@@ -78,7 +78,39 @@ TEST(MotionGrids, SameResultAsIndividualMapsThroughInsertObservation)
 		ASSERT_EQ(res.maskTier1.data, t1.lastMovingMask().data);
 		ASSERT_EQ(res.maskTier2.data, t2.lastMovingMask().data);
 		ASSERT_EQ(mg.flow()->lastPosterior(), t2.lastPosterior());
+		ASSERT_EQ(mg.background()->lastCells(), t1.lastCells());
+		ASSERT_EQ(mg.flow()->lastCells(), t2.lastCells());
 		scene.pop_back();
+	}
+}
+
+// MotionGrids hands tiers 1 and 2 one shared copy of the frame's cells and
+// reuses its buffer: a copy of a map taken in between keeps its own last
+// frame, and the maps keep theirs after the next frames.
+TEST(MotionGrids, SharedCellsOfTheLastFrameAreNeverOverwritten)
+{
+	GridParams p;
+	MotionGrids mg(p);
+	using namespace bims::maps::test;
+	const auto scene = room();
+	std::vector<CBackgroundSubtractionGrid> copies;
+	std::vector<std::vector<VoxelKey>> cellsSeen;
+	std::vector<std::vector<float>> postSeen;
+	for (int f = 0; f < 5; ++f)
+	{
+		const mrpt::poses::CPose3D T(0.1 * f, 0.05 * f, 1, 0.1 * f, 0, 0);
+		auto scan = renderScan(scene, T, 40, 30, 60, f);
+		mg.processFrame(*scan, T, nullptr);
+		ASSERT_EQ(mg.background()->lastCells(), mg.lastFrame().cells);
+		ASSERT_EQ(mg.flow()->lastCells(), mg.lastFrame().cells);
+		copies.push_back(*mg.background());
+		cellsSeen.push_back(mg.lastFrame().cells);
+		postSeen.push_back(mg.background()->lastPosterior());
+	}
+	for (size_t i = 0; i < copies.size(); ++i)
+	{
+		ASSERT_EQ(copies[i].lastCells(), cellsSeen[i]) << i;
+		ASSERT_EQ(copies[i].lastPosterior(), postSeen[i]) << i;
 	}
 }
 

@@ -49,11 +49,18 @@ class CMotionGridBase : public CBayesVoxelGridBase
 	 * this map's frame frameCount()+1 and computes the mask. */
 	void store(const FrameCloud& frame,
 	           const std::vector<float>& posteriorLogOdds);
+	/** store() without copying the frame's cells and posteriors (~2 MB per
+	 * VGA frame at 2 cm): \a cells holds frame.cells (shared: MotionGrids
+	 * gives tiers 1 and 2 one copy; a map never modifies a vector another
+	 * owner holds), \a posteriorLogOdds is swapped in (it is left holding
+	 * the previous frame's values). */
+	void store(const FrameCloud& frame, std::vector<float>&& posteriorLogOdds,
+	           std::shared_ptr<std::vector<VoxelKey>> cells);
 
 	/** Posterior log-odds of I of each of the last frame's cells. */
 	const std::vector<float>& lastPosterior() const { return lastPost_; }
 	/** Voxels of the last frame (same order as lastPosterior()). */
-	const std::vector<VoxelKey>& lastCells() const { return lastCells_; }
+	const std::vector<VoxelKey>& lastCells() const { return *lastCells_; }
 	/** Moving-pixel mask of the last frame (MAP: posterior > 1/2). Empty
 	 * (0 x 0) for unorganised clouds. */
 	const PixelMask& lastMovingMask() const { return lastMask_; }
@@ -92,8 +99,15 @@ class CMotionGridBase : public CBayesVoxelGridBase
 
 	Storage grid_;
 	std::vector<float> lastPost_;
-	std::vector<VoxelKey> lastCells_;
+	// Shared with copies of this map and with MotionGrids; modified only
+	// through ownCells().
+	std::shared_ptr<std::vector<VoxelKey>> lastCells_ =
+	    std::make_shared<std::vector<VoxelKey>>();
+	/** lastCells_, first replaced by a vector of its own if shared. */
+	std::vector<VoxelKey>& ownCells();
 	PixelMask lastMask_;
+	/** The cell writes and the mask of store(). */
+	void storeCells(const FrameCloud& frame, const std::vector<float>& post);
 	std::shared_ptr<const COccupancyBayesGrid> linked_;
 	std::shared_ptr<COccupancyBayesGrid> private_;
 	mrpt::Clock::time_point lastTimestampLocal_{};

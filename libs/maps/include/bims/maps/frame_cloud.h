@@ -149,7 +149,7 @@ class FrameCloudBuilder
 
  private:
 	struct Keyer;
-	/** Sorts the runs of runKey_/runStart_ into out.cells, out.hits and
+	/** Sorts the nRuns_ runs of runKey_/runStart_ into out.cells, out.hits and
 	 * out.cellOfPoint (out.points_W holds the kept readings). */
 	void finishCells(FrameCloud& out);
 	void bucketCells(FrameCloud& out, const int32_t lo[3], const size_t nb[3]);
@@ -163,13 +163,18 @@ class FrameCloudBuilder
 		double r[3];  // xn * R_WC.col(0)
 	};
 	std::vector<Column> col_;
-	// Runs of consecutive kept readings in one voxel: key and first reading.
+	// Runs of consecutive kept readings in one voxel: key and first reading
+	// (nRuns_ of them; the vectors only grow, one slot more than readings).
 	std::vector<VoxelKey> runKey_;
 	std::vector<uint32_t> runStart_, runCell_;
+	size_t nRuns_ = 0;
+	// bucketCells() packs a run's length in 23 bits: frames with more
+	// readings take radixCells().
+	static constexpr uint32_t kMaxBucketReadings = uint32_t(1) << 23;
 	// Sort scratch: (compact key << run bits) | run, or (key, run) pairs.
 	std::vector<uint64_t> packed_, packedTmp_;
 	std::vector<std::pair<uint64_t, uint32_t>> pairs_;
-	std::vector<uint32_t> bucketStart_, bucketFill_;
+	std::vector<uint32_t> bucketStart_;
 };
 
 }  // namespace bims::maps

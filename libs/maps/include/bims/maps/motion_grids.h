@@ -75,6 +75,9 @@ class MotionGrids
 	std::vector<float> prior_, post1_, post2_;
 	std::vector<float> priorN_;
 	std::vector<uint8_t> hold_;
+	// The frame's cells as kept by tiers 1 and 2 (one copy for both): two
+	// buffers, the one the maps no longer hold is refilled.
+	std::shared_ptr<std::vector<VoxelKey>> cellsBuf_[2];
 	int decisionTier_ = 2;
 };
 
