@@ -67,12 +67,24 @@ cv::Mat ObservedFlow::computeDerotated(const cv::Mat& prev, const cv::Mat& cur,
 	                    cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
 	                    cv::BORDER_REPLICATE);
 	cv::Mat flow = compute(warped, cur);
+	composeWithHomography(flow, H, flow);
+	return flow;
+}
+
+void composeWithHomography(const cv::Mat& residual, const cv::Matx33d& H,
+                           cv::Mat& flow)
+{
+	if (residual.type() != CV_32FC2)
+		throw std::invalid_argument(
+		    "composeWithHomography: the residual must be CV_32FC2");
+	flow.create(residual.size(), CV_32FC2);
 	for (int v = 0; v < flow.rows; v++)
 	{
+		const auto* r = residual.ptr<cv::Vec2f>(v);
 		auto* f = flow.ptr<cv::Vec2f>(v);
 		for (int u = 0; u < flow.cols; u++)
 		{
-			const double x = u + f[u][0], y = v + f[u][1];
+			const double x = u + r[u][0], y = v + r[u][1];
 			const double X = H(0, 0) * x + H(0, 1) * y + H(0, 2);
 			const double Y = H(1, 0) * x + H(1, 1) * y + H(1, 2);
 			const double Z = H(2, 0) * x + H(2, 1) * y + H(2, 2);
@@ -86,7 +98,6 @@ cv::Mat ObservedFlow::computeDerotated(const cv::Mat& prev, const cv::Mat& cur,
 			        static_cast<float>(Y / Z - v)};
 		}
 	}
-	return flow;
 }
 
 cv::Mat structureTensor(const cv::Mat& grey, int window)

@@ -43,6 +43,13 @@ class ObservedFlow
 	cv::Ptr<cv::DISOpticalFlow> dis_;
 };
 
+/** The flow of a derotated measurement composed back: for the residual flow
+ * r (CV_32FC2) measured against the image warped by \a H,
+ * flow(u) = H (u + r(u)) - u (dehomogenised; NaN where the third coordinate
+ * is not positive). \a flow may be \a residual (in place). */
+void composeWithHomography(const cv::Mat& residual, const cv::Matx33d& H,
+                           cv::Mat& flow);
+
 /** Local structure tensor of a grey image (CV_8UC1): per pixel the window
  * means of Ix^2, Ix Iy, Iy^2 (gradients in grey levels per pixel, Sobel),
  * over a \a window x \a window box. CV_32FC3. For a flow difference d,
