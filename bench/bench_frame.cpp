@@ -236,12 +236,15 @@ void benchWarp(bm::State& st)
 		                    cv::BORDER_REPLICATE);
 }
 
+// As ObservedFlow computes it: its buffers reused.
 void benchTensor(bm::State& st)
 {
+	bims::flow::TensorBuffers buf;
+	cv::Mat out;
 	ProcCpu cpu(st);
 	for (auto _ : st)
-		bm::DoNotOptimize(bims::flow::structureTensor(
-		    g_pair.cur.grey, g_flow.texture_window_px));
+		bims::flow::structureTensor(g_pair.cur.grey, g_flow.texture_window_px,
+		                            out, buf);
 }
 
 void benchDisWarped(bm::State& st)
