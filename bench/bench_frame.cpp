@@ -1,21 +1,31 @@
 // Per-frame stages of bims-run outside the grids, on two consecutive frames
 // of a rawlog: decoding the observation into grey + depth, the KLT tracker,
-// the observed flow (DIS presets x downscale, Farneback), the expected flow
-// and the labels. One JSON object per measurement on stdout (json_reporter.h).
+// the observed flow (DIS presets x downscale, Farneback), and the flow
+// stages as the pipeline runs them with an experiment's [flow] section:
+// the derotated observed flow and its parts (warp, structure tensor, DIS,
+// composition), the expected flow and the labels. One JSON object per
+// measurement on stdout (json_reporter.h); "proc_cpu_ms" is the CPU time of
+// the whole process per iteration (OpenCV's worker threads included).
 //
 //   bench_frame --rawlog=RAWLOG [--frame=N] [--cv_threads=K]
-//               [benchmark flags]
+//               [--config=EXP.ini] [--gt=GT.txt] [benchmark flags]
 //
 // Default rawlog: the bundled sample (320x240); give a 640x480 bims-sim
 // rawlog for VGA figures. --cv_threads calls cv::setNumThreads(K) first
-// (default: OpenCV's own choice).
+// (default: OpenCV's own choice). --config: the [flow] section to use
+// (default config/default.ini). --gt: the relative pose of the pair from a
+// TUM trajectory with one pose per 3D scan (bims-sim's NAME_gt/
+// groundtruth.txt); without it a made-up pose of a few degrees and
+// centimetres (the labels are then mostly Diff).
 #include <bims/common/rawlog.h>
+#include <bims/common/trajectory.h>
 #include <bims/ego/gyro_klt.h>
 #include <bims/ego/rgbd_input.h>
 #include <bims/flow/consistency.h>
 #include <bims/flow/expected_flow.h>
 #include <bims/flow/observed_flow.h>
 
+#include <mrpt/config/CConfigFile.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
 #include <opencv2/core/utility.hpp>
@@ -23,6 +33,9 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include <cmath>
+#include <ctime>
+#include <fstream>
 #include <iostream>
 #include <stdexcept>
 
@@ -37,8 +50,56 @@ struct Pair
 	mrpt::obs::CObservation3DRangeScan::Ptr scan;
 	bims::ego::RgbdFrame prev, cur;
 	mrpt::img::TCamera cam;
+	double tPrev = 0, tCur = 0;  ///< timestamps [s]
 };
 Pair g_pair;
+// The experiment's [flow] section, and the relative pose of the flow stages
+// (the derotation's homography is its rotation, the expected flow uses all
+// of it): the ground truth's with --gt, otherwise a pan of a few degrees and
+// a step of a few centimetres.
+bims::flow::FlowParams g_flow;
+mrpt::poses::CPose3D g_T_prev_cur(0.02, -0.01, 0.03, 0.035, -0.02, 0.01);
+
+/** T_{C(t-1) C(t)} of the pair from a TUM trajectory with one line per 3D
+ * scan (bims-sim's groundtruth.txt). */
+mrpt::poses::CPose3D relativePoseFromGt(const std::string& path, int frame)
+{
+	const bims::Trajectory gt = bims::loadTumTrajectory(path);
+	if (static_cast<int>(gt.size()) <= frame)
+		throw std::runtime_error(path + ": fewer than " +
+		                         std::to_string(frame + 1) + " poses");
+	const auto& a = gt[frame - 1];
+	const auto& b = gt[frame];
+	if (std::abs(a.t - g_pair.tPrev) > 1e-3 ||
+	    std::abs(b.t - g_pair.tCur) > 1e-3)
+		throw std::runtime_error(path +
+		                         ": timestamps differ from the rawlog's scans");
+	return b.T_WC - a.T_WC;
+}
+
+double processCpuMs()
+{
+	timespec ts{};
+	clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+	return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+/** Sets the counter proc_cpu_ms of \a st to the process CPU time per
+ * iteration over the object's lifetime (every thread). */
+class ProcCpu
+{
+ public:
+	explicit ProcCpu(bm::State& st) : st_(st), t0_(processCpuMs()) {}
+	~ProcCpu()
+	{
+		st_.counters["proc_cpu_ms"] =
+		    bm::Counter(processCpuMs() - t0_, bm::Counter::kAvgIterations);
+	}
+
+ private:
+	bm::State& st_;
+	double t0_;
+};
 
 void loadPair(const std::string& path, int frame)
 {
@@ -50,10 +111,15 @@ void loadPair(const std::string& path, int frame)
 		auto s =
 		    std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(o);
 		if (!s) continue;
-		if (k == frame - 1) prev = s;
+		if (k == frame - 1)
+		{
+			prev = s;
+			g_pair.tPrev = mrpt::Clock::toDouble(s->timestamp);
+		}
 		if (k == frame)
 		{
 			g_pair.scan = s;
+			g_pair.tCur = mrpt::Clock::toDouble(s->timestamp);
 			break;
 		}
 		++k;
@@ -127,27 +193,110 @@ void benchMaskDilate(bm::State& st)
 void benchObserved(bm::State& st, bims::flow::FlowParams p)
 {
 	bims::flow::ObservedFlow of(p);
+	ProcCpu cpu(st);
 	for (auto _ : st)
 		bm::DoNotOptimize(of.compute(g_pair.prev.grey, g_pair.cur.grey));
 }
 
-void benchExpected(bm::State& st)
+cv::Matx33d derotation()
 {
-	for (auto _ : st)
-		bm::DoNotOptimize(bims::flow::expectedFlowExact(
-		    g_pair.cur.depth, g_pair.cam, mrpt::poses::CPose3D()));
+	return bims::flow::rotationHomography(g_pair.cam, g_T_prev_cur);
 }
 
+cv::Mat warpedPrev()
+{
+	cv::Mat w;
+	cv::warpPerspective(
+	    g_pair.prev.grey, w, derotation(), g_pair.prev.grey.size(),
+	    cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+	return w;
+}
+
+// The pipeline's observed flow: ObservedFlow::computeDerotated with the
+// experiment's [flow] (warp, structure tensor, DIS, composition).
+void benchDerotated(bm::State& st)
+{
+	bims::flow::ObservedFlow of(g_flow);
+	const cv::Matx33d H = derotation();
+	ProcCpu cpu(st);
+	for (auto _ : st)
+		bm::DoNotOptimize(
+		    of.computeDerotated(g_pair.prev.grey, g_pair.cur.grey, H));
+}
+
+// Its parts.
+void benchWarp(bm::State& st)
+{
+	const cv::Matx33d H = derotation();
+	cv::Mat w;
+	ProcCpu cpu(st);
+	for (auto _ : st)
+		cv::warpPerspective(g_pair.prev.grey, w, H, g_pair.prev.grey.size(),
+		                    cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
+		                    cv::BORDER_REPLICATE);
+}
+
+// As ObservedFlow computes it: its buffers reused.
+void benchTensor(bm::State& st)
+{
+	bims::flow::TensorBuffers buf;
+	cv::Mat out;
+	ProcCpu cpu(st);
+	for (auto _ : st)
+		bims::flow::structureTensor(g_pair.cur.grey, g_flow.texture_window_px,
+		                            out, buf);
+}
+
+void benchDisWarped(bm::State& st)
+{
+	bims::flow::FlowParams p = g_flow;  // DIS alone: no tensor
+	p.visible_change_grey = 0;
+	p.refine_pose = "none";
+	bims::flow::ObservedFlow of(p);
+	const cv::Mat w = warpedPrev();
+	ProcCpu cpu(st);
+	for (auto _ : st) bm::DoNotOptimize(of.compute(w, g_pair.cur.grey));
+}
+
+void benchCompose(bm::State& st)
+{
+	bims::flow::FlowParams p = g_flow;
+	p.visible_change_grey = 0;
+	p.refine_pose = "none";
+	bims::flow::ObservedFlow of(p);
+	const cv::Mat residual = of.compute(warpedPrev(), g_pair.cur.grey);
+	const cv::Matx33d H = derotation();
+	cv::Mat flow;
+	ProcCpu cpu(st);
+	for (auto _ : st) bims::flow::composeWithHomography(residual, H, flow);
+}
+
+void benchExpected(bm::State& st)
+{
+	ProcCpu cpu(st);
+	for (auto _ : st)
+		bm::DoNotOptimize(bims::flow::expectedFlowExact(
+		    g_pair.cur.depth, g_pair.cam, g_T_prev_cur));
+}
+
+// The labels as the pipeline makes them: the derotated observed flow, the
+// exact expected flow and (visibility gate) the structure tensor.
 void benchLabels(bm::State& st)
 {
-	bims::flow::FlowParams p;
-	bims::flow::ObservedFlow of(p);
-	const cv::Mat obs = of.compute(g_pair.prev.grey, g_pair.cur.grey);
-	const cv::Mat exp =
-	    bims::flow::expectedFlowExact(g_pair.cur.depth, g_pair.cam, {});
+	bims::flow::ObservedFlow of(g_flow);
+	const cv::Mat obs =
+	    of.computeDerotated(g_pair.prev.grey, g_pair.cur.grey, derotation());
+	const cv::Mat exp = bims::flow::expectedFlowExact(g_pair.cur.depth,
+	                                                  g_pair.cam, g_T_prev_cur);
+	const cv::Mat* tensor = of.tensor().empty() ? nullptr : &of.tensor();
+	bims::flow::LabelStats stats;
+	ProcCpu cpu(st);
 	for (auto _ : st)
-		bm::DoNotOptimize(bims::flow::labelConsistency(
-		    obs, exp, g_pair.cur.depth, g_pair.cam, {}, p));
+		bm::DoNotOptimize(
+		    bims::flow::labelConsistency(obs, exp, g_pair.cur.depth, g_pair.cam,
+		                                 g_T_prev_cur, g_flow, &stats, tensor));
+	st.counters["diff"] = static_cast<double>(stats.diff);
+	st.counters["notdiff"] = static_cast<double>(stats.notDiff);
 }
 
 template <class F>
@@ -177,6 +326,11 @@ void registerAll()
 			        std::to_string(ds),
 			    [p](bm::State& st) { benchObserved(st, p); });
 		}
+	reg("observed/derotated", benchDerotated);
+	reg("observed/warp", benchWarp);
+	reg("observed/tensor", benchTensor);
+	reg("observed/dis", benchDisWarped);
+	reg("observed/compose", benchCompose);
 	reg("expected_exact", benchExpected);
 	reg("labels", benchLabels);
 }
@@ -189,6 +343,9 @@ int main(int argc, char** argv)
 		std::string rawlog =
 		    std::string(BIMS_SOURCE_DIR) + "/rawlogs/pendulum_slow.rawlog";
 		int frame = 20;
+		std::string gt;
+		std::string config =
+		    std::string(BIMS_SOURCE_DIR) + "/config/default.ini";
 		std::vector<char*> rest = {argv[0]};
 		for (int i = 1; i < argc; ++i)
 		{
@@ -198,6 +355,10 @@ int main(int argc, char** argv)
 				rawlog = v;
 			else if (auto v = val("--frame"))
 				frame = std::stoi(v);
+			else if (auto v = val("--gt"))
+				gt = v;
+			else if (auto v = val("--config"))
+				config = v;
 			else if (auto v = val("--cv_threads"))
 				cv::setNumThreads(std::stoi(v));
 			else
@@ -205,9 +366,15 @@ int main(int argc, char** argv)
 		}
 		if (frame < 1) throw std::runtime_error("--frame must be >= 1");
 		loadPair(rawlog, frame);
+		if (!gt.empty()) g_T_prev_cur = relativePoseFromGt(gt, frame);
+		if (!std::ifstream(config))
+			throw std::runtime_error("cannot open " + config);
+		g_flow.loadFromConfigFile(mrpt::config::CConfigFile(config), "flow");
 		std::cerr << "frames " << frame - 1 << ", " << frame << " of " << rawlog
 		          << ": " << g_pair.cur.grey.cols << "x" << g_pair.cur.grey.rows
-		          << ", OpenCV threads " << cv::getNumThreads() << "\n";
+		          << ", OpenCV threads " << cv::getNumThreads()
+		          << ", [flow] of " << config << ", T_prev_cur " << g_T_prev_cur
+		          << "\n";
 		registerAll();
 		int n = int(rest.size());
 		return bims::bench::runWithJsonLines(n, rest.data());

@@ -1,5 +1,6 @@
 #include <bims/flow/consistency.h>
 #include <bims/flow/flow_pose.h>
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
@@ -32,55 +33,111 @@ cv::Mat labelConsistency(const cv::Mat& observed, const cv::Mat& expected,
 	                         std::sqrt(tx * tx + ty * ty) * p.depth_noise_a;
 	const float W = static_cast<float>(depth.cols - 1);
 	const float H = static_cast<float>(depth.rows - 1);
+	// z <= max_depth_m (double) exactly as a float comparison: against the
+	// largest float not above it. It also rejects NaN and +inf, z > 0 rejects
+	// -inf; a non-finite flow fails the bounds tests below.
+	float maxDepth = static_cast<float>(p.max_depth_m);
+	if (static_cast<double>(maxDepth) > p.max_depth_m)
+		maxDepth = std::nextafter(maxDepth, 0.0f);
+	const double thr = p.diff_threshold_px + noiseGain;
+	const double thr2 = thr * thr;
 	cv::Mat edges;
 	if (p.depth_edge_rel > 0)
 		edges = depthEdgeMask(depth, p.depth_edge_rel, p.depth_edge_px);
+	// The squared flow difference in float is within 2^-22 (relative) of the
+	// double one: outside [lo, hi] the float comparison decides as the
+	// double one would; inside it, and for the visibility gate, the pixel is
+	// labelled in double (exactLabel).
+	const float hi = static_cast<float>(thr2 * (1 + 1e-5));
+	const float lo = static_cast<float>(thr2 * (1 - 1e-5));
 	cv::Mat labels(depth.size(), CV_8SC1);
 	LabelStats st;
 	for (int v = 0; v < depth.rows; v++)
 	{
 		const float* zr = depth.ptr<float>(v);
-		const auto* o = observed.ptr<cv::Vec2f>(v);
-		const auto* e = expected.ptr<cv::Vec2f>(v);
+		const float* o = observed.ptr<float>(v);
+		const float* e = expected.ptr<float>(v);
 		auto* l = labels.ptr<int8_t>(v);
-		const uint8_t* ed = edges.empty() ? nullptr : edges.ptr<uint8_t>(v);
 		const cv::Vec3f* S = visible ? tensor->ptr<cv::Vec3f>(v) : nullptr;
-		for (int u = 0; u < depth.cols; u++)
+		const float fv = static_cast<float>(v);
+		// The definition, one pixel (depth edges apart).
+		auto exactLabel = [&](int u) -> int8_t
 		{
 			const float z = zr[u];
-			int8_t lab = kNoLabel;
-			if (std::isfinite(z) && z > 0.0f && z <= p.max_depth_m &&
-			    !(ed && ed[u]) && std::isfinite(e[u][0]) &&
-			    std::isfinite(e[u][1]) && std::isfinite(o[u][0]) &&
-			    std::isfinite(o[u][1]))
-			{
-				const float eu = u + e[u][0], ev = v + e[u][1];
-				const float ou = u + o[u][0], ov = v + o[u][1];
-				if (eu >= 0 && ev >= 0 && eu <= W && ev <= H && ou >= 0 &&
-				    ov >= 0 && ou <= W && ov <= H)
-				{
-					// sigma of the expected flow from depth noise: f |t_xy| a
-					// z^2 / z^2
-					const double thr = p.diff_threshold_px + noiseGain;
-					const double du = o[u][0] - e[u][0], dv = o[u][1] - e[u][1];
-					lab = (du * du + dv * dv > thr * thr) ? kDiff : kNotDiff;
-					// d^T S d: squared RMS intensity change d would cause
-					if (lab == kDiff && S &&
-					    du * du * S[u][0] + 2 * du * dv * S[u][1] +
-					            dv * dv * S[u][2] <
-					        minChange2)
-						lab = kNotDiff;
-				}
-			}
-			l[u] = lab;
-			if (lab == kDiff)
-				st.diff++;
-			else if (lab == kNotDiff)
-				st.notDiff++;
-			else
-				st.none++;
+			const float fu = static_cast<float>(u);
+			const float e0 = e[2 * u], e1 = e[2 * u + 1];
+			const float o0 = o[2 * u], o1 = o[2 * u + 1];
+			const float eu = fu + e0, ev = fv + e1;
+			const float ou = fu + o0, ov = fv + o1;
+			// (the bounds also reject NaN and infinite flows)
+			if (!(z > 0.0f && z <= maxDepth && eu >= 0 && ev >= 0 && eu <= W &&
+			      ev <= H && ou >= 0 && ov >= 0 && ou <= W && ov <= H))
+				return kNoLabel;
+			const double du = o0 - e0, dv = o1 - e1;
+			if (!(du * du + dv * dv > thr2)) return kNotDiff;
+			// d^T S d: squared RMS intensity change d would cause
+			if (S &&
+			    du * du * S[u][0] + 2 * du * dv * S[u][1] + dv * dv * S[u][2] <
+			        minChange2)
+				return kNotDiff;
+			return kDiff;
+		};
+		int u = 0;
+#if CV_SIMD128
+		const cv::v_float32x4 zero = cv::v_setall_f32(0.0f),
+		                      vmax = cv::v_setall_f32(maxDepth),
+		                      vW = cv::v_setall_f32(W),
+		                      vH = cv::v_setall_f32(H),
+		                      vfv = cv::v_setall_f32(fv),
+		                      vhi = cv::v_setall_f32(hi),
+		                      vlo = cv::v_setall_f32(lo),
+		                      four = cv::v_setall_f32(4.0f);
+		cv::v_float32x4 vu(0.0f, 1.0f, 2.0f, 3.0f);
+		for (; u + 4 <= depth.cols; u += 4, vu += four)
+		{
+			const cv::v_float32x4 z = cv::v_load(zr + u);
+			cv::v_float32x4 e0, e1, o0, o1;
+			cv::v_load_deinterleave(e + 2 * u, e0, e1);
+			cv::v_load_deinterleave(o + 2 * u, o0, o1);
+			const cv::v_float32x4 eu = vu + e0, ev = vfv + e1;
+			const cv::v_float32x4 ou = vu + o0, ov = vfv + o1;
+			const cv::v_float32x4 ok = (z > zero) & (z <= vmax) & (eu >= zero) &
+			                           (ev >= zero) & (eu <= vW) & (ev <= vH) &
+			                           (ou >= zero) & (ov >= zero) &
+			                           (ou <= vW) & (ov <= vH);
+			const cv::v_float32x4 du = o0 - e0, dv = o1 - e1;
+			const cv::v_float32x4 d2 = du * du + dv * dv;
+			const int okBits = cv::v_signmask(ok);
+			const int hiBits = cv::v_signmask(d2 > vhi) & okBits;
+			const int midBits =
+			    cv::v_signmask((d2 >= vlo) & (d2 <= vhi)) & okBits;
+			const int exactBits = midBits | (S ? hiBits : 0);
+			// kDiff = 1, kNotDiff = 0, kNoLabel = -1: hi + ok - 1
+			for (int k = 0; k < 4; k++)
+				l[u + k] = static_cast<int8_t>(((hiBits >> k) & 1) +
+				                               ((okBits >> k) & 1) - 1);
+			if (exactBits)
+				for (int k = 0; k < 4; k++)
+					if (exactBits & (1 << k)) l[u + k] = exactLabel(u + k);
 		}
+#endif
+		for (; u < depth.cols; u++) l[u] = exactLabel(u);
+		if (!edges.empty())
+		{
+			const uint8_t* ed = edges.ptr<uint8_t>(v);
+			for (u = 0; u < depth.cols; u++)
+				if (ed[u]) l[u] = kNoLabel;
+		}
+		size_t nDiff = 0, nNot = 0;
+		for (u = 0; u < depth.cols; u++)
+		{
+			nDiff += l[u] == kDiff;
+			nNot += l[u] == kNotDiff;
+		}
+		st.diff += nDiff;
+		st.notDiff += nNot;
 	}
+	st.none = depth.total() - st.diff - st.notDiff;
 	if (stats) *stats = st;
 	return labels;
 }

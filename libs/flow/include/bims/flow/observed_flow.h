@@ -10,6 +10,12 @@
 
 namespace bims::flow
 {
+/** Scratch images of structureTensor(), kept between calls. */
+struct TensorBuffers
+{
+	cv::Mat gx, gy, products;
+};
+
 class ObservedFlow
 {
  public:
@@ -34,14 +40,27 @@ class ObservedFlow
 
 	/** Structure tensor of the last \a cur (structureTensor()), computed by
 	 * compute() when [flow] visible_change_grey > 0 or refine_pose is
-	 * enabled; empty otherwise. */
+	 * enabled; empty otherwise. Each compute() makes a new one: a copy of
+	 * the cv::Mat taken before keeps its data (as the returned flows). */
 	const cv::Mat& tensor() const { return tensor_; }
 
  private:
 	FlowParams p_;
 	cv::Mat tensor_;
+	/** The tensor before, whose memory the next one reuses when nobody
+	 * else holds it any more. */
+	cv::Mat spareTensor_;
+	TensorBuffers tensorBuf_;  ///< scratch, reused
+	cv::Mat warped_;           ///< scratch: prev derotated, reused
 	cv::Ptr<cv::DISOpticalFlow> dis_;
 };
+
+/** The flow of a derotated measurement composed back: for the residual flow
+ * r (CV_32FC2) measured against the image warped by \a H,
+ * flow(u) = H (u + r(u)) - u (dehomogenised; NaN where the third coordinate
+ * is not positive). \a flow may be \a residual (in place). */
+void composeWithHomography(const cv::Mat& residual, const cv::Matx33d& H,
+                           cv::Mat& flow);
 
 /** Local structure tensor of a grey image (CV_8UC1): per pixel the window
  * means of Ix^2, Ix Iy, Iy^2 (gradients in grey levels per pixel, Sobel),
@@ -50,6 +69,11 @@ class ObservedFlow
  * whether the observed flow can tell d at all (aperture, textureless
  * surfaces). */
 cv::Mat structureTensor(const cv::Mat& grey, int window);
+
+/** structureTensor() into \a out (its data reused when its size and type
+ * fit, as cv::Mat::create), with \a buf as scratch. */
+void structureTensor(const cv::Mat& grey, int window, cv::Mat& out,
+                     TensorBuffers& buf);
 
 /** Smaller eigenvalue of a structure tensor pixel (Sxx, Sxy, Syy). */
 inline float minEigen(const cv::Vec3f& s)
