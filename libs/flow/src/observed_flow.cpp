@@ -18,16 +18,21 @@ bool soleReference(const cv::Mat& m)
 }
 }  // namespace
 
+std::string disPresetFor(const std::string& preset, int width)
+{
+	if (preset != "auto") return preset;
+	return width >= kDisUltrafastMinWidth ? "ultrafast" : "fast";
+}
+
 ObservedFlow::ObservedFlow(const FlowParams& p) : p_(p)
 {
 	if (p_.method == "dis")
 	{
-		int preset = cv::DISOpticalFlow::PRESET_FAST;
-		if (p_.dis_preset == "ultrafast")
-			preset = cv::DISOpticalFlow::PRESET_ULTRAFAST;
-		if (p_.dis_preset == "medium")
-			preset = cv::DISOpticalFlow::PRESET_MEDIUM;
-		dis_ = cv::DISOpticalFlow::create(preset);
+		if (p_.dis_preset != "auto" && p_.dis_preset != "ultrafast" &&
+		    p_.dis_preset != "fast" && p_.dis_preset != "medium")
+			throw std::invalid_argument("observed flow: unknown DIS preset '" +
+			                            p_.dis_preset + "'");
+		// (created by the first compute(): "auto" depends on the width)
 	}
 	else if (p_.method != "farneback")
 		throw std::invalid_argument("observed flow: unknown method '" +
@@ -59,8 +64,19 @@ cv::Mat ObservedFlow::compute(const cv::Mat& prev, const cv::Mat& cur)
 		cv::resize(prev, b, s, 0, 0, cv::INTER_AREA);
 	}
 	cv::Mat flow;
-	if (dis_)
+	if (p_.method == "dis")
+	{
+		const std::string preset = disPresetFor(p_.dis_preset, a.cols);
+		if (!dis_ || preset != disPreset_)
+		{
+			dis_ = cv::DISOpticalFlow::create(
+			    preset == "ultrafast" ? cv::DISOpticalFlow::PRESET_ULTRAFAST
+			    : preset == "medium"  ? cv::DISOpticalFlow::PRESET_MEDIUM
+			                          : cv::DISOpticalFlow::PRESET_FAST);
+			disPreset_ = preset;
+		}
 		dis_->calc(a, b, flow);
+	}
 	else
 		cv::calcOpticalFlowFarneback(a, b, flow, 0.5, 4, 15, 3, 5, 1.1, 0);
 	if (p_.downscale > 1)

@@ -8,8 +8,8 @@ void FlowParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 {
 	ConfigSection s(cfg, section);
 	method = s.getEnum("method", method, {"dis", "farneback"});
-	dis_preset =
-	    s.getEnum("dis_preset", dis_preset, {"ultrafast", "fast", "medium"});
+	dis_preset = s.getEnum("dis_preset", dis_preset,
+	                       {"auto", "ultrafast", "fast", "medium"});
 	downscale = static_cast<int>(s.getInt("downscale", downscale, 1, 8));
 	derotate = s.getBool("derotate", derotate);
 	expected = s.getEnum("expected", expected, {"exact", "linear"});

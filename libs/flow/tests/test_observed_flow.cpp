@@ -130,3 +130,36 @@ TEST(ObservedFlow, DerotationRecoversAFastRotationThatPlainDisMisses)
 	EXPECT_LT(derotated, 0.3);
 	EXPECT_GT(plain, 3 * derotated) << "plain DIS " << plain << " px";
 }
+
+TEST(ObservedFlow, AutoPresetIsUltrafastOnVgaAndFastBelow)
+{
+	EXPECT_EQ(disPresetFor("auto", 640), "ultrafast");
+	EXPECT_EQ(disPresetFor("auto", 639), "fast");
+	EXPECT_EQ(disPresetFor("auto", 320), "fast");
+	EXPECT_EQ(disPresetFor("medium", 640), "medium");
+	EXPECT_EQ(disPresetFor("fast", 1280), "fast");
+	// and ObservedFlow runs that preset: the same flow, bit for bit, on the
+	// images it is given (after downscale)
+	auto flowWith = [](const std::string& preset, int w, int h, int ds)
+	{
+		FlowParams p;
+		p.dis_preset = preset;
+		p.downscale = ds;
+		ObservedFlow of(p);
+		const cv::Mat prev = test::texture(w, h, 3);
+		return of.compute(prev, test::shifted(prev, 1.4, 0.6));
+	};
+	auto same = [](const cv::Mat& a, const cv::Mat& b)
+	{ return a.size() == b.size() && cv::norm(a, b, cv::NORM_INF) == 0; };
+	EXPECT_TRUE(same(flowWith("auto", 640, 480, 1),
+	                 flowWith("ultrafast", 640, 480, 1)));
+	EXPECT_FALSE(
+	    same(flowWith("auto", 640, 480, 1), flowWith("fast", 640, 480, 1)));
+	EXPECT_TRUE(
+	    same(flowWith("auto", 320, 240, 1), flowWith("fast", 320, 240, 1)));
+	EXPECT_TRUE(
+	    same(flowWith("auto", 640, 480, 2), flowWith("fast", 640, 480, 2)));
+	FlowParams bad;
+	bad.dis_preset = "quick";
+	EXPECT_THROW(ObservedFlow{bad}, std::invalid_argument);
+}

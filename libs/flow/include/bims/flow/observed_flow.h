@@ -16,6 +16,15 @@ struct TensorBuffers
 	cv::Mat gx, gy, products;
 };
 
+/** [flow] dis_preset = auto: DIS "ultrafast" on images at least this wide,
+ * "fast" on smaller ones (measured in docs/results.md: at 640x480 ultrafast
+ * keeps the fused F1 within 0.003 of fast for 5 ms less CPU per frame; at
+ * 320x240 it loses up to 0.07 of flow-only F1 and 0.009 fused). */
+constexpr int kDisUltrafastMinWidth = 640;
+/** The DIS preset ObservedFlow uses for \a preset on images \a width wide
+ * (the images DIS sees: after [flow] downscale). */
+std::string disPresetFor(const std::string& preset, int width);
+
 class ObservedFlow
 {
  public:
@@ -53,6 +62,7 @@ class ObservedFlow
 	TensorBuffers tensorBuf_;  ///< scratch, reused
 	cv::Mat warped_;           ///< scratch: prev derotated, reused
 	cv::Ptr<cv::DISOpticalFlow> dis_;
+	std::string disPreset_;  ///< the preset dis_ was created with
 };
 
 /** The flow of a derotated measurement composed back: for the residual flow

@@ -12,7 +12,8 @@ struct FlowParams
 {
 	/** Dense observed flow: "dis" (OpenCV DIS) or "farneback". */
 	std::string method = "dis";
-	/** DIS preset: "ultrafast", "fast" or "medium". */
+	/** DIS preset: "ultrafast", "fast", "medium", or "auto" (ultrafast on
+	 * images >= 640 px wide, fast below: disPresetFor()). */
 	std::string dis_preset = "fast";
 	/** Observed flow is computed on images downscaled by this integer
 	 * factor (1 = full resolution) and upsampled (vectors scaled back). */
