@@ -150,30 +150,32 @@ class FrameCloudBuilder
  private:
 	struct Keyer;
 	/** Sorts the nRuns_ runs of runKey_/runStart_ into out.cells, out.hits and
-	 * out.cellOfPoint (out.points_W holds the kept readings). */
+	 * out.cellOfPoint (out.points_W holds the kept readings, out.cellOfPoint
+	 * the run of each). */
 	void finishCells(FrameCloud& out);
-	void bucketCells(FrameCloud& out, const int32_t lo[3], const size_t nb[3]);
-	void radixCells(FrameCloud& out, const int32_t lo[3], const int32_t hi[3]);
+	// Block bounds in the offset coordinates of packed keys (field >> 3).
+	void bucketCells(FrameCloud& out, const uint32_t lo[3], const size_t nb[3]);
+	void radixCells(FrameCloud& out, const uint32_t lo[3],
+	                const uint32_t hi[3]);
 
 	GridParams p_;
-	// Per-column terms of the unprojection.
-	struct Column
-	{
-		double a;     // 1 + xn^2
-		double r[3];  // xn * R_WC.col(0)
-	};
-	std::vector<Column> col_;
-	// Runs of consecutive kept readings in one voxel: key and first reading
-	// (nRuns_ of them; the vectors only grow, one slot more than readings).
-	std::vector<VoxelKey> runKey_;
+	// Per-column terms of the unprojection, one array each of width W:
+	// 1 + xn^2, then xn * R_WC.col(0) (x, y, z).
+	std::vector<double> colTab_;
+	// Runs of consecutive kept readings in one voxel: packed key (packKey)
+	// and first reading (nRuns_ of them; the vectors only grow, one slot
+	// more than readings), and each run's cell.
+	std::vector<uint64_t> runKey_;
 	std::vector<uint32_t> runStart_, runCell_;
 	size_t nRuns_ = 0;
-	// bucketCells() packs a run's length in 23 bits: frames with more
+	// bucketCells() packs a run's index in 23 bits: frames with more
 	// readings take radixCells().
 	static constexpr uint32_t kMaxBucketReadings = uint32_t(1) << 23;
-	// Sort scratch: (compact key << run bits) | run, or (key, run) pairs.
+	// Sort scratch: (compact key << run bits) | run, or (key, run) pairs;
+	// (run << 9) | cell per block.
 	std::vector<uint64_t> packed_, packedTmp_;
 	std::vector<std::pair<uint64_t, uint32_t>> pairs_;
+	std::vector<uint32_t> byBlock_;
 	std::vector<uint32_t> bucketStart_;
 };
 
