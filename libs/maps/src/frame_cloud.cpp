@@ -67,7 +67,8 @@ bool finitePose(const mrpt::poses::CPose3D& T)
 
 // Empties the frame; with keepBuffers, the per-reading vectors keep their
 // size (the caller overwrites and then shrinks them), so that growing them
-// again does not value-initialise what was already there.
+// again does not value-initialise what was already there (also cells
+// and hits: finishCells() writes and shrinks them).
 void resetFrame(FrameCloud& out, bool keepBuffers = false)
 {
 	if (!keepBuffers)
@@ -76,9 +77,9 @@ void resetFrame(FrameCloud& out, bool keepBuffers = false)
 		out.pixel.clear();
 		out.cellOfPoint.clear();
 		out.depth.clear();
+		out.cells.clear();
+		out.hits.clear();
 	}
-	out.cells.clear();
-	out.hits.clear();
 	out.stats = FrameStats();
 }
 
@@ -453,8 +454,6 @@ void FrameCloudBuilder::keyPoints(FrameCloud& out)
 {
 	Keyer keyer{1.0 / p_.voxel_size, p_.extent, p_.max_range * p_.max_range,
 	            out.origin_W, out.stats};
-	out.cells.clear();
-	out.hits.clear();
 	uint64_t prev = ~uint64_t(0);  // no packed key
 	const size_t n = out.points_W.size();
 	uint64_t* runKey = growTo(runKey_, n + 1);
@@ -560,30 +559,68 @@ inline uint32_t cellInBlock(uint64_t k)
 }
 }  // namespace
 
-// Orders the runs by 8^3 block (blocks in (x, y, z) lexicographic order) and
-// by cell inside a block (the cell index in the block, x fastest, as in the
-// storage): equal keys are the frame's distinct cells, already in block
-// order, so that the grids visit each storage block once per frame (one hash
-// lookup per block instead of per cell, and cache-friendly writes). No
-// hashing per reading. On entry out.cellOfPoint holds each reading's run;
-// on return its cell.
+// Merges the runs into entries, then orders the entries by 8^3 block (blocks
+// in (x, y, z) lexicographic order) and by cell inside a block (the cell
+// index in the block, x fastest, as in the storage): equal keys are the
+// frame's distinct cells, already in block order, so that the grids visit
+// each storage block once per frame (one hash lookup per block instead of
+// per cell, and cache-friendly writes). On entry out.cellOfPoint holds each
+// reading's run; on return its cell.
+//
+// The entries: a run whose key is in a small direct-mapped cache of recent
+// keys joins that key's entry, else it starts one (and takes the slot).
+// A voxel is hit by runs of several rows (8 on the VGA sim frame at 5 cm),
+// so there are far fewer entries than runs to sort; an entry is not always
+// a distinct voxel (a key evicted from the cache comes back as a new
+// entry): the sort merges equal keys anyway.
 void FrameCloudBuilder::finishCells(FrameCloud& out)
 {
 	const size_t w = out.points_W.size();
 	out.stats.valid = w;
 	out.cellOfPoint.resize(w);
-	out.cells.clear();
-	out.hits.clear();
-	if (w == 0) return;
+	if (w == 0)
+	{
+		out.cells.clear();
+		out.hits.clear();
+		return;
+	}
 	const size_t r = nRuns_;
-	runStart_[r] = uint32_t(w);  // the end of the last run
-	// Bounds of the blocks, in the offset coordinates of the packed keys.
-	uint32_t lo[3] = {UINT32_MAX, UINT32_MAX, UINT32_MAX};
-	uint32_t hi[3] = {0, 0, 0};
 	const uint64_t* runKey = runKey_.data();
+	const uint32_t* runStart = runStart_.data();
+	runStart_[r] = uint32_t(w);  // the end of the last run
+	constexpr unsigned kCacheBits = 12;
+	cacheKey_.assign(size_t(1) << kCacheBits, ~uint64_t(0));  // no key
+	uint32_t* cacheId = growTo(cacheId_, size_t(1) << kCacheBits);
+	uint64_t* cacheKey = cacheKey_.data();
+	uint64_t* eKey = growTo(entryKey_, r + 1);
+	uint32_t* eHits = growTo(entryHits_, r + 1);
+	uint32_t* runEntry = growTo(runEntry_, r);
+	uint32_t nE = 0;
 	for (size_t j = 0; j < r; ++j)
 	{
 		const uint64_t k = runKey[j];
+		const size_t h =
+		    size_t((k * 0x9E3779B97F4A7C15ull) >> (64 - kCacheBits));
+		// Without a branch (at 2 cm, a run starts an entry as often as not):
+		// the next entry's slot is written either way.
+		const bool hit = cacheKey[h] == k;
+		const uint32_t cached = cacheId[h];  // loaded either way: a cmov
+		const uint32_t e = hit ? cached : nE;
+		eKey[nE] = k;
+		eHits[nE] = 0;
+		eHits[e] += runStart[j + 1] - runStart[j];
+		cacheKey[h] = k;
+		cacheId[h] = e;
+		nE += !hit;
+		runEntry[j] = e;
+	}
+	nEntries_ = nE;
+	// Bounds of the blocks, in the offset coordinates of the packed keys.
+	uint32_t lo[3] = {UINT32_MAX, UINT32_MAX, UINT32_MAX};
+	uint32_t hi[3] = {0, 0, 0};
+	for (size_t j = 0; j < nE; ++j)
+	{
+		const uint64_t k = eKey[j];
 		const uint32_t b[3] = {fieldX(k) >> 3, fieldY(k) >> 3, fieldZ(k) >> 3};
 		for (int a = 0; a < 3; ++a)
 		{
@@ -591,35 +628,40 @@ void FrameCloudBuilder::finishCells(FrameCloud& out)
 			hi[a] = std::max(hi[a], b[a]);
 		}
 	}
-	out.cells.reserve(r);
-	out.hits.reserve(r);
-	runCell_.resize(r);
+	// At most one cell per entry: written in place, then shrunk.
+	growTo(out.cells, nE);
+	growTo(out.hits, nE);
+	entryCell_.resize(nE);
 	const size_t nb[3] = {size_t(hi[0] - lo[0]) + 1, size_t(hi[1] - lo[1]) + 1,
 	                      size_t(hi[2] - lo[2]) + 1};
 	const double nBlocks = double(nb[0]) * double(nb[1]) * double(nb[2]);
-	if (w < kMaxBucketReadings &&
-	    nBlocks <= double(std::min<size_t>(4 * r + 65536, size_t(1) << 24)))
-		bucketCells(out, lo, nb);
-	else
-		radixCells(out, lo, hi);
-	// Each reading's cell, from its run's.
+	const bool bucket =
+	    nE < kMaxBucketEntries &&
+	    nBlocks <=
+	        double(std::min<size_t>(4 * size_t(nE) + 65536, size_t(1) << 24));
+	const uint32_t nC =
+	    bucket ? bucketCells(out, lo, nb) : radixCells(out, lo, hi);
+	out.cells.resize(nC);
+	out.hits.resize(nC);
+	// Each reading's cell, from its run's entry.
 	uint32_t* cop = out.cellOfPoint.data();
-	const uint32_t* runCell = runCell_.data();
-	for (size_t i = 0; i < w; ++i) cop[i] = runCell[cop[i]];
+	const uint32_t* eCell = entryCell_.data();
+	for (size_t i = 0; i < w; ++i) cop[i] = eCell[runEntry[cop[i]]];
 }
 
 // finishCells() for frames whose bounding box has too many blocks for a
 // bucket per block: one radix sort of compact keys (block relative to the
 // frame's lowest block, then the cell index in the block, x fastest, as in
-// the storage) packed with the run index.
-void FrameCloudBuilder::radixCells(FrameCloud& out, const uint32_t lo[3],
-                                   const uint32_t hi[3])
+// the storage) packed with the entry index.
+uint32_t FrameCloudBuilder::radixCells(FrameCloud& out, const uint32_t lo[3],
+                                       const uint32_t hi[3])
 {
-	const size_t r = nRuns_;
+	const size_t n = nEntries_;
+	const uint64_t* eKey = entryKey_.data();
 	unsigned bits[3];
 	for (int a = 0; a < 3; ++a) bits[a] = bitWidth(uint64_t(hi[a] - lo[a]));
-	const unsigned idxBits = bitWidth(uint64_t(r - 1));
-	// Key fields above the run index: cell (9 bits), z, y, x blocks.
+	const unsigned idxBits = bitWidth(uint64_t(n - 1));
+	// Key fields above the entry index: cell (9 bits), z, y, x blocks.
 	const unsigned sz = 9, sy = sz + bits[2], sx = sy + bits[1];
 	const unsigned total = sx + bits[0];
 	auto compact = [&](uint64_t k)
@@ -629,51 +671,54 @@ void FrameCloudBuilder::radixCells(FrameCloud& out, const uint32_t lo[3],
 		       (uint64_t((fieldZ(k) >> 3) - lo[2]) << sz) |
 		       uint64_t(cellInBlock(k));
 	};
-	// Sorted (compact key, run) pairs: packed in one 64-bit value and radix
-	// sorted when both fit, else sorted as pairs.
+	// Sorted (compact key, entry) pairs: packed in one 64-bit value and
+	// radix sorted when both fit, else sorted as pairs.
 	auto& keys = packed_;
-	keys.resize(r);
+	keys.resize(n);
 	const bool packed = total + idxBits <= 64;
 	if (packed)
 	{
-		for (size_t j = 0; j < r; ++j)
-			keys[j] = (compact(runKey_[j]) << idxBits) | j;
+		for (size_t j = 0; j < n; ++j)
+			keys[j] = (compact(eKey[j]) << idxBits) | j;
 		radixSort(keys, packedTmp_, idxBits, total);
 	}
 	else
 	{
-		pairs_.resize(r);
-		for (size_t j = 0; j < r; ++j)
-			pairs_[j] = {compact(runKey_[j]), uint32_t(j)};
+		pairs_.resize(n);
+		for (size_t j = 0; j < n; ++j)
+			pairs_[j] = {compact(eKey[j]), uint32_t(j)};
 		std::sort(pairs_.begin(), pairs_.end());
 	}
 	const uint64_t idxMask = (uint64_t(1) << idxBits) - 1;
 	uint64_t last = ~uint64_t(0);
-	for (size_t j = 0; j < r; ++j)
+	uint32_t nC = 0;
+	for (size_t j = 0; j < n; ++j)
 	{
 		const uint64_t key = packed ? keys[j] >> idxBits : pairs_[j].first;
-		const uint32_t run =
+		const uint32_t e =
 		    packed ? uint32_t(keys[j] & idxMask) : pairs_[j].second;
 		if (key != last)
 		{
-			out.cells.push_back(unpackKey(runKey_[run]));
-			out.hits.push_back(0);
+			out.cells[nC] = unpackKey(eKey[e]);
+			out.hits[nC] = 0;
+			++nC;
 			last = key;
 		}
-		out.hits.back() += runStart_[run + 1] - runStart_[run];
-		runCell_[run] = uint32_t(out.cells.size() - 1);
+		out.hits[nC - 1] += entryHits_[e];
+		entryCell_[e] = nC - 1;
 	}
+	return nC;
 }
 
 // finishCells() with a bucket per block of the frame's bounding box: a
-// counting sort of the runs by block (blocks in (x, y, z) lexicographic
+// counting sort of the entries by block (blocks in (x, y, z) lexicographic
 // order), then, per block, the cells present in a 512-bit mask, numbered
-// in cell-index order (x fastest, as in the storage). A run is bucketed as
-// (run << 9) | cell in 32 bits (fewer than 2^23 runs).
-void FrameCloudBuilder::bucketCells(FrameCloud& out, const uint32_t lo[3],
-                                    const size_t nb[3])
+// in cell-index order (x fastest, as in the storage). An entry is bucketed
+// as (entry << 9) | cell in 32 bits (fewer than 2^23 entries).
+uint32_t FrameCloudBuilder::bucketCells(FrameCloud& out, const uint32_t lo[3],
+                                        const size_t nb[3])
 {
-	const size_t r = nRuns_;
+	const size_t nE = nEntries_;
 	const size_t n = nb[0] * nb[1] * nb[2];
 	const uint32_t nb1 = uint32_t(nb[1]), nb2 = uint32_t(nb[2]);
 	auto blockOf = [&](uint64_t k)
@@ -683,13 +728,13 @@ void FrameCloudBuilder::bucketCells(FrameCloud& out, const uint32_t lo[3],
 		           nb2 +
 		       ((fieldZ(k) >> 3) - lo[2]);
 	};
-	// Runs per block, then the first slot of each block; the scatter below
-	// advances start[b] to the end of block b.
+	// Entries per block, then the first slot of each block; the scatter
+	// below advances start[b] to the end of block b.
 	bucketStart_.assign(n, 0);
 	uint32_t* start = bucketStart_.data();
-	const uint64_t* runKey = runKey_.data();
-	const uint32_t* runStart = runStart_.data();
-	for (size_t j = 0; j < r; ++j) start[blockOf(runKey[j])]++;
+	const uint64_t* eKey = entryKey_.data();
+	const uint32_t* eHits = entryHits_.data();
+	for (size_t j = 0; j < nE; ++j) start[blockOf(eKey[j])]++;
 	uint32_t sum = 0;
 	for (size_t b = 0; b < n; ++b)
 	{
@@ -697,14 +742,17 @@ void FrameCloudBuilder::bucketCells(FrameCloud& out, const uint32_t lo[3],
 		start[b] = sum;
 		sum += t;
 	}
-	uint32_t* byBlock = growTo(byBlock_, r);
-	for (size_t j = 0; j < r; ++j)
+	uint32_t* byBlock = growTo(byBlock_, nE);
+	for (size_t j = 0; j < nE; ++j)
 	{
-		const uint64_t k = runKey[j];
+		const uint64_t k = eKey[j];
 		byBlock[start[blockOf(k)]++] = (uint32_t(j) << 9) | cellInBlock(k);
 	}
 	uint32_t cellId[512];
-	uint32_t* runCell = runCell_.data();
+	uint32_t* eCell = entryCell_.data();
+	VoxelKey* cells = out.cells.data();
+	uint32_t* hits = out.hits.data();
+	uint32_t nC = 0;
 	uint32_t b0 = 0;
 	size_t b = 0;
 	for (size_t bx = 0; bx < nb[0]; ++bx)
@@ -728,23 +776,23 @@ void FrameCloudBuilder::bucketCells(FrameCloud& out, const uint32_t lo[3],
 					{
 						const uint32_t c =
 						    wd * 64 + uint32_t(__builtin_ctzll(m));
-						cellId[c] = uint32_t(out.cells.size());
-						out.cells.push_back({ox + int32_t(c & 7),
-						                     oy + int32_t((c >> 3) & 7),
-						                     oz + int32_t(c >> 6)});
-						out.hits.push_back(0);
+						cellId[c] = nC;
+						cells[nC].x = ox + int32_t(c & 7);
+						cells[nC].y = oy + int32_t((c >> 3) & 7);
+						cells[nC].z = oz + int32_t(c >> 6);
+						hits[nC] = 0;
+						++nC;
 					}
-				uint32_t* hits = out.hits.data();
 				for (uint32_t j = b0; j < b1; ++j)
 				{
-					const uint32_t e = byBlock[j];
-					const uint32_t run = e >> 9;
-					const uint32_t id = cellId[e & 511];
-					hits[id] += runStart[run + 1] - runStart[run];
-					runCell[run] = id;
+					const uint32_t e = byBlock[j] >> 9;
+					const uint32_t id = cellId[byBlock[j] & 511];
+					hits[id] += eHits[e];
+					eCell[e] = id;
 				}
 				b0 = b1;
 			}
+	return nC;
 }
 
 }  // namespace bims::maps
