@@ -557,6 +557,36 @@ inline uint32_t cellInBlock(uint64_t k)
 {
 	return (fieldX(k) & 7) | ((fieldY(k) & 7) << 3) | ((fieldZ(k) & 7) << 6);
 }
+constexpr unsigned kCacheBits = 11;
+
+// The entries of finishCells(): each run joins the entry of its key if
+// the key is in the cache (direct-mapped, 2^kCacheBits slots), else starts
+// one and takes the slot. Without a branch (at 2 cm, a run starts an entry
+// as often as not): the next entry's slot is written either way. Returns
+// the number of entries.
+uint32_t mergeRuns(const uint64_t* __restrict runKey,
+                   const uint32_t* __restrict runStart, size_t r,
+                   uint64_t* __restrict cache, uint64_t* __restrict eKey,
+                   uint32_t* __restrict eHits, uint32_t* __restrict runEntry)
+{
+	uint32_t nE = 0;
+	for (size_t j = 0; j < r; ++j)
+	{
+		const uint64_t k = runKey[j];
+		uint64_t* c = cache + 2 * size_t((k * 0x9E3779B97F4A7C15ull) >>
+		                                 (64 - kCacheBits));
+		const bool hit = c[0] == k;
+		const uint32_t e = hit ? uint32_t(c[1]) : nE;
+		eKey[nE] = k;
+		eHits[nE] = 0;
+		eHits[e] += runStart[j + 1] - runStart[j];
+		c[0] = k;
+		c[1] = e;
+		nE += !hit;
+		runEntry[j] = e;
+	}
+	return nE;
+}
 }  // namespace
 
 // Merges the runs into entries, then orders the entries by 8^3 block (blocks
@@ -588,32 +618,13 @@ void FrameCloudBuilder::finishCells(FrameCloud& out)
 	const uint64_t* runKey = runKey_.data();
 	const uint32_t* runStart = runStart_.data();
 	runStart_[r] = uint32_t(w);  // the end of the last run
-	constexpr unsigned kCacheBits = 12;
-	cacheKey_.assign(size_t(1) << kCacheBits, ~uint64_t(0));  // no key
-	uint32_t* cacheId = growTo(cacheId_, size_t(1) << kCacheBits);
-	uint64_t* cacheKey = cacheKey_.data();
+	// Slots of (key, entry), no key in any.
+	cache_.assign(size_t(2) << kCacheBits, ~uint64_t(0));
 	uint64_t* eKey = growTo(entryKey_, r + 1);
 	uint32_t* eHits = growTo(entryHits_, r + 1);
 	uint32_t* runEntry = growTo(runEntry_, r);
-	uint32_t nE = 0;
-	for (size_t j = 0; j < r; ++j)
-	{
-		const uint64_t k = runKey[j];
-		const size_t h =
-		    size_t((k * 0x9E3779B97F4A7C15ull) >> (64 - kCacheBits));
-		// Without a branch (at 2 cm, a run starts an entry as often as not):
-		// the next entry's slot is written either way.
-		const bool hit = cacheKey[h] == k;
-		const uint32_t cached = cacheId[h];  // loaded either way: a cmov
-		const uint32_t e = hit ? cached : nE;
-		eKey[nE] = k;
-		eHits[nE] = 0;
-		eHits[e] += runStart[j + 1] - runStart[j];
-		cacheKey[h] = k;
-		cacheId[h] = e;
-		nE += !hit;
-		runEntry[j] = e;
-	}
+	const uint32_t nE =
+	    mergeRuns(runKey, runStart, r, cache_.data(), eKey, eHits, runEntry);
 	nEntries_ = nE;
 	// Bounds of the blocks, in the offset coordinates of the packed keys.
 	uint32_t lo[3] = {UINT32_MAX, UINT32_MAX, UINT32_MAX};

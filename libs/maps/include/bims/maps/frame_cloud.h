@@ -173,8 +173,9 @@ class FrameCloudBuilder
 	size_t nRuns_ = 0;
 	// Entries (runs of one voxel merged through a cache of recent keys,
 	// see finishCells()): key, readings, cell; and the cache.
-	std::vector<uint64_t> entryKey_, cacheKey_;
-	std::vector<uint32_t> entryHits_, entryCell_, cacheId_;
+	std::vector<uint64_t> entryKey_;
+	std::vector<uint32_t> entryHits_, entryCell_;
+	std::vector<uint64_t> cache_;
 	size_t nEntries_ = 0;
 	// bucketCells() packs an entry's index in 23 bits: frames with more
 	// entries take radixCells().
