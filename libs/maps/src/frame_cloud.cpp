@@ -3,7 +3,10 @@
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
+#if defined(__SSE2__) && defined(__x86_64__)
 #include <emmintrin.h>
+#define BIMS_FRAME_CLOUD_SSE2 1
+#endif
 
 #include <algorithm>
 #include <cmath>
@@ -126,6 +129,7 @@ inline void addFast(Readings& o, uint64_t key, uint32_t pixel, bool keep)
 	o.noDepth += !keep;
 }
 
+#ifdef BIMS_FRAME_CLOUD_SSE2
 // floor(v) of two doubles with |v| < 2^31 (SSE2: truncate, then one less
 // where the truncation is above v), in the two low int32 lanes.
 inline __m128i floorSmall2(__m128d v)
@@ -214,6 +218,17 @@ void fastRow(const uint16_t* raw, int W, uint32_t rawFast, uint32_t rowPix,
 	o = s;
 	if (u < W) other(u);
 }
+#else
+// Without SSE2 (not x86-64): every pixel through the scalar code.
+template <class Other>
+void fastRow(const uint16_t*, int W, uint32_t, uint32_t, const double*,
+             const double*, const double*, const double*,
+             const mrpt::math::TPoint3D&, double, double, float*, Readings&,
+             Other&& other)
+{
+	for (int u = 0; u < W; ++u) other(u);
+}
+#endif
 }  // namespace
 
 // The checks of one reading in {W} and its voxel key: the reading is kept
