@@ -285,3 +285,76 @@ TEST(FrameCloud, CellsOfSparseFramesSpanningManyBlocks)
 		expectCellsOfReadings(f, p.voxel_size);
 	}
 }
+
+// VGA frames (the SSE2 pairs of the fast path, an odd width for the last
+// pixel of a row, and many more runs than the cache of recent keys has
+// slots, so that keys are evicted and come back as new entries), built one
+// after the other with the same builder and cloud (their buffers grow and
+// shrink between frames of more and fewer readings): each equals the plain
+// per-pixel definition and a build with a fresh builder and cloud.
+TEST(FrameCloud, VgaFramesWithReusedBuffersEqualThePlainDefinition)
+{
+	std::mt19937 rng(23);
+	std::uniform_real_distribution<double> U(-1, 1);
+	GridParams p;
+	p.max_range = 6;
+	FrameCloudBuilder b(p);
+	FrameCloud f;
+	for (int trial = 0; trial < 6; ++trial)
+	{
+		p.voxel_size = trial % 2 == 0 ? 0.02 : 0.05;
+		b.setParams(p);
+		const int W = trial == 3 ? 639 : 640, H = 480;
+		const bool isDepth = trial != 4;
+		auto scan = randomScan(rng, W, H, 1.0f / 5000, isDepth, 65535);
+		// Noisy depth (short runs), holes, saturated and far readings; the
+		// share of holes changes from frame to frame.
+		std::normal_distribution<double> noise(0, 0.01);
+		const double holes = 0.02 + 0.1 * (trial % 3);
+		std::uniform_real_distribution<double> P(0, 1);
+		for (int v = 0; v < H; ++v)
+			for (int u = 0; u < W; ++u)
+			{
+				const double q = P(rng);
+				const double z =
+				    1 + 3 * (0.5 + 0.5 * std::sin(u * 0.01 + v * 0.02)) +
+				    noise(rng);
+				scan->rangeImage(v, u) =
+				    q < holes
+				        ? 0
+				        : (q < holes + 0.01
+				               ? 65535
+				               : uint16_t(std::clamp(z * 5000, 1.0, 65534.0)));
+			}
+		const mrpt::poses::CPose3D T_WS(3 * U(rng), 3 * U(rng), 3 * U(rng),
+		                                3 * U(rng), 1.5 * U(rng), 3 * U(rng));
+		b.build(*scan, T_WS, f);
+		const Plain ref = plainBuild(*scan, T_WS, p);
+		ASSERT_EQ(f.stats.noDepth, ref.st.noDepth) << trial;
+		ASSERT_EQ(f.stats.nonFinite, ref.st.nonFinite) << trial;
+		ASSERT_EQ(f.stats.beyondRange, ref.st.beyondRange) << trial;
+		ASSERT_EQ(f.stats.outsideExtent, ref.st.outsideExtent) << trial;
+		ASSERT_EQ(f.stats.valid, ref.st.valid) << trial;
+		ASSERT_GT(ref.st.beyondRange, 1000u) << trial;
+		ASSERT_EQ(f.numPoints(), ref.pts.size()) << trial;
+		ASSERT_TRUE(
+		    std::equal(f.pixel.begin(), f.pixel.end(), ref.pixel.begin()))
+		    << trial;
+		for (size_t i = 0; i < ref.pts.size(); ++i)
+			ASSERT_TRUE(sameBits(f.points_W[i].x, ref.pts[i].x) &&
+			            sameBits(f.points_W[i].y, ref.pts[i].y) &&
+			            sameBits(f.points_W[i].z, ref.pts[i].z))
+			    << trial << " reading " << i;
+		ASSERT_EQ(f.depth.size(), ref.depth.size());
+		for (size_t i = 0; i < ref.depth.size(); ++i)
+			ASSERT_TRUE(sameBits(f.depth[i], ref.depth[i]))
+			    << trial << " pixel " << i;
+		expectCellsOfReadings(f, p.voxel_size);
+		FrameCloudBuilder fresh(p);
+		FrameCloud g;
+		fresh.build(*scan, T_WS, g);
+		ASSERT_EQ(g.cells, f.cells) << trial;
+		ASSERT_EQ(g.hits, f.hits) << trial;
+		ASSERT_EQ(g.cellOfPoint, f.cellOfPoint) << trial;
+	}
+}

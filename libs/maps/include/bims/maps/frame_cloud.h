@@ -150,30 +150,41 @@ class FrameCloudBuilder
  private:
 	struct Keyer;
 	/** Sorts the nRuns_ runs of runKey_/runStart_ into out.cells, out.hits and
-	 * out.cellOfPoint (out.points_W holds the kept readings). */
+	 * out.cellOfPoint (out.points_W holds the kept readings, out.cellOfPoint
+	 * the run of each), through the entries below. */
 	void finishCells(FrameCloud& out);
-	void bucketCells(FrameCloud& out, const int32_t lo[3], const size_t nb[3]);
-	void radixCells(FrameCloud& out, const int32_t lo[3], const int32_t hi[3]);
+	// Sort the nEntries_ entries into cells (entryCell_; out.cells and
+	// out.hits have a slot per entry), returning the number of cells; block
+	// bounds in the offset coordinates of packed keys (field >> 3).
+	uint32_t bucketCells(FrameCloud& out, const uint32_t lo[3],
+	                     const size_t nb[3]);
+	uint32_t radixCells(FrameCloud& out, const uint32_t lo[3],
+	                    const uint32_t hi[3]);
 
 	GridParams p_;
-	// Per-column terms of the unprojection.
-	struct Column
-	{
-		double a;     // 1 + xn^2
-		double r[3];  // xn * R_WC.col(0)
-	};
-	std::vector<Column> col_;
-	// Runs of consecutive kept readings in one voxel: key and first reading
-	// (nRuns_ of them; the vectors only grow, one slot more than readings).
-	std::vector<VoxelKey> runKey_;
-	std::vector<uint32_t> runStart_, runCell_;
+	// Per-column terms of the unprojection, one array each of width W:
+	// 1 + xn^2, then xn * R_WC.col(0) (x, y, z).
+	std::vector<double> colTab_;
+	// Runs of consecutive kept readings in one voxel: packed key (packKey)
+	// and first reading (nRuns_ of them; the vectors only grow, one slot
+	// more than readings), and each run's entry.
+	std::vector<uint64_t> runKey_;
+	std::vector<uint32_t> runStart_, runEntry_;
 	size_t nRuns_ = 0;
-	// bucketCells() packs a run's length in 23 bits: frames with more
-	// readings take radixCells().
-	static constexpr uint32_t kMaxBucketReadings = uint32_t(1) << 23;
-	// Sort scratch: (compact key << run bits) | run, or (key, run) pairs.
+	// Entries (runs of one voxel merged through a cache of recent keys,
+	// see finishCells()): key, readings, cell; and the cache.
+	std::vector<uint64_t> entryKey_;
+	std::vector<uint32_t> entryHits_, entryCell_;
+	std::vector<uint64_t> cache_;
+	size_t nEntries_ = 0;
+	// bucketCells() packs an entry's index in 23 bits: frames with more
+	// entries take radixCells().
+	static constexpr uint32_t kMaxBucketEntries = uint32_t(1) << 23;
+	// Sort scratch: (compact key << entry bits) | entry, or (key, entry)
+	// pairs; (entry << 9) | cell per block.
 	std::vector<uint64_t> packed_, packedTmp_;
 	std::vector<std::pair<uint64_t, uint32_t>> pairs_;
+	std::vector<uint32_t> byBlock_;
 	std::vector<uint32_t> bucketStart_;
 };
 
