@@ -4,6 +4,7 @@
 
 #include <limits>
 #include <stdexcept>
+#include <type_traits>
 
 namespace bims::flow
 {
@@ -197,32 +198,26 @@ void structureTensor(const cv::Mat& grey, int window, cv::Mat& out,
 	cv::spatialGradient(grey, buf.gx, buf.gy, 3, cv::BORDER_DEFAULT);
 	const bool exact = window <= kMaxExactWindow;
 	buf.products.create(grey.size(), exact ? CV_32SC3 : CV_32FC3);
+	// gx², gx gy, gy² per pixel, in int32 (exact sums) or float
+	auto products = [&](auto* p, const int16_t* gx, const int16_t* gy)
+	{
+		using T = std::remove_pointer_t<decltype(p)>;
+		for (int u = 0; u < grey.cols; u++)
+		{
+			const T x = gx[u], y = gy[u];
+			p[3 * u] = x * x;
+			p[3 * u + 1] = x * y;
+			p[3 * u + 2] = y * y;
+		}
+	};
 	for (int v = 0; v < grey.rows; v++)
 	{
 		const int16_t* gx = buf.gx.ptr<int16_t>(v);
 		const int16_t* gy = buf.gy.ptr<int16_t>(v);
 		if (exact)
-		{
-			int32_t* p = buf.products.ptr<int32_t>(v);
-			for (int u = 0; u < grey.cols; u++)
-			{
-				const int32_t x = gx[u], y = gy[u];
-				p[3 * u] = x * x;
-				p[3 * u + 1] = x * y;
-				p[3 * u + 2] = y * y;
-			}
-		}
+			products(buf.products.ptr<int32_t>(v), gx, gy);
 		else
-		{
-			float* p = buf.products.ptr<float>(v);
-			for (int u = 0; u < grey.cols; u++)
-			{
-				const float x = gx[u], y = gy[u];
-				p[3 * u] = x * x;
-				p[3 * u + 1] = x * y;
-				p[3 * u + 2] = y * y;
-			}
-		}
+			products(buf.products.ptr<float>(v), gx, gy);
 	}
 	// One box filter over the three products: exact integer sums, then the
 	// window mean in float. The Sobel's 8x: 1/64, a power of two (exact).

@@ -134,6 +134,32 @@ void expectCellsOfReadings(const FrameCloud& f, double voxel)
 	}
 }
 
+// \a f equals the definition \a ref: the stats, every reading's pixel,
+// point and depth bit for bit, and its cells (expectCellsOfReadings).
+void expectSameAsPlain(const FrameCloud& f, const Plain& ref, double voxel,
+                       int trial)
+{
+	ASSERT_EQ(f.stats.noDepth, ref.st.noDepth) << trial;
+	ASSERT_EQ(f.stats.nonFinite, ref.st.nonFinite) << trial;
+	ASSERT_EQ(f.stats.beyondRange, ref.st.beyondRange) << trial;
+	ASSERT_EQ(f.stats.outsideExtent, ref.st.outsideExtent) << trial;
+	ASSERT_EQ(f.stats.valid, ref.st.valid) << trial;
+	ASSERT_EQ(f.numPoints(), ref.pts.size()) << trial;
+	ASSERT_EQ(f.pixel.size(), ref.pixel.size()) << trial;
+	ASSERT_TRUE(std::equal(f.pixel.begin(), f.pixel.end(), ref.pixel.begin()))
+	    << trial;
+	for (size_t i = 0; i < ref.pts.size(); ++i)
+		ASSERT_TRUE(sameBits(f.points_W[i].x, ref.pts[i].x) &&
+		            sameBits(f.points_W[i].y, ref.pts[i].y) &&
+		            sameBits(f.points_W[i].z, ref.pts[i].z))
+		    << trial << " reading " << i;
+	ASSERT_EQ(f.depth.size(), ref.depth.size());
+	for (size_t i = 0; i < ref.depth.size(); ++i)
+		ASSERT_TRUE(sameBits(f.depth[i], ref.depth[i]))
+		    << trial << " pixel " << i;
+	expectCellsOfReadings(f, voxel);
+}
+
 mrpt::obs::CObservation3DRangeScan::Ptr randomScan(std::mt19937& rng, int W,
                                                    int H, float units,
                                                    bool isDepth,
@@ -227,23 +253,7 @@ TEST(FrameCloud, BuildFromAScanEqualsThePlainUnprojectionBitForBit)
 		// Twice with the same builder and cloud (scratch reuse).
 		if (trial % 4 == 0) b.build(*scan, T_WS, f);
 		const Plain ref = plainBuild(*scan, T_WS, p);
-		ASSERT_EQ(f.stats.noDepth, ref.st.noDepth) << trial;
-		ASSERT_EQ(f.stats.nonFinite, ref.st.nonFinite) << trial;
-		ASSERT_EQ(f.stats.beyondRange, ref.st.beyondRange) << trial;
-		ASSERT_EQ(f.stats.outsideExtent, ref.st.outsideExtent) << trial;
-		ASSERT_EQ(f.stats.valid, ref.st.valid) << trial;
-		ASSERT_EQ(f.numPoints(), ref.pts.size()) << trial;
-		ASSERT_EQ(f.pixel, ref.pixel) << trial;
-		for (size_t i = 0; i < ref.pts.size(); ++i)
-			ASSERT_TRUE(sameBits(f.points_W[i].x, ref.pts[i].x) &&
-			            sameBits(f.points_W[i].y, ref.pts[i].y) &&
-			            sameBits(f.points_W[i].z, ref.pts[i].z))
-			    << trial << " reading " << i;
-		ASSERT_EQ(f.depth.size(), ref.depth.size());
-		for (size_t i = 0; i < ref.depth.size(); ++i)
-			ASSERT_TRUE(sameBits(f.depth[i], ref.depth[i]))
-			    << trial << " pixel " << i;
-		expectCellsOfReadings(f, p.voxel_size);
+		ASSERT_NO_FATAL_FAILURE(expectSameAsPlain(f, ref, p.voxel_size, trial));
 		checked[0] += ref.st.valid;
 		checked[1] += ref.st.beyondRange;
 		checked[2] += ref.st.outsideExtent;
@@ -330,26 +340,8 @@ TEST(FrameCloud, VgaFramesWithReusedBuffersEqualThePlainDefinition)
 		                                3 * U(rng), 1.5 * U(rng), 3 * U(rng));
 		b.build(*scan, T_WS, f);
 		const Plain ref = plainBuild(*scan, T_WS, p);
-		ASSERT_EQ(f.stats.noDepth, ref.st.noDepth) << trial;
-		ASSERT_EQ(f.stats.nonFinite, ref.st.nonFinite) << trial;
-		ASSERT_EQ(f.stats.beyondRange, ref.st.beyondRange) << trial;
-		ASSERT_EQ(f.stats.outsideExtent, ref.st.outsideExtent) << trial;
-		ASSERT_EQ(f.stats.valid, ref.st.valid) << trial;
 		ASSERT_GT(ref.st.beyondRange, 1000u) << trial;
-		ASSERT_EQ(f.numPoints(), ref.pts.size()) << trial;
-		ASSERT_TRUE(
-		    std::equal(f.pixel.begin(), f.pixel.end(), ref.pixel.begin()))
-		    << trial;
-		for (size_t i = 0; i < ref.pts.size(); ++i)
-			ASSERT_TRUE(sameBits(f.points_W[i].x, ref.pts[i].x) &&
-			            sameBits(f.points_W[i].y, ref.pts[i].y) &&
-			            sameBits(f.points_W[i].z, ref.pts[i].z))
-			    << trial << " reading " << i;
-		ASSERT_EQ(f.depth.size(), ref.depth.size());
-		for (size_t i = 0; i < ref.depth.size(); ++i)
-			ASSERT_TRUE(sameBits(f.depth[i], ref.depth[i]))
-			    << trial << " pixel " << i;
-		expectCellsOfReadings(f, p.voxel_size);
+		ASSERT_NO_FATAL_FAILURE(expectSameAsPlain(f, ref, p.voxel_size, trial));
 		FrameCloudBuilder fresh(p);
 		FrameCloud g;
 		fresh.build(*scan, T_WS, g);
