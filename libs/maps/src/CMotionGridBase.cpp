@@ -75,23 +75,62 @@ void CMotionGridBase::store(const FrameCloud& f, std::vector<float>&& post,
 	lastPost_.swap(post);
 }
 
+void CMotionGridBase::storePair(
+    CMotionGridBase& a, std::vector<float>&& postA, CMotionGridBase& b,
+    std::vector<float>&& postB, const FrameCloud& f,
+    const std::shared_ptr<std::vector<VoxelKey>>& cells)
+{
+	if (&a == &b)
+		throw std::invalid_argument(
+		    "CMotionGridBase::storePair: two different maps expected");
+	if (!cells || cells->size() != f.cells.size())
+		throw std::invalid_argument(
+		    "CMotionGridBase::store: the shared cells are not the frame's");
+	CMotionGridBase* const maps[2] = {&a, &b};
+	const std::vector<float>* const posts[2] = {&postA, &postB};
+	storeCellsOf<2>(maps, posts, f);
+	a.lastCells_ = cells;
+	b.lastCells_ = cells;
+	a.lastPost_.swap(postA);
+	b.lastPost_.swap(postB);
+}
+
 void CMotionGridBase::storeCells(const FrameCloud& f,
                                  const std::vector<float>& post)
 {
-	if (post.size() != f.cells.size())
-		throw std::invalid_argument(
-		    "CMotionGridBase::store: one posterior per frame cell expected");
-	const uint32_t F = frameCount_ + 1;
-	FrameStats st;
+	CMotionGridBase* const maps[1] = {this};
+	const std::vector<float>* const posts[1] = {&post};
+	storeCellsOf<1>(maps, posts, f);
+}
+
+template <size_t N>
+void CMotionGridBase::storeCellsOf(CMotionGridBase* const (&maps)[N],
+                                   const std::vector<float>* const (&posts)[N],
+                                   const FrameCloud& f)
+{
+	for (size_t g = 0; g < N; ++g)
+		if (posts[g]->size() != f.cells.size())
+			throw std::invalid_argument(
+			    "CMotionGridBase::store: one posterior per frame cell "
+			    "expected");
+	uint32_t F[N];
+	FrameStats st[N];
+	const float* post[N];
+	for (size_t g = 0; g < N; ++g)
+	{
+		F[g] = maps[g]->frameCount_ + 1;
+		post[g] = posts[g]->data();
+	}
 	const size_t m = f.cells.size();
+	const uint32_t* hits = f.hits.data();
 	// The cells' storage is found kPrefetchAhead cells ahead of the writes
-	// (one index lookup per block; blocks created in the order of the
-	// cells) and prefetched.
+	// (one index lookup per block and map; blocks created in the order of
+	// the cells) and prefetched.
 	constexpr size_t kRing = 2 * kPrefetchAhead;
 	static_assert((kRing & (kRing - 1)) == 0, "ring size: a power of two");
-	Cell* ring[kRing];
+	Cell* ring[kRing][N];
 	uint64_t lastKey = FlatHashMap::kEmpty;
-	Storage::Block* last = nullptr;
+	Storage::Block* last[N] = {};
 	for (size_t i = 0; i < m + kPrefetchAhead; ++i)
 	{
 		if (i < m)
@@ -100,45 +139,67 @@ void CMotionGridBase::storeCells(const FrameCloud& f,
 			const uint64_t bk = Storage::blockKeyOf(k.x, k.y, k.z);
 			if (bk != lastKey)
 			{
-				const uint32_t b = grid_.findOrCreateBlock(bk);
-				last = b == FlatHashMap::kNotFound ? nullptr : &grid_.block(b);
+				for (size_t g = 0; g < N; ++g)
+				{
+					auto& grid = maps[g]->grid_;
+					const uint32_t b = grid.findOrCreateBlock(bk);
+					last[g] =
+					    b == FlatHashMap::kNotFound ? nullptr : &grid.block(b);
+				}
 				lastKey = bk;
 			}
-			Cell* c = last ? &last->cells[Storage::cellIndexOf(k.x, k.y, k.z)]
-			               : nullptr;
+			const size_t ci = Storage::cellIndexOf(k.x, k.y, k.z);
+			for (size_t g = 0; g < N; ++g)
+			{
+				Cell* c = last[g] ? &last[g]->cells[ci] : nullptr;
 #if defined(__GNUC__)
-			if (c) __builtin_prefetch(c, 1);
+				if (c) __builtin_prefetch(c, 1);
 #endif
-			ring[i % kRing] = c;
+				ring[i % kRing][g] = c;
+			}
 		}
 		if (i < kPrefetchAhead) continue;
 		const size_t j = i - kPrefetchAhead;
-		Cell* c = ring[j % kRing];
-		if (!c)
+		for (size_t g = 0; g < N; ++g)
 		{
-			st.overBudget += f.hits[j];
-			continue;
+			Cell* c = ring[j % kRing][g];
+			if (!c)
+			{
+				st[g].overBudget += hits[j];
+				continue;
+			}
+			c->l = post[g][j];
+			c->stamp = F[g];
 		}
-		c->l = post[j];
-		c->stamp = F;
 	}
 	if (f.K.width > 0 && f.K.height > 0)
 	{
 		// Every reading has its own pixel: written without a branch on the
 		// (unpredictable) decision.
-		lastMask_.reset(f.K.width, f.K.height);
-		uint8_t* mask = lastMask_.data.data();
-		const float* pp = post.data();
+		uint8_t* mask[N];
+		for (size_t g = 0; g < N; ++g)
+		{
+			maps[g]->lastMask_.reset(f.K.width, f.K.height);
+			mask[g] = maps[g]->lastMask_.data.data();
+		}
 		const uint32_t* cop = f.cellOfPoint.data();
 		const uint32_t* pix = f.pixel.data();
-		for (size_t j = 0; j < f.pixel.size(); ++j)
-			mask[pix[j]] = uint8_t(-uint8_t(pp[cop[j]] > 0));
+		const size_t n = f.pixel.size();
+		for (size_t j = 0; j < n; ++j)
+		{
+			const uint32_t c = cop[j], p = pix[j];
+			for (size_t g = 0; g < N; ++g)
+				mask[g][p] = uint8_t(-uint8_t(post[g][c] > 0));
+		}
 	}
 	else
-		lastMask_.reset(0, 0);
-	frameCount_ = F;
-	lastTimestamp_ = f.timestamp;
-	if (st.overBudget) accountFrame(st);
+		for (size_t g = 0; g < N; ++g) maps[g]->lastMask_.reset(0, 0);
+	for (size_t g = 0; g < N; ++g)
+	{
+		maps[g]->frameCount_ = F[g];
+		maps[g]->lastTimestamp_ = f.timestamp;
+		if (st[g].overBudget) maps[g]->accountFrame(st[g]);
+	}
 }
 
 std::optional<double> CMotionGridBase::probabilityAt(

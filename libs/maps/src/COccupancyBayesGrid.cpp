@@ -138,8 +138,9 @@ void COccupancyBayesGrid::integrate(const FrameCloud& f,
 		    "COccupancyBayesGrid::integrate: one hold flag per cell expected");
 	checkFrame(f, "integrate");
 	pending_ = nullptr;
-	grid_.resolve(f.cells, cellPtr_);
-	applyFrame(f, priorOut, hold);
+	// The cells are found while the update runs (no array of pointers).
+	cellPtr_.clear();
+	applyFrame(f, priorOut, hold, false);
 }
 
 uint32_t COccupancyBayesGrid::priorFrameOf(const FrameCloud& f) const
@@ -182,18 +183,18 @@ void COccupancyBayesGrid::integratePending(const FrameCloud& f,
 		    "COccupancyBayesGrid::integratePending: one hold flag per cell "
 		    "expected");
 	pending_ = nullptr;
-	applyFrame(f, nullptr, hold);
+	applyFrame(f, nullptr, hold, true);
 }
 
 void COccupancyBayesGrid::applyFrame(const FrameCloud& f,
                                      std::vector<float>* priorOut,
-                                     const std::vector<uint8_t>* hold)
+                                     const std::vector<uint8_t>* hold,
+                                     bool resolved)
 {
 	const uint32_t F = frameCount_ + 1;
 	if (priorOut) priorOut->resize(f.cells.size());
 	FrameStats st;
 	const size_t m = f.cells.size();
-	Cell* const* cells = cellPtr_.data();
 	// priorFixed() and hitFixed() with the constants in locals: the cell
 	// writes (int32 fields) could alias the members for the compiler.
 	const bool lazy = params_.decay == DecayMode::All;
@@ -205,18 +206,14 @@ void COccupancyBayesGrid::applyFrame(const FrameCloud& f,
 	const uint32_t* hits = f.hits.data();
 	const uint8_t* held = hold ? hold->data() : nullptr;
 	float* pOut = priorOut ? priorOut->data() : nullptr;
-	for (size_t i = 0; i < m; ++i)
+	// The update of cell i (c: its storage, nullptr over budget).
+	auto update = [&](size_t i, Cell* c)
 	{
-#if defined(__GNUC__)
-		if (i + kPrefetchAhead < m && cells[i + kPrefetchAhead])
-			__builtin_prefetch(cells[i + kPrefetchAhead], 1);
-#endif
-		Cell* c = cells[i];
 		if (!c)
 		{
 			st.overBudget += hits[i];
 			if (pOut) pOut[i] = float(fromFixed(priorFixed(Cell(), F)));
-			continue;
+			return;
 		}
 		const Cell old = *c;
 		const LogOddsFx prior =
@@ -230,6 +227,54 @@ void COccupancyBayesGrid::applyFrame(const FrameCloud& f,
 		*c = {LogOddsFx(std::min<int64_t>(int64_t(prior) + hit, lmax)), prior,
 		      F};
 		if (pOut) pOut[i] = float(fromFixed(prior));
+	};
+	if (resolved)
+	{
+		Cell* const* cells = cellPtr_.data();
+		for (size_t i = 0; i < m; ++i)
+		{
+#if defined(__GNUC__)
+			if (i + kPrefetchAhead < m && cells[i + kPrefetchAhead])
+				__builtin_prefetch(cells[i + kPrefetchAhead], 1);
+#endif
+			update(i, cells[i]);
+		}
+	}
+	else
+	{
+		// The cells are found kPrefetchAhead cells ahead of the update (one
+		// index lookup per block, blocks created in the order of the cells
+		// as by Storage::resolve()) and prefetched.
+		constexpr size_t kRing = 2 * kPrefetchAhead;
+		static_assert((kRing & (kRing - 1)) == 0, "ring size: a power of two");
+		Cell* ring[kRing];
+		uint64_t lastKey = FlatHashMap::kEmpty;
+		Storage::Block* last = nullptr;
+		const VoxelKey* keys = f.cells.data();
+		for (size_t i = 0; i < m + kPrefetchAhead; ++i)
+		{
+			if (i < m)
+			{
+				const VoxelKey& k = keys[i];
+				const uint64_t bk = Storage::blockKeyOf(k.x, k.y, k.z);
+				if (bk != lastKey)
+				{
+					const uint32_t b = grid_.findOrCreateBlock(bk);
+					last =
+					    b == FlatHashMap::kNotFound ? nullptr : &grid_.block(b);
+					lastKey = bk;
+				}
+				Cell* c =
+				    last ? &last->cells[Storage::cellIndexOf(k.x, k.y, k.z)]
+				         : nullptr;
+#if defined(__GNUC__)
+				if (c) __builtin_prefetch(c, 1);
+#endif
+				ring[i % kRing] = c;
+			}
+			if (i >= kPrefetchAhead)
+				update(i - kPrefetchAhead, ring[(i - kPrefetchAhead) % kRing]);
+		}
 	}
 	if (params_.decay == DecayMode::Raycast) decayRaycast(f, F);
 	if (params_.decay == DecayMode::Frustum) decayFrustum(f, F);

@@ -118,8 +118,9 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 	if (cells.use_count() != 1)
 		cells = std::make_shared<std::vector<VoxelKey>>();
 	*cells = f.cells;
-	t1_->store(f, std::move(post1_), cells);
-	t2_->store(f, std::move(post2_), cells);
+	// One sweep over the cells and readings stores both tiers.
+	CMotionGridBase::storePair(*t1_, std::move(post1_), *t2_, std::move(post2_),
+	                           f, cells);
 	result_.maskTier1 = t1_->lastMovingMask();
 	result_.maskTier2 = t2_->lastMovingMask();
 	result_.updateMs = std::chrono::duration<double, std::milli>(

@@ -1,9 +1,12 @@
 // Tiers 1 and 2 in the grids: closed forms applied with the right O-, order
-// independence of a linked tier-0 map, and MotionGrids == individual maps.
+// independence of a linked tier-0 map, MotionGrids == individual maps, and
+// its fused passes (storePair, integrate) == the separate ones.
 #include <bims/maps/closed_form.h>
 #include <bims/maps/motion_grids.h>
 
 #include <gtest/gtest.h>
+#include <mrpt/io/CMemoryStream.h>
+#include <mrpt/serialization/CArchive.h>
 
 #include "scene_raycaster.h"
 #include "test_util.h"
@@ -146,4 +149,114 @@ TEST(FlowGrid, LabelsMoveTheDecisionAsTheModelSays)
 	// Wrong label size is an error, not a silently wrong answer.
 	EXPECT_THROW(mg.flow()->posterior(fr, PixelLabels(4, 1, 1), t1, post),
 	             std::invalid_argument);
+}
+
+namespace
+{
+std::vector<uint8_t> bytesOf(const mrpt::serialization::CSerializable& o)
+{
+	mrpt::io::CMemoryStream buf;
+	auto arch = mrpt::serialization::archiveFrom(buf);
+	arch << o;
+	const auto* d = static_cast<const uint8_t*>(buf.getRawBufferData());
+	return std::vector<uint8_t>(d, d + buf.getTotalBytesCount());
+}
+
+// Frames of a room with a moving box at 1 cm (more blocks than 1 MiB holds).
+std::vector<FrameCloud> framesOver(const GridParams& p, int n)
+{
+	using namespace bims::maps::test;
+	auto scene = room();
+	FrameCloudBuilder b(p);
+	std::vector<FrameCloud> out(n);
+	for (int f = 0; f < n; ++f)
+	{
+		scene.push_back({{2.0, -1.0 + 0.2 * f, 0}, {2.3, -0.7 + 0.2 * f, 1.5}});
+		const mrpt::poses::CPose3D T(0.1 * f, 0.05 * f, 1, 0.1 * f, 0, 0);
+		auto scan = renderScan(scene, T, 160, 120, 60, f);
+		b.build(*scan, T, out[f]);
+		out[f].timestamp =
+		    mrpt::Clock::time_point(mrpt::Clock::duration(f + 1));
+		scene.pop_back();
+	}
+	return out;
+}
+}  // namespace
+
+// MotionGrids stores tiers 1 and 2 in one sweep (storePair): the same maps
+// (cells, stamps, budget accounting, masks, last frame) as two store()s,
+// also when the memory budget leaves cells out.
+TEST(MotionGrids, StorePairEqualsTwoStores)
+{
+	for (const double mb : {256.0, 1.0})
+	{
+		GridParams p;
+		p.voxel_size = 0.01;
+		p.max_memory_mb = mb;
+		CBackgroundSubtractionGrid a1(p), b1(p);
+		CFlowConsistencyGrid a2(p), b2(p);
+		bool over = false;
+		int f = 0;
+		for (const auto& fr : framesOver(p, 5))
+		{
+			const size_t m = fr.cells.size();
+			std::vector<float> p1(m), p2(m);
+			for (size_t i = 0; i < m; ++i)
+			{
+				p1[i] = float((i * 7 + f) % 5) - 2.f;
+				p2[i] = float((i * 3 + f) % 7) - 3.f;
+			}
+			a1.store(fr, p1);
+			a2.store(fr, p2);
+			auto cells = std::make_shared<std::vector<VoxelKey>>(fr.cells);
+			auto q1 = p1, q2 = p2;
+			CMotionGridBase::storePair(b1, std::move(q1), b2, std::move(q2), fr,
+			                           cells);
+			ASSERT_EQ(bytesOf(a1), bytesOf(b1)) << mb << " " << f;
+			ASSERT_EQ(bytesOf(a2), bytesOf(b2)) << mb << " " << f;
+			ASSERT_EQ(a1.lastMovingMask().data, b1.lastMovingMask().data);
+			ASSERT_EQ(a2.lastMovingMask().data, b2.lastMovingMask().data);
+			ASSERT_EQ(b1.lastPosterior(), p1);
+			ASSERT_EQ(b2.lastPosterior(), p2);
+			ASSERT_EQ(b1.lastCells(), fr.cells);
+			ASSERT_EQ(b2.lastCells(), fr.cells);
+			for (const auto& k : fr.cells) over |= !b1.storage().find(k);
+			++f;
+		}
+		EXPECT_EQ(over, mb < 2) << "the small budget must leave cells out";
+		std::vector<float> p1(1), p2(1);
+		auto cells = std::make_shared<std::vector<VoxelKey>>();
+		EXPECT_THROW(
+		    CMotionGridBase::storePair(b1, std::move(p1), b1, std::move(p2),
+		                               FrameCloud(), cells),
+		    std::invalid_argument);
+	}
+}
+
+// integrate() finds the frame's cells during the update; beginFrame() +
+// integratePending() find them first: the same map and O-, also over
+// budget.
+TEST(OccupancyGrid, IntegrateEqualsBeginFrameThenPending)
+{
+	for (const double mb : {256.0, 1.0})
+	{
+		GridParams p;
+		p.voxel_size = 0.01;
+		p.max_memory_mb = mb;
+		COccupancyBayesGrid a(p), b(p);
+		bool over = false;
+		int f = 0;
+		for (const auto& fr : framesOver(p, 5))
+		{
+			std::vector<float> pa, pb;
+			a.integrate(fr, &pa);
+			b.beginFrame(fr, pb);
+			b.integratePending(fr, nullptr);
+			ASSERT_EQ(pa, pb) << mb << " " << f;
+			ASSERT_EQ(bytesOf(a), bytesOf(b)) << mb << " " << f;
+			for (const auto& k : fr.cells) over |= !a.storage().find(k);
+			++f;
+		}
+		EXPECT_EQ(over, mb < 2) << "the small budget must leave cells out";
+	}
 }

@@ -56,6 +56,13 @@ class CMotionGridBase : public CBayesVoxelGridBase
 	 * the previous frame's values). */
 	void store(const FrameCloud& frame, std::vector<float>&& posteriorLogOdds,
 	           std::shared_ptr<std::vector<VoxelKey>> cells);
+	/** a.store(frame, postA, cells) then b.store(frame, postB, cells) in
+	 * one sweep over the frame's cells and one over its readings (tiers 1
+	 * and 2 in MotionGrids). Same results; \a a and \a b must differ. */
+	static void storePair(CMotionGridBase& a, std::vector<float>&& postA,
+	                      CMotionGridBase& b, std::vector<float>&& postB,
+	                      const FrameCloud& frame,
+	                      const std::shared_ptr<std::vector<VoxelKey>>& cells);
 
 	/** Posterior log-odds of I of each of the last frame's cells. */
 	const std::vector<float>& lastPosterior() const { return lastPost_; }
@@ -108,6 +115,11 @@ class CMotionGridBase : public CBayesVoxelGridBase
 	PixelMask lastMask_;
 	/** The cell writes and the mask of store(). */
 	void storeCells(const FrameCloud& frame, const std::vector<float>& post);
+	/** storeCells() of N maps in one sweep (defined for N = 1, 2). */
+	template <size_t N>
+	static void storeCellsOf(CMotionGridBase* const (&maps)[N],
+	                         const std::vector<float>* const (&posts)[N],
+	                         const FrameCloud& frame);
 	std::shared_ptr<const COccupancyBayesGrid> linked_;
 	std::shared_ptr<COccupancyBayesGrid> private_;
 	mrpt::Clock::time_point lastTimestampLocal_{};

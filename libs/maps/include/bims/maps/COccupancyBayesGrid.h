@@ -124,9 +124,10 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 	void decayFrustum(const FrameCloud& f, uint32_t F);
 	void decayRaycast(const FrameCloud& f, uint32_t F);
 	void applyMiss(Cell& c, uint32_t F) const;
-	/** The update of integrate() once cellPtr_ holds the frame's cells. */
+	/** The update of integrate(): of the cells in cellPtr_ if \a resolved
+	 * (beginFrame() found them), else finding them on the way. */
 	void applyFrame(const FrameCloud& f, std::vector<float>* priorOut,
-	                const std::vector<uint8_t>* hold);
+	                const std::vector<uint8_t>* hold, bool resolved);
 	void checkFrame(const FrameCloud& f, const char* what) const;
 
 	// The cells of the frame being integrated (nullptr: over budget) and,
