@@ -87,7 +87,8 @@ Pipeline::Observed Pipeline::observe(const cv::Mat& prevGrey,
 	                   flow::rotationHomography(
 	                       cam, ego::toPose(R_derot, Eigen::Vector3d::Zero())))
 	             : observed_.compute(prevGrey, curGrey);
-	// a header of the tensor's own buffer: the next compute() allocates anew
+	// a header of the tensor: the next compute() writes only a tensor that
+	// nobody else holds (ObservedFlow::tensor())
 	o.tensor = observed_.tensor();
 	o.ms = msSince(t);
 	return o;
