@@ -29,6 +29,17 @@ struct WaitFor
 	}
 };
 
+/** Queues \a job on \a worker; its result (or exception) in the future. */
+template <class F>
+auto postTask(SerialWorker& worker, F job)
+{
+	using R = decltype(job());
+	auto task = std::make_shared<std::packaged_task<R()>>(std::move(job));
+	auto result = task->get_future();
+	worker.post([task] { (*task)(); });
+	return result;
+}
+
 mrpt::img::TCamera cameraOf(const ego::RgbdFrame& f)
 {
 	mrpt::img::TCamera c;
@@ -115,14 +126,12 @@ void Pipeline::startLookahead(const Next& next)
 	// What the next call would predict at its start: the egomotion of this
 	// frame is final, and the caller has added the IMU samples already.
 	const Eigen::Matrix3d R = odom_.predictRotation(next_.t);
-	auto job = std::make_shared<std::packaged_task<Observed()>>(
-	    [this, prevGrey = cur_.grey, curGrey = next_.grey,
-	     cam = cameraOf(next_), R]
-	    { return observe(prevGrey, curGrey, cam, R); });
-	nextObserved_ = job->get_future();
+	nextObserved_ =
+	    postTask(*flowThread_, [this, prevGrey = cur_.grey,
+	                            curGrey = next_.grey, cam = cameraOf(next_), R]
+	             { return observe(prevGrey, curGrey, cam, R); });
 	nextIndex_ = next.index;
 	nextAfter_ = nFrames_;
-	flowThread_->post([job] { (*job)(); });
 }
 
 const FrameResult& Pipeline::processFrame(
@@ -180,11 +189,7 @@ const FrameResult& Pipeline::processFrame(
 		    [this, prevGrey = prev_.grey, curGrey = cur_.grey, cam, R_derot]
 		{ return observe(prevGrey, curGrey, cam, R_derot); };
 		if (flowThread_)
-		{
-			auto task = std::make_shared<std::packaged_task<Observed()>>(job);
-			observing = task->get_future();
-			flowThread_->post([task] { (*task)(); });
-		}
+			observing = postTask(*flowThread_, job);
 		else
 			observeHere = job;
 	}
@@ -215,9 +220,7 @@ const FrameResult& Pipeline::processFrame(
 	{
 		T_WS = r.T_WC + (mrpt::poses::CPose3D() - T_SC());
 		if (!cloudThread_) return;
-		auto task = std::make_shared<std::packaged_task<void()>>(buildCloud);
-		building = task->get_future();
-		cloudThread_->post([task] { (*task)(); });
+		building = postTask(*cloudThread_, buildCloud);
 	};
 	if (!mayCorrect)
 	{
