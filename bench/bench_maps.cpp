@@ -133,9 +133,9 @@ void benchTier(bm::State& st, const Cloud& c, double voxel, std::string decay,
 {
 	const auto p = paramsFor(voxel, decay);
 	MotionGrids mg(p);
-	FrameCloudBuilder b(p);
-	FrameCloud f;
-	b.build(*c.scan, c.T_WS, f);
+	// As the pipeline does: the grids' own frame (its cells go to tiers 1
+	// and 2 without a copy), built outside the timed loop ("build/...").
+	const FrameCloud& f = mg.buildFrame(*c.scan, c.T_WS);
 	const auto labels = randomLabels(f.K.width, f.K.height);
 	for (int i = 0; i < 3; ++i) mg.processFrame(f, &labels);  // warm up
 	std::vector<float> prior, p1, p2;

@@ -123,53 +123,46 @@ void CMotionGridBase::storeCellsOf(CMotionGridBase* const (&maps)[N],
 	}
 	const size_t m = f.cells.size();
 	const uint32_t* hits = f.hits.data();
-	// The cells' storage is found kPrefetchAhead cells ahead of the writes
-	// (one index lookup per block and map; blocks created in the order of
-	// the cells) and prefetched.
-	constexpr size_t kRing = 2 * kPrefetchAhead;
-	static_assert((kRing & (kRing - 1)) == 0, "ring size: a power of two");
-	Cell* ring[kRing][N];
+	// The decisions (MAP: posterior > 1/2) of the N maps, bit g of one byte
+	// per cell: what the cells store, and a fraction of the posteriors'
+	// size for the readings' scattered lookups below.
+	auto& mvv = maps[0]->movingBits_;
+	mvv.resize(m);
+	uint8_t* mv = mvv.data();
+	for (size_t i = 0; i < m; ++i)
+	{
+		uint8_t b = 0;
+		for (size_t g = 0; g < N; ++g) b |= uint8_t((post[g][i] > 0) << g);
+		mv[i] = b;
+	}
+	// One index lookup per block and map (the cells come ordered by
+	// block). A block is 512 bytes (8 lines): no prefetching needed.
 	uint64_t lastKey = FlatHashMap::kEmpty;
 	Storage::Block* last[N] = {};
-	for (size_t i = 0; i < m + kPrefetchAhead; ++i)
+	for (size_t i = 0; i < m; ++i)
 	{
-		if (i < m)
+		const VoxelKey& k = f.cells[i];
+		const uint64_t bk = Storage::blockKeyOf(k.x, k.y, k.z);
+		if (bk != lastKey)
 		{
-			const VoxelKey& k = f.cells[i];
-			const uint64_t bk = Storage::blockKeyOf(k.x, k.y, k.z);
-			if (bk != lastKey)
-			{
-				for (size_t g = 0; g < N; ++g)
-				{
-					auto& grid = maps[g]->grid_;
-					const uint32_t b = grid.findOrCreateBlock(bk);
-					last[g] =
-					    b == FlatHashMap::kNotFound ? nullptr : &grid.block(b);
-				}
-				lastKey = bk;
-			}
-			const size_t ci = Storage::cellIndexOf(k.x, k.y, k.z);
 			for (size_t g = 0; g < N; ++g)
 			{
-				Cell* c = last[g] ? &last[g]->cells[ci] : nullptr;
-#if defined(__GNUC__)
-				if (c) __builtin_prefetch(c, 1);
-#endif
-				ring[i % kRing][g] = c;
+				auto& grid = maps[g]->grid_;
+				const uint32_t b = grid.findOrCreateBlock(bk);
+				last[g] =
+				    b == FlatHashMap::kNotFound ? nullptr : &grid.block(b);
 			}
+			lastKey = bk;
 		}
-		if (i < kPrefetchAhead) continue;
-		const size_t j = i - kPrefetchAhead;
+		const size_t ci = Storage::cellIndexOf(k.x, k.y, k.z);
 		for (size_t g = 0; g < N; ++g)
 		{
-			Cell* c = ring[j % kRing][g];
-			if (!c)
+			if (!last[g])
 			{
-				st[g].overBudget += hits[j];
+				st[g].overBudget += hits[i];
 				continue;
 			}
-			c->l = post[g][j];
-			c->stamp = F[g];
+			last[g]->cells[ci].moving = uint8_t((mv[i] >> g) & 1);
 		}
 	}
 	if (f.K.width > 0 && f.K.height > 0)
@@ -187,9 +180,10 @@ void CMotionGridBase::storeCellsOf(CMotionGridBase* const (&maps)[N],
 		const size_t n = f.pixel.size();
 		for (size_t j = 0; j < n; ++j)
 		{
-			const uint32_t c = cop[j], p = pix[j];
+			const uint32_t p = pix[j];
+			const uint8_t b = mv[cop[j]];
 			for (size_t g = 0; g < N; ++g)
-				mask[g][p] = uint8_t(-uint8_t(post[g][c] > 0));
+				mask[g][p] = uint8_t(-uint8_t((b >> g) & 1));
 		}
 	}
 	else
@@ -205,15 +199,18 @@ void CMotionGridBase::storeCellsOf(CMotionGridBase* const (&maps)[N],
 std::optional<double> CMotionGridBase::probabilityAt(
     const mrpt::math::TPoint3D& p) const
 {
-	const Cell* c = grid_.find(keyOf(p));
-	if (!c || c->stamp != frameCount_ || frameCount_ == 0) return std::nullopt;
-	return sigmoid(c->l);
+	if (frameCount_ == 0) return std::nullopt;
+	const VoxelKey k = keyOf(p);
+	const auto& cells = *lastCells_;
+	for (size_t i = 0; i < cells.size(); ++i)
+		if (cells[i] == k) return sigmoid(lastPost_[i]);
+	return std::nullopt;
 }
 
 bool CMotionGridBase::wasMovingAtLastHit(const VoxelKey& k) const
 {
 	const Cell* c = grid_.find(k);
-	return c && c->stamp != 0 && c->l > 0;
+	return c && c->moving;
 }
 
 std::vector<mrpt::math::TPoint3D> CMotionGridBase::movingCells() const
@@ -259,19 +256,13 @@ void CMotionGridBase::writeMotion(mrpt::serialization::CArchive& out) const
 	const uint64_t nb = grid_.numBlocks();
 	out << nb;
 	constexpr size_t N = Storage::kCellsPerBlock;
-	std::vector<float> l(N);
-	std::vector<uint32_t> st(N);
+	std::vector<uint8_t> mv(N);
 	for (size_t b = 0; b < nb; ++b)
 	{
 		const auto& blk = grid_.block(b);
-		for (size_t c = 0; c < N; ++c)
-		{
-			l[c] = blk.cells[c].l;
-			st[c] = blk.cells[c].stamp;
-		}
+		for (size_t c = 0; c < N; ++c) mv[c] = blk.cells[c].moving;
 		out << grid_.blockKey(b);
-		out.WriteBufferFixEndianness(l.data(), N);
-		out.WriteBufferFixEndianness(st.data(), N);
+		out.WriteBuffer(mv.data(), N);
 	}
 	// Last frame (masks can be recomputed only with the frame; keep the
 	// posteriors and keys, and the mask itself).
@@ -299,18 +290,27 @@ void CMotionGridBase::readMotion(mrpt::serialization::CArchive& in,
 	constexpr size_t N = Storage::kCellsPerBlock;
 	std::vector<float> l(N);
 	std::vector<uint32_t> st(N);
+	std::vector<uint8_t> mv(N);
 	for (uint64_t b = 0; b < nb; ++b)
 	{
 		uint64_t key;
 		in >> key;
-		in.ReadBufferFixEndianness(l.data(), N);
-		in.ReadBufferFixEndianness(st.data(), N);
+		if (version >= 3)
+			in.ReadBuffer(mv.data(), N);
+		else
+		{
+			// Up to version 2 a cell held the posterior log-odds at its last
+			// hit and the frame of that hit: the decision is its sign.
+			in.ReadBufferFixEndianness(l.data(), N);
+			in.ReadBufferFixEndianness(st.data(), N);
+			for (size_t c = 0; c < N; ++c) mv[c] = l[c] > 0;
+		}
 		const uint32_t id = grid_.findOrCreateBlock(key);
 		if (id == FlatHashMap::kNotFound)
 			throw std::runtime_error(
 			    "bims::maps: serialised map exceeds max_memory_mb");
 		auto& blk = grid_.block(id);
-		for (size_t c = 0; c < N; ++c) blk.cells[c] = {l[c], st[c]};
+		for (size_t c = 0; c < N; ++c) blk.cells[c].moving = mv[c] != 0;
 	}
 	uint64_t nl;
 	in >> nl;

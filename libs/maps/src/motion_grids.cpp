@@ -5,6 +5,8 @@
 
 namespace bims::maps
 {
+const PixelMask MotionFrameResult::kNoMask;
+
 MotionGrids::MotionGrids(const GridParams& p)
     : p_(p),
       t0_(std::make_shared<COccupancyBayesGrid>(p)),
@@ -35,8 +37,11 @@ const FrameCloud& MotionGrids::buildFrame(
     const mrpt::obs::CObservation3DRangeScan& scan,
     const mrpt::poses::CPose3D& T_WS)
 {
-	builder_.build(scan, T_WS, frame_);
-	return frame_;
+	if (!spare_ || spare_.use_count() != 1)
+		spare_ = std::make_shared<FrameCloud>();
+	builder_.build(scan, T_WS, *spare_);
+	std::swap(frame_, spare_);
+	return *frame_;
 }
 
 const MotionFrameResult& MotionGrids::processFrame(
@@ -52,14 +57,7 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 	if (f.voxel_size != p_.voxel_size)
 		throw std::invalid_argument(
 		    "MotionGrids::processFrame: frame keyed for another voxel size");
-	// A fresh result, keeping the masks' memory.
-	PixelMask m1 = std::move(result_.maskTier1),
-	          m2 = std::move(result_.maskTier2);
-	m1.reset(0, 0);
-	m2.reset(0, 0);
 	result_ = MotionFrameResult();
-	result_.maskTier1 = std::move(m1);
-	result_.maskTier2 = std::move(m2);
 	result_.stats = f.stats;
 	t0_->accountFrame(f.stats);
 	if (f.stats.badPose) return result_;
@@ -112,17 +110,25 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 		result_.movingTier1 += post1_[i] > 0;
 		result_.movingTier2 += post2_[i] > 0;
 	}
-	// Tiers 1 and 2 keep one copy of the cells, and the posteriors without
-	// a copy (post1_, post2_ are recomputed every frame).
-	auto& cells = cellsBuf_[0].use_count() <= 1 ? cellsBuf_[0] : cellsBuf_[1];
-	if (cells.use_count() != 1)
-		cells = std::make_shared<std::vector<VoxelKey>>();
-	*cells = f.cells;
+	// Tiers 1 and 2 keep the cells of lastFrame() (shared, no copy) or one
+	// copy of a caller's frame's, and the posteriors without a copy (post1_,
+	// post2_ are recomputed every frame).
+	std::shared_ptr<std::vector<VoxelKey>> cells;
+	if (&f == frame_.get())
+		cells = std::shared_ptr<std::vector<VoxelKey>>(frame_, &frame_->cells);
+	else
+	{
+		auto& buf = cellsBuf_[0].use_count() <= 1 ? cellsBuf_[0] : cellsBuf_[1];
+		if (buf.use_count() != 1)
+			buf = std::make_shared<std::vector<VoxelKey>>();
+		*buf = f.cells;
+		cells = buf;
+	}
 	// One sweep over the cells and readings stores both tiers.
 	CMotionGridBase::storePair(*t1_, std::move(post1_), *t2_, std::move(post2_),
 	                           f, cells);
-	result_.maskTier1 = t1_->lastMovingMask();
-	result_.maskTier2 = t2_->lastMovingMask();
+	result_.mask1_ = &t1_->lastMovingMask();
+	result_.mask2_ = &t2_->lastMovingMask();
 	result_.updateMs = std::chrono::duration<double, std::milli>(
 	                       std::chrono::steady_clock::now() - t0)
 	                       .count();

@@ -3,6 +3,7 @@
 #include <bims/maps/CMotionGridBase.h>
 #include <bims/maps/closed_form.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -108,10 +109,15 @@ void CFlowConsistencyGrid::posterior(const FrameCloud& f,
 				tab.d[a * T + b] = flowPosterior(
 				    0, p.flow_transition_tau, p.p_miss, logLambda, a, b, veto);
 	}
-	// Diff (k) and notDiff (l) counts per cell, interleaved, as
-	// countLabels().
+	// Diff (k) and notDiff (l) counts per cell, as countLabels(): packed
+	// k | l << 16 in one word (half the memory of two counters) when no
+	// cell has 2^16 readings, else interleaved.
 	const size_t m = f.cells.size();
-	counts_.assign(2 * m, 0);
+	const uint32_t* hits = f.hits.data();
+	uint32_t maxHits = 0;
+	for (size_t i = 0; i < m; ++i) maxHits = std::max(maxHits, hits[i]);
+	const bool packed = maxHits < (uint32_t(1) << 16);
+	counts_.assign(packed ? m : 2 * m, 0);
 	if (!labels.label.empty())
 	{
 		if (labels.width != f.K.width || labels.height != f.K.height ||
@@ -126,17 +132,26 @@ void CFlowConsistencyGrid::posterior(const FrameCloud& f,
 		const int8_t* lab = labels.label.data();
 		const uint32_t* cop = f.cellOfPoint.data();
 		const uint32_t* pix = f.pixel.data();
-		for (size_t j = 0; j < f.pixel.size(); ++j)
-		{
-			const int8_t v = lab[pix[j]];
-			kl[2 * size_t(cop[j]) + (v == 0)] += uint32_t(v == 0 || v == 1);
-		}
+		const size_t n = f.pixel.size();
+		if (packed)
+			for (size_t j = 0; j < n; ++j)
+			{
+				const int8_t v = lab[pix[j]];
+				kl[cop[j]] += uint32_t(v == 1) | (uint32_t(v == 0) << 16);
+			}
+		else
+			for (size_t j = 0; j < n; ++j)
+			{
+				const int8_t v = lab[pix[j]];
+				kl[2 * size_t(cop[j]) + (v == 0)] += uint32_t(v == 0 || v == 1);
+			}
 	}
 	post.resize(m);
 	const uint32_t* kl = counts_.data();
 	for (size_t i = 0; i < m; ++i)
 	{
-		const uint32_t k = kl[2 * i], l = kl[2 * i + 1];
+		const uint32_t k = packed ? kl[i] & 0xffff : kl[2 * i],
+		               l = packed ? kl[i] >> 16 : kl[2 * i + 1];
 		const double d = (k < T && l < T)
 		                     ? tab.d[k * T + l]
 		                     : flowPosterior(0, p.flow_transition_tau, p.p_miss,

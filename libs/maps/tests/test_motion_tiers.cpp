@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/serialization/CArchive.h>
+#include <cmath>
+#include <random>
 
 #include "scene_raycaster.h"
 #include "test_util.h"
@@ -78,8 +80,8 @@ TEST(MotionGrids, SameResultAsIndividualMapsThroughInsertObservation)
 		t1.insertObservation(*scan, T);
 		t2.setPendingLabels(labels);
 		t2.insertObservation(*scan, T);
-		ASSERT_EQ(res.maskTier1.data, t1.lastMovingMask().data);
-		ASSERT_EQ(res.maskTier2.data, t2.lastMovingMask().data);
+		ASSERT_EQ(res.maskTier1().data, t1.lastMovingMask().data);
+		ASSERT_EQ(res.maskTier2().data, t2.lastMovingMask().data);
 		ASSERT_EQ(mg.flow()->lastPosterior(), t2.lastPosterior());
 		ASSERT_EQ(mg.background()->lastCells(), t1.lastCells());
 		ASSERT_EQ(mg.flow()->lastCells(), t2.lastCells());
@@ -114,6 +116,141 @@ TEST(MotionGrids, SharedCellsOfTheLastFrameAreNeverOverwritten)
 	{
 		ASSERT_EQ(copies[i].lastCells(), cellsSeen[i]) << i;
 		ASSERT_EQ(copies[i].lastPosterior(), postSeen[i]) << i;
+	}
+}
+
+// processFrame(lastFrame()) hands the frame's cells to tiers 1 and 2 and
+// reports the tiers' masks without copying them; building the next frame
+// leaves the cells the tiers hold alone (it builds into another buffer).
+TEST(MotionGrids, LastFrameCellsAndMasksAreHandedOverWithoutACopy)
+{
+	GridParams p;
+	MotionGrids mg(p);
+	using namespace bims::maps::test;
+	const auto scene = room();
+	std::vector<VoxelKey> before;
+	for (int f = 0; f < 4; ++f)
+	{
+		const mrpt::poses::CPose3D T(0.1 * f, 0.05 * f, 1, 0.1 * f, 0, 0);
+		auto scan = renderScan(scene, T, 40, 30, 60, f);
+		const auto& fr = mg.buildFrame(*scan, T);
+		// The tiers still hold the previous frame's cells, unchanged.
+		ASSERT_EQ(mg.background()->lastCells(), before) << f;
+		if (f > 0)
+		{
+			ASSERT_NE(fr.cells, before) << f;
+		}
+		const auto& res = mg.processFrame(mg.lastFrame(), nullptr);
+		EXPECT_EQ(mg.background()->lastCells().data(), fr.cells.data());
+		EXPECT_EQ(mg.flow()->lastCells().data(), fr.cells.data());
+		EXPECT_EQ(&res.maskTier1(), &mg.background()->lastMovingMask());
+		EXPECT_EQ(&res.maskTier2(), &mg.flow()->lastMovingMask());
+		EXPECT_EQ(res.maskTier1().width, 40);
+		before = fr.cells;
+	}
+	// A caller's frame is copied: the caller may change it afterwards.
+	FrameCloud own = mg.lastFrame();
+	mg.processFrame(own, nullptr);
+	EXPECT_NE(mg.background()->lastCells().data(), own.cells.data());
+	EXPECT_EQ(mg.background()->lastCells(), own.cells);
+	own.cells.clear();
+	EXPECT_EQ(mg.background()->lastCells(), before);
+	// A frame skipped for its pose has no masks.
+	const auto scan = renderScan(scene, mrpt::poses::CPose3D(), 40, 30, 60, 9);
+	const double nan = std::nan("");
+	const auto& bad = mg.processFrame(
+	    *scan, mrpt::poses::CPose3D(nan, 0, 0, 0, 0, 0), nullptr);
+	EXPECT_TRUE(bad.stats.badPose);
+	EXPECT_TRUE(bad.maskTier1().data.empty());
+	EXPECT_TRUE(bad.maskTier2().data.empty());
+}
+
+// probabilityAt() of tiers 1 and 2: the posterior of the voxel if the last
+// frame hit it, nullopt otherwise (also for a voxel hit only before).
+TEST(MotionGrids, TierProbabilityIsTheLastFramesPosterior)
+{
+	GridParams p;
+	p.voxel_size = 0.1;
+	MotionGrids mg(p);
+	const VoxelKey a{3, 0, 0}, b{5, 1, 0};
+	mg.processFrame(frameAt(p, {a, b}, {4, 1}, {0, 0, 0}, 1), nullptr);
+	for (const CMotionGridBase* m :
+	     {static_cast<const CMotionGridBase*>(mg.background().get()),
+	      static_cast<const CMotionGridBase*>(mg.flow().get())})
+		for (size_t i = 0; i < 2; ++i)
+		{
+			const auto pr = m->probabilityAt(m->centerOf(m->lastCells()[i]));
+			ASSERT_TRUE(pr.has_value());
+			EXPECT_DOUBLE_EQ(
+			    *pr, 1 / (1 + std::exp(-double(m->lastPosterior()[i]))));
+		}
+	EXPECT_FALSE(mg.background()->probabilityAt({-5, 0, 0}).has_value());
+	mg.processFrame(frameAt(p, {b}, {2}, {0, 0, 0}, 2), nullptr);
+	EXPECT_FALSE(mg.background()
+	                 ->probabilityAt(mg.background()->centerOf(a))
+	                 .has_value());
+	EXPECT_TRUE(mg.background()
+	                ->probabilityAt(mg.background()->centerOf(b))
+	                .has_value());
+}
+
+// The per-cell Diff/notDiff counts of posterior() (packed in one word while
+// no cell has 2^16 readings) are countLabels()'s: the posterior is
+// tier 1 + flowPosterior(0, k, l) of those counts, bit for bit, on both
+// sides of the packing limit.
+TEST(FlowGrid, PosteriorCountsTheLabelsAsCountLabelsOnBothSidesOf65536)
+{
+	GridParams p;
+	p.voxel_size = 0.1;
+	CFlowConsistencyGrid g(p);
+	const double logLambda = std::log(p.flow_lambda);
+	std::mt19937 rng(7);
+	for (const uint32_t big : {40u, 65535u, 65536u, 70001u})
+	{
+		const std::vector<VoxelKey> keys = {
+		    {0, 0, 0}, {1, 0, 0}, {0, 3, 1}, {5, 5, 5}};
+		const std::vector<uint32_t> counts = {big, 7, 31, 1};
+		std::vector<mrpt::math::TPoint3Df> pts;
+		std::vector<uint32_t> pix;
+		for (size_t i = 0; i < keys.size(); ++i)
+			for (uint32_t j = 0; j < counts[i]; ++j)
+			{
+				pts.emplace_back(float((keys[i].x + 0.5) * p.voxel_size),
+				                 float((keys[i].y + 0.5) * p.voxel_size),
+				                 float((keys[i].z + 0.5) * p.voxel_size));
+				pix.push_back(uint32_t(pix.size()));
+			}
+		Intrinsics K;
+		K.width = int(pix.size());
+		K.height = 1;
+		K.fx = K.fy = 1;
+		FrameCloud fr;
+		FrameCloudBuilder(p).buildFromPoints(pts, pix, {0, 0, -1}, fr, K);
+		ASSERT_EQ(fr.cells.size(), keys.size());
+		PixelLabels lab(K.width, 1);
+		// The big cell all Diff (its count reaches the packing limit), the
+		// others at random.
+		for (size_t j = 0; j < lab.label.size(); ++j)
+			lab.label[j] = j < big ? int8_t(1) : int8_t(int(rng() % 3) - 1);
+		std::vector<float> t1(fr.cells.size());
+		for (auto& v : t1) v = float(rng() % 200) / 40.f - 2.5f;
+		std::vector<uint32_t> k, l;
+		CFlowConsistencyGrid::countLabels(fr, lab, k, l);
+		std::vector<float> post;
+		g.posterior(fr, lab, t1, post);
+		ASSERT_EQ(post.size(), fr.cells.size());
+		size_t labelled = 0, counted = 0;
+		for (const auto v : lab.label) labelled += v == 0 || v == 1;
+		for (size_t i = 0; i < fr.cells.size(); ++i) counted += k[i] + l[i];
+		ASSERT_EQ(counted, labelled);
+		for (size_t i = 0; i < fr.cells.size(); ++i)
+		{
+			EXPECT_EQ(
+			    post[i],
+			    float(t1[i] + flowPosterior(0, p.flow_transition_tau, p.p_miss,
+			                                logLambda, k[i], l[i], false)))
+			    << big << " cell " << i << " k " << k[i] << " l " << l[i];
+		}
 	}
 }
 

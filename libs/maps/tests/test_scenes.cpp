@@ -75,7 +75,8 @@ TEST(Scenes, BoxMovingIntoFreeSpaceIsFlagged)
 					if (scan->rangeImage(v, u) == 0) continue;
 					const bool isBox =
 					    scan->rangeImage(v, u) != bg->rangeImage(v, u);
-					const bool fl = r.maskTier1.data[size_t(v) * W + u] == 255;
+					const bool fl =
+					    r.maskTier1().data[size_t(v) * W + u] == 255;
 					(isBox ? boxPx : restPx)++;
 					(isBox ? boxFlagged : restFlagged) += fl;
 				}

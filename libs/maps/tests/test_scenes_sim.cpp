@@ -157,7 +157,7 @@ TEST(SimScenes, BoxMovingIntoFreeSpaceIsFlagged)
 			{
 				if (gt.depthMm[i] == 0) continue;
 				const bool isBox = gt.mask[i] == 255;
-				const bool fl = r.maskTier1.data[i] == 255;
+				const bool fl = r.maskTier1().data[i] == 255;
 				(isBox ? boxPx : restPx)++;
 				(isBox ? boxFlagged : restFlagged) += fl;
 			}

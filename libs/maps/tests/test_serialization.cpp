@@ -86,6 +86,107 @@ TEST(Serialization, MotionTiersRoundTrip)
 	EXPECT_EQ(t2->lastMovingMask().width, 48);
 	EXPECT_EQ(t1->movingCells().size(), mg.background()->movingCells().size());
 	EXPECT_EQ(t1->frameCount(), 4u);
+	// Every stored decision, and nothing more.
+	for (const CMotionGridBase* m :
+	     {static_cast<const CMotionGridBase*>(mg.background().get()),
+	      static_cast<const CMotionGridBase*>(mg.flow().get())})
+	{
+		auto b = roundTrip(*m);
+		size_t n = 0, moving = 0;
+		m->storage().forEachCell(
+		    [&](const VoxelKey& k, const auto& c)
+		    {
+			    const auto* d = b->storage().find(k);
+			    ASSERT_NE(d, nullptr);
+			    ASSERT_EQ(d->moving, c.moving);
+			    ASSERT_EQ(b->wasMovingAtLastHit(k), c.moving != 0);
+			    ++n;
+			    moving += c.moving;
+		    });
+		EXPECT_GT(n, 100u);
+		EXPECT_GT(moving, 0u);
+		EXPECT_EQ(b->storage().numBlocks(), m->storage().numBlocks());
+	}
+}
+
+namespace
+{
+// Writes a tier-1 map in the layout of version 2 (before the cells kept
+// only the decision): posterior log-odds and the frame of the last hit per
+// cell. Same class name in the stream, so ReadObject() reads it back as a
+// CBackgroundSubtractionGrid of version 2.
+class Tier1WrittenAsVersion2 : public CBackgroundSubtractionGrid
+{
+ public:
+	using CBackgroundSubtractionGrid::CBackgroundSubtractionGrid;
+
+ protected:
+	uint8_t serializeGetVersion() const override { return 2; }
+	void serializeTo(mrpt::serialization::CArchive& out) const override
+	{
+		writeBase(out);
+		const uint64_t nb = grid_.numBlocks();
+		out << nb;
+		constexpr size_t N = Storage::kCellsPerBlock;
+		std::vector<float> l(N);
+		std::vector<uint32_t> st(N);
+		for (size_t b = 0; b < nb; ++b)
+		{
+			const auto& blk = grid_.block(b);
+			for (size_t c = 0; c < N; ++c)
+			{
+				// Moving: a positive posterior; static: a negative one; never
+				// hit: 0 at stamp 0.
+				l[c] = blk.cells[c].moving ? 1.5f : -0.25f * float(c % 3);
+				st[c] = c % 3 ? 1 : 0;
+			}
+			out << grid_.blockKey(b);
+			out.WriteBufferFixEndianness(l.data(), N);
+			out.WriteBufferFixEndianness(st.data(), N);
+		}
+		const auto& cells = lastCells();
+		out << uint64_t(cells.size());
+		for (size_t i = 0; i < cells.size(); ++i)
+			out << cells[i].x << cells[i].y << cells[i].z << lastPosterior()[i];
+		out << int32_t(lastMask_.width) << int32_t(lastMask_.height);
+		if (!lastMask_.data.empty())
+			out.WriteBuffer(lastMask_.data.data(), lastMask_.data.size());
+		out << false;  // no private tier-0 map
+	}
+};
+}  // namespace
+
+TEST(Serialization, Tier1OfVersion2IsRead)
+{
+	GridParams p;
+	p.voxel_size = 0.1;
+	MotionGrids mg(p);
+	feed(mg, 4);
+	// The stored state of the pipeline's tier 1, in the version-2 writer.
+	Tier1WrittenAsVersion2 old(p);
+	{
+		mrpt::io::CMemoryStream buf;
+		auto arch = mrpt::serialization::archiveFrom(buf);
+		arch << *mg.background();
+		buf.Seek(0);
+		arch >> old;  // old now holds tier 1's state
+	}
+	auto b = roundTrip(static_cast<const CBackgroundSubtractionGrid&>(old));
+	ASSERT_TRUE(b);
+	EXPECT_EQ(b->frameCount(), old.frameCount());
+	EXPECT_EQ(b->lastCells(), old.lastCells());
+	EXPECT_EQ(b->lastPosterior(), old.lastPosterior());
+	EXPECT_EQ(b->lastMovingMask().data, old.lastMovingMask().data);
+	size_t n = 0, moving = 0;
+	old.storage().forEachCell(
+	    [&](const VoxelKey& k, const auto& c)
+	    {
+		    ASSERT_EQ(b->wasMovingAtLastHit(k), c.moving != 0);
+		    ++n;
+		    moving += c.moving;
+	    });
+	EXPECT_GT(n, 100u);
+	EXPECT_GT(moving, 0u);
 }
 
 TEST(Serialization, StandaloneTier1KeepsItsPrivateTier0)

@@ -276,8 +276,8 @@ const FrameResult& Pipeline::processFrame(
 		buildCloud();
 	const auto& g = grids_.processFrame(grids_.lastFrame(),
 	                                    haveFlow ? &pixLabels : nullptr);
-	r.maskTier1 = toMat(g.maskTier1, size);
-	r.maskTier2 = toMat(g.maskTier2, size);
+	r.maskTier1 = toMat(g.maskTier1(), size);
+	r.maskTier2 = toMat(g.maskTier2(), size);
 	r.hitVoxels = g.hitVoxels;
 	r.cloudStats = g.stats;
 	r.ms.grids = msSince(t);

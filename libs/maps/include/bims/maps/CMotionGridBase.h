@@ -24,11 +24,15 @@ class CMotionGridBase : public CBayesVoxelGridBase
 	DEFINE_VIRTUAL_SERIALIZABLE(CMotionGridBase)
 
  public:
-	/** Stored posterior log-odds of I at the voxel's last hit frame. */
+	/** What a voxel keeps between frames: the MAP decision (posterior of
+	 * I > 1/2) at its last hit; 0 for a voxel never hit. The posteriors
+	 * themselves are recomputed every frame (the model has no per-voxel
+	 * state for tiers 1 and 2) and kept for the last frame only
+	 * (lastPosterior()). One byte: tiers 1 and 2 rewrite a cell for every
+	 * voxel hit. */
 	struct Cell
 	{
-		float l = 0;
-		uint32_t stamp = 0;  //!< frame of the last hit; 0 = never
+		uint8_t moving = 0;
 	};
 	using Storage = SparseVoxelGrid<Cell, 3>;
 
@@ -73,7 +77,8 @@ class CMotionGridBase : public CBayesVoxelGridBase
 	const PixelMask& lastMovingMask() const { return lastMask_; }
 
 	/** Posterior probability of I at the voxel containing \a p_W if that
-	 * voxel was hit in the last frame, else nullopt. */
+	 * voxel was hit in the last frame, else nullopt. A query, not for
+	 * loops: O(voxels of the last frame). */
 	std::optional<double> probabilityAt(const mrpt::math::TPoint3D& p_W) const;
 	/** Whether the voxel was labelled moving (MAP) at its last hit. */
 	bool wasMovingAtLastHit(const VoxelKey& k) const;
@@ -113,6 +118,7 @@ class CMotionGridBase : public CBayesVoxelGridBase
 	/** lastCells_, first replaced by a vector of its own if shared. */
 	std::vector<VoxelKey>& ownCells();
 	PixelMask lastMask_;
+	std::vector<uint8_t> movingBits_;  // storeCellsOf scratch
 	/** The cell writes and the mask of store(). */
 	void storeCells(const FrameCloud& frame, const std::vector<float>& post);
 	/** storeCells() of N maps in one sweep (defined for N = 1, 2). */

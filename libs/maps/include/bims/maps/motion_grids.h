@@ -10,14 +10,22 @@ namespace bims::maps
 /** Output of MotionGrids::processFrame. */
 struct MotionFrameResult
 {
-	/** Moving-pixel masks (255 = moving) by tier-1 MAP and tier-2 MAP. */
-	PixelMask maskTier1, maskTier2;
+	/** Moving-pixel masks (255 = moving) by tier-1 MAP and tier-2 MAP: the
+	 * tiers' lastMovingMask() (not copied), valid until the next frame;
+	 * empty (0 x 0) for a frame skipped for its pose. */
+	const PixelMask& maskTier1() const { return mask1_ ? *mask1_ : kNoMask; }
+	const PixelMask& maskTier2() const { return mask2_ ? *mask2_ : kNoMask; }
 	/** Number of hit voxels and of those labelled moving by each tier. */
 	size_t hitVoxels = 0, movingTier1 = 0, movingTier2 = 0;
 	/** Readings used and skipped in this frame. */
 	FrameStats stats;
 	/** Wall time of the map updates (without building the cloud) [ms]. */
 	double updateMs = 0;
+
+ private:
+	friend class MotionGrids;
+	static const PixelMask kNoMask;
+	const PixelMask *mask1_ = nullptr, *mask2_ = nullptr;
 };
 
 /** Owns the three tiers (tiers 1 and 2 linked to tier 0) and runs one frame:
@@ -46,8 +54,10 @@ class MotionGrids
 	 * the caller prepares the labels. */
 	const FrameCloud& buildFrame(const mrpt::obs::CObservation3DRangeScan& scan,
 	                             const mrpt::poses::CPose3D& T_WS);
-	/** The FrameCloud of the last processFrame(scan, ...) / buildFrame. */
-	const FrameCloud& lastFrame() const { return frame_; }
+	/** The FrameCloud of the last processFrame(scan, ...) / buildFrame.
+	 * processFrame(lastFrame(), ...) hands its cells to tiers 1 and 2
+	 * without a copy; the next buildFrame() builds into another buffer. */
+	const FrameCloud& lastFrame() const { return *frame_; }
 	const MotionFrameResult& lastResult() const { return result_; }
 
 	std::shared_ptr<COccupancyBayesGrid> occupancy() const { return t0_; }
@@ -70,13 +80,15 @@ class MotionGrids
 	std::shared_ptr<CBackgroundSubtractionGrid> t1_;
 	std::shared_ptr<CFlowConsistencyGrid> t2_;
 	FrameCloudBuilder builder_;
-	FrameCloud frame_;
+	// lastFrame() and the buffer the next frame is built into (tiers 1 and
+	// 2 may still hold the cells of either: a held buffer is replaced).
+	std::shared_ptr<FrameCloud> frame_ = std::make_shared<FrameCloud>(), spare_;
 	MotionFrameResult result_;
 	std::vector<float> prior_, post1_, post2_;
 	std::vector<float> priorN_;
 	std::vector<uint8_t> hold_;
-	// The frame's cells as kept by tiers 1 and 2 (one copy for both): two
-	// buffers, the one the maps no longer hold is refilled.
+	// The cells of a caller's frame as kept by tiers 1 and 2 (one copy for
+	// both): two buffers, the one the maps no longer hold is refilled.
 	std::shared_ptr<std::vector<VoxelKey>> cellsBuf_[2];
 	int decisionTier_ = 2;
 };
