@@ -1,7 +1,10 @@
 // Voxel grid benchmark: tier 0/1/2 update time per frame for each decay
 // mode, MRPT's COccupancyGridMap3D and COctoMap on the same clouds, memory
-// per million occupied cells, and the storage choice (hashed voxels vs
-// hashed blocks). One JSON object per measurement on stdout (see
+// per million occupied cells, the storage choice (hashed voxels vs hashed
+// blocks), and the growth of the update with the readings (scale_points:
+// the frame thinned) and with the map (scale_extent: the frame among copies
+// of itself elsewhere; scale_explore: into unseen space, memory per frame).
+// One JSON object per measurement on stdout (see
 // json_reporter.h); run through scripts/bench.sh.
 //
 //   bench_maps [--bonn_depth=PNG] [--sim_rawlog=RAWLOG] [--sim_frame=N]
@@ -19,6 +22,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <random>
@@ -178,6 +182,105 @@ void benchTier(bm::State& st, const Cloud& c, double voxel, std::string decay,
 		st.counters["MiB_per_million_touched"] =
 		    mg.occupancy()->memoryBytes() / 1048576.0 / (stored / 1e6);
 	}
+}
+
+// ---- growth with point count and grid extent ------------------------------
+// The cloud thinned to every s-th pixel in both directions (1/s^2 of the
+// readings, same image size and intrinsics).
+mrpt::obs::CObservation3DRangeScan::Ptr thinned(const Cloud& c, int s)
+{
+	auto o = std::make_shared<mrpt::obs::CObservation3DRangeScan>(*c.scan);
+	for (int v = 0; v < int(o->rangeImage.rows()); ++v)
+		for (int u = 0; u < int(o->rangeImage.cols()); ++u)
+			if (u % s || v % s) o->rangeImage(v, u) = 0;
+	return o;
+}
+
+size_t gridsBytes(const MotionGrids& mg)
+{
+	return mg.occupancy()->memoryBytes() + mg.background()->memoryBytes() +
+	       mg.flow()->memoryBytes();
+}
+
+// The cloud seen from the k-th place of a 7 x 7 lattice 12 m apart in x, y
+// (k = 0: the cloud's own pose): disjoint regions of the map, all inside the
+// default extent.
+mrpt::poses::CPose3D placeOf(const Cloud& c, int k)
+{
+	const int i = k % 7, j = (k / 7) % 7;
+	return mrpt::poses::CPose3D(12.0 * (i - 3), 12.0 * (j - 3), 0, 0, 0, 0) +
+	       c.T_WS;
+}
+
+// FrameCloud build and tiers 0+1+2 (decay = all, with labels) of the
+// thinned cloud: time against readings.
+void benchScalePoints(bm::State& st, const Cloud& c, double voxel, int s)
+{
+	const auto p = paramsFor(voxel, "all");
+	const auto scan = thinned(c, s);
+	MotionGrids mg(p);
+	const FrameCloud& f = mg.buildFrame(*scan, c.T_WS);
+	const auto labels = randomLabels(f.K.width, f.K.height);
+	for (int i = 0; i < 3; ++i) mg.processFrame(mg.lastFrame(), &labels);
+	for (auto _ : st) mg.processFrame(mg.lastFrame(), &labels);
+	setCounters(st, c, voxel, f);
+	st.counters["pixel_stride"] = s;
+	FrameCloudBuilder b(p);
+	FrameCloud g;
+	std::vector<double> ms;
+	for (int r = 0; r < 5; ++r)
+	{
+		const auto t0 = std::chrono::steady_clock::now();
+		b.build(*scan, c.T_WS, g);
+		ms.push_back(std::chrono::duration<double, std::milli>(
+		                 std::chrono::steady_clock::now() - t0)
+		                 .count());
+	}
+	std::sort(ms.begin(), ms.end());
+	st.counters["build_ms_median"] = ms[2];
+}
+
+// Tiers 0+1+2 at the cloud's own place while the map also holds the cloud
+// at n other places: the cost of a larger map (index size) per frame.
+void benchExtentSteady(bm::State& st, const Cloud& c, double voxel, int n)
+{
+	const auto p = paramsFor(voxel, "all");
+	MotionGrids mg(p);
+	const auto labels = randomLabels(int(c.scan->rangeImage.cols()),
+	                                 int(c.scan->rangeImage.rows()));
+	for (int k = 1; k <= n; ++k)
+	{
+		mg.buildFrame(*c.scan, placeOf(c, k));
+		mg.processFrame(mg.lastFrame(), &labels);
+	}
+	mg.buildFrame(*c.scan, placeOf(c, 0));
+	for (int i = 0; i < 3; ++i) mg.processFrame(mg.lastFrame(), &labels);
+	for (auto _ : st) mg.processFrame(mg.lastFrame(), &labels);
+	setCounters(st, c, voxel, mg.lastFrame());
+	st.counters["places_in_map"] = n + 1;
+	st.counters["grids_MiB"] = gridsBytes(mg) / 1048576.0;
+	st.counters["blocks_tier0"] = double(mg.occupancy()->storage().numBlocks());
+}
+
+// Tiers 0+1+2 of a frame into space the map has not seen (every block
+// created): one new place per iteration; the grids' memory per frame.
+void benchExtentExplore(bm::State& st, const Cloud& c, double voxel)
+{
+	const auto p = paramsFor(voxel, "all");
+	MotionGrids mg(p);
+	const auto labels = randomLabels(int(c.scan->rangeImage.cols()),
+	                                 int(c.scan->rangeImage.rows()));
+	int k = 0;
+	for (auto _ : st)
+	{
+		st.PauseTiming();
+		mg.buildFrame(*c.scan, placeOf(c, k++));
+		st.ResumeTiming();
+		mg.processFrame(mg.lastFrame(), &labels);
+	}
+	setCounters(st, c, voxel, mg.lastFrame());
+	st.counters["places_in_map"] = k;
+	st.counters["grids_MiB_per_frame"] = gridsBytes(mg) / 1048576.0 / k;
 }
 
 // ---- MRPT baselines --------------------------------------------------------
@@ -357,6 +460,37 @@ void registerAll()
 					if (d == "raycast_mt2") b->MeasureProcessCPUTime();
 				}
 			}
+			for (int stride : {4, 2, 1})
+				bm::RegisterBenchmark(
+				    ("scale_points/" + c.name + "/" +
+				     std::to_string(int(std::lround(v * 100))) + "cm/stride" +
+				     std::to_string(stride))
+				        .c_str(),
+				    benchScalePoints, c, v, stride)
+				    ->Unit(bm::kMillisecond)
+				    ->UseRealTime()
+				    ->Iterations(20)
+				    ->Repetitions(5)
+				    ->ReportAggregatesOnly();
+			for (int n : {0, 8, 48})
+				bm::RegisterBenchmark(
+				    ("scale_extent/" + c.name + "/" +
+				     std::to_string(int(std::lround(v * 100))) + "cm/places" +
+				     std::to_string(n + 1))
+				        .c_str(),
+				    benchExtentSteady, c, v, n)
+				    ->Unit(bm::kMillisecond)
+				    ->UseRealTime()
+				    ->Iterations(20)
+				    ->Repetitions(5)
+				    ->ReportAggregatesOnly();
+			// 48 new places: the lattice has 49, the cloud's own is left.
+			bm::RegisterBenchmark(("scale_explore" + sfx).c_str(),
+			                      benchExtentExplore, c, v)
+			    ->Unit(bm::kMillisecond)
+			    ->UseRealTime()
+			    ->Iterations(48)
+			    ->Repetitions(1);
 			bm::RegisterBenchmark(("mrpt_grid3d_dec1" + sfx).c_str(),
 			                      benchGrid3D, c, v, 1)
 			    ->Unit(bm::kMillisecond)
