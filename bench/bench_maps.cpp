@@ -420,6 +420,19 @@ std::string findFirstPng(const std::string& dir)
 	return f.empty() ? std::string() : f.front();
 }
 
+// Milliseconds of wall time, a fixed number of iterations per repetition,
+// the aggregates of the repetitions only.
+bm::internal::Benchmark* timed(bm::internal::Benchmark* b, int iterations,
+                               int repetitions)
+{
+	b->Unit(bm::kMillisecond)
+	    ->UseRealTime()
+	    ->Iterations(iterations)
+	    ->Repetitions(repetitions);
+	if (repetitions > 1) b->ReportAggregatesOnly();
+	return b;
+}
+
 void registerAll()
 {
 	for (const auto& c : g_clouds)
@@ -428,12 +441,9 @@ void registerAll()
 			const std::string sfx = "/" + c.name + "/" +
 			                        std::to_string(int(std::lround(v * 100))) +
 			                        "cm";
-			bm::RegisterBenchmark(("build" + sfx).c_str(), benchBuild, c, v)
-			    ->Unit(bm::kMillisecond)
-			    ->UseRealTime()
-			    ->Iterations(10)
-			    ->Repetitions(5)
-			    ->ReportAggregatesOnly();
+			timed(bm::RegisterBenchmark(("build" + sfx).c_str(), benchBuild, c,
+			                            v),
+			      10, 5);
 			for (std::string d :
 			     {"all", "frustum", "raycast", "raycast_mt2", "raycast_voxels"})
 			{
@@ -448,100 +458,56 @@ void registerAll()
 				{
 					if (slow && (s == Stage::Tier1 || s == Stage::Tier2))
 						continue;  // decay-independent
-					auto* b = bm::RegisterBenchmark(
-					    (std::string(sn) + "/" + d + sfx).c_str(), benchTier, c,
-					    v, d, s);
-					b->Unit(bm::kMillisecond)
-					    ->UseRealTime()
-					    ->Iterations(it)
-					    ->Repetitions(5)
-					    ->ReportAggregatesOnly();
+					auto* b =
+					    timed(bm::RegisterBenchmark(
+					              (std::string(sn) + "/" + d + sfx).c_str(),
+					              benchTier, c, v, d, s),
+					          it, 5);
 					// CPU time of all threads, not only the calling one.
 					if (d == "raycast_mt2") b->MeasureProcessCPUTime();
 				}
 			}
 			for (int stride : {4, 2, 1})
-				bm::RegisterBenchmark(
-				    ("scale_points/" + c.name + "/" +
-				     std::to_string(int(std::lround(v * 100))) + "cm/stride" +
-				     std::to_string(stride))
-				        .c_str(),
-				    benchScalePoints, c, v, stride)
-				    ->Unit(bm::kMillisecond)
-				    ->UseRealTime()
-				    ->Iterations(20)
-				    ->Repetitions(5)
-				    ->ReportAggregatesOnly();
+				timed(bm::RegisterBenchmark(("scale_points" + sfx + "/stride" +
+				                             std::to_string(stride))
+				                                .c_str(),
+				                            benchScalePoints, c, v, stride),
+				      20, 5);
 			for (int n : {0, 8, 48})
-				bm::RegisterBenchmark(
-				    ("scale_extent/" + c.name + "/" +
-				     std::to_string(int(std::lround(v * 100))) + "cm/places" +
-				     std::to_string(n + 1))
-				        .c_str(),
-				    benchExtentSteady, c, v, n)
-				    ->Unit(bm::kMillisecond)
-				    ->UseRealTime()
-				    ->Iterations(20)
-				    ->Repetitions(5)
-				    ->ReportAggregatesOnly();
+				timed(bm::RegisterBenchmark(("scale_extent" + sfx + "/places" +
+				                             std::to_string(n + 1))
+				                                .c_str(),
+				                            benchExtentSteady, c, v, n),
+				      20, 5);
 			// 48 new places: the lattice has 49, the cloud's own is left.
-			bm::RegisterBenchmark(("scale_explore" + sfx).c_str(),
-			                      benchExtentExplore, c, v)
-			    ->Unit(bm::kMillisecond)
-			    ->UseRealTime()
-			    ->Iterations(48)
-			    ->Repetitions(1);
-			bm::RegisterBenchmark(("mrpt_grid3d_dec1" + sfx).c_str(),
-			                      benchGrid3D, c, v, 1)
-			    ->Unit(bm::kMillisecond)
-			    ->UseRealTime()
-			    ->Iterations(1)
-			    ->Repetitions(3)
-			    ->ReportAggregatesOnly();
-			bm::RegisterBenchmark(("mrpt_grid3d_default" + sfx).c_str(),
-			                      benchGrid3D, c, v, 0)
-			    ->Unit(bm::kMillisecond)
-			    ->UseRealTime()
-			    ->Iterations(3)
-			    ->Repetitions(3)
-			    ->ReportAggregatesOnly();
-			bm::RegisterBenchmark(("mrpt_octomap" + sfx).c_str(), benchOctoMap,
-			                      c, v)
-			    ->Unit(bm::kMillisecond)
-			    ->UseRealTime()
-			    ->Iterations(1)
-			    ->Repetitions(3)
-			    ->ReportAggregatesOnly();
-			bm::RegisterBenchmark(
-			    ("storage_raycast_hash_voxels_std" + sfx).c_str(),
-			    benchStorageUnordered, c, v)
-			    ->Unit(bm::kMillisecond)
-			    ->UseRealTime()
-			    ->Iterations(1)
-			    ->Repetitions(3)
-			    ->ReportAggregatesOnly();
-			bm::RegisterBenchmark(
-			    ("storage_raycast_hash_voxels_flat" + sfx).c_str(),
-			    benchStorageBlocks<0>, c, v)
-			    ->Unit(bm::kMillisecond)
-			    ->UseRealTime()
-			    ->Iterations(1)
-			    ->Repetitions(3)
-			    ->ReportAggregatesOnly();
-			bm::RegisterBenchmark(("storage_raycast_blocks8" + sfx).c_str(),
-			                      benchStorageBlocks<3>, c, v)
-			    ->Unit(bm::kMillisecond)
-			    ->UseRealTime()
-			    ->Iterations(1)
-			    ->Repetitions(3)
-			    ->ReportAggregatesOnly();
-			bm::RegisterBenchmark(("storage_raycast_blocks16" + sfx).c_str(),
-			                      benchStorageBlocks<4>, c, v)
-			    ->Unit(bm::kMillisecond)
-			    ->UseRealTime()
-			    ->Iterations(1)
-			    ->Repetitions(3)
-			    ->ReportAggregatesOnly();
+			timed(bm::RegisterBenchmark(("scale_explore" + sfx).c_str(),
+			                            benchExtentExplore, c, v),
+			      48, 1);
+			timed(bm::RegisterBenchmark(("mrpt_grid3d_dec1" + sfx).c_str(),
+			                            benchGrid3D, c, v, 1),
+			      1, 3);
+			timed(bm::RegisterBenchmark(("mrpt_grid3d_default" + sfx).c_str(),
+			                            benchGrid3D, c, v, 0),
+			      3, 3);
+			timed(bm::RegisterBenchmark(("mrpt_octomap" + sfx).c_str(),
+			                            benchOctoMap, c, v),
+			      1, 3);
+			timed(bm::RegisterBenchmark(
+			          ("storage_raycast_hash_voxels_std" + sfx).c_str(),
+			          benchStorageUnordered, c, v),
+			      1, 3);
+			timed(bm::RegisterBenchmark(
+			          ("storage_raycast_hash_voxels_flat" + sfx).c_str(),
+			          benchStorageBlocks<0>, c, v),
+			      1, 3);
+			timed(
+			    bm::RegisterBenchmark(("storage_raycast_blocks8" + sfx).c_str(),
+			                          benchStorageBlocks<3>, c, v),
+			    1, 3);
+			timed(bm::RegisterBenchmark(
+			          ("storage_raycast_blocks16" + sfx).c_str(),
+			          benchStorageBlocks<4>, c, v),
+			      1, 3);
 		}
 }
 }  // namespace
