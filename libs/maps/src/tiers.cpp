@@ -14,14 +14,14 @@ CBackgroundSubtractionGrid::CBackgroundSubtractionGrid(const GridParams& p)
 {
 }
 
-void CBackgroundSubtractionGrid::posterior(const FrameCloud& f,
+void CBackgroundSubtractionGrid::posterior(const GridParams& p,
+                                           const FrameCloud& f,
                                            const std::vector<float>& priorO,
-                                           std::vector<float>& post) const
+                                           std::vector<float>& post)
 {
 	if (priorO.size() != f.cells.size())
 		throw std::invalid_argument(
 		    "CBackgroundSubtractionGrid::posterior: one O- per cell expected");
-	const auto& p = params_;
 	const double logLambda = std::log(p.reading_lambda);
 	post.resize(f.cells.size());
 	// The hit evidence depends on n only; cache the common small counts.
@@ -164,8 +164,7 @@ void CFlowConsistencyGrid::computePosterior(const FrameCloud& f,
                                             const std::vector<float>& priorO,
                                             std::vector<float>& post)
 {
-	CBackgroundSubtractionGrid t1(params_);
-	t1.posterior(f, priorO, t1scratch_);
+	CBackgroundSubtractionGrid::posterior(params_, f, priorO, t1scratch_);
 	PixelLabels labels = std::move(pending_);
 	pending_ = PixelLabels();
 	posterior(f, labels, t1scratch_, post);

@@ -143,7 +143,15 @@ class CBackgroundSubtractionGrid : public CMotionGridBase
 
 	/** Tier-1 posterior log-odds for each of frame.cells from O-. */
 	void posterior(const FrameCloud& frame, const std::vector<float>& priorO,
-	               std::vector<float>& post) const;
+	               std::vector<float>& post) const
+	{
+		posterior(params_, frame, priorO, post);
+	}
+	/** The same with parameters \a p (no map needed: tier 2 on its own
+	 * computes tier 1 through it). */
+	static void posterior(const GridParams& p, const FrameCloud& frame,
+	                      const std::vector<float>& priorO,
+	                      std::vector<float>& post);
 
 	void getVisualizationInto(mrpt::opengl::CSetOfObjects& o) const override;
 
