@@ -174,10 +174,25 @@ void fastRow(const uint16_t* raw, int W, uint32_t rawFast, uint32_t rowPix,
 	              tz = _mm_set1_pd(t.z);
 	const __m128d vUnits = _mm_set1_pd(units), vInv = _mm_set1_pd(inv);
 	Readings s = o;  // in registers, not aliased by the stores below
+	const __m128i zero16 = _mm_setzero_si128();
 	int u = 0;
 	while (u + 1 < W)
 	{
 		const uint32_t r0 = raw[u], r1 = raw[u + 1];
+		// Eight pixels without depth (a hole, a sparse image) at once: depth
+		// 0, counted, nothing else written (their slots would be
+		// overwritten by the next reading kept).
+		if (r0 == 0 && u + 8 <= W &&
+		    _mm_movemask_epi8(_mm_cmpeq_epi16(
+		        _mm_loadu_si128(reinterpret_cast<const __m128i*>(raw + u)),
+		        zero16)) == 0xFFFF)
+		{
+			_mm_storeu_ps(depthRow + u, _mm_setzero_ps());
+			_mm_storeu_ps(depthRow + u + 4, _mm_setzero_ps());
+			s.noDepth += 8;
+			u += 8;
+			continue;
+		}
 		if (r0 > rawFast || r1 > rawFast)
 		{
 			o = s;
