@@ -1,0 +1,33 @@
+#include <bims/common/pixel_labels.h>
+
+#include <mrpt/serialization/CArchive.h>
+#include <mrpt/serialization/stl_serialization.h>
+
+#include <algorithm>
+#include <vector>
+
+namespace bims
+{
+void BulkPixelLabels::internal_writeToStream(
+    mrpt::serialization::CArchive& out) const
+{
+	// The layout of TPixelLabelInfo<1> (after the header writeToStream()
+	// writes): rows, columns, the labels column after column, the label
+	// names.
+	const uint32_t nR = uint32_t(pixelLabels.rows()),
+	               nC = uint32_t(pixelLabels.cols());
+	out << nR << nC;
+	// Column-major from the row-major matrix, in tiles (both sides stay in
+	// cache).
+	std::vector<uint8_t> col(size_t(nR) * nC);
+	constexpr uint32_t T = 32;
+	for (uint32_t r0 = 0; r0 < nR; r0 += T)
+		for (uint32_t c0 = 0; c0 < nC; c0 += T)
+			for (uint32_t r = r0; r < std::min(nR, r0 + T); ++r)
+				for (uint32_t c = c0; c < std::min(nC, c0 + T); ++c)
+					col[size_t(c) * nR + r] = pixelLabels(r, c);
+	if (!col.empty()) out.WriteBuffer(col.data(), col.size());
+	out << pixelLabelNames;
+}
+
+}  // namespace bims
