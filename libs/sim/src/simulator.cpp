@@ -1,4 +1,5 @@
 #include <bims/common/app.h>
+#include <bims/common/pixel_labels.h>
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
@@ -65,12 +66,14 @@ mrpt::obs::CObservation3DRangeScan::Ptr makeScan(const SimConfig& cfg,
 	    unsigned(f.width), unsigned(f.height), true, f.rgb.data(), true);
 	if (cfg.seq.pixelLabels)
 	{
-		auto labels = std::make_shared<mrpt::obs::TPixelLabelInfo<1>>();
+		// Label 0, bit 0 of each pixel; written in one buffer (MRPT's bytes).
+		auto labels = std::make_shared<bims::BulkPixelLabels>();
 		labels->setSize(f.height, f.width);
 		labels->setLabelName(0, "moving");
 		for (int v = 0; v < f.height; v++)
 			for (int u = 0; u < f.width; u++)
-				if (f.mask[size_t(v) * f.width + u]) labels->setLabel(v, u, 0);
+				labels->pixelLabels(v, u) =
+				    uint8_t(f.mask[size_t(v) * f.width + u] != 0);
 		o->pixelLabels = labels;
 	}
 	return o;
