@@ -201,6 +201,9 @@ std::optional<double> CMotionGridBase::probabilityAt(
 {
 	if (frameCount_ == 0) return std::nullopt;
 	const VoxelKey k = keyOf(p);
+	// Never stored (never hit, or left out by the memory budget): no
+	// search.
+	if (!grid_.find(k)) return std::nullopt;
 	const auto& cells = *lastCells_;
 	for (size_t i = 0; i < cells.size(); ++i)
 		if (cells[i] == k) return sigmoid(lastPost_[i]);

@@ -77,8 +77,9 @@ class CMotionGridBase : public CBayesVoxelGridBase
 	const PixelMask& lastMovingMask() const { return lastMask_; }
 
 	/** Posterior probability of I at the voxel containing \a p_W if that
-	 * voxel was hit in the last frame, else nullopt. A query, not for
-	 * loops: O(voxels of the last frame). */
+	 * voxel was hit in the last frame (and stored: within the memory
+	 * budget), else nullopt. A query, not for loops: O(voxels of the last
+	 * frame) for a voxel stored before. */
 	std::optional<double> probabilityAt(const mrpt::math::TPoint3D& p_W) const;
 	/** Whether the voxel was labelled moving (MAP) at its last hit. */
 	bool wasMovingAtLastHit(const VoxelKey& k) const;
