@@ -89,9 +89,9 @@ TEST(MotionGrids, SameResultAsIndividualMapsThroughInsertObservation)
 	}
 }
 
-// MotionGrids hands tiers 1 and 2 one shared copy of the frame's cells and
-// reuses its buffer: a copy of a map taken in between keeps its own last
-// frame, and the maps keep theirs after the next frames.
+// MotionGrids hands tiers 1 and 2 the frame's cells (shared) and reuses its
+// buffers: a copy of a map taken in between keeps its own last frame, and
+// the maps keep theirs after the next frames.
 TEST(MotionGrids, SharedCellsOfTheLastFrameAreNeverOverwritten)
 {
 	GridParams p;
