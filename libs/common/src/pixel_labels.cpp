@@ -8,6 +8,22 @@
 
 namespace bims
 {
+std::shared_ptr<BulkPixelLabels> BulkPixelLabels::fromMask(
+    const uint8_t* mask, int rows, int cols, size_t stride,
+    const std::string& name)
+{
+	auto l = std::make_shared<BulkPixelLabels>();
+	l->setSize(rows, cols);
+	l->setLabelName(0, name);
+	for (int v = 0; v < rows; v++)
+	{
+		const uint8_t* m = mask + size_t(v) * stride;
+		for (int u = 0; u < cols; u++)
+			l->pixelLabels(v, u) = uint8_t(m[u] != 0);
+	}
+	return l;
+}
+
 void BulkPixelLabels::internal_writeToStream(
     mrpt::serialization::CArchive& out) const
 {

@@ -137,16 +137,9 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 	{
 		// Label 0 ("moving"), bit 0 of each pixel's byte; written in one
 		// buffer (MRPT's TPixelLabelInfo<1> bytes, ~3 ms less per VGA frame).
-		auto labels = std::make_shared<bims::BulkPixelLabels>();
-		labels->setSize(r.mask.rows, r.mask.cols);
-		labels->setLabelName(0, "moving");
-		for (int v = 0; v < r.mask.rows; v++)
-		{
-			const uint8_t* m = r.mask.ptr<uint8_t>(v);
-			for (int u = 0; u < r.mask.cols; u++)
-				labels->pixelLabels(v, u) = uint8_t(m[u] != 0);
-		}
-		scan.pixelLabels = labels;  // no copy of the images
+		scan.pixelLabels = bims::BulkPixelLabels::fromMask(
+		    r.mask.ptr<uint8_t>(0), r.mask.rows, r.mask.cols, r.mask.step[0],
+		    "moving");  // no copy of the images
 		rawlog_->write(scan);
 		// a plain rawlog reaches the OS frame by frame: a killed run leaves
 		// it readable up to the last whole frame

@@ -67,14 +67,8 @@ mrpt::obs::CObservation3DRangeScan::Ptr makeScan(const SimConfig& cfg,
 	if (cfg.seq.pixelLabels)
 	{
 		// Label 0, bit 0 of each pixel; written in one buffer (MRPT's bytes).
-		auto labels = std::make_shared<bims::BulkPixelLabels>();
-		labels->setSize(f.height, f.width);
-		labels->setLabelName(0, "moving");
-		for (int v = 0; v < f.height; v++)
-			for (int u = 0; u < f.width; u++)
-				labels->pixelLabels(v, u) =
-				    uint8_t(f.mask[size_t(v) * f.width + u] != 0);
-		o->pixelLabels = labels;
+		o->pixelLabels = bims::BulkPixelLabels::fromMask(
+		    f.mask.data(), f.height, f.width, size_t(f.width), "moving");
 	}
 	return o;
 }

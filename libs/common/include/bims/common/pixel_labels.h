@@ -4,6 +4,9 @@
 #include <mrpt/math/CMatrixDynamic.h>
 #include <mrpt/obs/TPixelLabelInfo.h>
 
+#include <memory>
+#include <string>
+
 namespace bims
 {
 /** mrpt::obs::TPixelLabelInfo<1> (8 labels per pixel) whose serialisation
@@ -13,6 +16,14 @@ namespace bims
  * RawLogViewer read it back as a TPixelLabelInfo<1>. */
 class BulkPixelLabels : public mrpt::obs::TPixelLabelInfo<1>
 {
+ public:
+	/** One label \a name (index 0) on the pixels where \a mask (rows x
+	 * cols bytes, \a stride bytes from row to row) is non-zero. */
+	static std::shared_ptr<BulkPixelLabels> fromMask(const uint8_t* mask,
+	                                                 int rows, int cols,
+	                                                 size_t stride,
+	                                                 const std::string& name);
+
  protected:
 	void internal_writeToStream(
 	    mrpt::serialization::CArchive& out) const override;
