@@ -14,6 +14,8 @@ const std::vector<std::string>& experimentSections()
 	    "tracker",      // ego: gyro-aided KLT
 	    "translation",  // ego: robust translation / refinement
 	    "odometry",     // ego: overall egomotion mode
+	    "anchor",       // ego: map-anchored (keyframe) tracking
+	    "depth_correction",  // ego: depth sensor's smooth distortion
 	    "grids",        // maps: the three Bayesian grids
 	    "flow",         // flow: observed / expected flow, Diff labels
 	    "pipeline",     // pipeline: orchestration, variants

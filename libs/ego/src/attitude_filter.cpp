@@ -351,7 +351,12 @@ std::string flagsToString(uint32_t flags)
 	    {kFlagAccelGated, "accel_gated"},
 	    {kFlagMagGated, "mag_gated"},
 	    {kFlagBadImage, "bad_image"},
-	    {kFlagWorldReanchored, "world_reanchored"}};
+	    {kFlagWorldReanchored, "world_reanchored"},
+	    {kFlagAnchored, "anchored"},
+	    {kFlagAnchorFailed, "anchor_failed"},
+	    {kFlagNewKeyframe, "new_keyframe"},
+	    {kFlagAnchorLost, "anchor_lost"},
+	    {kFlagMaskIgnored, "mask_ignored"}};
 	std::string s;
 	for (const auto& [bit, name] : names)
 		if (flags & bit) s += (s.empty() ? "" : "|") + std::string(name);

@@ -4,6 +4,8 @@
 
 #include <mrpt/math/CMatrixFixed.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include <chrono>
 
 namespace bims::ego
@@ -35,8 +37,10 @@ const char* toString(RotationSource s)
 
 bool FrameEgomotion::ok() const
 {
-	return !(flags & (kFlagTooFewTracks | kFlagTooFewInliers | kFlagOutOfOrder |
-	                  kFlagBadImage));
+	if (flags & (kFlagOutOfOrder | kFlagBadImage)) return false;
+	// the keyframe alignment measures the motion even without tracks
+	return (flags & kFlagAnchored) ||
+	       !(flags & (kFlagTooFewTracks | kFlagTooFewInliers));
 }
 
 mrpt::poses::CPose3D toPose(const Eigen::Matrix3d& R, const Eigen::Vector3d& t)
@@ -52,7 +56,11 @@ mrpt::poses::CPose3D toPose(const Eigen::Matrix3d& R, const Eigen::Vector3d& t)
 }
 
 Odometry::Odometry(const EgoConfig& cfg)
-    : cfg_(cfg), att_(cfg.attitude), klt_(cfg.tracker), est_(cfg.translation)
+    : cfg_(cfg),
+      att_(cfg.attitude),
+      klt_(cfg.tracker),
+      est_(cfg.translation),
+      anchor_(cfg.anchor)
 {
 }
 
@@ -127,6 +135,31 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		return r;
 	}
 	++nFrames_;
+	lastAnchored_ = false;
+	const bool anchoring = cfg_.anchor.enable;
+	// The previous frame becomes a keyframe now that its moving mask is
+	// known.
+	if (anchoring && anchor_.addPending(mask ? *mask : cv::Mat()))
+		r.flags |= kFlagNewKeyframe;
+	// What moved in the previous frame: the caller's mask (segmentation)
+	// and the anchor's own outliers. Not used when it covers too much.
+	cv::Mat moving;
+	const bool own = anchoring && anchorMoving_.size() == f.grey.size();
+	if (mask && !mask->empty() && own && mask->size() == f.grey.size())
+		cv::bitwise_or(*mask, anchorMoving_, moving);  // (a new buffer)
+	else if (mask && !mask->empty())
+		moving = *mask;
+	else if (own)
+		moving = anchorMoving_;
+	anchorMoving_.release();
+	if (!moving.empty() && cv::countNonZero(moving) >
+	                           cfg_.anchor.max_excluded_fraction *
+	                               static_cast<double>(moving.total()))
+	{
+		r.flags |= kFlagMaskIgnored;
+		moving.release();
+	}
+	mask = moving.empty() ? nullptr : &moving;
 	const bool imuMode = cfg_.odometry.mode == "imu";
 	uint32_t imuFlags = 0;
 	const auto R_WC_imu = imuRotation(f.t, &imuFlags);
@@ -147,6 +180,12 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		const auto t1 = std::chrono::steady_clock::now();
 		klt_.track(f.grey, f.K, nullptr, mask);
 		r.ms_track = msSince(t1);
+		if (anchoring)
+		{
+			r.anchor = anchor_.track(f, R_WC_, t_WC_, {}, nullptr, cv::Mat());
+			anchor_.wantKeyframe(r.anchor, R_WC_, t_WC_, true);
+			r.ms_anchor = r.anchor.ms;
+		}
 		r.T_WC = T_WC_;
 		r.flags = kFlagFirstFrame | (imuMode ? imuFlags : 0);
 		havePrev_ = true;
@@ -295,6 +334,50 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		R_WCprev_ = R_fix * R_WCprev_;
 		t_WCprev_ = R_fix * t_WCprev_;
 		r.flags |= kFlagWorldReanchored;
+		anchor_.clear();  // the keyframes are in the old world
+	}
+	if (anchoring)
+	{
+		// Measure the pose against the static scene, from the
+		// frame-to-frame guess (and the IMU rotation as the prior).
+		// The frame-to-frame estimate first; the constant-velocity
+		// prediction as a second guess (features on people can corrupt the
+		// first).
+		const InitialGuess constVel{
+		    useImu ? R_WC_ : Eigen::Matrix3d(R_WCprev_ * lastR_rel_),
+		    t_WCprev_ + R_WCprev_ * lastT_rel_};
+		const Eigen::Matrix3d R_prior = R_WC_;
+		r.anchor = anchor_.track(f, R_WC_, t_WC_, {constVel},
+		                         useImu ? &R_prior : nullptr,
+		                         mask ? *mask : cv::Mat());
+		r.ms_anchor = r.anchor.ms;
+		bool lost = false;
+		if (r.anchor.accepted)
+		{
+			cv::resize(r.anchor.outliers, anchorMoving_, f.grey.size(), 0, 0,
+			           cv::INTER_NEAREST);
+			R_WC_ = orthonormalize(r.anchor.R_WC);
+			t_WC_ = r.anchor.t_WC;
+			R_rel = R_WCprev_.transpose() * R_WC_;
+			t_rel = R_WCprev_.transpose() * (t_WC_ - t_WCprev_);
+			r.flags |= kFlagAnchored;
+			anchorFailures_ = 0;
+			lastAnchored_ = true;
+		}
+		else if (r.anchor.tried)
+		{
+			r.flags |= kFlagAnchorFailed;
+			lost = ++anchorFailures_ >= cfg_.anchor.lost_frames;
+		}
+		if (lost)
+		{
+			// Go on from this frame's (frame-to-frame) pose: it becomes a
+			// keyframe; the older keyframes stay for when the view returns.
+			r.flags |= kFlagAnchorLost;
+			anchorFailures_ = 0;
+		}
+		anchor_.wantKeyframe(r.anchor, R_WC_, t_WC_,
+		                     lost || (r.flags & kFlagWorldReanchored));
 	}
 	lastR_rel_ = R_rel;
 	lastT_rel_ = t_rel;
@@ -313,7 +396,7 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 mrpt::poses::CPose3D Odometry::correctLastMotion(
     const mrpt::poses::CPose3D& T_CprevC)
 {
-	if (!haveMotion_) return T_WC_;
+	if (!haveMotion_ || lastAnchored_) return T_WC_;
 	Eigen::Matrix3d R;
 	const auto& Rm = T_CprevC.getRotationMatrix();
 	for (int i = 0; i < 3; i++)

@@ -130,6 +130,55 @@ void OdometryParams::loadFromConfigFile(
 	s.finish();
 }
 
+void AnchorParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+                                      const std::string& section)
+{
+	ConfigSection s(cfg, section);
+	enable = s.getBool("enable", enable);
+	finest_level =
+	    static_cast<int>(s.getInt("finest_level", finest_level, 0, 6));
+	coarsest_level =
+	    static_cast<int>(s.getInt("coarsest_level", coarsest_level, 0, 6));
+	if (coarsest_level < finest_level)
+		s.fail("coarsest_level", "must be >= finest_level");
+	iterations = static_cast<int>(s.getInt("iterations", iterations, 1, 100));
+	stride_px = static_cast<int>(s.getInt("stride_px", stride_px, 1, 16));
+	geo_sigma_m = s.getDouble("geo_sigma_m", geo_sigma_m, 1e-5, 1);
+	geo_sigma_z2 = s.getDouble("geo_sigma_z2", geo_sigma_z2, 0, 1);
+	gate_m = s.getDouble("gate_m", gate_m, 1e-3, 10);
+	gate_z2 = s.getDouble("gate_z2", gate_z2, 0, 10);
+	photo_sigma_grey =
+	    s.getDouble("photo_sigma_grey", photo_sigma_grey, 0.01, 255);
+	photo_weight = s.getDouble("photo_weight", photo_weight, 0, 100);
+	tukey_c = s.getDouble("tukey_c", tukey_c, 1, 100);
+	rotation_prior_sigma_deg = s.getDouble("rotation_prior_sigma_deg",
+	                                       rotation_prior_sigma_deg, 0, 180);
+	min_inliers =
+	    static_cast<int>(s.getInt("min_inliers", min_inliers, 6, 10000000));
+	min_inlier_fraction =
+	    s.getDouble("min_inlier_fraction", min_inlier_fraction, 0, 1);
+	max_correction_m =
+	    s.getDouble("max_correction_m", max_correction_m, 1e-4, 100);
+	max_correction_deg =
+	    s.getDouble("max_correction_deg", max_correction_deg, 1e-3, 180);
+	keyframe_distance_m =
+	    s.getDouble("keyframe_distance_m", keyframe_distance_m, 0.001, 100);
+	keyframe_angle_deg =
+	    s.getDouble("keyframe_angle_deg", keyframe_angle_deg, 0.01, 180);
+	keyframe_min_overlap =
+	    s.getDouble("keyframe_min_overlap", keyframe_min_overlap, 0, 1);
+	max_keyframes =
+	    static_cast<int>(s.getInt("max_keyframes", max_keyframes, 1, 100000));
+	lost_frames = static_cast<int>(s.getInt("lost_frames", lost_frames, 1, 1e6));
+	max_excluded_fraction =
+	    s.getDouble("max_excluded_fraction", max_excluded_fraction, 0, 1);
+	min_depth_m = s.getDouble("min_depth_m", min_depth_m, 0, 100);
+	max_depth_m = s.getDouble("max_depth_m", max_depth_m, 0.01, 1000);
+	if (max_depth_m <= min_depth_m)
+		s.fail("max_depth_m", "must be greater than min_depth_m");
+	s.finish();
+}
+
 void CalibrationParams::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& cfg, const std::string& section,
     bool requireR)
@@ -213,6 +262,8 @@ void EgoConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	tracker.loadFromConfigFile(cfg);
 	translation.loadFromConfigFile(cfg);
 	odometry.loadFromConfigFile(cfg);
+	anchor.loadFromConfigFile(cfg);
+	depth_correction.loadFromConfigFile(cfg);
 	calibration.loadFromConfigFile(
 	    cfg, "calibration", requireCalibration && odometry.mode == "imu");
 	camera.loadFromConfigFile(cfg);
@@ -224,6 +275,8 @@ void EgoConfig::overrideSensorSections(const mrpt::config::CConfigFileBase& cal)
 	if (cal.sectionExists("calibration")) calibration.loadFromConfigFile(cal);
 	if (cal.sectionExists("camera")) camera.loadFromConfigFile(cal);
 	if (cal.sectionExists("sensors")) sensors.loadFromConfigFile(cal);
+	if (cal.sectionExists("depth_correction"))
+		depth_correction.loadFromConfigFile(cal);
 }
 
 }  // namespace bims::ego

@@ -1,6 +1,7 @@
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
 #include <bims/ego/flags.h>
+#include <bims/ego/depth_correction.h>
 #include <bims/ego/replay.h>
 
 #include <mrpt/core/Clock.h>
@@ -22,6 +23,7 @@ ReplayStats replayRawlog(const std::string& path, Odometry& odo,
 	double lastImuT = -std::numeric_limits<double>::infinity();
 	double newestT = lastImuT;
 	std::deque<CObservation3DRangeScan::Ptr> pending;
+	DepthCorrection depthCorrection(cfg.depth_correction);
 	ProgressBar bar("bims-odom", 0, opt.progress);
 	bool done = false;
 
@@ -76,6 +78,7 @@ ReplayStats replayRawlog(const std::string& path, Odometry& odo,
 				++st.otherLabel;
 				continue;
 			}
+			depthCorrection.apply(*scan, cfg.camera);
 			pending.push_back(scan);
 		}
 		newestT = std::max(newestT, t);

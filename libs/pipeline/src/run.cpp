@@ -5,6 +5,7 @@
 #include <bims/ego/flags.h>
 #include <bims/maps/export.h>
 #include <bims/pipeline/run.h>
+#include <bims/ego/depth_correction.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/obs/TPixelLabelInfo.h>
@@ -206,6 +207,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	try
 	{
 		ReadAhead input(opt.rawlogs, kReadAhead, cfg.pipeline.read_ahead);
+		ego::DepthCorrection depthCorrection(cfg.ego.depth_correction);
 		for (;;)
 		{
 			double wait = 0;
@@ -259,6 +261,9 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 					continue;
 				}
 				lastScanT = t;
+				// the sensor's depth distortion corrected once, for every
+				// stage and for the written scan
+				depthCorrection.apply(*scan, cfg.ego.camera);
 				pending.push_back(
 				    {scan, idx, t, readMs, readCpuMs, inWaitMs, {}});
 				readMs = readCpuMs = inWaitMs = 0;

@@ -25,6 +25,22 @@ enum EgoFlag : uint32_t
 	 * world's rotation was re-anchored on it (T_WC jumps, T_CprevC is the
 	 * vision estimate). */
 	kFlagWorldReanchored = 1u << 10,
+	/** The pose was aligned to a keyframe of the static scene ([anchor]). */
+	kFlagAnchored = 1u << 11,
+	/** [anchor] enabled but the alignment failed or was rejected (too few
+	 * inliers, a correction beyond max_correction_*): the frame-to-frame
+	 * pose is kept. */
+	kFlagAnchorFailed = 1u << 12,
+	/** This frame's predecessor became a keyframe. */
+	kFlagNewKeyframe = 1u << 13,
+	/** lost_frames frames in a row without an accepted alignment: the
+	 * anchoring restarts from this frame (its pose is the frame-to-frame
+	 * one; nothing jumps; the older keyframes stay). */
+	kFlagAnchorLost = 1u << 14,
+	/** The moving mask covered more than [anchor] max_excluded_fraction of
+	 * the image: not used for this frame (the feedback must not starve the
+	 * tracker). */
+	kFlagMaskIgnored = 1u << 15,
 };
 
 /** "imu_gap|too_few_tracks" style text ("ok" for none). */

@@ -7,12 +7,17 @@
 //                                 translation from the rotation-compensated
 //                                 features (optionally refined with SE(3));
 //                  mode = vision: full SE(3) from the 3D features (RANSAC).
+// Then ([anchor] enable) the pose is aligned densely to a keyframe of the
+// static scene (KeyframeAnchor): the frame-to-frame estimate is only its
+// initial guess (and the IMU rotation its prior).
 // The moving-region mask of the previous frame (from the segmentation) keeps
-// features off independently moving objects. No threads, no I/O.
+// features off independently moving objects, out of the alignment and out
+// of the keyframe the previous frame may become. No threads, no I/O.
 #pragma once
 
 #include <bims/ego/attitude_filter.h>
 #include <bims/ego/gyro_klt.h>
+#include <bims/ego/keyframe_anchor.h>
 #include <bims/ego/params.h>
 #include <bims/ego/rgbd_input.h>
 #include <bims/ego/translation_estimator.h>
@@ -50,7 +55,10 @@ struct FrameEgomotion
 	std::vector<Track> tracks;  ///< KLT tracks previous -> this frame
 	/** Per track: 1 inlier, 0 outlier (candidate moving), -1 no depth. */
 	std::vector<int8_t> trackInlier;
+	/** What the map anchoring did ([anchor]; tried = false when off). */
+	AnchorResult anchor;
 	double ms_input = 0, ms_track = 0, ms_motion = 0;  ///< stage times [ms]
+	double ms_anchor = 0;  ///< of ms_motion: the keyframe alignment [ms]
 	TrackerStats tracker;  ///< KLT counters of this frame
 	/** Previous-image positions of all features the KLT tried [px]. */
 	std::vector<cv::Point2f> attempted;
@@ -86,7 +94,9 @@ class Odometry
 	 * attitude_blend pulls R_WC back towards the filter's in later frames).
 	 * Returns the new T_WC. Does
 	 * nothing (returns the current T_WC) when the last frame estimated no
-	 * motion (first frame, out-of-order or unusable frame). */
+	 * motion (first frame, out-of-order or unusable frame), or when that
+	 * frame was anchored to a keyframe: the anchored pose is measured
+	 * against the static scene and stays. */
 	mrpt::poses::CPose3D correctLastMotion(
 	    const mrpt::poses::CPose3D& T_CprevC);
 
@@ -114,6 +124,13 @@ class Odometry
 	AttitudeFilter att_;
 	GyroAidedKLT klt_;
 	TranslationEstimator est_;
+	KeyframeAnchor anchor_;
+	int anchorFailures_ = 0;  // frames in a row without an accepted anchor
+	bool lastAnchored_ = false;
+	/** Full-size image of the last accepted alignment's outliers: the
+	 * anchor's own moving mask, used with the caller's for the next frame
+	 * (bims-odom has no other). */
+	cv::Mat anchorMoving_;
 	bool havePrev_ = false;
 	double tPrev_ = 0;
 	cv::Mat depthPrev_;

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <optional>
 #include <string>
 
@@ -142,6 +143,62 @@ struct OdometryParams
 	                        const std::string& section = "odometry");
 };
 
+/** [anchor]: map-anchored tracking. Each frame is aligned densely
+ * (point-to-plane ICP + photometric, robust Tukey weights, coarse to fine) to
+ * a keyframe of the static scene registered in the same world, starting from
+ * the frame-to-frame estimate; content absent from the keyframe (people who
+ * walked in, or moved) gets no weight (docs/ego.md, "Map-anchored tracking"). */
+struct AnchorParams
+{
+	bool enable = true;  ///< false: frame-to-frame egomotion only
+	int finest_level = 1;   ///< finest pyramid level aligned (0 = full size)
+	int coarsest_level = 3;  ///< coarsest level (each level halves the size)
+	int iterations = 8;      ///< Gauss-Newton iterations per level (max)
+	int stride_px = 2;       ///< pixel sampling step at the finest level
+	/** Geometric residual scale a + b z^2 [m] (point-to-plane). */
+	double geo_sigma_m = 0.004;
+	double geo_sigma_z2 = 0.004;  ///< b above [1/m]
+	/** A point whose depth differs from the keyframe's at its pixel by
+	 * more than a + b z^2 is not associated (occlusion, moving) [m]. */
+	double gate_m = 0.08;
+	double gate_z2 = 0.02;  ///< b above [1/m]
+	/** Least photometric residual scale [grey levels]; the scale used is
+	 * 1.4826 x the median |residual| of the last pass when larger. */
+	double photo_sigma_grey = 8;
+	double photo_weight = 1;      ///< weight of the photometric term (0: off)
+	double tukey_c = 4.685;       ///< Tukey biweight limit [scales]
+	/** mode = imu: std. dev. of the IMU rotation as the alignment's prior
+	 * [deg]; 0 keeps the IMU rotation and aligns the translation only (the
+	 * paper's split: rotation from the IMU, translation from vision). */
+	double rotation_prior_sigma_deg = 0;
+	int min_inliers = 400;  ///< fewer inliers at the finest level: failed
+	/** Fewer than this share of the associated points inliers: failed. */
+	double min_inlier_fraction = 0.3;
+	/** Anchored pose farther than this from the frame-to-frame one: the
+	 * alignment is rejected (flagged, frame-to-frame kept) [m], [deg]. */
+	double max_correction_m = 0.15;
+	double max_correction_deg = 6;
+	/** A new keyframe when the frame is farther than this from its
+	 * keyframe [m], [deg], or when the keyframe covers less than
+	 * keyframe_min_overlap of its points (occluders count as covered). */
+	double keyframe_distance_m = 0.3;
+	double keyframe_angle_deg = 15;
+	double keyframe_min_overlap = 0.5;
+	int max_keyframes = 64;  ///< oldest dropped beyond this
+	/** After this many frames in a row without an accepted alignment the
+	 * current frame becomes the keyframe (tracking lost, flagged). */
+	int lost_frames = 10;
+	/** A moving mask that covers more than this share of a frame's depth
+	 * readings is not used for that frame (counted, flagged in the CSV):
+	 * the feedback must not starve the alignment. */
+	double max_excluded_fraction = 0.7;
+	double min_depth_m = 0.3;  ///< depth outside [min,max] unused [m]
+	double max_depth_m = 6.0;
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+	                        const std::string& section = "anchor");
+};
+
 /** [calibration]: IMU-camera extrinsics. Convention (bims/common/frames.h):
  * R_IC is the camera frame {C} (optical) expressed in the IMU frame {I}:
  * p_I = R_IC p_C, so R_WC = R_WI R_IC. Time: the IMU sample stamped
@@ -183,6 +240,23 @@ struct SensorsParams
 	                        const std::string& section = "sensors");
 };
 
+/** Terms of the depth correction polynomial (bims/ego/depth_correction.h). */
+constexpr int kDepthCorrectionTerms = 12;
+
+/** [depth_correction]: a smooth multiplicative correction of the depth
+ * readings, z (1 + delta(x, y)) (bims/ego/depth_correction.h; fitted by
+ * bims-calib-depth): enable, coefficients (12 reals). */
+struct DepthCorrectionParams
+{
+	bool enable = false;
+	std::array<double, kDepthCorrectionTerms> coefficients{};
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+	                        const std::string& section = "depth_correction");
+	/** The section as .ini text (what bims-calib-depth writes). */
+	std::string toIni(const std::string& comment = "") const;
+};
+
 /** Everything the egomotion stage reads from one experiment file. */
 struct EgoConfig
 {
@@ -190,6 +264,8 @@ struct EgoConfig
 	TrackerParams tracker;
 	TranslationParams translation;
 	OdometryParams odometry;
+	AnchorParams anchor;
+	DepthCorrectionParams depth_correction;
 	CalibrationParams calibration;
 	CameraParams camera;
 	SensorsParams sensors;

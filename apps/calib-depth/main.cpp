@@ -1,0 +1,180 @@
+// bims-calib-depth CONFIG.ini IN.rawlog [--frames A:B] [--poses TRAJ.txt]
+//                  -o OUT.ini
+// Fits the depth sensor's smooth distortion (docs/ego.md, "Depth
+// correction") to a stretch of a static scene: point-to-plane residuals
+// between frame pairs at known poses (--poses, a TUM trajectory) or at the
+// poses of bims' own frame-to-frame vision odometry (no ground truth
+// needed). Writes a [depth_correction] section to paste into (or include
+// with) the experiment .ini.
+#include <bims/common/app.h>
+#include <bims/common/config.h>
+#include <bims/common/experiment.h>
+#include <bims/common/trajectory.h>
+#include <bims/ego/depth_correction.h>
+#include <bims/ego/flags.h>
+#include <bims/ego/replay.h>
+
+#include <mrpt/3rdparty/tclap/CmdLine.h>
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/system/filesystem.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+namespace
+{
+Eigen::Matrix4d toMatrix(const mrpt::poses::CPose3D& T)
+{
+	Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
+	for (int i = 0; i < 3; i++)
+	{
+		for (int j = 0; j < 3; j++) M(i, j) = T.getRotationMatrix()(i, j);
+		M(i, 3) = T.translation()[i];
+	}
+	return M;
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+	return bims::runApp(
+	    "bims-calib-depth",
+	    [&]()
+	    {
+		    using namespace bims;
+		    TCLAP::CmdLine cmd(
+		        "Fits the depth sensor's smooth distortion to a static stretch "
+		        "of a recording and writes a [depth_correction] section.",
+		        ' ', "0.1");
+		    TCLAP::UnlabeledValueArg<std::string> cfgArg(
+		        "CONFIG", "experiment .ini ([camera], [sensors])", true, "",
+		        "CONFIG.ini", cmd);
+		    TCLAP::UnlabeledValueArg<std::string> inArg(
+		        "RAWLOG", "input rawlog (RGB-D)", true, "", "IN.rawlog", cmd);
+		    TCLAP::ValueArg<std::string> framesArg(
+		        "", "frames",
+		        "3D-scan indices A:B (inclusive) of a stretch without moving "
+		        "objects (default: all)",
+		        false, "", "A:B", cmd);
+		    TCLAP::ValueArg<std::string> posesArg(
+		        "", "poses",
+		        "TUM trajectory of the camera (e.g. ground truth); default: "
+		        "bims' frame-to-frame vision odometry",
+		        false, "", "TRAJ.txt", cmd);
+		    TCLAP::ValueArg<std::string> outArg(
+		        "o", "out", "where to write the [depth_correction] section",
+		        true, "", "OUT.ini", cmd);
+		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
+		    bims::parseCommandLine(cmd, argc, argv);
+
+		    const std::string cfgPath = cfgArg.getValue();
+		    if (!mrpt::system::fileExists(cfgPath))
+			    throw UsageError(cfgPath + ": no such config file");
+		    mrpt::config::CConfigFile cfg(cfgPath);
+		    checkExperimentSections(cfg);
+		    ego::EgoConfig ec;
+		    ec.loadFromConfigFile(cfg, false);
+		    // raw depth, frame-to-frame vision odometry
+		    ec.odometry.mode = "vision";
+		    ec.anchor.enable = false;
+		    ec.depth_correction.enable = false;
+		    size_t first = 0, last = static_cast<size_t>(-1);
+		    if (framesArg.isSet())
+		    {
+			    const std::string& f = framesArg.getValue();
+			    const auto colon = f.find(':');
+			    try
+			    {
+				    if (colon == std::string::npos) throw 0;
+				    first = std::stoul(f.substr(0, colon));
+				    last = std::stoul(f.substr(colon + 1));
+			    }
+			    catch (...)
+			    {
+				    throw UsageError("--frames: expected A:B, got '" + f + "'");
+			    }
+			    if (last < first)
+				    throw UsageError("--frames: B must not be less than A");
+		    }
+		    Trajectory known;
+		    if (posesArg.isSet()) known = loadTumTrajectory(posesArg.getValue());
+		    auto poseAt = [&known](double t) -> const StampedPose*
+		    {
+			    const StampedPose* best = nullptr;
+			    double dt = 5e-3;
+			    for (const auto& p : known)
+				    if (std::abs(p.t - t) < dt)
+				    {
+					    dt = std::abs(p.t - t);
+					    best = &p;
+				    }
+			    return best;
+		    };
+
+		    ego::Odometry odo(ec);
+		    std::vector<ego::RgbdFrame> frames;
+		    std::vector<Eigen::Matrix4d> poses;
+		    size_t index = 0, noPose = 0;
+		    ego::ReplayOptions ro;
+		    ro.progress = !quiet.getValue();
+		    if (last != static_cast<size_t>(-1)) ro.max_frames = last + 1;
+		    ego::replayRawlog(
+		        inArg.getValue(), odo,
+		        [&](const ego::FrameEgomotion& r,
+		            const mrpt::obs::CObservation3DRangeScan& scan)
+		        {
+			        const size_t i = index++;
+			        if (i < first || i > last) return;
+			        if (r.flags & (ego::kFlagOutOfOrder | ego::kFlagBadImage))
+				        return;
+			        mrpt::poses::CPose3D T = r.T_WC;
+			        if (!known.empty())
+			        {
+				        const StampedPose* p = poseAt(r.t);
+				        if (!p)
+				        {
+					        ++noPose;
+					        return;
+				        }
+				        T = p->T_WC;
+			        }
+			        ego::RgbdFrame f;
+			        if (!ego::rgbdFrameFrom(scan, ec.camera, f).empty()) return;
+			        frames.push_back(std::move(f));
+			        poses.push_back(toMatrix(T));
+		        },
+		        ro);
+		    if (frames.empty())
+			    throw std::runtime_error(
+			        inArg.getValue() +
+			        ": no usable RGB-D frame in the range (check --frames, "
+			        "[sensors] rgbd_label" +
+			        std::string(known.empty() ? ")" : ", --poses stamps)"));
+		    const ego::DepthFitResult res =
+		        ego::estimateDepthCorrection(frames, poses);
+		    std::printf(
+		        "bims-calib-depth: %zu frames (%zu without a pose), %d pairs, "
+		        "%zu residuals; robust RMS point-to-plane %.4f -> %.4f m\n"
+		        "bims-calib-depth: correction (1 + delta): left %+.2f %%, right "
+		        "%+.2f %%, top %+.2f %%, bottom %+.2f %%, top-left corner "
+		        "%+.2f %%\n",
+		        frames.size(), noPose, res.pairs, res.residuals,
+		        res.rms_before_m, res.rms_after_m, 100 * res.left,
+		        100 * res.right, 100 * res.top, 100 * res.bottom,
+		        100 * res.corner);
+		    std::ofstream out(outArg.getValue());
+		    if (!out)
+			    throw std::runtime_error(outArg.getValue() + ": cannot write");
+		    char note[512];
+		    std::snprintf(note, sizeof(note),
+		                  "# bims-calib-depth: %zu frames of %s (%s poses), "
+		                  "robust RMS %.4f -> %.4f m\n",
+		                  frames.size(),
+		                  mrpt::system::extractFileName(inArg.getValue()).c_str(),
+		                  known.empty() ? "vision odometry" : "given",
+		                  res.rms_before_m, res.rms_after_m);
+		    out << res.params.toIni(note);
+		    return 0;
+	    });
+}

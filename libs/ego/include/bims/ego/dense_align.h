@@ -1,0 +1,128 @@
+// Dense RGB-D alignment of a frame to a reference frame (a keyframe): the
+// motion T_RC (current camera in the reference camera) that makes the
+// current frame's points land on the reference's surfaces (point-to-plane
+// ICP with projective association) and its grey values match the reference's
+// (photometric term), coarse to fine, with Tukey's biweight on both
+// residuals. Content the reference does not hold (a person who walked in, an
+// object that moved) lands far from the reference surface: it fails the
+// depth gate or gets zero weight, so it does not pull the pose.
+//
+// The reference's normals and gradients are computed once
+// (DenseFrame::prepareReference): a keyframe is reused for many frames.
+// Derivation and measurements: docs/ego.md, "Map-anchored tracking".
+#pragma once
+
+#include <bims/ego/params.h>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include <string>
+#include <vector>
+
+namespace bims::ego
+{
+/** A reference pixel packed for the alignment's lookups (one cache line
+ * for two pixels): depth, normal, plane offset d = n . P, grey, gradient. */
+struct RefPixel
+{
+	float z, nx, ny, nz, d, g, gx, gy;
+};
+
+/** One pyramid level of a frame. */
+struct DenseLevel
+{
+	cv::Mat depth;   ///< CV_32FC1 [m], 0 = none (or excluded)
+	cv::Mat grey;    ///< CV_32FC1 grey levels
+	cv::Mat gx, gy;  ///< CV_32FC1 grey gradients [grey/px] (reference only)
+	cv::Mat normal;  ///< CV_32FC3 unit normals, 0 = none (reference only)
+	std::vector<RefPixel> packed;  ///< the same, packed (reference only)
+	float fx = 0, fy = 0, cx = 0, cy = 0;  ///< intrinsics of the level [px]
+};
+
+/** A frame as a pyramid (level 0 = full size, each level half the last). */
+class DenseFrame
+{
+ public:
+	/** Builds levels 0..p.coarsest_level from \a grey (CV_8UC1) and
+	 * \a depth (CV_32FC1 [m]). Depth outside [min, max]_depth_m and pixels
+	 * where \a exclude (CV_8UC1, may be empty) is non-zero are dropped. A
+	 * 2x2 block's depth is the mean of its readings when they agree (within
+	 * 3 % + 1 cm), else none (no averaging across depth edges). */
+	void build(const cv::Mat& grey, const cv::Mat& depth,
+	           const Eigen::Matrix3d& K, const AnchorParams& p,
+	           const cv::Mat& exclude = cv::Mat());
+	/** Adds gradients and normals at levels finest..coarsest: the frame
+	 * can then be the reference of alignDense(). */
+	void prepareReference(const AnchorParams& p);
+	bool isReference() const { return reference_; }
+	/** Drops the readings where \a mask (CV_8UC1 of the finest level's
+	 * size) is non-zero, from the finest and every coarser level: content
+	 * known to move. */
+	void dropReadings(const cv::Mat& mask, const AnchorParams& p);
+	bool empty() const { return levels.empty(); }
+
+	std::vector<DenseLevel> levels;
+
+ private:
+	bool reference_ = false;
+};
+
+/** Result of one alignment. */
+struct DenseAlignResult
+{
+	bool ok = false;  ///< converged with enough inliers
+	std::string why;  ///< why not (empty when ok)
+	Eigen::Matrix3d R_RC = Eigen::Matrix3d::Identity();  ///< current in ref
+	Eigen::Vector3d t_RC = Eigen::Vector3d::Zero();      ///< [m]
+	int points = 0;      ///< sampled points with depth, finest level
+	int associated = 0;  ///< of those, landing on a reference reading
+	int inliers = 0;     ///< of those, within the gate and Tukey's limit
+	double inlier_fraction = 0;  ///< inliers / associated
+	double overlap = 0;          ///< inliers / points
+	/** associated / points: how much of the frame the reference covers
+	 * (occluders count as covered; they are not a reason for a new
+	 * keyframe). */
+	double coverage = 0;
+	int guess = 0;  ///< index of the initial guess that won
+	double rms_geo_m = 0;        ///< RMS point-to-plane residual of inliers
+	int iterations = 0;          ///< Gauss-Newton steps over all levels
+	/** Finest-level image (CV_8UC1): 255 where a current point is an
+	 * outlier (in front of the reference's surface or off it: candidate
+	 * moving), 0 elsewhere. */
+	cv::Mat outliers;
+	/** Reference pixels (finest level, v * width + u) that a current point
+	 * lies behind by more than the gate: the reference's surface there has
+	 * moved away (a static surface is never seen through). */
+	std::vector<int> seenThrough;
+};
+
+/** An initial guess of T_RC. */
+struct InitialGuess
+{
+	Eigen::Matrix3d R;
+	Eigen::Vector3d t;
+};
+
+/** Aligns \a cur to \a ref (ref.isReference()) from the initial guess
+ * (R_init, t_init) = T_RC. \param R_prior optional prior on R_RC with
+ * std. dev. \a sigmaPrior_rad (the IMU's rotation); sigmaPrior_rad = 0
+ * holds the rotation at R_prior and estimates the translation only. */
+DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
+                            const Eigen::Matrix3d& R_init,
+                            const Eigen::Vector3d& t_init,
+                            const AnchorParams& p,
+                            const Eigen::Matrix3d* R_prior = nullptr,
+                            double sigmaPrior_rad = 0);
+
+/** Same, from several initial guesses: each is iterated at the coarsest
+ * level, the one with most inliers there goes on to the finer levels
+ * (e.g. the frame-to-frame estimate, which people in view can corrupt, and
+ * the constant-velocity prediction). */
+DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
+                            const std::vector<InitialGuess>& inits,
+                            const AnchorParams& p,
+                            const Eigen::Matrix3d* R_prior = nullptr,
+                            double sigmaPrior_rad = 0);
+
+}  // namespace bims::ego

@@ -1,0 +1,662 @@
+#include <bims/ego/dense_align.h>
+#include <bims/ego/so3.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <Eigen/Cholesky>
+
+#include <cmath>
+
+namespace bims::ego
+{
+namespace
+{
+/** 2x2 block depth: the mean of the readings that agree, else none. */
+inline float blockDepth(const float z[4])
+{
+	float lo = 1e30f, hi = 0, sum = 0;
+	int n = 0;
+	for (int i = 0; i < 4; i++)
+		if (z[i] > 0)
+		{
+			lo = std::min(lo, z[i]);
+			hi = std::max(hi, z[i]);
+			sum += z[i];
+			++n;
+		}
+	return (n > 0 && hi - lo <= 0.03f * lo + 0.01f) ? sum / n : 0.f;
+}
+
+cv::Mat downsampleDepth(const cv::Mat& d)
+{
+	const int W = d.cols / 2, H = d.rows / 2;
+	cv::Mat out(H, W, CV_32FC1);
+	for (int v = 0; v < H; v++)
+	{
+		const float* r0 = d.ptr<float>(2 * v);
+		const float* r1 = d.ptr<float>(2 * v + 1);
+		float* o = out.ptr<float>(v);
+		for (int u = 0; u < W; u++)
+		{
+			const float z[4] = {r0[2 * u], r0[2 * u + 1], r1[2 * u],
+			                    r1[2 * u + 1]};
+			o[u] = blockDepth(z);
+		}
+	}
+	return out;
+}
+
+/** Unit normals from the depth's central differences, facing the camera;
+ * none at depth edges and where a neighbour has no reading. */
+cv::Mat normalsOf(const DenseLevel& L)
+{
+	const int W = L.depth.cols, H = L.depth.rows;
+	cv::Mat n(H, W, CV_32FC3, cv::Scalar::all(0));
+	auto P = [&L](int u, int v, float z)
+	{
+		return Eigen::Vector3f((u - L.cx) / L.fx * z, (v - L.cy) / L.fy * z,
+		                       z);
+	};
+	for (int v = 1; v + 1 < H; v++)
+	{
+		const float* dm = L.depth.ptr<float>(v - 1);
+		const float* d0 = L.depth.ptr<float>(v);
+		const float* dp = L.depth.ptr<float>(v + 1);
+		auto* o = n.ptr<cv::Vec3f>(v);
+		for (int u = 1; u + 1 < W; u++)
+		{
+			const float z = d0[u], zl = d0[u - 1], zr = d0[u + 1], zu = dm[u],
+			            zd = dp[u];
+			if (z <= 0 || zl <= 0 || zr <= 0 || zu <= 0 || zd <= 0) continue;
+			const float lim = 0.05f * z + 0.01f;
+			if (std::abs(zr - zl) > 2 * lim || std::abs(zd - zu) > 2 * lim)
+				continue;
+			const Eigen::Vector3f dx = P(u + 1, v, zr) - P(u - 1, v, zl);
+			const Eigen::Vector3f dy = P(u, v + 1, zd) - P(u, v - 1, zu);
+			Eigen::Vector3f nn = dx.cross(dy);
+			const float len = nn.norm();
+			if (!(len > 0)) continue;
+			nn /= len;
+			if (nn.dot(P(u, v, z)) > 0) nn = -nn;
+			o[u] = cv::Vec3f(nn.x(), nn.y(), nn.z());
+		}
+	}
+	return n;
+}
+
+void pack(DenseLevel& L)
+{
+	const int W = L.depth.cols, H = L.depth.rows;
+	L.packed.resize(static_cast<size_t>(W) * H);
+	for (int v = 0; v < H; v++)
+	{
+		const float* z = L.depth.ptr<float>(v);
+		const cv::Vec3f* n = L.normal.ptr<cv::Vec3f>(v);
+		const float* g = L.grey.ptr<float>(v);
+		const float* gx = L.gx.ptr<float>(v);
+		const float* gy = L.gy.ptr<float>(v);
+		RefPixel* o = &L.packed[static_cast<size_t>(v) * W];
+		for (int u = 0; u < W; u++)
+		{
+			const float px = (u - L.cx) / L.fx * z[u],
+			            py = (v - L.cy) / L.fy * z[u];
+			o[u] = {z[u],        n[u][0], n[u][1], n[u][2],
+			        n[u][0] * px + n[u][1] * py + n[u][2] * z[u],
+			        g[u],        gx[u],   gy[u]};
+		}
+	}
+}
+
+/** A sampled point of the current frame at one level. */
+struct Sample
+{
+	float x, y, z, grey;
+	int pix;  // v * W + u at the level
+};
+
+std::vector<Sample> samplesOf(const DenseLevel& L, int stride)
+{
+	std::vector<Sample> s;
+	s.reserve(static_cast<size_t>(L.depth.total() / (stride * stride)));
+	for (int v = 0; v < L.depth.rows; v += stride)
+	{
+		const float* d = L.depth.ptr<float>(v);
+		const float* g = L.grey.ptr<float>(v);
+		for (int u = 0; u < L.depth.cols; u += stride)
+		{
+			const float z = d[u];
+			if (z <= 0) continue;
+			s.push_back({(u - L.cx) / L.fx * z, (v - L.cy) / L.fy * z, z, g[u],
+			             v * L.depth.cols + u});
+		}
+	}
+	return s;
+}
+
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+
+/** Normal equations of one pass, and its counts. */
+struct Pass
+{
+	Mat6 H = Mat6::Zero();
+	Vec6 b = Vec6::Zero();
+	int associated = 0, inliers = 0;
+	double sumGeo2 = 0;
+	/** Robust cost: Tukey loss of both terms; a sample off the reference
+	 * or beyond the gate costs the loss's maximum (so that leaving the
+	 * overlap is no gain). */
+	double cost = 0;
+	double photoSum = 0, photoW = 0;  // for the brightness offset
+	// |photometric residual| histogram (2 grey levels a bin), for the scale
+	static constexpr int kBins = 64;
+	int photoHist[kBins] = {0};
+	int photoN = 0;
+
+	/** 1.4826 x the median |photometric residual| (robust scale). */
+	double photoScaleEstimate() const
+	{
+		if (photoN == 0) return 0;
+		int acc = 0;
+		for (int i = 0; i < kBins; i++)
+			if ((acc += photoHist[i]) * 2 >= photoN) return 1.4826 * (2 * i + 1);
+		return 1.4826 * 2 * kBins;
+	}
+};
+
+/** Tukey's biweight loss rho(e) (c^2 / 6 beyond c). */
+inline double tukeyLoss(double e, double c)
+{
+	const double a = e / c;
+	if (a * a >= 1) return c * c / 6;
+	const double s = 1 - a * a;
+	return c * c / 6 * (1 - s * s * s);
+}
+
+inline double tukeyWeight(double e, double c)
+{
+	const double a = e / c;
+	if (a * a >= 1) return 0;
+	const double s = 1 - a * a;
+	return s * s;
+}
+
+/** One pass over the samples at pose (R, t): the normal equations (when
+ * \a H wanted) and the counts; \a outliers (optional) gets 255 at the
+ * samples that are associated but not inliers. */
+Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
+          const Eigen::Matrix3d& R, const Eigen::Vector3d& t, float offset,
+          double photoSigma, const AnchorParams& p, bool normalEquations,
+          cv::Mat* outliers,
+          std::vector<int>* seenThrough = nullptr)
+{
+	Pass out;
+	const int W = ref.depth.cols, H = ref.depth.rows;
+	const float r00 = float(R(0, 0)), r01 = float(R(0, 1)), r02 = float(R(0, 2));
+	const float r10 = float(R(1, 0)), r11 = float(R(1, 1)), r12 = float(R(1, 2));
+	const float r20 = float(R(2, 0)), r21 = float(R(2, 1)), r22 = float(R(2, 2));
+	const float t0 = float(t[0]), t1 = float(t[1]), t2 = float(t[2]);
+	const float fx = ref.fx, fy = ref.fy, cx = ref.cx, cy = ref.cy;
+	const float zmin = float(p.min_depth_m);
+	const double c = p.tukey_c;
+	const bool photo = p.photo_weight > 0 && !outliers;
+	const double sp = photoSigma;
+	const double photoScale = p.photo_weight / (sp * sp);
+	const double rhoMax = c * c / 6;
+	// upper triangle accumulators
+	double h[21] = {0}, bb[6] = {0};
+	auto accumulate = [&h, &bb](const float* J, double w, double r)
+	{
+		int k = 0;
+		for (int i = 0; i < 6; i++)
+		{
+			const double wi = w * J[i];
+			bb[i] += wi * r;
+			for (int j = i; j < 6; j++) h[k++] += wi * J[j];
+		}
+	};
+	for (const Sample& s : cur)
+	{
+		const float X = r00 * s.x + r01 * s.y + r02 * s.z + t0;
+		const float Y = r10 * s.x + r11 * s.y + r12 * s.z + t1;
+		const float Z = r20 * s.x + r21 * s.y + r22 * s.z + t2;
+		if (Z < zmin)
+		{
+			out.cost += rhoMax;
+			continue;
+		}
+		const float iz = 1.f / Z;
+		const float u = fx * X * iz + cx, v = fy * Y * iz + cy;
+		if (!(u > -0.5f && v > -0.5f && u < W - 0.5f && v < H - 0.5f))
+		{
+			out.cost += rhoMax;
+			continue;
+		}
+		const int ui = static_cast<int>(u + 0.5f),
+		          vi = static_cast<int>(v + 0.5f);
+		const RefPixel* P = ref.packed.data();
+		const RefPixel& q = P[vi * W + ui];
+		const float zr = q.z;
+		if (zr <= 0)
+		{
+			out.cost += rhoMax;
+			continue;
+		}
+		// no normal at depth edges: no geometric term there, but the
+		// photometric one (where the texture is) still applies
+		const bool hasNormal = !(q.nx == 0 && q.ny == 0 && q.nz == 0);
+		++out.associated;
+		const float gate = float(p.gate_m + p.gate_z2 * zr * zr);
+		if (Z > zr + gate)
+		{
+			// The current frame sees through the reference's surface: that
+			// surface was not static (it has moved away); the current point
+			// is no outlier of its own frame.
+			if (seenThrough) seenThrough->push_back(vi * W + ui);
+			out.cost += rhoMax;
+			continue;
+		}
+		bool inlier = Z >= zr - gate;
+		double wg = 0, rg = 0, sg = 1;
+		if (inlier && hasNormal)
+		{
+			rg = q.nx * X + q.ny * Y + q.nz * Z - q.d;
+			sg = p.geo_sigma_m + p.geo_sigma_z2 * zr * zr;
+			wg = tukeyWeight(rg / sg, c);
+			inlier = wg > 0;
+			out.cost += tukeyLoss(rg / sg, c);
+		}
+		if (!inlier)
+		{
+			if (outliers) outliers->data[s.pix] = 255;
+			if (!hasNormal || Z < zr - gate) out.cost += rhoMax;
+			continue;
+		}
+		++out.inliers;
+		out.sumGeo2 += rg * rg;
+		if (hasNormal && normalEquations)
+		{
+			// point-to-plane: d r / d(v, w) = [n, X x n]
+			const float Jg[6] = {q.nx,
+			                     q.ny,
+			                     q.nz,
+			                     Y * q.nz - Z * q.ny,
+			                     Z * q.nx - X * q.nz,
+			                     X * q.ny - Y * q.nx};
+			accumulate(Jg, wg / (sg * sg), rg);
+		}
+		if (!photo) continue;
+		if (!(u >= 0 && v >= 0 && u < W - 1 && v < H - 1))
+		{
+			out.cost += p.photo_weight * rhoMax;
+			continue;
+		}
+		const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
+		const float au = u - u0, av = v - v0;
+		const RefPixel& a0 = P[v0 * W + u0];
+		const RefPixel& a1 = P[v0 * W + u0 + 1];
+		const RefPixel& b0 = P[(v0 + 1) * W + u0];
+		const RefPixel& b1 = P[(v0 + 1) * W + u0 + 1];
+		const float w00 = (1 - av) * (1 - au), w01 = (1 - av) * au,
+		            w10 = av * (1 - au), w11 = av * au;
+		auto bil = [&](float RefPixel::*f)
+		{ return w00 * a0.*f + w01 * a1.*f + w10 * b0.*f + w11 * b1.*f; };
+		const float Ir = bil(&RefPixel::g);
+		const double rp = Ir - s.grey - offset;
+		++out.photoN;
+		++out.photoHist[std::min(Pass::kBins - 1,
+		                         static_cast<int>(std::abs(rp) * 0.5))];
+		const double wp = tukeyWeight(rp / sp, c);
+		out.cost += p.photo_weight * tukeyLoss(rp / sp, c);
+		out.photoSum += wp * (Ir - s.grey);
+		out.photoW += wp;
+		if (wp <= 0 || !normalEquations) continue;
+		const float gx = bil(&RefPixel::gx), gy = bil(&RefPixel::gy);
+		const float g0 = gx * fx * iz, g1 = gy * fy * iz,
+		            g2 = -(gx * fx * X + gy * fy * Y) * iz * iz;
+		const float Jp[6] = {g0,
+		                     g1,
+		                     g2,
+		                     Y * g2 - Z * g1,
+		                     Z * g0 - X * g2,
+		                     X * g1 - Y * g0};
+		accumulate(Jp, wp * photoScale, rp);
+	}
+	int k = 0;
+	for (int i = 0; i < 6; i++)
+	{
+		out.b[i] = bb[i];
+		for (int j = i; j < 6; j++)
+		{
+			out.H(i, j) = out.H(j, i) = h[k];
+			++k;
+		}
+	}
+	return out;
+}
+
+}  // namespace
+
+void DenseFrame::build(const cv::Mat& grey, const cv::Mat& depth,
+                       const Eigen::Matrix3d& K, const AnchorParams& p,
+                       const cv::Mat& exclude)
+{
+	CV_Assert(grey.type() == CV_8UC1 && depth.type() == CV_32FC1 &&
+	          grey.size() == depth.size());
+	CV_Assert(exclude.empty() ||
+	          (exclude.type() == CV_8UC1 && exclude.size() == depth.size()));
+	reference_ = false;
+	levels.assign(static_cast<size_t>(p.coarsest_level) + 1, DenseLevel());
+	const float zmin = float(p.min_depth_m), zmax = float(p.max_depth_m);
+	auto reading = [zmin, zmax](float z, const uint8_t* e, int u)
+	{
+		// (NaN fails both comparisons)
+		return (z >= zmin && z <= zmax && !(e && e[u])) ? z : 0.f;
+	};
+	DenseLevel& L0 = levels[0];
+	L0.fx = float(K(0, 0));
+	L0.fy = float(K(1, 1));
+	L0.cx = float(K(0, 2));
+	L0.cy = float(K(1, 2));
+	size_t first = 1;
+	if (p.finest_level == 0 || levels.size() == 1)
+	{
+		L0.depth.create(depth.size(), CV_32FC1);
+		for (int v = 0; v < depth.rows; v++)
+		{
+			const float* d = depth.ptr<float>(v);
+			const uint8_t* e =
+			    exclude.empty() ? nullptr : exclude.ptr<uint8_t>(v);
+			float* o = L0.depth.ptr<float>(v);
+			for (int u = 0; u < depth.cols; u++) o[u] = reading(d[u], e, u);
+		}
+		grey.convertTo(L0.grey, CV_32F);
+	}
+	else
+	{
+		// Level 1 straight from the input (level 0 is not used): the same
+		// readings and the same 2x2 rules, in one pass.
+		DenseLevel& L1 = levels[1];
+		const int W = depth.cols / 2, H = depth.rows / 2;
+		L1.depth.create(H, W, CV_32FC1);
+		L1.grey.create(H, W, CV_32FC1);
+		for (int v = 0; v < H; v++)
+		{
+			const float* d0 = depth.ptr<float>(2 * v);
+			const float* d1 = depth.ptr<float>(2 * v + 1);
+			const uint8_t* g0 = grey.ptr<uint8_t>(2 * v);
+			const uint8_t* g1 = grey.ptr<uint8_t>(2 * v + 1);
+			const uint8_t* e0 =
+			    exclude.empty() ? nullptr : exclude.ptr<uint8_t>(2 * v);
+			const uint8_t* e1 =
+			    exclude.empty() ? nullptr : exclude.ptr<uint8_t>(2 * v + 1);
+			float* od = L1.depth.ptr<float>(v);
+			float* og = L1.grey.ptr<float>(v);
+			for (int u = 0; u < W; u++)
+			{
+				const int a = 2 * u, b = 2 * u + 1;
+				og[u] = 0.25f * float(g0[a] + g0[b] + g1[a] + g1[b]);
+				// (NaN fails both comparisons)
+				float z[4] = {d0[a], d0[b], d1[a], d1[b]};
+				for (float& zi : z)
+					if (!(zi >= zmin && zi <= zmax)) zi = 0;
+				if (e0)
+				{
+					if (e0[a]) z[0] = 0;
+					if (e0[b]) z[1] = 0;
+					if (e1[a]) z[2] = 0;
+					if (e1[b]) z[3] = 0;
+				}
+				od[u] = blockDepth(z);
+			}
+		}
+		L1.fx = L0.fx / 2;
+		L1.fy = L0.fy / 2;
+		L1.cx = (L0.cx + 0.5f) / 2 - 0.5f;
+		L1.cy = (L0.cy + 0.5f) / 2 - 0.5f;
+		first = 2;
+	}
+	for (size_t l = first; l < levels.size(); l++)
+	{
+		const DenseLevel& a = levels[l - 1];
+		DenseLevel& b = levels[l];
+		b.depth = downsampleDepth(a.depth);
+		cv::resize(a.grey, b.grey, b.depth.size(), 0, 0, cv::INTER_AREA);
+		b.fx = a.fx / 2;
+		b.fy = a.fy / 2;
+		b.cx = (a.cx + 0.5f) / 2 - 0.5f;
+		b.cy = (a.cy + 0.5f) / 2 - 0.5f;
+	}
+}
+
+void DenseFrame::prepareReference(const AnchorParams& p)
+{
+	for (int l = p.finest_level; l < static_cast<int>(levels.size()); l++)
+	{
+		DenseLevel& L = levels[static_cast<size_t>(l)];
+		cv::Sobel(L.grey, L.gx, CV_32F, 1, 0, 3, 1.0 / 8);
+		cv::Sobel(L.grey, L.gy, CV_32F, 0, 1, 3, 1.0 / 8);
+		L.normal = normalsOf(L);
+		pack(L);
+	}
+	reference_ = true;
+}
+
+namespace
+{
+/** Levenberg-Marquardt at one level from (R, t): a step is taken only if
+ * it lowers the robust cost (the photometric scale and brightness offset
+ * stay fixed within the level, so that costs compare; they are estimated
+ * afresh for the next level at the end). Returns the steps taken. */
+int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
+                 Eigen::Matrix3d& R, Eigen::Vector3d& t, float& offset,
+                 double& photoSigma, const AnchorParams& p,
+                 const Eigen::Matrix3d* R_prior, double sigmaPrior_rad,
+                 int* inliers)
+{
+	const bool fixRotation = R_prior && !(sigmaPrior_rad > 0);
+	if (fixRotation) R = *R_prior;
+	const double wPrior =
+	    R_prior && !fixRotation ? 1 / (sigmaPrior_rad * sigmaPrior_rad) : 0;
+	auto priorCost = [&](const Eigen::Matrix3d& Rx)
+	{
+		return wPrior > 0
+		           ? 0.5 * wPrior * logSO3(R_prior->transpose() * Rx).squaredNorm()
+		           : 0.0;
+	};
+	Pass cur = pass(Lr, samples, R, t, offset, photoSigma, p, true, nullptr);
+	double curCost = cur.cost + priorCost(R);
+	double lambda = 1e-4;
+	int steps = 0;
+	for (int it = 0; it < p.iterations && cur.inliers >= 6; it++)
+	{
+		Mat6 H = cur.H;
+		Vec6 b = cur.b;
+		if (wPrior > 0)
+		{
+			// r = Log(R_prior^T R), dr/dw ~ R^T (left perturbation)
+			const Eigen::Vector3d e = logSO3(R_prior->transpose() * R);
+			H.block<3, 3>(3, 3) += wPrior * Eigen::Matrix3d::Identity();
+			b.segment<3>(3) += wPrior * (R * e);
+		}
+		Vec6 d = Vec6::Zero();
+		if (fixRotation)
+		{
+			Eigen::Matrix3d A = H.topLeftCorner<3, 3>();
+			A.diagonal() *= 1 + lambda;
+			d.head<3>() = A.ldlt().solve(-b.head<3>());
+		}
+		else
+		{
+			H.diagonal() *= 1 + lambda;
+			d = H.ldlt().solve(-b);
+		}
+		if (!d.allFinite()) break;
+		const Eigen::Matrix3d dR = expSO3(d.segment<3>(3));
+		const Eigen::Matrix3d Rn = dR * R;
+		const Eigen::Vector3d tn = dR * t + d.head<3>();
+		Pass nxt = pass(Lr, samples, Rn, tn, offset, photoSigma, p, true, nullptr);
+		const double nxtCost = nxt.cost + priorCost(Rn);
+		++steps;
+		if (nxtCost < curCost)
+		{
+			R = Rn;
+			t = tn;
+			cur = std::move(nxt);
+			curCost = nxtCost;
+			lambda = std::max(lambda / 3, 1e-7);
+			if (d.head<3>().norm() < 1e-5 && d.tail<3>().norm() < 1e-5) break;
+		}
+		else
+		{
+			lambda *= 8;
+			if (lambda > 1e3) break;
+		}
+	}
+	if (inliers) *inliers = cur.inliers;
+	// the next level's photometric scale and brightness offset, from the
+	// residuals at this level's result
+	photoSigma = std::max(p.photo_sigma_grey, cur.photoScaleEstimate());
+	if (cur.photoW > 0) offset = float(cur.photoSum / cur.photoW);
+	return steps;
+}
+}  // namespace
+
+void DenseFrame::dropReadings(const cv::Mat& m, const AnchorParams& p)
+{
+	const size_t f = static_cast<size_t>(p.finest_level);
+	if (levels.size() <= f || levels[f].depth.empty()) return;
+	const int W = levels[f].depth.cols, H = levels[f].depth.rows;
+	CV_Assert(m.type() == CV_8UC1 && m.cols == W && m.rows == H);
+	for (size_t l = f; l < levels.size(); l++)
+	{
+		DenseLevel& L = levels[l];
+		const int k = static_cast<int>(l - f);
+		for (int v = 0; v < H; v++)
+		{
+			const uint8_t* row = m.ptr<uint8_t>(v);
+			for (int u = 0; u < W; u++)
+			{
+				if (!row[u]) continue;
+				const int uu = u >> k, vv = v >> k;
+				if (uu >= L.depth.cols || vv >= L.depth.rows) continue;
+				L.depth.ptr<float>(vv)[uu] = 0;
+				if (!L.normal.empty())
+					L.normal.ptr<cv::Vec3f>(vv)[uu] = cv::Vec3f(0, 0, 0);
+				if (!L.packed.empty())
+				{
+					RefPixel& q =
+					    L.packed[static_cast<size_t>(vv) * L.depth.cols + uu];
+					q.z = q.nx = q.ny = q.nz = 0;
+				}
+			}
+		}
+	}
+}
+
+DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
+                            const Eigen::Matrix3d& R_init,
+                            const Eigen::Vector3d& t_init,
+                            const AnchorParams& p,
+                            const Eigen::Matrix3d* R_prior,
+                            double sigmaPrior_rad)
+{
+	return alignDense(ref, cur, {{R_init, t_init}}, p, R_prior,
+	                  sigmaPrior_rad);
+}
+
+DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
+                            const std::vector<InitialGuess>& inits,
+                            const AnchorParams& p,
+                            const Eigen::Matrix3d* R_prior,
+                            double sigmaPrior_rad)
+{
+	DenseAlignResult r;
+	if (!inits.empty())
+	{
+		r.R_RC = inits.front().R;
+		r.t_RC = inits.front().t;
+	}
+	const int top = p.coarsest_level, fine = p.finest_level;
+	if (!ref.isReference() || static_cast<int>(ref.levels.size()) <= top ||
+	    static_cast<int>(cur.levels.size()) <= top || inits.empty())
+	{
+		r.why = inits.empty() ? "no initial guess"
+		                      : "frames not prepared for these levels";
+		return r;
+	}
+	// about as many samples at every level: stride_px at the finest, half
+	// that a level up, ...
+	const auto strideAt = [&p, fine](int l)
+	{ return std::max(1, p.stride_px >> (l - fine)); };
+	// The coarsest level from each guess; the one with most inliers goes on.
+	const std::vector<Sample> coarse =
+	    samplesOf(cur.levels[static_cast<size_t>(top)], strideAt(top));
+	Eigen::Matrix3d R = r.R_RC;
+	Eigen::Vector3d t = r.t_RC;
+	float offset = 0;
+	// a wide first scale; each pass then estimates it from its residuals
+	const double sigma0 = std::max(p.photo_sigma_grey, 40.0);
+	double photoSigma = sigma0;
+	int best = -1;
+	for (size_t k = 0; k < inits.size(); k++)
+	{
+		Eigen::Matrix3d Rk = inits[k].R;
+		Eigen::Vector3d tk = inits[k].t;
+		float ok = 0;
+		double sk = sigma0;
+		int inl = 0;
+		r.iterations += iterateLevel(ref.levels[static_cast<size_t>(top)],
+		                             coarse, Rk, tk, ok, sk, p, R_prior,
+		                             sigmaPrior_rad, &inl);
+		if (inl > best)
+		{
+			best = inl;
+			R = Rk;
+			t = tk;
+			offset = ok;
+			photoSigma = sk;
+			r.guess = static_cast<int>(k);
+		}
+	}
+	std::vector<Sample> samples = coarse;
+	for (int l = top - 1; l >= fine; l--)
+	{
+		samples = samplesOf(cur.levels[static_cast<size_t>(l)], strideAt(l));
+		r.iterations +=
+		    iterateLevel(ref.levels[static_cast<size_t>(l)], samples, R, t,
+		                 offset, photoSigma, p, R_prior, sigmaPrior_rad, nullptr);
+	}
+	// Final counts and the outlier image at the finest level.
+	const DenseLevel& Lf = cur.levels[static_cast<size_t>(fine)];
+	r.outliers = cv::Mat::zeros(Lf.depth.size(), CV_8UC1);
+	const Pass fin = pass(ref.levels[static_cast<size_t>(fine)], samples, R, t,
+	                      offset, photoSigma, p, false, &r.outliers,
+	                      &r.seenThrough);
+	if (p.stride_px > 1)
+	{
+		// a sample stands for its stride x stride block
+		const cv::Mat k(p.stride_px, p.stride_px, CV_8UC1, cv::Scalar(1));
+		cv::dilate(r.outliers, r.outliers, k, cv::Point(0, 0));
+	}
+	r.R_RC = orthonormalize(R);
+	r.t_RC = t;
+	r.points = static_cast<int>(samples.size());
+	r.associated = fin.associated;
+	r.inliers = fin.inliers;
+	r.inlier_fraction =
+	    fin.associated > 0 ? double(fin.inliers) / fin.associated : 0;
+	r.overlap = r.points > 0 ? double(fin.inliers) / r.points : 0;
+	r.coverage = r.points > 0 ? double(fin.associated) / r.points : 0;
+	r.rms_geo_m = fin.inliers > 0 ? std::sqrt(fin.sumGeo2 / fin.inliers) : 0;
+	if (!R.allFinite() || !t.allFinite())
+		r.why = "diverged";
+	else if (r.inliers < p.min_inliers)
+		r.why = "too few inliers (" + std::to_string(r.inliers) + ")";
+	else if (r.inlier_fraction < p.min_inlier_fraction)
+		r.why = "inlier fraction " + std::to_string(r.inlier_fraction);
+	r.ok = r.why.empty();
+	return r;
+}
+
+}  // namespace bims::ego

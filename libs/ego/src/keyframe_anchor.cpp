@@ -1,0 +1,219 @@
+#include <bims/ego/keyframe_anchor.h>
+#include <bims/ego/so3.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <chrono>
+#include <cmath>
+
+namespace bims::ego
+{
+namespace
+{
+constexpr double kDeg = M_PI / 180;
+
+/** Share of the depth readings of \a depth that \a mask marks. */
+double maskedShare(const cv::Mat& depth, const cv::Mat& mask)
+{
+	size_t valid = 0, masked = 0;
+	for (int v = 0; v < depth.rows; v++)
+	{
+		const float* d = depth.ptr<float>(v);
+		const uint8_t* m = mask.ptr<uint8_t>(v);
+		for (int u = 0; u < depth.cols; u++)
+			if (d[u] > 0)
+			{
+				++valid;
+				masked += m[u] ? 1 : 0;
+			}
+	}
+	return valid ? double(masked) / double(valid) : 0;
+}
+}  // namespace
+
+KeyframeAnchor::KeyframeAnchor(const AnchorParams& p) : p_(p) {}
+
+void KeyframeAnchor::clear()
+{
+	kf_.clear();
+	pending_ = false;
+}
+
+KeyframeAnchor::Keyframe* KeyframeAnchor::nearest(const Eigen::Matrix3d& R_WC,
+                                                  const Eigen::Vector3d& t_WC)
+{
+	Keyframe* best = nullptr;
+	double bestScore = 1e300;
+	// newest first: ties go to the most recent keyframe
+	for (auto it = kf_.rbegin(); it != kf_.rend(); ++it)
+	{
+		const double d = (it->t_WK - t_WC).norm() / p_.keyframe_distance_m;
+		const double a = angleSO3(it->R_WK.transpose() * R_WC) /
+		                 (p_.keyframe_angle_deg * kDeg);
+		const double s = d * d + a * a;
+		if (s < bestScore)
+		{
+			bestScore = s;
+			best = &*it;
+		}
+	}
+	return best;
+}
+
+AnchorResult KeyframeAnchor::track(const RgbdFrame& f,
+                                   const Eigen::Matrix3d& R_pred,
+                                   const Eigen::Vector3d& t_pred,
+                                   const std::vector<InitialGuess>& others,
+                                   const Eigen::Matrix3d* R_prior,
+                                   const cv::Mat& moving)
+{
+	const auto t0 = std::chrono::steady_clock::now();
+	AnchorResult r;
+	r.R_WC = R_pred;
+	r.t_WC = t_pred;
+	lastOutliers_.release();
+	pending_ = false;
+	cv::Mat exclude;
+	if (!moving.empty())
+	{
+		r.excluded_fraction = maskedShare(f.depth, moving);
+		if (r.excluded_fraction <= p_.max_excluded_fraction)
+			exclude = moving;
+		else
+			r.maskIgnored = true;
+	}
+	// (also the frame that may become a keyframe: no copy of the images)
+	cur_.build(f.grey, f.depth, f.K, p_, exclude);
+	haveLast_ = true;
+	Keyframe* k = nearest(R_pred, t_pred);
+	if (!k)
+	{
+		r.why = "no keyframe yet";
+		return r;
+	}
+	// guesses of T_KC = T_WK^-1 T_WC
+	std::vector<InitialGuess> inits;
+	inits.push_back({k->R_WK.transpose() * R_pred,
+	                 k->R_WK.transpose() * (t_pred - k->t_WK)});
+	for (const auto& g : others)
+		inits.push_back(
+		    {k->R_WK.transpose() * g.R, k->R_WK.transpose() * (g.t - k->t_WK)});
+	Eigen::Matrix3d R_KCprior;
+	if (R_prior) R_KCprior = k->R_WK.transpose() * *R_prior;
+	const DenseAlignResult a =
+	    alignDense(k->frame, cur_, inits, p_, R_prior ? &R_KCprior : nullptr,
+	               p_.rotation_prior_sigma_deg * kDeg);
+	r.tried = true;
+	r.keyframe = k->id;
+	r.points = a.points;
+	r.inliers = a.inliers;
+	r.inlier_fraction = a.inlier_fraction;
+	r.overlap = a.overlap;
+	r.coverage = a.coverage;
+	r.guess = a.guess;
+	r.outliers = a.outliers;
+	lastOutliers_ = a.outliers;
+	const Eigen::Matrix3d R_WC = k->R_WK * a.R_RC;
+	const Eigen::Vector3d t_WC = k->R_WK * a.t_RC + k->t_WK;
+	// The correction against the nearest guess: a result next to the
+	// constant-velocity guess is no jump even when the frame-to-frame one
+	// (that people in view can corrupt) is far.
+	r.correction_m = 1e300;
+	std::vector<InitialGuess> all = {{R_pred, t_pred}};
+	all.insert(all.end(), others.begin(), others.end());
+	for (const auto& g : all)
+	{
+		const double dm = (t_WC - g.t).norm();
+		const double dd = angleSO3(g.R.transpose() * R_WC) / kDeg;
+		if (dm / p_.max_correction_m + dd / p_.max_correction_deg <
+		    r.correction_m / p_.max_correction_m +
+		        r.correction_deg / p_.max_correction_deg)
+		{
+			r.correction_m = dm;
+			r.correction_deg = dd;
+		}
+	}
+	if (!a.ok)
+		r.why = a.why;
+	else if (r.correction_m > p_.max_correction_m ||
+	         r.correction_deg > p_.max_correction_deg)
+		r.why = "correction too large";
+	if (r.why.empty())
+	{
+		r.accepted = true;
+		r.R_WC = R_WC;
+		r.t_WC = t_WC;
+		// what the keyframe held there has moved away: not static
+		r.seen_through = static_cast<int>(a.seenThrough.size());
+		if (!a.seenThrough.empty())
+		{
+			const DenseLevel& L =
+			    k->frame.levels[static_cast<size_t>(p_.finest_level)];
+			cv::Mat m = cv::Mat::zeros(L.depth.size(), CV_8UC1);
+			for (int i : a.seenThrough) m.data[i] = 255;
+			cv::dilate(m, m, cv::Mat());
+			k->frame.dropReadings(m, p_);
+		}
+	}
+	r.ms = std::chrono::duration<double, std::milli>(
+	           std::chrono::steady_clock::now() - t0)
+	           .count();
+	return r;
+}
+
+bool KeyframeAnchor::wantKeyframe(const AnchorResult& r,
+                                  const Eigen::Matrix3d& R_WC,
+                                  const Eigen::Vector3d& t_WC, bool force)
+{
+	bool want = force || kf_.empty();
+	if (!want && r.accepted)
+	{
+		for (const auto& k : kf_)
+			if (k.id == r.keyframe)
+				want = (k.t_WK - t_WC).norm() > p_.keyframe_distance_m ||
+				       angleSO3(k.R_WK.transpose() * R_WC) >
+				           p_.keyframe_angle_deg * kDeg;
+		want = want || r.coverage < p_.keyframe_min_overlap;
+	}
+	pending_ = want && haveLast_;
+	// outliers of an alignment that was not accepted say nothing
+	if (!r.accepted) lastOutliers_.release();
+	R_pending_ = R_WC;
+	t_pending_ = t_WC;
+	return pending_;
+}
+
+bool KeyframeAnchor::addPending(const cv::Mat& moving)
+{
+	if (!pending_) return false;
+	pending_ = false;
+	// what moved in it (its mask, its alignment outliers) is no keyframe
+	// content
+	const DenseLevel& Lf = cur_.levels[static_cast<size_t>(p_.finest_level)];
+	cv::Mat drop = cv::Mat::zeros(Lf.depth.size(), CV_8UC1);
+	if (!moving.empty())
+	{
+		cv::Mat m;
+		cv::resize(moving, m, drop.size(), 0, 0, cv::INTER_AREA);  // any > 0
+		drop.setTo(255, m);
+	}
+	if (lastOutliers_.size() == drop.size())
+	{
+		cv::Mat o;
+		cv::dilate(lastOutliers_, o, cv::Mat());
+		drop.setTo(255, o);
+	}
+	Keyframe k;
+	k.id = nextId_++;
+	k.R_WK = R_pending_;
+	k.t_WK = t_pending_;
+	k.frame = std::move(cur_);
+	k.frame.dropReadings(drop, p_);
+	k.frame.prepareReference(p_);
+	haveLast_ = false;
+	kf_.push_back(std::move(k));
+	while (static_cast<int>(kf_.size()) > p_.max_keyframes) kf_.pop_front();
+	return true;
+}
+
+}  // namespace bims::ego
