@@ -111,7 +111,8 @@ void pack(DenseLevel& L)
 struct Sample
 {
 	float x, y, z, grey;
-	int pix;  // v * W + u at the level
+	int pix;        // v * W + u at the level
+	bool excluded;  // predicted moving: not used in the fit
 };
 
 std::vector<Sample> samplesOf(const DenseLevel& L, int stride)
@@ -122,12 +123,13 @@ std::vector<Sample> samplesOf(const DenseLevel& L, int stride)
 	{
 		const float* d = L.depth.ptr<float>(v);
 		const float* g = L.grey.ptr<float>(v);
+		const uint8_t* e = L.exclude.empty() ? nullptr : L.exclude.ptr<uint8_t>(v);
 		for (int u = 0; u < L.depth.cols; u += stride)
 		{
 			const float z = d[u];
 			if (z <= 0) continue;
 			s.push_back({(u - L.cx) / L.fx * z, (v - L.cy) / L.fy * z, z, g[u],
-			             v * L.depth.cols + u});
+			             v * L.depth.cols + u, e && e[u]});
 		}
 	}
 	return s;
@@ -142,6 +144,8 @@ struct Pass
 	Mat6 H = Mat6::Zero();
 	Vec6 b = Vec6::Zero();
 	int associated = 0, inliers = 0;
+	int occluding = 0;    ///< associated, in front of the reference surface
+	int seenThrough = 0;  ///< associated, behind it
 	double sumGeo2 = 0;
 	/** Robust cost: Tukey loss of both terms; a sample off the reference
 	 * or beyond the gate costs the loss's maximum (so that leaving the
@@ -217,19 +221,23 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 	};
 	for (const Sample& s : cur)
 	{
+		// excluded samples (predicted moving) only get classified, in the
+		// final pass, for the outlier image
+		if (s.excluded && !outliers) continue;
+		const bool counts = !s.excluded;
 		const float X = r00 * s.x + r01 * s.y + r02 * s.z + t0;
 		const float Y = r10 * s.x + r11 * s.y + r12 * s.z + t1;
 		const float Z = r20 * s.x + r21 * s.y + r22 * s.z + t2;
 		if (Z < zmin)
 		{
-			out.cost += rhoMax;
+			if (counts) out.cost += rhoMax;
 			continue;
 		}
 		const float iz = 1.f / Z;
 		const float u = fx * X * iz + cx, v = fy * Y * iz + cy;
 		if (!(u > -0.5f && v > -0.5f && u < W - 0.5f && v < H - 0.5f))
 		{
-			out.cost += rhoMax;
+			if (counts) out.cost += rhoMax;
 			continue;
 		}
 		const int ui = static_cast<int>(u + 0.5f),
@@ -237,41 +245,61 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 		const RefPixel* P = ref.packed.data();
 		const RefPixel& q = P[vi * W + ui];
 		const float zr = q.z;
-		if (zr <= 0)
+		if (zr < 0)
 		{
+			// the reference saw something moving here: the point is covered
+			// (no reason for a new keyframe) and likely moving itself
+			if (outliers) outliers->data[s.pix] = 255;
+			if (!counts) continue;
+			++out.associated;
+			++out.occluding;
 			out.cost += rhoMax;
+			continue;
+		}
+		if (zr == 0)
+		{
+			if (counts) out.cost += rhoMax;
 			continue;
 		}
 		// no normal at depth edges: no geometric term there, but the
 		// photometric one (where the texture is) still applies
 		const bool hasNormal = !(q.nx == 0 && q.ny == 0 && q.nz == 0);
-		++out.associated;
 		const float gate = float(p.gate_m + p.gate_z2 * zr * zr);
 		if (Z > zr + gate)
 		{
 			// The current frame sees through the reference's surface: that
 			// surface was not static (it has moved away); the current point
 			// is no outlier of its own frame.
+			if (!counts) continue;
+			++out.associated;
+			++out.seenThrough;
 			if (seenThrough) seenThrough->push_back(vi * W + ui);
 			out.cost += rhoMax;
 			continue;
 		}
-		bool inlier = Z >= zr - gate;
-		double wg = 0, rg = 0, sg = 1;
-		if (inlier && hasNormal)
+		if (Z < zr - gate)
+		{
+			// in front of the reference's surface: an occluder (moving, or
+			// static but new), no evidence against the pose
+			if (outliers) outliers->data[s.pix] = 255;
+			if (!counts) continue;
+			++out.associated;
+			++out.occluding;
+			out.cost += rhoMax;
+			continue;
+		}
+		double wg = 1, rg = 0, sg = 1;
+		if (hasNormal)
 		{
 			rg = q.nx * X + q.ny * Y + q.nz * Z - q.d;
 			sg = p.geo_sigma_m + p.geo_sigma_z2 * zr * zr;
 			wg = tukeyWeight(rg / sg, c);
-			inlier = wg > 0;
-			out.cost += tukeyLoss(rg / sg, c);
 		}
-		if (!inlier)
-		{
-			if (outliers) outliers->data[s.pix] = 255;
-			if (!hasNormal || Z < zr - gate) out.cost += rhoMax;
-			continue;
-		}
+		if (wg <= 0 && outliers) outliers->data[s.pix] = 255;
+		if (!counts) continue;
+		++out.associated;
+		if (hasNormal) out.cost += tukeyLoss(rg / sg, c);
+		if (wg <= 0) continue;
 		++out.inliers;
 		out.sumGeo2 += rg * rg;
 		if (hasNormal && normalEquations)
@@ -348,10 +376,10 @@ void DenseFrame::build(const cv::Mat& grey, const cv::Mat& depth,
 	reference_ = false;
 	levels.assign(static_cast<size_t>(p.coarsest_level) + 1, DenseLevel());
 	const float zmin = float(p.min_depth_m), zmax = float(p.max_depth_m);
-	auto reading = [zmin, zmax](float z, const uint8_t* e, int u)
+	auto reading = [zmin, zmax](float z)
 	{
 		// (NaN fails both comparisons)
-		return (z >= zmin && z <= zmax && !(e && e[u])) ? z : 0.f;
+		return (z >= zmin && z <= zmax) ? z : 0.f;
 	};
 	DenseLevel& L0 = levels[0];
 	L0.fx = float(K(0, 0));
@@ -365,10 +393,8 @@ void DenseFrame::build(const cv::Mat& grey, const cv::Mat& depth,
 		for (int v = 0; v < depth.rows; v++)
 		{
 			const float* d = depth.ptr<float>(v);
-			const uint8_t* e =
-			    exclude.empty() ? nullptr : exclude.ptr<uint8_t>(v);
 			float* o = L0.depth.ptr<float>(v);
-			for (int u = 0; u < depth.cols; u++) o[u] = reading(d[u], e, u);
+			for (int u = 0; u < depth.cols; u++) o[u] = reading(d[u]);
 		}
 		grey.convertTo(L0.grey, CV_32F);
 	}
@@ -386,10 +412,6 @@ void DenseFrame::build(const cv::Mat& grey, const cv::Mat& depth,
 			const float* d1 = depth.ptr<float>(2 * v + 1);
 			const uint8_t* g0 = grey.ptr<uint8_t>(2 * v);
 			const uint8_t* g1 = grey.ptr<uint8_t>(2 * v + 1);
-			const uint8_t* e0 =
-			    exclude.empty() ? nullptr : exclude.ptr<uint8_t>(2 * v);
-			const uint8_t* e1 =
-			    exclude.empty() ? nullptr : exclude.ptr<uint8_t>(2 * v + 1);
 			float* od = L1.depth.ptr<float>(v);
 			float* og = L1.grey.ptr<float>(v);
 			for (int u = 0; u < W; u++)
@@ -400,13 +422,6 @@ void DenseFrame::build(const cv::Mat& grey, const cv::Mat& depth,
 				float z[4] = {d0[a], d0[b], d1[a], d1[b]};
 				for (float& zi : z)
 					if (!(zi >= zmin && zi <= zmax)) zi = 0;
-				if (e0)
-				{
-					if (e0[a]) z[0] = 0;
-					if (e0[b]) z[1] = 0;
-					if (e1[a]) z[2] = 0;
-					if (e1[b]) z[3] = 0;
-				}
 				od[u] = blockDepth(z);
 			}
 		}
@@ -426,6 +441,23 @@ void DenseFrame::build(const cv::Mat& grey, const cv::Mat& depth,
 		b.fy = a.fy / 2;
 		b.cx = (a.cx + 0.5f) / 2 - 0.5f;
 		b.cy = (a.cy + 0.5f) / 2 - 0.5f;
+	}
+	// the excluded pixels of every level: a pixel is excluded when any of
+	// the pixels it covers is (INTER_AREA: any non-zero stays non-zero)
+	if (!exclude.empty())
+	{
+		const cv::Mat* src = &exclude;
+		for (size_t l = 0; l < levels.size(); l++)
+		{
+			DenseLevel& L = levels[l];
+			if (l == 0 && L.depth.empty()) continue;
+			if (src->size() == L.depth.size())
+				L.exclude = src->clone();
+			else
+				cv::resize(*src, L.exclude, L.depth.size(), 0, 0,
+				           cv::INTER_AREA);
+			src = &L.exclude;
+		}
 	}
 }
 
@@ -545,9 +577,11 @@ void DenseFrame::dropReadings(const cv::Mat& m, const AnchorParams& p)
 					L.normal.ptr<cv::Vec3f>(vv)[uu] = cv::Vec3f(0, 0, 0);
 				if (!L.packed.empty())
 				{
+					// -1: known to be moving (not merely without a reading)
 					RefPixel& q =
 					    L.packed[static_cast<size_t>(vv) * L.depth.cols + uu];
-					q.z = q.nx = q.ny = q.nz = 0;
+					q.z = -1;
+					q.nx = q.ny = q.nz = 0;
 				}
 			}
 		}
@@ -641,11 +675,14 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 	}
 	r.R_RC = orthonormalize(R);
 	r.t_RC = t;
-	r.points = static_cast<int>(samples.size());
+	r.points = 0;
+	for (const Sample& q : samples) r.points += q.excluded ? 0 : 1;
 	r.associated = fin.associated;
 	r.inliers = fin.inliers;
-	r.inlier_fraction =
-	    fin.associated > 0 ? double(fin.inliers) / fin.associated : 0;
+	// occluders and surfaces seen through are explained by motion in the
+	// scene: the fraction is over the points that landed on a surface
+	const int onSurface = fin.associated - fin.occluding - fin.seenThrough;
+	r.inlier_fraction = onSurface > 0 ? double(fin.inliers) / onSurface : 0;
 	r.overlap = r.points > 0 ? double(fin.inliers) / r.points : 0;
 	r.coverage = r.points > 0 ? double(fin.associated) / r.points : 0;
 	r.rms_geo_m = fin.inliers > 0 ? std::sqrt(fin.sumGeo2 / fin.inliers) : 0;

@@ -91,20 +91,40 @@ AnchorResult KeyframeAnchor::track(const RgbdFrame& f,
 		r.why = "no keyframe yet";
 		return r;
 	}
+	alignTo(*k, R_pred, t_pred, others, R_prior, r);
+	// The nearest keyframe may be an old one the pose has drifted from (a
+	// correction too large to take): the newest keyframe then anchors it.
+	if (!r.accepted && &kf_.back() != k)
+	{
+		AnchorResult again = r;
+		alignTo(kf_.back(), R_pred, t_pred, others, R_prior, again);
+		if (again.accepted) r = again;
+	}
+	r.ms = std::chrono::duration<double, std::milli>(
+	           std::chrono::steady_clock::now() - t0)
+	           .count();
+	return r;
+}
+
+void KeyframeAnchor::alignTo(Keyframe& k, const Eigen::Matrix3d& R_pred,
+                             const Eigen::Vector3d& t_pred,
+                             const std::vector<InitialGuess>& others,
+                             const Eigen::Matrix3d* R_prior, AnchorResult& r)
+{
 	// guesses of T_KC = T_WK^-1 T_WC
 	std::vector<InitialGuess> inits;
-	inits.push_back({k->R_WK.transpose() * R_pred,
-	                 k->R_WK.transpose() * (t_pred - k->t_WK)});
+	inits.push_back({k.R_WK.transpose() * R_pred,
+	                 k.R_WK.transpose() * (t_pred - k.t_WK)});
 	for (const auto& g : others)
 		inits.push_back(
-		    {k->R_WK.transpose() * g.R, k->R_WK.transpose() * (g.t - k->t_WK)});
+		    {k.R_WK.transpose() * g.R, k.R_WK.transpose() * (g.t - k.t_WK)});
 	Eigen::Matrix3d R_KCprior;
-	if (R_prior) R_KCprior = k->R_WK.transpose() * *R_prior;
+	if (R_prior) R_KCprior = k.R_WK.transpose() * *R_prior;
 	const DenseAlignResult a =
-	    alignDense(k->frame, cur_, inits, p_, R_prior ? &R_KCprior : nullptr,
+	    alignDense(k.frame, cur_, inits, p_, R_prior ? &R_KCprior : nullptr,
 	               p_.rotation_prior_sigma_deg * kDeg);
 	r.tried = true;
-	r.keyframe = k->id;
+	r.keyframe = k.id;
 	r.points = a.points;
 	r.inliers = a.inliers;
 	r.inlier_fraction = a.inlier_fraction;
@@ -113,12 +133,13 @@ AnchorResult KeyframeAnchor::track(const RgbdFrame& f,
 	r.guess = a.guess;
 	r.outliers = a.outliers;
 	lastOutliers_ = a.outliers;
-	const Eigen::Matrix3d R_WC = k->R_WK * a.R_RC;
-	const Eigen::Vector3d t_WC = k->R_WK * a.t_RC + k->t_WK;
+	const Eigen::Matrix3d R_WC = k.R_WK * a.R_RC;
+	const Eigen::Vector3d t_WC = k.R_WK * a.t_RC + k.t_WK;
 	// The correction against the nearest guess: a result next to the
 	// constant-velocity guess is no jump even when the frame-to-frame one
 	// (that people in view can corrupt) is far.
 	r.correction_m = 1e300;
+	r.correction_deg = 0;
 	std::vector<InitialGuess> all = {{R_pred, t_pred}};
 	all.insert(all.end(), others.begin(), others.end());
 	for (const auto& g : all)
@@ -133,32 +154,27 @@ AnchorResult KeyframeAnchor::track(const RgbdFrame& f,
 			r.correction_deg = dd;
 		}
 	}
+	r.why.clear();
+	r.accepted = false;
 	if (!a.ok)
 		r.why = a.why;
 	else if (r.correction_m > p_.max_correction_m ||
 	         r.correction_deg > p_.max_correction_deg)
 		r.why = "correction too large";
-	if (r.why.empty())
+	if (!r.why.empty()) return;
+	r.accepted = true;
+	r.R_WC = R_WC;
+	r.t_WC = t_WC;
+	// what the keyframe held there has moved away: not static
+	r.seen_through = static_cast<int>(a.seenThrough.size());
+	if (!a.seenThrough.empty())
 	{
-		r.accepted = true;
-		r.R_WC = R_WC;
-		r.t_WC = t_WC;
-		// what the keyframe held there has moved away: not static
-		r.seen_through = static_cast<int>(a.seenThrough.size());
-		if (!a.seenThrough.empty())
-		{
-			const DenseLevel& L =
-			    k->frame.levels[static_cast<size_t>(p_.finest_level)];
-			cv::Mat m = cv::Mat::zeros(L.depth.size(), CV_8UC1);
-			for (int i : a.seenThrough) m.data[i] = 255;
-			cv::dilate(m, m, cv::Mat());
-			k->frame.dropReadings(m, p_);
-		}
+		const DenseLevel& L = k.frame.levels[static_cast<size_t>(p_.finest_level)];
+		cv::Mat m = cv::Mat::zeros(L.depth.size(), CV_8UC1);
+		for (int i : a.seenThrough) m.data[i] = 255;
+		cv::dilate(m, m, cv::Mat());
+		k.frame.dropReadings(m, p_);
 	}
-	r.ms = std::chrono::duration<double, std::milli>(
-	           std::chrono::steady_clock::now() - t0)
-	           .count();
-	return r;
 }
 
 bool KeyframeAnchor::wantKeyframe(const AnchorResult& r,
@@ -197,6 +213,8 @@ bool KeyframeAnchor::addPending(const cv::Mat& moving)
 		cv::resize(moving, m, drop.size(), 0, 0, cv::INTER_AREA);  // any > 0
 		drop.setTo(255, m);
 	}
+	// (and what was predicted moving when it was tracked)
+	if (Lf.exclude.size() == drop.size()) drop.setTo(255, Lf.exclude);
 	if (lastOutliers_.size() == drop.size())
 	{
 		cv::Mat o;
@@ -208,8 +226,8 @@ bool KeyframeAnchor::addPending(const cv::Mat& moving)
 	k.R_WK = R_pending_;
 	k.t_WK = t_pending_;
 	k.frame = std::move(cur_);
-	k.frame.dropReadings(drop, p_);
 	k.frame.prepareReference(p_);
+	k.frame.dropReadings(drop, p_);
 	haveLast_ = false;
 	kf_.push_back(std::move(k));
 	while (static_cast<int>(kf_.size()) > p_.max_keyframes) kf_.pop_front();

@@ -23,7 +23,8 @@
 namespace bims::ego
 {
 /** A reference pixel packed for the alignment's lookups (one cache line
- * for two pixels): depth, normal, plane offset d = n . P, grey, gradient. */
+ * for two pixels): depth (0 none, -1 dropped as moving), normal, plane
+ * offset d = n . P, grey, gradient. */
 struct RefPixel
 {
 	float z, nx, ny, nz, d, g, gx, gy;
@@ -37,6 +38,9 @@ struct DenseLevel
 	cv::Mat gx, gy;  ///< CV_32FC1 grey gradients [grey/px] (reference only)
 	cv::Mat normal;  ///< CV_32FC3 unit normals, 0 = none (reference only)
 	std::vector<RefPixel> packed;  ///< the same, packed (reference only)
+	/** CV_8UC1 non-zero = predicted moving: not sampled for the fit (still
+	 * classified in the outlier image), or empty. */
+	cv::Mat exclude;
 	float fx = 0, fy = 0, cx = 0, cy = 0;  ///< intrinsics of the level [px]
 };
 
@@ -45,8 +49,9 @@ class DenseFrame
 {
  public:
 	/** Builds levels 0..p.coarsest_level from \a grey (CV_8UC1) and
-	 * \a depth (CV_32FC1 [m]). Depth outside [min, max]_depth_m and pixels
-	 * where \a exclude (CV_8UC1, may be empty) is non-zero are dropped. A
+	 * \a depth (CV_32FC1 [m]). Depth outside [min, max]_depth_m is dropped;
+	 * pixels where \a exclude (CV_8UC1, may be empty) is non-zero are not
+	 * sampled when this frame is aligned (DenseLevel::exclude). A
 	 * 2x2 block's depth is the mean of its readings when they agree (within
 	 * 3 % + 1 cm), else none (no averaging across depth edges). */
 	void build(const cv::Mat& grey, const cv::Mat& depth,
@@ -58,7 +63,8 @@ class DenseFrame
 	bool isReference() const { return reference_; }
 	/** Drops the readings where \a mask (CV_8UC1 of the finest level's
 	 * size) is non-zero, from the finest and every coarser level: content
-	 * known to move. */
+	 * known to move (marked so: a point landing there counts as covered
+	 * and as an outlier). Call after prepareReference(). */
 	void dropReadings(const cv::Mat& mask, const AnchorParams& p);
 	bool empty() const { return levels.empty(); }
 
@@ -78,7 +84,10 @@ struct DenseAlignResult
 	int points = 0;      ///< sampled points with depth, finest level
 	int associated = 0;  ///< of those, landing on a reference reading
 	int inliers = 0;     ///< of those, within the gate and Tukey's limit
-	double inlier_fraction = 0;  ///< inliers / associated
+	/** inliers / the associated points that landed on the reference's
+	 * surface (not in front of it, not behind it: those are explained by
+	 * motion in the scene). */
+	double inlier_fraction = 0;
 	double overlap = 0;          ///< inliers / points
 	/** associated / points: how much of the frame the reference covers
 	 * (occluders count as covered; they are not a reason for a new

@@ -82,6 +82,12 @@ class KeyframeAnchor
 		Eigen::Vector3d t_WK;
 	};
 	Keyframe* nearest(const Eigen::Matrix3d& R_WC, const Eigen::Vector3d& t_WC);
+	/** Aligns the frame in cur_ to \a k; fills \a r (accepted or why not)
+	 * and drops from \a k what the frame saw through. */
+	void alignTo(Keyframe& k, const Eigen::Matrix3d& R_pred,
+	             const Eigen::Vector3d& t_pred,
+	             const std::vector<InitialGuess>& others,
+	             const Eigen::Matrix3d* R_prior, AnchorResult& r);
 
 	AnchorParams p_;
 	std::deque<Keyframe> kf_;

@@ -153,8 +153,10 @@ struct AnchorParams
 	bool enable = true;  ///< false: frame-to-frame egomotion only
 	int finest_level = 1;   ///< finest pyramid level aligned (0 = full size)
 	int coarsest_level = 3;  ///< coarsest level (each level halves the size)
-	int iterations = 8;      ///< Gauss-Newton iterations per level (max)
-	int stride_px = 2;       ///< pixel sampling step at the finest level
+	int iterations = 4;  ///< Levenberg-Marquardt steps per level (max)
+	/** Pixel sampling step at the finest level (half that a level up...,
+	 * so that every level has about as many samples). */
+	int stride_px = 4;
 	/** Geometric residual scale a + b z^2 [m] (point-to-plane). */
 	double geo_sigma_m = 0.004;
 	double geo_sigma_z2 = 0.004;  ///< b above [1/m]
@@ -169,8 +171,8 @@ struct AnchorParams
 	double tukey_c = 4.685;       ///< Tukey biweight limit [scales]
 	/** mode = imu: std. dev. of the IMU rotation as the alignment's prior
 	 * [deg]; 0 keeps the IMU rotation and aligns the translation only (the
-	 * paper's split: rotation from the IMU, translation from vision). */
-	double rotation_prior_sigma_deg = 0;
+	 * paper's split, but the gyro's drift then stays in the map). */
+	double rotation_prior_sigma_deg = 0.02;
 	int min_inliers = 400;  ///< fewer inliers at the finest level: failed
 	/** Fewer than this share of the associated points inliers: failed. */
 	double min_inlier_fraction = 0.3;
