@@ -356,7 +356,8 @@ std::string flagsToString(uint32_t flags)
 	    {kFlagAnchorFailed, "anchor_failed"},
 	    {kFlagNewKeyframe, "new_keyframe"},
 	    {kFlagAnchorLost, "anchor_lost"},
-	    {kFlagMaskIgnored, "mask_ignored"}};
+	    {kFlagMaskIgnored, "mask_ignored"},
+	    {kFlagAnchorRelocalised, "anchor_relocalised"}};
 	std::string s;
 	for (const auto& [bit, name] : names)
 		if (flags & bit) s += (s.empty() ? "" : "|") + std::string(name);

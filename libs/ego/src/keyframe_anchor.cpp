@@ -156,11 +156,20 @@ void KeyframeAnchor::alignTo(Keyframe& k, const Eigen::Matrix3d& R_pred,
 	}
 	r.why.clear();
 	r.accepted = false;
+	r.relocalised = false;
 	if (!a.ok)
 		r.why = a.why;
 	else if (r.correction_m > p_.max_correction_m ||
 	         r.correction_deg > p_.max_correction_deg)
-		r.why = "correction too large";
+	{
+		// A large correction is taken only from a keyframe the frame fits
+		// almost entirely: the pose had drifted (flagged, not silent).
+		if (a.inlier_fraction >= p_.relocalise_inlier_fraction &&
+		    a.overlap >= p_.relocalise_overlap)
+			r.relocalised = true;
+		else
+			r.why = "correction too large";
+	}
 	if (!r.why.empty()) return;
 	r.accepted = true;
 	r.R_WC = R_WC;

@@ -361,6 +361,7 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 			R_rel = R_WCprev_.transpose() * R_WC_;
 			t_rel = R_WCprev_.transpose() * (t_WC_ - t_WCprev_);
 			r.flags |= kFlagAnchored;
+			if (r.anchor.relocalised) r.flags |= kFlagAnchorRelocalised;
 			anchorFailures_ = 0;
 			lastAnchored_ = true;
 		}

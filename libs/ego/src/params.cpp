@@ -161,6 +161,10 @@ void AnchorParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	    s.getDouble("max_correction_m", max_correction_m, 1e-4, 100);
 	max_correction_deg =
 	    s.getDouble("max_correction_deg", max_correction_deg, 1e-3, 180);
+	relocalise_inlier_fraction = s.getDouble(
+	    "relocalise_inlier_fraction", relocalise_inlier_fraction, 0, 1.01);
+	relocalise_overlap =
+	    s.getDouble("relocalise_overlap", relocalise_overlap, 0, 1.01);
 	keyframe_distance_m =
 	    s.getDouble("keyframe_distance_m", keyframe_distance_m, 0.001, 100);
 	keyframe_angle_deg =

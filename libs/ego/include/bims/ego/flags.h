@@ -41,6 +41,10 @@ enum EgoFlag : uint32_t
 	 * the image: not used for this frame (the feedback must not starve the
 	 * tracker). */
 	kFlagMaskIgnored = 1u << 15,
+	/** Anchored with a correction beyond [anchor] max_correction_*: the
+	 * frame fits a keyframe almost entirely, the pose had drifted and jumps
+	 * back (relocalisation). */
+	kFlagAnchorRelocalised = 1u << 16,
 };
 
 /** "imu_gap|too_few_tracks" style text ("ok" for none). */

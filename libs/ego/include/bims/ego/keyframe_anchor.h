@@ -39,6 +39,9 @@ struct AnchorResult
 	/** Share of the frame's depth readings excluded by the moving mask. */
 	double excluded_fraction = 0;
 	bool maskIgnored = false;  ///< the mask excluded too much: not used
+	/** Accepted with a correction beyond max_correction_* (the frame fits
+	 * the keyframe almost entirely: the pose had drifted). */
+	bool relocalised = false;
 	cv::Mat outliers;  ///< alignment outliers (finest level), or empty
 	double ms = 0;     ///< time of this frame's anchoring [ms]
 };

@@ -180,6 +180,11 @@ struct AnchorParams
 	 * alignment is rejected (flagged, frame-to-frame kept) [m], [deg]. */
 	double max_correction_m = 0.15;
 	double max_correction_deg = 6;
+	/** ... unless the frame fits the keyframe almost entirely: inlier
+	 * fraction and overlap (inliers / points) at least these. Then the
+	 * pose had drifted and is corrected (flagged anchor_relocalised). */
+	double relocalise_inlier_fraction = 0.97;
+	double relocalise_overlap = 0.35;
 	/** A new keyframe when the frame is farther than this from its
 	 * keyframe [m], [deg], or when the keyframe covers less than
 	 * keyframe_min_overlap of its points (occluders count as covered). */
