@@ -152,7 +152,9 @@ struct AnchorParams
 {
 	bool enable = true;  ///< false: frame-to-frame egomotion only
 	int finest_level = 1;   ///< finest pyramid level aligned (0 = full size)
-	int coarsest_level = 3;  ///< coarsest level (each level halves the size)
+	/** Coarsest level (each level halves the size; 2 = 160x120 for VGA:
+	 * the frame-to-frame guess is close, a coarser start only costs). */
+	int coarsest_level = 2;
 	int iterations = 4;  ///< Levenberg-Marquardt steps per level (max)
 	/** Pixel sampling step at the finest level (half that a level up...,
 	 * so that every level has about as many samples). */
