@@ -77,13 +77,15 @@ int main(int argc, char** argv)
 		while (auto o = reader.next())
 		{
 			auto scan =
-			    std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(o);
+			    std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(
+			        o);
 			if (!scan || (!ec.sensors.rgbd_label.empty() &&
 			              scan->sensorLabel != ec.sensors.rgbd_label))
 				continue;
 			if (correct) dc.apply(*scan, ec.camera);
 			bims::ego::RgbdFrame f;
-			const std::string why = bims::ego::rgbdFrameFrom(*scan, ec.camera, f);
+			const std::string why =
+			    bims::ego::rgbdFrameFrom(*scan, ec.camera, f);
 			if (!why.empty()) throw std::runtime_error(in + ": " + why);
 			if (!odo)
 			{
@@ -130,8 +132,10 @@ int main(int argc, char** argv)
 		bims::saveTumTrajectory(out, traj,
 		                        "OpenCV cv::rgbd " + method + " odometry");
 		std::sort(ms.begin(), ms.end());
-		const auto pct = [&ms](double p)
-		{ return ms.empty() ? 0.0 : ms[static_cast<size_t>(p * (ms.size() - 1))]; };
+		const auto pct = [&ms](double p) {
+			return ms.empty() ? 0.0
+			                  : ms[static_cast<size_t>(p * (ms.size() - 1))];
+		};
 		std::printf(
 		    "rgbd_odometry_baseline: %zu frames, %zu failed, ms/frame median "
 		    "%.2f p95 %.2f (method %s, depth correction %s)\n",

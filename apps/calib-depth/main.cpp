@@ -98,7 +98,8 @@ int main(int argc, char** argv)
 				    throw UsageError("--frames: B must not be less than A");
 		    }
 		    Trajectory known;
-		    if (posesArg.isSet()) known = loadTumTrajectory(posesArg.getValue());
+		    if (posesArg.isSet())
+			    known = loadTumTrajectory(posesArg.getValue());
 		    auto poseAt = [&known](double t) -> const StampedPose*
 		    {
 			    const StampedPose* best = nullptr;
@@ -156,7 +157,8 @@ int main(int argc, char** argv)
 		    std::printf(
 		        "bims-calib-depth: %zu frames (%zu without a pose), %d pairs, "
 		        "%zu residuals; robust RMS point-to-plane %.4f -> %.4f m\n"
-		        "bims-calib-depth: correction (1 + delta): left %+.2f %%, right "
+		        "bims-calib-depth: correction (1 + delta): left %+.2f %%, "
+		        "right "
 		        "%+.2f %%, top %+.2f %%, bottom %+.2f %%, top-left corner "
 		        "%+.2f %%\n",
 		        frames.size(), noPose, res.pairs, res.residuals,
@@ -167,13 +169,14 @@ int main(int argc, char** argv)
 		    if (!out)
 			    throw std::runtime_error(outArg.getValue() + ": cannot write");
 		    char note[512];
-		    std::snprintf(note, sizeof(note),
-		                  "# bims-calib-depth: %zu frames of %s (%s poses), "
-		                  "robust RMS %.4f -> %.4f m\n",
-		                  frames.size(),
-		                  mrpt::system::extractFileName(inArg.getValue()).c_str(),
-		                  known.empty() ? "vision odometry" : "given",
-		                  res.rms_before_m, res.rms_after_m);
+		    std::snprintf(
+		        note, sizeof(note),
+		        "# bims-calib-depth: %zu frames of %s (%s poses), "
+		        "robust RMS %.4f -> %.4f m\n",
+		        frames.size(),
+		        mrpt::system::extractFileName(inArg.getValue()).c_str(),
+		        known.empty() ? "vision odometry" : "given", res.rms_before_m,
+		        res.rms_after_m);
 		    out << res.params.toIni(note);
 		    return 0;
 	    });

@@ -127,8 +127,10 @@ int main(int argc, char** argv)
 			           "ms_input,ms_track,ms_motion,true_rate_deg_s,"
 			           "attempted_with_depth,tracked_within_2px,"
 			           "anchor_keyframe,anchor_inliers,anchor_inlier_fraction,"
-			           "anchor_overlap,anchor_coverage,anchor_guess,anchor_correction_m,"
-			           "anchor_correction_deg,anchor_excluded,anchor_seen_through,ms_anchor,"
+			           "anchor_overlap,anchor_coverage,anchor_guess,anchor_"
+			           "correction_m,"
+			           "anchor_correction_deg,anchor_excluded,anchor_seen_"
+			           "through,ms_anchor,"
 			           "anchor_note\n";
 		    }
 		    Trajectory gt;
@@ -215,17 +217,19 @@ int main(int argc, char** argv)
 				        const auto& a = r.anchor;
 				        std::snprintf(
 				            buf, sizeof(buf),
-				            "%.6f,%s,%s,%d,%d,%.5f,%zu,%.3f,%.3f,%.3f,%.3f,%d,%d,"
-				            "%d,%d,%.3f,%.3f,%.3f,%d,%.4f,%.3f,%.3f,%d,%.3f,%s\n",
+				            "%.6f,%s,%s,%d,%d,%.5f,%zu,%.3f,%.3f,%.3f,%.3f,%d,%"
+				            "d,"
+				            "%d,%d,%.3f,%.3f,%.3f,%d,%.4f,%.3f,%.3f,%d,%.3f,%"
+				            "s\n",
 				            r.t, ego::flagsToString(r.flags).c_str(),
 				            ego::toString(r.R_source), r.correspondences,
 				            r.inliers, r.residual_rms_m, r.tracks.size(),
-				            r.ms_input, r.ms_track, r.ms_motion, rate, denom, good,
-				            a.keyframe, a.inliers, a.inlier_fraction, a.overlap,
-				            a.coverage, a.guess,
-				            a.correction_m, a.correction_deg, a.excluded_fraction,
-				            a.seen_through,
-				            r.ms_anchor, a.why.empty() ? "-" : a.why.c_str());
+				            r.ms_input, r.ms_track, r.ms_motion, rate, denom,
+				            good, a.keyframe, a.inliers, a.inlier_fraction,
+				            a.overlap, a.coverage, a.guess, a.correction_m,
+				            a.correction_deg, a.excluded_fraction,
+				            a.seen_through, r.ms_anchor,
+				            a.why.empty() ? "-" : a.why.c_str());
 				        csv << buf;
 			        }
 		        },

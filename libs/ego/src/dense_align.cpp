@@ -52,10 +52,8 @@ cv::Mat normalsOf(const DenseLevel& L)
 {
 	const int W = L.depth.cols, H = L.depth.rows;
 	cv::Mat n(H, W, CV_32FC3, cv::Scalar::all(0));
-	auto P = [&L](int u, int v, float z)
-	{
-		return Eigen::Vector3f((u - L.cx) / L.fx * z, (v - L.cy) / L.fy * z,
-		                       z);
+	auto P = [&L](int u, int v, float z) {
+		return Eigen::Vector3f((u - L.cx) / L.fx * z, (v - L.cy) / L.fy * z, z);
 	};
 	for (int v = 1; v + 1 < H; v++)
 	{
@@ -100,9 +98,14 @@ void pack(DenseLevel& L)
 		{
 			const float px = (u - L.cx) / L.fx * z[u],
 			            py = (v - L.cy) / L.fy * z[u];
-			o[u] = {z[u],        n[u][0], n[u][1], n[u][2],
+			o[u] = {z[u],
+			        n[u][0],
+			        n[u][1],
+			        n[u][2],
 			        n[u][0] * px + n[u][1] * py + n[u][2] * z[u],
-			        g[u],        gx[u],   gy[u]};
+			        g[u],
+			        gx[u],
+			        gy[u]};
 		}
 	}
 }
@@ -123,7 +126,8 @@ std::vector<Sample> samplesOf(const DenseLevel& L, int stride)
 	{
 		const float* d = L.depth.ptr<float>(v);
 		const float* g = L.grey.ptr<float>(v);
-		const uint8_t* e = L.exclude.empty() ? nullptr : L.exclude.ptr<uint8_t>(v);
+		const uint8_t* e =
+		    L.exclude.empty() ? nullptr : L.exclude.ptr<uint8_t>(v);
 		for (int u = 0; u < L.depth.cols; u += stride)
 		{
 			const float z = d[u];
@@ -163,7 +167,8 @@ struct Pass
 		if (photoN == 0) return 0;
 		int acc = 0;
 		for (int i = 0; i < kBins; i++)
-			if ((acc += photoHist[i]) * 2 >= photoN) return 1.4826 * (2 * i + 1);
+			if ((acc += photoHist[i]) * 2 >= photoN)
+				return 1.4826 * (2 * i + 1);
 		return 1.4826 * 2 * kBins;
 	}
 };
@@ -191,14 +196,16 @@ inline double tukeyWeight(double e, double c)
 Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
           const Eigen::Matrix3d& R, const Eigen::Vector3d& t, float offset,
           double photoSigma, const AnchorParams& p, bool normalEquations,
-          cv::Mat* outliers,
-          std::vector<int>* seenThrough = nullptr)
+          cv::Mat* outliers, std::vector<int>* seenThrough = nullptr)
 {
 	Pass out;
 	const int W = ref.depth.cols, H = ref.depth.rows;
-	const float r00 = float(R(0, 0)), r01 = float(R(0, 1)), r02 = float(R(0, 2));
-	const float r10 = float(R(1, 0)), r11 = float(R(1, 1)), r12 = float(R(1, 2));
-	const float r20 = float(R(2, 0)), r21 = float(R(2, 1)), r22 = float(R(2, 2));
+	const float r00 = float(R(0, 0)), r01 = float(R(0, 1)),
+	            r02 = float(R(0, 2));
+	const float r10 = float(R(1, 0)), r11 = float(R(1, 1)),
+	            r12 = float(R(1, 2));
+	const float r20 = float(R(2, 0)), r21 = float(R(2, 1)),
+	            r22 = float(R(2, 2));
 	const float t0 = float(t[0]), t1 = float(t[1]), t2 = float(t[2]);
 	const float fx = ref.fx, fy = ref.fy, cx = ref.cx, cy = ref.cy;
 	const float zmin = float(p.min_depth_m);
@@ -342,12 +349,8 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 		const float gx = bil(&RefPixel::gx), gy = bil(&RefPixel::gy);
 		const float g0 = gx * fx * iz, g1 = gy * fy * iz,
 		            g2 = -(gx * fx * X + gy * fy * Y) * iz * iz;
-		const float Jp[6] = {g0,
-		                     g1,
-		                     g2,
-		                     Y * g2 - Z * g1,
-		                     Z * g0 - X * g2,
-		                     X * g1 - Y * g0};
+		const float Jp[6] = {
+		    g0, g1, g2, Y * g2 - Z * g1, Z * g0 - X * g2, X * g1 - Y * g0};
 		accumulate(Jp, wp * photoScale, rp);
 	}
 	int k = 0;
@@ -492,9 +495,9 @@ int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
 	    R_prior && !fixRotation ? 1 / (sigmaPrior_rad * sigmaPrior_rad) : 0;
 	auto priorCost = [&](const Eigen::Matrix3d& Rx)
 	{
-		return wPrior > 0
-		           ? 0.5 * wPrior * logSO3(R_prior->transpose() * Rx).squaredNorm()
-		           : 0.0;
+		return wPrior > 0 ? 0.5 * wPrior *
+		                        logSO3(R_prior->transpose() * Rx).squaredNorm()
+		                  : 0.0;
 	};
 	Pass cur = pass(Lr, samples, R, t, offset, photoSigma, p, true, nullptr);
 	double curCost = cur.cost + priorCost(R);
@@ -527,7 +530,8 @@ int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
 		const Eigen::Matrix3d dR = expSO3(d.segment<3>(3));
 		const Eigen::Matrix3d Rn = dR * R;
 		const Eigen::Vector3d tn = dR * t + d.head<3>();
-		Pass nxt = pass(Lr, samples, Rn, tn, offset, photoSigma, p, true, nullptr);
+		Pass nxt =
+		    pass(Lr, samples, Rn, tn, offset, photoSigma, p, true, nullptr);
 		const double nxtCost = nxt.cost + priorCost(Rn);
 		++steps;
 		if (nxtCost < curCost)
@@ -595,8 +599,7 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
                             const Eigen::Matrix3d* R_prior,
                             double sigmaPrior_rad)
 {
-	return alignDense(ref, cur, {{R_init, t_init}}, p, R_prior,
-	                  sigmaPrior_rad);
+	return alignDense(ref, cur, {{R_init, t_init}}, p, R_prior, sigmaPrior_rad);
 }
 
 DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
@@ -640,9 +643,9 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 		float ok = 0;
 		double sk = sigma0;
 		int inl = 0;
-		r.iterations += iterateLevel(ref.levels[static_cast<size_t>(top)],
-		                             coarse, Rk, tk, ok, sk, p, R_prior,
-		                             sigmaPrior_rad, &inl);
+		r.iterations +=
+		    iterateLevel(ref.levels[static_cast<size_t>(top)], coarse, Rk, tk,
+		                 ok, sk, p, R_prior, sigmaPrior_rad, &inl);
 		if (inl > best)
 		{
 			best = inl;
@@ -657,16 +660,16 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 	for (int l = top - 1; l >= fine; l--)
 	{
 		samples = samplesOf(cur.levels[static_cast<size_t>(l)], strideAt(l));
-		r.iterations +=
-		    iterateLevel(ref.levels[static_cast<size_t>(l)], samples, R, t,
-		                 offset, photoSigma, p, R_prior, sigmaPrior_rad, nullptr);
+		r.iterations += iterateLevel(ref.levels[static_cast<size_t>(l)],
+		                             samples, R, t, offset, photoSigma, p,
+		                             R_prior, sigmaPrior_rad, nullptr);
 	}
 	// Final counts and the outlier image at the finest level.
 	const DenseLevel& Lf = cur.levels[static_cast<size_t>(fine)];
 	r.outliers = cv::Mat::zeros(Lf.depth.size(), CV_8UC1);
-	const Pass fin = pass(ref.levels[static_cast<size_t>(fine)], samples, R, t,
-	                      offset, photoSigma, p, false, &r.outliers,
-	                      &r.seenThrough);
+	const Pass fin =
+	    pass(ref.levels[static_cast<size_t>(fine)], samples, R, t, offset,
+	         photoSigma, p, false, &r.outliers, &r.seenThrough);
 	if (p.stride_px > 1)
 	{
 		// a sample stands for its stride x stride block

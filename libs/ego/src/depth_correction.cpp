@@ -12,11 +12,11 @@
 namespace bims::ego
 {
 std::array<double, kDepthCorrectionTerms> depthCorrectionBasis(double x,
-                                                                double y)
+                                                               double y)
 {
 	const double x2 = x * x, y2 = y * y;
-	return {x,      y,      x2,      x * y,   y2,      x2 * x,
-	        x2 * y, x * y2, y2 * y,  x2 * x2, y2 * y2, x2 * y2};
+	return {x,      y,      x2,     x * y,   y2,      x2 * x,
+	        x2 * y, x * y2, y2 * y, x2 * x2, y2 * y2, x2 * y2};
 }
 
 void DepthCorrectionParams::loadFromConfigFile(
@@ -25,8 +25,8 @@ void DepthCorrectionParams::loadFromConfigFile(
 	ConfigSection s(cfg, section);
 	enable = s.getBool("enable", enable);
 	const std::vector<double> def(coefficients.begin(), coefficients.end());
-	const auto c = s.getDoubles("coefficients", def, kDepthCorrectionTerms,
-	                            -10, 10);
+	const auto c =
+	    s.getDoubles("coefficients", def, kDepthCorrectionTerms, -10, 10);
 	for (int i = 0; i < kDepthCorrectionTerms; i++) coefficients[i] = c[i];
 	s.allow("fitted_on");  // informative keys written by bims-calib-depth
 	s.allow("rms_before_m");
@@ -49,8 +49,7 @@ std::string DepthCorrectionParams::toIni(const std::string& comment) const
 	return os.str();
 }
 
-const cv::Mat& DepthCorrection::factors(const Eigen::Matrix3d& K,
-                                        cv::Size size)
+const cv::Mat& DepthCorrection::factors(const Eigen::Matrix3d& K, cv::Size size)
 {
 	if (f_.size() == size && K == K_) return f_;
 	K_ = K;
@@ -84,7 +83,8 @@ void DepthCorrection::apply(mrpt::obs::CObservation3DRangeScan& obs,
 	if (!p_.enable || !obs.hasRangeImage) return;
 	obs.load();
 	auto& img = obs.rangeImage;
-	const int H = static_cast<int>(img.rows()), W = static_cast<int>(img.cols());
+	const int H = static_cast<int>(img.rows()),
+	          W = static_cast<int>(img.cols());
 	Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
 	if (cam.given)
 		K << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1;
@@ -150,7 +150,8 @@ DepthFitResult estimateDepthCorrection(const std::vector<RgbdFrame>& frames,
 	{
 		DepthCorrectionParams cur;
 		cur.enable = true;
-		for (int k = 0; k < kDepthCorrectionTerms; k++) cur.coefficients[k] = a[k];
+		for (int k = 0; k < kDepthCorrectionTerms; k++)
+			cur.coefficients[k] = a[k];
 		DepthCorrection corr(cur);
 		std::vector<DenseFrame> ref(frames.size());
 		std::vector<cv::Mat> depth(frames.size());
@@ -193,7 +194,8 @@ DepthFitResult estimateDepthCorrection(const std::vector<RgbdFrame>& frames,
 				              std::lround(L.fx * Y.x() / Y.z() + L.cx)),
 				          vi = static_cast<int>(
 				              std::lround(L.fy * Y.y() / Y.z() + L.cy));
-				if (ui < 0 || vi < 0 || ui >= L.depth.cols || vi >= L.depth.rows)
+				if (ui < 0 || vi < 0 || ui >= L.depth.cols ||
+				    vi >= L.depth.rows)
 					continue;
 				const RefPixel& q =
 				    L.packed[static_cast<size_t>(vi) * L.depth.cols + ui];
@@ -232,8 +234,7 @@ DepthFitResult estimateDepthCorrection(const std::vector<RgbdFrame>& frames,
 	for (int k = 0; k < kDepthCorrectionTerms; k++)
 		res.params.coefficients[k] = a[k];
 	const RgbdFrame& f = frames.front();
-	const double fx = f.K(0, 0), fy = f.K(1, 1), cx = f.K(0, 2),
-	             cy = f.K(1, 2);
+	const double fx = f.K(0, 0), fy = f.K(1, 1), cx = f.K(0, 2), cy = f.K(1, 2);
 	const int W = f.depth.cols, H = f.depth.rows;
 	auto at = [&](double u, double v)
 	{ return basisVec((u - cx) / fx, (v - cy) / fy).dot(a); };

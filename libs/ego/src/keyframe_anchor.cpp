@@ -31,7 +31,9 @@ double maskedShare(const cv::Mat& depth, const cv::Mat& mask)
 }
 }  // namespace
 
-KeyframeAnchor::KeyframeAnchor(const AnchorParams& p) : p_(p) {}
+KeyframeAnchor::KeyframeAnchor(const AnchorParams& p) : p_(p)
+{
+}
 
 void KeyframeAnchor::clear()
 {
@@ -113,8 +115,8 @@ void KeyframeAnchor::alignTo(Keyframe& k, const Eigen::Matrix3d& R_pred,
 {
 	// guesses of T_KC = T_WK^-1 T_WC
 	std::vector<InitialGuess> inits;
-	inits.push_back({k.R_WK.transpose() * R_pred,
-	                 k.R_WK.transpose() * (t_pred - k.t_WK)});
+	inits.push_back(
+	    {k.R_WK.transpose() * R_pred, k.R_WK.transpose() * (t_pred - k.t_WK)});
 	for (const auto& g : others)
 		inits.push_back(
 		    {k.R_WK.transpose() * g.R, k.R_WK.transpose() * (g.t - k.t_WK)});
@@ -178,7 +180,8 @@ void KeyframeAnchor::alignTo(Keyframe& k, const Eigen::Matrix3d& R_pred,
 	r.seen_through = static_cast<int>(a.seenThrough.size());
 	if (!a.seenThrough.empty())
 	{
-		const DenseLevel& L = k.frame.levels[static_cast<size_t>(p_.finest_level)];
+		const DenseLevel& L =
+		    k.frame.levels[static_cast<size_t>(p_.finest_level)];
 		cv::Mat m = cv::Mat::zeros(L.depth.size(), CV_8UC1);
 		for (int i : a.seenThrough) m.data[i] = 255;
 		cv::dilate(m, m, cv::Mat());

@@ -152,9 +152,9 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	else if (own)
 		moving = anchorMoving_;
 	anchorMoving_.release();
-	if (!moving.empty() && cv::countNonZero(moving) >
-	                           cfg_.anchor.max_excluded_fraction *
-	                               static_cast<double>(moving.total()))
+	if (!moving.empty() &&
+	    cv::countNonZero(moving) > cfg_.anchor.max_excluded_fraction *
+	                                   static_cast<double>(moving.total()))
 	{
 		r.flags |= kFlagMaskIgnored;
 		moving.release();

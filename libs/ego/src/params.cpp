@@ -173,7 +173,8 @@ void AnchorParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	    s.getDouble("keyframe_min_overlap", keyframe_min_overlap, 0, 1);
 	max_keyframes =
 	    static_cast<int>(s.getInt("max_keyframes", max_keyframes, 1, 100000));
-	lost_frames = static_cast<int>(s.getInt("lost_frames", lost_frames, 1, 1e6));
+	lost_frames =
+	    static_cast<int>(s.getInt("lost_frames", lost_frames, 1, 1e6));
 	max_excluded_fraction =
 	    s.getDouble("max_excluded_fraction", max_excluded_fraction, 0, 1);
 	min_depth_m = s.getDouble("min_depth_m", min_depth_m, 0, 100);

@@ -1,7 +1,7 @@
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
-#include <bims/ego/flags.h>
 #include <bims/ego/depth_correction.h>
+#include <bims/ego/flags.h>
 #include <bims/ego/replay.h>
 
 #include <mrpt/core/Clock.h>

@@ -49,8 +49,7 @@ struct Err
 Err errorOf(const DenseAlignResult& a, const Eigen::Matrix3d& R,
             const Eigen::Vector3d& t)
 {
-	return {(a.t_RC - t).norm(),
-	        angleSO3(a.R_RC.transpose() * R) * 180 / M_PI};
+	return {(a.t_RC - t).norm(), angleSO3(a.R_RC.transpose() * R) * 180 / M_PI};
 }
 
 /** Keyframe at time 0, current frame at time tc of test::Motion. */

@@ -2,10 +2,10 @@
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
+#include <bims/ego/depth_correction.h>
 #include <bims/ego/flags.h>
 #include <bims/maps/export.h>
 #include <bims/pipeline/run.h>
-#include <bims/ego/depth_correction.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/obs/TPixelLabelInfo.h>

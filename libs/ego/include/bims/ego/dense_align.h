@@ -88,14 +88,14 @@ struct DenseAlignResult
 	 * surface (not in front of it, not behind it: those are explained by
 	 * motion in the scene). */
 	double inlier_fraction = 0;
-	double overlap = 0;          ///< inliers / points
+	double overlap = 0;  ///< inliers / points
 	/** associated / points: how much of the frame the reference covers
 	 * (occluders count as covered; they are not a reason for a new
 	 * keyframe). */
 	double coverage = 0;
-	int guess = 0;  ///< index of the initial guess that won
-	double rms_geo_m = 0;        ///< RMS point-to-plane residual of inliers
-	int iterations = 0;          ///< Gauss-Newton steps over all levels
+	int guess = 0;         ///< index of the initial guess that won
+	double rms_geo_m = 0;  ///< RMS point-to-plane residual of inliers
+	int iterations = 0;    ///< Gauss-Newton steps over all levels
 	/** Finest-level image (CV_8UC1): 255 where a current point is an
 	 * outlier (in front of the reference's surface or off it: candidate
 	 * moving), 0 elsewhere. */

@@ -30,7 +30,7 @@ namespace bims::ego
 {
 /** The polynomial's terms at normalised image coordinates (x, y). */
 std::array<double, kDepthCorrectionTerms> depthCorrectionBasis(double x,
-                                                                double y);
+                                                               double y);
 
 /** Applies a correction; keeps the per-pixel factors of the last camera. */
 class DepthCorrection
@@ -56,12 +56,12 @@ class DepthCorrection
 /** Options of the fit. */
 struct DepthFitOptions
 {
-	int min_gap = 9;             ///< frame pairs at least this far apart
-	int max_gap = 40;            ///< ... and at most this far
-	int step = 3;                ///< every step-th frame is used
+	int min_gap = 9;              ///< frame pairs at least this far apart
+	int max_gap = 40;             ///< ... and at most this far
+	int step = 3;                 ///< every step-th frame is used
 	int samples_per_pair = 4000;  ///< random pixels per pair (fixed seed)
-	int iterations = 5;          ///< Gauss-Newton / IRLS rounds
-	double huber_m = 0.02;       ///< Huber scale of the residuals [m]
+	int iterations = 5;           ///< Gauss-Newton / IRLS rounds
+	double huber_m = 0.02;        ///< Huber scale of the residuals [m]
 	double min_depth_m = 0.3, max_depth_m = 6.0;
 };
 
@@ -70,8 +70,8 @@ struct DepthFitResult
 {
 	DepthCorrectionParams params;
 	int pairs = 0;
-	size_t residuals = 0;       ///< in the last round
-	double rms_before_m = 0;    ///< robust RMS point-to-plane residual
+	size_t residuals = 0;     ///< in the last round
+	double rms_before_m = 0;  ///< robust RMS point-to-plane residual
 	double rms_after_m = 0;
 	/** delta at the centre of the left, right, top and bottom borders and
 	 * at the top-left corner (for the report). */
@@ -81,8 +81,8 @@ struct DepthFitResult
 /** Fits the correction to \a frames of a static scene (registered RGB-D
  * with their intrinsics) at camera poses \a T_WC (same order). Throws
  * std::invalid_argument when the sizes disagree or no pair qualifies. */
-DepthFitResult estimateDepthCorrection(
-    const std::vector<RgbdFrame>& frames,
-    const std::vector<Eigen::Matrix4d>& T_WC, const DepthFitOptions& o = {});
+DepthFitResult estimateDepthCorrection(const std::vector<RgbdFrame>& frames,
+                                       const std::vector<Eigen::Matrix4d>& T_WC,
+                                       const DepthFitOptions& o = {});
 
 }  // namespace bims::ego

@@ -29,7 +29,7 @@ struct AnchorResult
 	std::string why;        ///< why not accepted (empty when accepted)
 	Eigen::Matrix3d R_WC = Eigen::Matrix3d::Identity();  ///< anchored pose
 	Eigen::Vector3d t_WC = Eigen::Vector3d::Zero();
-	int keyframe = -1;           ///< id of the keyframe aligned to
+	int keyframe = -1;            ///< id of the keyframe aligned to
 	int points = 0, inliers = 0;  ///< of the alignment (finest level)
 	double inlier_fraction = 0, overlap = 0, coverage = 0;
 	int guess = 0;  ///< 0: the prediction won, k: others[k - 1]
@@ -64,7 +64,8 @@ class KeyframeAnchor
 
 	/** Whether the frame of the last track() should become a keyframe at
 	 * (R_WC, t_WC) (its final pose): no keyframe yet, its keyframe covers
-	 * too little of it (coverage), or it is too far from its keyframe. Remembers the decision. */
+	 * too little of it (coverage), or it is too far from its keyframe.
+	 * Remembers the decision. */
 	bool wantKeyframe(const AnchorResult& r, const Eigen::Matrix3d& R_WC,
 	                  const Eigen::Vector3d& t_WC, bool force = false);
 

@@ -147,11 +147,12 @@ struct OdometryParams
  * (point-to-plane ICP + photometric, robust Tukey weights, coarse to fine) to
  * a keyframe of the static scene registered in the same world, starting from
  * the frame-to-frame estimate; content absent from the keyframe (people who
- * walked in, or moved) gets no weight (docs/ego.md, "Map-anchored tracking"). */
+ * walked in, or moved) gets no weight (docs/ego.md, "Map-anchored tracking").
+ */
 struct AnchorParams
 {
-	bool enable = true;  ///< false: frame-to-frame egomotion only
-	int finest_level = 1;   ///< finest pyramid level aligned (0 = full size)
+	bool enable = true;    ///< false: frame-to-frame egomotion only
+	int finest_level = 1;  ///< finest pyramid level aligned (0 = full size)
 	/** Coarsest level (each level halves the size; 2 = 160x120 for VGA:
 	 * the frame-to-frame guess is close, a coarser start only costs). */
 	int coarsest_level = 2;
@@ -169,8 +170,8 @@ struct AnchorParams
 	/** Least photometric residual scale [grey levels]; the scale used is
 	 * 1.4826 x the median |residual| of the last pass when larger. */
 	double photo_sigma_grey = 8;
-	double photo_weight = 1;      ///< weight of the photometric term (0: off)
-	double tukey_c = 4.685;       ///< Tukey biweight limit [scales]
+	double photo_weight = 1;  ///< weight of the photometric term (0: off)
+	double tukey_c = 4.685;   ///< Tukey biweight limit [scales]
 	/** mode = imu: std. dev. of the IMU rotation as the alignment's prior
 	 * [deg]; 0 keeps the IMU rotation and aligns the translation only (the
 	 * paper's split, but the gyro's drift then stays in the map). */
