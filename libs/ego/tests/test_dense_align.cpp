@@ -220,3 +220,36 @@ TEST(KeyframeAnchor, LostTrackingIsFlaggedAndRecovers)
 	// tracking resumed: the last frames are anchored again
 	EXPECT_TRUE(e.flags & kFlagAnchored) << flagsToString(e.flags);
 }
+
+TEST(KeyframeAnchor, AnImuThatStopsIsFlaggedAndTheAnchorCarriesOn)
+{
+	EgoConfig cfg;
+	cfg.odometry.mode = "imu";
+	cfg.calibration.has_R_IC = true;
+	cfg.calibration.R_IC = expSO3(Eigen::Vector3d(0.3, -0.2, 0.1));
+	cfg.anchor = params320();
+	Odometry odo(cfg);
+	test::Motion m;
+	m.w_C = Eigen::Vector3d(0.05, 0.2, 0.02);
+	m.v_W = Eigen::Vector3d(0.15, 0.1, 0.0);
+	double tImu = 0;
+	FrameEgomotion e;
+	int missing = 0, anchored = 0;
+	for (int k = 0; k < 16; k++)
+	{
+		const double t = k * 0.05;
+		// the IMU stops after 0.3 s
+		for (; tImu <= std::min(t + 0.03, 0.3); tImu += 0.005)
+			odo.addImu(test::imuAt(m, cfg.calibration.R_IC, tImu));
+		e = odo.processFrame(test::render(m.R(t), m.p(t), K320(), 320, 240, t));
+		if (e.flags & (kFlagImuMissing | kFlagImuGap)) ++missing;
+		if (e.flags & kFlagAnchored) ++anchored;
+		ASSERT_TRUE(std::isfinite(e.T_WC.x())) << k;
+	}
+	EXPECT_GE(missing, 8);
+	EXPECT_GE(anchored, 14);
+	// the distance from the first frame (the world's origin) is still right
+	const double t = 15 * 0.05;
+	EXPECT_LT(std::abs((m.p(t) - m.p(0)).norm() - e.T_WC.translation().norm()),
+	          0.02);
+}
