@@ -13,6 +13,7 @@
 #include <bims/ego/depth_correction.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/replay.h>
+#include <bims/pipeline/run.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/config/CConfigFile.h>
@@ -65,6 +66,11 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<std::string> outArg(
 		        "o", "out", "where to write the [depth_correction] section",
 		        true, "", "OUT.ini", cmd);
+		    TCLAP::ValueArg<double> maxArg(
+		        "", "max-correction",
+		        "refuse a fit that corrects any pixel by more than this "
+		        "fraction (0.1): the poses did not fit a static scene",
+		        false, 0.1, "FRACTION", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
 
@@ -79,24 +85,18 @@ int main(int argc, char** argv)
 		    ec.odometry.mode = "vision";
 		    ec.anchor.enable = false;
 		    ec.depth_correction.enable = false;
-		    size_t first = 0, last = static_cast<size_t>(-1);
-		    if (framesArg.isSet())
+		    // (the same A:B rule as bims-run's)
+		    pipeline::FrameRange range;
+		    try
 		    {
-			    const std::string& f = framesArg.getValue();
-			    const auto colon = f.find(':');
-			    try
-			    {
-				    if (colon == std::string::npos) throw 0;
-				    first = std::stoul(f.substr(0, colon));
-				    last = std::stoul(f.substr(colon + 1));
-			    }
-			    catch (...)
-			    {
-				    throw UsageError("--frames: expected A:B, got '" + f + "'");
-			    }
-			    if (last < first)
-				    throw UsageError("--frames: B must not be less than A");
+			    if (framesArg.isSet())
+				    range = pipeline::FrameRange::parse(framesArg.getValue());
 		    }
+		    catch (const std::invalid_argument& e)
+		    {
+			    throw UsageError(std::string("--frames: ") + e.what());
+		    }
+		    const size_t first = range.first, last = range.last;
 		    Trajectory known;
 		    if (posesArg.isSet())
 			    known = loadTumTrajectory(posesArg.getValue());
@@ -165,6 +165,29 @@ int main(int argc, char** argv)
 		        res.rms_before_m, res.rms_after_m, 100 * res.left,
 		        100 * res.right, 100 * res.top, 100 * res.bottom,
 		        100 * res.corner);
+		    // A sensor's distortion is a few percent: a larger fit absorbed
+		    // pose errors (a poor odometry, or moving objects in the stretch).
+		    {
+			    ego::DepthCorrection dc(res.params);
+			    const ego::RgbdFrame& f0 = frames.front();
+			    double worst = 0;
+			    cv::Mat fac = dc.factors(f0.K, f0.depth.size());
+			    cv::minMaxLoc(cv::abs(fac - 1), nullptr, &worst);
+			    if (worst > maxArg.getValue())
+			    {
+				    char msg[400];
+				    std::snprintf(
+				        msg, sizeof(msg),
+				        "the fitted correction reaches %.1f %% (limit "
+				        "--max-correction %.1f %%): the %s do not fit a static "
+				        "scene well enough; give --poses (e.g. ground truth) "
+				        "or a "
+				        "slower, longer static stretch (nothing written)",
+				        100 * worst, 100 * maxArg.getValue(),
+				        known.empty() ? "odometry's poses" : "given poses");
+				    throw std::runtime_error(msg);
+			    }
+		    }
 		    std::ofstream out(outArg.getValue());
 		    if (!out)
 			    throw std::runtime_error(outArg.getValue() + ": cannot write");

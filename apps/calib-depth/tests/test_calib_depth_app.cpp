@@ -1,0 +1,98 @@
+// bims-calib-depth end to end on the bundled sample (simulated: no depth
+// distortion to find).
+#include <bims/ego/params.h>
+
+#include <mrpt/config/CConfigFile.h>
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+namespace
+{
+const std::string kApp = std::string(BIMS_BIN_DIR) + "/bims-calib-depth";
+const std::string kSrc = BIMS_SOURCE_DIR;
+const std::string kOut = std::string(BIMS_BINARY_DIR) + "/calib_depth_test";
+
+int run(const std::string& args, const std::string& log)
+{
+	const int rc =
+	    std::system((kApp + " " + args + " > '" + log + "' 2>&1").c_str());
+	return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+std::string slurp(const std::string& p)
+{
+	std::ifstream f(p);
+	std::stringstream s;
+	s << f.rdbuf();
+	return s.str();
+}
+}  // namespace
+
+TEST(CalibDepthApp, AnUndistortedSensorGetsAlmostNoCorrection)
+{
+	ASSERT_EQ(std::system(("mkdir -p '" + kOut + "'").c_str()), 0);
+	const std::string out = kOut + "/sample.ini", log = kOut + "/sample.log";
+	std::remove(out.c_str());
+	ASSERT_EQ(run("'" + kSrc + "/config/default.ini' '" + kSrc +
+	                  "/rawlogs/pendulum_slow.rawlog' --frames 0:40 --poses '" +
+	                  kSrc + "/rawlogs/pendulum_slow_gt/groundtruth.txt' -o '" +
+	                  out + "' -q",
+	              log),
+	          0)
+	    << slurp(log);
+	mrpt::config::CConfigFile f(out);
+	bims::ego::DepthCorrectionParams p;
+	p.loadFromConfigFile(f);
+	EXPECT_TRUE(p.enable);
+	// at the borders and corners of the 320 x 240 sample (fx 270)
+	for (const auto& [x, y] : {std::pair{-0.59, 0.0},
+	                           {0.59, 0.0},
+	                           {0.0, -0.44},
+	                           {0.0, 0.44},
+	                           {-0.59, -0.44},
+	                           {0.59, 0.44}})
+	{
+		const double x2 = x * x, y2 = y * y;
+		const double b[12] = {x,      y,       x2,      x * y,
+		                      y2,     x2 * x,  x2 * y,  x * y2,
+		                      y2 * y, x2 * x2, y2 * y2, x2 * y2};
+		double d = 0;
+		for (int i = 0; i < 12; i++) d += p.coefficients[i] * b[i];
+		EXPECT_LT(std::abs(d), 0.025) << x << " " << y;
+	}
+}
+
+TEST(CalibDepthApp, PosesThatDoNotFitAreRefusedNotWritten)
+{
+	ASSERT_EQ(std::system(("mkdir -p '" + kOut + "'").c_str()), 0);
+	const std::string out = kOut + "/refused.ini", log = kOut + "/refused.log";
+	std::remove(out.c_str());
+	// the 320 x 240 sample's frame-to-frame vision odometry is too poor
+	// (0.34 deg per frame) for a fit: refused with a reason
+	EXPECT_EQ(run("'" + kSrc + "/config/default.ini' '" + kSrc +
+	                  "/rawlogs/pendulum_slow.rawlog' --frames 0:40 -o '" +
+	                  out + "' -q",
+	              log),
+	          1);
+	EXPECT_NE(slurp(log).find("do not fit a static scene"), std::string::npos)
+	    << slurp(log);
+	EXPECT_FALSE(std::ifstream(out).good());
+	// bad arguments are usage errors
+	EXPECT_EQ(
+	    run("'" + kSrc + "/config/default.ini' '" + kSrc +
+	            "/rawlogs/pendulum_slow.rawlog' --frames 9:2 -o '" + out + "'",
+	        log),
+	    2);
+	EXPECT_EQ(run("'" + kSrc + "/config/default.ini' /nonexistent.rawlog -o '" +
+	                  out + "'",
+	              log),
+	          1);
+	EXPECT_NE(slurp(log).find("/nonexistent.rawlog"), std::string::npos);
+}
