@@ -638,10 +638,6 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 	int best = -1;
 	for (size_t k = 0; k < inits.size(); k++)
 	{
-		// a guess next to the first one would converge to the same place
-		if (k > 0 && (inits[k].t - inits[0].t).norm() < 0.005 &&
-		    angleSO3(inits[k].R.transpose() * inits[0].R) < 0.1 * M_PI / 180)
-			continue;
 		Eigen::Matrix3d Rk = inits[k].R;
 		Eigen::Vector3d tk = inits[k].t;
 		float ok = 0;
