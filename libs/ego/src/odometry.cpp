@@ -137,10 +137,6 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	++nFrames_;
 	lastAnchored_ = false;
 	const bool anchoring = cfg_.anchor.enable;
-	// The previous frame becomes a keyframe now that its moving mask is
-	// known.
-	if (anchoring && anchor_.addPending(mask ? *mask : cv::Mat()))
-		r.flags |= kFlagNewKeyframe;
 	// What moved in the previous frame: the caller's mask (segmentation)
 	// and the anchor's own outliers. Not used when it covers too much.
 	cv::Mat moving;
@@ -160,6 +156,9 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		moving.release();
 	}
 	mask = moving.empty() ? nullptr : &moving;
+	// The previous frame becomes a keyframe now that its moving mask is
+	// known (the same mask, after the same guard).
+	if (anchoring && anchor_.addPending(moving)) r.flags |= kFlagNewKeyframe;
 	const bool imuMode = cfg_.odometry.mode == "imu";
 	uint32_t imuFlags = 0;
 	const auto R_WC_imu = imuRotation(f.t, &imuFlags);

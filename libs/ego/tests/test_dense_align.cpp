@@ -253,3 +253,30 @@ TEST(KeyframeAnchor, AnImuThatStopsIsFlaggedAndTheAnchorCarriesOn)
 	EXPECT_LT(std::abs((m.p(t) - m.p(0)).norm() - e.T_WC.translation().norm()),
 	          0.02);
 }
+
+TEST(KeyframeAnchor, AMaskOverMostOfTheImageIsCountedAndNotUsed)
+{
+	EgoConfig cfg;
+	cfg.odometry.mode = "vision";
+	cfg.anchor = params320();
+	Odometry odo(cfg);
+	test::Motion m;
+	cv::Mat most = cv::Mat::zeros(240, 320, CV_8UC1), some = most.clone();
+	most(cv::Rect(0, 0, 300, 240)).setTo(255);  // 94 % of the image
+	some(cv::Rect(0, 0, 96, 240)).setTo(255);   // 30 %
+	odo.processFrame(test::render(m.R(0), m.p(0), K320(), 320, 240, 0));
+	const FrameEgomotion a = odo.processFrame(
+	    test::render(m.R(0.05), m.p(0.05), K320(), 320, 240, 0.05), &most);
+	EXPECT_TRUE(a.flags & kFlagMaskIgnored) << flagsToString(a.flags);
+	EXPECT_TRUE(a.flags & kFlagAnchored) << flagsToString(a.flags);
+	EXPECT_GT(a.tracks.size(), 50u);  // the tracker was not starved
+	// ... nor for the keyframe the previous frame became (it would have
+	// lost 94 % of its readings)
+	EXPECT_LT(cv::countNonZero(a.anchor.outliers),
+	          0.1 * a.anchor.outliers.total());
+	const FrameEgomotion b = odo.processFrame(
+	    test::render(m.R(0.1), m.p(0.1), K320(), 320, 240, 0.1), &some);
+	EXPECT_FALSE(b.flags & kFlagMaskIgnored) << flagsToString(b.flags);
+	EXPECT_TRUE(b.flags & kFlagAnchored);
+	EXPECT_GT(b.anchor.excluded_fraction, 0.2);  // the mask was used
+}
