@@ -16,13 +16,13 @@
 #include <bims/ego/depth_correction.h>
 #include <bims/ego/odometry.h>
 #include <bims/ego/rgbd_input.h>
+#include <bims/pipeline/run.h>
 
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
 #include <opencv2/rgbd.hpp>
 
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -131,15 +131,11 @@ int main(int argc, char** argv)
 		}
 		bims::saveTumTrajectory(out, traj,
 		                        "OpenCV cv::rgbd " + method + " odometry");
-		std::sort(ms.begin(), ms.end());
-		const auto pct = [&ms](double p) {
-			return ms.empty() ? 0.0
-			                  : ms[static_cast<size_t>(p * (ms.size() - 1))];
-		};
+		const auto pc = bims::pipeline::Percentiles::of(ms);
 		std::printf(
 		    "rgbd_odometry_baseline: %zu frames, %zu failed, ms/frame median "
 		    "%.2f p95 %.2f (method %s, depth correction %s)\n",
-		    traj.size(), failed, pct(0.5), pct(0.95), method.c_str(),
+		    traj.size(), failed, pc.median, pc.p95, method.c_str(),
 		    correct && dc.enabled() ? "on" : "off");
 		return 0;
 	}

@@ -23,20 +23,6 @@
 #include <cstdio>
 #include <fstream>
 
-namespace
-{
-Eigen::Matrix4d toMatrix(const mrpt::poses::CPose3D& T)
-{
-	Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
-	for (int i = 0; i < 3; i++)
-	{
-		for (int j = 0; j < 3; j++) M(i, j) = T.getRotationMatrix()(i, j);
-		M(i, 3) = T.translation()[i];
-	}
-	return M;
-}
-}  // namespace
-
 int main(int argc, char** argv)
 {
 	return bims::runApp(
@@ -100,18 +86,6 @@ int main(int argc, char** argv)
 		    Trajectory known;
 		    if (posesArg.isSet())
 			    known = loadTumTrajectory(posesArg.getValue());
-		    auto poseAt = [&known](double t) -> const StampedPose*
-		    {
-			    const StampedPose* best = nullptr;
-			    double dt = 5e-3;
-			    for (const auto& p : known)
-				    if (std::abs(p.t - t) < dt)
-				    {
-					    dt = std::abs(p.t - t);
-					    best = &p;
-				    }
-			    return best;
-		    };
 
 		    ego::Odometry odo(ec);
 		    std::vector<ego::RgbdFrame> frames;
@@ -132,7 +106,7 @@ int main(int argc, char** argv)
 			        mrpt::poses::CPose3D T = r.T_WC;
 			        if (!known.empty())
 			        {
-				        const StampedPose* p = poseAt(r.t);
+				        const StampedPose* p = poseNear(known, r.t, 5e-3);
 				        if (!p)
 				        {
 					        ++noPose;
@@ -143,7 +117,9 @@ int main(int argc, char** argv)
 			        ego::RgbdFrame f;
 			        if (!ego::rgbdFrameFrom(scan, ec.camera, f).empty()) return;
 			        frames.push_back(std::move(f));
-			        poses.push_back(toMatrix(T));
+			        poses.push_back(
+			            T.getHomogeneousMatrixVal<mrpt::math::CMatrixDouble44>()
+			                .asEigen());
 		        },
 		        ro);
 		    if (frames.empty())

@@ -136,18 +136,7 @@ int main(int argc, char** argv)
 		    Trajectory gt;
 		    if (gtArg.isSet()) gt = loadTumTrajectory(gtArg.getValue());
 		    // Ground-truth pose nearest to t (within 5 ms), or nullptr.
-		    const auto gtAt = [&](double t) -> const StampedPose*
-		    {
-			    auto it = std::lower_bound(gt.begin(), gt.end(), t,
-			                               [](const StampedPose& p, double v)
-			                               { return p.t < v; });
-			    const StampedPose* best = nullptr;
-			    double bestDt = 5e-3;
-			    for (auto j : {it, it == gt.begin() ? it : it - 1})
-				    if (j != gt.end() && std::abs(j->t - t) < bestDt)
-					    best = &*j, bestDt = std::abs(j->t - t);
-			    return best;
-		    };
+		    const auto gtAt = [&gt](double t) { return poseNear(gt, t, 5e-3); };
 		    ego::RgbdFrame prevFrame;
 		    double prevT = 0;
 		    ego::ReplayOptions ro;

@@ -1,6 +1,6 @@
 // bims-calib-depth end to end on the bundled sample (simulated: no depth
 // distortion to find).
-#include <bims/ego/params.h>
+#include <bims/ego/depth_correction.h>
 
 #include <mrpt/config/CConfigFile.h>
 
@@ -59,12 +59,10 @@ TEST(CalibDepthApp, AnUndistortedSensorGetsAlmostNoCorrection)
 	                           {-0.59, -0.44},
 	                           {0.59, 0.44}})
 	{
-		const double x2 = x * x, y2 = y * y;
-		const double b[12] = {x,      y,       x2,      x * y,
-		                      y2,     x2 * x,  x2 * y,  x * y2,
-		                      y2 * y, x2 * x2, y2 * y2, x2 * y2};
+		const auto b = bims::ego::depthCorrectionBasis(x, y);
 		double d = 0;
-		for (int i = 0; i < 12; i++) d += p.coefficients[i] * b[i];
+		for (int i = 0; i < bims::ego::kDepthCorrectionTerms; i++)
+			d += p.coefficients[i] * b[i];
 		EXPECT_LT(std::abs(d), 0.025) << x << " " << y;
 	}
 }

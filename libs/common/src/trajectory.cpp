@@ -1,6 +1,7 @@
 #include <bims/common/trajectory.h>
 #include <mrpt/poses/CPose3DQuat.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -64,6 +65,22 @@ void saveTumTrajectory(const std::string& path, const Trajectory& traj,
 	f << "# timestamp tx ty tz qx qy qz qw\n";
 	for (const auto& p : traj) f << tumLine(p.t, p.T_WC) << "\n";
 	if (!f) throw std::runtime_error(path + ": write failed");
+}
+
+const StampedPose* poseNear(const Trajectory& traj, double t, double maxDt)
+{
+	auto it = std::lower_bound(traj.begin(), traj.end(), t,
+	                           [](const StampedPose& p, double v)
+	                           { return p.t < v; });
+	const StampedPose* best = nullptr;
+	double bestDt = maxDt;
+	for (auto j : {it, it == traj.begin() ? it : it - 1})
+		if (j != traj.end() && std::abs(j->t - t) < bestDt)
+		{
+			best = &*j;
+			bestDt = std::abs(j->t - t);
+		}
+	return best;
 }
 
 }  // namespace bims

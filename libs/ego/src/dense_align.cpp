@@ -46,6 +46,15 @@ cv::Mat downsampleDepth(const cv::Mat& d)
 	return out;
 }
 
+/** \a b's intrinsics: those of \a a at half the size (pixel centres). */
+void halveIntrinsics(const DenseLevel& a, DenseLevel& b)
+{
+	b.fx = a.fx / 2;
+	b.fy = a.fy / 2;
+	b.cx = (a.cx + 0.5f) / 2 - 0.5f;
+	b.cy = (a.cy + 0.5f) / 2 - 0.5f;
+}
+
 /** Unit normals from the depth's central differences, facing the camera;
  * none at depth edges and where a neighbour has no reading. */
 cv::Mat normalsOf(const DenseLevel& L)
@@ -252,17 +261,6 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 		const RefPixel* P = ref.packed.data();
 		const RefPixel& q = P[vi * W + ui];
 		const float zr = q.z;
-		if (zr < 0)
-		{
-			// the reference saw something moving here: the point is covered
-			// (no reason for a new keyframe) and likely moving itself
-			if (outliers) outliers->data[s.pix] = 255;
-			if (!counts) continue;
-			++out.associated;
-			++out.occluding;
-			out.cost += rhoMax;
-			continue;
-		}
 		if (zr == 0)
 		{
 			if (counts) out.cost += rhoMax;
@@ -272,7 +270,7 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 		// photometric one (where the texture is) still applies
 		const bool hasNormal = !(q.nx == 0 && q.ny == 0 && q.nz == 0);
 		const float gate = float(p.gate_m + p.gate_z2 * zr * zr);
-		if (Z > zr + gate)
+		if (zr > 0 && Z > zr + gate)
 		{
 			// The current frame sees through the reference's surface: that
 			// surface was not static (it has moved away); the current point
@@ -284,10 +282,12 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 			out.cost += rhoMax;
 			continue;
 		}
-		if (Z < zr - gate)
+		if (zr < 0 || Z < zr - gate)
 		{
-			// in front of the reference's surface: an occluder (moving, or
-			// static but new), no evidence against the pose
+			// In front of the reference's surface: an occluder (moving, or
+			// static but new), no evidence against the pose. Or where the
+			// reference saw something moving (zr < 0): covered (no reason
+			// for a new keyframe), and likely moving itself.
 			if (outliers) outliers->data[s.pix] = 255;
 			if (!counts) continue;
 			++out.associated;
@@ -421,17 +421,12 @@ void DenseFrame::build(const cv::Mat& grey, const cv::Mat& depth,
 			{
 				const int a = 2 * u, b = 2 * u + 1;
 				og[u] = 0.25f * float(g0[a] + g0[b] + g1[a] + g1[b]);
-				// (NaN fails both comparisons)
-				float z[4] = {d0[a], d0[b], d1[a], d1[b]};
-				for (float& zi : z)
-					if (!(zi >= zmin && zi <= zmax)) zi = 0;
+				const float z[4] = {reading(d0[a]), reading(d0[b]),
+				                    reading(d1[a]), reading(d1[b])};
 				od[u] = blockDepth(z);
 			}
 		}
-		L1.fx = L0.fx / 2;
-		L1.fy = L0.fy / 2;
-		L1.cx = (L0.cx + 0.5f) / 2 - 0.5f;
-		L1.cy = (L0.cy + 0.5f) / 2 - 0.5f;
+		halveIntrinsics(L0, L1);
 		first = 2;
 	}
 	for (size_t l = first; l < levels.size(); l++)
@@ -440,10 +435,7 @@ void DenseFrame::build(const cv::Mat& grey, const cv::Mat& depth,
 		DenseLevel& b = levels[l];
 		b.depth = downsampleDepth(a.depth);
 		cv::resize(a.grey, b.grey, b.depth.size(), 0, 0, cv::INTER_AREA);
-		b.fx = a.fx / 2;
-		b.fy = a.fy / 2;
-		b.cx = (a.cx + 0.5f) / 2 - 0.5f;
-		b.cy = (a.cy + 0.5f) / 2 - 0.5f;
+		halveIntrinsics(a, b);
 	}
 	// the excluded pixels of every level: a pixel is excluded when any of
 	// the pixels it covers is (INTER_AREA: any non-zero stays non-zero)

@@ -85,14 +85,9 @@ void DepthCorrection::apply(mrpt::obs::CObservation3DRangeScan& obs,
 	auto& img = obs.rangeImage;
 	const int H = static_cast<int>(img.rows()),
 	          W = static_cast<int>(img.cols());
-	Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
-	if (cam.given)
-		K << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1;
-	else
-	{
-		const auto& c = obs.cameraParams;
-		K << c.fx(), 0, c.cx(), 0, c.fy(), c.cy(), 0, 0, 1;
-	}
+	Eigen::Matrix3d K;
+	// (unusable intrinsics: left to rgbdFrameFrom() to report)
+	if (!intrinsicsOf(obs, cam, K).empty()) return;
 	const cv::Mat& f = factors(K, cv::Size(W, H));
 	for (int v = 0; v < H; v++)
 	{

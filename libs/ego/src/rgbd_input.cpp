@@ -36,23 +36,8 @@ std::string rgbdFrameFrom(const mrpt::obs::CObservation3DRangeScan& obs,
 		   << "x" << out.grey.rows << " differ (registered RGB-D expected)";
 		return os.str();
 	}
-	if (cam.given)
-	{
-		if (cam.width != W || cam.height != H)
-		{
-			std::ostringstream os;
-			os << "[camera] says " << cam.width << "x" << cam.height
-			   << " but the images are " << W << "x" << H;
-			return os.str();
-		}
-		out.K << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1;
-	}
-	else
-	{
-		const auto& cp = obs.cameraParams;
-		if (cp.fx() <= 0 || cp.fy() <= 0) return "invalid cameraParams";
-		out.K << cp.fx(), 0, cp.cx(), 0, cp.fy(), cp.cy(), 0, 0, 1;
-	}
+	if (std::string why = intrinsicsOf(obs, cam, out.K); !why.empty())
+		return why;
 	out.depth.create(H, W, CV_32FC1);
 	const float units = obs.rangeUnits;
 	const double fx = out.K(0, 0), fy = out.K(1, 1), cx = out.K(0, 2),
@@ -71,6 +56,29 @@ std::string rgbdFrameFrom(const mrpt::obs::CObservation3DRangeScan& obs,
 			row[u] = z;
 		}
 	}
+	return {};
+}
+
+std::string intrinsicsOf(const mrpt::obs::CObservation3DRangeScan& obs,
+                         const CameraParams& cam, Eigen::Matrix3d& K)
+{
+	const int H = static_cast<int>(obs.rangeImage.rows());
+	const int W = static_cast<int>(obs.rangeImage.cols());
+	if (cam.given)
+	{
+		if (cam.width != W || cam.height != H)
+		{
+			std::ostringstream os;
+			os << "[camera] says " << cam.width << "x" << cam.height
+			   << " but the images are " << W << "x" << H;
+			return os.str();
+		}
+		K << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1;
+		return {};
+	}
+	const auto& cp = obs.cameraParams;
+	if (cp.fx() <= 0 || cp.fy() <= 0) return "invalid cameraParams";
+	K << cp.fx(), 0, cp.cx(), 0, cp.fy(), cp.cy(), 0, 0, 1;
 	return {};
 }
 

@@ -15,6 +15,14 @@
 
 namespace bims::ego::test
 {
+/** Intrinsics of the tests' 320 x 240 camera (about 63 x 49 deg). */
+inline Eigen::Matrix3d K320()
+{
+	Eigen::Matrix3d K;
+	K << 262.5, 0, 159.5, 0, 262.5, 119.5, 0, 0, 1;
+	return K;
+}
+
 /** Smooth value noise in [0, 255] on plane coordinates (metres). */
 inline double valueNoise(double u, double v, uint32_t seed)
 {

@@ -12,12 +12,7 @@ using namespace bims::ego;
 
 namespace
 {
-Eigen::Matrix3d K320()
-{
-	Eigen::Matrix3d K;
-	K << 270, 0, 159.5, 0, 270, 119.5, 0, 0, 1;
-	return K;
-}
+using test::K320;
 
 AnchorParams params320()
 {

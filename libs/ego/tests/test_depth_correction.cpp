@@ -13,12 +13,7 @@ using namespace bims::ego;
 
 namespace
 {
-Eigen::Matrix3d K320()
-{
-	Eigen::Matrix3d K;
-	K << 270, 0, 159.5, 0, 270, 119.5, 0, 0, 1;
-	return K;
-}
+using test::K320;
 
 /** A distortion like the Bonn Kinect's: borders read short. */
 DepthCorrectionParams trueCorrection()
@@ -85,7 +80,7 @@ TEST(DepthCorrection, AppliesToAnObservationsRangeImage)
 	o.rangeImage(5, 5) = 0;  // no reading stays no reading
 	CameraParams cam;
 	cam.given = true;
-	cam.fx = cam.fy = 270;
+	cam.fx = cam.fy = K320()(0, 0);
 	cam.cx = 159.5;
 	cam.cy = 119.5;
 	cam.width = 320;

@@ -13,12 +13,7 @@ using namespace bims::ego;
 
 namespace
 {
-Eigen::Matrix3d K320()
-{
-	Eigen::Matrix3d K;
-	K << 262.5, 0, 159.5, 0, 262.5, 119.5, 0, 0, 1;
-	return K;
-}
+using test::K320;
 Eigen::Vector2d project(const Eigen::Matrix3d& K, const Eigen::Vector3d& p)
 {
 	const Eigen::Vector3d x = K * p;

@@ -13,12 +13,7 @@ using namespace bims::ego;
 
 namespace
 {
-Eigen::Matrix3d K320()
-{
-	Eigen::Matrix3d K;
-	K << 262.5, 0, 159.5, 0, 262.5, 119.5, 0, 0, 1;
-	return K;
-}
+using test::K320;
 const Eigen::Matrix3d kR_IC = expSO3(Eigen::Vector3d(0.3, -1.2, 0.4));
 
 Eigen::Matrix3d R_of(const mrpt::poses::CPose3D& T)

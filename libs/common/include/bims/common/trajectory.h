@@ -28,6 +28,10 @@ Trajectory loadTumTrajectory(const std::string& path);
 void saveTumTrajectory(const std::string& path, const Trajectory& traj,
                        const std::string& headerComment = {});
 
+/** The pose of \a traj (sorted by time) nearest to \a t, if it is less
+ * than \a maxDt away [s]; else nullptr. */
+const StampedPose* poseNear(const Trajectory& traj, double t, double maxDt);
+
 /** One TUM line for a pose (no newline). */
 std::string tumLine(double t, const mrpt::poses::CPose3D& T_WC);
 

@@ -42,8 +42,9 @@ class DepthCorrection
 	const cv::Mat& factors(const Eigen::Matrix3d& K, cv::Size size);
 	/** Corrects a metric depth image (CV_32FC1) in place. */
 	void apply(cv::Mat& depth, const Eigen::Matrix3d& K);
-	/** Corrects the observation's range image in place (intrinsics: \a cam
-	 * when given, else the observation's). Does nothing when disabled. */
+	/** Corrects the observation's range image in place (intrinsics:
+	 * intrinsicsOf()). Does nothing when disabled or without usable
+	 * intrinsics (rgbdFrameFrom() reports those). */
 	void apply(mrpt::obs::CObservation3DRangeScan& obs,
 	           const CameraParams& cam);
 
