@@ -77,12 +77,8 @@ int main(int argc, char** argv)
 		    bims::parseCommandLine(cmd, argc, argv);
 
 		    const std::string cfgPath = cfgArg.getValue();
-		    if (!mrpt::system::fileExists(cfgPath))
-			    throw UsageError(cfgPath + ": no such config file");
-		    mrpt::config::CConfigFile cfg(cfgPath);
-		    checkExperimentSections(cfg);
 		    ego::EgoConfig ec;
-		    ec.loadFromConfigFile(cfg, false);
+		    ec.loadFromFile(cfgPath);
 		    if (!calibArg.getValue().empty())
 		    {
 			    const std::string cp = calibArg.getValue();

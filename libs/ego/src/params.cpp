@@ -1,6 +1,11 @@
+#include <bims/common/app.h>
 #include <bims/common/config.h>
+#include <bims/common/experiment.h>
 #include <bims/ego/params.h>
 #include <bims/ego/so3.h>
+
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/system/filesystem.h>
 
 #include <Eigen/SVD>
 
@@ -273,6 +278,15 @@ void EgoConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	    cfg, "calibration", requireCalibration && odometry.mode == "imu");
 	camera.loadFromConfigFile(cfg);
 	sensors.loadFromConfigFile(cfg);
+}
+
+void EgoConfig::loadFromFile(const std::string& path)
+{
+	if (!mrpt::system::fileExists(path))
+		throw UsageError(path + ": no such config file");
+	mrpt::config::CConfigFile cfg(path);
+	checkExperimentSections(cfg);
+	loadFromConfigFile(cfg, false);
 }
 
 void EgoConfig::overrideSensorSections(const mrpt::config::CConfigFileBase& cal)

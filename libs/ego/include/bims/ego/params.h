@@ -288,6 +288,11 @@ struct EgoConfig
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        bool requireCalibration = true);
 
+	/** Opens the experiment file \a path, checks its sections and reads
+	 * it (loadFromConfigFile(cfg, false)); a missing file is a
+	 * bims::UsageError naming it (what the egomotion programs share). */
+	void loadFromFile(const std::string& path);
+
 	/** Overrides [calibration], [camera] and [sensors] with those present
 	 * in \a cal (e.g. bims-sim's OUT_gt/calibration.ini); sections absent
 	 * from \a cal are left as they are. */
