@@ -2,17 +2,18 @@
 #include <bims/common/rawlog.h>
 #include <bims/eval/depth_consistency.h>
 #include <bims/eval/json.h>
+#include <bims/eval/mask_labels.h>
 #include <bims/eval/mask_metrics.h>
 #include <bims/eval/plots.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <stdexcept>
 
@@ -23,34 +24,6 @@ namespace fs = std::filesystem;
 
 namespace
 {
-struct MaskFile
-{
-	long index;
-	std::string name;  // NNNNNN.png
-};
-
-/** Files named <digits>.png in \a dir, sorted by their number. */
-std::vector<MaskFile> listMasks(const std::string& dir)
-{
-	if (!fs::is_directory(dir))
-		throw std::runtime_error(dir + ": mask directory not found");
-	std::vector<MaskFile> out;
-	for (const auto& e : fs::directory_iterator(dir))
-	{
-		const auto p = e.path();
-		const std::string stem = p.stem().string();
-		if (p.extension() != ".png" || stem.empty() ||
-		    !std::all_of(stem.begin(), stem.end(),
-		                 [](unsigned char c) { return std::isdigit(c); }))
-			continue;
-		out.push_back({std::stol(stem), p.filename().string()});
-	}
-	std::sort(out.begin(), out.end(),
-	          [](const MaskFile& a, const MaskFile& b)
-	          { return a.index < b.index; });
-	return out;
-}
-
 /** Streams the 3D scans of a rawlog by their index (from 0). */
 class ScanStream
 {
@@ -94,15 +67,19 @@ std::string frameName(long k)
 int cmdMasks(int argc, char** argv)
 {
 	TCLAP::CmdLine cmd(
-	    "Precision, recall, F1 and IoU of predicted moving-pixel masks "
-	    "(8-bit PNG, 255 = moving, NNNNNN.png = 3D scan index) against ground "
-	    "truth, per frame and in total, over pixels with valid depth. The last "
-	    "line is 'total precision P recall R F1 F IoU I'.",
+	    "Precision, recall, F1, IoU and the share of static pixels called "
+	    "moving of predicted moving-pixel masks (8-bit PNG, 255 = moving, "
+	    "NNNNNN.png = 3D scan index) against labels, per frame and in total. "
+	    "Labels named NNNNNN.png pair by index; labels named SECONDS.png "
+	    "(e.g. a TUM/Bonn folder's depth stamps) pair by time with the run's "
+	    "frames.csv. The last line is 'total precision P recall R F1 F IoU "
+	    "I'.",
 	    ' ', "0.1");
 	TCLAP::UnlabeledValueArg<std::string> gtArg(
-	    "GT_MASK_DIR", "ground-truth masks", true, "", "GT_MASK_DIR", cmd);
+	    "GT_MASK_DIR", "labels (ground truth)", true, "", "GT_MASK_DIR", cmd);
 	TCLAP::UnlabeledValueArg<std::string> predArg(
-	    "PRED_MASK_DIR", "predicted masks", true, "", "PRED_MASK_DIR", cmd);
+	    "PRED_MASK_DIR", "predicted masks (bims-run's OUT/masks)", true, "",
+	    "PRED_MASK_DIR", cmd);
 	TCLAP::ValueArg<std::string> depth(
 	    "", "depth-valid",
 	    "rawlog whose 3D scans give the valid-depth pixels (and the overlay "
@@ -121,46 +98,127 @@ int cmdMasks(int argc, char** argv)
 	    "with --depth-valid: edge of the cubes of the voxel-level figures "
 	    "[m] (0 = none)",
 	    false, 0.05, "M", cmd);
+	TCLAP::ValueArg<int> movingValue(
+	    "", "moving-value",
+	    "label value meaning moving (with it, or with --static-value or "
+	    "--ignore-values, a label pixel of any other value is an error; "
+	    "default: >= 128 is moving)",
+	    false, -1, "V", cmd);
+	TCLAP::ValueArg<int> staticValue("", "static-value",
+	                                 "label value meaning static (default 0 "
+	                                 "when values are given)",
+	                                 false, -1, "V", cmd);
+	TCLAP::ValueArg<std::string> ignoreValues(
+	    "", "ignore-values",
+	    "label values not scored, e.g. 150,50 (ambiguous, no depth)", false, "",
+	    "LIST", cmd);
+	TCLAP::ValueArg<std::string> framesCsv(
+	    "", "frames-csv",
+	    "time stamps of the predictions (columns index, t) when labels are "
+	    "named by time (default: frames.csv beside PRED_MASK_DIR)",
+	    false, "", "FILE", cmd);
+	TCLAP::ValueArg<double> maxDt(
+	    "", "max-dt", "largest |t_label - t_prediction| of a pair [s]", false,
+	    0.01, "S", cmd);
+	TCLAP::SwitchArg sparse(
+	    "", "sparse-labels",
+	    "labels are a subset of the frames: a prediction inside the labels' "
+	    "time span without a label is not an error",
+	    cmd);
 	TCLAP::SwitchArg quiet("q", "quiet", "no per-frame lines", cmd);
 	bims::parseCommandLine(cmd, argc, argv);
 
+	if (voxel.getValue() < 0 || !std::isfinite(voxel.getValue()))
+		throw bims::UsageError("--voxel-size must be >= 0");
+	if (!(maxDt.getValue() > 0) || !std::isfinite(maxDt.getValue()))
+		throw bims::UsageError("--max-dt must be > 0");
+	ev::LabelConvention labels;
+	if (movingValue.isSet() || staticValue.isSet() || ignoreValues.isSet())
+	{
+		try
+		{
+			labels = ev::LabelConvention::explicitValues(
+			    movingValue.getValue(), staticValue.getValue(),
+			    ev::parseLabelValues(ignoreValues.getValue()));
+		}
+		catch (const std::invalid_argument& e)
+		{
+			throw bims::UsageError(std::string("label values: ") + e.what());
+		}
+	}
 	const std::string gtDir = gtArg.getValue(), predDir = predArg.getValue();
-	const auto gtFiles = listMasks(gtDir);
-	if (!fs::is_directory(predDir))
-		throw std::runtime_error(predDir + ": mask directory not found");
-	if (gtFiles.empty())
-		throw std::runtime_error(gtDir + ": no NNNNNN.png masks");
+	const auto gtFiles = ev::listMaskFiles(gtDir);
+	const auto predFiles = ev::listMaskFiles(predDir);
+	std::string p = predDir;
+	while (p.size() > 1 && p.back() == '/') p.pop_back();
+	std::map<long, double> stamps;
+	if (gtFiles.front().byTime() && !predFiles.front().byTime())
+	{
+		const std::string csv =
+		    framesCsv.isSet()
+		        ? framesCsv.getValue()
+		        : (fs::path(p).parent_path() / "frames.csv").string();
+		if (!framesCsv.isSet() && !fs::exists(csv))
+			throw std::runtime_error(
+			    gtDir + ": labels are named by time and " + predDir +
+			    " by scan index: their stamps are in the run's frames.csv, not "
+			    "found at " +
+			    csv + " (give --frames-csv)");
+		stamps = ev::readFrameStamps(csv);
+	}
+	const ev::MaskMatch match =
+	    ev::matchMasks(gtFiles, predFiles, stamps, maxDt.getValue());
+	const size_t nLabels = gtFiles.size(), nPairs = match.pairs.size();
+	if (nPairs == 0)
+		throw std::runtime_error(
+		    predDir + ": none of the " + std::to_string(nLabels) +
+		    " labels of " + gtDir + " has a prediction" +
+		    (gtFiles.front().byTime()
+		         ? " within " + std::to_string(maxDt.getValue()) + " s"
+		         : std::string(" of its name")));
+	if (gtFiles.front().byTime() && 2 * nPairs < nLabels)
+		throw std::runtime_error(
+		    predDir + ": only " + std::to_string(nPairs) + " of the " +
+		    std::to_string(nLabels) + " labels of " + gtDir +
+		    " have a prediction within " + std::to_string(maxDt.getValue()) +
+		    " s: the predictions are not of these frames (another run?)");
+	if (!match.predictionsWithoutLabel.empty() && !sparse.getValue())
+	{
+		const ev::MaskFile* f = match.predictionsWithoutLabel.front();
+		throw std::runtime_error(
+		    gtDir + ": no label within " + std::to_string(maxDt.getValue()) +
+		    " s of prediction " + f->name +
+		    (f->byTime() ? std::string()
+		                 : " (t " + std::to_string(stamps.at(f->index)) + ")") +
+		    ", inside the labels' time span (" +
+		    std::to_string(match.predictionsWithoutLabel.size()) +
+		    " such): a missing label frame? (--sparse-labels if the labels "
+		    "are a subset)");
+	}
+	if (depth.isSet() && predFiles.front().byTime())
+		throw bims::UsageError(
+		    "--depth-valid needs predictions named by scan index");
 
 	std::string outDir;
 	if (!noPlots.getValue())
 	{
-		outDir = plotDir.getValue();
-		if (outDir.empty())
-		{
-			std::string p = predDir;
-			while (p.size() > 1 && p.back() == '/') p.pop_back();
-			outDir = p + "_eval";
-		}
+		outDir = plotDir.isSet() ? plotDir.getValue() : p + "_eval";
 		bims::makeDirs(outDir);
 	}
 	std::unique_ptr<ScanStream> scans;
 	if (depth.isSet()) scans = std::make_unique<ScanStream>(depth.getValue());
 
-	if (voxel.getValue() < 0 || !std::isfinite(voxel.getValue()))
-		throw bims::UsageError("--voxel-size must be >= 0");
 	ev::MaskMetrics total, totalVoxels;
-	size_t compared = 0, missing = 0;
 	std::string jsonFrames;
-	for (const auto& f : gtFiles)
+	for (const ev::MaskPair& pair : match.pairs)
 	{
+		const ev::MaskFile& f = *pair.pred;
 		const std::string predPath = predDir + "/" + f.name;
-		if (!fs::exists(predPath))
-		{
-			missing++;
-			continue;
-		}
-		const std::string gtPath = gtDir + "/" + f.name;
-		const cv::Mat g = ev::loadMask(gtPath), p = ev::loadMask(predPath);
+		const std::string gtPath = gtDir + "/" + pair.label->name;
+		const std::string frame = f.byTime()
+		                              ? f.name.substr(0, f.name.size() - 4)
+		                              : frameName(f.index);
+		const cv::Mat g = ev::loadMask(gtPath), pm = ev::loadMask(predPath);
 		cv::Mat valid, background, depthM;
 		mrpt::img::TCamera cam;
 		if (scans)
@@ -185,11 +243,24 @@ int cmdMasks(int argc, char** argv)
 		ev::MaskMetrics m;
 		try
 		{
-			m.accumulate(g, p, valid);
+			m.accumulate(g, pm, valid, labels);
 			if (!depthM.empty() && voxel.getValue() > 0)
+			{
+				// the voxel figures read the labels by the same convention
+				cv::Mat gv = g.clone(), pv = pm.clone();
+				for (int v = 0; v < gv.rows; v++)
+					for (int u = 0; u < gv.cols; u++)
+					{
+						const auto c = labels.classOf(gv.at<uint8_t>(v, u));
+						gv.at<uint8_t>(v, u) =
+						    c == ev::LabelClass::Moving ? 255 : 0;
+						if (c == ev::LabelClass::NotScored)
+							depthM.at<float>(v, u) = 0;
+					}
 				totalVoxels +=
-				    ev::voxelMaskMetrics(g, p, depthM, cam.fx(), cam.fy(),
+				    ev::voxelMaskMetrics(gv, pv, depthM, cam.fx(), cam.fy(),
 				                         cam.cx(), cam.cy(), voxel.getValue());
+			}
 		}
 		catch (const std::invalid_argument& e)
 		{
@@ -197,31 +268,52 @@ int cmdMasks(int argc, char** argv)
 			                         e.what());
 		}
 		total += m;
-		compared++;
-		const std::string line = "frame " + frameName(f.index) + " tp " +
+		const std::string line = "frame " + frame + " tp " +
 		                         std::to_string(m.tp) + " fp " +
 		                         std::to_string(m.fp) + " fn " +
 		                         std::to_string(m.fn) + " " + m.scoresLine();
 		if (!quiet.getValue()) std::printf("%s\n", line.c_str());
 		if (!outDir.empty())
-			ev::writePng(outDir + "/" + f.name,
-			             ev::maskOverlay(g, p, valid, background,
-			                             "frame " + frameName(f.index) + "  " +
-			                                 m.scoresLine()));
+		{
+			cv::Mat gShown = g;
+			if (!labels.isContract())
+			{
+				// moving 255, static 0; not-scored pixels drawn as invalid
+				gShown = cv::Mat(g.size(), CV_8UC1, cv::Scalar(0));
+				gShown.setTo(255, g == labels.moving);
+				cv::Mat ok = valid.empty()
+				                 ? cv::Mat(g.size(), CV_8UC1, cv::Scalar(255))
+				                 : valid.clone();
+				for (int v : labels.ignored) ok.setTo(0, g == v);
+				valid = ok;
+			}
+			ev::writePng(
+			    outDir + "/" + f.name,
+			    ev::maskOverlay(gShown, pm, valid, background,
+			                    "frame " + frame + "  " + m.scoresLine()));
+		}
 		if (!jsonFrames.empty()) jsonFrames += ",\n";
-		jsonFrames += "    {\"frame\": " + std::to_string(f.index) +
-		              ", \"metrics\": " + m.toJson() + "}";
+		jsonFrames +=
+		    "    {\"frame\": " +
+		    (f.byTime() ? ev::jsonString(frame) : std::to_string(f.index)) +
+		    ", \"label\": " + ev::jsonString(pair.label->name) +
+		    ", \"dt\": " + std::to_string(pair.dt) +
+		    ", \"metrics\": " + m.toJson() + "}";
 	}
-	if (compared == 0)
-		throw std::runtime_error(
-		    predDir + ": none of the " + std::to_string(gtFiles.size()) +
-		    " ground-truth mask names of " + gtDir + " is present");
-	if (missing)
+	if (!match.labelsWithoutPrediction.empty())
 		std::fprintf(
 		    stderr,
-		    "bims-eval masks: warning: %zu of %zu ground-truth frames have no "
-		    "prediction in %s (not counted)\n",
-		    missing, gtFiles.size(), predDir.c_str());
+		    "bims-eval masks: warning: %zu of %zu labels have no prediction in "
+		    "%s (not counted; first: %s)\n",
+		    match.labelsWithoutPrediction.size(), nLabels, predDir.c_str(),
+		    match.labelsWithoutPrediction.front()->name.c_str());
+	if (match.predictionsOutside > 0 || !match.predictionsWithoutLabel.empty())
+		std::fprintf(stderr,
+		             "bims-eval masks: %zu predictions without a label (%d "
+		             "outside the labels' time span), not scored\n",
+		             match.predictionsWithoutLabel.size() +
+		                 size_t(match.predictionsOutside),
+		             match.predictionsOutside);
 	if (!outDir.empty())
 		std::fprintf(
 		    stderr,
@@ -242,8 +334,10 @@ int cmdMasks(int argc, char** argv)
 		std::ofstream jf(json.getValue());
 		jf << "{\n  \"gt\": " << ev::jsonString(gtDir)
 		   << ",\n  \"pred\": " << ev::jsonString(predDir)
-		   << ",\n  \"frames_compared\": " << compared
-		   << ",\n  \"frames_missing\": " << missing
+		   << ",\n  \"labels\": " << ev::jsonString(labels.describe())
+		   << ",\n  \"frames_compared\": " << nPairs
+		   << ",\n  \"frames_missing\": "
+		   << match.labelsWithoutPrediction.size()
 		   << ",\n  \"depth_valid_only\": " << (scans ? "true" : "false")
 		   << ",\n  \"total\": " << total.toJson();
 		if (voxels)
@@ -254,12 +348,17 @@ int cmdMasks(int argc, char** argv)
 	}
 	std::printf(
 	    "total_counts frames %zu tp %llu fp %llu fn %llu tn %llu invalid "
-	    "%llu\n",
-	    compared, static_cast<unsigned long long>(total.tp),
+	    "%llu ignored %llu\n",
+	    nPairs, static_cast<unsigned long long>(total.tp),
 	    static_cast<unsigned long long>(total.fp),
 	    static_cast<unsigned long long>(total.fn),
 	    static_cast<unsigned long long>(total.tn),
-	    static_cast<unsigned long long>(total.invalid));
+	    static_cast<unsigned long long>(total.invalid),
+	    static_cast<unsigned long long>(total.ignored));
+	std::printf(
+	    "total_static_as_moving %.4f (labelled-static pixels called "
+	    "moving)\n",
+	    total.staticAsMoving());
 	std::printf("total %s\n", total.scoresLine().c_str());
 	return 0;
 }

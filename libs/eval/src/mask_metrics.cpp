@@ -37,7 +37,8 @@ double ratio(uint64_t num, uint64_t den)
 }  // namespace
 
 void MaskMetrics::accumulate(const cv::Mat& gt, const cv::Mat& pred,
-                             const cv::Mat& validDepth)
+                             const cv::Mat& validDepth,
+                             const LabelConvention& labels)
 {
 	checkMask(gt, "ground-truth mask");
 	checkMask(pred, "predicted mask");
@@ -53,6 +54,10 @@ void MaskMetrics::accumulate(const cv::Mat& gt, const cv::Mat& pred,
 			                            sizeText(validDepth) +
 			                            " but the masks are " + sizeText(gt));
 	}
+	// the class of every label value, once
+	LabelClass cls[256];
+	for (int i = 0; i < 256; i++) cls[i] = labels.classOf(i);
+	MaskMetrics add;
 	for (int v = 0; v < gt.rows; v++)
 	{
 		const uint8_t* g = gt.ptr<uint8_t>(v);
@@ -61,29 +66,46 @@ void MaskMetrics::accumulate(const cv::Mat& gt, const cv::Mat& pred,
 		    validDepth.empty() ? nullptr : validDepth.ptr<uint8_t>(v);
 		for (int u = 0; u < gt.cols; u++)
 		{
+			const LabelClass c = cls[g[u]];
+			if (c == LabelClass::Unknown)
+			{
+				const int n = cv::countNonZero(gt == g[u]);
+				throw std::invalid_argument(
+				    "label value " + std::to_string(g[u]) + " at pixel (" +
+				    std::to_string(u) + ", " + std::to_string(v) + ") and " +
+				    std::to_string(n - 1) + " other pixels is none of " +
+				    labels.describe());
+			}
 			if (d && !d[u])
 			{
-				invalid++;
+				add.invalid++;
 				continue;
 			}
-			const bool gm = g[u] >= 128, pm = p[u] >= 128;
+			if (c == LabelClass::NotScored)
+			{
+				add.ignored++;
+				continue;
+			}
+			const bool gm = c == LabelClass::Moving, pm = p[u] >= 128;
 			if (gm && pm)
-				tp++;
+				add.tp++;
 			else if (pm)
-				fp++;
+				add.fp++;
 			else if (gm)
-				fn++;
+				add.fn++;
 			else
-				tn++;
+				add.tn++;
 		}
 	}
+	*this += add;  // (nothing added when a value is unknown)
 }
 
 MaskMetrics MaskMetrics::compute(const cv::Mat& gt, const cv::Mat& pred,
-                                 const cv::Mat& validDepth)
+                                 const cv::Mat& validDepth,
+                                 const LabelConvention& labels)
 {
 	MaskMetrics m;
-	m.accumulate(gt, pred, validDepth);
+	m.accumulate(gt, pred, validDepth, labels);
 	return m;
 }
 
@@ -94,6 +116,7 @@ MaskMetrics& MaskMetrics::operator+=(const MaskMetrics& o)
 	fn += o.fn;
 	tn += o.tn;
 	invalid += o.invalid;
+	ignored += o.ignored;
 	return *this;
 }
 
@@ -113,6 +136,10 @@ double MaskMetrics::iou() const
 {
 	return ratio(tp, tp + fp + fn);
 }
+double MaskMetrics::staticAsMoving() const
+{
+	return ratio(fp, fp + tn);
+}
 
 std::string MaskMetrics::scoresLine() const
 {
@@ -125,9 +152,11 @@ std::string MaskMetrics::toJson() const
 	std::ostringstream o;
 	o << "{\"tp\": " << tp << ", \"fp\": " << fp << ", \"fn\": " << fn
 	  << ", \"tn\": " << tn << ", \"invalid\": " << invalid
+	  << ", \"ignored\": " << ignored
 	  << ", \"precision\": " << jnum(precision())
 	  << ", \"recall\": " << jnum(recall()) << ", \"f1\": " << jnum(f1())
-	  << ", \"iou\": " << jnum(iou()) << "}";
+	  << ", \"iou\": " << jnum(iou())
+	  << ", \"static_as_moving\": " << jnum(staticAsMoving()) << "}";
 	return o.str();
 }
 

@@ -232,6 +232,99 @@ TEST(EvalMasks, HandComputedTotalsAndErrors)
 	    << r.out;
 }
 
+TEST(EvalMasks, LabelsByTimestampWithIgnoredValues)
+{
+	// A TUM/Bonn-style label folder (named by depth stamp; 255 moving, 0
+	// static, 150 and 50 not scored) against a run's NNNNNN.png masks and
+	// its frames.csv. Label 0 has no prediction (the importer dropped it).
+	const auto d = tmpDir("masks_time");
+	fs::create_directories(d + "/labels");
+	fs::create_directories(d + "/run/masks");
+	const char* names[] = {"100.00000", "100.03300", "100.06600", "100.09900"};
+	for (const char* n : names)
+	{
+		// cols 0-1 moving, 2 ambiguous, 3 no depth, 4-7 static
+		cv::Mat l(2, 8, CV_8UC1, cv::Scalar(0));
+		l.colRange(0, 2) = 255;
+		l.col(2) = 150;
+		l.col(3) = 50;
+		cv::imwrite(d + "/labels/" + n + ".png", l);
+	}
+	// predictions: cols 0 and 2-4 moving (TP 2, FP 2, FN 2 a frame)
+	for (int k = 0; k < 3; k++)
+	{
+		cv::Mat p(2, 8, CV_8UC1, cv::Scalar(0));
+		p.col(0) = 255;
+		p.colRange(2, 5) = 255;
+		cv::imwrite(d + "/run/masks/00000" + std::to_string(k) + ".png", p);
+	}
+	std::ofstream(d + "/run/frames.csv")
+	    << "index,t,ego_flags\n0,100.033001,0\n1,100.066000,0\n2,100.099,0\n";
+	const std::string conv =
+	    " --moving-value 255 --static-value 0 --ignore-values 150,50";
+	auto r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	             "/run/masks --no-plots" + conv);
+	ASSERT_EQ(r.code, 0) << r.out;
+	// 3 frames: TP 6, FP 6, FN 6; 24 static pixels, 6 called moving
+	EXPECT_EQ(lastLine(r.out),
+	          "total precision 0.5000 recall 0.5000 F1 0.5000 IoU 0.3333")
+	    << r.out;
+	EXPECT_NE(r.out.find("total_static_as_moving 0.2500"), std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("ignored 12"), std::string::npos) << r.out;
+	EXPECT_NE(r.out.find("1 of 4 labels have no prediction"), std::string::npos)
+	    << r.out;
+	// A label value outside the convention: an error naming the file.
+	cv::Mat bad(2, 8, CV_8UC1, cv::Scalar(0));
+	bad.at<uint8_t>(1, 5) = 77;
+	cv::imwrite(d + "/labels/100.06600.png", bad);
+	r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	        "/run/masks --no-plots" + conv);
+	EXPECT_EQ(r.code, 1);
+	EXPECT_NE(r.out.find("100.06600.png vs"), std::string::npos) << r.out;
+	EXPECT_NE(r.out.find("label value 77 at pixel (5, 1)"), std::string::npos)
+	    << r.out;
+	// A label of another size.
+	cv::imwrite(d + "/labels/100.06600.png",
+	            cv::Mat(4, 8, CV_8UC1, cv::Scalar(0)));
+	r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	        "/run/masks --no-plots" + conv);
+	EXPECT_EQ(r.code, 1);
+	EXPECT_NE(r.out.find("mask sizes differ"), std::string::npos) << r.out;
+	// A missing label frame inside the labels' span.
+	fs::remove(d + "/labels/100.06600.png");
+	r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	        "/run/masks --no-plots" + conv);
+	EXPECT_EQ(r.code, 1);
+	EXPECT_NE(r.out.find("no label within 0.010000 s of prediction 000001.png"),
+	          std::string::npos)
+	    << r.out;
+	r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	        "/run/masks --no-plots --sparse-labels" + conv);
+	EXPECT_EQ(r.code, 0) << r.out;
+	// Predictions of another run (stamps that do not match): no score.
+	std::ofstream(d + "/run/frames.csv")
+	    << "index,t\n0,200.033000\n1,200.066000\n2,200.099\n";
+	r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	        "/run/masks --no-plots" + conv);
+	EXPECT_EQ(r.code, 1);
+	EXPECT_NE(r.out.find("has a prediction within"), std::string::npos)
+	    << r.out;
+	EXPECT_EQ(r.out.find("total precision"), std::string::npos) << r.out;
+	// No frames.csv beside the masks: says where it looked.
+	fs::remove(d + "/run/frames.csv");
+	r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	        "/run/masks --no-plots" + conv);
+	EXPECT_EQ(r.code, 1);
+	EXPECT_NE(r.out.find("--frames-csv"), std::string::npos) << r.out;
+	// A bad value list is a usage error naming it.
+	r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	        "/run/masks --ignore-values 150,x");
+	EXPECT_NE(r.code, 0);
+	EXPECT_NE(r.out.find("'x' is not a label value"), std::string::npos)
+	    << r.out;
+}
+
 TEST(EvalTraj, BadInputIsAClearError)
 {
 	const auto d = tmpDir("traj");

@@ -2,6 +2,7 @@
 // ground-truth mask, counted over the pixels with valid depth.
 #pragma once
 
+#include <bims/eval/mask_labels.h>
 #include <opencv2/core.hpp>
 
 #include <cstdint>
@@ -19,17 +20,23 @@ struct MaskMetrics
 	uint64_t fn = 0;       ///< moving in GT, predicted static
 	uint64_t tn = 0;       ///< static in both
 	uint64_t invalid = 0;  ///< pixels skipped (no valid depth)
+	uint64_t ignored = 0;  ///< pixels whose label is a value not scored
 
-	/** Adds the counts of one frame. \a gt and \a pred are CV_8UC1 masks
-	 * (value >= 128 means moving; the contract writes 0/255); \a validDepth
-	 * is empty (all pixels count) or CV_8UC1 of the same size (non-zero =
-	 * valid). Throws std::invalid_argument on empty masks, other types or
-	 * different sizes. */
+	/** Adds the counts of one frame. \a gt and \a pred are CV_8UC1 masks;
+	 * \a gt's values are read with \a labels (by default the contract:
+	 * >= 128 moving, the contract writes 0/255), \a pred's by the contract;
+	 * \a validDepth is empty (all pixels count) or CV_8UC1 of the same size
+	 * (non-zero = valid). Throws std::invalid_argument on empty masks, other
+	 * types, different sizes or a label value \a labels does not know
+	 * (naming the value, a pixel holding it and how many do). */
 	void accumulate(const cv::Mat& gt, const cv::Mat& pred,
-	                const cv::Mat& validDepth = cv::Mat());
+	                const cv::Mat& validDepth = cv::Mat(),
+	                const LabelConvention& labels = LabelConvention());
 	/** The counts of one frame (see accumulate()). */
-	static MaskMetrics compute(const cv::Mat& gt, const cv::Mat& pred,
-	                           const cv::Mat& validDepth = cv::Mat());
+	static MaskMetrics compute(
+	    const cv::Mat& gt, const cv::Mat& pred,
+	    const cv::Mat& validDepth = cv::Mat(),
+	    const LabelConvention& labels = LabelConvention());
 
 	MaskMetrics& operator+=(const MaskMetrics& o);
 
@@ -37,6 +44,8 @@ struct MaskMetrics
 	double recall() const;     ///< tp / (tp + fn)
 	double f1() const;         ///< 2 tp / (2 tp + fp + fn)
 	double iou() const;        ///< tp / (tp + fp + fn)
+	/** fp / (fp + tn): the share of the static pixels called moving. */
+	double staticAsMoving() const;
 	uint64_t valid() const { return tp + fp + fn + tn; }
 
 	/** "precision P recall R F1 F IoU I" with 4 decimals ("nan" if
