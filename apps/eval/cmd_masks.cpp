@@ -125,11 +125,24 @@ int cmdMasks(int argc, char** argv)
 	    "labels are a subset of the frames: a prediction inside the labels' "
 	    "time span without a label is not an error",
 	    cmd);
+	TCLAP::ValueArg<std::string> strip(
+	    "", "strip",
+	    "also write the overlays of --strip-frames side by side (half size) "
+	    "to this PNG",
+	    false, "", "OUT.png", cmd);
+	TCLAP::ValueArg<std::string> stripFrames(
+	    "", "strip-frames",
+	    "comma-separated scan indices of the predictions for --strip", false,
+	    "", "i,j,..", cmd);
 	TCLAP::SwitchArg quiet("q", "quiet", "no per-frame lines", cmd);
 	bims::parseCommandLine(cmd, argc, argv);
 
 	if (voxel.getValue() < 0 || !std::isfinite(voxel.getValue()))
 		throw bims::UsageError("--voxel-size must be >= 0");
+	const auto stripSet =
+	    bims::parseIndexList(stripFrames.getValue(), "--strip-frames");
+	if (strip.isSet() != !stripSet.empty())
+		throw bims::UsageError("--strip and --strip-frames go together");
 	if (!(maxDt.getValue() > 0) || !std::isfinite(maxDt.getValue()))
 		throw bims::UsageError("--max-dt must be > 0");
 	ev::LabelConvention labels;
@@ -208,7 +221,9 @@ int cmdMasks(int argc, char** argv)
 	std::unique_ptr<ScanStream> scans;
 	if (depth.isSet()) scans = std::make_unique<ScanStream>(depth.getValue());
 
-	ev::MaskMetrics total, totalVoxels;
+	ev::MaskMetrics total, totalVoxels, peopleFree;
+	size_t nPeopleFree = 0;
+	std::map<long, cv::Mat> tiles;  // for --strip
 	std::string jsonFrames;
 	for (const ev::MaskPair& pair : match.pairs)
 	{
@@ -268,12 +283,19 @@ int cmdMasks(int argc, char** argv)
 			                         e.what());
 		}
 		total += m;
+		if (m.tp + m.fn == 0)
+		{
+			// no moving label in the frame: every call of moving is false
+			peopleFree += m;
+			++nPeopleFree;
+		}
 		const std::string line = "frame " + frame + " tp " +
 		                         std::to_string(m.tp) + " fp " +
 		                         std::to_string(m.fp) + " fn " +
 		                         std::to_string(m.fn) + " " + m.scoresLine();
 		if (!quiet.getValue()) std::printf("%s\n", line.c_str());
-		if (!outDir.empty())
+		const bool inStrip = stripSet.count(static_cast<size_t>(f.index)) > 0;
+		if (!outDir.empty() || inStrip)
 		{
 			cv::Mat gShown = g;
 			if (!labels.isContract())
@@ -287,10 +309,11 @@ int cmdMasks(int argc, char** argv)
 				for (int v : labels.ignored) ok.setTo(0, g == v);
 				valid = ok;
 			}
-			ev::writePng(
-			    outDir + "/" + f.name,
+			const cv::Mat o =
 			    ev::maskOverlay(gShown, pm, valid, background,
-			                    "frame " + frame + "  " + m.scoresLine()));
+			                    "frame " + frame + "  " + m.scoresLine());
+			if (!outDir.empty()) ev::writePng(outDir + "/" + f.name, o);
+			if (inStrip) tiles[f.index] = o;
 		}
 		if (!jsonFrames.empty()) jsonFrames += ",\n";
 		jsonFrames +=
@@ -314,6 +337,19 @@ int cmdMasks(int argc, char** argv)
 		             match.predictionsWithoutLabel.size() +
 		                 size_t(match.predictionsOutside),
 		             match.predictionsOutside);
+	if (strip.isSet())
+	{
+		if (tiles.size() != stripSet.size())
+			throw std::runtime_error(
+			    "--strip-frames: " +
+			    std::to_string(stripSet.size() - tiles.size()) +
+			    " of the frames have no label and prediction pair");
+		std::vector<cv::Mat> row;
+		for (auto& [k, t] : tiles) row.push_back(t);
+		ev::writePng(strip.getValue(), ev::imageStrip(row, 0.5));
+		std::fprintf(stderr, "bims-eval masks: strip of %zu frames in %s\n",
+		             row.size(), strip.getValue().c_str());
+	}
 	if (!outDir.empty())
 		std::fprintf(
 		    stderr,
@@ -339,7 +375,9 @@ int cmdMasks(int argc, char** argv)
 		   << ",\n  \"frames_missing\": "
 		   << match.labelsWithoutPrediction.size()
 		   << ",\n  \"depth_valid_only\": " << (scans ? "true" : "false")
-		   << ",\n  \"total\": " << total.toJson();
+		   << ",\n  \"total\": " << total.toJson()
+		   << ",\n  \"frames_nothing_moving\": " << nPeopleFree
+		   << ",\n  \"total_nothing_moving\": " << peopleFree.toJson();
 		if (voxels)
 			jf << ",\n  \"voxel_size_m\": " << voxel.getValue()
 			   << ",\n  \"total_voxels\": " << totalVoxels.toJson();
@@ -359,6 +397,10 @@ int cmdMasks(int argc, char** argv)
 	    "total_static_as_moving %.4f (labelled-static pixels called "
 	    "moving)\n",
 	    total.staticAsMoving());
+	std::printf(
+	    "total_nothing_moving frames %zu static_as_moving %.4f "
+	    "(frames without a moving label)\n",
+	    nPeopleFree, peopleFree.staticAsMoving());
 	std::printf("total %s\n", total.scoresLine().c_str());
 	return 0;
 }

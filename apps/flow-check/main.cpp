@@ -18,6 +18,7 @@
 #include <bims/common/app.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/rgbd_input.h>
+#include <bims/eval/plots.h>
 #include <bims/eval/pose_utils.h>
 #include <bims/flow/consistency.h>
 #include <bims/flow/expected_flow.h>
@@ -93,24 +94,6 @@ PoseScore score(const cv::Mat& obs, const cv::Mat& depth,
 	return s;
 }
 
-std::set<size_t> parseList(const std::string& s)
-{
-	std::set<size_t> out;
-	std::stringstream ss(s);
-	std::string tok;
-	while (std::getline(ss, tok, ','))
-	{
-		try
-		{
-			out.insert(std::stoul(tok));
-		}
-		catch (const std::exception&)
-		{
-			throw bims::UsageError("--strip-frames: bad index '" + tok + "'");
-		}
-	}
-	return out;
-}
 }  // namespace
 
 int main(int argc, char** argv)
@@ -156,7 +139,8 @@ int main(int argc, char** argv)
 			    throw bims::UsageError(std::string("--variant: ") + e.what());
 		    }
 		    const bims::Trajectory gt = bims::loadTumTrajectory(aGt.getValue());
-		    const auto stripFrames = parseList(aStripFrames.getValue());
+		    const auto stripFrames =
+		        bims::parseIndexList(aStripFrames.getValue(), "--strip-frames");
 		    if (aStrip.isSet() && stripFrames.empty())
 			    throw bims::UsageError("--strip needs --strip-frames");
 		    std::map<size_t, cv::Mat> tiles;
@@ -321,17 +305,9 @@ int main(int argc, char** argv)
 			    if (tiles.empty())
 				    throw std::runtime_error("--strip: none of the frames ran");
 			    std::vector<cv::Mat> row;
-			    for (auto& [i, m] : tiles)
-			    {
-				    cv::Mat s;
-				    cv::resize(m, s, {}, 0.5, 0.5, cv::INTER_AREA);
-				    row.push_back(s);
-			    }
-			    cv::Mat out;
-			    cv::hconcat(row, out);
-			    if (!cv::imwrite(aStrip.getValue(), out))
-				    throw std::runtime_error(aStrip.getValue() +
-				                             ": cannot write");
+			    for (auto& [i, m] : tiles) row.push_back(m);
+			    bims::eval::writePng(aStrip.getValue(),
+			                         bims::eval::imageStrip(row, 0.5));
 			    std::printf("strip: %s (%zu frames)\n",
 			                aStrip.getValue().c_str(), tiles.size());
 		    }

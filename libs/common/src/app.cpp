@@ -6,6 +6,7 @@
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
+#include <sstream>
 #include <stdexcept>
 
 namespace bims
@@ -59,6 +60,31 @@ void makeDirs(const std::string& path)
 	if (ec)
 		throw std::runtime_error(path +
 		                         ": cannot create directory: " + ec.message());
+}
+
+std::set<size_t> parseIndexList(const std::string& text,
+                                const std::string& flag)
+{
+	std::set<size_t> out;
+	std::stringstream ss(text);
+	std::string tok;
+	while (std::getline(ss, tok, ','))
+	{
+		size_t used = 0;
+		unsigned long v = 0;
+		try
+		{
+			v = std::stoul(tok, &used);
+		}
+		catch (const std::exception&)
+		{
+			used = 0;
+		}
+		if (used == 0 || used != tok.size() || tok[0] == '-')
+			throw UsageError(flag + ": bad index '" + tok + "'");
+		out.insert(static_cast<size_t>(v));
+	}
+	return out;
 }
 
 }  // namespace bims

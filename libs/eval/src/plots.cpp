@@ -116,6 +116,25 @@ cv::Mat plotTrajectories(const Trajectory& gt, const Trajectory& estAligned,
 	return img;
 }
 
+cv::Mat imageStrip(const std::vector<cv::Mat>& images, double scale)
+{
+	if (images.empty()) throw std::invalid_argument("a strip of no image");
+	if (!(scale > 0)) throw std::invalid_argument("strip scale must be > 0");
+	std::vector<cv::Mat> row;
+	for (const cv::Mat& m : images)
+	{
+		if (m.size() != images.front().size() ||
+		    m.type() != images.front().type())
+			throw std::invalid_argument("strip images differ in size or type");
+		cv::Mat s;
+		cv::resize(m, s, {}, scale, scale, cv::INTER_AREA);
+		row.push_back(s);
+	}
+	cv::Mat out;
+	cv::hconcat(row, out);
+	return out;
+}
+
 void writePng(const std::string& path, const cv::Mat& img)
 {
 	bool ok = false;

@@ -219,6 +219,11 @@ TEST(EvalMasks, HandComputedTotalsAndErrors)
 	          "total precision 0.6667 recall 0.5000 F1 0.5714 IoU 0.4000")
 	    << r.out;
 	EXPECT_TRUE(fs::exists(d + "/pred_eval/000001.png"));
+	// frame 1 labels nothing moving: 8 of its 64 static pixels called moving
+	EXPECT_NE(r.out.find("total_nothing_moving frames 1 static_as_moving "
+	                     "0.1250"),
+	          std::string::npos)
+	    << r.out;
 	// A mask of another size is an error naming both files.
 	cv::imwrite(d + "/pred/000001.png", cv::Mat(4, 8, CV_8UC1, cv::Scalar(0)));
 	r = run(kBin + "/bims-eval masks " + d + "/gt " + d + "/pred --no-plots");
@@ -263,8 +268,13 @@ TEST(EvalMasks, LabelsByTimestampWithIgnoredValues)
 	const std::string conv =
 	    " --moving-value 255 --static-value 0 --ignore-values 150,50";
 	auto r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
-	             "/run/masks --no-plots" + conv);
+	             "/run/masks --no-plots --strip " + d + "/strip.png" +
+	             " --strip-frames 0,2" + conv);
 	ASSERT_EQ(r.code, 0) << r.out;
+	// two overlays of 8x2 at half size side by side
+	const cv::Mat strip = cv::imread(d + "/strip.png");
+	EXPECT_EQ(strip.cols, 8);
+	EXPECT_EQ(strip.rows, 1);
 	// 3 frames: TP 6, FP 6, FN 6; 24 static pixels, 6 called moving
 	EXPECT_EQ(lastLine(r.out),
 	          "total precision 0.5000 recall 0.5000 F1 0.5000 IoU 0.3333")

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <functional>
+#include <set>
 #include <stdexcept>
 #include <string>
 
@@ -49,6 +50,11 @@ void parseCommandLine(CmdLine& cmd, int argc, char** argv)
  * frame in bims-run; docs/results.md). For programs that process frames
  * in a loop; call once at the start of main(). */
 void keepFreedMemoryForReuse();
+
+/** "3,40,7" -> {3, 7, 40} (frame indices of a command-line flag); throws
+ * UsageError naming \a flag and the bad item. */
+std::set<size_t> parseIndexList(const std::string& text,
+                                const std::string& flag);
 
 /** Creates a directory and its parents; throws naming it on failure. */
 void makeDirs(const std::string& path);

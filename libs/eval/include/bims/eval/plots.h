@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include <string>
+#include <vector>
 
 namespace bims::eval
 {
@@ -16,6 +17,11 @@ namespace bims::eval
  * (gt, estAligned) as in AteResult::pairs (may be empty). */
 cv::Mat plotTrajectories(const Trajectory& gt, const Trajectory& estAligned,
                          const IndexPairs& pairs, const std::string& title);
+
+/** The images side by side, each scaled by \a scale (INTER_AREA), in one
+ * row (a strip of frames). All must have the same size and type; throws
+ * std::invalid_argument otherwise or when there is none. */
+cv::Mat imageStrip(const std::vector<cv::Mat>& images, double scale);
 
 /** Writes an image; throws std::runtime_error naming the file on failure. */
 void writePng(const std::string& path, const cv::Mat& img);
