@@ -4,6 +4,9 @@
 // vision-only egomotion: the recording has no IMU), while frames with
 // walking people are not. Frames are read straight from the TUM folder
 // (no rawlog written). Figures in docs/results.md (Pipeline section).
+#include <bims/ego/depth_correction.h>
+#include <bims/eval/mask_labels.h>
+#include <bims/eval/mask_metrics.h>
 #include <bims/eval/tum_import.h>
 #include <bims/pipeline/pipeline.h>
 #include <gtest/gtest.h>
@@ -49,7 +52,101 @@ double meanMovingFraction(const ExperimentConfig& cfg,
 	}
 	return n ? sum / n : 0;
 }
+/** Scores of every frame of \a folder against the masks_proxy labels
+ * (255 moving, 0 static, 150 and 50 not scored), paired by time stamp as
+ * bims-eval masks pairs them; \a peopleFree gets the frames without a
+ * moving label. */
+bims::eval::MaskMetrics scoreAgainstProxy(const ExperimentConfig& cfg,
+                                          const bims::eval::TumFolder& folder,
+                                          const bims::eval::ImportParams& ip,
+                                          bims::eval::MaskMetrics* peopleFree)
+{
+	namespace ev = bims::eval;
+	const auto labels = ev::listMaskFiles(kBonn + "/masks_proxy");
+	const auto conv = ev::LabelConvention::explicitValues(255, 0, {150, 50});
+	Pipeline pipe(cfg);
+	// the depth correction of config/bonn.ini, as bims-run applies it
+	bims::ego::DepthCorrection depthCorrection(cfg.ego.depth_correction);
+	std::vector<ev::MaskFile> preds;
+	std::vector<cv::Mat> masks;
+	for (size_t i = 0; i < folder.frames.size(); i++)
+	{
+		const auto scan = bims::eval::loadFrame(folder.frames[i], ip);
+		depthCorrection.apply(*scan, cfg.ego.camera);
+		const FrameResult& r = pipe.processFrame(*scan, i);
+		ev::MaskFile f;
+		f.name = std::to_string(i);
+		f.stamp = r.t;
+		preds.push_back(f);
+		masks.push_back(r.mask.clone());
+	}
+	const auto match = ev::matchMasks(labels, preds, {}, 0.01);
+	EXPECT_EQ(match.pairs.size(), 200u);
+	EXPECT_TRUE(match.predictionsWithoutLabel.empty());
+	ev::MaskMetrics total;
+	for (const auto& p : match.pairs)
+	{
+		const cv::Mat l = ev::loadMask(kBonn + "/masks_proxy/" + p.label->name);
+		const auto m = ev::MaskMetrics::compute(
+		    l, masks[static_cast<size_t>(p.pred - preds.data())], cv::Mat(),
+		    conv);
+		total += m;
+		if (peopleFree && m.tp + m.fn == 0) *peopleFree += m;
+	}
+	return total;
+}
 }  // namespace
+
+TEST(BonnEndToEnd, SegmentationAgainstProxyLabels)
+{
+	// The real-data configuration (config/bonn.ini, its variant) against
+	// the per-pixel labels of the slice, and the single-cue variants beside
+	// it. Figures of bench/segmentation_real.sh in docs/results.md.
+	if (!std::filesystem::exists(kBonn + "/masks_proxy"))
+		GTEST_SKIP() << "no Bonn labels at " << kBonn;
+	mrpt::config::CConfigFile file(kConfig);
+	bims::eval::ImportParams ip;
+	ip.loadFromConfigFile(file);
+	const auto folder = bims::eval::readTumFolder(kBonn, ip);
+	ExperimentConfig cfg;
+	cfg.loadFromFile(kConfig);
+	cfg.ego.odometry.mode = "vision";  // no IMU in the recording
+	cfg.ego.odometry.gyro_aid = false;
+	bims::eval::MaskMetrics free;
+	const auto chosen = scoreAgainstProxy(cfg, folder, ip, &free);
+	std::printf(
+	    "config/bonn.ini: %s, static called moving %.3f %% (frames "
+	    "without people %.3f %%)\n",
+	    chosen.scoresLine().c_str(), 100 * chosen.staticAsMoving(),
+	    100 * free.staticAsMoving());
+	// issue 14's targets: F1 >= 0.85, <= 2 % of static pixels, <= 1 % on
+	// the frames without people
+	EXPECT_GT(chosen.f1(), 0.85);
+	EXPECT_LT(chosen.staticAsMoving(), 0.02);
+	EXPECT_LT(free.staticAsMoving(), 0.01);
+	// The paper's claim on real data: fused against each cue alone (same
+	// grid model). It beats the flow alone on F1; against the bottom tier
+	// alone F1 is a tie (measured 0.9953 vs 0.9957) and the fusion halves
+	// the false alarms.
+	ExperimentConfig flowOnly = cfg, bottomOnly = cfg, frustum = cfg;
+	flowOnly.setVariant(Variant::FlowOnly);
+	bottomOnly.setVariant(Variant::BottomOnly);
+	const auto mFlow = scoreAgainstProxy(flowOnly, folder, ip, nullptr);
+	const auto mBottom = scoreAgainstProxy(bottomOnly, folder, ip, nullptr);
+	std::printf(
+	    "flow-only: %s\nbottom-only: %s, static called moving "
+	    "%.3f %%\n",
+	    mFlow.scoresLine().c_str(), mBottom.scoresLine().c_str(),
+	    100 * mBottom.staticAsMoving());
+	EXPECT_GT(chosen.f1(), mFlow.f1() + 0.2);
+	EXPECT_NEAR(chosen.f1(), mBottom.f1(), 0.01);
+	EXPECT_LT(chosen.staticAsMoving(), mBottom.staticAsMoving());
+	// the reason for decay = raycast in config/bonn.ini
+	frustum.grids.decay = bims::maps::DecayMode::Frustum;
+	const auto mFrustum = scoreAgainstProxy(frustum, folder, ip, nullptr);
+	std::printf("decay=frustum: %s\n", mFrustum.scoresLine().c_str());
+	EXPECT_GT(chosen.f1(), mFrustum.f1() + 0.1);
+}
 
 TEST(BonnEndToEnd, FlowLabelsKeepTheStaticRoomStaticAndSeePeople)
 {
