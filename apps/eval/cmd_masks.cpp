@@ -101,8 +101,8 @@ int cmdMasks(int argc, char** argv)
 	TCLAP::ValueArg<int> movingValue(
 	    "", "moving-value",
 	    "label value meaning moving (with it, or with --static-value or "
-	    "--ignore-values, a label pixel of any other value is an error; "
-	    "default: >= 128 is moving)",
+	    "--ignore-values, labels may hold only the values given; default: "
+	    ">= 128 is moving)",
 	    false, -1, "V", cmd);
 	TCLAP::ValueArg<int> staticValue("", "static-value",
 	                                 "label value meaning static (default 0 "
@@ -123,7 +123,7 @@ int cmdMasks(int argc, char** argv)
 	TCLAP::SwitchArg sparse(
 	    "", "sparse-labels",
 	    "labels are a subset of the frames: a prediction inside the labels' "
-	    "time span without a label is not an error",
+	    "time span without a label is accepted (not scored)",
 	    cmd);
 	TCLAP::ValueArg<std::string> strip(
 	    "", "strip",
