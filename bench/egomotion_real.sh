@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Egomotion in a crowd (issue 13's targets; not part of CTest, ~10 minutes):
 # the trajectory of bims-run (the pipeline, with its moving masks fed back)
-# and of bims-odom (egomotion alone, its own alignment outliers as the only
-# mask) against ground truth, on the real Bonn slice (vision only, and with an
+# and of bims-odom (egomotion alone, no mask: moving content left to the
+# robust alignment) against ground truth, on the real Bonn slice (vision only, and with an
 # IMU synthesised from the ground truth) and on every simulator preset at
 # 640x480, beside OpenCV contrib's RgbdICPOdometry on the same frames.
 #

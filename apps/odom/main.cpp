@@ -1,5 +1,6 @@
 // bims-odom CONFIG.ini IN.rawlog -o TRAJ.txt [--calib CALIB.ini]
 //           [--mode imu|vision] [--gyro-aid true|false] [--csv FRAMES.csv]
+//           [--masks DIR]
 // Egomotion alone: writes the camera trajectory T_WC in the TUM format and a
 // per-stage timing summary. Works with or without IMU data in the rawlog
 // (mode = vision for data without IMU).
@@ -65,6 +66,14 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<std::string> csvArg(
 		        "", "csv", "per-frame details (flags, inliers, stage times)",
 		        false, "", "FRAMES.csv", cmd);
+		    TCLAP::ValueArg<std::string> masksArg(
+		        "", "masks",
+		        "folder of moving masks NNNNNN.png (bims-run's OUT/masks, or "
+		        "a simulation's ground truth): scan k-1's mask is left out of "
+		        "frame k's tracking, as bims-run feeds its segmentation back "
+		        "(without it: no mask, moving content is left to the robust "
+		        "alignment)",
+		        false, "", "DIR", cmd);
 		    TCLAP::ValueArg<std::string> gtArg(
 		        "", "gt",
 		        "ground-truth TUM trajectory: adds to --csv the true angular "
@@ -138,6 +147,13 @@ int main(int argc, char** argv)
 		    ego::ReplayOptions ro;
 		    ro.max_frames = maxArg.getValue();
 		    ro.progress = !quiet.getValue();
+		    if (masksArg.isSet())
+		    {
+			    if (!mrpt::system::directoryExists(masksArg.getValue()))
+				    throw std::runtime_error(masksArg.getValue() +
+				                             ": mask directory not found");
+			    ro.masks_dir = masksArg.getValue();
+		    }
 		    const auto st = ego::replayRawlog(
 		        inArg.getValue(), odo,
 		        [&](const ego::FrameEgomotion& r,
@@ -240,6 +256,14 @@ int main(int argc, char** argv)
 		        percentile(msTrack, 0.95), percentile(msMotion, 0.5),
 		        percentile(msMotion, 0.95), percentile(msEgo, 0.5),
 		        percentile(msEgo, 0.95));
+		    if (masksArg.isSet())
+			    std::fprintf(stderr,
+			                 "bims-odom: masks of %s for %zu of %zu frames\n",
+			                 ro.masks_dir.c_str(), st.masksUsed, st.frames);
+		    else
+			    std::fprintf(stderr,
+			                 "bims-odom: no --masks: moving content is left to "
+			                 "the robust alignment (no mask)\n");
 		    return 0;
 	    });
 }

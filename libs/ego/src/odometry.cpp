@@ -137,17 +137,12 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	++nFrames_;
 	lastAnchored_ = false;
 	const bool anchoring = cfg_.anchor.enable;
-	// What moved in the previous frame: the caller's mask (segmentation)
-	// and the anchor's own outliers. Not used when it covers too much.
+	// What moved in the previous frame: the caller's mask (segmentation).
+	// Not used when it covers too much. (The anchor's own outliers are not
+	// fed back: that locked a pose onto a mover and cost 2-3x the ATE on
+	// the crowded preset and Bonn; docs/ego.md.)
 	cv::Mat moving;
-	const bool own = anchoring && anchorMoving_.size() == f.grey.size();
-	if (mask && !mask->empty() && own && mask->size() == f.grey.size())
-		cv::bitwise_or(*mask, anchorMoving_, moving);  // (a new buffer)
-	else if (mask && !mask->empty())
-		moving = *mask;
-	else if (own)
-		moving = anchorMoving_;
-	anchorMoving_.release();
+	if (mask && !mask->empty()) moving = *mask;
 	if (!moving.empty() &&
 	    cv::countNonZero(moving) > cfg_.anchor.max_excluded_fraction *
 	                                   static_cast<double>(moving.total()))
@@ -353,8 +348,6 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		bool lost = false;
 		if (r.anchor.accepted)
 		{
-			cv::resize(r.anchor.outliers, anchorMoving_, f.grey.size(), 0, 0,
-			           cv::INTER_NEAREST);
 			R_WC_ = orthonormalize(r.anchor.R_WC);
 			t_WC_ = r.anchor.t_WC;
 			R_rel = R_WCprev_.transpose() * R_WC_;

@@ -6,8 +6,13 @@
 
 #include <mrpt/core/Clock.h>
 
+#include <opencv2/imgcodecs.hpp>
+
+#include <cstdio>
 #include <deque>
+#include <filesystem>
 #include <limits>
+#include <stdexcept>
 
 namespace bims::ego
 {
@@ -22,15 +27,38 @@ ReplayStats replayRawlog(const std::string& path, Odometry& odo,
 	const double offset = cfg.calibration.time_offset_s;
 	double lastImuT = -std::numeric_limits<double>::infinity();
 	double newestT = lastImuT;
-	std::deque<CObservation3DRangeScan::Ptr> pending;
+	// scans waiting for the IMU, with their index among the 3D scans
+	std::deque<std::pair<CObservation3DRangeScan::Ptr, long>> pending;
+	long nScans = 0;
+	cv::Mat mask;
 	DepthCorrection depthCorrection(cfg.depth_correction);
 	ProgressBar bar("bims-odom", 0, opt.progress);
 	bool done = false;
 
-	const auto process = [&](const CObservation3DRangeScan::Ptr& o)
+	const auto process = [&](const CObservation3DRangeScan::Ptr& o, long k)
 	{
 		o->load();
-		const FrameEgomotion r = odo.processFrame(*o);
+		mask.release();
+		if (!opt.masks_dir.empty() && k > 0)
+		{
+			char name[32];
+			std::snprintf(name, sizeof(name), "/%06ld.png", k - 1);
+			const std::string mp = opt.masks_dir + name;
+			if (std::filesystem::exists(mp))
+			{
+				mask = cv::imread(mp, cv::IMREAD_UNCHANGED);
+				if (mask.type() != CV_8UC1 ||
+				    mask.cols != static_cast<int>(o->rangeImage.cols()) ||
+				    mask.rows != static_cast<int>(o->rangeImage.rows()))
+					throw std::runtime_error(
+					    mp + ": not an 8-bit mask of the depth image's size (" +
+					    std::to_string(o->rangeImage.cols()) + "x" +
+					    std::to_string(o->rangeImage.rows()) + ")");
+				++st.masksUsed;
+			}
+		}
+		const FrameEgomotion r =
+		    odo.processFrame(*o, mask.empty() ? nullptr : &mask);
 		++st.frames;
 		if (!r.ok() && !(r.flags & kFlagFirstFrame)) ++st.flagged;
 		if (onFrame) onFrame(r, *o);
@@ -41,10 +69,11 @@ ReplayStats replayRawlog(const std::string& path, Odometry& odo,
 	{
 		while (!pending.empty() && !done)
 		{
-			const double t = mrpt::Clock::toDouble(pending.front()->timestamp);
+			const double t =
+			    mrpt::Clock::toDouble(pending.front().first->timestamp);
 			if (!all && t + offset > lastImuT && newestT - t <= opt.imu_wait_s)
 				break;
-			process(pending.front());
+			process(pending.front().first, pending.front().second);
 			pending.pop_front();
 		}
 	};
@@ -79,7 +108,7 @@ ReplayStats replayRawlog(const std::string& path, Odometry& odo,
 				continue;
 			}
 			depthCorrection.apply(*scan, cfg.camera);
-			pending.push_back(scan);
+			pending.emplace_back(scan, nScans++);
 		}
 		newestT = std::max(newestT, t);
 		flush(false);

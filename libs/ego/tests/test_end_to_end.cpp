@@ -9,6 +9,9 @@
 
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/system/filesystem.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include <filesystem>
 
 using namespace bims::ego;
 
@@ -91,4 +94,55 @@ TEST(EndToEnd, VisionModeOnBundledSample)
 	EXPECT_EQ(d.flagged, 0u);
 	std::printf("vision: max translation drift %.4f m\n", d.maxTrans);
 	EXPECT_LT(d.maxTrans, 0.85);  // measured 0.67 m (weak: docs/ego.md)
+}
+
+TEST(EndToEnd, MasksFolderReachesTheTrackerAsThePreviousFramesMask)
+{
+	// bims-odom --masks: scan k-1's mask is handed to frame k (here the
+	// simulator's ground truth); without a folder nothing is excluded.
+	if (!mrpt::system::fileExists(kDir + "pendulum_slow.rawlog"))
+		GTEST_SKIP() << "bundled sample missing";
+	mrpt::config::CConfigFile cal(kDir + "pendulum_slow_gt/calibration.ini");
+	EgoConfig cfg;
+	cfg.calibration.loadFromConfigFile(cal);
+	cfg.camera.loadFromConfigFile(cal);
+	cfg.sensors.loadFromConfigFile(cal);
+	const auto excludedFrames = [&](const std::string& dir, size_t* used)
+	{
+		Odometry odo(cfg);
+		ReplayOptions ro;
+		ro.progress = false;
+		ro.max_frames = 40;
+		ro.masks_dir = dir;
+		int n = 0;
+		const auto st = replayRawlog(
+		    kDir + "pendulum_slow.rawlog", odo,
+		    [&](const FrameEgomotion& r, const auto&)
+		    { n += r.anchor.excluded_fraction > 0 ? 1 : 0; },
+		    ro);
+		if (used) *used = st.masksUsed;
+		return n;
+	};
+	size_t used = 0;
+	EXPECT_EQ(excludedFrames("", &used), 0);
+	EXPECT_EQ(used, 0u);
+	// the pendulum is in view in most frames
+	EXPECT_GT(excludedFrames(kDir + "pendulum_slow_gt/masks", &used), 20);
+	EXPECT_EQ(used, 39u);  // every frame but the first
+	// a mask of another size is an error naming it
+	const std::string bad =
+	    (std::filesystem::temp_directory_path() / "bims_ego_bad_masks")
+	        .string();
+	std::filesystem::create_directories(bad);
+	cv::imwrite(bad + "/000000.png", cv::Mat(4, 4, CV_8UC1, cv::Scalar(0)));
+	try
+	{
+		excludedFrames(bad, nullptr);
+		FAIL() << "a mask of another size must throw";
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("000000.png"), std::string::npos)
+		    << e.what();
+	}
 }

@@ -127,10 +127,6 @@ class Odometry
 	KeyframeAnchor anchor_;
 	int anchorFailures_ = 0;  // frames in a row without an accepted anchor
 	bool lastAnchored_ = false;
-	/** Full-size image of the last accepted alignment's outliers: the
-	 * anchor's own moving mask, used with the caller's for the next frame
-	 * (bims-odom has no other). */
-	cv::Mat anchorMoving_;
 	bool havePrev_ = false;
 	double tPrev_ = 0;
 	cv::Mat depthPrev_;

@@ -17,6 +17,12 @@ struct ReplayOptions
 	double imu_wait_s = 0.2;  ///< max wait for the IMU behind a frame [s]
 	size_t max_frames = 0;    ///< stop after this many frames (0 = all)
 	bool progress = true;     ///< progress line on stderr
+	/** Folder of moving masks NNNNNN.png (3D-scan index from 0, 8-bit, non-zero
+	 * = moving; bims-run's OUT/masks, or a simulation's ground truth): scan
+	 * k-1's mask is handed to frame k, as bims-run feeds its segmentation
+	 * back. Empty: none (moving content is then left to the alignment's robust
+	 * weights). */
+	std::string masks_dir;
 };
 
 struct ReplayStats
@@ -25,6 +31,7 @@ struct ReplayStats
 	size_t imu = 0;         ///< IMU observations fed
 	size_t flagged = 0;     ///< frames with a failure flag (!ok())
 	size_t otherLabel = 0;  ///< observations skipped for their label
+	size_t masksUsed = 0;   ///< frames given a mask from masks_dir
 };
 
 using FrameCallback = std::function<void(
