@@ -102,6 +102,19 @@ AnchorResult KeyframeAnchor::track(const RgbdFrame& f,
 		alignTo(kf_.back(), R_pred, t_pred, others, R_prior, again);
 		if (again.accepted) r = again;
 	}
+	// The mask may have left too little to align (or be wrong): once more
+	// with every pixel, flagged (the feedback must not starve the tracker).
+	if (!r.accepted && !exclude.empty())
+	{
+		for (DenseLevel& L : cur_.levels) L.exclude.release();
+		AnchorResult again = r;
+		alignTo(*k, R_pred, t_pred, others, R_prior, again);
+		if (again.accepted)
+		{
+			r = again;
+			r.maskIgnored = true;
+		}
+	}
 	r.ms = std::chrono::duration<double, std::milli>(
 	           std::chrono::steady_clock::now() - t0)
 	           .count();

@@ -345,6 +345,7 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		                         useImu ? &R_prior : nullptr,
 		                         mask ? *mask : cv::Mat());
 		r.ms_anchor = r.anchor.ms;
+		if (r.anchor.maskIgnored) r.flags |= kFlagMaskIgnored;
 		bool lost = false;
 		if (r.anchor.accepted)
 		{
