@@ -3,6 +3,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -41,14 +42,16 @@ void KeyframeAnchor::clear()
 	pending_ = false;
 }
 
-KeyframeAnchor::Keyframe* KeyframeAnchor::nearest(const Eigen::Matrix3d& R_WC,
-                                                  const Eigen::Vector3d& t_WC)
+KeyframeAnchor::Keyframe* KeyframeAnchor::nearest(
+    const Eigen::Matrix3d& R_WC, const Eigen::Vector3d& t_WC,
+    const std::vector<Keyframe*>& skip)
 {
 	Keyframe* best = nullptr;
 	double bestScore = 1e300;
 	// newest first: ties go to the most recent keyframe
 	for (auto it = kf_.rbegin(); it != kf_.rend(); ++it)
 	{
+		if (std::find(skip.begin(), skip.end(), &*it) != skip.end()) continue;
 		const double d = (it->t_WK - t_WC).norm() / p_.keyframe_distance_m;
 		const double a = angleSO3(it->R_WK.transpose() * R_WC) /
 		                 (p_.keyframe_angle_deg * kDeg);
@@ -96,10 +99,18 @@ AnchorResult KeyframeAnchor::track(const RgbdFrame& f,
 	alignTo(*k, R_pred, t_pred, others, R_prior, r);
 	// The nearest keyframe may be an old one the pose has drifted from (a
 	// correction too large to take): the newest keyframe then anchors it.
-	if (!r.accepted && &kf_.back() != k)
+	// Or it may hold too little static scene (made while a mover filled the
+	// view): the next nearest ones then, up to kMoreKeyframes of them.
+	constexpr size_t kMoreKeyframes = 3;
+	std::vector<Keyframe*> tried = {k};
+	for (size_t n = 0; !r.accepted && n <= kMoreKeyframes; n++)
 	{
+		Keyframe* q = n == 0 ? &kf_.back() : nearest(R_pred, t_pred, tried);
+		if (!q || std::find(tried.begin(), tried.end(), q) != tried.end())
+			continue;
+		tried.push_back(q);
 		AnchorResult again = r;
-		alignTo(kf_.back(), R_pred, t_pred, others, R_prior, again);
+		alignTo(*q, R_pred, t_pred, others, R_prior, again);
 		if (again.accepted) r = again;
 	}
 	// The mask may have left too little to align (or be wrong): once more

@@ -275,3 +275,31 @@ TEST(KeyframeAnchor, AMaskOverMostOfTheImageIsCountedAndNotUsed)
 	EXPECT_TRUE(b.flags & kFlagAnchored);
 	EXPECT_GT(b.anchor.excluded_fraction, 0.2);  // the mask was used
 }
+
+TEST(KeyframeAnchor, AKeyframeLeftWithLittleStaticSceneFallsBackToAnOlderOne)
+{
+	// Keyframe 1 is made from a frame whose moving mask covered 99 % of it
+	// (a mover filling the view): it holds too little to anchor to, and it
+	// is the nearest and newest one. The next frame anchors to keyframe 0.
+	KeyframeAnchor anchor(params320());
+	test::Motion m;
+	const auto frame = [&](double t)
+	{ return test::render(m.R(t), m.p(t), K320(), 320, 240, t); };
+	const auto R = [&](double t)
+	{ return Eigen::Matrix3d(m.R(0).transpose() * m.R(t)); };
+	const auto p = [&](double t)
+	{ return Eigen::Vector3d(m.R(0).transpose() * (m.p(t) - m.p(0))); };
+	AnchorResult a = anchor.track(frame(0), R(0), p(0), {}, nullptr, cv::Mat());
+	anchor.wantKeyframe(a, R(0), p(0), true);
+	EXPECT_TRUE(anchor.addPending(cv::Mat()));  // keyframe 0
+	a = anchor.track(frame(0.05), R(0.05), p(0.05), {}, nullptr, cv::Mat());
+	EXPECT_TRUE(a.accepted) << a.why;
+	anchor.wantKeyframe(a, R(0.05), p(0.05), true);
+	cv::Mat most = cv::Mat::zeros(240, 320, CV_8UC1);
+	most(cv::Rect(0, 0, 316, 240)).setTo(255);
+	EXPECT_TRUE(anchor.addPending(most));  // keyframe 1: 1 % of its readings
+	EXPECT_EQ(anchor.keyframes(), 2u);
+	a = anchor.track(frame(0.1), R(0.1), p(0.1), {}, nullptr, cv::Mat());
+	EXPECT_TRUE(a.accepted) << a.why;
+	EXPECT_EQ(a.keyframe, 0);
+}

@@ -11,26 +11,29 @@ namespace
 {
 const std::string kPresets = std::string(BIMS_SOURCE_DIR) + "/config/sim/";
 
-/** Mean fraction of moving pixels over n frames spread over the sequence. */
-double movingFraction(const SimConfig& c, int n)
+/** Fraction of moving pixels at time t (320x240), or of object \a id's. */
+double fractionAt(const SimConfig& c, double t, uint64_t seed = 0, int id = -1)
 {
 	const Scene scene = c.buildScene();
 	CameraParams cam = c.camera;
 	cam.setResolution("320x240");
 	const Renderer r(cam, c.depth, c.rgb);
-	const HandheldMotion motion(c.motion);
-	double sum = 0;
+	const auto k = HandheldMotion(c.motion).at(t);
 	RenderedFrame f;
+	r.render(scene, t, k.R_WC, k.p_WC, 1, seed, f);
+	size_t m = 0;
+	for (size_t i = 0; i < f.mask.size(); i++)
+		m += (id < 0 ? f.mask[i] != 0 : f.objectId[i] == id) ? 1 : 0;
+	return double(m) / f.mask.size();
+}
+/** Mean fraction of moving pixels over n frames spread over the sequence. */
+double movingFraction(const SimConfig& c, int n)
+{
+	double sum = 0;
 	for (int i = 0; i < n; i++)
-	{
-		const double t =
-		    (c.seq.frames - 1) / c.seq.fps * i / std::max(1, n - 1);
-		const auto k = motion.at(t);
-		r.render(scene, t, k.R_WC, k.p_WC, 1, uint64_t(i), f);
-		size_t m = 0;
-		for (auto v : f.mask) m += v ? 1 : 0;
-		sum += double(m) / f.mask.size();
-	}
+		sum += fractionAt(
+		    c, (c.seq.frames - 1) / c.seq.fps * i / std::max(1, n - 1),
+		    uint64_t(i));
 	return sum / n;
 }
 double peakRateDegS(const SimConfig& c)
@@ -89,4 +92,17 @@ TEST(Presets, EachHasItsPromisedProperty)
 	        180 / M_PI,
 	    3.0);
 	EXPECT_NE(mis.imu.timeOffsetS, 0.0);
+	// occluder: the room (and a walker) first, the box (object 1) out of
+	// view, then the box over half the image for at least 1 s
+	const auto occ = SimConfig::load(kPresets + "occluder.ini");
+	double before = 0, longest = 0, run = 0;
+	for (double t = 0; t < occ.seq.frames / occ.seq.fps; t += 0.1)
+	{
+		const double f = fractionAt(occ, t);
+		if (t < 0.95) before = std::max(before, fractionAt(occ, t, 0, 1));
+		run = f >= 0.5 ? run + 0.1 : 0;
+		longest = std::max(longest, run);
+	}
+	EXPECT_EQ(before, 0.0);
+	EXPECT_GE(longest, 1.0);
 }

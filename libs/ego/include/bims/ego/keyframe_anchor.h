@@ -18,6 +18,7 @@
 #include <opencv2/core.hpp>
 
 #include <deque>
+#include <vector>
 
 namespace bims::ego
 {
@@ -85,7 +86,8 @@ class KeyframeAnchor
 		Eigen::Matrix3d R_WK;
 		Eigen::Vector3d t_WK;
 	};
-	Keyframe* nearest(const Eigen::Matrix3d& R_WC, const Eigen::Vector3d& t_WC);
+	Keyframe* nearest(const Eigen::Matrix3d& R_WC, const Eigen::Vector3d& t_WC,
+	                  const std::vector<Keyframe*>& skip = {});
 	/** Aligns the frame in cur_ to \a k; fills \a r (accepted or why not)
 	 * and drops from \a k what the frame saw through. */
 	void alignTo(Keyframe& k, const Eigen::Matrix3d& R_pred,
