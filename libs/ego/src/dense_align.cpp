@@ -628,6 +628,7 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 	const double sigma0 = std::max(p.photo_sigma_grey, 40.0);
 	double photoSigma = sigma0;
 	int best = -1;
+	int firstInliers = -1;  // the first guess's, before iterating
 	for (size_t k = 0; k < inits.size(); k++)
 	{
 		Eigen::Matrix3d Rk = inits[k].R;
@@ -635,6 +636,16 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 		float ok = 0;
 		double sk = sigma0;
 		int inl = 0;
+		// A later guess is iterated only when it starts with more inliers
+		// than the first one did (the frame-to-frame guess is usually the
+		// better one: 4 Gauss-Newton passes saved, the same trajectories).
+		const int start = pass(ref.levels[static_cast<size_t>(top)], coarse, Rk,
+		                       tk, 0, sigma0, p, false, nullptr)
+		                      .inliers;
+		if (k == 0)
+			firstInliers = start;
+		else if (start <= firstInliers)
+			continue;
 		r.iterations +=
 		    iterateLevel(ref.levels[static_cast<size_t>(top)], coarse, Rk, tk,
 		                 ok, sk, p, R_prior, sigmaPrior_rad, &inl);

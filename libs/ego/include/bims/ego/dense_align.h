@@ -125,9 +125,10 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
                             double sigmaPrior_rad = 0);
 
 /** Same, from several initial guesses: each is iterated at the coarsest
- * level, the one with most inliers there goes on to the finer levels
- * (e.g. the frame-to-frame estimate, which people in view can corrupt, and
- * the constant-velocity prediction). */
+ * level (a later one only if it starts with more inliers than the first),
+ * the one with most inliers there goes on to the finer levels (e.g. the
+ * frame-to-frame estimate, which people in view can corrupt, and the
+ * constant-velocity prediction). */
 DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
                             const std::vector<InitialGuess>& inits,
                             const AnchorParams& p,
