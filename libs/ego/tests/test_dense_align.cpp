@@ -303,3 +303,30 @@ TEST(KeyframeAnchor, AKeyframeLeftWithLittleStaticSceneFallsBackToAnOlderOne)
 	EXPECT_TRUE(a.accepted) << a.why;
 	EXPECT_EQ(a.keyframe, 0);
 }
+
+TEST(KeyframeAnchor, AMaskThatLeavesNothingToAlignIsRetriedWithout)
+{
+	// The mask covers 60 % of the frame (below max_excluded_fraction) and
+	// the rest is a board the keyframe does not hold (occluders, no
+	// inliers): with the mask nothing is left to align, so the alignment is
+	// tried once more without it (flagged), not failed.
+	KeyframeAnchor anchor(params320());
+	test::Motion m;
+	const auto frame = [&](double t)
+	{ return test::render(m.R(t), m.p(t), K320(), 320, 240, t); };
+	const auto R = [&](double t)
+	{ return Eigen::Matrix3d(m.R(0).transpose() * m.R(t)); };
+	const auto p = [&](double t)
+	{ return Eigen::Vector3d(m.R(0).transpose() * (m.p(t) - m.p(0))); };
+	AnchorResult a = anchor.track(frame(0), R(0), p(0), {}, nullptr, cv::Mat());
+	anchor.wantKeyframe(a, R(0), p(0), true);
+	ASSERT_TRUE(anchor.addPending(cv::Mat()));
+	RgbdFrame f = frame(0.05);
+	cv::Mat mask = cv::Mat::zeros(240, 320, CV_8UC1);
+	mask(cv::Rect(0, 0, 192, 240)).setTo(255);  // 60 %
+	occlude(f, 192, 320, 1.0f, 7);
+	a = anchor.track(f, R(0.05), p(0.05), {}, nullptr, mask);
+	EXPECT_TRUE(a.accepted) << a.why;
+	EXPECT_TRUE(a.maskIgnored);
+	EXPECT_LT((a.t_WC - p(0.05)).norm(), 0.01);
+}
