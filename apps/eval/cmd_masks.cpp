@@ -256,26 +256,22 @@ int cmdMasks(int argc, char** argv)
 			if (background.size() != g.size()) background = cv::Mat();
 		}
 		ev::MaskMetrics m;
+		// the labels in the contract's terms, for the voxel figures and the
+		// overlay (not-scored pixels drawn and binned as without depth)
+		cv::Mat gMoving = g, scored;
 		try
 		{
 			m.accumulate(g, pm, valid, labels);
-			if (!depthM.empty() && voxel.getValue() > 0)
+			if (!labels.isContract())
 			{
-				// the voxel figures read the labels by the same convention
-				cv::Mat gv = g.clone(), pv = pm.clone();
-				for (int v = 0; v < gv.rows; v++)
-					for (int u = 0; u < gv.cols; u++)
-					{
-						const auto c = labels.classOf(gv.at<uint8_t>(v, u));
-						gv.at<uint8_t>(v, u) =
-						    c == ev::LabelClass::Moving ? 255 : 0;
-						if (c == ev::LabelClass::NotScored)
-							depthM.at<float>(v, u) = 0;
-					}
-				totalVoxels +=
-				    ev::voxelMaskMetrics(gv, pv, depthM, cam.fx(), cam.fy(),
-				                         cam.cx(), cam.cy(), voxel.getValue());
+				labels.toContract(g, gMoving, scored);
+				valid = valid.empty() ? scored : (valid & scored);
+				if (!depthM.empty()) depthM.setTo(0, scored == 0);
 			}
+			if (!depthM.empty() && voxel.getValue() > 0)
+				totalVoxels += ev::voxelMaskMetrics(
+				    gMoving, pm, depthM, cam.fx(), cam.fy(), cam.cx(), cam.cy(),
+				    voxel.getValue());
 		}
 		catch (const std::invalid_argument& e)
 		{
@@ -297,20 +293,8 @@ int cmdMasks(int argc, char** argv)
 		const bool inStrip = stripSet.count(static_cast<size_t>(f.index)) > 0;
 		if (!outDir.empty() || inStrip)
 		{
-			cv::Mat gShown = g;
-			if (!labels.isContract())
-			{
-				// moving 255, static 0; not-scored pixels drawn as invalid
-				gShown = cv::Mat(g.size(), CV_8UC1, cv::Scalar(0));
-				gShown.setTo(255, g == labels.moving);
-				cv::Mat ok = valid.empty()
-				                 ? cv::Mat(g.size(), CV_8UC1, cv::Scalar(255))
-				                 : valid.clone();
-				for (int v : labels.ignored) ok.setTo(0, g == v);
-				valid = ok;
-			}
 			const cv::Mat o =
-			    ev::maskOverlay(gShown, pm, valid, background,
+			    ev::maskOverlay(gMoving, pm, valid, background,
 			                    "frame " + frame + "  " + m.scoresLine());
 			if (!outDir.empty()) ev::writePng(outDir + "/" + f.name, o);
 			if (inStrip) tiles[f.index] = o;

@@ -67,6 +67,25 @@ std::string LabelConvention::describe() const
 	return s;
 }
 
+void LabelConvention::toContract(const cv::Mat& labels, cv::Mat& moving,
+                                 cv::Mat& scored) const
+{
+	cv::Mat lutMoving(1, 256, CV_8UC1), lutScored(1, 256, CV_8UC1);
+	for (int i = 0; i < 256; i++)
+	{
+		const LabelClass c = classOf(i);
+		lutMoving.at<uint8_t>(i) = c == LabelClass::Moving ? 255 : 0;
+		lutScored.at<uint8_t>(i) =
+		    c == LabelClass::Moving || c == LabelClass::Static ? 255 : 0;
+	}
+	// (new buffers: \a moving may share \a labels' pixels)
+	cv::Mat m, s;
+	cv::LUT(labels, lutMoving, m);
+	cv::LUT(labels, lutScored, s);
+	moving = m;
+	scored = s;
+}
+
 std::vector<int> parseLabelValues(const std::string& text)
 {
 	std::string t = text;

@@ -56,6 +56,15 @@ TEST(LabelConvention, ProxyValuesAreScoredIgnoredOrAnError)
 	const ev::LabelConvention contract;
 	EXPECT_EQ(contract.classOf(150), ev::LabelClass::Moving);
 	EXPECT_EQ(contract.classOf(50), ev::LabelClass::Static);
+	const cv::Mat l = (cv::Mat_<uint8_t>(1, 4) << 255, 0, 150, 50);
+	cv::Mat moving = l, scored;  // (the output may share the input)
+	c.toContract(l, moving, scored);
+	EXPECT_EQ(
+	    cv::countNonZero(moving == (cv::Mat_<uint8_t>(1, 4) << 255, 0, 0, 0)),
+	    4);
+	EXPECT_EQ(
+	    cv::countNonZero(scored == (cv::Mat_<uint8_t>(1, 4) << 255, 255, 0, 0)),
+	    4);
 	EXPECT_THROW(ev::LabelConvention::explicitValues(255, 0, {255}),
 	             std::invalid_argument);
 	EXPECT_THROW(ev::LabelConvention::explicitValues(300, 0, {}),

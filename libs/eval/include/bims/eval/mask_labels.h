@@ -4,6 +4,8 @@
 // scores against which label (by index, or by timestamp within a tolerance).
 #pragma once
 
+#include <opencv2/core.hpp>
+
 #include <map>
 #include <string>
 #include <vector>
@@ -37,6 +39,12 @@ struct LabelConvention
 	LabelClass classOf(int value) const;
 	/** "moving 255, static 0, not scored 150 50" (or the contract's). */
 	std::string describe() const;
+	/** A label image (CV_8UC1) in the contract's terms: \a moving 255
+	 * where the label means moving, else 0; \a scored 255 where it means
+	 * moving or static, else 0 (not scored, or unknown: accumulate()
+	 * reports those). */
+	void toContract(const cv::Mat& labels, cv::Mat& moving,
+	                cv::Mat& scored) const;
 };
 
 /** Parses "150,50" (or "150 50"): values 0-255; throws
