@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 namespace
 {
@@ -26,6 +27,18 @@ int run(const std::string& args, const std::string& log)
 	return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }
 
+const std::string kSample = "'" + kSrc + "/config/default.ini' '" + kSrc +
+                            "/rawlogs/pendulum_slow.rawlog' ";
+
+/** The output kOut/NAME.ini (removed first) and log kOut/NAME.log. */
+std::pair<std::string, std::string> freshOutput(const std::string& name)
+{
+	EXPECT_EQ(std::system(("mkdir -p '" + kOut + "'").c_str()), 0);
+	const std::string out = kOut + "/" + name + ".ini";
+	std::remove(out.c_str());
+	return {out, kOut + "/" + name + ".log"};
+}
+
 std::string slurp(const std::string& p)
 {
 	std::ifstream f(p);
@@ -37,13 +50,10 @@ std::string slurp(const std::string& p)
 
 TEST(CalibDepthApp, AnUndistortedSensorGetsAlmostNoCorrection)
 {
-	ASSERT_EQ(std::system(("mkdir -p '" + kOut + "'").c_str()), 0);
-	const std::string out = kOut + "/sample.ini", log = kOut + "/sample.log";
-	std::remove(out.c_str());
-	ASSERT_EQ(run("'" + kSrc + "/config/default.ini' '" + kSrc +
-	                  "/rawlogs/pendulum_slow.rawlog' --frames 0:40 --poses '" +
-	                  kSrc + "/rawlogs/pendulum_slow_gt/groundtruth.txt' -o '" +
-	                  out + "' -q",
+	const auto [out, log] = freshOutput("sample");
+	ASSERT_EQ(run(kSample + "--frames 0:40 --poses '" + kSrc +
+	                  "/rawlogs/pendulum_slow_gt/groundtruth.txt' -o '" + out +
+	                  "' -q",
 	              log),
 	          0)
 	    << slurp(log);
@@ -59,35 +69,22 @@ TEST(CalibDepthApp, AnUndistortedSensorGetsAlmostNoCorrection)
 	                           {-0.59, -0.44},
 	                           {0.59, 0.44}})
 	{
-		const auto b = bims::ego::depthCorrectionBasis(x, y);
-		double d = 0;
-		for (int i = 0; i < bims::ego::kDepthCorrectionTerms; i++)
-			d += p.coefficients[i] * b[i];
-		EXPECT_LT(std::abs(d), 0.025) << x << " " << y;
+		EXPECT_LT(std::abs(bims::ego::depthCorrectionDelta(p, x, y)), 0.025)
+		    << x << " " << y;
 	}
 }
 
 TEST(CalibDepthApp, PosesThatDoNotFitAreRefusedNotWritten)
 {
-	ASSERT_EQ(std::system(("mkdir -p '" + kOut + "'").c_str()), 0);
-	const std::string out = kOut + "/refused.ini", log = kOut + "/refused.log";
-	std::remove(out.c_str());
+	const auto [out, log] = freshOutput("refused");
 	// the 320 x 240 sample's frame-to-frame vision odometry is too poor
 	// (0.34 deg per frame) for a fit: refused with a reason
-	EXPECT_EQ(run("'" + kSrc + "/config/default.ini' '" + kSrc +
-	                  "/rawlogs/pendulum_slow.rawlog' --frames 0:40 -o '" +
-	                  out + "' -q",
-	              log),
-	          1);
+	EXPECT_EQ(run(kSample + "--frames 0:40 -o '" + out + "' -q", log), 1);
 	EXPECT_NE(slurp(log).find("do not fit a static scene"), std::string::npos)
 	    << slurp(log);
 	EXPECT_FALSE(std::ifstream(out).good());
 	// bad arguments are usage errors
-	EXPECT_EQ(
-	    run("'" + kSrc + "/config/default.ini' '" + kSrc +
-	            "/rawlogs/pendulum_slow.rawlog' --frames 9:2 -o '" + out + "'",
-	        log),
-	    2);
+	EXPECT_EQ(run(kSample + "--frames 9:2 -o '" + out + "'", log), 2);
 	EXPECT_EQ(run("'" + kSrc + "/config/default.ini' /nonexistent.rawlog -o '" +
 	                  out + "'",
 	              log),

@@ -49,6 +49,15 @@ std::string DepthCorrectionParams::toIni(const std::string& comment) const
 	return os.str();
 }
 
+double depthCorrectionDelta(const DepthCorrectionParams& p, double x, double y)
+{
+	const auto b = depthCorrectionBasis(x, y);
+	double d = 0;
+	for (int i = 0; i < kDepthCorrectionTerms; i++)
+		d += p.coefficients[i] * b[i];
+	return d;
+}
+
 const cv::Mat& DepthCorrection::factors(const Eigen::Matrix3d& K, cv::Size size)
 {
 	if (f_.size() == size && K == K_) return f_;
@@ -60,11 +69,8 @@ const cv::Mat& DepthCorrection::factors(const Eigen::Matrix3d& K, cv::Size size)
 		float* o = f_.ptr<float>(v);
 		for (int u = 0; u < size.width; u++)
 		{
-			const auto b = depthCorrectionBasis((u - cx) / fx, (v - cy) / fy);
-			double d = 0;
-			for (int i = 0; i < kDepthCorrectionTerms; i++)
-				d += p_.coefficients[i] * b[i];
-			o[u] = static_cast<float>(1 + d);
+			o[u] = static_cast<float>(
+			    1 + depthCorrectionDelta(p_, (u - cx) / fx, (v - cy) / fy));
 		}
 	}
 	return f_;

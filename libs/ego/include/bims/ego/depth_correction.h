@@ -32,6 +32,10 @@ namespace bims::ego
 std::array<double, kDepthCorrectionTerms> depthCorrectionBasis(double x,
                                                                double y);
 
+/** delta(x, y) = sum c_i term_i(x, y): the correction at normalised image
+ * coordinates (z_true = z (1 + delta)). */
+double depthCorrectionDelta(const DepthCorrectionParams& p, double x, double y);
+
 /** Applies a correction; keeps the per-pixel factors of the last camera. */
 class DepthCorrection
 {
