@@ -276,30 +276,51 @@ TEST(KeyframeAnchor, AMaskOverMostOfTheImageIsCountedAndNotUsed)
 	EXPECT_GT(b.anchor.excluded_fraction, 0.2);  // the mask was used
 }
 
+namespace
+{
+/** test::Motion seen by a KeyframeAnchor: frames and true poses in the
+ * first camera's frame; construction makes frame 0 keyframe 0. */
+struct AnchorOnMotion
+{
+	KeyframeAnchor anchor{params320()};
+	test::Motion m;
+	AnchorOnMotion()
+	{
+		const AnchorResult a =
+		    anchor.track(frame(0), R(0), p(0), {}, nullptr, cv::Mat());
+		anchor.wantKeyframe(a, R(0), p(0), true);
+		EXPECT_TRUE(anchor.addPending(cv::Mat()));  // keyframe 0
+	}
+	RgbdFrame frame(double t) const
+	{
+		return test::render(m.R(t), m.p(t), K320(), 320, 240, t);
+	}
+	Eigen::Matrix3d R(double t) const { return m.R(0).transpose() * m.R(t); }
+	Eigen::Vector3d p(double t) const
+	{
+		return m.R(0).transpose() * (m.p(t) - m.p(0));
+	}
+	AnchorResult track(const RgbdFrame& f, double t, const cv::Mat& mask = {})
+	{
+		return anchor.track(f, R(t), p(t), {}, nullptr, mask);
+	}
+};
+}  // namespace
+
 TEST(KeyframeAnchor, AKeyframeLeftWithLittleStaticSceneFallsBackToAnOlderOne)
 {
 	// Keyframe 1 is made from a frame whose moving mask covered 99 % of it
 	// (a mover filling the view): it holds too little to anchor to, and it
 	// is the nearest and newest one. The next frame anchors to keyframe 0.
-	KeyframeAnchor anchor(params320());
-	test::Motion m;
-	const auto frame = [&](double t)
-	{ return test::render(m.R(t), m.p(t), K320(), 320, 240, t); };
-	const auto R = [&](double t)
-	{ return Eigen::Matrix3d(m.R(0).transpose() * m.R(t)); };
-	const auto p = [&](double t)
-	{ return Eigen::Vector3d(m.R(0).transpose() * (m.p(t) - m.p(0))); };
-	AnchorResult a = anchor.track(frame(0), R(0), p(0), {}, nullptr, cv::Mat());
-	anchor.wantKeyframe(a, R(0), p(0), true);
-	EXPECT_TRUE(anchor.addPending(cv::Mat()));  // keyframe 0
-	a = anchor.track(frame(0.05), R(0.05), p(0.05), {}, nullptr, cv::Mat());
+	AnchorOnMotion s;
+	AnchorResult a = s.track(s.frame(0.05), 0.05);
 	EXPECT_TRUE(a.accepted) << a.why;
-	anchor.wantKeyframe(a, R(0.05), p(0.05), true);
+	s.anchor.wantKeyframe(a, s.R(0.05), s.p(0.05), true);
 	cv::Mat most = cv::Mat::zeros(240, 320, CV_8UC1);
 	most(cv::Rect(0, 0, 316, 240)).setTo(255);
-	EXPECT_TRUE(anchor.addPending(most));  // keyframe 1: 1 % of its readings
-	EXPECT_EQ(anchor.keyframes(), 2u);
-	a = anchor.track(frame(0.1), R(0.1), p(0.1), {}, nullptr, cv::Mat());
+	EXPECT_TRUE(s.anchor.addPending(most));  // keyframe 1: 1 % of its readings
+	EXPECT_EQ(s.anchor.keyframes(), 2u);
+	a = s.track(s.frame(0.1), 0.1);
 	EXPECT_TRUE(a.accepted) << a.why;
 	EXPECT_EQ(a.keyframe, 0);
 }
@@ -310,23 +331,13 @@ TEST(KeyframeAnchor, AMaskThatLeavesNothingToAlignIsRetriedWithout)
 	// the rest is a board the keyframe does not hold (occluders, no
 	// inliers): with the mask nothing is left to align, so the alignment is
 	// tried once more without it (flagged), not failed.
-	KeyframeAnchor anchor(params320());
-	test::Motion m;
-	const auto frame = [&](double t)
-	{ return test::render(m.R(t), m.p(t), K320(), 320, 240, t); };
-	const auto R = [&](double t)
-	{ return Eigen::Matrix3d(m.R(0).transpose() * m.R(t)); };
-	const auto p = [&](double t)
-	{ return Eigen::Vector3d(m.R(0).transpose() * (m.p(t) - m.p(0))); };
-	AnchorResult a = anchor.track(frame(0), R(0), p(0), {}, nullptr, cv::Mat());
-	anchor.wantKeyframe(a, R(0), p(0), true);
-	ASSERT_TRUE(anchor.addPending(cv::Mat()));
-	RgbdFrame f = frame(0.05);
+	AnchorOnMotion s;
+	RgbdFrame f = s.frame(0.05);
 	cv::Mat mask = cv::Mat::zeros(240, 320, CV_8UC1);
 	mask(cv::Rect(0, 0, 192, 240)).setTo(255);  // 60 %
 	occlude(f, 192, 320, 1.0f, 7);
-	a = anchor.track(f, R(0.05), p(0.05), {}, nullptr, mask);
+	const AnchorResult a = s.track(f, 0.05, mask);
 	EXPECT_TRUE(a.accepted) << a.why;
 	EXPECT_TRUE(a.maskIgnored);
-	EXPECT_LT((a.t_WC - p(0.05)).norm(), 0.01);
+	EXPECT_LT((a.t_WC - s.p(0.05)).norm(), 0.01);
 }
