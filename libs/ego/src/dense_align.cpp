@@ -638,14 +638,18 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 		int inl = 0;
 		// A later guess is iterated only when it starts with more inliers
 		// than the first one did (the frame-to-frame guess is usually the
-		// better one: 4 Gauss-Newton passes saved, the same trajectories).
-		const int start = pass(ref.levels[static_cast<size_t>(top)], coarse, Rk,
-		                       tk, 0, sigma0, p, false, nullptr)
-		                      .inliers;
-		if (k == 0)
-			firstInliers = start;
-		else if (start <= firstInliers)
-			continue;
+		// better one: 4 Gauss-Newton passes saved; docs/ego.md). A single
+		// guess needs no count.
+		if (inits.size() > 1)
+		{
+			const int start = pass(ref.levels[static_cast<size_t>(top)], coarse,
+			                       Rk, tk, 0, sigma0, p, false, nullptr)
+			                      .inliers;
+			if (k == 0)
+				firstInliers = start;
+			else if (start <= firstInliers)
+				continue;
+		}
 		r.iterations +=
 		    iterateLevel(ref.levels[static_cast<size_t>(top)], coarse, Rk, tk,
 		                 ok, sk, p, R_prior, sigmaPrior_rad, &inl);
