@@ -11,16 +11,33 @@ namespace
 {
 const std::string kPresets = std::string(BIMS_SOURCE_DIR) + "/config/sim/";
 
-/** Fraction of moving pixels at time t (320x240), or of object \a id's. */
-double fractionAt(const SimConfig& c, double t, uint64_t seed = 0, int id = -1)
+/** A preset's scene seen along its motion at 320x240 (built once). */
+struct PresetView
 {
-	const Scene scene = c.buildScene();
-	CameraParams cam = c.camera;
-	cam.setResolution("320x240");
-	const Renderer r(cam, c.depth, c.rgb);
-	const auto k = HandheldMotion(c.motion).at(t);
-	RenderedFrame f;
-	r.render(scene, t, k.R_WC, k.p_WC, 1, seed, f);
+	explicit PresetView(const SimConfig& c)
+	    : scene(c.buildScene()), r(cam320(c), c.depth, c.rgb), motion(c.motion)
+	{
+	}
+	static CameraParams cam320(const SimConfig& c)
+	{
+		CameraParams cam = c.camera;
+		cam.setResolution("320x240");
+		return cam;
+	}
+	RenderedFrame at(double t, uint64_t seed = 0) const
+	{
+		const auto k = motion.at(t);
+		RenderedFrame f;
+		r.render(scene, t, k.R_WC, k.p_WC, 1, seed, f);
+		return f;
+	}
+	Scene scene;
+	Renderer r;
+	HandheldMotion motion;
+};
+/** Share of the frame's pixels that move, or that belong to object \a id. */
+double share(const RenderedFrame& f, int id = -1)
+{
 	size_t m = 0;
 	for (size_t i = 0; i < f.mask.size(); i++)
 		m += (id < 0 ? f.mask[i] != 0 : f.objectId[i] == id) ? 1 : 0;
@@ -29,11 +46,12 @@ double fractionAt(const SimConfig& c, double t, uint64_t seed = 0, int id = -1)
 /** Mean fraction of moving pixels over n frames spread over the sequence. */
 double movingFraction(const SimConfig& c, int n)
 {
+	const PresetView view(c);
 	double sum = 0;
 	for (int i = 0; i < n; i++)
-		sum += fractionAt(
-		    c, (c.seq.frames - 1) / c.seq.fps * i / std::max(1, n - 1),
-		    uint64_t(i));
+		sum += share(
+		    view.at((c.seq.frames - 1) / c.seq.fps * i / std::max(1, n - 1),
+		            uint64_t(i)));
 	return sum / n;
 }
 double peakRateDegS(const SimConfig& c)
@@ -95,11 +113,13 @@ TEST(Presets, EachHasItsPromisedProperty)
 	// occluder: the room (and a walker) first, the box (object 1) out of
 	// view, then the box over half the image for at least 1 s
 	const auto occ = SimConfig::load(kPresets + "occluder.ini");
+	const PresetView occView(occ);
 	double before = 0, longest = 0, run = 0;
 	for (double t = 0; t < occ.seq.frames / occ.seq.fps; t += 0.1)
 	{
-		const double f = fractionAt(occ, t);
-		if (t < 0.95) before = std::max(before, fractionAt(occ, t, 0, 1));
+		const RenderedFrame frame = occView.at(t);
+		const double f = share(frame);
+		if (t < 0.95) before = std::max(before, share(frame, 1));
 		run = f >= 0.5 ? run + 0.1 : 0;
 		longest = std::max(longest, run);
 	}
