@@ -1,4 +1,5 @@
 #include <bims/common/app.h>
+#include <bims/common/frame_files.h>
 #include <bims/common/rawlog.h>
 #include <bims/eval/depth_consistency.h>
 #include <bims/eval/json.h>
@@ -56,11 +57,11 @@ class ScanStream
 	mrpt::obs::CObservation3DRangeScan::Ptr cur_;
 };
 
+/** "000042" for scan 42 (the stem of its frame files). */
 std::string frameName(long k)
 {
-	char b[32];
-	std::snprintf(b, sizeof(b), "%06ld", k);
-	return b;
+	std::string s = bims::frameFileName(k);
+	return s.erase(s.rfind('.'));
 }
 }  // namespace
 

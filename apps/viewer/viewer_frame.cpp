@@ -1,4 +1,5 @@
 #include "viewer_frame.h"
+#include <bims/common/frame_files.h>
 
 #include <bims/common/app.h>
 
@@ -271,9 +272,8 @@ void ViewerFrame::refreshViews(bool resetCamera)
 	}
 	if (!pngDir_.empty() && ctl_->currentFrame() >= 0)
 	{
-		char name[32];
-		std::snprintf(name, sizeof(name), "/%06ld.png", ctl_->currentFrame());
-		canvas_->requestCapture(pngDir_ + name);
+		canvas_->requestCapture(pngDir_ + "/" +
+		                        bims::frameFileName(ctl_->currentFrame()));
 	}
 	canvas_->Refresh(false);
 	for (size_t i = 0; i < panels_.size(); ++i)

@@ -1,3 +1,4 @@
+#include <bims/common/frame_files.h>
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
 #include <bims/ego/depth_correction.h>
@@ -41,9 +42,7 @@ ReplayStats replayRawlog(const std::string& path, Odometry& odo,
 		mask.release();
 		if (!opt.masks_dir.empty() && k > 0)
 		{
-			char name[32];
-			std::snprintf(name, sizeof(name), "/%06ld.png", k - 1);
-			const std::string mp = opt.masks_dir + name;
+			const std::string mp = opt.masks_dir + "/" + frameFileName(k - 1);
 			if (std::filesystem::exists(mp))
 			{
 				mask = cv::imread(mp, cv::IMREAD_UNCHANGED);

@@ -6,6 +6,7 @@
 //
 //   bims-maps-figure RAWLOG GT_DIR OUT.png [--frames N] [--voxel M]
 #include <bims/common/app.h>
+#include <bims/common/frame_files.h>
 #include <bims/common/frames.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
@@ -63,8 +64,7 @@ int main(int argc, char** argv)
 			    if (!scan) continue;
 			    if (k >= frames || k >= int(traj.size())) break;
 			    const auto T_WS = traj[k].T_WC + (-bims::T_SC());
-			    char name[32];
-			    std::snprintf(name, sizeof name, "/masks/%06d.png", k);
+			    const std::string name = "/masks/" + bims::frameFileName(k);
 			    const cv::Mat m = cv::imread(gt + name, cv::IMREAD_GRAYSCALE);
 			    bims::maps::PixelLabels labels;
 			    if (!m.empty())

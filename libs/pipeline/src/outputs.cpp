@@ -1,4 +1,5 @@
 #include "outputs.h"
+#include <bims/common/frame_files.h>
 
 #include "cpu_time.h"
 
@@ -15,15 +16,6 @@
 
 namespace bims::pipeline
 {
-namespace
-{
-std::string frameName(size_t index, const char* ext)
-{
-	char buf[32];
-	std::snprintf(buf, sizeof(buf), "%06zu.%s", index, ext);
-	return buf;
-}
-}  // namespace
 
 void writePointsPly(const std::string& path,
                     const std::vector<mrpt::math::TPoint3D>& pts)
@@ -100,7 +92,7 @@ double OutputWriter::writeFrame(const FrameResult& r,
 void OutputWriter::doWriteFrame(const FrameResult& r,
                                 mrpt::obs::CObservation3DRangeScan& scan)
 {
-	const std::string mpath = dir_ + "/masks/" + frameName(r.index, "png");
+	const std::string mpath = dir_ + "/masks/" + frameFileName(long(r.index));
 	bool ok = false;
 	try
 	{
@@ -112,14 +104,15 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 	}
 	if (!ok) throw std::runtime_error(mpath + ": cannot write mask");
 	if (p_.moving_ply)
-		writePointsPly(dir_ + "/moving_voxels/" + frameName(r.index, "ply"),
-		               r.movingVoxelCentres);
+		writePointsPly(
+		    dir_ + "/moving_voxels/" + frameFileName(long(r.index), "ply"),
+		    r.movingVoxelCentres);
 	if (p_.flow_labels && !r.labels.empty())
 	{
 		cv::Mat vis(r.labels.size(), CV_8UC1, cv::Scalar(0));
 		vis.setTo(128, r.labels == 0);
 		vis.setTo(255, r.labels == 1);
-		cv::imwrite(dir_ + "/flow_labels/" + frameName(r.index, "png"), vis);
+		cv::imwrite(dir_ + "/flow_labels/" + frameFileName(long(r.index)), vis);
 	}
 	traj_ << tumLine(r.t, r.T_WC) << "\n";
 	traj_.flush();

@@ -1,4 +1,5 @@
 #include <bims/common/app.h>
+#include <bims/common/frame_files.h>
 #include <bims/common/pixel_labels.h>
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
@@ -217,8 +218,7 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 		out.write(*makeScan(cfg, frame, t0 + tSeq));
 
 		gt.push_back({t0 + tSeq, toPose(k.R_WC, k.p_WC)});
-		char name[64];
-		std::snprintf(name, sizeof(name), "/masks/%06d.png", j);
+		const std::string name = "/masks/" + frameFileName(j);
 		const cv::Mat mask(frame.height, frame.width, CV_8UC1,
 		                   frame.mask.data());
 		if (!cv::imwrite(st.gtDir + name, mask))

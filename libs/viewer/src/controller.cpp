@@ -1,3 +1,4 @@
+#include <bims/common/frame_files.h>
 #include <bims/common/frames.h>
 #include <bims/viewer/controller.h>
 #include <bims/viewer/panels.h>
@@ -130,9 +131,7 @@ void ReplayController::loadResultsFrame()
 {
 	resultsMask_.release();
 	if (opt_.resultsDir.empty() || cur_ < 0) return;
-	char name[32];
-	std::snprintf(name, sizeof(name), "/masks/%06ld.png", cur_);
-	const std::string p = opt_.resultsDir + name;
+	const std::string p = opt_.resultsDir + "/masks/" + frameFileName(cur_);
 	if (mrpt::system::fileExists(p))
 		resultsMask_ = cv::imread(p, cv::IMREAD_GRAYSCALE);
 }
