@@ -37,8 +37,8 @@ mkdir -p "$DATA"
 RAWLOG="$DATA/$(basename "$BONN").rawlog"
 [ -f "$RAWLOG" ] || "$BIN/bims-import-tum" "$BONN" -o "$RAWLOG" --config "$CONFIG" -q > /dev/null
 CONV=(--moving-value 255 --static-value 0 --ignore-values 150,50)
-field() { # "key" FILE -> the number after key
-	sed -n "s/^$1 \([0-9.na]*\).*/\1/p" "$2" | head -1
+pct() { # share -> "12.34 %"
+	awk -v x="$1" 'BEGIN{ if (x == "nan") print "nan"; else printf "%.2f %%", 100 * x }'
 }
 echo "| variant | precision | recall | F1 | IoU | static called moving | same, frames without people | frames/s |"
 echo "|---|---|---|---|---|---|---|---|"
@@ -56,10 +56,11 @@ for v in $VARIANTS; do
 			--depth-valid "$RAWLOG" --voxel-size 0 > /dev/null 2>> "$out.eval.err" ||
 			{ cat "$out.eval.err" >&2; exit 1; }
 	fi
-	read -r p r f i < <(awk '/^total precision/{print $3, $5, $7, $9}' "$out.eval")
-	sm=$(field total_static_as_moving "$out.eval")
-	pf=$(sed -n 's/^total_nothing_moving frames [0-9]* static_as_moving \([0-9.na]*\).*/\1/p' "$out.eval")
+	# precision recall F1 IoU, static called moving (all frames, frames
+	# without a moving label) from bims-eval's total lines
+	read -r p r f i sm pf < <(awk '/^total precision/{t = $3 " " $5 " " $7 " " $9}
+		/^total_static_as_moving/{a = $2} /^total_nothing_moving/{b = $5}
+		END{print t, a, b}' "$out.eval")
 	fps=$(grep -o '"fps": [0-9.]*' "$out/metrics.json" | awk '{print $2}')
-	pct() { awk -v x="$1" 'BEGIN{ if (x == "nan") print "nan"; else printf "%.2f %%", 100 * x }'; }
 	echo "| $v | $p | $r | $f | $i | $(pct "$sm") | $(pct "$pf") | $fps |"
 done
