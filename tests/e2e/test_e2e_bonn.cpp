@@ -23,6 +23,30 @@ const std::string kBonn =
     std::string(BIMS_SHARED_DATA_DIR) + "/bonn_crowd_f150_349";
 const std::string kConfig = std::string(BIMS_SOURCE_DIR) + "/config/bonn.ini";
 
+/** The slice as config/bonn.ini imports it. */
+struct Slice
+{
+	bims::eval::ImportParams ip;
+	bims::eval::TumFolder folder;
+};
+Slice loadSlice()
+{
+	mrpt::config::CConfigFile file(kConfig);
+	Slice s;
+	s.ip.loadFromConfigFile(file);
+	s.folder = bims::eval::readTumFolder(kBonn, s.ip);
+	return s;
+}
+/** config/bonn.ini, vision-only egomotion (the recording has no IMU). */
+ExperimentConfig visionConfig()
+{
+	ExperimentConfig cfg;
+	cfg.loadFromFile(kConfig);
+	cfg.ego.odometry.mode = "vision";
+	cfg.ego.odometry.gyro_aid = false;
+	return cfg;
+}
+
 /** Mean over the non-warm-up frames [first, last] of the moving share of the
  * valid-depth pixels. */
 double meanMovingFraction(const ExperimentConfig& cfg,
@@ -104,14 +128,8 @@ TEST(BonnEndToEnd, SegmentationAgainstProxyLabels)
 	// it. Figures of bench/segmentation_real.sh in docs/results.md.
 	if (!std::filesystem::exists(kBonn + "/masks_proxy"))
 		GTEST_SKIP() << "no Bonn labels at " << kBonn;
-	mrpt::config::CConfigFile file(kConfig);
-	bims::eval::ImportParams ip;
-	ip.loadFromConfigFile(file);
-	const auto folder = bims::eval::readTumFolder(kBonn, ip);
-	ExperimentConfig cfg;
-	cfg.loadFromFile(kConfig);
-	cfg.ego.odometry.mode = "vision";  // no IMU in the recording
-	cfg.ego.odometry.gyro_aid = false;
+	const auto [ip, folder] = loadSlice();
+	const ExperimentConfig cfg = visionConfig();
 	bims::eval::MaskMetrics free;
 	const auto chosen = scoreAgainstProxy(cfg, folder, ip, &free);
 	std::printf(
@@ -152,17 +170,11 @@ TEST(BonnEndToEnd, FlowLabelsKeepTheStaticRoomStaticAndSeePeople)
 {
 	if (!std::filesystem::exists(kBonn + "/depth.txt"))
 		GTEST_SKIP() << "no Bonn sample at " << kBonn;
-	mrpt::config::CConfigFile file(kConfig);
-	bims::eval::ImportParams ip;
-	ip.loadFromConfigFile(file);
-	const auto folder = bims::eval::readTumFolder(kBonn, ip);
+	const auto [ip, folder] = loadSlice();
 	ASSERT_EQ(folder.frames.size(), 200u);
 
-	ExperimentConfig cfg;
-	cfg.loadFromFile(kConfig);
+	ExperimentConfig cfg = visionConfig();
 	cfg.setVariant(Variant::FlowOnly);
-	cfg.ego.odometry.mode = "vision";  // no IMU in the recording
-	cfg.ego.odometry.gyro_aid = false;
 
 	// Measured (VGA, this commit): 0.27 % on frames 0-59; without the texture
 	// gate and the dense-flow refinement (and with a synthetic IMU) 29 %.
