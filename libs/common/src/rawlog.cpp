@@ -1,9 +1,11 @@
 #include <bims/common/rawlog.h>
+
 #include <mrpt/img/CImage.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/archiveFrom_std_streams.h>
 #include <mrpt/system/filesystem.h>
+#include "scan_guard.h"
 
 #include <algorithm>
 #include <cstring>
@@ -64,6 +66,26 @@ class BufferedInArchive : public mrpt::serialization::CArchive
 			return false;
 		}
 		return next_ == buf_.size();
+	}
+	/** The next n bytes without consuming them (fewer at the end of the
+	 * file). */
+	std::pair<const uint8_t*, size_t> peek(size_t n)
+	{
+		if (buf_.size() - next_ < n && !eof_)
+		{
+			buf_.erase(buf_.begin(), buf_.begin() + next_);
+			next_ = 0;
+			while (buf_.size() < n && !eof_)
+			{
+				const size_t have = buf_.size();
+				buf_.resize(have + std::max(kChunk, n - have));
+				const size_t k =
+				    in_.Read(buf_.data() + have, buf_.size() - have);
+				buf_.resize(have + k);
+				if (k == 0) eof_ = true;
+			}
+		}
+		return {buf_.data() + next_, buf_.size() - next_};
 	}
 
  protected:
@@ -149,6 +171,13 @@ mrpt::obs::CObservation::Ptr RawlogReader::next()
 		mrpt::serialization::CSerializable::Ptr obj;
 		auto& arch = static_cast<BufferedInArchive&>(*arch_);
 		const uint64_t pos0 = arch.position();
+		const std::string bad = checkSerializedScanSizes(
+		    [&arch](size_t n) { return arch.peek(n); });
+		if (!bad.empty())
+			throw RawlogError(path_ + ": corrupt rawlog at entry " +
+			                  std::to_string(entry_ + 1) + " (" +
+			                  std::to_string(nObs_) +
+			                  " observations read before): " + bad);
 		try
 		{
 			obj = arch_->ReadObject();

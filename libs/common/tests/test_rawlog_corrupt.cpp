@@ -1,0 +1,252 @@
+// Corrupt rawlogs: declared sizes MRPT would trust, and a byte-flip campaign
+// over the bundled sample; every case must end in RawlogError or a clean
+// end, never a crash or a huge allocation.
+#include <bims/common/rawlog.h>
+#include <gtest/gtest.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <random>
+
+namespace
+{
+std::string tmpPath(const std::string& name)
+{
+	const auto dir =
+	    std::filesystem::temp_directory_path() / "bims_test_common";
+	std::filesystem::create_directories(dir);
+	return (dir / name).string();
+}
+
+std::vector<uint8_t> readBytes(const std::string& path)
+{
+	std::ifstream f(path, std::ios::binary);
+	return {std::istreambuf_iterator<char>(f), {}};
+}
+
+void writeBytes(const std::string& path, const std::vector<uint8_t>& b)
+{
+	std::ofstream f(path, std::ios::binary | std::ios::trunc);
+	f.write(reinterpret_cast<const char*>(b.data()),
+	        static_cast<std::streamsize>(b.size()));
+}
+
+/** Byte offset of the first uint32 pair (a, b) in \a bytes. */
+size_t findPair(const std::vector<uint8_t>& bytes, uint32_t a, uint32_t b)
+{
+	for (size_t i = 0; i + 8 <= bytes.size(); i++)
+	{
+		uint32_t x, y;
+		std::memcpy(&x, &bytes[i], 4);
+		std::memcpy(&y, &bytes[i + 4], 4);
+		if (x == a && y == b) return i;
+	}
+	ADD_FAILURE() << "pair " << a << ", " << b << " not found";
+	return 0;
+}
+
+/** A plain rawlog of one 3D scan of a 37 x 53 depth image (rows x columns:
+ * sizes that occur nowhere else in the bytes), with \a points stored 3D
+ * points when > 0. */
+std::vector<uint8_t> scanRawlog(const std::string& path, uint32_t points)
+{
+	mrpt::obs::CObservation3DRangeScan s;
+	s.sensorLabel = "RGBD";
+	s.hasRangeImage = true;
+	s.rangeImage_setSize(37, 53);
+	s.rangeImage.fill(1000);
+	s.cameraParams.ncols = 53;
+	s.cameraParams.nrows = 37;
+	if (points > 0)
+	{
+		s.hasPoints3D = true;
+		s.resizePoints3DVectors(points);
+	}
+	{
+		bims::RawlogWriter w(path, 0);
+		w.write(s);
+	}
+	return readBytes(path);
+}
+
+/** The RawlogError text of reading \a path to its end ("" if none). */
+std::string readError(const std::string& path)
+{
+	try
+	{
+		bims::RawlogReader r(path);
+		while (r.next())
+		{
+		}
+	}
+	catch (const bims::RawlogError& e)
+	{
+		return e.what();
+	}
+	return {};
+}
+
+void putU32(std::vector<uint8_t>& b, size_t at, uint32_t v)
+{
+	std::memcpy(&b[at], &v, 4);
+}
+}  // namespace
+
+TEST(RawlogCorrupt, ASaneScanReadsBack)
+{
+	const auto p = tmpPath("scan_ok.rawlog");
+	scanRawlog(p, 5);
+	bims::RawlogReader r(p);
+	auto s =
+	    std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(r.next());
+	ASSERT_TRUE(s);
+	EXPECT_EQ(s->rangeImage.rows(), 37);
+	EXPECT_EQ(s->rangeImage.cols(), 53);
+	EXPECT_EQ(s->points3D_x.size(), 5u);
+	EXPECT_FALSE(r.next());
+}
+
+TEST(RawlogCorrupt, AHugeDepthImageSizeIsAnErrorNotAnAllocation)
+{
+	// MRPT 2.5.8 alone: a 1.3 TB allocation that fails silently, then a
+	// segmentation fault (rows 0x7fffffff), or a 270 M pixel allocation.
+	const auto p = tmpPath("scan_huge.rawlog");
+	const auto good = scanRawlog(p, 0);
+	const size_t at = findPair(good, 37, 53);
+	const std::vector<std::pair<uint32_t, uint32_t>> sizes = {
+	    {0x7fffffffu, 53}, {37, 0x7fffffffu}, {0xffffffffu, 53},
+	    {16384, 16384},    {16385, 1},        {1, 16385}};
+	for (const auto& [rows, cols] : sizes)
+	{
+		auto b = good;
+		putU32(b, at, rows);
+		putU32(b, at + 4, cols);
+		writeBytes(p, b);
+		const auto msg = readError(p);
+		const auto want =
+		    "scan_huge.rawlog: corrupt rawlog at entry 0 (0 "
+		    "observations read before): the 3D scan's depth "
+		    "image is " +
+		    std::to_string(rows) + " x " + std::to_string(cols);
+		EXPECT_NE(msg.find(want), std::string::npos) << msg;
+	}
+}
+
+TEST(RawlogCorrupt, AHugeStoredPointCountIsAnError)
+{
+	const auto p = tmpPath("scan_points.rawlog");
+	auto b = scanRawlog(p, 7);
+	// the count precedes the points; 7 as uint32 followed by x of point 0
+	// (0.0f) is the first such pair after the class name
+	const size_t at = findPair(b, 7, 0);
+	putU32(b, at, 0xfffffff0u);
+	writeBytes(p, b);
+	const auto msg = readError(p);
+	EXPECT_NE(msg.find("the 3D scan declares 4294967280 stored points"),
+	          std::string::npos)
+	    << msg;
+}
+
+TEST(RawlogCorrupt, SizesAtTheLimitAreLeftToMrpt)
+{
+	// 4096 x 16384 is 2^26 pixels, allowed: the file then ends inside the
+	// image, which MRPT reports as a truncation.
+	const auto p = tmpPath("scan_limit.rawlog");
+	auto b = scanRawlog(p, 0);
+	const size_t at = findPair(b, 37, 53);
+	putU32(b, at, 4096);
+	putU32(b, at + 4, 16384);
+	writeBytes(p, b);
+	const auto msg = readError(p);
+	EXPECT_NE(msg.find("truncated or corrupt rawlog at entry 0"),
+	          std::string::npos)
+	    << msg;
+}
+
+TEST(RawlogCorrupt, ByteFlipsOfTheSampleNeverCrash)
+{
+	// The first 3 depth frames of the bundled sample (with the IMU samples
+	// between them), rewritten plain; then 300 mutations at a fixed seed:
+	// one byte set, one uint32 set to a size-like value, one bit flipped, or
+	// a size-like field (a uint32 in 1..16384 in the first scan's header, as
+	// image sizes are) set to a huge value; most in the first scan's header.
+	const auto base = tmpPath("sample_head.rawlog");
+	size_t scans = 0, objects = 0;
+	{
+		bims::RawlogReader r(std::string(BIMS_SOURCE_DIR) +
+		                     "/rawlogs/pendulum_slow.rawlog");
+		bims::RawlogWriter w(base, 0);
+		while (auto o = r.next())
+		{
+			if (IS_CLASS(*o, mrpt::obs::CObservation3DRangeScan) && ++scans > 3)
+				break;
+			w.write(*o);
+			objects++;
+		}
+	}
+	const auto good = readBytes(base);
+	const char kName[] = "mrpt::obs::CObservation3DRangeScan";
+	const auto it =
+	    std::search(good.begin(), good.end(), kName, kName + sizeof(kName) - 1);
+	ASSERT_NE(it, good.end());
+	const size_t scan0 = static_cast<size_t>(it - good.begin());
+
+	std::vector<size_t> sizeLike;
+	for (size_t i = scan0; i < scan0 + 2000; i++)
+	{
+		uint32_t v;
+		std::memcpy(&v, &good[i], 4);
+		if (v >= 1 && v <= 16384) sizeLike.push_back(i);
+	}
+	ASSERT_FALSE(sizeLike.empty());
+
+	std::mt19937 rng(1);
+	const auto uniform = [&rng](size_t n)
+	{ return std::uniform_int_distribution<size_t>(0, n - 1)(rng); };
+	const uint32_t values[] = {0,           1,     0x7fffffffu, 0x80000000u,
+	                           0xffffffffu, 65536, 100000};
+	const auto p = tmpPath("sample_mutated.rawlog");
+	size_t errors = 0, clean = 0;
+	for (int k = 0; k < 300; k++)
+	{
+		auto b = good;
+		const size_t at =
+		    uniform(3) == 0 ? uniform(b.size() - 4) : scan0 + uniform(2000);
+		switch (uniform(4))
+		{
+			case 3:
+				putU32(b, sizeLike[uniform(sizeLike.size())],
+				       uniform(2) ? 0x7fffffffu : 0x10000u + uniform(1u << 20));
+				break;
+			case 0:
+				b[at] = static_cast<uint8_t>(uniform(256));
+				break;
+			case 1:
+				putU32(b, at, values[uniform(std::size(values))]);
+				break;
+			default:
+				b[at] ^= static_cast<uint8_t>(1u << uniform(8));
+		}
+		writeBytes(p, b);
+		size_t n = 0;
+		try
+		{
+			bims::RawlogReader r(p);
+			while (r.next()) n++;
+			clean++;
+			EXPECT_LE(n, objects) << "mutation " << k;
+		}
+		catch (const bims::RawlogError& e)
+		{
+			errors++;
+			EXPECT_NE(std::string(e.what()).find("sample_mutated.rawlog: "),
+			          std::string::npos)
+			    << e.what();
+		}
+	}
+	EXPECT_EQ(errors + clean, 300u);
+	EXPECT_GT(errors, 0u);  // the campaign does reach the checks
+}
