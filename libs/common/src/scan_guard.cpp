@@ -62,47 +62,173 @@ class Cursor
 	bool ok_ = true;
 };
 
+/** Whether a rows x cols image passes the limits. */
+bool saneSize(uint64_t rows, uint64_t cols)
+{
+	return rows <= kMaxImageSide && cols <= kMaxImageSide &&
+	       rows * cols <= kMaxImagePixels;
+}
+
 std::string tooLarge(const std::string& what, uint64_t rows, uint64_t cols)
 {
-	return what + " is " + std::to_string(rows) + " x " + std::to_string(cols) +
-	       " (rows x columns), beyond the " + std::to_string(kMaxImageSide) +
-	       " per side and " + std::to_string(kMaxImagePixels) +
-	       " pixels a rawlog may hold";
+	return "the 3D scan's " + what + " is " + std::to_string(rows) + " x " +
+	       std::to_string(cols) + " (rows x columns), beyond the " +
+	       std::to_string(kMaxImageSide) + " per side and " +
+	       std::to_string(kMaxImagePixels) + " pixels a rawlog may hold";
 }
+
+/** Walks a serialized scan field by field. Each step returns false to stop:
+ * with `problem` set when a declared size is insane, empty when the bytes
+ * end or hold a layout this walker does not know (MRPT then decides). */
+class ScanWalker
+{
+ public:
+	explicit ScanWalker(const PeekFn& peek) : c_(peek) {}
+	std::string problem;
+
+	bool run()
+	{
+		uint8_t version = 0;
+		if (c_.header(version) != "mrpt::obs::CObservation3DRangeScan")
+			return false;
+		if (version != 9 && version != 10) return false;
+		c_.skip(sizeof(float));  // maxRange
+		if (!pose()) return false;
+		if (c_.read<uint8_t>())  // hasPoints3D
+		{
+			const auto n = c_.read<uint32_t>();
+			if (!c_.ok()) return false;
+			if (n > kMaxImagePixels)
+			{
+				problem = "the 3D scan declares " + std::to_string(n) +
+				          " stored points, beyond the " +
+				          std::to_string(kMaxImagePixels) +
+				          " a rawlog may hold";
+				return false;
+			}
+			// x, y, z as float, pixel column and row as uint16
+			c_.skip(uint64_t{n} * (3 * sizeof(float) + 2 * sizeof(uint16_t)));
+		}
+		const bool hasRange = c_.read<uint8_t>();
+		c_.skip(sizeof(float));  // rangeUnits
+		if (hasRange && !matrix("depth image", sizeof(uint16_t))) return false;
+		if (c_.read<uint8_t>() && !image("intensity image")) return false;
+		if (c_.read<uint8_t>() && !image("confidence image")) return false;
+		if (!camera() || !camera() || !pose()) return false;
+		c_.skip(sizeof(float) + sizeof(uint64_t));  // stdError, timestamp
+		if (!string()) return false;                // sensorLabel
+		for (int k = 0; k < 2; k++)  // external points / range image files
+		{
+			c_.skip(1);
+			if (!string()) return false;
+		}
+		c_.skip(2);  // range_is_depth, intensityImageChannel
+		// pixel labels: their names (a typed map) follow the image; the
+		// walk stops there, leaving extra depth layers after labels unchecked
+		if (c_.read<uint8_t>()) return labels() && false;
+		if (version >= 10)
+		{
+			const auto layers = c_.read<uint8_t>();
+			for (unsigned k = 0; k < layers; k++)
+				if (!string() || !matrix("extra depth layer", sizeof(uint16_t)))
+					return false;
+		}
+		return c_.ok();
+	}
+
+ private:
+	/** rows, cols (uint32), then rows * cols elements of \a elem bytes. */
+	bool matrix(const std::string& what, uint64_t elem)
+	{
+		const uint64_t rows = c_.read<uint32_t>(), cols = c_.read<uint32_t>();
+		if (!c_.ok()) return false;
+		if (!saneSize(rows, cols))
+		{
+			problem = tooLarge(what, rows, cols);
+			return false;
+		}
+		c_.skip(rows * cols * elem);
+		return c_.ok();
+	}
+	bool string()
+	{
+		c_.skip(c_.read<uint32_t>());
+		return c_.ok();
+	}
+	bool end() { return c_.read<uint8_t>() == 0x88 && c_.ok(); }
+	bool pose()
+	{
+		uint8_t v = 0;
+		if (c_.header(v) != "mrpt::poses::CPose3D" || v != 3) return false;
+		c_.skip(12 * sizeof(double));  // translation and rotation matrix
+		return end();
+	}
+	bool camera()
+	{
+		uint8_t v = 0;
+		if (c_.header(v) != "mrpt::img::TCamera" || v != 6) return false;
+		// 13 doubles (distortion, focal length [m], fx fy cx cy), the
+		// image size (MRPT corrects it from the depth image), the name, the
+		// distortion model
+		c_.skip(13 * sizeof(double) + 2 * sizeof(uint32_t));
+		if (!string()) return false;
+		c_.skip(1);
+		return end();
+	}
+	bool image(const std::string& what)
+	{
+		uint8_t v = 0;
+		if (c_.header(v) != "mrpt::img::CImage" || v != 9) return false;
+		if (c_.read<uint8_t>()) return string() && end();  // external file
+		if (!c_.read<uint8_t>())  // grey: w h origin size depth zip data
+		{
+			const uint64_t w = c_.read<uint32_t>(), h = c_.read<uint32_t>();
+			c_.skip(sizeof(int32_t));
+			const auto size = c_.read<uint32_t>();
+			c_.skip(sizeof(int32_t));
+			if (!c_.ok()) return false;
+			if (!saneSize(h, w))
+			{
+				problem = tooLarge(what, h, w);
+				return false;
+			}
+			if (c_.read<uint8_t>()) return false;  // zip: MRPT refuses it
+			c_.skip(size);
+			return end();
+		}
+		const auto w = c_.read<int32_t>(), h = c_.read<int32_t>();
+		if (!c_.ok()) return false;
+		if (w >= 1 && h >= 1) return string() && end();  // JPEG bytes
+		if (w < 0 && h < 0)                              // raw BGR
+		{
+			const uint64_t rw = -int64_t{w}, rh = -int64_t{h};
+			if (!saneSize(rh, rw))
+			{
+				problem = tooLarge(what, rh, rw);
+				return false;
+			}
+			c_.skip(3 * rw * rh);
+		}
+		return end();
+	}
+	bool labels()
+	{
+		// two header bytes (version, bytes per pixel), then the label
+		// image; the walk stops after its size, so the element size does
+		// not matter here
+		c_.skip(2);
+		return matrix("pixel-label image", 1);
+	}
+
+	Cursor c_;
+};
 }  // namespace
 
 std::string checkSerializedScanSizes(const PeekFn& peek)
 {
-	Cursor c(peek);
-	uint8_t version = 0;
-	if (c.header(version) != "mrpt::obs::CObservation3DRangeScan") return {};
-	if (version != 9 && version != 10) return {};
-	c.skip(sizeof(float));  // maxRange
-	uint8_t poseVersion = 0;
-	if (c.header(poseVersion) != "mrpt::poses::CPose3D" || poseVersion != 3)
-		return {};  // a layout this check does not know: MRPT decides
-	c.skip(12 * sizeof(double));  // translation and rotation matrix
-	if (c.read<uint8_t>() != 0x88) return {};  // end-of-object flag
-	if (c.read<uint8_t>())                     // hasPoints3D
-	{
-		const auto n = c.read<uint32_t>();
-		if (!c.ok()) return {};
-		if (n > kMaxImagePixels)
-			return "the 3D scan declares " + std::to_string(n) +
-			       " stored points, beyond the " +
-			       std::to_string(kMaxImagePixels) + " a rawlog may hold";
-		// x, y, z as float, pixel column and row as uint16
-		c.skip(uint64_t{n} * (3 * sizeof(float) + 2 * sizeof(uint16_t)));
-	}
-	const bool hasRange = c.read<uint8_t>();
-	c.skip(sizeof(float));  // rangeUnits
-	if (!hasRange) return {};
-	const uint64_t rows = c.read<uint32_t>(), cols = c.read<uint32_t>();
-	if (!c.ok()) return {};
-	if (rows > kMaxImageSide || cols > kMaxImageSide ||
-	    rows * cols > kMaxImagePixels)
-		return tooLarge("the 3D scan's depth image", rows, cols);
-	return {};
+	ScanWalker w(peek);
+	w.run();
+	return w.problem;
 }
 
 }  // namespace bims

@@ -3,7 +3,7 @@
 // MRPT 2.5.8's CObservation3DRangeScan reader trusts the stored sizes: a
 // corrupt depth-image height of 0x7fffffff makes it allocate 1.3 TB, which
 // fails without an exception, and the next memset crashes the process. The
-// rawlog reader peeks at each top-level object first and refuses declared
+// rawlog reader walks each top-level scan's bytes first and refuses declared
 // sizes no real sensor produces.
 #pragma once
 
@@ -15,7 +15,7 @@
 
 namespace bims
 {
-/** Largest depth image side and pixel count a rawlog may declare (a 16384 x
+/** Largest image side and pixel count a rawlog's scan may declare (a 16384 x
  * 4096 image; real RGB-D sensors give at most a few megapixels). */
 constexpr uint32_t kMaxImageSide = 16384;
 constexpr uint64_t kMaxImagePixels = uint64_t{1} << 26;
@@ -26,8 +26,10 @@ using PeekFn = std::function<std::pair<const uint8_t*, size_t>(size_t n)>;
 
 /** For a top-level mrpt::obs::CObservation3DRangeScan of serialization
  * version 9 or 10 (what MRPT 2.x writes), the problem with its declared
- * point count or depth image size ("" when they are sane, when the object is
- * of another class or version, or when the file ends before the sizes:
+ * point count or the size of one of its images (depth, intensity,
+ * confidence, pixel labels, extra layers) ("" when they are sane, when the
+ * object is of another class or version or holds a layout the walk does not
+ * know, or when the file ends first:
  * MRPT's reader then reports the truncation). */
 std::string checkSerializedScanSizes(const PeekFn& peek);
 

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -50,8 +51,10 @@ size_t findPair(const std::vector<uint8_t>& bytes, uint32_t a, uint32_t b)
 
 /** A plain rawlog of one 3D scan of a 37 x 53 depth image (rows x columns:
  * sizes that occur nowhere else in the bytes), with \a points stored 3D
- * points when > 0. */
-std::vector<uint8_t> scanRawlog(const std::string& path, uint32_t points)
+ * points when > 0 and, with \a labels, an RGB image and a 41 x 59
+ * pixel-label image. */
+std::vector<uint8_t> scanRawlog(const std::string& path, uint32_t points,
+                                bool labels = false)
 {
 	mrpt::obs::CObservation3DRangeScan s;
 	s.sensorLabel = "RGBD";
@@ -60,6 +63,14 @@ std::vector<uint8_t> scanRawlog(const std::string& path, uint32_t points)
 	s.rangeImage.fill(1000);
 	s.cameraParams.ncols = 53;
 	s.cameraParams.nrows = 37;
+	if (labels)
+	{
+		s.hasIntensityImage = true;
+		s.intensityImage.resize(53, 37, mrpt::img::CH_RGB);
+		auto l = std::make_shared<mrpt::obs::TPixelLabelInfo<1>>();
+		l->setSize(41, 59);
+		s.pixelLabels = l;
+	}
 	if (points > 0)
 	{
 		s.hasPoints3D = true;
@@ -150,6 +161,22 @@ TEST(RawlogCorrupt, AHugeStoredPointCountIsAnError)
 	    << msg;
 }
 
+TEST(RawlogCorrupt, AHugePixelLabelImageIsAnError)
+{
+	// the labels follow the RGB image, both camera models and the strings:
+	// the check walks every field of the scan up to them
+	const auto p = tmpPath("scan_labels.rawlog");
+	auto b = scanRawlog(p, 0, true);
+	EXPECT_EQ(readError(p), "");
+	const size_t at = findPair(b, 41, 59);
+	putU32(b, at + 4, 0xffffff00u);
+	writeBytes(p, b);
+	const auto msg = readError(p);
+	EXPECT_NE(msg.find("the 3D scan's pixel-label image is 41 x 4294967040"),
+	          std::string::npos)
+	    << msg;
+}
+
 TEST(RawlogCorrupt, SizesAtTheLimitAreLeftToMrpt)
 {
 	// 4096 x 16384 is 2^26 pixels, allowed: the file then ends inside the
@@ -171,10 +198,12 @@ TEST(RawlogCorrupt, ByteFlipsOfTheSampleNeverCrash)
 	// The first 3 depth frames of the bundled sample (with the IMU samples
 	// between them), rewritten plain; then 300 mutations at a fixed seed:
 	// one byte set, one uint32 set to a size-like value, one bit flipped, or
-	// a size-like field (a uint32 in 1..16384 in the first scan's header, as
-	// image sizes are) set to a huge value; most in the first scan's header.
+	// a size field (a uint32 of the first scan equal to its image width or
+	// height: depth, camera models, pixel labels) set to a huge value; most
+	// of the others in the first scan's header.
 	const auto base = tmpPath("sample_head.rawlog");
 	size_t scans = 0, objects = 0;
+	uint32_t rows = 0, cols = 0;
 	{
 		bims::RawlogReader r(std::string(BIMS_SOURCE_DIR) +
 		                     "/rawlogs/pendulum_slow.rawlog");
@@ -195,13 +224,17 @@ TEST(RawlogCorrupt, ByteFlipsOfTheSampleNeverCrash)
 	const size_t scan0 = static_cast<size_t>(it - good.begin());
 
 	std::vector<size_t> sizeLike;
-	for (size_t i = scan0; i < scan0 + 2000; i++)
+	const auto scan1 =
+	    std::search(it + 1, good.end(), kName, kName + sizeof(kName) - 1);
+	for (size_t i = scan0; i + 4 <= static_cast<size_t>(scan1 - good.begin());
+	     i++)
 	{
 		uint32_t v;
 		std::memcpy(&v, &good[i], 4);
-		if (v >= 1 && v <= 16384) sizeLike.push_back(i);
+		if (v == rows || v == cols) sizeLike.push_back(i);
 	}
-	ASSERT_FALSE(sizeLike.empty());
+	// depth image, two camera models and the pixel labels: 2 each at least
+	ASSERT_GE(sizeLike.size(), 8u);
 
 	std::mt19937 rng(1);
 	const auto uniform = [&rng](size_t n)
