@@ -42,13 +42,46 @@ class VectorArchive : public mrpt::serialization::CArchive
 	std::vector<uint8_t>& buf_;
 };
 
+/** An allocator whose resize() leaves new bytes uninitialised: the read
+ * buffer is filled from the file right after growing (a 640x480 scan is
+ * ~2 MB that would otherwise be zeroed first). */
+template <typename T>
+struct UninitAllocator : std::allocator<T>
+{
+	template <typename U>
+	struct rebind
+	{
+		using other = UninitAllocator<U>;
+	};
+	UninitAllocator() = default;
+	template <typename U>
+	UninitAllocator(const UninitAllocator<U>&) noexcept
+	{
+	}
+	template <typename U>
+	void construct(U* p) noexcept
+	{
+		::new (static_cast<void*>(p)) U;
+	}
+	template <typename U, typename... Args>
+	void construct(U* p, Args&&... args)
+	{
+		::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+	}
+};
+
 /** A CArchive reading a (gzip or plain) file through a buffer of its own,
  * for the same reason: one gzread per 256 KB instead of one per matrix
  * element. */
 class BufferedInArchive : public mrpt::serialization::CArchive
 {
  public:
-	explicit BufferedInArchive(mrpt::io::CFileGZInputStream& in) : in_(in) {}
+	explicit BufferedInArchive(mrpt::io::CFileGZInputStream& in) : in_(in)
+	{
+		// room for a whole 640x480 scan with RGB and labels (~2 MB), which
+		// peek() holds at once: no reallocation while it grows
+		buf_.reserve(kPeekReserve);
+	}
 	/** Bytes handed out so far. */
 	uint64_t position() const { return pos_; }
 	/** Nothing left, in the buffer or in the file (false on a read error:
@@ -137,8 +170,9 @@ class BufferedInArchive : public mrpt::serialization::CArchive
 	}
 
 	static constexpr size_t kChunk = 256 * 1024;
+	static constexpr size_t kPeekReserve = 4 * 1024 * 1024;
 	mrpt::io::CFileGZInputStream& in_;
-	std::vector<uint8_t> buf_;
+	std::vector<uint8_t, UninitAllocator<uint8_t>> buf_;
 	size_t next_ = 0;
 	uint64_t pos_ = 0;
 	bool eof_ = false;

@@ -38,8 +38,11 @@ std::string rgbdFrameFrom(const mrpt::obs::CObservation3DRangeScan& obs,
 	}
 	if (std::string why = intrinsicsOf(obs, cam, out.K); !why.empty())
 		return why;
-	out.depth.create(H, W, CV_32FC1);
 	const float units = obs.rangeUnits;
+	if (!(units > 0) || !std::isfinite(units))
+		return "invalid rangeUnits " + std::to_string(units) +
+		       " (a finite value > 0 expected)";
+	out.depth.create(H, W, CV_32FC1);
 	const double fx = out.K(0, 0), fy = out.K(1, 1), cx = out.K(0, 2),
 	             cy = out.K(1, 2);
 	for (int v = 0; v < H; v++)
@@ -77,7 +80,17 @@ std::string intrinsicsOf(const mrpt::obs::CObservation3DRangeScan& obs,
 		return {};
 	}
 	const auto& cp = obs.cameraParams;
-	if (cp.fx() <= 0 || cp.fy() <= 0) return "invalid cameraParams";
+	// NaN fails every comparison: require finite, positive focal lengths
+	if (!(cp.fx() > 0) || !(cp.fy() > 0) || !std::isfinite(cp.fx()) ||
+	    !std::isfinite(cp.fy()) || !std::isfinite(cp.cx()) ||
+	    !std::isfinite(cp.cy()))
+	{
+		std::ostringstream os;
+		os << "invalid cameraParams (fx " << cp.fx() << ", fy " << cp.fy()
+		   << ", cx " << cp.cx() << ", cy " << cp.cy()
+		   << "; finite values and fx, fy > 0 expected)";
+		return os.str();
+	}
 	K << cp.fx(), 0, cp.cx(), 0, cp.fy(), cp.cy(), 0, 0, 1;
 	return {};
 }
