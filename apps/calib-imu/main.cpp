@@ -64,6 +64,7 @@ int main(int argc, char** argv)
 		    {
 			    if (!mrpt::system::fileExists(calibArg.getValue()))
 				    throw UsageError(calibArg.getValue() + ": no such file");
+			    bims::checkIniFile(calibArg.getValue());
 			    mrpt::config::CConfigFile cal(calibArg.getValue());
 			    checkExperimentSections(cal);
 			    ec.overrideSensorSections(cal);

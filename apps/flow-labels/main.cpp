@@ -88,6 +88,7 @@ int main(int argc, char** argv)
 			    if (!mrpt::system::fileExists(aCfg.getValue()))
 				    throw std::runtime_error(aCfg.getValue() +
 				                             ": no such config file");
+			    bims::checkIniFile(aCfg.getValue());
 			    mrpt::config::CConfigFile cfg(aCfg.getValue());
 			    bims::checkExperimentSections(cfg);
 			    params.loadFromConfigFile(cfg, "flow");

@@ -8,6 +8,7 @@
 // every frame, so a kill or an unplug loses at most the last frame. No
 // device: a clear message and exit code 1. See docs/grab.md.
 #include <bims/common/app.h>
+#include <bims/common/config.h>
 #include <bims/grab/grabber.h>
 #include <bims/pipeline/pipeline.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
@@ -93,6 +94,7 @@ int main(int argc, char** argv)
 			    throw std::runtime_error("cannot open '" + aCfg.getValue() +
 			                             "'");
 
+		    bims::checkIniFile(aCfg.getValue());
 		    mrpt::config::CConfigFile ini(aCfg.getValue());
 		    bims::grab::Grabber grabber(ini);  // throws without devices
 		    for (const auto& s : grabber.describe())

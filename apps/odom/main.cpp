@@ -93,6 +93,7 @@ int main(int argc, char** argv)
 			    const std::string cp = calibArg.getValue();
 			    if (!mrpt::system::fileExists(cp))
 				    throw UsageError(cp + ": no such calibration file");
+			    bims::checkIniFile(cp);
 			    mrpt::config::CConfigFile cal(cp);
 			    checkExperimentSections(cal);
 			    ec.overrideSensorSections(cal);

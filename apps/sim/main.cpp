@@ -27,6 +27,7 @@ int imuFromTum(const std::string& tum, const std::string& out, uint64_t seed,
 	{
 		std::ifstream f(iniPath);
 		if (!f) throw std::runtime_error(iniPath + ": cannot open IMU config");
+		bims::checkIniFile(iniPath);
 		mrpt::config::CConfigFile ini(iniPath);
 		bims::checkSections(ini, {"imu", "calibration"});
 		p.loadFromConfigFile(ini, "imu", "calibration");

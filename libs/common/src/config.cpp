@@ -6,6 +6,9 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <sstream>
 
 namespace bims
@@ -45,6 +48,59 @@ bool parseLong(const std::string& s, long& out)
 	return errno == 0 && end && *end == '\0';
 }
 }  // namespace
+
+void checkIniFile(const std::string& path)
+{
+	std::error_code ec;
+	if (!std::filesystem::is_regular_file(path, ec))
+		throw ConfigError(
+		    path + (std::filesystem::exists(path, ec)
+		                ? ": not a regular file (a folder?), not a config file"
+		                : ": no such config file"));
+	std::ifstream f(path);
+	if (!f) throw ConfigError(path + ": cannot open config file");
+	std::map<std::string, int> sections;  // lower-case name -> line
+	std::map<std::string, int> keys;      // of the current section
+	std::string section, line;
+	bool inSection = false;
+	for (int n = 1; std::getline(f, line); n++)
+	{
+		const std::string t = trim(line);
+		const auto at = path + ":" + std::to_string(n) + ": ";
+		if (t.empty() || t[0] == ';' || t[0] == '#' || t[0] == '@' ||
+		    t.rfind("//", 0) == 0)
+			continue;
+		if (t[0] == '[')
+		{
+			if (t.back() != ']')
+				throw ConfigError(at + "section header '" + t +
+				                  "' has no closing ']'");
+			section = trim(t.substr(1, t.size() - 2));
+			const auto [it, fresh] = sections.emplace(lower(section), n);
+			if (!fresh)
+				throw ConfigError(at + "section [" + section +
+				                  "] given twice (first on line " +
+				                  std::to_string(it->second) + ")");
+			keys.clear();
+			inSection = true;
+			continue;
+		}
+		const auto eq = t.find('=');
+		if (eq == std::string::npos)
+			throw ConfigError(at + "'" + t +
+			                  "' is neither [section] nor key = value");
+		const std::string key = trim(t.substr(0, eq));
+		if (key.empty()) throw ConfigError(at + "a value without a key");
+		if (!inSection)
+			throw ConfigError(at + "key '" + key +
+			                  "' before the first [section]");
+		const auto [it, fresh] = keys.emplace(lower(key), n);
+		if (!fresh)
+			throw ConfigError(at + "[" + section + "] " + key +
+			                  " given twice (first on line " +
+			                  std::to_string(it->second) + ")");
+	}
+}
 
 std::string configSourceName(const mrpt::config::CConfigFileBase& cfg)
 {

@@ -2,6 +2,10 @@
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
 
+#include <filesystem>
+#include <fstream>
+#include <functional>
+
 using bims::ConfigError;
 using bims::ConfigSection;
 
@@ -91,4 +95,85 @@ TEST(ConfigSection, UnknownSectionsAreErrors)
 	const auto msg =
 	    errorOf([&] { bims::checkSections(cfg, {"a"}, {"map_"}); });
 	EXPECT_NE(msg.find("[oops]: unknown section"), std::string::npos) << msg;
+}
+
+namespace
+{
+/** The ConfigError of checking an .ini file holding \a text ("" if none). */
+std::string iniError(const std::string& text, const std::string& name)
+{
+	const auto dir =
+	    std::filesystem::temp_directory_path() / "bims_test_common";
+	std::filesystem::create_directories(dir);
+	const auto p = (dir / name).string();
+	std::ofstream(p) << text;
+	return errorOf([&] { bims::checkIniFile(p); });
+}
+}  // namespace
+
+TEST(IniSyntax, AWellFormedFileWithCommentsPasses)
+{
+	EXPECT_EQ(iniError("; comment\n# comment\n// comment\n@define X 1\n\n"
+	                   "[a]\nx = 1\ny=\n[b : a]\nx = 2\n",
+	                   "ok.ini"),
+	          "");
+}
+
+TEST(IniSyntax, EveryMalformedCaseNamesFileAndLine)
+{
+	const std::vector<std::pair<std::string, std::string>> cases = {
+	    {"[a]\nx = 1\nx = 2\n",
+	     "dup_key.ini:3: [a] x given twice (first on line 2)"},
+	    {"[a]\nX = 1\nx = 2\n",
+	     "dup_case.ini:3: [a] x given twice (first on line 2)"},
+	    {"[a]\nx = 1\n[b]\n[a]\n",
+	     "dup_sec.ini:4: section [a] given twice (first on line 1)"},
+	    {"x = 1\n[a]\n", "no_sec.ini:1: key 'x' before the first [section]"},
+	    {"[a]\nx 1\n",
+	     "no_eq.ini:2: 'x 1' is neither [section] nor key = value"},
+	    {"[a\nx = 1\n",
+	     "open_sec.ini:1: section header '[a' has no closing ']'"},
+	    {"[a]\n = 1\n", "no_key.ini:2: a value without a key"}};
+	for (const auto& [text, want] : cases)
+	{
+		const auto name = want.substr(0, want.find(':'));
+		const auto msg = iniError(text, name);
+		EXPECT_NE(msg.find(want), std::string::npos) << msg;
+	}
+	// the same key in two sections is no duplicate
+	EXPECT_EQ(iniError("[a]\nx = 1\n[b]\nx = 1\n", "two_sections.ini"), "");
+}
+
+TEST(IniSyntax, AFolderOrAMissingFileIsNamed)
+{
+	const auto dir =
+	    std::filesystem::temp_directory_path() / "bims_test_common";
+	std::filesystem::create_directories(dir / "a_folder.ini");
+	EXPECT_NE(
+	    errorOf([&] { bims::checkIniFile((dir / "a_folder.ini").string()); })
+	        .find("a_folder.ini: not a regular file"),
+	    std::string::npos);
+	EXPECT_NE(
+	    errorOf([&] { bims::checkIniFile((dir / "missing.ini").string()); })
+	        .find("missing.ini: no such config file"),
+	    std::string::npos);
+}
+
+TEST(IniSyntax, EveryBundledIniPasses)
+{
+	size_t n = 0;
+	for (const auto* sub : {"config", "config/sim", "rawlogs", "share"})
+	{
+		const auto d = std::filesystem::path(BIMS_SOURCE_DIR) / sub;
+		if (!std::filesystem::is_directory(d)) continue;
+		for (const auto& e : std::filesystem::recursive_directory_iterator(d))
+			if (e.path().extension() == ".ini")
+			{
+				EXPECT_EQ(
+				    errorOf([&] { bims::checkIniFile(e.path().string()); }), "")
+				    << e.path();
+				n++;
+			}
+	}
+	EXPECT_GT(n, 5u);
 }

@@ -284,6 +284,7 @@ void EgoConfig::loadFromFile(const std::string& path)
 {
 	if (!mrpt::system::fileExists(path))
 		throw UsageError(path + ": no such config file");
+	bims::checkIniFile(path);
 	mrpt::config::CConfigFile cfg(path);
 	checkExperimentSections(cfg);
 	loadFromConfigFile(cfg, false);

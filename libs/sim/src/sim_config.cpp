@@ -22,6 +22,7 @@ SimConfig SimConfig::load(const std::string& path)
 		std::ifstream f(path);
 		if (!f) throw std::runtime_error(path + ": cannot open scene file");
 	}
+	bims::checkIniFile(path);
 	mrpt::config::CConfigFile ini(path);
 	SimConfig c;
 	c.file = path;

@@ -21,6 +21,15 @@ class ConfigError : public std::runtime_error
 	using std::runtime_error::runtime_error;
 };
 
+/** Checks the syntax of the .ini file \a path before MRPT reads it (MRPT
+ * keeps the last of two equal keys or sections and skips malformed lines
+ * silently). Throws ConfigError naming the file and the line for: a path
+ * that is not a readable regular file, a line that is neither `[section]`,
+ * `key = value`, a comment (`;`, `#`, `//`) nor an MRPT directive (`@...`),
+ * a key before the first section, a section or a key (within its section)
+ * given twice; names compare without case, as MRPT looks them up. */
+void checkIniFile(const std::string& path);
+
 /** The file name behind a config object ("<memory>" when there is none). */
 std::string configSourceName(const mrpt::config::CConfigFileBase& cfg);
 
