@@ -1,6 +1,8 @@
 #include <bims/common/config.h>
 #include <gtest/gtest.h>
+
 #include <mrpt/config/CConfigFileMemory.h>
+#include "tmp_path.h"
 
 #include <filesystem>
 #include <fstream>
@@ -102,10 +104,7 @@ namespace
 /** The ConfigError of checking an .ini file holding \a text ("" if none). */
 std::string iniError(const std::string& text, const std::string& name)
 {
-	const auto dir =
-	    std::filesystem::temp_directory_path() / "bims_test_common";
-	std::filesystem::create_directories(dir);
-	const auto p = (dir / name).string();
+	const auto p = bims::test::tmpPath(name);
 	std::ofstream(p) << text;
 	return errorOf([&] { bims::checkIniFile(p); });
 }

@@ -1,20 +1,16 @@
 #include <bims/common/rawlog.h>
 #include <gtest/gtest.h>
+
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/system/filesystem.h>
+#include "tmp_path.h"
 
 #include <filesystem>
 #include <fstream>
 
 namespace
 {
-std::string tmpPath(const std::string& name)
-{
-	const auto dir =
-	    std::filesystem::temp_directory_path() / "bims_test_common";
-	std::filesystem::create_directories(dir);
-	return (dir / name).string();
-}
+using bims::test::tmpPath;
 
 void writeImus(const std::string& path, int n, int gz)
 {

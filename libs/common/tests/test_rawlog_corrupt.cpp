@@ -3,7 +3,9 @@
 // end, never a crash or a huge allocation.
 #include <bims/common/rawlog.h>
 #include <gtest/gtest.h>
+
 #include <mrpt/obs/CObservation3DRangeScan.h>
+#include "tmp_path.h"
 
 #include <algorithm>
 #include <cstring>
@@ -14,13 +16,7 @@
 
 namespace
 {
-std::string tmpPath(const std::string& name)
-{
-	const auto dir =
-	    std::filesystem::temp_directory_path() / "bims_test_common";
-	std::filesystem::create_directories(dir);
-	return (dir / name).string();
-}
+using bims::test::tmpPath;
 
 std::vector<uint8_t> readBytes(const std::string& path)
 {
