@@ -12,24 +12,6 @@ namespace bims::ego
 namespace
 {
 constexpr double kDeg = M_PI / 180;
-
-/** Share of the depth readings of \a depth that \a mask marks. */
-double maskedShare(const cv::Mat& depth, const cv::Mat& mask)
-{
-	size_t valid = 0, masked = 0;
-	for (int v = 0; v < depth.rows; v++)
-	{
-		const float* d = depth.ptr<float>(v);
-		const uint8_t* m = mask.ptr<uint8_t>(v);
-		for (int u = 0; u < depth.cols; u++)
-			if (d[u] > 0)
-			{
-				++valid;
-				masked += m[u] ? 1 : 0;
-			}
-	}
-	return valid ? double(masked) / double(valid) : 0;
-}
 }  // namespace
 
 KeyframeAnchor::KeyframeAnchor(const AnchorParams& p) : p_(p)
@@ -78,17 +60,8 @@ AnchorResult KeyframeAnchor::track(const RgbdFrame& f,
 	r.t_WC = t_pred;
 	lastOutliers_.release();
 	pending_ = false;
-	cv::Mat exclude;
-	if (!moving.empty())
-	{
-		r.excluded_fraction = maskedShare(f.depth, moving);
-		if (r.excluded_fraction <= p_.max_excluded_fraction)
-			exclude = moving;
-		else
-			r.maskIgnored = true;
-	}
 	// (also the frame that may become a keyframe: no copy of the images)
-	cur_.build(f.grey, f.depth, f.K, p_, exclude);
+	cur_.build(f.grey, f.depth, f.K, p_, moving);
 	haveLast_ = true;
 	Keyframe* k = nearest(R_pred, t_pred);
 	if (!k)
@@ -115,7 +88,7 @@ AnchorResult KeyframeAnchor::track(const RgbdFrame& f,
 	}
 	// The mask may have left too little to align (or be wrong): once more
 	// with every pixel, flagged (the feedback must not starve the tracker).
-	if (!r.accepted && !exclude.empty())
+	if (!r.accepted && !moving.empty())
 	{
 		for (DenseLevel& L : cur_.levels) L.exclude.release();
 		AnchorResult again = r;

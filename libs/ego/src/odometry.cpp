@@ -1,4 +1,5 @@
 #include <bims/ego/flags.h>
+#include <bims/ego/moving_prediction.h>
 #include <bims/ego/odometry.h>
 #include <bims/ego/so3.h>
 
@@ -7,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <chrono>
+#include <stdexcept>
 
 namespace bims::ego
 {
@@ -137,18 +139,24 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	++nFrames_;
 	lastAnchored_ = false;
 	const bool anchoring = cfg_.anchor.enable;
-	// What moved in the previous frame: the caller's mask (segmentation).
-	// Not used when it covers too much. (The anchor's own outliers are not
-	// fed back: that locked a pose onto a mover and cost 2-3x the ATE on
-	// the crowded preset and Bonn; docs/ego.md.)
+	// What moved in the previous frame: the caller's mask (segmentation;
+	// none before a previous frame). Not used when it covers too much of
+	// the image. (The anchor's own outliers are not fed back:
+	// that locked a pose onto a mover and cost 2-3x the ATE on the crowded
+	// preset and Bonn; docs/ego.md.)
 	cv::Mat moving;
-	if (mask && !mask->empty()) moving = *mask;
-	if (!moving.empty() &&
-	    cv::countNonZero(moving) > cfg_.anchor.max_excluded_fraction *
-	                                   static_cast<double>(moving.total()))
+	if (havePrev_ && mask && !mask->empty())
 	{
-		r.flags |= kFlagMaskIgnored;
-		moving.release();
+		if (mask->type() != CV_8UC1 || mask->size() != depthPrev_.size())
+			throw std::invalid_argument(
+			    "Odometry: the moving mask must be CV_8UC1 of the previous "
+			    "frame's size");
+		moving = *mask;
+		if (tooLarge(moving))
+		{
+			r.flags |= kFlagMaskIgnored;
+			moving.release();
+		}
 	}
 	mask = moving.empty() ? nullptr : &moving;
 	// The previous frame becomes a keyframe now that its moving mask is
@@ -341,9 +349,29 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		    useImu ? R_WC_ : Eigen::Matrix3d(R_WCprev_ * lastR_rel_),
 		    t_WCprev_ + R_WCprev_ * lastT_rel_};
 		const Eigen::Matrix3d R_prior = R_WC_;
+		// The previous frame's movers where they are expected in this one,
+		// with the motion predicted as for the alignment's second guess (the
+		// gyro's rotation, else the last frame's; the last translation), not
+		// the frame-to-frame estimate that features on movers can corrupt.
+		cv::Mat exclude;
+		double excluded = 0;
+		if (mask)
+		{
+			exclude =
+			    cfg_.anchor.predict_mask
+			        ? predictMovingMask(*mask, depthPrev_, f.K,
+			                            R_rel_gyro ? *R_rel_gyro : lastR_rel_,
+			                            lastT_rel_, cfg_.anchor.mask_margin_px)
+			        : *mask;
+			if (tooLarge(exclude, &excluded))
+			{
+				r.flags |= kFlagMaskIgnored;
+				exclude.release();
+			}
+		}
 		r.anchor = anchor_.track(f, R_WC_, t_WC_, {constVel},
-		                         useImu ? &R_prior : nullptr,
-		                         mask ? *mask : cv::Mat());
+		                         useImu ? &R_prior : nullptr, exclude);
+		r.anchor.excluded_fraction = excluded;
 		r.ms_anchor = r.anchor.ms;
 		if (r.anchor.maskIgnored) r.flags |= kFlagMaskIgnored;
 		bool lost = false;
@@ -385,6 +413,13 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	R_WC_imuPrev_ = R_WC_imu;
 	R_WC_gyroPrev_ = R_WC_gyro;
 	return r;
+}
+
+bool Odometry::tooLarge(const cv::Mat& moving, double* share) const
+{
+	const double s = cv::countNonZero(moving) / double(moving.total());
+	if (share) *share = s;
+	return s > cfg_.anchor.max_excluded_fraction;
 }
 
 mrpt::poses::CPose3D Odometry::correctLastMotion(

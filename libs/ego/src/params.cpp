@@ -182,6 +182,9 @@ void AnchorParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	    static_cast<int>(s.getInt("lost_frames", lost_frames, 1, 1e6));
 	max_excluded_fraction =
 	    s.getDouble("max_excluded_fraction", max_excluded_fraction, 0, 1);
+	predict_mask = s.getBool("predict_mask", predict_mask);
+	mask_margin_px =
+	    static_cast<int>(s.getInt("mask_margin_px", mask_margin_px, 0, 100));
 	min_depth_m = s.getDouble("min_depth_m", min_depth_m, 0, 100);
 	max_depth_m = s.getDouble("max_depth_m", max_depth_m, 0.01, 1000);
 	if (max_depth_m <= min_depth_m)

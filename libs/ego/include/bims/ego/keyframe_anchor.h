@@ -37,9 +37,12 @@ struct AnchorResult
 	/** Keyframe readings this frame saw through (dropped from it). */
 	int seen_through = 0;
 	double correction_m = 0, correction_deg = 0;  ///< anchored vs predicted
-	/** Share of the frame's depth readings excluded by the moving mask. */
+	/** Share of the frame's pixels excluded by the moving mask (set by the
+	 * caller, Odometry, that judges the mask). */
 	double excluded_fraction = 0;
-	bool maskIgnored = false;  ///< the mask excluded too much: not used
+	/** The mask was not used: too large, or the alignment failed with it
+	 * and was accepted without it. */
+	bool maskIgnored = false;
 	/** Accepted with a correction beyond max_correction_* (the frame fits
 	 * the keyframe almost entirely: the pose had drifted). */
 	bool relocalised = false;
@@ -57,7 +60,9 @@ class KeyframeAnchor
 	 * constant-velocity one; the best at the coarsest level goes on).
 	 * \param R_prior rotation prior (T_WC's rotation, e.g. the IMU's), or
 	 * nullptr. \param moving CV_8UC1 pixels of \a f predicted moving
-	 * (excluded), or empty. Keeps \a f for addPending(). */
+	 * (excluded; the caller judged it not too large), or empty. An
+	 * alignment that fails with it is tried once more without it
+	 * (maskIgnored). Keeps \a f for addPending(). */
 	AnchorResult track(const RgbdFrame& f, const Eigen::Matrix3d& R_pred,
 	                   const Eigen::Vector3d& t_pred,
 	                   const std::vector<InitialGuess>& others,

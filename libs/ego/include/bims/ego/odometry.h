@@ -11,8 +11,10 @@
 // static scene (KeyframeAnchor): the frame-to-frame estimate is only its
 // initial guess (and the IMU rotation its prior).
 // The moving-region mask of the previous frame (from the segmentation) keeps
-// features off independently moving objects, out of the alignment and out
-// of the keyframe the previous frame may become. No threads, no I/O.
+// features off independently moving objects and out of the keyframe the
+// previous frame may become; predicted into this frame with the
+// frame-to-frame motion (moving_prediction.h), it keeps them out of the
+// alignment. No threads, no I/O.
 #pragma once
 
 #include <bims/ego/attitude_filter.h>
@@ -120,6 +122,11 @@ class Odometry
 	size_t framesProcessed() const { return nFrames_; }
 
  private:
+	/** Whether \a moving covers more than [anchor] max_excluded_fraction of
+	 * the image: then it is not used (the one rule for the previous
+	 * frame's mask and its prediction). \param share gets the share. */
+	bool tooLarge(const cv::Mat& moving, double* share = nullptr) const;
+
 	EgoConfig cfg_;
 	AttitudeFilter att_;
 	GyroAidedKLT klt_;

@@ -207,6 +207,16 @@ struct AnchorParams
 	 * mask over 70-89 % of the view (simulator preset occluder) is what
 	 * keeps the pose on the static scene (docs/ego.md). */
 	double max_excluded_fraction = 0.9;
+	/** true: the previous frame's moving mask is predicted into the frame
+	 * (its masked readings moved with the predicted motion and projected:
+	 * moving_prediction.h) before it excludes pixels from the alignment
+	 * and from the keyframe the frame may become; false: the previous mask
+	 * is used as it is. Off by default: measured no better on the Bonn
+	 * slice and the presets, and worse on one (docs/results.md). */
+	bool predict_mask = false;
+	/** The predicted mask grows by this many pixels a side (the movers' own
+	 * motion between two frames, the prediction's error) [px]. */
+	int mask_margin_px = 4;
 	double min_depth_m = 0.3;  ///< depth outside [min,max] unused [m]
 	double max_depth_m = 6.0;
 
