@@ -6,7 +6,7 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_ARGS ?=
 
-.PHONY: all deps configure build test demo bench format clean
+.PHONY: all deps configure build test demo bench fuzz format clean
 
 all: build
 
@@ -29,6 +29,10 @@ demo: build
 
 bench: build
 	@./scripts/bench.sh $(BUILD_DIR)
+
+# make fuzz TARGET=rawlog|ini|tum|labels SECONDS=N (docs/fuzz.md)
+fuzz:
+	@./scripts/fuzz.sh $(TARGET) $(SECONDS)
 
 format:
 	@find apps libs tests bench -name '*.cpp' -o -name '*.h' | xargs -r clang-format -i

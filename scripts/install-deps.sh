@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs every Debian package bims needs (build, tests, GUI tests, benchmarks).
 # Idempotent: a fast no-op when everything is already present.
+#   scripts/install-deps.sh        what make demo / make test need
+#   scripts/install-deps.sh fuzz   and clang with libFuzzer (scripts/fuzz.sh)
 set -euo pipefail
 
 PACKAGES=(
@@ -13,6 +15,9 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth imagemagick xdotool x11-apps libgl1-mesa-dri
 )
+if [ "${1:-}" = fuzz ]; then
+  PACKAGES+=(clang libclang-rt-14-dev)
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -205,8 +205,8 @@ mrpt::obs::CObservation::Ptr RawlogReader::next()
 		mrpt::serialization::CSerializable::Ptr obj;
 		auto& arch = static_cast<BufferedInArchive&>(*arch_);
 		const uint64_t pos0 = arch.position();
-		const std::string bad = checkSerializedScanSizes(
-		    [&arch](size_t n) { return arch.peek(n); });
+		const std::string bad =
+		    checkSerializedSizes([&arch](size_t n) { return arch.peek(n); });
 		if (!bad.empty())
 			throw RawlogError(path_ + ": corrupt rawlog at entry " +
 			                  std::to_string(entry_ + 1) + " (" +

@@ -77,20 +77,44 @@ std::string tooLarge(const std::string& what, uint64_t rows, uint64_t cols)
 	       std::to_string(kMaxImagePixels) + " pixels a rawlog may hold";
 }
 
-/** Walks a serialized scan field by field. Each step returns false to stop:
- * with `problem` set when a declared size is insane, empty when the bytes
- * end or hold a layout this walker does not know (MRPT then decides). */
-class ScanWalker
+/** Walks a serialized observation field by field. Each step returns false
+ * to stop: with `problem` set when a declared size is insane, empty when the
+ * bytes end or hold a layout this walker does not know (MRPT then decides). */
+class ObservationWalker
 {
  public:
-	explicit ScanWalker(const PeekFn& peek) : c_(peek) {}
+	explicit ObservationWalker(const PeekFn& peek) : c_(peek) {}
 	std::string problem;
 
 	bool run()
 	{
 		uint8_t version = 0;
-		if (c_.header(version) != "mrpt::obs::CObservation3DRangeScan")
-			return false;
+		const std::string cls = c_.header(version);
+		if (cls == "mrpt::obs::CObservation3DRangeScan")
+		{
+			what_ = "3D scan";
+			return scan(version);
+		}
+		if (cls == "mrpt::obs::CObservationIMU")
+		{
+			what_ = "IMU observation";
+			return imu(version);
+		}
+		return false;
+	}
+
+ private:
+	/** MRPT 2.x's layout (version 4): the sensor pose, 31 flags of the
+	 * data present, the stamp, 31 measurements, the label. */
+	bool imu(uint8_t version)
+	{
+		if (version != 4 || !pose()) return false;
+		c_.skip(31 + sizeof(uint64_t) + 31 * sizeof(double));
+		return string("sensor label") && end();
+	}
+
+	bool scan(uint8_t version)
+	{
 		if (version != 9 && version != 10) return false;
 		c_.skip(sizeof(float));  // maxRange
 		if (!pose()) return false;
@@ -116,11 +140,11 @@ class ScanWalker
 		if (c_.read<uint8_t>() && !image("confidence image")) return false;
 		if (!camera() || !camera() || !pose()) return false;
 		c_.skip(sizeof(float) + sizeof(uint64_t));  // stdError, timestamp
-		if (!string()) return false;                // sensorLabel
+		if (!string("sensor label")) return false;
 		for (int k = 0; k < 2; k++)  // external points / range image files
 		{
 			c_.skip(1);
-			if (!string()) return false;
+			if (!string("external file name")) return false;
 		}
 		c_.skip(2);  // range_is_depth, intensityImageChannel
 		// pixel labels: their names (a typed map) follow the image; the
@@ -130,13 +154,13 @@ class ScanWalker
 		{
 			const auto layers = c_.read<uint8_t>();
 			for (unsigned k = 0; k < layers; k++)
-				if (!string() || !matrix("extra depth layer", sizeof(uint16_t)))
+				if (!string("layer name") ||
+				    !matrix("extra depth layer", sizeof(uint16_t)))
 					return false;
 		}
 		return c_.ok();
 	}
 
- private:
 	/** rows, cols (uint32), then rows * cols elements of \a elem bytes. */
 	bool matrix(const std::string& what, uint64_t elem)
 	{
@@ -150,9 +174,19 @@ class ScanWalker
 		c_.skip(rows * cols * elem);
 		return c_.ok();
 	}
-	bool string()
+	/** A string or byte block: its length (uint32), then the bytes. */
+	bool string(const std::string& what)
 	{
-		c_.skip(c_.read<uint32_t>());
+		const uint64_t n = c_.read<uint32_t>();
+		if (!c_.ok()) return false;
+		if (n > kMaxStringBytes)
+		{
+			problem = "the " + what_ + "'s " + what + " declares " +
+			          std::to_string(n) + " bytes, beyond the " +
+			          std::to_string(kMaxStringBytes) + " a rawlog may hold";
+			return false;
+		}
+		c_.skip(n);
 		return c_.ok();
 	}
 	bool end() { return c_.read<uint8_t>() == 0x88 && c_.ok(); }
@@ -171,7 +205,7 @@ class ScanWalker
 		// image size (MRPT corrects it from the depth image), the name, the
 		// distortion model
 		c_.skip(13 * sizeof(double) + 2 * sizeof(uint32_t));
-		if (!string()) return false;
+		if (!string("camera name")) return false;
 		c_.skip(1);
 		return end();
 	}
@@ -179,7 +213,8 @@ class ScanWalker
 	{
 		uint8_t v = 0;
 		if (c_.header(v) != "mrpt::img::CImage" || v != 9) return false;
-		if (c_.read<uint8_t>()) return string() && end();  // external file
+		if (c_.read<uint8_t>())
+			return string(what + " file name") && end();  // external file
 		if (!c_.read<uint8_t>())  // grey: w h origin size depth zip data
 		{
 			const uint64_t w = c_.read<uint32_t>(), h = c_.read<uint32_t>();
@@ -198,8 +233,8 @@ class ScanWalker
 		}
 		const auto w = c_.read<int32_t>(), h = c_.read<int32_t>();
 		if (!c_.ok()) return false;
-		if (w >= 1 && h >= 1) return string() && end();  // JPEG bytes
-		if (w < 0 && h < 0)                              // raw BGR
+		if (w >= 1 && h >= 1) return string(what) && end();  // JPEG bytes
+		if (w < 0 && h < 0)                                  // raw BGR
 		{
 			const uint64_t rw = -int64_t{w}, rh = -int64_t{h};
 			if (!saneSize(rh, rw))
@@ -221,12 +256,13 @@ class ScanWalker
 	}
 
 	Cursor c_;
+	std::string what_;  ///< "3D scan", "IMU observation"
 };
 }  // namespace
 
-std::string checkSerializedScanSizes(const PeekFn& peek)
+std::string checkSerializedSizes(const PeekFn& peek)
 {
-	ScanWalker w(peek);
+	ObservationWalker w(peek);
 	w.run();
 	return w.problem;
 }

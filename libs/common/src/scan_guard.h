@@ -1,10 +1,12 @@
-// Checks the sizes a serialized 3D scan declares, before MRPT allocates them.
+// Checks the sizes a serialized observation declares, before MRPT allocates
+// them.
 //
-// MRPT 2.5.8's CObservation3DRangeScan reader trusts the stored sizes: a
-// corrupt depth-image height of 0x7fffffff makes it allocate 1.3 TB, which
-// fails without an exception, and the next memset crashes the process. The
-// rawlog reader walks each top-level scan's bytes first and refuses declared
-// sizes no real sensor produces.
+// MRPT 2.5.8's readers trust the stored sizes: a corrupt depth-image height
+// of 0x7fffffff makes CObservation3DRangeScan allocate 1.3 TB, which fails
+// without an exception, and the next memset crashes the process; a string
+// length of 0xffffffff (an IMU's sensor label) allocates 4 GB. The rawlog
+// reader walks each top-level 3D scan's and IMU observation's bytes first
+// and refuses declared sizes no real sensor produces.
 #pragma once
 
 #include <cstddef>
@@ -19,18 +21,22 @@ namespace bims
  * 4096 image; real RGB-D sensors give at most a few megapixels). */
 constexpr uint32_t kMaxImageSide = 16384;
 constexpr uint64_t kMaxImagePixels = uint64_t{1} << 26;
+/** Largest string or byte block (labels, file names, a JPEG image) an
+ * observation may declare. */
+constexpr uint64_t kMaxStringBytes = uint64_t{1} << 26;
 
 /** The next bytes of the stream without consuming them: at least n unless
  * the file ends first. */
 using PeekFn = std::function<std::pair<const uint8_t*, size_t>(size_t n)>;
 
 /** For a top-level mrpt::obs::CObservation3DRangeScan of serialization
- * version 9 or 10 (what MRPT 2.x writes), the problem with its declared
- * point count or the size of one of its images (depth, intensity,
- * confidence, pixel labels, extra layers) ("" when they are sane, when the
- * object is of another class or version or holds a layout the walk does not
- * know, or when the file ends first:
- * MRPT's reader then reports the truncation). */
-std::string checkSerializedScanSizes(const PeekFn& peek);
+ * version 9 or 10 or mrpt::obs::CObservationIMU of version 4 (what MRPT 2.x
+ * writes), the problem with its declared point count, the size of one of
+ * its images (depth, intensity, confidence, pixel labels, extra layers) or
+ * the length of one of its strings ("" when they are sane, when the object
+ * is of another class or version or holds a layout the walk does not know,
+ * or when the file ends first: MRPT's reader then reports the
+ * truncation). */
+std::string checkSerializedSizes(const PeekFn& peek);
 
 }  // namespace bims

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationIMU.h>
 #include "tmp_path.h"
 
 #include <algorithm>
@@ -278,4 +279,42 @@ TEST(RawlogCorrupt, ByteFlipsOfTheSampleNeverCrash)
 	}
 	EXPECT_EQ(errors + clean, 300u);
 	EXPECT_GT(errors, 0u);  // the campaign does reach the checks
+}
+
+TEST(RawlogCorrupt, HugeStringLengthsAreErrorsNotAllocations)
+{
+	// Found by the rawlog fuzz target (tests/fuzz/corpus/rawlog/
+	// oom-imu-label-length): an IMU observation whose sensor label declares
+	// 0xffffffff bytes made MRPT allocate 4 GB before failing. Likewise a
+	// 3D scan's label. The label "LBL1" is found by its bytes.
+	const auto p = tmpPath("imu_label.rawlog");
+	{
+		mrpt::obs::CObservationIMU imu;
+		imu.sensorLabel = "LBL1";
+		mrpt::obs::CObservation3DRangeScan s;
+		s.sensorLabel = "LBL2";
+		s.hasRangeImage = true;
+		s.rangeImage_setSize(4, 5);
+		s.cameraParams.ncols = 5;
+		s.cameraParams.nrows = 4;
+		bims::RawlogWriter w(p, 0);
+		w.write(imu);
+		w.write(s);
+	}
+	const auto bytes = readBytes(p);
+	EXPECT_EQ(readError(p), "");
+	for (const char* label : {"LBL1", "LBL2"})
+	{
+		const auto at =
+		    std::search(bytes.begin(), bytes.end(), label, label + 4) -
+		    bytes.begin();
+		ASSERT_GE(at, 4);
+		auto bad = bytes;
+		putU32(bad, static_cast<size_t>(at) - 4, 0xffffffffu);
+		writeBytes(p, bad);
+		const std::string err = readError(p);
+		EXPECT_NE(err.find("sensor label declares 4294967295 bytes"),
+		          std::string::npos)
+		    << label << ": " << err;
+	}
 }

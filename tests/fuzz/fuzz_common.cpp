@@ -1,0 +1,53 @@
+#include "fuzz_common.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+
+#include <unistd.h>
+
+namespace bims::fuzz
+{
+const std::string& scratchDir()
+{
+	static const std::string dir = []
+	{
+		const char* tmp = std::getenv("TMPDIR");
+		std::string tpl =
+		    std::string(tmp && *tmp ? tmp : "/tmp") + "/bims-fuzz-XXXXXX";
+		if (!mkdtemp(tpl.data()))
+			throw std::runtime_error("fuzz: cannot make a scratch folder");
+		return tpl;
+	}();
+	return dir;
+}
+
+std::string writeFile(const std::string& name, const uint8_t* data, size_t size)
+{
+	const std::string path = scratchDir() + "/" + name;
+	FILE* f = std::fopen(path.c_str(), "wb");
+	if (!f) throw std::runtime_error("fuzz: cannot write " + path);
+	const bool ok = std::fwrite(data, 1, size, f) == size;
+	if (std::fclose(f) != 0 || !ok)
+		throw std::runtime_error("fuzz: cannot write " + path);
+	return path;
+}
+
+std::vector<std::string> splitParts(const uint8_t* data, size_t size, size_t n)
+{
+	const std::string s(reinterpret_cast<const char*>(data), size);
+	const std::string sep = "\n--\n";
+	std::vector<std::string> parts;
+	size_t pos = 0;
+	while (parts.size() + 1 < n)
+	{
+		const size_t at = s.find(sep, pos);
+		if (at == std::string::npos) break;
+		parts.push_back(s.substr(pos, at - pos));
+		pos = at + sep.size();
+	}
+	parts.push_back(s.substr(pos));
+	parts.resize(n);
+	return parts;
+}
+}  // namespace bims::fuzz

@@ -1,0 +1,111 @@
+// Writes the fuzz targets' seed inputs (docs/fuzz.md):
+//   fuzz_make_seeds SAMPLE.rawlog OUT_DIR
+// OUT_DIR/rawlog: the sample's first scans shrunk to 32 x 24 (depth,
+// intensity, camera models) with the IMU samples between them, plain;
+// OUT_DIR/labels and OUT_DIR/tum: small hand-made inputs of each kind.
+#include <bims/common/rawlog.h>
+
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationIMU.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+namespace
+{
+void shrink(mrpt::obs::CObservation3DRangeScan& s, int W, int H)
+{
+	const int w0 = static_cast<int>(s.rangeImage.cols()),
+	          h0 = static_cast<int>(s.rangeImage.rows());
+	const mrpt::math::CMatrix_u16 r = s.rangeImage;
+	s.rangeImage_setSize(H, W);
+	for (int v = 0; v < H; v++)
+		for (int u = 0; u < W; u++)
+			s.rangeImage(v, u) = r(v * h0 / H, u * w0 / W);
+	mrpt::img::CImage small;
+	s.intensityImage.scaleImage(small, W, H);
+	s.intensityImage = small;
+	const double k = double(W) / w0;
+	for (auto* c : {&s.cameraParams, &s.cameraParamsIntensity})
+	{
+		c->setIntrinsicParamsFromValues(c->fx() * k, c->fy() * k, c->cx() * k,
+		                                c->cy() * k);
+		c->ncols = W;
+		c->nrows = H;
+	}
+	s.pixelLabels.reset();
+}
+
+void writeText(const std::filesystem::path& p, const std::string& text)
+{
+	std::ofstream f(p, std::ios::binary);
+	f << text;
+	if (!f) throw std::runtime_error(p.string() + ": cannot write");
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+	namespace fs = std::filesystem;
+	if (argc != 3)
+	{
+		std::cerr << "usage: fuzz_make_seeds SAMPLE.rawlog OUT_DIR\n";
+		return 2;
+	}
+	try
+	{
+		const fs::path out = argv[2];
+		for (const char* d : {"rawlog", "labels", "tum"})
+			fs::create_directories(out / d);
+		{
+			bims::RawlogReader in(argv[1]);
+			bims::RawlogWriter w(
+			    (out / "rawlog" / "sample_head.rawlog").string(), 0);
+			int scans = 0;
+			while (scans < 2)
+			{
+				const auto o = in.next();
+				if (!o) break;
+				if (auto s = std::dynamic_pointer_cast<
+				        mrpt::obs::CObservation3DRangeScan>(o))
+				{
+					shrink(*s, 32, 24);
+					++scans;
+				}
+				w.write(*o);
+			}
+			w.close();
+		}
+		cv::Mat lab(6, 8, CV_8UC1, cv::Scalar(0));
+		lab(cv::Rect(2, 1, 3, 3)).setTo(255);
+		lab.col(7).setTo(150);
+		lab.row(5).setTo(50);
+		std::vector<uint8_t> png;
+		cv::imencode(".png", lab, png);
+		png.insert(png.begin(), 0);
+		std::ofstream(out / "labels" / "png", std::ios::binary)
+		    .write(reinterpret_cast<const char*>(png.data()),
+		           static_cast<std::streamsize>(png.size()));
+		writeText(out / "labels" / "frames_csv",
+		          std::string(1, '\1') +
+		              "index,t,ego_flags\n0,1548339824.89375,1\n1,"
+		              "1548339824.9275,2048\n");
+		writeText(out / "labels" / "values", std::string(1, '\2') + "150,50");
+		writeText(out / "tum" / "folder",
+		          "# rgb\n1.0 rgb/1.0.png\n1.033 rgb/1.033.png\n--\n# depth\n"
+		          "1.001 depth/1.001.png\n1.034 depth/1.034.png\n--\n"
+		          "# timestamp tx ty tz qx qy qz qw\n"
+		          "1.0 0 0 0 0 0 0 1\n1.04 0.01 0 0 0 0 0 1\n--\n"
+		          "1.0 0 0 9.81\n");
+		std::cout << "seeds in " << out.string() << "\n";
+	}
+	catch (const std::exception& e)
+	{
+		std::cerr << "fuzz_make_seeds: " << e.what() << "\n";
+		return 1;
+	}
+	return 0;
+}
