@@ -109,7 +109,21 @@ class ObservationWalker
 	bool imu(uint8_t version)
 	{
 		if (version != 4 || !pose()) return false;
-		c_.skip(31 + sizeof(uint64_t) + 31 * sizeof(double));
+		// each flag a bool: any other byte is undefined behaviour in MRPT's
+		// accessors (found by the fuzzer)
+		for (int k = 0; k < 31; k++)
+		{
+			const auto b = c_.read<uint8_t>();
+			if (!c_.ok()) return false;
+			if (b > 1)
+			{
+				problem = "the IMU observation's data-present flag " +
+				          std::to_string(k) + " is " + std::to_string(b) +
+				          ", not 0 or 1";
+				return false;
+			}
+		}
+		c_.skip(sizeof(uint64_t) + 31 * sizeof(double));
 		return string("sensor label") && end();
 	}
 

@@ -318,3 +318,29 @@ TEST(RawlogCorrupt, HugeStringLengthsAreErrorsNotAllocations)
 		    << label << ": " << err;
 	}
 }
+
+TEST(RawlogCorrupt, AnImuFlagThatIsNoBoolIsAnError)
+{
+	// Found by the rawlog fuzz target (tests/fuzz/corpus/rawlog/
+	// ub-imu-flag-not-bool): a data-present flag stored as 10 is read into
+	// a bool by MRPT, undefined behaviour in its accessors.
+	const auto p = tmpPath("imu_flag.rawlog");
+	{
+		mrpt::obs::CObservationIMU imu;
+		imu.sensorLabel = "IMU";
+		bims::RawlogWriter w(p, 0);
+		w.write(imu);
+	}
+	auto bytes = readBytes(p);
+	EXPECT_EQ(readError(p), "");
+	// the flags follow the sensor pose's end byte 0x88 (its 12 doubles of a
+	// default pose hold no 0x88)
+	const auto pose =
+	    std::search(bytes.begin(), bytes.end(), "CPose3D", "CPose3D" + 7);
+	const auto end = std::find(pose, bytes.end(), 0x88);
+	ASSERT_NE(end, bytes.end());
+	*(end + 1 + 5) = 10;
+	writeBytes(p, bytes);
+	EXPECT_NE(readError(p).find("data-present flag 5 is 10"), std::string::npos)
+	    << readError(p);
+}
