@@ -203,18 +203,41 @@ class ObservationWalker
 		c_.skip(n);
 		return c_.ok();
 	}
-	bool end() { return c_.read<uint8_t>() == 0x88 && c_.ok(); }
+	/** An object's end flag. */
+	bool end()
+	{
+		const auto b = c_.read<uint8_t>();
+		return c_.ok() &&
+		       (b == 0x88 || mismatch("an object's end flag", c_.offset() - 1));
+	}
+	/** Another class (or no object) where every MRPT version writes the
+	 * named one, or no end flag: corrupt (MRPT itself would read on and may
+	 * allocate what the bytes declare). Returns false. */
+	bool mismatch(const std::string& where, size_t at)
+	{
+		if (c_.ok())
+			problem = "the " + what_ + " does not hold MRPT's layout (" +
+			          where + " expected at byte " + std::to_string(at) +
+			          " of the entry)";
+		return false;
+	}
 	bool pose()
 	{
 		uint8_t v = 0;
-		if (c_.header(v) != "mrpt::poses::CPose3D" || v != 3) return false;
+		const size_t at = c_.offset();
+		if (c_.header(v) != "mrpt::poses::CPose3D")
+			return mismatch("a CPose3D", at);
+		if (v != 3) return false;      // another MRPT's: MRPT decides
 		c_.skip(12 * sizeof(double));  // translation and rotation matrix
 		return end();
 	}
 	bool camera()
 	{
 		uint8_t v = 0;
-		if (c_.header(v) != "mrpt::img::TCamera" || v != 6) return false;
+		const size_t at = c_.offset();
+		if (c_.header(v) != "mrpt::img::TCamera")
+			return mismatch("a TCamera", at);
+		if (v != 6) return false;  // another MRPT's: MRPT decides
 		// 13 doubles (distortion, focal length [m], fx fy cx cy), the
 		// image size (MRPT corrects it from the depth image), the name, the
 		// distortion model
@@ -226,7 +249,10 @@ class ObservationWalker
 	bool image(const std::string& what)
 	{
 		uint8_t v = 0;
-		if (c_.header(v) != "mrpt::img::CImage" || v != 9) return false;
+		const size_t at = c_.offset();
+		if (c_.header(v) != "mrpt::img::CImage")
+			return mismatch("a CImage", at);
+		if (v != 9) return false;  // another MRPT's: MRPT decides
 		if (c_.read<uint8_t>())
 			return string(what + " file name") && end();  // external file
 		if (!c_.read<uint8_t>())  // grey: w h origin size depth zip data

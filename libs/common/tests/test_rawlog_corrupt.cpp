@@ -344,3 +344,26 @@ TEST(RawlogCorrupt, AnImuFlagThatIsNoBoolIsAnError)
 	EXPECT_NE(readError(p).find("data-present flag 5 is 10"), std::string::npos)
 	    << readError(p);
 }
+
+TEST(RawlogCorrupt, AnInnerObjectOfAnotherClassIsAnError)
+{
+	// Found by the rawlog fuzz target (tests/fuzz/corpus/rawlog/
+	// oom-imu-pose-class-name): an IMU observation whose sensor pose is
+	// named "mrpt::posei::CPose3D"; MRPT read on and allocated 4 GB.
+	const auto p = tmpPath("imu_pose_class.rawlog");
+	{
+		mrpt::obs::CObservationIMU imu;
+		bims::RawlogWriter w(p, 0);
+		w.write(imu);
+	}
+	auto bytes = readBytes(p);
+	const char* name = "mrpt::poses::";
+	auto at = std::search(bytes.begin(), bytes.end(), name, name + 13);
+	ASSERT_NE(at, bytes.end());
+	*(at + 10) = 'i';  // poses -> posei
+	writeBytes(p, bytes);
+	EXPECT_NE(readError(p).find("the IMU observation does not hold MRPT's "
+	                            "layout (a CPose3D expected at byte 28"),
+	          std::string::npos)
+	    << readError(p);
+}
