@@ -1,5 +1,7 @@
 #include "scan_guard.h"
 
+#include <mrpt/rtti/CObject.h>
+
 #include <cstring>
 
 namespace bims
@@ -62,6 +64,14 @@ class Cursor
 	bool ok_ = true;
 };
 
+/** \a s with bytes outside printable ASCII as '?'. */
+std::string printable(std::string s)
+{
+	for (char& ch : s)
+		if (ch < 0x20 || ch > 0x7e) ch = '?';
+	return s;
+}
+
 /** Whether a rows x cols image passes the limits. */
 bool saneSize(uint64_t rows, uint64_t cols)
 {
@@ -90,6 +100,14 @@ class ObservationWalker
 	{
 		uint8_t version = 0;
 		const std::string cls = c_.header(version);
+		// a class MRPT does not know: it would read on as a typed object
+		// and may allocate what the bytes declare (found by the fuzzer)
+		if (!cls.empty() && !mrpt::rtti::findRegisteredClass(cls, false))
+		{
+			problem = "an object of a class MRPT does not know ('" +
+			          printable(cls) + "')";
+			return false;
+		}
 		if (cls == "mrpt::obs::CObservation3DRangeScan")
 		{
 			what_ = "3D scan";

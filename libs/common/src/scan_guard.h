@@ -29,7 +29,8 @@ constexpr uint64_t kMaxStringBytes = uint64_t{1} << 26;
  * the file ends first. */
 using PeekFn = std::function<std::pair<const uint8_t*, size_t>(size_t n)>;
 
-/** For a top-level mrpt::obs::CObservation3DRangeScan of serialization
+/** For a top-level object of a class MRPT does not know, that problem;
+ * for a top-level mrpt::obs::CObservation3DRangeScan of serialization
  * version 9 or 10 or mrpt::obs::CObservationIMU of version 4 (what MRPT 2.x
  * writes), the problem with its declared point count, the size of one of
  * its images (depth, intensity, confidence, pixel labels, extra layers) or

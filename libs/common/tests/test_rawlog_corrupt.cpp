@@ -367,3 +367,25 @@ TEST(RawlogCorrupt, AnInnerObjectOfAnotherClassIsAnError)
 	          std::string::npos)
 	    << readError(p);
 }
+
+TEST(RawlogCorrupt, AnObjectOfAnUnknownClassIsAnError)
+{
+	// Found by the rawlog fuzz target (tests/fuzz/corpus/rawlog/
+	// oom-unknown-class-name): a top-level object named
+	// "mbpt::obs::CObservationIMU"; MRPT read on and allocated 4 GB.
+	const auto p = tmpPath("unknown_class.rawlog");
+	{
+		mrpt::obs::CObservationIMU imu;
+		bims::RawlogWriter w(p, 0);
+		w.write(imu);
+	}
+	auto bytes = readBytes(p);
+	ASSERT_EQ(bytes[2], 'r');
+	bytes[2] = 'b';  // mrpt -> mbpt
+	writeBytes(p, bytes);
+	EXPECT_NE(readError(p).find("corrupt rawlog at entry 0 (0 observations "
+	                            "read before): an object of a class MRPT "
+	                            "does not know ('mbpt::obs::CObservationIMU')"),
+	          std::string::npos)
+	    << readError(p);
+}
