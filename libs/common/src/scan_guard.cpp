@@ -101,8 +101,11 @@ class ObservationWalker
 		uint8_t version = 0;
 		const std::string cls = c_.header(version);
 		// a class MRPT does not know: it would read on as a typed object
-		// and may allocate what the bytes declare (found by the fuzzer)
-		if (!cls.empty() && !mrpt::rtti::findRegisteredClass(cls, false))
+		// and may allocate what the bytes declare (found by the fuzzer). A
+		// name with a namespace must match whole (MRPT's own lookup drops
+		// it); one without (older rawlogs) is looked up as MRPT does.
+		const bool ns = cls.find("::") != std::string::npos;
+		if (!cls.empty() && !mrpt::rtti::findRegisteredClass(cls, !ns))
 		{
 			problem = "an object of a class MRPT does not know ('" +
 			          printable(cls) + "')";

@@ -6,6 +6,7 @@
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
+#include <mrpt/rtti/CObject.h>
 #include "tmp_path.h"
 
 #include <algorithm>
@@ -380,6 +381,8 @@ TEST(RawlogCorrupt, AnObjectOfAnUnknownClassIsAnError)
 		w.write(imu);
 	}
 	auto bytes = readBytes(p);
+	EXPECT_TRUE(mrpt::rtti::findRegisteredClass("CObservationIMU", true))
+	    << "a name without namespace is looked up as MRPT does";
 	ASSERT_EQ(bytes[2], 'r');
 	bytes[2] = 'b';  // mrpt -> mbpt
 	writeBytes(p, bytes);
