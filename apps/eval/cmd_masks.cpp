@@ -1,5 +1,6 @@
 #include <bims/common/app.h>
 #include <bims/common/frame_files.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
 #include <bims/eval/depth_consistency.h>
 #include <bims/eval/json.h>
@@ -16,6 +17,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 
 #include "commands.h"
@@ -137,6 +139,11 @@ int cmdMasks(int argc, char** argv)
 	    "", "i,j,..", cmd);
 	TCLAP::SwitchArg quiet("q", "quiet", "no per-frame lines", cmd);
 	bims::parseCommandLine(cmd, argc, argv);
+	const std::vector<std::string> inputs = {
+	    gtArg.getValue(), predArg.getValue(), depth.getValue(),
+	    framesCsv.getValue()};
+	bims::checkOutputsSpareInputs(inputs,
+	                              bims::givenValues(plotDir, json, strip));
 
 	if (voxel.getValue() < 0 || !std::isfinite(voxel.getValue()))
 		throw bims::UsageError("--voxel-size must be >= 0");
@@ -217,6 +224,7 @@ int cmdMasks(int argc, char** argv)
 	if (!noPlots.getValue())
 	{
 		outDir = plotDir.isSet() ? plotDir.getValue() : p + "_eval";
+		bims::checkOutputsSpareInputs(inputs, {outDir});
 		bims::makeDirs(outDir);
 	}
 	std::unique_ptr<ScanStream> scans;
@@ -352,7 +360,7 @@ int cmdMasks(int argc, char** argv)
 		             "and --voxel-size > 0\n");
 	if (json.isSet())
 	{
-		std::ofstream jf(json.getValue());
+		std::ostringstream jf;
 		jf << "{\n  \"gt\": " << ev::jsonString(gtDir)
 		   << ",\n  \"pred\": " << ev::jsonString(predDir)
 		   << ",\n  \"labels\": " << ev::jsonString(labels.describe())
@@ -367,7 +375,7 @@ int cmdMasks(int argc, char** argv)
 			jf << ",\n  \"voxel_size_m\": " << voxel.getValue()
 			   << ",\n  \"total_voxels\": " << totalVoxels.toJson();
 		jf << ",\n  \"frames\": [\n" << jsonFrames << "\n  ]\n}\n";
-		if (!jf) throw std::runtime_error(json.getValue() + ": cannot write");
+		bims::writeFileAtomically(json.getValue(), jf.str());
 	}
 	std::printf(
 	    "total_counts frames %zu tp %llu fp %llu fn %llu tn %llu invalid "

@@ -16,6 +16,7 @@
 // --strip writes a picture: for each listed frame the RGB image with the
 // used pose's Diff pixels in red (docs/results.md).
 #include <bims/common/app.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/rgbd_input.h>
 #include <bims/eval/plots.h>
@@ -126,6 +127,9 @@ int main(int argc, char** argv)
 		        "", "variant", "pipeline variant (default flow-only)", false,
 		        "flow-only", "VARIANT", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::checkOutputsSpareInputs(
+		        {aCfg.getValue(), aIn.getValue(), aGt.getValue()},
+		        bims::givenValues(aCsv, aStrip));
 
 		    bims::pipeline::ExperimentConfig cfg;
 		    cfg.loadFromFile(aCfg.getValue());
@@ -154,6 +158,7 @@ int main(int argc, char** argv)
 		    std::ofstream csv;
 		    if (aCsv.isSet())
 		    {
+			    bims::replaceSymlink(aCsv.getValue());
 			    csv.open(aCsv.getValue());
 			    if (!csv)
 				    throw std::runtime_error(aCsv.getValue() +

@@ -9,6 +9,7 @@
 // device: a clear message and exit code 1. See docs/grab.md.
 #include <bims/common/app.h>
 #include <bims/common/config.h>
+#include <bims/common/output_paths.h>
 #include <bims/grab/grabber.h>
 #include <bims/pipeline/pipeline.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
@@ -86,6 +87,8 @@ int main(int argc, char** argv)
 		                             "mask) in a window",
 		                             cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::checkOutputsSpareInputs({aCfg.getValue(), aExp.getValue()},
+		                                  {aOut.getValue()});
 		    std::signal(SIGINT, onSignal);  // Ctrl-C from now on: clean stop
 		    std::signal(SIGTERM, onSignal);
 		    if (aFrames.getValue() < 0)

@@ -7,6 +7,7 @@
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/replay.h>
@@ -84,6 +85,12 @@ int main(int argc, char** argv)
 		        "", "max-frames", "stop after N frames", false, 0, "N", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    auto outputs = bims::givenValues(csvArg);
+		    outputs.push_back(outArg.getValue());
+		    checkOutputsSpareInputs(
+		        {cfgArg.getValue(), inArg.getValue(), calibArg.getValue(),
+		         masksArg.getValue(), gtArg.getValue()},
+		        outputs);
 
 		    const std::string cfgPath = cfgArg.getValue();
 		    ego::EgoConfig ec;
@@ -124,6 +131,7 @@ int main(int argc, char** argv)
 		    std::ofstream csv;
 		    if (csvArg.isSet())
 		    {
+			    replaceSymlink(csvArg.getValue());
 			    csv.open(csvArg.getValue());
 			    if (!csv)
 				    throw std::runtime_error(csvArg.getValue() +

@@ -8,6 +8,7 @@
 // segmented.rawlog (masks as pixel labels), frames.csv, metrics.json, and
 // prints a summary table. See docs/pipeline.md.
 #include <bims/common/app.h>
+#include <bims/common/output_paths.h>
 #include <bims/pipeline/run.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
@@ -42,6 +43,9 @@ int main(int argc, char** argv)
 		        false, "", "VARIANT", cmd);
 		    TCLAP::SwitchArg aQuiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    auto inputs = aIn.getValue();
+		    inputs.push_back(aCfg.getValue());
+		    bims::checkOutputsSpareInputs(inputs, {aOut.getValue()});
 
 		    bims::pipeline::ExperimentConfig cfg;
 		    cfg.loadFromFile(aCfg.getValue());

@@ -1,3 +1,4 @@
+#include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
 
 #include <mrpt/img/CImage.h>
@@ -259,6 +260,7 @@ RawlogWriter::RawlogWriter(const std::string& path, int gzLevel) : path_(path)
 {
 	if (gzLevel < 0 || gzLevel > 9)
 		throw RawlogError(path + ": gzip level must be in 0..9");
+	replaceSymlink(path);
 	if (gzLevel == 0)
 	{
 		plain_.open(path, std::ios::binary | std::ios::trunc);
@@ -311,7 +313,9 @@ void RawlogWriter::write(const mrpt::obs::CObservation& obs)
 
 void RawlogWriter::flush()
 {
-	if (plain_.is_open()) plain_.flush();
+	if (!plain_.is_open()) return;
+	plain_.flush();
+	if (!plain_) throw RawlogError(path_ + ": write failed (disk full?)");
 }
 
 void RawlogWriter::close()
@@ -319,7 +323,12 @@ void RawlogWriter::close()
 	if (!open_) return;
 	open_ = false;
 	arch_.reset();
-	if (plain_.is_open()) plain_.close();
+	if (plain_.is_open())
+	{
+		plain_.close();
+		if (!plain_)
+			throw RawlogError(path_ + ": write failed on close (disk full?)");
+	}
 	if (gz_.fileOpenCorrectly()) gz_.close();
 }
 

@@ -1,5 +1,6 @@
 #include "outputs.h"
 #include <bims/common/frame_files.h>
+#include <bims/common/output_paths.h>
 
 #include "cpu_time.h"
 
@@ -12,6 +13,7 @@
 #include <chrono>
 #include <cstdio>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 #include <stdexcept>
 
 namespace bims::pipeline
@@ -20,17 +22,18 @@ namespace bims::pipeline
 void writePointsPly(const std::string& path,
                     const std::vector<mrpt::math::TPoint3D>& pts)
 {
-	std::ofstream f(path);
-	if (!f) throw std::runtime_error(path + ": cannot write PLY file");
-	f << "ply\nformat ascii 1.0\nelement vertex " << pts.size()
-	  << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+	std::string text = "ply\nformat ascii 1.0\nelement vertex " +
+	                   std::to_string(pts.size()) +
+	                   "\nproperty float x\nproperty float y\nproperty float "
+	                   "z\nend_header\n";
+	text.reserve(text.size() + 32 * pts.size());
 	char buf[96];
 	for (const auto& p : pts)
 	{
 		std::snprintf(buf, sizeof(buf), "%.4f %.4f %.4f\n", p.x, p.y, p.z);
-		f << buf;
+		text += buf;
 	}
-	if (!f) throw std::runtime_error(path + ": write failed");
+	writeFileAtomically(path, text);
 }
 
 namespace
@@ -51,6 +54,9 @@ OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
 	makeDirs(dir_ + "/masks");
 	if (p_.moving_ply) makeDirs(dir_ + "/moving_voxels");
 	if (p_.flow_labels) makeDirs(dir_ + "/flow_labels");
+	// the streamed files replace a symbolic link, never write through it
+	replaceSymlink(dir_ + "/trajectory.txt");
+	replaceSymlink(dir_ + "/frames.csv");
 	traj_.open(dir_ + "/trajectory.txt");
 	csv_.open(dir_ + "/frames.csv");
 	if (!traj_ || !csv_)
@@ -92,17 +98,7 @@ double OutputWriter::writeFrame(const FrameResult& r,
 void OutputWriter::doWriteFrame(const FrameResult& r,
                                 mrpt::obs::CObservation3DRangeScan& scan)
 {
-	const std::string mpath = dir_ + "/masks/" + frameFileName(long(r.index));
-	bool ok = false;
-	try
-	{
-		ok = cv::imwrite(mpath, r.mask);
-	}
-	catch (const cv::Exception& e)
-	{
-		throw std::runtime_error(mpath + ": cannot write mask: " + e.what());
-	}
-	if (!ok) throw std::runtime_error(mpath + ": cannot write mask");
+	writeImageFile(dir_ + "/masks/" + frameFileName(long(r.index)), r.mask);
 	if (p_.moving_ply)
 		writePointsPly(
 		    dir_ + "/moving_voxels/" + frameFileName(long(r.index), "ply"),
@@ -112,7 +108,8 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 		cv::Mat vis(r.labels.size(), CV_8UC1, cv::Scalar(0));
 		vis.setTo(128, r.labels == 0);
 		vis.setTo(255, r.labels == 1);
-		cv::imwrite(dir_ + "/flow_labels/" + frameFileName(long(r.index)), vis);
+		writeImageFile(dir_ + "/flow_labels/" + frameFileName(long(r.index)),
+		               vis);
 	}
 	traj_ << tumLine(r.t, r.T_WC) << "\n";
 	traj_.flush();
@@ -175,10 +172,13 @@ size_t OutputWriter::close(const Pipeline& pipe)
 		motion = g.flow().get();
 	if (p_.static_map && pipe.framesProcessed() > 0)
 	{
-		nStatic = maps::writeStaticPly(dir_ + "/static_map.ply", *g.occupancy(),
-		                               motion, p_.static_p_occupied);
-		maps::writeStaticOctomap(dir_ + "/static_map.bt", *g.occupancy(),
-		                         motion, p_.static_p_occupied);
+		PartialFile ply(dir_ + "/static_map.ply"), bt(dir_ + "/static_map.bt");
+		nStatic = maps::writeStaticPly(ply.path(), *g.occupancy(), motion,
+		                               p_.static_p_occupied);
+		maps::writeStaticOctomap(bt.path(), *g.occupancy(), motion,
+		                         p_.static_p_occupied);
+		ply.commit();
+		bt.commit();
 	}
 	staticVoxels_ = nStatic;
 	if (!err.empty()) throw std::runtime_error(err);
@@ -188,8 +188,7 @@ size_t OutputWriter::close(const Pipeline& pipe)
 void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
 {
 	const size_t nStatic = staticVoxels_;
-	std::ofstream j(dir_ + "/metrics.json");
-	if (!j) throw std::runtime_error(dir_ + "/metrics.json: cannot write");
+	std::ostringstream j;
 	char buf[1024];
 	j << "{\n";
 	j << "  \"variant\": \"" << sum.variant << "\",\n";
@@ -231,6 +230,7 @@ void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
 			err += c;
 	}
 	j << "  \"error\": \"" << err << "\"\n}\n";
+	writeFileAtomically(dir_ + "/metrics.json", j.str());
 }
 
 }  // namespace bims::pipeline

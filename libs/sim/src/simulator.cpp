@@ -1,5 +1,6 @@
 #include <bims/common/app.h>
 #include <bims/common/frame_files.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/pixel_labels.h>
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
@@ -172,7 +173,8 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	const HandheldMotion motion(cfg.motion);
 	const Renderer renderer(cfg.camera, cfg.depth, cfg.rgb);
 	ImuSimulator imu(cfg.imu, seed);
-	RawlogWriter out(outRawlog, cfg.seq.gzLevel);
+	PartialFile part(outRawlog);  // renamed once complete
+	RawlogWriter out(part.path(), cfg.seq.gzLevel);
 
 	Trajectory gt;
 	std::vector<ImuTruth> imuTruth;
@@ -241,6 +243,7 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	writeImuUntil(duration +
 	              0.5 / cfg.seq.fps);  // IMU a little past the last frame
 	out.close();
+	part.commit();
 	bar.finish();
 
 	saveTumTrajectory(st.gtDir + "/groundtruth.txt", gt,

@@ -5,6 +5,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace bims
 {
@@ -42,6 +43,16 @@ void parseCommandLine(CmdLine& cmd, int argc, char** argv)
 			throw ExitRequest{0};
 	}
 	throw ExitRequest{2};
+}
+
+/** The values of those TCLAP value arguments that the command line gave
+ * (e.g. the optional outputs, for checkOutputsSpareInputs). */
+template <class... Arg>
+std::vector<std::string> givenValues(Arg&... args)
+{
+	std::vector<std::string> v;
+	(..., (args.isSet() ? v.push_back(args.getValue()) : void()));
+	return v;
 }
 
 /** Tells the C library's allocator to keep freed memory for reuse instead

@@ -62,7 +62,8 @@ class RawlogReader
 class RawlogWriter
 {
  public:
-	/** Creates (truncates) \a path. gzLevel 1..9 writes a gzip-compressed
+	/** Creates (truncates) \a path (a symbolic link there is replaced, its
+	 * target untouched). gzLevel 1..9 writes a gzip-compressed
 	 * rawlog (flushed only on close); 0 writes a plain rawlog whose flush()
 	 * reaches the OS, for live grabbing. Throws RawlogError if the file
 	 * cannot be created. */
@@ -74,8 +75,10 @@ class RawlogWriter
 	/** Appends one observation (observations-only rawlog format). */
 	void write(const mrpt::obs::CObservation& obs);
 	/** Pushes buffered bytes to the OS (so a kill loses at most the last
-	 * object). */
+	 * object). Throws RawlogError naming the file if the write failed. */
 	void flush();
+	/** Closes the file; throws RawlogError naming it if the last bytes
+	 * could not be written (plain rawlogs). */
 	void close();
 	size_t written() const { return n_; }
 	const std::string& path() const { return path_; }
