@@ -74,13 +74,15 @@ OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
 }
 
 double OutputWriter::writeFrame(const FrameResult& r,
-                                mrpt::obs::CObservation3DRangeScan::Ptr scan)
+                                mrpt::obs::CObservation3DRangeScan::Ptr scan,
+                                uint32_t flags)
 {
 	// What the writer needs, in buffers of its own (the pipeline keeps the
 	// mask as its feedback).
 	auto c = std::make_shared<FrameResult>(r);
 	c->maskTier1 = c->maskTier2 = c->maskFlow = cv::Mat();
 	c->flowObserved = c->flowExpected = cv::Mat();
+	c->ego.flags = flags;
 	c->mask = r.mask.clone();
 	c->labels = p_.flow_labels ? r.labels.clone() : cv::Mat();
 	return worker_.post(
@@ -193,19 +195,20 @@ void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
 	j << "{\n";
 	j << "  \"variant\": \"" << sum.variant << "\",\n";
 	j << "  \"config\": \"" << pipe.config().source << "\",\n";
-	std::snprintf(
-	    buf, sizeof(buf),
-	    "  \"frames_processed\": %zu,\n  \"frames_flagged\": %zu,\n  "
-	    "\"scans_read\": %zu,\n  \"imu_read\": %zu,\n"
-	    "  \"scans_out_of_order\": %zu,\n  \"wall_seconds\": %.3f,\n "
-	    " \"cpu_seconds\": %.3f,\n  \"peak_resident_mib\": %.1f,\n"
-	    "  \"fps\": %.3f,\n  \"data_seconds\": %.3f,\n"
-	    "  \"mean_moving_pixel_fraction\": %.6f,\n  "
-	    "\"static_map_voxels\": %zu,\n  \"frames_flow_ahead\": %zu,\n",
-	    sum.framesProcessed, sum.framesFlagged, sum.scansRead, sum.imuRead,
-	    sum.scansOutOfOrder, sum.seconds, sum.cpuSeconds, sum.peakResidentMiB,
-	    sum.fps(), sum.dataSeconds, sum.meanMovingPixelFraction, nStatic,
-	    sum.framesFlowAhead);
+	std::snprintf(buf, sizeof(buf),
+	              "  \"frames_processed\": %zu,\n  \"frames_flagged\": %zu,\n  "
+	              "\"scans_read\": %zu,\n  \"imu_read\": %zu,\n"
+	              "  \"scans_out_of_order\": %zu,\n  \"wall_seconds\": %.3f,\n "
+	              " \"cpu_seconds\": %.3f,\n  \"peak_resident_mib\": %.1f,\n"
+	              "  \"fps\": %.3f,\n  \"data_seconds\": %.3f,\n"
+	              "  \"mean_moving_pixel_fraction\": %.6f,\n  "
+	              "\"static_map_voxels\": %zu,\n  \"frames_flow_ahead\": %zu,\n"
+	              "  \"imu_rejected\": %zu,\n  \"scans_bad_stamp\": %zu,\n",
+	              sum.framesProcessed, sum.framesFlagged, sum.scansRead,
+	              sum.imuRead, sum.scansOutOfOrder, sum.seconds, sum.cpuSeconds,
+	              sum.peakResidentMiB, sum.fps(), sum.dataSeconds,
+	              sum.meanMovingPixelFraction, nStatic, sum.framesFlowAhead,
+	              sum.imuRejected, sum.scansBadStamp);
 	j << buf;
 	j << "  \"stage_ms\": {";
 	bool first = true;

@@ -23,11 +23,13 @@ class OutputWriter
 	/** Queues the frame's outputs: mask PNG, moving-voxel PLY, trajectory and
 	 * CSV lines (flushed), and the scan into the labelled rawlog with the
 	 * mask as its pixel labels (set on \a scan itself, so the images are not
-	 * copied: the caller must not touch \a scan any more). Returns the time
-	 * spent waiting for room in the queue [ms]. Throws the error of an
-	 * earlier write that failed. */
+	 * copied: the caller must not touch \a scan any more). \a flags: the
+	 * frame's ego flags as written (r.ego.flags and those the run adds).
+	 * Returns the time spent waiting for room in the queue [ms]. Throws the
+	 * error of an earlier write that failed. */
 	double writeFrame(const FrameResult& r,
-	                  mrpt::obs::CObservation3DRangeScan::Ptr scan);
+	                  mrpt::obs::CObservation3DRangeScan::Ptr scan,
+	                  uint32_t flags);
 	/** Queues a non-scan observation (IMU) for the labelled rawlog. */
 	double writeOther(mrpt::obs::CObservation::Ptr obs);
 	/** Waits for the queued writes, closes the labelled rawlog, writes the

@@ -37,6 +37,13 @@ struct RunSummary
 	size_t scansRead = 0, framesProcessed = 0, imuRead = 0, otherSkipped = 0;
 	size_t framesFlagged = 0;    ///< frames with an egomotion flag
 	size_t scansOutOfOrder = 0;  ///< dropped: timestamp not increasing
+	/** dropped: timestamp more than kMaxScanGapS after the previous scan's
+	 * and the next scan's not close to it (a stray stamp) */
+	size_t scansBadStamp = 0;
+	/** IMU samples not used: a field not finite or beyond any sensor's
+	 * range (bims::imuSampleProblem); the frames whose interval held one
+	 * are flagged imu_rejected */
+	size_t imuRejected = 0;
 	/** frames whose observed flow ran during the previous frame's grids
 	 * ([pipeline] flow_lookahead) */
 	size_t framesFlowAhead = 0;
@@ -76,6 +83,17 @@ struct RunOptions
 	bool progress = true;
 	FrameCallback onFrame;
 };
+
+/** A 3D scan stamped more than this after the previous one [s] is held
+ * back: processed when the next scan follows it within this gap (the
+ * recording jumped, e.g. a second rawlog), skipped with a warning when the
+ * next scan does not (a stray stamp), or when it is the last. */
+constexpr double kMaxScanGapS = 10.0;
+
+/** Throws std::runtime_error naming the frame (scan index and time) if
+ * anything bims-run writes of it is not finite: the pose, the moving
+ * voxels. */
+void checkFiniteOutputs(const FrameResult& r);
 
 /** Runs \a cfg over the rawlogs, reading ahead on a thread ([pipeline]
  * read_ahead) and writing on another ([output] writer_thread); returns when
