@@ -1,4 +1,5 @@
 #include <bims/common/app.h>
+#include <bims/common/json.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
 #include <bims/eval/plots.h>
@@ -108,7 +109,7 @@ int cmdTraj(int argc, char** argv)
 
 	if (json.isSet())
 	{
-		bims::writeFileAtomically(json.getValue(), rep.toJson());
+		bims::writeJsonFile(json.getValue(), rep.toJson());
 	}
 	if (!noPlot.getValue())
 	{

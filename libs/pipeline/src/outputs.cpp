@@ -1,5 +1,6 @@
 #include "outputs.h"
 #include <bims/common/frame_files.h>
+#include <bims/common/json.h>
 #include <bims/common/output_paths.h>
 
 #include "cpu_time.h"
@@ -13,7 +14,6 @@
 #include <chrono>
 #include <cstdio>
 #include <opencv2/imgcodecs.hpp>
-#include <sstream>
 #include <stdexcept>
 
 namespace bims::pipeline
@@ -189,51 +189,33 @@ size_t OutputWriter::close(const Pipeline& pipe)
 
 void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
 {
-	const size_t nStatic = staticVoxels_;
-	std::ostringstream j;
-	char buf[1024];
-	j << "{\n";
-	j << "  \"variant\": \"" << sum.variant << "\",\n";
-	j << "  \"config\": \"" << pipe.config().source << "\",\n";
-	std::snprintf(buf, sizeof(buf),
-	              "  \"frames_processed\": %zu,\n  \"frames_flagged\": %zu,\n  "
-	              "\"scans_read\": %zu,\n  \"imu_read\": %zu,\n"
-	              "  \"scans_out_of_order\": %zu,\n  \"wall_seconds\": %.3f,\n "
-	              " \"cpu_seconds\": %.3f,\n  \"peak_resident_mib\": %.1f,\n"
-	              "  \"fps\": %.3f,\n  \"data_seconds\": %.3f,\n"
-	              "  \"mean_moving_pixel_fraction\": %.6f,\n  "
-	              "\"static_map_voxels\": %zu,\n  \"frames_flow_ahead\": %zu,\n"
-	              "  \"imu_rejected\": %zu,\n  \"scans_bad_stamp\": %zu,\n",
-	              sum.framesProcessed, sum.framesFlagged, sum.scansRead,
-	              sum.imuRead, sum.scansOutOfOrder, sum.seconds, sum.cpuSeconds,
-	              sum.peakResidentMiB, sum.fps(), sum.dataSeconds,
-	              sum.meanMovingPixelFraction, nStatic, sum.framesFlowAhead,
-	              sum.imuRejected, sum.scansBadStamp);
-	j << buf;
-	j << "  \"stage_ms\": {";
-	bool first = true;
+	Json j;
+	j["variant"] = sum.variant;
+	j["config"] = pipe.config().source;
+	j["frames_processed"] = sum.framesProcessed;
+	j["frames_flagged"] = sum.framesFlagged;
+	j["scans_read"] = sum.scansRead;
+	j["imu_read"] = sum.imuRead;
+	j["scans_out_of_order"] = sum.scansOutOfOrder;
+	j["wall_seconds"] = jsonNumber(sum.seconds, 3);
+	j["cpu_seconds"] = jsonNumber(sum.cpuSeconds, 3);
+	j["peak_resident_mib"] = jsonNumber(sum.peakResidentMiB, 1);
+	j["fps"] = jsonNumber(sum.fps(), 3);
+	j["data_seconds"] = jsonNumber(sum.dataSeconds, 3);
+	j["mean_moving_pixel_fraction"] =
+	    jsonNumber(sum.meanMovingPixelFraction, 6);
+	j["static_map_voxels"] = staticVoxels_;
+	j["frames_flow_ahead"] = sum.framesFlowAhead;
+	j["imu_rejected"] = sum.imuRejected;
+	j["scans_bad_stamp"] = sum.scansBadStamp;
+	Json& stages = j["stage_ms"] = Json::object();
 	for (const auto& [name, p] : sum.stageMs)
-	{
-		std::snprintf(buf, sizeof(buf),
-		              "%s\n    \"%s\": {\"median\": %.3f, \"p95\": %.3f, "
-		              "\"mean\": %.3f, \"n\": %zu}",
-		              first ? "" : ",", name.c_str(), p.median, p.p95, p.mean,
-		              p.n);
-		j << buf;
-		first = false;
-	}
-	j << "\n  },\n";
-	std::string err;
-	for (char c : sum.error)
-	{
-		if (c == '"' || c == '\\') err += '\\';
-		if (c == '\n')
-			err += "\\n";
-		else
-			err += c;
-	}
-	j << "  \"error\": \"" << err << "\"\n}\n";
-	writeFileAtomically(dir_ + "/metrics.json", j.str());
+		stages[name] = {{"median", jsonNumber(p.median, 3)},
+		                {"p95", jsonNumber(p.p95, 3)},
+		                {"mean", jsonNumber(p.mean, 3)},
+		                {"n", p.n}};
+	j["error"] = sum.error;
+	writeJsonFile(dir_ + "/metrics.json", j);
 }
 
 }  // namespace bims::pipeline

@@ -1,6 +1,7 @@
 // bims-run's runExperiment on inputs that are wrong in their values, not in
 // their bytes: IMU samples no sensor gives, a stray scan timestamp, a frame
 // whose outputs would not be finite.
+#include <bims/common/json.h>
 #include <bims/common/rawlog.h>
 #include <bims/ego/flags.h>
 #include <bims/pipeline/run.h>
@@ -58,10 +59,11 @@ std::string sampleWith(const std::string& dir, size_t scans,
 	return path;
 }
 
-RunSummary runOn(const std::string& rawlog, const std::string& out)
+RunSummary runOn(const std::string& rawlog, const std::string& out,
+                 const std::string& ini = kSrc + "/config/default.ini")
 {
 	ExperimentConfig cfg;
-	cfg.loadFromFile(kSrc + "/config/default.ini");
+	cfg.loadFromFile(ini);
 	RunOptions opt;
 	opt.rawlogs = {rawlog};
 	opt.outDir = out;
@@ -191,4 +193,25 @@ TEST(RunFaults, AFrameWithANonFiniteOutputIsAnErrorNamingIt)
 	r.T_WC = mrpt::poses::CPose3D();
 	r.movingVoxelCentres.push_back({1, std::nan(""), 0});
 	EXPECT_THROW(checkFiniteOutputs(r), std::runtime_error);
+}
+
+TEST(RunFaults, MetricsJsonStaysValidWithQuotesAndControlCharacters)
+{
+	// the config path holds a quote, the error text (naming the truncated
+	// rawlog) a control character
+	const auto d = tmpDir("json") + "/a\"b\x01" + "c";
+	fs::create_directories(d);
+	const std::string ini = d + "/con\"fig.ini";
+	fs::copy_file(kSrc + "/config/default.ini", ini);
+	const std::string in = sampleWith(d, 4, [](auto&, int, int) {});
+	fs::resize_file(in, fs::file_size(in) - 1000);
+	const auto sum = runOn(in, d + "/out", ini);
+	ASSERT_NE(sum.error.find("\x01"), std::string::npos) << sum.error;
+	std::ifstream f(d + "/out/metrics.json");
+	std::stringstream s;
+	s << f.rdbuf();
+	const auto j = bims::Json::parse(s.str());  // throws if invalid
+	EXPECT_EQ(j["config"], ini);
+	EXPECT_EQ(j["error"], sum.error);
+	EXPECT_EQ(j["frames_processed"], sum.framesProcessed);
 }
