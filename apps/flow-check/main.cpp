@@ -33,6 +33,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <set>
@@ -155,19 +156,16 @@ int main(int argc, char** argv)
 		    if (aFrames.isSet())
 			    opt.frames =
 			        bims::pipeline::FrameRange::parse(aFrames.getValue());
-		    std::ofstream csv;
+		    std::unique_ptr<bims::AppendFile> csv;  // each line checked
 		    if (aCsv.isSet())
 		    {
-			    bims::replaceSymlink(aCsv.getValue());
-			    csv.open(aCsv.getValue());
-			    if (!csv)
-				    throw std::runtime_error(aCsv.getValue() +
-				                             ": cannot create");
-			    csv << "index,flags,valid_px,diff_ego,diff_used,diff_gt,diff_"
-			           "flow,px_ego,px_used,px_gt,px_flow,rot_ego_gt_deg,"
-			           "rot_ego_flow_deg,rot_gt_flow_deg,rot_used_flow_deg,"
-			           "t_ego_gt_mm,t_ego_flow_mm,t_gt_flow_mm,t_used_flow_mm,"
-			           "gt_rot_deg,gt_t_mm,edge_share_used\n";
+			    csv = std::make_unique<bims::AppendFile>(aCsv.getValue());
+			    csv->append(
+			        "index,flags,valid_px,diff_ego,diff_used,diff_gt,diff_"
+			        "flow,px_ego,px_used,px_gt,px_flow,rot_ego_gt_deg,"
+			        "rot_ego_flow_deg,rot_gt_flow_deg,rot_used_flow_deg,"
+			        "t_ego_gt_mm,t_ego_flow_mm,t_gt_flow_mm,t_used_flow_mm,"
+			        "gt_rot_deg,gt_t_mm,edge_share_used\n");
 		    }
 		    std::printf(
 		        "# index flags | Diff%% ego used gt flow | median px ego used "
@@ -253,9 +251,11 @@ int main(int argc, char** argv)
 			        row[17], row[18]);
 			    if (csv)
 			    {
-				    csv << r.index << "," << r.ego.flags << "," << validPx;
-				    for (double x : row) csv << "," << x;
-				    csv << "\n";
+				    std::ostringstream line;
+				    line << r.index << "," << r.ego.flags << "," << validPx;
+				    for (double x : row) line << "," << x;
+				    line << "\n";
+				    csv->append(line.str());
 			    }
 			    if (stripFrames.count(r.index))
 			    {

@@ -3,6 +3,7 @@
 #include <bims_test/run_command.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -93,4 +94,84 @@ TEST(RunApp, SymlinkedOutputFilesAreReplacedNotFollowed)
 		EXPECT_FALSE(fs::is_symlink(fs::symlink_status(out + "/" + f))) << f;
 		EXPECT_GT(fs::file_size(out + "/" + f), 0u) << f;
 	}
+}
+
+namespace
+{
+/** default.ini with [output] as given (the other sections as they are). */
+std::string configWithOutput(const std::string& dir, const std::string& out)
+{
+	std::string ini = slurp(kConfig);
+	ini = ini.substr(0, ini.find("[output]")) + "[output]\n" + out;
+	const std::string path = dir + "/exp.ini";
+	std::ofstream(path) << ini;
+	return path;
+}
+
+/** bims-run ARGS with every file limited to \a kib KiB (ulimit -f) and
+ * SIGXFSZ ignored: a write past it fails with EFBIG, as on a full disk. */
+bims::test::CommandResult runLimited(int kib, const std::string& args)
+{
+	return bims::test::runCommand("bash -c \"ulimit -f " + std::to_string(kib) +
+	                              "; trap '' XFSZ; exec " + kBin +
+	                              "/bims-run " + args + "\"");
+}
+
+size_t lineCount(const std::string& path)
+{
+	const std::string s = slurp(path);
+	return static_cast<size_t>(std::count(s.begin(), s.end(), '\n'));
+}
+/** bims-run CONFIG on the sample into DIR/out with files limited to \a kib
+ * KiB: expects exit 1 and the error naming DIR/out/FILE; returns the
+ * frames in frames.csv. */
+size_t framesWhenFull(const std::string& dir, const std::string& config,
+                      int kib, const std::string& file)
+{
+	const auto r = runLimited(
+	    kib, q(config) + " " + q(kSample) + " -o " + q(dir + "/out") + " -q");
+	EXPECT_EQ(r.code, 1) << r.out;
+	EXPECT_NE(
+	    r.out.find(dir + "/out/" + file + ": write failed: File too large"),
+	    std::string::npos)
+	    << r.out;
+	const size_t frames = lineCount(dir + "/out/frames.csv") - 1;
+	EXPECT_LT(frames, 150u);
+	return frames;
+}
+}  // namespace
+
+TEST(RunApp, AFullDiskStopsTheRunAtTheFirstFailedWriteNamingTheFile)
+{
+	// masks, trajectory and CSV only: trajectory.txt passes 6 KiB first
+	const auto d = tmpDir("full_disk");
+	const auto ini = configWithOutput(
+	    d, "labelled_rawlog=false\nmoving_ply=false\nstatic_map=false\n");
+	const size_t frames = framesWhenFull(d, ini, 6, "trajectory.txt");
+	EXPECT_GT(frames, 5u);
+	// every file holds whole lines, the same frames; every mask is whole
+	const std::string traj = slurp(d + "/out/trajectory.txt");
+	const std::string csv = slurp(d + "/out/frames.csv");
+	ASSERT_FALSE(csv.empty());
+	EXPECT_EQ(traj.back(), '\n');
+	EXPECT_EQ(csv.back(), '\n');
+	EXPECT_LE(lineCount(d + "/out/trajectory.txt") - 2, frames + 1);
+	size_t masks = 0;
+	for (const auto& e : fs::directory_iterator(d + "/out/masks"))
+	{
+		EXPECT_GT(fs::file_size(e.path()), 0u) << e.path();
+		EXPECT_EQ(e.path().extension(), ".png") << e.path();  // no .partial
+		masks++;
+	}
+	EXPECT_LE(masks, frames + 1);
+	// the error is in metrics.json too
+	EXPECT_NE(
+	    slurp(d + "/out/metrics.json").find("trajectory.txt: write failed"),
+	    std::string::npos);
+}
+
+TEST(RunApp, AFullDiskUnderTheLabelledRawlogStopsTheRunToo)
+{
+	const auto d = tmpDir("full_disk_rawlog");
+	EXPECT_GT(framesWhenFull(d, kConfig, 2048, "segmented.rawlog"), 2u);
 }

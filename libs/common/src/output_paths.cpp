@@ -131,6 +131,48 @@ void writeFileAtomically(const std::string& path, const std::string& bytes)
 	part.commit();
 }
 
+AppendFile::AppendFile(std::string path) : path_(std::move(path))
+{
+	replaceSymlink(path_);
+	fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+	if (fd_ < 0) throw systemError(path_, "cannot create");
+}
+
+AppendFile::~AppendFile()
+{
+	if (fd_ >= 0) ::close(fd_);
+}
+
+void AppendFile::append(const void* data, size_t n)
+{
+	if (fd_ < 0) throw std::runtime_error(path_ + ": write after close");
+	const char* p = static_cast<const char*>(data);
+	size_t done = 0;
+	while (done < n)
+	{
+		const ssize_t k = ::write(fd_, p + done, n - done);
+		if (k < 0 && errno == EINTR) continue;
+		if (k <= 0)
+		{
+			const auto e = systemError(path_, "write failed");
+			// back to the last whole record (shrinking is always allowed)
+			if (::ftruncate(fd_, static_cast<off_t>(size_)) == 0)
+				::lseek(fd_, static_cast<off_t>(size_), SEEK_SET);
+			throw e;
+		}
+		done += static_cast<size_t>(k);
+	}
+	size_ += n;
+}
+
+void AppendFile::close()
+{
+	if (fd_ < 0) return;
+	const int fd = fd_;
+	fd_ = -1;
+	if (::close(fd) != 0) throw systemError(path_, "write failed on close");
+}
+
 void writeImageFile(const std::string& path, const cv::Mat& img)
 {
 	std::vector<uchar> bytes;

@@ -3,6 +3,11 @@
 #include <bims/common/app.h>
 #include <bims/common/output_paths.h>
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
 
 #include <filesystem>
 #include <fstream>
@@ -135,4 +140,37 @@ TEST(OutputPaths, APartialFileAppearsOnlyWhenCommitted)
 	}
 	EXPECT_EQ(slurp(d + "/out.rawlog"), "whole");
 	EXPECT_FALSE(fs::exists(d + "/out.rawlog.partial"));
+}
+
+TEST(OutputPaths, AFailedAppendLeavesTheFileAtItsLastWholeRecord)
+{
+	// a child limited to 100-byte files (SIGXFSZ ignored: writes fail with
+	// EFBIG, as on a full disk) appends 18-byte records
+	const auto d = fresh("append_limit");
+	const std::string path = d + "/records.txt";
+	const pid_t pid = fork();
+	ASSERT_GE(pid, 0);
+	if (pid == 0)
+	{
+		std::signal(SIGXFSZ, SIG_IGN);
+		const rlimit lim{100, 100};
+		setrlimit(RLIMIT_FSIZE, &lim);
+		try
+		{
+			bims::AppendFile f(path);
+			for (int i = 0; i < 100; i++) f.append("record 0123456789\n");
+			_exit(0);
+		}
+		catch (const std::exception& e)
+		{
+			const std::string m = e.what();
+			_exit(m.find(path + ": write failed: File too large") == 0 ? 3 : 4);
+		}
+	}
+	int status = 0;
+	waitpid(pid, &status, 0);
+	ASSERT_TRUE(WIFEXITED(status));
+	EXPECT_EQ(WEXITSTATUS(status), 3);
+	EXPECT_EQ(fs::file_size(path), 90u);  // 5 whole records
+	EXPECT_EQ(slurp(path).back(), '\n');
 }

@@ -13,6 +13,8 @@
 
 #include <chrono>
 #include <cstdio>
+#include <functional>
+#include <initializer_list>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
@@ -54,20 +56,16 @@ OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
 	makeDirs(dir_ + "/masks");
 	if (p_.moving_ply) makeDirs(dir_ + "/moving_voxels");
 	if (p_.flow_labels) makeDirs(dir_ + "/flow_labels");
-	// the streamed files replace a symbolic link, never write through it
-	replaceSymlink(dir_ + "/trajectory.txt");
-	replaceSymlink(dir_ + "/frames.csv");
-	traj_.open(dir_ + "/trajectory.txt");
-	csv_.open(dir_ + "/frames.csv");
-	if (!traj_ || !csv_)
-		throw std::runtime_error(dir_ + ": cannot create output files");
-	traj_ << "# bims-run estimated camera trajectory T_WC (optical frame)\n# "
-	         "timestamp tx ty tz qx qy qz qw\n";
-	csv_ << "index,t,ego_flags,correspondences,inliers,residual_m,hit_voxels,"
-	        "moving_voxels,moving_px,diff_px,notdiff_px,"
-	        "ms_input,ms_ego,ms_flow,ms_grids,ms_total\n";
-	traj_.flush();
-	csv_.flush();
+	// grown line by line, each line checked and whole
+	traj_ = std::make_unique<AppendFile>(dir_ + "/trajectory.txt");
+	csv_ = std::make_unique<AppendFile>(dir_ + "/frames.csv");
+	traj_->append(
+	    "# bims-run estimated camera trajectory T_WC (optical frame)\n# "
+	    "timestamp tx ty tz qx qy qz qw\n");
+	csv_->append(
+	    "index,t,ego_flags,correspondences,inliers,residual_m,hit_voxels,"
+	    "moving_voxels,moving_px,diff_px,notdiff_px,"
+	    "ms_input,ms_ego,ms_flow,ms_grids,ms_total\n");
 	if (p_.labelled_rawlog)
 		rawlog_ = std::make_unique<RawlogWriter>(dir_ + "/segmented.rawlog",
 		                                         p_.labelled_rawlog_gz_level);
@@ -113,8 +111,7 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 		writeImageFile(dir_ + "/flow_labels/" + frameFileName(long(r.index)),
 		               vis);
 	}
-	traj_ << tumLine(r.t, r.T_WC) << "\n";
-	traj_.flush();
+	traj_->append(tumLine(r.t, r.T_WC) + "\n");
 	char buf[512];
 	std::snprintf(
 	    buf, sizeof(buf),
@@ -123,8 +120,7 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 	    r.ego.residual_rms_m, r.hitVoxels, r.movingVoxels,
 	    cv::countNonZero(r.mask), r.labelStats.diff, r.labelStats.notDiff,
 	    r.ms.input, r.ms.ego, r.ms.flow, r.ms.grids, r.ms.total);
-	csv_ << buf;
-	csv_.flush();
+	csv_->append(buf);
 	if (rawlog_)
 	{
 		// Label 0 ("moving"), bit 0 of each pixel's byte; written in one
@@ -133,8 +129,8 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 		    r.mask.ptr<uint8_t>(0), r.mask.rows, r.mask.cols, r.mask.step[0],
 		    "moving");  // no copy of the images
 		rawlog_->write(scan);
-		// a plain rawlog reaches the OS frame by frame: a killed run leaves
-		// it readable up to the last whole frame
+		// a plain rawlog reaches the OS object by object: a killed run
+		// leaves it readable up to the last whole frame
 		rawlog_->flush();
 	}
 }
@@ -164,7 +160,25 @@ size_t OutputWriter::close(const Pipeline& pipe)
 	{
 		err = e.what();
 	}
-	if (rawlog_) rawlog_->close();
+	// every file closed, the first error kept
+	for (const auto& closeOne :
+	     std::initializer_list<std::function<void()>>{[&] { traj_->close(); },
+	                                                  [&] { csv_->close(); },
+	                                                  [&]
+	                                                  {
+		                                                  if (rawlog_)
+			                                                  rawlog_->close();
+	                                                  }})
+	{
+		try
+		{
+			closeOne();
+		}
+		catch (const std::exception& e)
+		{
+			if (err.empty()) err = e.what();
+		}
+	}
 	size_t nStatic = 0;
 	const auto& g = pipe.grids();
 	const maps::CMotionGridBase* motion = nullptr;

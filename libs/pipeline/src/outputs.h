@@ -3,6 +3,7 @@
 // thread ([output] writer_thread), in the order the frames were given.
 #pragma once
 
+#include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
 #include <bims/pipeline/pipeline.h>
 #include <bims/pipeline/run.h>
@@ -50,7 +51,7 @@ class OutputWriter
 
 	std::string dir_;
 	OutputParams p_;
-	std::ofstream traj_, csv_;
+	std::unique_ptr<AppendFile> traj_, csv_;
 	std::unique_ptr<RawlogWriter> rawlog_;
 	size_t staticVoxels_ = 0;
 	// written by the worker thread, read after close()

@@ -407,7 +407,17 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	        .count();
 	sum.cpuSeconds = 1e-3 * (processCpuMs() - cpu0);
 	sum.peakResidentMiB = peakResidentMiB();
-	if (out) out->writeMetrics(pipe, sum);
+	if (out)
+	{
+		try
+		{
+			out->writeMetrics(pipe, sum);
+		}
+		catch (const std::exception& e)
+		{
+			addError(sum, e.what());  // reported by the caller
+		}
+	}
 	return sum;
 }
 

@@ -52,6 +52,35 @@ class PartialFile
 	bool done_ = false;
 };
 
+/** A file that grows record by record (trajectory.txt, frames.csv, a plain
+ * rawlog), for a run that may stop at any time: created (truncated; a
+ * symbolic link there replaced), each append() reaches the OS at once and
+ * is checked. A failed append (disk full, file size limit) truncates the
+ * file back to its last whole record and throws naming the file and the
+ * reason: the file never ends in half a record. */
+class AppendFile
+{
+ public:
+	explicit AppendFile(std::string path);
+	/** Closes (errors dropped: call close() to see them). */
+	~AppendFile();
+	AppendFile(const AppendFile&) = delete;
+	AppendFile& operator=(const AppendFile&) = delete;
+
+	void append(const void* data, size_t n);
+	void append(const std::string& s) { append(s.data(), s.size()); }
+	/** Closes the file; throws naming it if that fails. */
+	void close();
+	const std::string& path() const { return path_; }
+	/** Bytes written (whole records). */
+	size_t size() const { return size_; }
+
+ private:
+	std::string path_;
+	int fd_ = -1;
+	size_t size_ = 0;
+};
+
 /** Writes \a bytes to \a path through a PartialFile: every write and the
  * close checked (a full disk is an error naming the file, never a short
  * file), then renamed. */

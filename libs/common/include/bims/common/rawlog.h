@@ -5,6 +5,7 @@
 // corrupt file raises RawlogError instead of ending silently.
 #pragma once
 
+#include <bims/common/output_paths.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CObservation.h>
@@ -72,10 +73,12 @@ class RawlogWriter
 	RawlogWriter(const RawlogWriter&) = delete;
 	RawlogWriter& operator=(const RawlogWriter&) = delete;
 
-	/** Appends one observation (observations-only rawlog format). */
+	/** Appends one observation (observations-only rawlog format). A plain
+	 * rawlog gets it at once or not at all (bims::AppendFile: a failed write
+	 * leaves the file at its last whole observation and throws naming it). */
 	void write(const mrpt::obs::CObservation& obs);
-	/** Pushes buffered bytes to the OS (so a kill loses at most the last
-	 * object). Throws RawlogError naming the file if the write failed. */
+	/** Nothing to do for a plain rawlog (each object reaches the OS when
+	 * written, so a kill loses at most the last object). */
 	void flush();
 	/** Closes the file; throws RawlogError naming it if the last bytes
 	 * could not be written (plain rawlogs). */
@@ -85,7 +88,7 @@ class RawlogWriter
 
  private:
 	std::string path_;
-	std::ofstream plain_;
+	std::unique_ptr<AppendFile> plain_;  ///< a plain rawlog
 	mrpt::io::CFileGZOutputStream gz_;
 	std::vector<uint8_t> buf_;  ///< the object being written
 	std::unique_ptr<mrpt::serialization::CArchive> arch_;
