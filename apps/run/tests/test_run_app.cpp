@@ -1,7 +1,14 @@
 // bims-run as a program: what it refuses before any work, and what it never
 // does to files it did not create.
+#include <bims/common/json.h>
 #include <bims_test/run_command.h>
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <tuple>
 
 #include <algorithm>
 #include <filesystem>
@@ -94,6 +101,7 @@ TEST(RunApp, SymlinkedOutputFilesAreReplacedNotFollowed)
 		EXPECT_FALSE(fs::is_symlink(fs::symlink_status(out + "/" + f))) << f;
 		EXPECT_GT(fs::file_size(out + "/" + f), 0u) << f;
 	}
+	EXPECT_EQ(bims::Json::parse(slurp(out + "/metrics.json"))["status"], "ok");
 }
 
 namespace
@@ -174,4 +182,63 @@ TEST(RunApp, AFullDiskUnderTheLabelledRawlogStopsTheRunToo)
 {
 	const auto d = tmpDir("full_disk_rawlog");
 	EXPECT_GT(framesWhenFull(d, kConfig, 2048, "segmented.rawlog"), 2u);
+}
+
+namespace
+{
+/** bims-run on the sample twice (300 frames) into DIR/out; \a sig is sent
+ * once masks/000005.png is written. Returns the exit code (-signal if it
+ * was killed); its output goes to DIR/log. */
+int interruptedRun(const std::string& dir, int sig)
+{
+	const std::string bin = kBin + "/bims-run", out = dir + "/out",
+	                  log = dir + "/log";
+	const pid_t pid = fork();
+	if (pid == 0)
+	{
+		const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+		dup2(fd, 1);
+		dup2(fd, 2);
+		execl(bin.c_str(), bin.c_str(), kConfig.c_str(), kSample.c_str(),
+		      kSample.c_str(), "-o", out.c_str(), "-q", nullptr);
+		_exit(127);
+	}
+	for (int i = 0; i < 4000 && !fs::exists(out + "/masks/000005.png"); i++)
+		usleep(2000);
+	kill(pid, sig);
+	int st = 0;
+	waitpid(pid, &st, 0);
+	return WIFEXITED(st) ? WEXITSTATUS(st) : -WTERMSIG(st);
+}
+}  // namespace
+
+TEST(RunApp, SigintAndSigtermStopAfterTheCurrentFrameWithEverythingWritten)
+{
+	for (const auto& [sig, code, name] :
+	     {std::tuple{SIGINT, 130, "SIGINT"}, {SIGTERM, 143, "SIGTERM"}})
+	{
+		const auto d = tmpDir(name);
+		EXPECT_EQ(interruptedRun(d, sig), code) << slurp(d + "/log");
+		EXPECT_NE(slurp(d + "/log").find(std::string("interrupted by ") + name),
+		          std::string::npos)
+		    << slurp(d + "/log");
+		const auto m = bims::Json::parse(slurp(d + "/out/metrics.json"));
+		EXPECT_EQ(m["status"], "interrupted");
+		const size_t frames = m["frames_processed"];
+		EXPECT_GT(frames, 5u);
+		EXPECT_LT(frames, 300u);
+		// the frames done, each in full in every output
+		EXPECT_EQ(lineCount(d + "/out/frames.csv"), frames + 1);
+		EXPECT_EQ(lineCount(d + "/out/trajectory.txt"), frames + 2);
+		size_t masks = 0, plys = 0;
+		for ([[maybe_unused]] const auto& e :
+		     fs::directory_iterator(d + "/out/masks"))
+			masks++;
+		for ([[maybe_unused]] const auto& e :
+		     fs::directory_iterator(d + "/out/moving_voxels"))
+			plys++;
+		EXPECT_EQ(masks, frames);
+		EXPECT_EQ(plys, frames);
+		EXPECT_TRUE(fs::exists(d + "/out/static_map.ply"));
+	}
 }

@@ -11,8 +11,10 @@
 #include <bims/maps/export.h>
 #include <mrpt/obs/TPixelLabelInfo.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <functional>
 #include <initializer_list>
 #include <opencv2/imgcodecs.hpp>
@@ -54,6 +56,11 @@ OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
     : dir_(dir), p_(p), worker_(kQueuedWrites, p.writer_thread)
 {
 	makeDirs(dir_ + "/masks");
+	// written last: a folder without it is partial (an earlier run's would
+	// say otherwise)
+	if (std::remove((dir_ + "/metrics.json").c_str()) != 0 && errno != ENOENT)
+		throw std::runtime_error(
+		    dir_ + "/metrics.json: cannot remove: " + std::strerror(errno));
 	if (p_.moving_ply) makeDirs(dir_ + "/moving_voxels");
 	if (p_.flow_labels) makeDirs(dir_ + "/flow_labels");
 	// grown line by line, each line checked and whole
@@ -111,16 +118,6 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 		writeImageFile(dir_ + "/flow_labels/" + frameFileName(long(r.index)),
 		               vis);
 	}
-	traj_->append(tumLine(r.t, r.T_WC) + "\n");
-	char buf[512];
-	std::snprintf(
-	    buf, sizeof(buf),
-	    "%zu,%.6f,%u,%d,%d,%.5f,%zu,%zu,%d,%zu,%zu,%.3f,%.3f,%.3f,%.3f,%.3f\n",
-	    r.index, r.t, r.ego.flags, r.ego.correspondences, r.ego.inliers,
-	    r.ego.residual_rms_m, r.hitVoxels, r.movingVoxels,
-	    cv::countNonZero(r.mask), r.labelStats.diff, r.labelStats.notDiff,
-	    r.ms.input, r.ms.ego, r.ms.flow, r.ms.grids, r.ms.total);
-	csv_->append(buf);
 	if (rawlog_)
 	{
 		// Label 0 ("moving"), bit 0 of each pixel's byte; written in one
@@ -133,6 +130,18 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 		// leaves it readable up to the last whole frame
 		rawlog_->flush();
 	}
+	// the trajectory and frames.csv last: a frame in frames.csv is in every
+	// output
+	traj_->append(tumLine(r.t, r.T_WC) + "\n");
+	char buf[512];
+	std::snprintf(
+	    buf, sizeof(buf),
+	    "%zu,%.6f,%u,%d,%d,%.5f,%zu,%zu,%d,%zu,%zu,%.3f,%.3f,%.3f,%.3f,%.3f\n",
+	    r.index, r.t, r.ego.flags, r.ego.correspondences, r.ego.inliers,
+	    r.ego.residual_rms_m, r.hitVoxels, r.movingVoxels,
+	    cv::countNonZero(r.mask), r.labelStats.diff, r.labelStats.notDiff,
+	    r.ms.input, r.ms.ego, r.ms.flow, r.ms.grids, r.ms.total);
+	csv_->append(buf);
 }
 
 double OutputWriter::writeOther(mrpt::obs::CObservation::Ptr obs)
@@ -204,6 +213,7 @@ size_t OutputWriter::close(const Pipeline& pipe)
 void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
 {
 	Json j;
+	j["status"] = sum.status();
 	j["variant"] = sum.variant;
 	j["config"] = pipe.config().source;
 	j["frames_processed"] = sum.framesProcessed;

@@ -271,6 +271,11 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		ReadAhead input(opt.rawlogs, kReadAhead, cfg.pipeline.read_ahead);
 		for (;;)
 		{
+			if (opt.stop && *opt.stop)
+			{
+				sum.interrupted = true;  // the frames done stay written
+				break;
+			}
 			double wait = 0;
 			const auto item = input.next(&wait);
 			const auto& o = item.obs;
@@ -364,8 +369,11 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 			newestT = std::max(newestT, t);
 			flush(false);
 		}
-		if (held) dropHeld(input.path(lastFile), "it is the last scan");
-		flush(true);
+		if (!sum.interrupted)
+		{
+			if (held) dropHeld(input.path(lastFile), "it is the last scan");
+			flush(true);
+		}
 	}
 	catch (const std::exception& e)
 	{

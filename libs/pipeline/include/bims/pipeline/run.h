@@ -5,6 +5,7 @@
 
 #include <bims/pipeline/pipeline.h>
 
+#include <atomic>
 #include <functional>
 #include <map>
 #include <memory>
@@ -66,6 +67,13 @@ struct RunSummary
 	std::string variant;
 	/** Error that stopped the run early (outputs so far stay valid). */
 	std::string error;
+	/** Stopped on request (RunOptions::stop) before the end of the input. */
+	bool interrupted = false;
+	/** "interrupted", "error" or "ok" (metrics.json's "status"). */
+	const char* status() const
+	{
+		return interrupted ? "interrupted" : error.empty() ? "ok" : "error";
+	}
 	double fps() const { return seconds > 0 ? framesProcessed / seconds : 0; }
 };
 
@@ -82,6 +90,10 @@ struct RunOptions
 	FrameRange frames;
 	bool progress = true;
 	FrameCallback onFrame;
+	/** When it turns true (e.g. bims::installStopSignals), the run stops
+	 * after the current frame: the frames done are written in full,
+	 * metrics.json says "status": "interrupted". */
+	const std::atomic<bool>* stop = nullptr;
 };
 
 /** A 3D scan stamped more than this after the previous one [s] is held
