@@ -240,6 +240,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	};
 
 	ego::DepthCorrection depthCorrection(cfg.ego.depth_correction);
+	std::string readError;  ///< the input's, after the frames before it
 	auto accept = [&](PendingScan&& p)
 	{
 		lastScanT = p.t;
@@ -277,7 +278,18 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 				break;
 			}
 			double wait = 0;
-			const auto item = input.next(&wait);
+			ReadAhead::Item item;
+			try
+			{
+				item = input.next(&wait);
+			}
+			catch (const std::exception& e)
+			{
+				// a truncated or missing input ends it like its end: every
+				// frame read whole is still processed and written
+				readError = e.what();
+				break;
+			}
 			const auto& o = item.obs;
 			if (!o) break;
 			readMs += item.readMs;
@@ -380,6 +392,9 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		sum.error = e.what();
 		pending.clear();
 	}
+	if (!readError.empty())  // first: it came first
+		sum.error =
+		    readError + (sum.error.empty() ? "" : "; then: " + sum.error);
 	if (sum.scansRead == 0 && sum.error.empty())
 	{
 		std::string files;

@@ -1,6 +1,7 @@
 // bims-run's runExperiment on inputs that are wrong in their values, not in
 // their bytes: IMU samples no sensor gives, a stray scan timestamp, a frame
 // whose outputs would not be finite.
+#include <bims/common/frame_files.h>
 #include <bims/common/json.h>
 #include <bims/common/rawlog.h>
 #include <bims/ego/flags.h>
@@ -59,13 +60,14 @@ std::string sampleWith(const std::string& dir, size_t scans,
 	return path;
 }
 
-RunSummary runOn(const std::string& rawlog, const std::string& out,
+RunSummary runOn(const std::vector<std::string>& rawlogs,
+                 const std::string& out,
                  const std::string& ini = kSrc + "/config/default.ini")
 {
 	ExperimentConfig cfg;
 	cfg.loadFromFile(ini);
 	RunOptions opt;
-	opt.rawlogs = {rawlog};
+	opt.rawlogs = rawlogs;
 	opt.outDir = out;
 	opt.progress = false;
 	return runExperiment(cfg, opt);
@@ -101,7 +103,7 @@ TEST(RunFaults, AbsurdImuSamplesAreRejectedCountedAndFlagged)
 			               m->set(mrpt::obs::IMU_Z_ACC,
 			                      std::numeric_limits<double>::quiet_NaN());
 	               });
-	const auto sum = runOn(in, d + "/out");
+	const auto sum = runOn({in}, d + "/out");
 	EXPECT_EQ(sum.error, "");
 	EXPECT_EQ(sum.framesProcessed, 12u);
 	EXPECT_EQ(sum.imuRejected, 2u);
@@ -137,7 +139,7 @@ TEST(RunFaults, AStrayScanStampSkipsThatFrameOnly)
 	                           {
 		                           if (scan == 6) shift(o, 1e6);
 	                           });
-	const auto sum = runOn(in, d + "/out");
+	const auto sum = runOn({in}, d + "/out");
 	EXPECT_EQ(sum.error, "");
 	EXPECT_EQ(sum.scansRead, 20u);
 	EXPECT_EQ(sum.framesProcessed, 19u);
@@ -150,7 +152,7 @@ TEST(RunFaults, AStrayScanStampSkipsThatFrameOnly)
 	                            {
 		                            if (scan == 19) shift(o, 1e6);
 	                            });
-	const auto sum2 = runOn(in2, d + "/out2");
+	const auto sum2 = runOn({in2}, d + "/out2");
 	EXPECT_EQ(sum2.framesProcessed, 19u);
 	EXPECT_EQ(sum2.scansBadStamp, 1u);
 }
@@ -166,7 +168,7 @@ TEST(RunFaults, AJumpOfTheWholeRecordingLosesNoFrame)
 		                           if (scan == 6) jumped = true;
 		                           if (jumped) shift(o, 1000);
 	                           });
-	const auto sum = runOn(in, d + "/out");
+	const auto sum = runOn({in}, d + "/out");
 	EXPECT_EQ(sum.error, "");
 	EXPECT_EQ(sum.framesProcessed, 20u);
 	EXPECT_EQ(sum.scansBadStamp, 0u);
@@ -205,7 +207,7 @@ TEST(RunFaults, MetricsJsonStaysValidWithQuotesAndControlCharacters)
 	fs::copy_file(kSrc + "/config/default.ini", ini);
 	const std::string in = sampleWith(d, 4, [](auto&, int, int) {});
 	fs::resize_file(in, fs::file_size(in) - 1000);
-	const auto sum = runOn(in, d + "/out", ini);
+	const auto sum = runOn({in}, d + "/out", ini);
 	ASSERT_NE(sum.error.find("\x01"), std::string::npos) << sum.error;
 	std::ifstream f(d + "/out/metrics.json");
 	std::stringstream s;
@@ -214,4 +216,41 @@ TEST(RunFaults, MetricsJsonStaysValidWithQuotesAndControlCharacters)
 	EXPECT_EQ(j["config"], ini);
 	EXPECT_EQ(j["error"], sum.error);
 	EXPECT_EQ(j["frames_processed"], sum.framesProcessed);
+}
+
+TEST(RunFaults, ATruncatedInputKeepsEveryFrameReadWhole)
+{
+	// the bundled sample cut at several offsets, look-ahead on (default)
+	const auto d = tmpDir("cut");
+	const std::string whole = kSrc + "/rawlogs/pendulum_slow.rawlog";
+	for (const size_t offset : {300000u, 777777u, 1500000u, 2345678u})
+	{
+		const std::string cut =
+		    d + "/cut_" + std::to_string(offset) + ".rawlog";
+		fs::copy_file(whole, cut);
+		fs::resize_file(cut, offset);
+		const auto out = d + "/out_" + std::to_string(offset);
+		const auto sum = runOn({cut}, out);
+		EXPECT_NE(sum.error.find(cut + ": truncated or corrupt rawlog"),
+		          std::string::npos)
+		    << sum.error;
+		EXPECT_GT(sum.scansRead, 1u) << offset;
+		EXPECT_EQ(sum.framesProcessed, sum.scansRead) << offset;
+		EXPECT_EQ(lines(out + "/frames.csv").size(), sum.scansRead + 1)
+		    << offset;
+		EXPECT_TRUE(fs::exists(out + "/masks/" +
+		                       bims::frameFileName(long(sum.scansRead) - 1)))
+		    << offset;
+	}
+}
+
+TEST(RunFaults, AMissingSecondInputKeepsTheFirstFilesLastFrame)
+{
+	const auto d = tmpDir("missing");
+	const auto first = sampleWith(d, 10, [](auto&, int, int) {});
+	const auto sum = runOn({first, d + "/nothing.rawlog"}, d + "/out");
+	EXPECT_NE(sum.error.find("nothing.rawlog"), std::string::npos) << sum.error;
+	EXPECT_EQ(sum.scansRead, 10u);
+	EXPECT_EQ(sum.framesProcessed, 10u);
+	EXPECT_TRUE(fs::exists(d + "/out/masks/000009.png"));
 }
