@@ -1,5 +1,6 @@
 // bims-run as a program: what it refuses before any work, and what it never
 // does to files it did not create.
+#include <bims/common/frame_files.h>
 #include <bims/common/json.h>
 #include <bims_test/run_command.h>
 #include <fcntl.h>
@@ -241,4 +242,39 @@ TEST(RunApp, SigintAndSigtermStopAfterTheCurrentFrameWithEverythingWritten)
 		EXPECT_EQ(plys, frames);
 		EXPECT_TRUE(fs::exists(d + "/out/static_map.ply"));
 	}
+}
+
+TEST(RunApp, AfterSigkillEveryFileIsWholeAndNoMetricsSaysDone)
+{
+	const auto d = tmpDir("sigkill");
+	fs::create_directories(d + "/out");
+	std::ofstream(d + "/out/metrics.json")
+	    << "{\"status\": \"ok\"}\n";  // stale
+	EXPECT_EQ(interruptedRun(d, SIGKILL), -SIGKILL);
+	EXPECT_FALSE(fs::exists(d + "/out/metrics.json"));
+	const std::string csv = slurp(d + "/out/frames.csv");
+	ASSERT_FALSE(csv.empty());
+	EXPECT_EQ(csv.back(), '\n');
+	// a frame in frames.csv has its mask and PLY, each whole
+	std::stringstream lines(csv);
+	std::string line;
+	std::getline(lines, line);  // header
+	size_t frames = 0;
+	while (std::getline(lines, line))
+	{
+		const long i = std::stol(line.substr(0, line.find(',')));
+		EXPECT_GT(fs::file_size(d + "/out/masks/" + bims::frameFileName(i)), 0u)
+		    << i;
+		const std::string ply =
+		    slurp(d + "/out/moving_voxels/" + bims::frameFileName(i, "ply"));
+		const auto n = std::stoul(ply.substr(ply.find("element vertex ") + 15));
+		const auto body = ply.substr(ply.find("end_header\n") + 11);
+		EXPECT_EQ(
+		    static_cast<size_t>(std::count(body.begin(), body.end(), '\n')), n)
+		    << i;
+		frames++;
+	}
+	EXPECT_GT(frames, 5u);
+	for (const auto& e : fs::directory_iterator(d + "/out/moving_voxels"))
+		EXPECT_GT(fs::file_size(e.path()), 0u) << e.path();
 }
