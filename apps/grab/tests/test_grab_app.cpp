@@ -143,6 +143,16 @@ TEST(GrabApp, BadConfigNamesFileSectionAndKey)
 	const std::string msg = slurp(log);
 	EXPECT_NE(msg.find("frame_rate"), std::string::npos) << msg;
 	EXPECT_NE(msg.find("RGBD"), std::string::npos) << msg;
+	// a driver that is none: the file, the section and the driver named
+	std::ofstream(ini) << "[RGBD]\ndriver=OpenNI2\ndevice_uri=Dummy\n"
+	                      "[IMU]\ndriver=NoSuchImu\n";
+	EXPECT_EQ(run("'" + kGrab + "' '" + ini + "' -o '" + kOut +
+	              "/bad.rawlog' > '" + log + "' 2>&1"),
+	          1);
+	const std::string msg2 = slurp(log);
+	EXPECT_NE(msg2.find(ini + ": [IMU] driver=NoSuchImu: not an IMU driver"),
+	          std::string::npos)
+	    << msg2;
 }
 
 TEST(GrabApp, CtrlCStopsCleanlyAndKillLosesAtMostTheLastFrame)

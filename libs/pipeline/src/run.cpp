@@ -241,6 +241,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 
 	ego::DepthCorrection depthCorrection(cfg.ego.depth_correction);
 	std::string readError;  ///< the input's, after the frames before it
+	std::string firstSize;  ///< "WxH (3D scan #i of FILE)" of the first scan
 	auto accept = [&](PendingScan&& p)
 	{
 		lastScanT = p.t;
@@ -366,6 +367,27 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 					    "timestamp not after the previous one; skipped\n",
 					    path.c_str(), idx);
 					continue;
+				}
+				if (scan->hasRangeImage)
+				{
+					const std::string size =
+					    std::to_string(scan->rangeImage.cols()) + "x" +
+					    std::to_string(scan->rangeImage.rows());
+					if (firstSize.empty())
+						firstSize = size + " (3D scan #" + std::to_string(idx) +
+						            " of " + path + ")";
+					else if (firstSize.compare(0, size.size() + 1,
+					                           size + " ") != 0)
+					{
+						// an input error: the frames before it are written
+						readError = path + ": 3D scan #" + std::to_string(idx) +
+						            " has a " + size +
+						            " depth image where the run's first had " +
+						            firstSize +
+						            ": one run takes one image size (camera "
+						            "mode)";
+						break;
+					}
 				}
 				PendingScan p{scan, idx, t, readMs, readCpuMs, inWaitMs, {}};
 				readMs = readCpuMs = inWaitMs = 0;

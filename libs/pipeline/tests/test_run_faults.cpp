@@ -254,3 +254,27 @@ TEST(RunFaults, AMissingSecondInputKeepsTheFirstFilesLastFrame)
 	EXPECT_EQ(sum.framesProcessed, 10u);
 	EXPECT_TRUE(fs::exists(d + "/out/masks/000009.png"));
 }
+
+TEST(RunFaults, AChangedImageSizeIsAnErrorNamingFileScanAndSizes)
+{
+	const auto d = tmpDir("size");
+	const auto in = sampleWith(
+	    d, 8,
+	    [](mrpt::obs::CObservation& o, int scan, int)
+	    {
+		    auto* s = dynamic_cast<mrpt::obs::CObservation3DRangeScan*>(&o);
+		    if (!s || scan != 5) return;
+		    s->rangeImage_setSize(120, 160);
+		    s->intensityImage = mrpt::img::CImage(160, 120, mrpt::img::CH_RGB);
+	    });
+	const auto sum = runOn({in}, d + "/out");
+	EXPECT_NE(sum.error.find(in +
+	                         ": 3D scan #5 has a 160x120 depth image "
+	                         "where the run's first had 320x240 (3D "
+	                         "scan #0 of " +
+	                         in + ")"),
+	          std::string::npos)
+	    << sum.error;
+	EXPECT_EQ(sum.framesProcessed, 5u);  // those before it, all written
+	EXPECT_TRUE(fs::exists(d + "/out/masks/000004.png"));
+}
