@@ -63,7 +63,17 @@ void saveTumTrajectory(const std::string& path, const Trajectory& traj,
 	std::string text;
 	if (!headerComment.empty()) text += "# " + headerComment + "\n";
 	text += "# timestamp tx ty tz qx qy qz qw\n";
-	for (const auto& p : traj) text += tumLine(p.t, p.T_WC) + "\n";
+	for (const auto& p : traj)
+	{
+		const std::string line = tumLine(p.t, p.T_WC);
+		// a NaN pose is a failure upstream, never a trajectory line
+		if (line.find("nan") != std::string::npos ||
+		    line.find("inf") != std::string::npos)
+			throw std::runtime_error(path + ": the pose at t " +
+			                         std::to_string(p.t) + " is not finite (" +
+			                         line + "); nothing written");
+		text += line + "\n";
+	}
 	writeFileAtomically(path, text);
 }
 
