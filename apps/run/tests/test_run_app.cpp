@@ -226,7 +226,7 @@ TEST(RunApp, SigintAndSigtermStopAfterTheCurrentFrameWithEverythingWritten)
 		const auto m = bims::Json::parse(slurp(d + "/out/metrics.json"));
 		EXPECT_EQ(m["status"], "interrupted");
 		const size_t frames = m["frames_processed"];
-		EXPECT_GT(frames, 5u);
+		EXPECT_GE(frames, 5u);  // masks/000005.png was being written
 		EXPECT_LT(frames, 300u);
 		// the frames done, each in full in every output
 		EXPECT_EQ(lineCount(d + "/out/frames.csv"), frames + 1);
@@ -274,7 +274,7 @@ TEST(RunApp, AfterSigkillEveryFileIsWholeAndNoMetricsSaysDone)
 		    << i;
 		frames++;
 	}
-	EXPECT_GT(frames, 5u);
+	EXPECT_GE(frames, 5u);  // masks/000005.png was being written
 	for (const auto& e : fs::directory_iterator(d + "/out/moving_voxels"))
 		EXPECT_GT(fs::file_size(e.path()), 0u) << e.path();
 }

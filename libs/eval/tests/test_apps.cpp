@@ -518,5 +518,13 @@ TEST(Apps, NoProgramWritesOverItsInput)
 		    << args << "\n"
 		    << r.out;
 	}
+	if (fs::exists(kBin + "/bims-viewer"))  // built with the GUI
+	{
+		const ::Run r = run(kBin + "/bims-viewer " + in +
+		                    " --frames 3 --screenshot " + d + "/link.rawlog");
+		EXPECT_EQ(r.code, 2) << r.out;
+		EXPECT_NE(r.out.find("would overwrite the input"), std::string::npos)
+		    << r.out;
+	}
 	EXPECT_EQ(fs::file_size(in), size);
 }
