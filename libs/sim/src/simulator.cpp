@@ -20,7 +20,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
-#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace bims::sim
@@ -96,14 +96,12 @@ void writePreview(const RenderedFrame& f, double maxRange,
 			img.at<cv::Vec3b>(v, 2 * W + u) =
 			    cv::Vec3b(f.mask[k], f.mask[k], f.mask[k]);
 		}
-	if (!cv::imwrite(path, img))
-		throw std::runtime_error(path + ": cannot write preview");
+	writeImageFile(path, img);
 }
 
 void writeCalibration(const SimConfig& cfg, const std::string& path)
 {
-	std::ofstream f(path);
-	if (!f) throw std::runtime_error(path + ": cannot write");
+	std::ostringstream f;
 	char buf[256];
 	const std::string sceneName =
 	    cfg.file.substr(cfg.file.find_last_of('/') + 1);
@@ -146,7 +144,7 @@ void writeCalibration(const SimConfig& cfg, const std::string& path)
 	              "mag_field_W=%.9f %.9f %.9f\n",
 	              m.x(), m.y(), m.z());
 	f << buf;
-	if (!f) throw std::runtime_error(path + ": write failed");
+	writeFileAtomically(path, f.str());
 }
 }  // namespace
 
@@ -178,9 +176,7 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 
 	Trajectory gt;
 	std::vector<ImuTruth> imuTruth;
-	std::ofstream objs(st.gtDir + "/objects.txt");
-	if (!objs)
-		throw std::runtime_error(st.gtDir + "/objects.txt: cannot write");
+	std::ostringstream objs;  // written at the end
 	objs << "# bims-sim moving-object poses T_WO (root frame of each object in "
 	        "{W}), one line\n"
 	        "# per frame and object: frame object_id name t[s] tx ty tz qx qy "
@@ -223,8 +219,7 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 		const std::string name = "/masks/" + frameFileName(j);
 		const cv::Mat mask(frame.height, frame.width, CV_8UC1,
 		                   frame.mask.data());
-		if (!cv::imwrite(st.gtDir + name, mask))
-			throw std::runtime_error(st.gtDir + name + ": cannot write mask");
+		writeImageFile(st.gtDir + name, mask);
 		if (j == previewFrame)
 			writePreview(frame, cfg.depth.maxRange, st.gtDir + "/preview.png");
 		size_t nMoving = 0;
@@ -251,8 +246,7 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	                  "world z up, x north");
 	saveImuTruth(st.gtDir + "/imu.txt", imuTruth);
 	writeCalibration(cfg, st.gtDir + "/calibration.ini");
-	if (!objs)
-		throw std::runtime_error(st.gtDir + "/objects.txt: write failed");
+	writeFileAtomically(st.gtDir + "/objects.txt", objs.str());
 
 	st.frames = size_t(cfg.seq.frames);
 	st.imuSamples = imuTruth.size();
