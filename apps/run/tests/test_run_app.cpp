@@ -3,6 +3,7 @@
 #include <bims/common/frame_files.h>
 #include <bims/common/json.h>
 #include <bims_test/run_command.h>
+#include <bims_test/tmp_dir.h>
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -33,10 +34,7 @@ bims::test::CommandResult run(const std::string& args)
 }
 std::string tmpDir(const std::string& name)
 {
-	const auto d = fs::temp_directory_path() / "bims_test_run_app" / name;
-	fs::remove_all(d);
-	fs::create_directories(d);
-	return d.string();
+	return bims::test::freshTmpDir("bims_test_run_app", name);
 }
 std::string slurp(const std::string& p)
 {

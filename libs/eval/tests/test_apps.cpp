@@ -3,6 +3,7 @@
 #include <bims/common/trajectory.h>
 #include <bims/eval/tum_import.h>
 #include <bims_test/run_command.h>
+#include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileMemory.h>
@@ -30,10 +31,7 @@ Run run(const std::string& args)
 }
 std::string tmpDir(const std::string& name)
 {
-	const auto d = fs::temp_directory_path() / "bims_test_eval" / name;
-	fs::remove_all(d);
-	fs::create_directories(d);
-	return d.string();
+	return bims::test::freshTmpDir("bims_test_eval", name);
 }
 std::string lastLine(const std::string& s)
 {

@@ -6,6 +6,7 @@
 #include <bims/common/rawlog.h>
 #include <bims/ego/flags.h>
 #include <bims/pipeline/run.h>
+#include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
@@ -28,10 +29,7 @@ const std::string kSrc = BIMS_SOURCE_DIR;
 
 std::string tmpDir(const std::string& name)
 {
-	const auto d = fs::temp_directory_path() / "bims_test_run_faults" / name;
-	fs::remove_all(d);
-	fs::create_directories(d);
-	return d.string();
+	return bims::test::freshTmpDir("bims_test_run_faults", name);
 }
 
 /** The first \a scans 3D scans of the bundled sample with the IMU samples
