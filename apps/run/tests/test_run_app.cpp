@@ -62,12 +62,17 @@ TEST(RunApp, AnInputInsideTheOutputFolderIsRefusedUntouched)
 	    << r.out;
 	EXPECT_EQ(fs::file_size(in), before);
 	EXPECT_FALSE(fs::exists(d + "/trajectory.txt"));
-	// the config counts as an input too
-	const auto r2 = run(q(kConfig) + " " + q(kSample) + " -o " +
-	                    q(kSrc + "/config") + " -q");
+	// the config counts as an input too (a copy: never an output in the
+	// source tree, even if the rule broke)
+	fs::create_directories(d + "/cfg");
+	const std::string ini = d + "/cfg/exp.ini";
+	fs::copy_file(kConfig, ini);
+	const auto r2 =
+	    run(q(ini) + " " + q(kSample) + " -o " + q(d + "/cfg") + " -q");
 	EXPECT_EQ(r2.code, 2) << r2.out;
-	EXPECT_NE(r2.out.find("contains the input " + kConfig), std::string::npos)
+	EXPECT_NE(r2.out.find("contains the input " + ini), std::string::npos)
 	    << r2.out;
+	EXPECT_FALSE(fs::exists(d + "/cfg/trajectory.txt"));
 }
 
 TEST(RunApp, AnEmptyOutputFolderIsRefused)
