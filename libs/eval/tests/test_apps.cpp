@@ -487,8 +487,9 @@ TEST(ImportTum, AFailedImportLeavesNoRawlogUnderItsName)
 TEST(Apps, NoProgramWritesOverItsInput)
 {
 	const auto d = tmpDir("aliases");
-	const std::string cfg =
-	    std::string(BIMS_SOURCE_DIR) + "/config/default.ini";
+	// copies: a broken rule must not write over the source tree
+	const std::string cfg = d + "/default.ini";
+	fs::copy_file(std::string(BIMS_SOURCE_DIR) + "/config/default.ini", cfg);
 	const std::string in = d + "/in.rawlog";
 	fs::copy_file(
 	    std::string(BIMS_SOURCE_DIR) + "/rawlogs/pendulum_slow.rawlog", in);
@@ -525,4 +526,6 @@ TEST(Apps, NoProgramWritesOverItsInput)
 		    << r.out;
 	}
 	EXPECT_EQ(fs::file_size(in), size);
+	EXPECT_EQ(fs::file_size(cfg), fs::file_size(std::string(BIMS_SOURCE_DIR) +
+	                                            "/config/default.ini"));
 }
