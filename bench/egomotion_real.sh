@@ -51,7 +51,7 @@ counts_odom() { # bims-odom CSV (flags as text)
 	echo "$(grep -c '|anchored\|,anchored' "$1" || true) / $(grep -c anchor_failed "$1" || true) / $(grep -c anchor_lost "$1" || true) / $(grep -c anchor_relocalised "$1" || true)"
 }
 stage_ms() { # metrics.json -> egomotion median
-	grep -o '"egomotion": {"median": [0-9.]*' "$1" | awk '{print $NF}'
+	python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["stage_ms"]["egomotion"]["median"])' "$1"
 }
 odom_ms() { # bims-odom summary line -> egomotion median
 	sed -n 's/.*egomotion \([0-9.]*\).*/\1/p'

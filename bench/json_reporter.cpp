@@ -1,5 +1,7 @@
 #include "json_reporter.h"
 
+#include <bims/common/json.h>
+
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -29,13 +31,6 @@ double toMs(const benchmark::BenchmarkReporter::Run& r, double t)
 	}
 	return t;
 }
-std::string jsonNumber(double v)
-{
-	if (!std::isfinite(v)) return "null";
-	char b[64];
-	std::snprintf(b, sizeof b, "%.6g", v);
-	return b;
-}
 }  // namespace
 
 void JsonLinesReporter::ReportRuns(const std::vector<Run>& runs)
@@ -44,8 +39,9 @@ void JsonLinesReporter::ReportRuns(const std::vector<Run>& runs)
 	{
 		if (r.error_occurred)
 		{
-			std::cout << "{\"name\":\"" << r.benchmark_name()
-			          << "\",\"error\":\"" << r.error_message << "\"}\n";
+			std::cout << jsonLine({{"name", r.benchmark_name()},
+			                       {"error", r.error_message}})
+			          << "\n";
 			continue;
 		}
 		const std::string key = r.run_name.function_name;
@@ -79,15 +75,13 @@ void JsonLinesReporter::flush(const std::string& key)
 {
 	auto it = pending_.find(key);
 	if (it == pending_.end()) return;
-	std::ostringstream s;
-	s << "{\"name\":\"" << it->second.name << "\"";
+	Json j;
+	j["name"] = it->second.name;
 	auto vox = it->second.fields.find("voxel_m");
-	if (vox != it->second.fields.end())
-		s << ",\"voxel_m\":" << jsonNumber(vox->second);
+	if (vox != it->second.fields.end()) j["voxel_m"] = jsonNumber(vox->second);
 	for (const auto& [k, v] : it->second.fields)
-		if (k != "voxel_m") s << ",\"" << k << "\":" << jsonNumber(v);
-	s << "}";
-	std::cout << s.str() << std::endl;
+		if (k != "voxel_m") j[k] = jsonNumber(v);
+	std::cout << jsonLine(j) << std::endl;
 	pending_.erase(it);
 }
 

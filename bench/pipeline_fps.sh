@@ -40,10 +40,11 @@ sed -e "/^\[sim\]/a gz_level=$GZ\npixel_labels=$([ "$LABELS" = 1 ] && echo true 
 
 # "median / p95" of a stage in metrics.json, "-" when absent
 stage() {
-  sed -n "s/.*\"$1\": {\"median\": \([0-9.]*\), \"p95\": \([0-9.]*\).*/\1 \/ \2/p" "$2" |
-    awk '{printf "%.2f / %.2f", $1, $3} END {if (NR == 0) printf "-"}'
+  python3 -c 'import json, sys
+s = json.load(open(sys.argv[2]))["stage_ms"].get(sys.argv[1])
+print("%.2f / %.2f" % (s["median"], s["p95"]) if s else "-", end="")' "$1" "$2"
 }
-field() { sed -n "s/.*\"$1\": \([0-9.]*\).*/\1/p" "$2"; }
+field() { python3 -c 'import json, sys; print(json.load(open(sys.argv[2]))[sys.argv[1]])' "$1" "$2"; }
 load() { cut -d' ' -f1 /proc/loadavg; }
 
 echo "bims-run: $RUN, $CONFIG; input gzip level $GZ, pixel labels $LABELS; $(nproc) cores; $(date -u '+%Y-%m-%d %H:%M UTC')"

@@ -52,6 +52,8 @@ function(bims_add_gtest)
     BIMS_BINARY_DIR="${PROJECT_BINARY_DIR}"
     BIMS_BIN_DIR="${CMAKE_RUNTIME_OUTPUT_DIRECTORY}"
     BIMS_SHARED_DATA_DIR="${BIMS_SHARED_DATA_DIR}")
+  # helpers shared by the tests (bims_test/...)
+  target_include_directories(${A_NAME} PRIVATE ${PROJECT_SOURCE_DIR}/tests/support)
   bims_target_defaults(${A_NAME})
   gtest_discover_tests(${A_NAME}
     DISCOVERY_MODE PRE_TEST

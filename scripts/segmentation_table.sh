@@ -63,7 +63,7 @@ for p in $PRESETS; do
 		vf1=$(echo "$ev" | sed -n 's/^voxel_total.* F1 \([0-9.na]*\) .*/\1/p')
 		ate=$("$BIN/bims-eval" traj "$gt/groundtruth.txt" "$out/trajectory.txt" --no-plot 2>/dev/null |
 			awk '/^ate_rmse/ {print $2}')
-		ms=$(sed -n 's/.*"total": *{[^}]*"median": *\([0-9.]*\).*/\1/p' "$out/metrics.json" | head -n 1)
+		ms=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["stage_ms"]["total"]["median"])' "$out/metrics.json" 2>/dev/null)
 		echo "| $p | $name | $pr | $re | $f1 | $iou | ${vf1:--} | $ate | ${ms:--} |"
 	done
 done

@@ -9,6 +9,7 @@
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/depth_correction.h>
 #include <bims/ego/flags.h>
@@ -59,6 +60,9 @@ int main(int argc, char** argv)
 		        false, 0.1, "FRACTION", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::checkOutputsSpareInputs(
+		        {cfgArg.getValue(), inArg.getValue(), posesArg.getValue()},
+		        {outArg.getValue()});
 
 		    const std::string cfgPath = cfgArg.getValue();
 		    ego::EgoConfig ec;
@@ -160,9 +164,6 @@ int main(int argc, char** argv)
 				    throw std::runtime_error(msg);
 			    }
 		    }
-		    std::ofstream out(outArg.getValue());
-		    if (!out)
-			    throw std::runtime_error(outArg.getValue() + ": cannot write");
 		    char note[512];
 		    std::snprintf(
 		        note, sizeof(note),
@@ -172,7 +173,8 @@ int main(int argc, char** argv)
 		        mrpt::system::extractFileName(inArg.getValue()).c_str(),
 		        known.empty() ? "vision odometry" : "given", res.rms_before_m,
 		        res.rms_after_m);
-		    out << res.params.toIni(note);
+		    bims::writeFileAtomically(outArg.getValue(),
+		                              res.params.toIni(note));
 		    return 0;
 	    });
 }

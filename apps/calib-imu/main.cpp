@@ -7,6 +7,7 @@
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
+#include <bims/common/output_paths.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/replay.h>
 #include <bims/ego/rotation_calibration.h>
@@ -20,6 +21,7 @@
 #include <cstdio>
 #include <deque>
 #include <fstream>
+#include <sstream>
 
 int main(int argc, char** argv)
 {
@@ -56,6 +58,9 @@ int main(int argc, char** argv)
 		        0.3, "DEG", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::checkOutputsSpareInputs(
+		        {cfgArg.getValue(), inArg.getValue(), calibArg.getValue()},
+		        bims::givenValues(outArg));
 
 		    const std::string cfgPath = cfgArg.getValue();
 		    ego::EgoConfig ec;
@@ -141,10 +146,7 @@ int main(int argc, char** argv)
 			        ego::angleSO3(R_ref.transpose() * res.R_IC) * 180 / M_PI);
 		    if (outArg.isSet())
 		    {
-			    std::ofstream f(outArg.getValue());
-			    if (!f)
-				    throw std::runtime_error(outArg.getValue() +
-				                             ": cannot write");
+			    std::ostringstream f;
 			    f << "# bims-calib-imu estimate from " << inArg.getValue()
 			      << "\n"
 			      << "[calibration]\n; p_I = R_IC p_C, row major\nR_IC =";
@@ -157,6 +159,7 @@ int main(int argc, char** argv)
 					    f << buf;
 				    }
 			    f << "\ntime_offset_s = " << off << "\n";
+			    bims::writeFileAtomically(outArg.getValue(), f.str());
 		    }
 		    return 0;
 	    });

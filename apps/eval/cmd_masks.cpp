@@ -1,8 +1,9 @@
 #include <bims/common/app.h>
 #include <bims/common/frame_files.h>
+#include <bims/common/json.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
 #include <bims/eval/depth_consistency.h>
-#include <bims/eval/json.h>
 #include <bims/eval/mask_labels.h>
 #include <bims/eval/mask_metrics.h>
 #include <bims/eval/plots.h>
@@ -16,6 +17,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 
 #include "commands.h"
@@ -137,6 +139,11 @@ int cmdMasks(int argc, char** argv)
 	    "", "i,j,..", cmd);
 	TCLAP::SwitchArg quiet("q", "quiet", "no per-frame lines", cmd);
 	bims::parseCommandLine(cmd, argc, argv);
+	const std::vector<std::string> inputs = {
+	    gtArg.getValue(), predArg.getValue(), depth.getValue(),
+	    framesCsv.getValue()};
+	bims::checkOutputsSpareInputs(inputs,
+	                              bims::givenValues(plotDir, json, strip));
 
 	if (voxel.getValue() < 0 || !std::isfinite(voxel.getValue()))
 		throw bims::UsageError("--voxel-size must be >= 0");
@@ -217,6 +224,7 @@ int cmdMasks(int argc, char** argv)
 	if (!noPlots.getValue())
 	{
 		outDir = plotDir.isSet() ? plotDir.getValue() : p + "_eval";
+		bims::checkOutputsSpareInputs(inputs, {outDir});
 		bims::makeDirs(outDir);
 	}
 	std::unique_ptr<ScanStream> scans;
@@ -225,7 +233,7 @@ int cmdMasks(int argc, char** argv)
 	ev::MaskMetrics total, totalVoxels, peopleFree;
 	size_t nPeopleFree = 0;
 	std::map<long, cv::Mat> tiles;  // for --strip
-	std::string jsonFrames;
+	bims::Json jsonFrames = bims::Json::array();
 	for (const ev::MaskPair& pair : match.pairs)
 	{
 		const ev::MaskFile& f = *pair.pred;
@@ -300,13 +308,11 @@ int cmdMasks(int argc, char** argv)
 			if (!outDir.empty()) ev::writePng(outDir + "/" + f.name, o);
 			if (inStrip) tiles[f.index] = o;
 		}
-		if (!jsonFrames.empty()) jsonFrames += ",\n";
-		jsonFrames +=
-		    "    {\"frame\": " +
-		    (f.byTime() ? ev::jsonString(frame) : std::to_string(f.index)) +
-		    ", \"label\": " + ev::jsonString(pair.label->name) +
-		    ", \"dt\": " + std::to_string(pair.dt) +
-		    ", \"metrics\": " + m.toJson() + "}";
+		jsonFrames.push_back(
+		    {{"frame", f.byTime() ? bims::Json(frame) : bims::Json(f.index)},
+		     {"label", pair.label->name},
+		     {"dt", bims::jsonNumber(pair.dt, 6)},
+		     {"metrics", m.toJson()}});
 	}
 	if (!match.labelsWithoutPrediction.empty())
 		std::fprintf(
@@ -352,22 +358,23 @@ int cmdMasks(int argc, char** argv)
 		             "and --voxel-size > 0\n");
 	if (json.isSet())
 	{
-		std::ofstream jf(json.getValue());
-		jf << "{\n  \"gt\": " << ev::jsonString(gtDir)
-		   << ",\n  \"pred\": " << ev::jsonString(predDir)
-		   << ",\n  \"labels\": " << ev::jsonString(labels.describe())
-		   << ",\n  \"frames_compared\": " << nPairs
-		   << ",\n  \"frames_missing\": "
-		   << match.labelsWithoutPrediction.size()
-		   << ",\n  \"depth_valid_only\": " << (scans ? "true" : "false")
-		   << ",\n  \"total\": " << total.toJson()
-		   << ",\n  \"frames_nothing_moving\": " << nPeopleFree
-		   << ",\n  \"total_nothing_moving\": " << peopleFree.toJson();
+		bims::Json jf;
+		jf["gt"] = gtDir;
+		jf["pred"] = predDir;
+		jf["labels"] = labels.describe();
+		jf["frames_compared"] = nPairs;
+		jf["frames_missing"] = match.labelsWithoutPrediction.size();
+		jf["depth_valid_only"] = bool(scans);
+		jf["total"] = total.toJson();
+		jf["frames_nothing_moving"] = nPeopleFree;
+		jf["total_nothing_moving"] = peopleFree.toJson();
 		if (voxels)
-			jf << ",\n  \"voxel_size_m\": " << voxel.getValue()
-			   << ",\n  \"total_voxels\": " << totalVoxels.toJson();
-		jf << ",\n  \"frames\": [\n" << jsonFrames << "\n  ]\n}\n";
-		if (!jf) throw std::runtime_error(json.getValue() + ": cannot write");
+		{
+			jf["voxel_size_m"] = voxel.getValue();
+			jf["total_voxels"] = totalVoxels.toJson();
+		}
+		jf["frames"] = std::move(jsonFrames);
+		bims::writeJsonFile(json.getValue(), jf);
 	}
 	std::printf(
 	    "total_counts frames %zu tp %llu fp %llu fn %llu tn %llu invalid "

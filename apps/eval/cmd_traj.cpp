@@ -1,4 +1,6 @@
 #include <bims/common/app.h>
+#include <bims/common/json.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
 #include <bims/eval/plots.h>
 #include <bims/eval/trajectory_metrics.h>
@@ -51,6 +53,9 @@ int cmdTraj(int argc, char** argv)
 	                               "time offset added to EST stamps [s] (0)",
 	                               false, 0.0, "S", cmd);
 	bims::parseCommandLine(cmd, argc, argv);
+	const std::vector<std::string> inputs = {gtArg.getValue(),
+	                                         estArg.getValue()};
+	bims::checkOutputsSpareInputs(inputs, bims::givenValues(plot, json));
 
 	ev::TrajectoryReport rep;
 	rep.gtPath = gtArg.getValue();
@@ -104,9 +109,7 @@ int cmdTraj(int argc, char** argv)
 
 	if (json.isSet())
 	{
-		std::ofstream f(json.getValue());
-		f << rep.toJson();
-		if (!f) throw std::runtime_error(json.getValue() + ": cannot write");
+		bims::writeJsonFile(json.getValue(), rep.toJson());
 	}
 	if (!noPlot.getValue())
 	{

@@ -16,6 +16,7 @@
 // --strip writes a picture: for each listed frame the RGB image with the
 // used pose's Diff pixels in red (docs/results.md).
 #include <bims/common/app.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/rgbd_input.h>
 #include <bims/eval/plots.h>
@@ -32,6 +33,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <set>
@@ -126,6 +128,9 @@ int main(int argc, char** argv)
 		        "", "variant", "pipeline variant (default flow-only)", false,
 		        "flow-only", "VARIANT", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::checkOutputsSpareInputs(
+		        {aCfg.getValue(), aIn.getValue(), aGt.getValue()},
+		        bims::givenValues(aCsv, aStrip));
 
 		    bims::pipeline::ExperimentConfig cfg;
 		    cfg.loadFromFile(aCfg.getValue());
@@ -151,18 +156,16 @@ int main(int argc, char** argv)
 		    if (aFrames.isSet())
 			    opt.frames =
 			        bims::pipeline::FrameRange::parse(aFrames.getValue());
-		    std::ofstream csv;
+		    std::unique_ptr<bims::AppendFile> csv;  // each line checked
 		    if (aCsv.isSet())
 		    {
-			    csv.open(aCsv.getValue());
-			    if (!csv)
-				    throw std::runtime_error(aCsv.getValue() +
-				                             ": cannot create");
-			    csv << "index,flags,valid_px,diff_ego,diff_used,diff_gt,diff_"
-			           "flow,px_ego,px_used,px_gt,px_flow,rot_ego_gt_deg,"
-			           "rot_ego_flow_deg,rot_gt_flow_deg,rot_used_flow_deg,"
-			           "t_ego_gt_mm,t_ego_flow_mm,t_gt_flow_mm,t_used_flow_mm,"
-			           "gt_rot_deg,gt_t_mm,edge_share_used\n";
+			    csv = std::make_unique<bims::AppendFile>(aCsv.getValue());
+			    csv->append(
+			        "index,flags,valid_px,diff_ego,diff_used,diff_gt,diff_"
+			        "flow,px_ego,px_used,px_gt,px_flow,rot_ego_gt_deg,"
+			        "rot_ego_flow_deg,rot_gt_flow_deg,rot_used_flow_deg,"
+			        "t_ego_gt_mm,t_ego_flow_mm,t_gt_flow_mm,t_used_flow_mm,"
+			        "gt_rot_deg,gt_t_mm,edge_share_used\n");
 		    }
 		    std::printf(
 		        "# index flags | Diff%% ego used gt flow | median px ego used "
@@ -248,9 +251,11 @@ int main(int argc, char** argv)
 			        row[17], row[18]);
 			    if (csv)
 			    {
-				    csv << r.index << "," << r.ego.flags << "," << validPx;
-				    for (double x : row) csv << "," << x;
-				    csv << "\n";
+				    std::ostringstream line;
+				    line << r.index << "," << r.ego.flags << "," << validPx;
+				    for (double x : row) line << "," << x;
+				    line << "\n";
+				    csv->append(line.str());
 			    }
 			    if (stripFrames.count(r.index))
 			    {

@@ -11,6 +11,7 @@
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
+#include <bims/common/output_paths.h>
 #include <bims/flow/consistency.h>
 #include <bims/flow/expected_flow.h>
 #include <bims/flow/observed_flow.h>
@@ -81,6 +82,9 @@ int main(int argc, char** argv)
 		        "", "pose", "T_C0C1 as 'x y z yaw pitch roll' (m, deg)", false,
 		        "0 0 0 0 0 0", "POSE", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::checkOutputsSpareInputs({aRgb0.getValue(), aRgb1.getValue(),
+		                                   aDepth1.getValue(), aCfg.getValue()},
+		                                  {aOut.getValue()});
 
 		    bims::flow::FlowParams params;
 		    if (aCfg.isSet())
@@ -155,16 +159,13 @@ int main(int argc, char** argv)
 					    overlay.at<cv::Vec3b>(v, u) =
 					        overlay.at<cv::Vec3b>(v, u) / 2 +
 					        cv::Vec3b(0, 0, 127);
-		    const bool ok = cv::imwrite(out + "/observed_flow.png",
-		                                bims::flow::flowToColor(obs, 10.0)) &&
-		                    cv::imwrite(out + "/expected_flow.png",
-		                                bims::flow::flowToColor(exp, 10.0)) &&
-		                    cv::imwrite(out + "/labels.png",
-		                                bims::flow::labelsToColor(lab)) &&
-		                    cv::imwrite(out + "/overlay.png", overlay);
-		    if (!ok)
-			    throw std::runtime_error(out +
-			                             ": cannot write the output pictures");
+		    bims::writeImageFile(out + "/observed_flow.png",
+		                         bims::flow::flowToColor(obs, 10.0));
+		    bims::writeImageFile(out + "/expected_flow.png",
+		                         bims::flow::flowToColor(exp, 10.0));
+		    bims::writeImageFile(out + "/labels.png",
+		                         bims::flow::labelsToColor(lab));
+		    bims::writeImageFile(out + "/overlay.png", overlay);
 		    const size_t labelled = st.diff + st.notDiff;
 		    std::printf(
 		        "pixels %dx%d  labelled %zu  Diff %zu (%.2f %%)  notDiff %zu  "

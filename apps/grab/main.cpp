@@ -9,6 +9,7 @@
 // device: a clear message and exit code 1. See docs/grab.md.
 #include <bims/common/app.h>
 #include <bims/common/config.h>
+#include <bims/common/output_paths.h>
 #include <bims/grab/grabber.h>
 #include <bims/pipeline/pipeline.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
@@ -25,16 +26,6 @@
 
 namespace
 {
-std::atomic<bool> gStop{false};
-
-extern "C" void onSignal(int)
-{
-	gStop = true;
-	// A second Ctrl-C kills at once (default handler).
-	std::signal(SIGINT, SIG_DFL);
-	std::signal(SIGTERM, SIG_DFL);
-}
-
 /** RGB with the moving mask in red (live preview). */
 mrpt::img::CImage preview(const mrpt::obs::CObservation3DRangeScan& scan,
                           const cv::Mat& mask)
@@ -86,8 +77,10 @@ int main(int argc, char** argv)
 		                             "mask) in a window",
 		                             cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
-		    std::signal(SIGINT, onSignal);  // Ctrl-C from now on: clean stop
-		    std::signal(SIGTERM, onSignal);
+		    bims::checkOutputsSpareInputs({aCfg.getValue(), aExp.getValue()},
+		                                  {aOut.getValue()});
+		    // Ctrl-C from now on: clean stop
+		    const auto& stop = bims::installStopSignals();
 		    if (aFrames.getValue() < 0)
 			    throw bims::UsageError("--frames must be >= 0");
 		    if (!mrpt::system::fileExists(aCfg.getValue()))
@@ -155,7 +148,7 @@ int main(int argc, char** argv)
 		    };
 
 		    const auto st = grabber.run(
-		        out, gStop, static_cast<size_t>(aFrames.getValue()), onFrame);
+		        out, stop, static_cast<size_t>(aFrames.getValue()), onFrame);
 		    out.close();
 		    std::fprintf(stderr,
 		                 "bims-grab: %zu RGB-D frames, %zu IMU samples in "

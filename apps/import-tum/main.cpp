@@ -3,6 +3,7 @@
 // Converts a TUM RGB-D-layout folder into a bims rawlog plus OUT_gt/
 // (groundtruth.txt, calibration.ini). See docs/eval.md.
 #include <bims/common/app.h>
+#include <bims/common/output_paths.h>
 #include <bims/eval/pose_utils.h>
 #include <bims/eval/tum_import.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
@@ -100,6 +101,10 @@ int main(int argc, char** argv)
 		        "N", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::checkOutputsSpareInputs(
+		        {folder.getValue(), config.getValue()},
+		        {out.getValue(),
+		         bims::eval::groundTruthDirFor(out.getValue())});
 
 		    if (gz.getValue() < 0 || gz.getValue() > 9)
 			    throw bims::UsageError("--gz must be in 0..9");

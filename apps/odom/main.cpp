@@ -7,6 +7,7 @@
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/replay.h>
@@ -20,6 +21,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <vector>
 
 namespace
@@ -84,6 +86,12 @@ int main(int argc, char** argv)
 		        "", "max-frames", "stop after N frames", false, 0, "N", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    auto outputs = bims::givenValues(csvArg);
+		    outputs.push_back(outArg.getValue());
+		    checkOutputsSpareInputs(
+		        {cfgArg.getValue(), inArg.getValue(), calibArg.getValue(),
+		         masksArg.getValue(), gtArg.getValue()},
+		        outputs);
 
 		    const std::string cfgPath = cfgArg.getValue();
 		    ego::EgoConfig ec;
@@ -121,23 +129,21 @@ int main(int argc, char** argv)
 		    ego::Odometry odo(ec);
 		    Trajectory traj;
 		    std::vector<double> msIn, msTrack, msMotion, msEgo;
-		    std::ofstream csv;
+		    std::unique_ptr<AppendFile> csv;  // each line checked
 		    if (csvArg.isSet())
 		    {
-			    csv.open(csvArg.getValue());
-			    if (!csv)
-				    throw std::runtime_error(csvArg.getValue() +
-				                             ": cannot write");
-			    csv << "t,flags,rotation,correspondences,inliers,residual_m,"
-			           "tracks,"
-			           "ms_input,ms_track,ms_motion,true_rate_deg_s,"
-			           "attempted_with_depth,tracked_within_2px,"
-			           "anchor_keyframe,anchor_inliers,anchor_inlier_fraction,"
-			           "anchor_overlap,anchor_coverage,anchor_guess,anchor_"
-			           "correction_m,"
-			           "anchor_correction_deg,anchor_excluded,anchor_seen_"
-			           "through,ms_anchor,"
-			           "anchor_note\n";
+			    csv = std::make_unique<AppendFile>(csvArg.getValue());
+			    csv->append(
+			        "t,flags,rotation,correspondences,inliers,residual_m,"
+			        "tracks,"
+			        "ms_input,ms_track,ms_motion,true_rate_deg_s,"
+			        "attempted_with_depth,tracked_within_2px,"
+			        "anchor_keyframe,anchor_inliers,anchor_inlier_fraction,"
+			        "anchor_overlap,anchor_coverage,anchor_guess,anchor_"
+			        "correction_m,"
+			        "anchor_correction_deg,anchor_excluded,anchor_seen_"
+			        "through,ms_anchor,"
+			        "anchor_note\n");
 		    }
 		    Trajectory gt;
 		    if (gtArg.isSet()) gt = loadTumTrajectory(gtArg.getValue());
@@ -213,7 +219,7 @@ int main(int argc, char** argv)
 				        prevFrame = cur;
 			        }
 			        prevT = r.t;
-			        if (csv.is_open())
+			        if (csv)
 			        {
 				        char buf[512];
 				        const auto& a = r.anchor;
@@ -232,7 +238,7 @@ int main(int argc, char** argv)
 				            a.correction_deg, a.excluded_fraction,
 				            a.seen_through, r.ms_anchor,
 				            a.why.empty() ? "-" : a.why.c_str());
-				        csv << buf;
+				        csv->append(buf);
 			        }
 		        },
 		        ro);
@@ -241,6 +247,7 @@ int main(int argc, char** argv)
 			        inArg.getValue() +
 			        ": no usable RGB-D frame (check [sensors] "
 			        "rgbd_label)");
+		    if (csv) csv->close();
 		    saveTumTrajectory(
 		        outArg.getValue(), traj,
 		        "bims-odom mode=" + ec.odometry.mode +

@@ -8,9 +8,11 @@
 // segmented.rawlog (masks as pixel labels), frames.csv, metrics.json, and
 // prints a summary table. See docs/pipeline.md.
 #include <bims/common/app.h>
+#include <bims/common/output_paths.h>
 #include <bims/pipeline/run.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
+#include <csignal>
 #include <cstdio>
 
 int main(int argc, char** argv)
@@ -42,6 +44,9 @@ int main(int argc, char** argv)
 		        false, "", "VARIANT", cmd);
 		    TCLAP::SwitchArg aQuiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    auto inputs = aIn.getValue();
+		    inputs.push_back(aCfg.getValue());
+		    bims::checkOutputsSpareInputs(inputs, {aOut.getValue()});
 
 		    bims::pipeline::ExperimentConfig cfg;
 		    cfg.loadFromFile(aCfg.getValue());
@@ -62,6 +67,8 @@ int main(int argc, char** argv)
 		    opt.rawlogs = aIn.getValue();
 		    opt.outDir = aOut.getValue();
 		    opt.progress = !aQuiet.getValue();
+		    // SIGINT / SIGTERM: stop after the current frame, write it all
+		    opt.stop = &bims::installStopSignals();
 		    if (aFrames.isSet())
 		    {
 			    try
@@ -80,11 +87,19 @@ int main(int argc, char** argv)
 		        "outputs in %s/ (trajectory.txt, masks/, metrics.json, ...)\n",
 		        opt.outDir.c_str());
 		    if (!sum.error.empty())
-		    {
 			    std::fprintf(stderr, "bims-run: error: %s\n",
 			                 sum.error.c_str());
-			    return 1;
+		    if (sum.interrupted)
+		    {
+			    const int sig = bims::stopSignal();
+			    std::fprintf(stderr,
+			                 "bims-run: interrupted by %s after %zu frames: "
+			                 "their outputs are complete, metrics.json says "
+			                 "\"status\": \"interrupted\"\n",
+			                 sig == SIGTERM ? "SIGTERM" : "SIGINT",
+			                 sum.framesProcessed);
+			    return 128 + (sig ? sig : SIGINT);
 		    }
-		    return 0;
+		    return sum.error.empty() ? 0 : 1;
 	    });
 }

@@ -6,6 +6,7 @@
 // See docs/sim.md.
 #include <bims/common/app.h>
 #include <bims/common/config.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/sim/imu.h>
@@ -35,9 +36,11 @@ int imuFromTum(const std::string& tum, const std::string& out, uint64_t seed,
 	const auto traj = bims::loadTumTrajectory(tum);
 	std::vector<bims::sim::ImuTruth> truth;
 	const auto obs = bims::sim::synthesizeImu(traj, p, seed, &truth);
-	bims::RawlogWriter w(out, 1);
+	bims::PartialFile part(out);  // renamed once complete
+	bims::RawlogWriter w(part.path(), 1);
 	for (const auto& o : obs) w.write(*o);
 	w.close();
+	part.commit();
 	const std::string gtDir = bims::sim::groundTruthDirFor(out);
 	bims::makeDirs(gtDir);
 	bims::sim::saveImuTruth(gtDir + "/imu.txt", truth);
@@ -90,6 +93,9 @@ int main(int argc, char** argv)
 		        false, -1, "N", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "No progress bar", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::checkOutputsSpareInputs(
+		        {scene.getValue(), tum.getValue(), config.getValue()},
+		        {out.getValue(), bims::sim::groundTruthDirFor(out.getValue())});
 
 		    if (tum.isSet())
 		    {

@@ -9,6 +9,7 @@
 // Non-interactive use (tests, figures): --frames N steps N frames, then
 // --screenshot writes the 3D view as shown in the window and quits.
 #include <bims/common/app.h>
+#include <bims/common/output_paths.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/system/filesystem.h>
 
@@ -97,6 +98,9 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<std::string> aSize("", "size", "window size WxH",
 		                                       false, "1280x800", "WxH", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::checkOutputsSpareInputs({aIn.getValue(), aRes.getValue(),
+		                                   aCfg.getValue(), aGt.getValue()},
+		                                  bims::givenValues(aShot, aSeq));
 
 		    auto& o = gOptions;
 		    if (aCfg.getValue().empty())

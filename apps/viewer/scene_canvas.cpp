@@ -1,9 +1,11 @@
 #include "scene_canvas.h"
 
 #include <GL/gl.h>
+#include <bims/common/output_paths.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
 
 namespace bims::viewer_app
 {
@@ -48,8 +50,14 @@ void SceneCanvas::postRender()
 	cv::Mat bgr;
 	cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
 	cv::flip(bgr, bgr, 0);  // GL rows go bottom-up
-	if (!cv::imwrite(capturePath_, bgr))
-		captureError_ = "cannot write '" + capturePath_ + "'";
+	try
+	{
+		bims::writeImageFile(capturePath_, bgr);
+	}
+	catch (const std::exception& e)
+	{
+		captureError_ = e.what();
+	}
 }
 
 }  // namespace bims::viewer_app

@@ -441,7 +441,7 @@ TEST(EndToEnd, WriteErrorStopsTheRunNamingTheFileAndKeepsEarlierFrames)
 		fs::create_directories(opt.outDir + "/masks/000003.png/x");
 		opt.progress = false;
 		const auto sum = runExperiment(cfg, opt);
-		EXPECT_NE(sum.error.find("masks/000003.png: cannot write mask"),
+		EXPECT_NE(sum.error.find("masks/000003.png: is a folder, cannot write"),
 		          std::string::npos)
 		    << sum.error;
 		EXPECT_LT(sum.framesProcessed, 30u);

@@ -135,14 +135,25 @@ TEST(GrabApp, BadConfigNamesFileSectionAndKey)
 {
 	ASSERT_EQ(run("mkdir -p '" + kOut + "'"), 0);
 	const std::string ini = kOut + "/badkey.ini", log = kOut + "/badkey.log";
-	std::ofstream(ini) << "[RGBD]\ndriver=OpenNI2\ndevice_uri=Dummy\n"
-	                      "frame_rate=30\n";
-	EXPECT_EQ(run("'" + kGrab + "' '" + ini + "' -o '" + kOut +
-	              "/bad.rawlog' > '" + log + "' 2>&1"),
-	          1);
-	const std::string msg = slurp(log);
+	// bims-grab on an .ini of this text: exit 1, its output
+	const auto grabWith = [&](const std::string& text)
+	{
+		std::ofstream(ini) << text;
+		EXPECT_EQ(run("'" + kGrab + "' '" + ini + "' -o '" + kOut +
+		              "/bad.rawlog' > '" + log + "' 2>&1"),
+		          1);
+		return slurp(log);
+	};
+	const std::string msg =
+	    grabWith("[RGBD]\ndriver=OpenNI2\ndevice_uri=Dummy\nframe_rate=30\n");
 	EXPECT_NE(msg.find("frame_rate"), std::string::npos) << msg;
 	EXPECT_NE(msg.find("RGBD"), std::string::npos) << msg;
+	// a driver that is none: the file, the section and the driver named
+	const std::string msg2 = grabWith(
+	    "[RGBD]\ndriver=OpenNI2\ndevice_uri=Dummy\n[IMU]\ndriver=NoSuchImu\n");
+	EXPECT_NE(msg2.find(ini + ": [IMU] driver=NoSuchImu: not an IMU driver"),
+	          std::string::npos)
+	    << msg2;
 }
 
 TEST(GrabApp, CtrlCStopsCleanlyAndKillLosesAtMostTheLastFrame)

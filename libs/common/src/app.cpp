@@ -1,6 +1,7 @@
 #include <bims/common/app.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #if defined(__GLIBC__)
@@ -51,6 +52,33 @@ int runApp(const std::string& program, const std::function<int()>& body)
 		std::fprintf(stderr, "%s: error: %s\n", program.c_str(), e.what());
 		return 1;
 	}
+}
+
+namespace
+{
+std::atomic<bool> gStop{false};
+std::atomic<int> gStopSignal{0};
+
+extern "C" void onStopSignal(int sig)
+{
+	gStopSignal = sig;
+	gStop = true;
+	// a second signal kills at once (default action)
+	std::signal(SIGINT, SIG_DFL);
+	std::signal(SIGTERM, SIG_DFL);
+}
+}  // namespace
+
+const std::atomic<bool>& installStopSignals()
+{
+	std::signal(SIGINT, onStopSignal);
+	std::signal(SIGTERM, onStopSignal);
+	return gStop;
+}
+
+int stopSignal()
+{
+	return gStopSignal;
 }
 
 void makeDirs(const std::string& path)

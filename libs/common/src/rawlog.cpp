@@ -1,3 +1,4 @@
+#include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
 
 #include <mrpt/img/CImage.h>
@@ -261,11 +262,18 @@ RawlogWriter::RawlogWriter(const std::string& path, int gzLevel) : path_(path)
 		throw RawlogError(path + ": gzip level must be in 0..9");
 	if (gzLevel == 0)
 	{
-		plain_.open(path, std::ios::binary | std::ios::trunc);
-		if (!plain_) throw RawlogError(path + ": cannot create rawlog file");
+		try
+		{
+			plain_ = std::make_unique<AppendFile>(path);
+		}
+		catch (const std::exception& e)
+		{
+			throw RawlogError(std::string(e.what()) + " (rawlog file)");
+		}
 	}
 	else
 	{
+		replaceSymlink(path);
 		if (!gz_.open(path, gzLevel, std::nullopt,
 		              mrpt::io::OpenMode::TRUNCATE))
 			throw RawlogError(path + ": cannot create rawlog file");
@@ -298,11 +306,16 @@ void RawlogWriter::write(const mrpt::obs::CObservation& obs)
 		throw RawlogError(path_ + ": write failed: " + e.what());
 	}
 	const auto n = buf_.size();
-	if (plain_.is_open())
+	if (plain_)
 	{
-		plain_.write(reinterpret_cast<const char*>(buf_.data()),
-		             static_cast<std::streamsize>(n));
-		if (!plain_) throw RawlogError(path_ + ": write failed (disk full?)");
+		try
+		{
+			plain_->append(buf_.data(), n);
+		}
+		catch (const std::exception& e)
+		{
+			throw RawlogError(e.what());
+		}
 	}
 	else if (gz_.Write(buf_.data(), n) != n)
 		throw RawlogError(path_ + ": write failed (disk full?)");
@@ -311,7 +324,7 @@ void RawlogWriter::write(const mrpt::obs::CObservation& obs)
 
 void RawlogWriter::flush()
 {
-	if (plain_.is_open()) plain_.flush();
+	// a plain rawlog reaches the OS object by object (AppendFile)
 }
 
 void RawlogWriter::close()
@@ -319,7 +332,18 @@ void RawlogWriter::close()
 	if (!open_) return;
 	open_ = false;
 	arch_.reset();
-	if (plain_.is_open()) plain_.close();
+	if (plain_)
+	{
+		auto f = std::move(plain_);
+		try
+		{
+			f->close();
+		}
+		catch (const std::exception& e)
+		{
+			throw RawlogError(e.what());
+		}
+	}
 	if (gz_.fileOpenCorrectly()) gz_.close();
 }
 

@@ -1,3 +1,4 @@
+#include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
 #include <mrpt/poses/CPose3DQuat.h>
 
@@ -59,12 +60,21 @@ std::string tumLine(double t, const mrpt::poses::CPose3D& T_WC)
 void saveTumTrajectory(const std::string& path, const Trajectory& traj,
                        const std::string& headerComment)
 {
-	std::ofstream f(path);
-	if (!f) throw std::runtime_error(path + ": cannot write trajectory file");
-	if (!headerComment.empty()) f << "# " << headerComment << "\n";
-	f << "# timestamp tx ty tz qx qy qz qw\n";
-	for (const auto& p : traj) f << tumLine(p.t, p.T_WC) << "\n";
-	if (!f) throw std::runtime_error(path + ": write failed");
+	std::string text;
+	if (!headerComment.empty()) text += "# " + headerComment + "\n";
+	text += "# timestamp tx ty tz qx qy qz qw\n";
+	for (const auto& p : traj)
+	{
+		const std::string line = tumLine(p.t, p.T_WC);
+		// a NaN pose is a failure upstream, never a trajectory line
+		if (line.find("nan") != std::string::npos ||
+		    line.find("inf") != std::string::npos)
+			throw std::runtime_error(path + ": the pose at t " +
+			                         std::to_string(p.t) + " is not finite (" +
+			                         line + "); nothing written");
+		text += line + "\n";
+	}
+	writeFileAtomically(path, text);
 }
 
 const StampedPose* poseNear(const Trajectory& traj, double t, double maxDt)

@@ -1,6 +1,8 @@
 #include <bims/common/trajectory.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -59,4 +61,25 @@ TEST(Trajectory, MalformedLinesAreErrorsWithLineNumbers)
 		f << "1 0 0 0 0 0 0 2\n";
 	}
 	EXPECT_THROW(bims::loadTumTrajectory(p), std::runtime_error);
+}
+
+TEST(Trajectory, ANonFinitePoseIsAnErrorNamingItsTimeAndNothingIsWritten)
+{
+	const auto p = tmpPath("nan_traj.txt");
+	std::remove(p.c_str());
+	bims::Trajectory t;
+	t.push_back({1.0, mrpt::poses::CPose3D(1, 2, 3, 0, 0, 0)});
+	t.push_back({1.5, mrpt::poses::CPose3D(std::nan(""), 2, 3, 0, 0, 0)});
+	try
+	{
+		bims::saveTumTrajectory(p, t);
+		FAIL() << "no error";
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find(p + ": the pose at t 1.5"),
+		          std::string::npos)
+		    << e.what();
+	}
+	EXPECT_FALSE(std::filesystem::exists(p));
 }

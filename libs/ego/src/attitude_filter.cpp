@@ -357,7 +357,8 @@ std::string flagsToString(uint32_t flags)
 	    {kFlagNewKeyframe, "new_keyframe"},
 	    {kFlagAnchorLost, "anchor_lost"},
 	    {kFlagMaskIgnored, "mask_ignored"},
-	    {kFlagAnchorRelocalised, "anchor_relocalised"}};
+	    {kFlagAnchorRelocalised, "anchor_relocalised"},
+	    {kFlagImuRejected, "imu_rejected"}};
 	std::string s;
 	for (const auto& [bit, name] : names)
 		if (flags & bit) s += (s.empty() ? "" : "|") + std::string(name);

@@ -9,12 +9,11 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "json.h"
+#include "text_format.h"
 
 namespace bims::eval
 {
 using detail::fmt4;
-using detail::jnum;
 
 namespace
 {
@@ -147,17 +146,19 @@ std::string MaskMetrics::scoresLine() const
 	       " F1 " + fmt4(f1()) + " IoU " + fmt4(iou());
 }
 
-std::string MaskMetrics::toJson() const
+Json MaskMetrics::toJson() const
 {
-	std::ostringstream o;
-	o << "{\"tp\": " << tp << ", \"fp\": " << fp << ", \"fn\": " << fn
-	  << ", \"tn\": " << tn << ", \"invalid\": " << invalid
-	  << ", \"ignored\": " << ignored
-	  << ", \"precision\": " << jnum(precision())
-	  << ", \"recall\": " << jnum(recall()) << ", \"f1\": " << jnum(f1())
-	  << ", \"iou\": " << jnum(iou())
-	  << ", \"static_as_moving\": " << jnum(staticAsMoving()) << "}";
-	return o.str();
+	return {{"tp", tp},
+	        {"fp", fp},
+	        {"fn", fn},
+	        {"tn", tn},
+	        {"invalid", invalid},
+	        {"ignored", ignored},
+	        {"precision", jsonNumber(precision())},
+	        {"recall", jsonNumber(recall())},
+	        {"f1", jsonNumber(f1())},
+	        {"iou", jsonNumber(iou())},
+	        {"static_as_moving", jsonNumber(staticAsMoving())}};
 }
 
 MaskMetrics voxelMaskMetrics(const cv::Mat& gt, const cv::Mat& pred,

@@ -1,3 +1,4 @@
+#include <bims/common/output_paths.h>
 #include <bims/eval/plots.h>
 
 #include <algorithm>
@@ -137,16 +138,7 @@ cv::Mat imageStrip(const std::vector<cv::Mat>& images, double scale)
 
 void writePng(const std::string& path, const cv::Mat& img)
 {
-	bool ok = false;
-	try
-	{
-		ok = cv::imwrite(path, img);
-	}
-	catch (const cv::Exception& e)
-	{
-		throw std::runtime_error(path + ": cannot write image: " + e.what());
-	}
-	if (!ok) throw std::runtime_error(path + ": cannot write image");
+	writeImageFile(path, img);
 }
 
 }  // namespace bims::eval

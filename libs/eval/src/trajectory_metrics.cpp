@@ -8,13 +8,10 @@
 #include <stdexcept>
 
 #include "eigen_pose.h"
-#include "json.h"
 
 namespace bims::eval
 {
 using detail::fromIso;
-using detail::jnum;
-using detail::jstr;
 using detail::toIso;
 
 ErrorStats ErrorStats::of(std::vector<double> v)
@@ -171,35 +168,35 @@ Trajectory alignTrajectory(const Trajectory& est, const mrpt::poses::CPose3D& T)
 
 namespace
 {
-std::string statsJson(const ErrorStats& s)
+Json statsJson(const ErrorStats& s)
 {
-	std::ostringstream o;
-	o << "{\"count\": " << s.count << ", \"rmse\": " << jnum(s.rmse)
-	  << ", \"mean\": " << jnum(s.mean) << ", \"median\": " << jnum(s.median)
-	  << ", \"std\": " << jnum(s.std) << ", \"min\": " << jnum(s.min)
-	  << ", \"max\": " << jnum(s.max) << "}";
-	return o.str();
+	return {{"count", s.count},           {"rmse", jsonNumber(s.rmse)},
+	        {"mean", jsonNumber(s.mean)}, {"median", jsonNumber(s.median)},
+	        {"std", jsonNumber(s.std)},   {"min", jsonNumber(s.min)},
+	        {"max", jsonNumber(s.max)}};
 }
 }  // namespace
 
-std::string TrajectoryReport::toJson() const
+Json TrajectoryReport::toJson() const
 {
-	std::ostringstream o;
 	const auto& T = ate.T_alignment;
-	o << "{\n  \"gt\": " << jstr(gtPath) << ",\n  \"est\": " << jstr(estPath)
-	  << ",\n  \"gt_poses\": " << gtPoses << ",\n  \"est_poses\": " << estPoses
-	  << ",\n  \"ate\": {\"max_time_difference_s\": "
-	  << jnum(ateOptions.maxTimeDifference)
-	  << ", \"pairs\": " << ate.pairs.size()
-	  << ", \"error_m\": " << statsJson(ate.stats)
-	  << ", \"alignment_T_WgWe\": [" << jnum(T.x()) << ", " << jnum(T.y())
-	  << ", " << jnum(T.z()) << ", " << jnum(T.yaw()) << ", " << jnum(T.pitch())
-	  << ", " << jnum(T.roll())
-	  << "]},\n  \"rpe\": {\"delta_s\": " << jnum(rpeOptions.delta)
-	  << ", \"pairs\": " << rpe.pairs.size()
-	  << ", \"trans_m_per_s\": " << statsJson(rpe.trans)
-	  << ", \"rot_deg_per_s\": " << statsJson(rpe.rot) << "}\n}\n";
-	return o.str();
+	Json j;
+	j["gt"] = gtPath;
+	j["est"] = estPath;
+	j["gt_poses"] = gtPoses;
+	j["est_poses"] = estPoses;
+	j["ate"] = {
+	    {"max_time_difference_s", jsonNumber(ateOptions.maxTimeDifference)},
+	    {"pairs", ate.pairs.size()},
+	    {"error_m", statsJson(ate.stats)},
+	    {"alignment_T_WgWe",
+	     {jsonNumber(T.x()), jsonNumber(T.y()), jsonNumber(T.z()),
+	      jsonNumber(T.yaw()), jsonNumber(T.pitch()), jsonNumber(T.roll())}}};
+	j["rpe"] = {{"delta_s", jsonNumber(rpeOptions.delta)},
+	            {"pairs", rpe.pairs.size()},
+	            {"trans_m_per_s", statsJson(rpe.trans)},
+	            {"rot_deg_per_s", statsJson(rpe.rot)}};
+	return j;
 }
 
 }  // namespace bims::eval

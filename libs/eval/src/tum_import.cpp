@@ -1,4 +1,5 @@
 #include <bims/common/app.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
 #include <bims/eval/pose_utils.h>
@@ -89,8 +90,6 @@ namespace
 {
 void writeCalibration(const std::string& path, const ImportParams& params)
 {
-	std::ofstream f(path);
-	if (!f) throw std::runtime_error(path + ": cannot write");
 	const auto& c = params.camera;
 	char buf[512];
 	std::snprintf(
@@ -101,8 +100,7 @@ void writeCalibration(const std::string& path, const ImportParams& params)
 	    "imu_label = %s\n",
 	    c.fx, c.fy, c.cx, c.cy, c.width, c.height, c.depthScale,
 	    params.rgbdLabel.c_str(), params.imuLabel.c_str());
-	f << buf;
-	if (!f) throw std::runtime_error(path + ": write failed");
+	writeFileAtomically(path, buf);
 }
 }  // namespace
 
@@ -168,7 +166,10 @@ ImportSummary importTum(const std::string& folder, const std::string& outRawlog,
 	                 [](const Item& a, const Item& b)
 	                 { return a.t < b.t || (a.t == b.t && a.kind < b.kind); });
 
-	RawlogWriter w(outRawlog, options.gzLevel);
+	// OUT.rawlog.partial until complete: a failed import leaves no
+	// half-written rawlog under the final name
+	PartialFile part(outRawlog);
+	RawlogWriter w(part.path(), options.gzLevel);
 	ProgressBar bar("import", tum.frames.size(), options.progress);
 	for (const auto& it : items)
 	{
@@ -196,6 +197,7 @@ ImportSummary importTum(const std::string& folder, const std::string& outRawlog,
 		}
 	}
 	w.close();
+	part.commit();
 	bar.finish();
 	return sum;
 }

@@ -2,6 +2,8 @@
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/eval/tum_import.h>
+#include <bims_test/run_command.h>
+#include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileMemory.h>
@@ -22,29 +24,14 @@ const std::string kBin = BIMS_BIN_DIR;
 const std::string kBonn =
     std::string(BIMS_SHARED_DATA_DIR) + "/bonn_crowd_f150_349";
 
-struct Run
-{
-	int code;
-	std::string out;
-};
+using Run = bims::test::CommandResult;
 Run run(const std::string& args)
 {
-	const std::string c = args + " 2>&1";
-	FILE* p = popen(c.c_str(), "r");
-	Run r{-1, {}};
-	if (!p) return r;
-	std::array<char, 4096> buf;
-	while (fgets(buf.data(), buf.size(), p)) r.out += buf.data();
-	const int st = pclose(p);
-	r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-	return r;
+	return bims::test::runCommand(args);
 }
 std::string tmpDir(const std::string& name)
 {
-	const auto d = fs::temp_directory_path() / "bims_test_eval" / name;
-	fs::remove_all(d);
-	fs::create_directories(d);
-	return d.string();
+	return bims::test::freshTmpDir("bims_test_eval", name);
 }
 std::string lastLine(const std::string& s)
 {
@@ -461,4 +448,84 @@ TEST(Apps, HelpExitsCleanlyAndBadOptionsAreUsageErrors)
 		EXPECT_EQ(b.out.find("no such"), std::string::npos) << app << "\n"
 		                                                    << b.out;
 	}
+}
+
+TEST(ImportTum, AFailedImportLeavesNoRawlogUnderItsName)
+{
+	// frame 1 imports, frame 2's depth image is missing: the rawlog was
+	// half written when the import failed
+	const auto d = tmpDir("import_partial");
+	fs::create_directories(d + "/rgb");
+	fs::create_directories(d + "/depth");
+	ASSERT_TRUE(cv::imwrite(d + "/rgb/a.png",
+	                        cv::Mat(480, 640, CV_8UC3, cv::Scalar(9, 9, 9))));
+	ASSERT_TRUE(cv::imwrite(d + "/depth/a.png",
+	                        cv::Mat(480, 640, CV_16UC1, cv::Scalar(5000))));
+	ASSERT_TRUE(cv::imwrite(d + "/rgb/b.png",
+	                        cv::Mat(480, 640, CV_8UC3, cv::Scalar(9, 9, 9))));
+	std::ofstream(d + "/rgb.txt") << "1.0 rgb/a.png\n1.1 rgb/b.png\n";
+	std::ofstream(d + "/depth.txt") << "1.0 depth/a.png\n1.1 depth/b.png\n";
+	const std::string out = d + "/x.rawlog";
+	const auto r =
+	    run(kBin + "/bims-import-tum " + d + " -o " + out + " --gz 0 -q");
+	EXPECT_EQ(r.code, 1) << r.out;
+	EXPECT_NE(r.out.find("depth/b.png: cannot read depth image"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_FALSE(fs::exists(out));
+	EXPECT_FALSE(fs::exists(out + ".partial"));
+	// the same folder whole: the rawlog under its name, no partial file
+	ASSERT_TRUE(cv::imwrite(d + "/depth/b.png",
+	                        cv::Mat(480, 640, CV_16UC1, cv::Scalar(5000))));
+	const auto ok =
+	    run(kBin + "/bims-import-tum " + d + " -o " + out + " --gz 0 -q");
+	EXPECT_EQ(ok.code, 0) << ok.out;
+	EXPECT_GT(fs::file_size(out), 0u);
+	EXPECT_FALSE(fs::exists(out + ".partial"));
+}
+
+TEST(Apps, NoProgramWritesOverItsInput)
+{
+	const auto d = tmpDir("aliases");
+	// copies: a broken rule must not write over the source tree
+	const std::string cfg = d + "/default.ini";
+	fs::copy_file(std::string(BIMS_SOURCE_DIR) + "/config/default.ini", cfg);
+	const std::string in = d + "/in.rawlog";
+	fs::copy_file(
+	    std::string(BIMS_SOURCE_DIR) + "/rawlogs/pendulum_slow.rawlog", in);
+	const auto size = fs::file_size(in);
+	std::ofstream(d + "/gt.txt") << "1 0 0 0 0 0 0 1\n";
+	fs::create_symlink(in, d + "/link.rawlog");
+	for (const std::string& args :
+	     {"bims-odom " + cfg + " " + in + " -o " + in,
+	      "bims-odom " + cfg + " " + in + " -o " + d + "/link.rawlog",
+	      "bims-odom " + cfg + " " + in + " -o " + d + "/t.txt --csv " + in,
+	      "bims-odom " + cfg + " " + in + " -o ''",
+	      "bims-calib-depth " + cfg + " " + in + " -o " + in,
+	      "bims-calib-imu " + cfg + " " + in + " -o " + cfg,
+	      "bims-eval traj " + d + "/gt.txt " + d + "/gt.txt --json " + d +
+	          "/gt.txt",
+	      "bims-sim " + cfg + " -o " + cfg,
+	      "bims-import-tum " + d + " -o " + d + "/../aliases"})
+	{
+		const ::Run r = run(kBin + "/" + args);
+		EXPECT_EQ(r.code, 2) << args << "\n" << r.out;
+		EXPECT_TRUE(r.out.find("would overwrite the input") !=
+		                std::string::npos ||
+		            r.out.find("contains the input") != std::string::npos ||
+		            r.out.find("output path is empty") != std::string::npos)
+		    << args << "\n"
+		    << r.out;
+	}
+	if (fs::exists(kBin + "/bims-viewer"))  // built with the GUI
+	{
+		const ::Run r = run(kBin + "/bims-viewer " + in +
+		                    " --frames 3 --screenshot " + d + "/link.rawlog");
+		EXPECT_EQ(r.code, 2) << r.out;
+		EXPECT_NE(r.out.find("would overwrite the input"), std::string::npos)
+		    << r.out;
+	}
+	EXPECT_EQ(fs::file_size(in), size);
+	EXPECT_EQ(fs::file_size(cfg), fs::file_size(std::string(BIMS_SOURCE_DIR) +
+	                                            "/config/default.ini"));
 }

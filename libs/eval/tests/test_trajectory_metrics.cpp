@@ -166,7 +166,7 @@ TEST(TrajectoryReport, JsonHasTheFigures)
 	ev::TrajectoryReport rep;
 	rep.gtPath = "g\"t.txt";
 	rep.ate.stats.rmse = 0.25;
-	const auto j = rep.toJson();
+	const auto j = bims::jsonText(rep.toJson());
 	EXPECT_NE(j.find("\"rmse\": 0.25"), std::string::npos) << j;
 	EXPECT_NE(j.find("g\\\"t.txt"), std::string::npos) << j;
 }

@@ -153,7 +153,8 @@ std::unique_ptr<ImuSource> makeImuSource(
 #ifdef BIMS_GRAB_WITH_SIM
 	if (driver == "SimImu") return makeSimImuSource(cfg, section);
 #endif
-	throw ConfigError("[" + section + "] driver=" + driver +
+	throw ConfigError(configSourceName(cfg) + ": [" + section +
+	                  "] driver=" + driver +
 	                  ": not an IMU driver (CIMUXSens_MT4, RawlogImu"
 #ifdef BIMS_GRAB_WITH_SIM
 	                  ", SimImu"

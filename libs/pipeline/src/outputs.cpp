@@ -1,5 +1,7 @@
 #include "outputs.h"
 #include <bims/common/frame_files.h>
+#include <bims/common/json.h>
+#include <bims/common/output_paths.h>
 
 #include "cpu_time.h"
 
@@ -9,8 +11,12 @@
 #include <bims/maps/export.h>
 #include <mrpt/obs/TPixelLabelInfo.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <functional>
+#include <initializer_list>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
@@ -20,17 +26,18 @@ namespace bims::pipeline
 void writePointsPly(const std::string& path,
                     const std::vector<mrpt::math::TPoint3D>& pts)
 {
-	std::ofstream f(path);
-	if (!f) throw std::runtime_error(path + ": cannot write PLY file");
-	f << "ply\nformat ascii 1.0\nelement vertex " << pts.size()
-	  << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+	std::string text = "ply\nformat ascii 1.0\nelement vertex " +
+	                   std::to_string(pts.size()) +
+	                   "\nproperty float x\nproperty float y\nproperty float "
+	                   "z\nend_header\n";
+	text.reserve(text.size() + 32 * pts.size());
 	char buf[96];
 	for (const auto& p : pts)
 	{
 		std::snprintf(buf, sizeof(buf), "%.4f %.4f %.4f\n", p.x, p.y, p.z);
-		f << buf;
+		text += buf;
 	}
-	if (!f) throw std::runtime_error(path + ": write failed");
+	writeFileAtomically(path, text);
 }
 
 namespace
@@ -49,32 +56,38 @@ OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
     : dir_(dir), p_(p), worker_(kQueuedWrites, p.writer_thread)
 {
 	makeDirs(dir_ + "/masks");
+	// written last: a folder without it is partial (an earlier run's would
+	// say otherwise)
+	if (std::remove((dir_ + "/metrics.json").c_str()) != 0 && errno != ENOENT)
+		throw std::runtime_error(
+		    dir_ + "/metrics.json: cannot remove: " + std::strerror(errno));
 	if (p_.moving_ply) makeDirs(dir_ + "/moving_voxels");
 	if (p_.flow_labels) makeDirs(dir_ + "/flow_labels");
-	traj_.open(dir_ + "/trajectory.txt");
-	csv_.open(dir_ + "/frames.csv");
-	if (!traj_ || !csv_)
-		throw std::runtime_error(dir_ + ": cannot create output files");
-	traj_ << "# bims-run estimated camera trajectory T_WC (optical frame)\n# "
-	         "timestamp tx ty tz qx qy qz qw\n";
-	csv_ << "index,t,ego_flags,correspondences,inliers,residual_m,hit_voxels,"
-	        "moving_voxels,moving_px,diff_px,notdiff_px,"
-	        "ms_input,ms_ego,ms_flow,ms_grids,ms_total\n";
-	traj_.flush();
-	csv_.flush();
+	// grown line by line, each line checked and whole
+	traj_ = std::make_unique<AppendFile>(dir_ + "/trajectory.txt");
+	csv_ = std::make_unique<AppendFile>(dir_ + "/frames.csv");
+	traj_->append(
+	    "# bims-run estimated camera trajectory T_WC (optical frame)\n# "
+	    "timestamp tx ty tz qx qy qz qw\n");
+	csv_->append(
+	    "index,t,ego_flags,correspondences,inliers,residual_m,hit_voxels,"
+	    "moving_voxels,moving_px,diff_px,notdiff_px,"
+	    "ms_input,ms_ego,ms_flow,ms_grids,ms_total\n");
 	if (p_.labelled_rawlog)
 		rawlog_ = std::make_unique<RawlogWriter>(dir_ + "/segmented.rawlog",
 		                                         p_.labelled_rawlog_gz_level);
 }
 
 double OutputWriter::writeFrame(const FrameResult& r,
-                                mrpt::obs::CObservation3DRangeScan::Ptr scan)
+                                mrpt::obs::CObservation3DRangeScan::Ptr scan,
+                                uint32_t flags)
 {
 	// What the writer needs, in buffers of its own (the pipeline keeps the
 	// mask as its feedback).
 	auto c = std::make_shared<FrameResult>(r);
 	c->maskTier1 = c->maskTier2 = c->maskFlow = cv::Mat();
 	c->flowObserved = c->flowExpected = cv::Mat();
+	c->ego.flags = flags;
 	c->mask = r.mask.clone();
 	c->labels = p_.flow_labels ? r.labels.clone() : cv::Mat();
 	return worker_.post(
@@ -92,17 +105,7 @@ double OutputWriter::writeFrame(const FrameResult& r,
 void OutputWriter::doWriteFrame(const FrameResult& r,
                                 mrpt::obs::CObservation3DRangeScan& scan)
 {
-	const std::string mpath = dir_ + "/masks/" + frameFileName(long(r.index));
-	bool ok = false;
-	try
-	{
-		ok = cv::imwrite(mpath, r.mask);
-	}
-	catch (const cv::Exception& e)
-	{
-		throw std::runtime_error(mpath + ": cannot write mask: " + e.what());
-	}
-	if (!ok) throw std::runtime_error(mpath + ": cannot write mask");
+	writeImageFile(dir_ + "/masks/" + frameFileName(long(r.index)), r.mask);
 	if (p_.moving_ply)
 		writePointsPly(
 		    dir_ + "/moving_voxels/" + frameFileName(long(r.index), "ply"),
@@ -112,20 +115,9 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 		cv::Mat vis(r.labels.size(), CV_8UC1, cv::Scalar(0));
 		vis.setTo(128, r.labels == 0);
 		vis.setTo(255, r.labels == 1);
-		cv::imwrite(dir_ + "/flow_labels/" + frameFileName(long(r.index)), vis);
+		writeImageFile(dir_ + "/flow_labels/" + frameFileName(long(r.index)),
+		               vis);
 	}
-	traj_ << tumLine(r.t, r.T_WC) << "\n";
-	traj_.flush();
-	char buf[512];
-	std::snprintf(
-	    buf, sizeof(buf),
-	    "%zu,%.6f,%u,%d,%d,%.5f,%zu,%zu,%d,%zu,%zu,%.3f,%.3f,%.3f,%.3f,%.3f\n",
-	    r.index, r.t, r.ego.flags, r.ego.correspondences, r.ego.inliers,
-	    r.ego.residual_rms_m, r.hitVoxels, r.movingVoxels,
-	    cv::countNonZero(r.mask), r.labelStats.diff, r.labelStats.notDiff,
-	    r.ms.input, r.ms.ego, r.ms.flow, r.ms.grids, r.ms.total);
-	csv_ << buf;
-	csv_.flush();
 	if (rawlog_)
 	{
 		// Label 0 ("moving"), bit 0 of each pixel's byte; written in one
@@ -134,10 +126,22 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 		    r.mask.ptr<uint8_t>(0), r.mask.rows, r.mask.cols, r.mask.step[0],
 		    "moving");  // no copy of the images
 		rawlog_->write(scan);
-		// a plain rawlog reaches the OS frame by frame: a killed run leaves
-		// it readable up to the last whole frame
+		// a plain rawlog reaches the OS object by object: a killed run
+		// leaves it readable up to the last whole frame
 		rawlog_->flush();
 	}
+	// the trajectory and frames.csv last: a frame in frames.csv is in every
+	// output
+	traj_->append(tumLine(r.t, r.T_WC) + "\n");
+	char buf[512];
+	std::snprintf(
+	    buf, sizeof(buf),
+	    "%zu,%.6f,%u,%d,%d,%.5f,%zu,%zu,%d,%zu,%zu,%.3f,%.3f,%.3f,%.3f,%.3f\n",
+	    r.index, r.t, r.ego.flags, r.ego.correspondences, r.ego.inliers,
+	    r.ego.residual_rms_m, r.hitVoxels, r.movingVoxels,
+	    cv::countNonZero(r.mask), r.labelStats.diff, r.labelStats.notDiff,
+	    r.ms.input, r.ms.ego, r.ms.flow, r.ms.grids, r.ms.total);
+	csv_->append(buf);
 }
 
 double OutputWriter::writeOther(mrpt::obs::CObservation::Ptr obs)
@@ -165,7 +169,25 @@ size_t OutputWriter::close(const Pipeline& pipe)
 	{
 		err = e.what();
 	}
-	if (rawlog_) rawlog_->close();
+	// every file closed, the first error kept
+	for (const auto& closeOne :
+	     std::initializer_list<std::function<void()>>{[&] { traj_->close(); },
+	                                                  [&] { csv_->close(); },
+	                                                  [&]
+	                                                  {
+		                                                  if (rawlog_)
+			                                                  rawlog_->close();
+	                                                  }})
+	{
+		try
+		{
+			closeOne();
+		}
+		catch (const std::exception& e)
+		{
+			if (err.empty()) err = e.what();
+		}
+	}
 	size_t nStatic = 0;
 	const auto& g = pipe.grids();
 	const maps::CMotionGridBase* motion = nullptr;
@@ -175,10 +197,13 @@ size_t OutputWriter::close(const Pipeline& pipe)
 		motion = g.flow().get();
 	if (p_.static_map && pipe.framesProcessed() > 0)
 	{
-		nStatic = maps::writeStaticPly(dir_ + "/static_map.ply", *g.occupancy(),
-		                               motion, p_.static_p_occupied);
-		maps::writeStaticOctomap(dir_ + "/static_map.bt", *g.occupancy(),
-		                         motion, p_.static_p_occupied);
+		PartialFile ply(dir_ + "/static_map.ply"), bt(dir_ + "/static_map.bt");
+		nStatic = maps::writeStaticPly(ply.path(), *g.occupancy(), motion,
+		                               p_.static_p_occupied);
+		maps::writeStaticOctomap(bt.path(), *g.occupancy(), motion,
+		                         p_.static_p_occupied);
+		ply.commit();
+		bt.commit();
 	}
 	staticVoxels_ = nStatic;
 	if (!err.empty()) throw std::runtime_error(err);
@@ -187,50 +212,34 @@ size_t OutputWriter::close(const Pipeline& pipe)
 
 void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
 {
-	const size_t nStatic = staticVoxels_;
-	std::ofstream j(dir_ + "/metrics.json");
-	if (!j) throw std::runtime_error(dir_ + "/metrics.json: cannot write");
-	char buf[1024];
-	j << "{\n";
-	j << "  \"variant\": \"" << sum.variant << "\",\n";
-	j << "  \"config\": \"" << pipe.config().source << "\",\n";
-	std::snprintf(
-	    buf, sizeof(buf),
-	    "  \"frames_processed\": %zu,\n  \"frames_flagged\": %zu,\n  "
-	    "\"scans_read\": %zu,\n  \"imu_read\": %zu,\n"
-	    "  \"scans_out_of_order\": %zu,\n  \"wall_seconds\": %.3f,\n "
-	    " \"cpu_seconds\": %.3f,\n  \"peak_resident_mib\": %.1f,\n"
-	    "  \"fps\": %.3f,\n  \"data_seconds\": %.3f,\n"
-	    "  \"mean_moving_pixel_fraction\": %.6f,\n  "
-	    "\"static_map_voxels\": %zu,\n  \"frames_flow_ahead\": %zu,\n",
-	    sum.framesProcessed, sum.framesFlagged, sum.scansRead, sum.imuRead,
-	    sum.scansOutOfOrder, sum.seconds, sum.cpuSeconds, sum.peakResidentMiB,
-	    sum.fps(), sum.dataSeconds, sum.meanMovingPixelFraction, nStatic,
-	    sum.framesFlowAhead);
-	j << buf;
-	j << "  \"stage_ms\": {";
-	bool first = true;
+	Json j;
+	j["status"] = sum.status();
+	j["variant"] = sum.variant;
+	j["config"] = pipe.config().source;
+	j["frames_processed"] = sum.framesProcessed;
+	j["frames_flagged"] = sum.framesFlagged;
+	j["scans_read"] = sum.scansRead;
+	j["imu_read"] = sum.imuRead;
+	j["scans_out_of_order"] = sum.scansOutOfOrder;
+	j["wall_seconds"] = jsonNumber(sum.seconds, 3);
+	j["cpu_seconds"] = jsonNumber(sum.cpuSeconds, 3);
+	j["peak_resident_mib"] = jsonNumber(sum.peakResidentMiB, 1);
+	j["fps"] = jsonNumber(sum.fps(), 3);
+	j["data_seconds"] = jsonNumber(sum.dataSeconds, 3);
+	j["mean_moving_pixel_fraction"] =
+	    jsonNumber(sum.meanMovingPixelFraction, 6);
+	j["static_map_voxels"] = staticVoxels_;
+	j["frames_flow_ahead"] = sum.framesFlowAhead;
+	j["imu_rejected"] = sum.imuRejected;
+	j["scans_bad_stamp"] = sum.scansBadStamp;
+	Json& stages = j["stage_ms"] = Json::object();
 	for (const auto& [name, p] : sum.stageMs)
-	{
-		std::snprintf(buf, sizeof(buf),
-		              "%s\n    \"%s\": {\"median\": %.3f, \"p95\": %.3f, "
-		              "\"mean\": %.3f, \"n\": %zu}",
-		              first ? "" : ",", name.c_str(), p.median, p.p95, p.mean,
-		              p.n);
-		j << buf;
-		first = false;
-	}
-	j << "\n  },\n";
-	std::string err;
-	for (char c : sum.error)
-	{
-		if (c == '"' || c == '\\') err += '\\';
-		if (c == '\n')
-			err += "\\n";
-		else
-			err += c;
-	}
-	j << "  \"error\": \"" << err << "\"\n}\n";
+		stages[name] = {{"median", jsonNumber(p.median, 3)},
+		                {"p95", jsonNumber(p.p95, 3)},
+		                {"mean", jsonNumber(p.mean, 3)},
+		                {"n", p.n}};
+	j["error"] = sum.error;
+	writeJsonFile(dir_ + "/metrics.json", j);
 }
 
 }  // namespace bims::pipeline

@@ -3,6 +3,7 @@
 // thread ([output] writer_thread), in the order the frames were given.
 #pragma once
 
+#include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
 #include <bims/pipeline/pipeline.h>
 #include <bims/pipeline/run.h>
@@ -23,11 +24,13 @@ class OutputWriter
 	/** Queues the frame's outputs: mask PNG, moving-voxel PLY, trajectory and
 	 * CSV lines (flushed), and the scan into the labelled rawlog with the
 	 * mask as its pixel labels (set on \a scan itself, so the images are not
-	 * copied: the caller must not touch \a scan any more). Returns the time
-	 * spent waiting for room in the queue [ms]. Throws the error of an
-	 * earlier write that failed. */
+	 * copied: the caller must not touch \a scan any more). \a flags: the
+	 * frame's ego flags as written (r.ego.flags and those the run adds).
+	 * Returns the time spent waiting for room in the queue [ms]. Throws the
+	 * error of an earlier write that failed. */
 	double writeFrame(const FrameResult& r,
-	                  mrpt::obs::CObservation3DRangeScan::Ptr scan);
+	                  mrpt::obs::CObservation3DRangeScan::Ptr scan,
+	                  uint32_t flags);
 	/** Queues a non-scan observation (IMU) for the labelled rawlog. */
 	double writeOther(mrpt::obs::CObservation::Ptr obs);
 	/** Waits for the queued writes, closes the labelled rawlog, writes the
@@ -48,7 +51,7 @@ class OutputWriter
 
 	std::string dir_;
 	OutputParams p_;
-	std::ofstream traj_, csv_;
+	std::unique_ptr<AppendFile> traj_, csv_;
 	std::unique_ptr<RawlogWriter> rawlog_;
 	size_t staticVoxels_ = 0;
 	// written by the worker thread, read after close()

@@ -1,4 +1,5 @@
 #include <bims/common/app.h>
+#include <bims/common/imu_check.h>
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
@@ -19,6 +20,7 @@
 #include <limits>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
 #include <sstream>
 
 #include "cpu_time.h"
@@ -72,6 +74,26 @@ Percentiles Percentiles::of(std::vector<double> v)
 	for (double x : v) s += x;
 	p.mean = s / v.size();
 	return p;
+}
+
+void checkFiniteOutputs(const FrameResult& r)
+{
+	const auto M =
+	    r.T_WC.getHomogeneousMatrixVal<mrpt::math::CMatrixDouble44>();
+	bool finite = std::isfinite(r.t);
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < 4; j++) finite = finite && std::isfinite(M(i, j));
+	char what[160];
+	std::snprintf(what, sizeof(what), "3D scan #%zu (t %.6f): ", r.index, r.t);
+	if (!finite)
+		throw std::runtime_error(what +
+		                         std::string("the estimated pose is not "
+		                                     "finite; nothing of it written"));
+	for (const auto& p : r.movingVoxelCentres)
+		if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+			throw std::runtime_error(
+			    what + std::string("a moving voxel is not finite; nothing of "
+			                       "it written"));
 }
 
 namespace
@@ -138,6 +160,11 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 
 	std::map<std::string, std::vector<double>> stage;
 	std::deque<PendingScan> pending;
+	std::deque<double> rejectedImuT;  ///< stamps of rejected IMU samples
+	/** A scan stamped far after the previous one, until the next scan says
+	 * whether the recording jumped or the stamp is stray. */
+	std::optional<PendingScan> held;
+	size_t obsInFile = 0, lastFile = 0;
 	double lastImuT = -std::numeric_limits<double>::infinity();
 	double newestT = lastImuT, lastScanT = lastImuT, firstT = NAN, lastT = NAN;
 	const double offset = cfg.ego.calibration.time_offset_s;
@@ -154,9 +181,17 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		if (next) ahead = {next->scan.get(), next->index};
 		const FrameResult& r = pipe.processFrame(*p.scan, p.index, ahead);
 		stage["total_cpu"].push_back(threadCpuMs() - frameCpu0);
+		checkFiniteOutputs(r);
+		// IMU samples rejected up to this frame's time flag it
+		uint32_t flags = r.ego.flags;
+		while (!rejectedImuT.empty() && rejectedImuT.front() <= r.t)
+		{
+			flags |= ego::kFlagImuRejected;
+			rejectedImuT.pop_front();
+		}
 		sum.framesProcessed++;
 		if (r.flowAhead) sum.framesFlowAhead++;
-		if (r.ego.flags & ~static_cast<uint32_t>(ego::kFlagFirstFrame))
+		if (flags & ~static_cast<uint32_t>(ego::kFlagFirstFrame))
 			sum.framesFlagged++;
 		stage["read"].push_back(p.readMs);
 		stage["read_cpu"].push_back(p.readCpuMs);
@@ -176,7 +211,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		if (opt.onFrame) opt.onFrame(r, *p.scan);
 		if (out)
 		{
-			stage["wait_output"].push_back(out->writeFrame(r, p.scan));
+			stage["wait_output"].push_back(out->writeFrame(r, p.scan, flags));
 			for (const auto& o : p.after) out->writeOther(o);
 		}
 		bar.update(sum.framesProcessed, "frame " + std::to_string(p.index));
@@ -204,20 +239,67 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		}
 	};
 
+	ego::DepthCorrection depthCorrection(cfg.ego.depth_correction);
+	std::string readError;  ///< the input's, after the frames before it
+	std::string firstSize;  ///< "WxH (3D scan #i of FILE)" of the first scan
+	auto accept = [&](PendingScan&& p)
+	{
+		lastScanT = p.t;
+		newestT = std::max(newestT, p.t);
+		// the sensor's depth distortion corrected once, for every stage and
+		// for the written scan
+		depthCorrection.apply(*p.scan, cfg.ego.camera);
+		pending.push_back(std::move(p));
+	};
+	auto dropHeld = [&](const std::string& path, const char* why)
+	{
+		sum.scansBadStamp++;
+		std::fprintf(stderr,
+		             "bims-run: warning: %s: 3D scan #%zu (t %.6f) is %.6g s "
+		             "after the previous scan and %s: a stray timestamp; "
+		             "skipped\n",
+		             path.c_str(), held->index, held->t, held->t - lastScanT,
+		             why);
+		// the IMU samples read after it stay in the labelled rawlog, in order
+		if (!out) return;
+		for (auto& o : held->after)
+			if (pending.empty())
+				out->writeOther(o);
+			else
+				pending.back().after.push_back(std::move(o));
+	};
 	try
 	{
 		ReadAhead input(opt.rawlogs, kReadAhead, cfg.pipeline.read_ahead);
-		ego::DepthCorrection depthCorrection(cfg.ego.depth_correction);
 		for (;;)
 		{
+			if (opt.stop && *opt.stop)
+			{
+				sum.interrupted = true;  // the frames done stay written
+				break;
+			}
 			double wait = 0;
-			const auto item = input.next(&wait);
+			ReadAhead::Item item;
+			try
+			{
+				item = input.next(&wait);
+			}
+			catch (const std::exception& e)
+			{
+				// a truncated or missing input ends it like its end: every
+				// frame read whole is still processed and written
+				readError = e.what();
+				break;
+			}
 			const auto& o = item.obs;
 			if (!o) break;
 			readMs += item.readMs;
 			readCpuMs += item.readCpuMs;
 			inWaitMs += wait;
 			const std::string& path = input.path(item.file);
+			if (item.file != lastFile) obsInFile = 0;
+			lastFile = item.file;
+			const size_t obsIndex = obsInFile++;
 			const double t = mrpt::Clock::toDouble(o->timestamp);
 			if (auto imu =
 			        std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(o))
@@ -227,12 +309,29 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 					sum.otherSkipped++;
 					continue;
 				}
-				pipe.addImu(*imu);
 				sum.imuRead++;
-				lastImuT = std::max(lastImuT, t);
+				const std::string bad = imuSampleProblem(*imu);
+				if (bad.empty())
+				{
+					pipe.addImu(*imu);
+					lastImuT = std::max(lastImuT, t);
+				}
+				else
+				{
+					sum.imuRejected++;
+					rejectedImuT.push_back(t);
+					std::fprintf(
+					    stderr,
+					    "bims-run: warning: %s: observation #%zu (IMU, "
+					    "t %.6f): %s; sample not used (%zu so far)\n",
+					    path.c_str(), obsIndex, t, bad.c_str(),
+					    sum.imuRejected);
+				}
 				if (out)
 				{
-					if (pending.empty())
+					if (held)
+						held->after.push_back(imu);
+					else if (pending.empty())
 						out->writeOther(imu);
 					else
 						pending.back().after.push_back(imu);
@@ -248,6 +347,15 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 				}
 				const size_t idx = scanIndex++;
 				sum.scansRead++;
+				if (held)
+				{
+					// this scan follows the held one: the recording jumped
+					if (t > held->t && t - held->t <= kMaxScanGapS)
+						accept(std::move(*held));
+					else
+						dropHeld(path, "the next scan is not");
+					held.reset();
+				}
 				if (idx > opt.frames.last) break;  // stops reading
 				if (!opt.frames.contains(idx)) continue;
 				if (t <= lastScanT)
@@ -260,26 +368,55 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 					    path.c_str(), idx);
 					continue;
 				}
-				lastScanT = t;
-				// the sensor's depth distortion corrected once, for every
-				// stage and for the written scan
-				depthCorrection.apply(*scan, cfg.ego.camera);
-				pending.push_back(
-				    {scan, idx, t, readMs, readCpuMs, inWaitMs, {}});
+				if (scan->hasRangeImage)
+				{
+					const std::string size =
+					    std::to_string(scan->rangeImage.cols()) + "x" +
+					    std::to_string(scan->rangeImage.rows());
+					if (firstSize.empty())
+						firstSize = size + " (3D scan #" + std::to_string(idx) +
+						            " of " + path + ")";
+					else if (firstSize.compare(0, size.size() + 1,
+					                           size + " ") != 0)
+					{
+						// an input error: the frames before it are written
+						readError = path + ": 3D scan #" + std::to_string(idx) +
+						            " has a " + size +
+						            " depth image where the run's first had " +
+						            firstSize +
+						            ": one run takes one image size (camera "
+						            "mode)";
+						break;
+					}
+				}
+				PendingScan p{scan, idx, t, readMs, readCpuMs, inWaitMs, {}};
 				readMs = readCpuMs = inWaitMs = 0;
+				if (std::isfinite(lastScanT) && t - lastScanT > kMaxScanGapS)
+				{
+					held = std::move(p);  // the next scan decides
+					continue;
+				}
+				accept(std::move(p));
 			}
 			else
 				sum.otherSkipped++;
 			newestT = std::max(newestT, t);
 			flush(false);
 		}
-		flush(true);
+		if (!sum.interrupted)
+		{
+			if (held) dropHeld(input.path(lastFile), "it is the last scan");
+			flush(true);
+		}
 	}
 	catch (const std::exception& e)
 	{
 		sum.error = e.what();
 		pending.clear();
 	}
+	if (!readError.empty())  // first: it came first
+		sum.error =
+		    readError + (sum.error.empty() ? "" : "; then: " + sum.error);
 	if (sum.scansRead == 0 && sum.error.empty())
 	{
 		std::string files;
@@ -315,7 +452,17 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	        .count();
 	sum.cpuSeconds = 1e-3 * (processCpuMs() - cpu0);
 	sum.peakResidentMiB = peakResidentMiB();
-	if (out) out->writeMetrics(pipe, sum);
+	if (out)
+	{
+		try
+		{
+			out->writeMetrics(pipe, sum);
+		}
+		catch (const std::exception& e)
+		{
+			addError(sum, e.what());  // reported by the caller
+		}
+	}
 	return sum;
 }
 
@@ -346,6 +493,15 @@ std::string formatSummary(const RunSummary& s)
 		if (it == s.stageMs.end()) continue;
 		std::snprintf(buf, sizeof(buf), "%-12s %9.2f %8.2f %9.2f\n", k,
 		              it->second.median, it->second.p95, it->second.mean);
+		o << buf;
+	}
+	if (s.imuRejected || s.scansBadStamp || s.scansOutOfOrder)
+	{
+		std::snprintf(buf, sizeof(buf),
+		              "not used: %zu IMU samples (a field not finite or "
+		              "beyond range), %zu 3D scans with a stray timestamp, %zu "
+		              "out of order (warnings above)\n",
+		              s.imuRejected, s.scansBadStamp, s.scansOutOfOrder);
 		o << buf;
 	}
 	if (!s.error.empty()) o << "stopped early: " << s.error << "\n";

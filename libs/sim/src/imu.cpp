@@ -1,12 +1,13 @@
 #include <bims/common/config.h>
 #include <bims/common/frames.h>
+#include <bims/common/output_paths.h>
 #include <bims/sim/imu.h>
 #include <bims/sim/rng.h>
 #include <mrpt/system/datetime.h>
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace bims::sim
@@ -234,8 +235,7 @@ std::vector<mrpt::obs::CObservationIMU::Ptr> synthesizeImu(
 
 void saveImuTruth(const std::string& path, const std::vector<ImuTruth>& truth)
 {
-	std::ofstream f(path);
-	if (!f) throw std::runtime_error(path + ": cannot write IMU ground truth");
+	std::ostringstream f;
 	f << "# bims-sim IMU ground truth, one line per IMU observation in the "
 	     "rawlog.\n"
 	     "# t_stamp[s] t_true[s] wx wy wz[rad/s, true angular rate in {I}] "
@@ -258,7 +258,7 @@ void saveImuTruth(const std::string& path, const std::vector<ImuTruth>& truth)
 		              t.q_WI.w(), t.magBias.x(), t.magBias.y(), t.magBias.z());
 		f << buf;
 	}
-	if (!f) throw std::runtime_error(path + ": write failed");
+	writeFileAtomically(path, f.str());
 }
 
 }  // namespace bims::sim

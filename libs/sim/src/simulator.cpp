@@ -1,5 +1,6 @@
 #include <bims/common/app.h>
 #include <bims/common/frame_files.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/pixel_labels.h>
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
@@ -19,7 +20,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
-#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace bims::sim
@@ -95,14 +96,12 @@ void writePreview(const RenderedFrame& f, double maxRange,
 			img.at<cv::Vec3b>(v, 2 * W + u) =
 			    cv::Vec3b(f.mask[k], f.mask[k], f.mask[k]);
 		}
-	if (!cv::imwrite(path, img))
-		throw std::runtime_error(path + ": cannot write preview");
+	writeImageFile(path, img);
 }
 
 void writeCalibration(const SimConfig& cfg, const std::string& path)
 {
-	std::ofstream f(path);
-	if (!f) throw std::runtime_error(path + ": cannot write");
+	std::ostringstream f;
 	char buf[256];
 	const std::string sceneName =
 	    cfg.file.substr(cfg.file.find_last_of('/') + 1);
@@ -145,7 +144,7 @@ void writeCalibration(const SimConfig& cfg, const std::string& path)
 	              "mag_field_W=%.9f %.9f %.9f\n",
 	              m.x(), m.y(), m.z());
 	f << buf;
-	if (!f) throw std::runtime_error(path + ": write failed");
+	writeFileAtomically(path, f.str());
 }
 }  // namespace
 
@@ -172,13 +171,12 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	const HandheldMotion motion(cfg.motion);
 	const Renderer renderer(cfg.camera, cfg.depth, cfg.rgb);
 	ImuSimulator imu(cfg.imu, seed);
-	RawlogWriter out(outRawlog, cfg.seq.gzLevel);
+	PartialFile part(outRawlog);  // renamed once complete
+	RawlogWriter out(part.path(), cfg.seq.gzLevel);
 
 	Trajectory gt;
 	std::vector<ImuTruth> imuTruth;
-	std::ofstream objs(st.gtDir + "/objects.txt");
-	if (!objs)
-		throw std::runtime_error(st.gtDir + "/objects.txt: cannot write");
+	std::ostringstream objs;  // written at the end
 	objs << "# bims-sim moving-object poses T_WO (root frame of each object in "
 	        "{W}), one line\n"
 	        "# per frame and object: frame object_id name t[s] tx ty tz qx qy "
@@ -221,8 +219,7 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 		const std::string name = "/masks/" + frameFileName(j);
 		const cv::Mat mask(frame.height, frame.width, CV_8UC1,
 		                   frame.mask.data());
-		if (!cv::imwrite(st.gtDir + name, mask))
-			throw std::runtime_error(st.gtDir + name + ": cannot write mask");
+		writeImageFile(st.gtDir + name, mask);
 		if (j == previewFrame)
 			writePreview(frame, cfg.depth.maxRange, st.gtDir + "/preview.png");
 		size_t nMoving = 0;
@@ -241,6 +238,7 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	writeImuUntil(duration +
 	              0.5 / cfg.seq.fps);  // IMU a little past the last frame
 	out.close();
+	part.commit();
 	bar.finish();
 
 	saveTumTrajectory(st.gtDir + "/groundtruth.txt", gt,
@@ -248,8 +246,7 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	                  "world z up, x north");
 	saveImuTruth(st.gtDir + "/imu.txt", imuTruth);
 	writeCalibration(cfg, st.gtDir + "/calibration.ini");
-	if (!objs)
-		throw std::runtime_error(st.gtDir + "/objects.txt: write failed");
+	writeFileAtomically(st.gtDir + "/objects.txt", objs.str());
 
 	st.frames = size_t(cfg.seq.frames);
 	st.imuSamples = imuTruth.size();

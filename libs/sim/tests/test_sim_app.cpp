@@ -17,6 +17,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <regex>
@@ -403,4 +404,22 @@ TEST(BundledSample, RegeneratingGivesTheSameBytes)
 	ASSERT_EQ(run("diff -r '" + d + "/pendulum_slow_gt' '" + ref + "_gt'", out),
 	          0)
 	    << out;
+}
+
+TEST(BimsSim, AFullDiskIsAnErrorAndLeavesNoRawlogUnderItsName)
+{
+	// every file limited to 256 KiB (SIGXFSZ ignored: writes fail with
+	// EFBIG, as on a full disk); the gzip level 1 rawlog passes it
+	const std::string d = tmpDir("full");
+	std::string out;
+	const int rc =
+	    run("bash -c \"ulimit -f 256; trap '' XFSZ; exec '" + kBin +
+	            "/bims-sim' '" + kSrc + "/rawlogs/pendulum_slow.ini' -o '" + d +
+	            "/x.rawlog' --frames 40 -q\"",
+	        out);
+	EXPECT_EQ(rc, 1) << out;
+	EXPECT_NE(out.find("x.rawlog.partial: write failed"), std::string::npos)
+	    << out;
+	EXPECT_FALSE(std::filesystem::exists(d + "/x.rawlog"));
+	EXPECT_FALSE(std::filesystem::exists(d + "/x.rawlog.partial"));
 }

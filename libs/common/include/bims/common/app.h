@@ -1,10 +1,12 @@
 // Shared entry-point plumbing for the bims command-line programs.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace bims
 {
@@ -43,6 +45,24 @@ void parseCommandLine(CmdLine& cmd, int argc, char** argv)
 	}
 	throw ExitRequest{2};
 }
+
+/** The values of those TCLAP value arguments that the command line gave
+ * (e.g. the optional outputs, for checkOutputsSpareInputs). */
+template <class... Arg>
+std::vector<std::string> givenValues(Arg&... args)
+{
+	std::vector<std::string> v;
+	(..., (args.isSet() ? v.push_back(args.getValue()) : void()));
+	return v;
+}
+
+/** From now on SIGINT and SIGTERM ask the program to stop cleanly: the
+ * returned flag turns true (the program finishes its current step, writes
+ * what it has and exits); a second signal kills at once (default action).
+ * For main() only: libraries take the flag. */
+const std::atomic<bool>& installStopSignals();
+/** The signal that set the stop flag (0: none yet). */
+int stopSignal();
 
 /** Tells the C library's allocator to keep freed memory for reuse instead
  * of returning it to the system at once: per-frame image buffers (several

@@ -5,6 +5,7 @@
 // corrupt file raises RawlogError instead of ending silently.
 #pragma once
 
+#include <bims/common/output_paths.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CObservation.h>
@@ -62,7 +63,8 @@ class RawlogReader
 class RawlogWriter
 {
  public:
-	/** Creates (truncates) \a path. gzLevel 1..9 writes a gzip-compressed
+	/** Creates (truncates) \a path (a symbolic link there is replaced, its
+	 * target untouched). gzLevel 1..9 writes a gzip-compressed
 	 * rawlog (flushed only on close); 0 writes a plain rawlog whose flush()
 	 * reaches the OS, for live grabbing. Throws RawlogError if the file
 	 * cannot be created. */
@@ -71,18 +73,22 @@ class RawlogWriter
 	RawlogWriter(const RawlogWriter&) = delete;
 	RawlogWriter& operator=(const RawlogWriter&) = delete;
 
-	/** Appends one observation (observations-only rawlog format). */
+	/** Appends one observation (observations-only rawlog format). A plain
+	 * rawlog gets it at once or not at all (bims::AppendFile: a failed write
+	 * leaves the file at its last whole observation and throws naming it). */
 	void write(const mrpt::obs::CObservation& obs);
-	/** Pushes buffered bytes to the OS (so a kill loses at most the last
-	 * object). */
+	/** Nothing to do for a plain rawlog (each object reaches the OS when
+	 * written, so a kill loses at most the last object). */
 	void flush();
+	/** Closes the file; throws RawlogError naming it if the last bytes
+	 * could not be written (plain rawlogs). */
 	void close();
 	size_t written() const { return n_; }
 	const std::string& path() const { return path_; }
 
  private:
 	std::string path_;
-	std::ofstream plain_;
+	std::unique_ptr<AppendFile> plain_;  ///< a plain rawlog
 	mrpt::io::CFileGZOutputStream gz_;
 	std::vector<uint8_t> buf_;  ///< the object being written
 	std::unique_ptr<mrpt::serialization::CArchive> arch_;

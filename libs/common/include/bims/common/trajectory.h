@@ -24,7 +24,9 @@ using Trajectory = std::vector<StampedPose>;
 Trajectory loadTumTrajectory(const std::string& path);
 
 /** Writes a TUM trajectory (header comment, 6 decimals for time, 9 for
- * values). Throws std::runtime_error if the file cannot be written. */
+ * values), complete or not at all (writeFileAtomically). Throws
+ * std::runtime_error if the file cannot be written or a pose or time is not
+ * finite (naming its time; nothing is written then). */
 void saveTumTrajectory(const std::string& path, const Trajectory& traj,
                        const std::string& headerComment = {});
 

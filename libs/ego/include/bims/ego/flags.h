@@ -45,6 +45,10 @@ enum EgoFlag : uint32_t
 	 * frame fits a keyframe almost entirely, the pose had drifted and jumps
 	 * back (relocalisation). */
 	kFlagAnchorRelocalised = 1u << 16,
+	/** An IMU sample in this frame's interval was rejected (a field not
+	 * finite or beyond any sensor's range; bims::imuSampleProblem) and
+	 * not used. Set by bims-run. */
+	kFlagImuRejected = 1u << 17,
 };
 
 /** "imu_gap|too_few_tracks" style text ("ok" for none). */

@@ -2,6 +2,7 @@
 // ground-truth mask, counted over the pixels with valid depth.
 #pragma once
 
+#include <bims/common/json.h>
 #include <bims/eval/mask_labels.h>
 #include <opencv2/core.hpp>
 
@@ -52,7 +53,7 @@ struct MaskMetrics
 	 * undefined). */
 	std::string scoresLine() const;
 	/** JSON object with counts and scores. */
-	std::string toJson() const;
+	Json toJson() const;
 };
 
 /** Voxel-level counts of one frame: the pixels with valid \a depthM

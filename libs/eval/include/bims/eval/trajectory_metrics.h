@@ -4,6 +4,7 @@
 // docs/eval.md.
 #pragma once
 
+#include <bims/common/json.h>
 #include <bims/common/trajectory.h>
 #include <bims/eval/association.h>
 #include <mrpt/poses/CPose3D.h>
@@ -95,7 +96,7 @@ struct TrajectoryReport
 	AteResult ate;
 	RpeResult rpe;
 	/** A JSON object (summaries only, no per-pair arrays). */
-	std::string toJson() const;
+	Json toJson() const;
 };
 
 /** The estimate's positions mapped into the ground-truth world with

@@ -5,6 +5,7 @@
 
 #include <bims/pipeline/pipeline.h>
 
+#include <atomic>
 #include <functional>
 #include <map>
 #include <memory>
@@ -37,6 +38,13 @@ struct RunSummary
 	size_t scansRead = 0, framesProcessed = 0, imuRead = 0, otherSkipped = 0;
 	size_t framesFlagged = 0;    ///< frames with an egomotion flag
 	size_t scansOutOfOrder = 0;  ///< dropped: timestamp not increasing
+	/** dropped: timestamp more than kMaxScanGapS after the previous scan's
+	 * and the next scan's not close to it (a stray stamp) */
+	size_t scansBadStamp = 0;
+	/** IMU samples not used: a field not finite or beyond any sensor's
+	 * range (bims::imuSampleProblem); the frames whose interval held one
+	 * are flagged imu_rejected */
+	size_t imuRejected = 0;
 	/** frames whose observed flow ran during the previous frame's grids
 	 * ([pipeline] flow_lookahead) */
 	size_t framesFlowAhead = 0;
@@ -59,6 +67,13 @@ struct RunSummary
 	std::string variant;
 	/** Error that stopped the run early (outputs so far stay valid). */
 	std::string error;
+	/** Stopped on request (RunOptions::stop) before the end of the input. */
+	bool interrupted = false;
+	/** "interrupted", "error" or "ok" (metrics.json's "status"). */
+	const char* status() const
+	{
+		return interrupted ? "interrupted" : error.empty() ? "ok" : "error";
+	}
 	double fps() const { return seconds > 0 ? framesProcessed / seconds : 0; }
 };
 
@@ -75,7 +90,22 @@ struct RunOptions
 	FrameRange frames;
 	bool progress = true;
 	FrameCallback onFrame;
+	/** When it turns true (e.g. bims::installStopSignals), the run stops
+	 * after the current frame: the frames done are written in full,
+	 * metrics.json says "status": "interrupted". */
+	const std::atomic<bool>* stop = nullptr;
 };
+
+/** A 3D scan stamped more than this after the previous one [s] is held
+ * back: processed when the next scan follows it within this gap (the
+ * recording jumped, e.g. a second rawlog), skipped with a warning when the
+ * next scan does not (a stray stamp), or when it is the last. */
+constexpr double kMaxScanGapS = 10.0;
+
+/** Throws std::runtime_error naming the frame (scan index and time) if
+ * anything bims-run writes of it is not finite: the pose, the moving
+ * voxels. */
+void checkFiniteOutputs(const FrameResult& r);
 
 /** Runs \a cfg over the rawlogs, reading ahead on a thread ([pipeline]
  * read_ahead) and writing on another ([output] writer_thread); returns when

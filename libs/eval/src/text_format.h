@@ -1,22 +1,12 @@
-// Minimal JSON writing helpers (internal).
+// Number formatting of the evaluation's text reports (internal).
 #pragma once
 
-#include <bims/eval/json.h>
 #include <cmath>
 #include <cstdio>
-
 #include <string>
 
 namespace bims::eval::detail
 {
-inline std::string jnum(double v)
-{
-	return jsonNumber(v);
-}
-inline std::string jstr(const std::string& s)
-{
-	return jsonString(s);
-}
 /** "%.4f" or "nan". */
 inline std::string fmt4(double v)
 {

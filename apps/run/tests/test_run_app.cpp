@@ -1,0 +1,283 @@
+// bims-run as a program: what it refuses before any work, and what it never
+// does to files it did not create.
+#include <bims/common/frame_files.h>
+#include <bims/common/json.h>
+#include <bims_test/run_command.h>
+#include <bims_test/tmp_dir.h>
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <tuple>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace
+{
+const std::string kBin = BIMS_BIN_DIR;
+const std::string kSrc = BIMS_SOURCE_DIR;
+const std::string kConfig = kSrc + "/config/default.ini";
+const std::string kSample = kSrc + "/rawlogs/pendulum_slow.rawlog";
+
+/** bims-run ARGS: exit code and output. */
+bims::test::CommandResult run(const std::string& args)
+{
+	return bims::test::runCommand(kBin + "/bims-run " + args);
+}
+std::string tmpDir(const std::string& name)
+{
+	return bims::test::freshTmpDir("bims_test_run_app", name);
+}
+std::string slurp(const std::string& p)
+{
+	std::ifstream f(p, std::ios::binary);
+	std::stringstream s;
+	s << f.rdbuf();
+	return s.str();
+}
+std::string q(const std::string& s)
+{
+	return "'" + s + "'";
+}
+}  // namespace
+
+TEST(RunApp, AnInputInsideTheOutputFolderIsRefusedUntouched)
+{
+	const auto d = tmpDir("input_in_output");
+	const std::string in = d + "/segmented.rawlog";
+	fs::copy_file(kSample, in);
+	const auto before = fs::file_size(in);
+	const auto r = run(q(kConfig) + " " + q(in) + " -o " + q(d) + " -q");
+	EXPECT_EQ(r.code, 2) << r.out;
+	EXPECT_NE(r.out.find("output folder " + d + " contains the input " + in),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_EQ(fs::file_size(in), before);
+	EXPECT_FALSE(fs::exists(d + "/trajectory.txt"));
+	// the config counts as an input too (a copy: never an output in the
+	// source tree, even if the rule broke)
+	fs::create_directories(d + "/cfg");
+	const std::string ini = d + "/cfg/exp.ini";
+	fs::copy_file(kConfig, ini);
+	const auto r2 =
+	    run(q(ini) + " " + q(kSample) + " -o " + q(d + "/cfg") + " -q");
+	EXPECT_EQ(r2.code, 2) << r2.out;
+	EXPECT_NE(r2.out.find("contains the input " + ini), std::string::npos)
+	    << r2.out;
+	EXPECT_FALSE(fs::exists(d + "/cfg/trajectory.txt"));
+}
+
+TEST(RunApp, AnEmptyOutputFolderIsRefused)
+{
+	const auto r = run(q(kConfig) + " " + q(kSample) + " -o '' -q");
+	EXPECT_EQ(r.code, 2) << r.out;
+	EXPECT_NE(r.out.find("output path is empty"), std::string::npos) << r.out;
+	EXPECT_EQ(r.out.find("outputs in"), std::string::npos) << r.out;
+}
+
+TEST(RunApp, SymlinkedOutputFilesAreReplacedNotFollowed)
+{
+	const auto d = tmpDir("symlinks");
+	const std::string out = d + "/out";
+	fs::create_directories(out + "/masks");
+	fs::create_directories(out + "/moving_voxels");
+	std::ofstream(d + "/precious.txt") << "precious";
+	for (const char* f :
+	     {"trajectory.txt", "frames.csv", "metrics.json", "segmented.rawlog",
+	      "static_map.ply", "masks/000001.png", "moving_voxels/000001.ply"})
+		fs::create_symlink(d + "/precious.txt", out + "/" + f);
+	const auto r = run(q(kConfig) + " " + q(kSample) + " -o " + q(out) +
+	                   " --frames 0:2 -q");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_EQ(slurp(d + "/precious.txt"), "precious");
+	for (const char* f :
+	     {"trajectory.txt", "frames.csv", "metrics.json", "segmented.rawlog",
+	      "static_map.ply", "masks/000001.png", "moving_voxels/000001.ply"})
+	{
+		EXPECT_FALSE(fs::is_symlink(fs::symlink_status(out + "/" + f))) << f;
+		EXPECT_GT(fs::file_size(out + "/" + f), 0u) << f;
+	}
+	EXPECT_EQ(bims::Json::parse(slurp(out + "/metrics.json"))["status"], "ok");
+}
+
+namespace
+{
+/** default.ini with [output] as given (the other sections as they are). */
+std::string configWithOutput(const std::string& dir, const std::string& out)
+{
+	std::string ini = slurp(kConfig);
+	ini = ini.substr(0, ini.find("[output]")) + "[output]\n" + out;
+	const std::string path = dir + "/exp.ini";
+	std::ofstream(path) << ini;
+	return path;
+}
+
+/** bims-run ARGS with every file limited to \a kib KiB (ulimit -f) and
+ * SIGXFSZ ignored: a write past it fails with EFBIG, as on a full disk. */
+bims::test::CommandResult runLimited(int kib, const std::string& args)
+{
+	return bims::test::runCommand("bash -c \"ulimit -f " + std::to_string(kib) +
+	                              "; trap '' XFSZ; exec " + kBin +
+	                              "/bims-run " + args + "\"");
+}
+
+size_t lineCount(const std::string& path)
+{
+	const std::string s = slurp(path);
+	return static_cast<size_t>(std::count(s.begin(), s.end(), '\n'));
+}
+/** bims-run CONFIG on the sample into DIR/out with files limited to \a kib
+ * KiB: expects exit 1 and the error naming DIR/out/FILE; returns the
+ * frames in frames.csv. */
+size_t framesWhenFull(const std::string& dir, const std::string& config,
+                      int kib, const std::string& file)
+{
+	const auto r = runLimited(
+	    kib, q(config) + " " + q(kSample) + " -o " + q(dir + "/out") + " -q");
+	EXPECT_EQ(r.code, 1) << r.out;
+	EXPECT_NE(
+	    r.out.find(dir + "/out/" + file + ": write failed: File too large"),
+	    std::string::npos)
+	    << r.out;
+	const size_t frames = lineCount(dir + "/out/frames.csv") - 1;
+	EXPECT_LT(frames, 150u);
+	return frames;
+}
+}  // namespace
+
+TEST(RunApp, AFullDiskStopsTheRunAtTheFirstFailedWriteNamingTheFile)
+{
+	// masks, trajectory and CSV only: trajectory.txt passes 6 KiB first
+	const auto d = tmpDir("full_disk");
+	const auto ini = configWithOutput(
+	    d, "labelled_rawlog=false\nmoving_ply=false\nstatic_map=false\n");
+	const size_t frames = framesWhenFull(d, ini, 6, "trajectory.txt");
+	EXPECT_GT(frames, 5u);
+	// every file holds whole lines, the same frames; every mask is whole
+	const std::string traj = slurp(d + "/out/trajectory.txt");
+	const std::string csv = slurp(d + "/out/frames.csv");
+	ASSERT_FALSE(csv.empty());
+	EXPECT_EQ(traj.back(), '\n');
+	EXPECT_EQ(csv.back(), '\n');
+	EXPECT_LE(lineCount(d + "/out/trajectory.txt") - 2, frames + 1);
+	size_t masks = 0;
+	for (const auto& e : fs::directory_iterator(d + "/out/masks"))
+	{
+		EXPECT_GT(fs::file_size(e.path()), 0u) << e.path();
+		EXPECT_EQ(e.path().extension(), ".png") << e.path();  // no .partial
+		masks++;
+	}
+	EXPECT_LE(masks, frames + 1);
+	// the error is in metrics.json too
+	EXPECT_NE(
+	    slurp(d + "/out/metrics.json").find("trajectory.txt: write failed"),
+	    std::string::npos);
+}
+
+TEST(RunApp, AFullDiskUnderTheLabelledRawlogStopsTheRunToo)
+{
+	const auto d = tmpDir("full_disk_rawlog");
+	EXPECT_GT(framesWhenFull(d, kConfig, 2048, "segmented.rawlog"), 2u);
+}
+
+namespace
+{
+/** bims-run on the sample twice (300 frames) into DIR/out; \a sig is sent
+ * once masks/000005.png is written. Returns the exit code (-signal if it
+ * was killed); its output goes to DIR/log. */
+int interruptedRun(const std::string& dir, int sig)
+{
+	const std::string bin = kBin + "/bims-run", out = dir + "/out",
+	                  log = dir + "/log";
+	const pid_t pid = fork();
+	if (pid == 0)
+	{
+		const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+		dup2(fd, 1);
+		dup2(fd, 2);
+		execl(bin.c_str(), bin.c_str(), kConfig.c_str(), kSample.c_str(),
+		      kSample.c_str(), "-o", out.c_str(), "-q", nullptr);
+		_exit(127);
+	}
+	for (int i = 0; i < 4000 && !fs::exists(out + "/masks/000005.png"); i++)
+		usleep(2000);
+	kill(pid, sig);
+	int st = 0;
+	waitpid(pid, &st, 0);
+	return WIFEXITED(st) ? WEXITSTATUS(st) : -WTERMSIG(st);
+}
+}  // namespace
+
+TEST(RunApp, SigintAndSigtermStopAfterTheCurrentFrameWithEverythingWritten)
+{
+	for (const auto& [sig, code, name] :
+	     {std::tuple{SIGINT, 130, "SIGINT"}, {SIGTERM, 143, "SIGTERM"}})
+	{
+		const auto d = tmpDir(name);
+		EXPECT_EQ(interruptedRun(d, sig), code) << slurp(d + "/log");
+		EXPECT_NE(slurp(d + "/log").find(std::string("interrupted by ") + name),
+		          std::string::npos)
+		    << slurp(d + "/log");
+		const auto m = bims::Json::parse(slurp(d + "/out/metrics.json"));
+		EXPECT_EQ(m["status"], "interrupted");
+		const size_t frames = m["frames_processed"];
+		EXPECT_GE(frames, 5u);  // masks/000005.png was being written
+		EXPECT_LT(frames, 300u);
+		// the frames done, each in full in every output
+		EXPECT_EQ(lineCount(d + "/out/frames.csv"), frames + 1);
+		EXPECT_EQ(lineCount(d + "/out/trajectory.txt"), frames + 2);
+		size_t masks = 0, plys = 0;
+		for ([[maybe_unused]] const auto& e :
+		     fs::directory_iterator(d + "/out/masks"))
+			masks++;
+		for ([[maybe_unused]] const auto& e :
+		     fs::directory_iterator(d + "/out/moving_voxels"))
+			plys++;
+		EXPECT_EQ(masks, frames);
+		EXPECT_EQ(plys, frames);
+		EXPECT_TRUE(fs::exists(d + "/out/static_map.ply"));
+	}
+}
+
+TEST(RunApp, AfterSigkillEveryFileIsWholeAndNoMetricsSaysDone)
+{
+	const auto d = tmpDir("sigkill");
+	fs::create_directories(d + "/out");
+	std::ofstream(d + "/out/metrics.json")
+	    << "{\"status\": \"ok\"}\n";  // stale
+	EXPECT_EQ(interruptedRun(d, SIGKILL), -SIGKILL);
+	EXPECT_FALSE(fs::exists(d + "/out/metrics.json"));
+	const std::string csv = slurp(d + "/out/frames.csv");
+	ASSERT_FALSE(csv.empty());
+	EXPECT_EQ(csv.back(), '\n');
+	// a frame in frames.csv has its mask and PLY, each whole
+	std::stringstream lines(csv);
+	std::string line;
+	std::getline(lines, line);  // header
+	size_t frames = 0;
+	while (std::getline(lines, line))
+	{
+		const long i = std::stol(line.substr(0, line.find(',')));
+		EXPECT_GT(fs::file_size(d + "/out/masks/" + bims::frameFileName(i)), 0u)
+		    << i;
+		const std::string ply =
+		    slurp(d + "/out/moving_voxels/" + bims::frameFileName(i, "ply"));
+		const auto n = std::stoul(ply.substr(ply.find("element vertex ") + 15));
+		const auto body = ply.substr(ply.find("end_header\n") + 11);
+		EXPECT_EQ(
+		    static_cast<size_t>(std::count(body.begin(), body.end(), '\n')), n)
+		    << i;
+		frames++;
+	}
+	EXPECT_GE(frames, 5u);  // masks/000005.png was being written
+	for (const auto& e : fs::directory_iterator(d + "/out/moving_voxels"))
+		EXPECT_GT(fs::file_size(e.path()), 0u) << e.path();
+}

@@ -1,0 +1,93 @@
+// The one rule of every bims program that writes files: outputs never
+// alias inputs, a file the program creates replaces a symbolic link instead
+// of writing through it, and whole-file outputs appear under their final
+// name only once complete (written as NAME.partial, then renamed).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace cv
+{
+class Mat;
+}
+
+namespace bims
+{
+/** Refuses, before any work, outputs that would destroy an input: an empty
+ * output path, an output that is an input, or an output folder that
+ * contains an input. Paths are compared after resolving symbolic links, `.`
+ * and `..` (std::filesystem::weakly_canonical), so a link or a relative
+ * path to an input is the input. Empty input strings (optional arguments
+ * not given) are ignored. Throws UsageError naming both paths. */
+void checkOutputsSpareInputs(const std::vector<std::string>& inputs,
+                             const std::vector<std::string>& outputs);
+
+/** Before a program creates the file \a path: a symbolic link there is
+ * removed (the link itself, never its target), so the new file replaces the
+ * link. Throws naming the path if it is a folder or the link cannot be
+ * removed. */
+void replaceSymlink(const std::string& path);
+
+/** A whole-file output written under PATH.partial and renamed to PATH by
+ * commit() (std::rename: atomic, and it replaces a symbolic link at PATH,
+ * not its target). Dropped without commit() (an error on the way), the
+ * partial file is removed: PATH is never a half-written file. */
+class PartialFile
+{
+ public:
+	explicit PartialFile(std::string finalPath);
+	~PartialFile();
+	PartialFile(const PartialFile&) = delete;
+	PartialFile& operator=(const PartialFile&) = delete;
+
+	/** Where to write: PATH.partial. */
+	const std::string& path() const { return partial_; }
+	const std::string& finalPath() const { return final_; }
+	/** Renames PATH.partial to PATH; throws naming both on failure. */
+	void commit();
+
+ private:
+	std::string final_, partial_;
+	bool done_ = false;
+};
+
+/** A file that grows record by record (trajectory.txt, frames.csv, a plain
+ * rawlog), for a run that may stop at any time: created (truncated; a
+ * symbolic link there replaced), each append() reaches the OS at once and
+ * is checked. A failed append (disk full, file size limit) truncates the
+ * file back to its last whole record and throws naming the file and the
+ * reason: the file never ends in half a record. */
+class AppendFile
+{
+ public:
+	explicit AppendFile(std::string path);
+	/** Closes (errors dropped: call close() to see them). */
+	~AppendFile();
+	AppendFile(const AppendFile&) = delete;
+	AppendFile& operator=(const AppendFile&) = delete;
+
+	void append(const void* data, size_t n);
+	void append(const std::string& s) { append(s.data(), s.size()); }
+	/** Closes the file; throws naming it if that fails. */
+	void close();
+	const std::string& path() const { return path_; }
+	/** Bytes written (whole records). */
+	size_t size() const { return size_; }
+
+ private:
+	std::string path_;
+	int fd_ = -1;
+	size_t size_ = 0;
+};
+
+/** Writes \a bytes to \a path through a PartialFile: every write and the
+ * close checked (a full disk is an error naming the file, never a short
+ * file), then renamed. */
+void writeFileAtomically(const std::string& path, const std::string& bytes);
+
+/** Encodes \a img in the format of the path's extension (.png) and writes
+ * it with writeFileAtomically; throws naming the file. */
+void writeImageFile(const std::string& path, const cv::Mat& img);
+
+}  // namespace bims

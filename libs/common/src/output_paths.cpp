@@ -1,0 +1,192 @@
+#include <bims/common/app.h>
+#include <bims/common/output_paths.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <stdexcept>
+
+namespace fs = std::filesystem;
+
+namespace bims
+{
+namespace
+{
+/** The path with links, `.` and `..` resolved as far as it exists. */
+fs::path resolved(const std::string& p)
+{
+	std::error_code ec;
+	fs::path r = fs::weakly_canonical(p, ec);
+	if (ec) r = fs::absolute(p, ec).lexically_normal();
+	return r;
+}
+
+/** \a inner is \a outer or lies inside it (component by component). */
+bool within(const fs::path& inner, const fs::path& outer)
+{
+	auto i = inner.begin();
+	for (auto o = outer.begin(); o != outer.end(); ++o, ++i)
+	{
+		if (o->empty() && std::next(o) == outer.end()) break;  // trailing '/'
+		if (i == inner.end() || *i != *o) return false;
+	}
+	return true;
+}
+
+std::runtime_error systemError(const std::string& path, const char* what)
+{
+	return std::runtime_error(path + ": " + what + ": " + std::strerror(errno));
+}
+}  // namespace
+
+void checkOutputsSpareInputs(const std::vector<std::string>& inputs,
+                             const std::vector<std::string>& outputs)
+{
+	for (const auto& out : outputs)
+	{
+		if (out.empty())
+			throw UsageError(
+			    "the output path is empty (nothing would be "
+			    "written)");
+		const fs::path ro = resolved(out);
+		for (const auto& in : inputs)
+		{
+			if (in.empty()) continue;
+			const fs::path ri = resolved(in);
+			if (!within(ri, ro)) continue;
+			const std::string both =
+			    ro == fs::path(out) && ri == fs::path(in)
+			        ? std::string()
+			        : " (" + ro.string() + " and " + ri.string() + ")";
+			if (ri == ro)
+				throw UsageError("output " + out +
+				                 " would overwrite the input " + in + both);
+			throw UsageError("output folder " + out + " contains the input " +
+			                 in + both +
+			                 ": choose an output that holds no input");
+		}
+	}
+}
+
+void replaceSymlink(const std::string& path)
+{
+	std::error_code ec;
+	const auto st = fs::symlink_status(path, ec);
+	if (fs::is_directory(st))
+		throw std::runtime_error(path + ": is a folder, cannot write a file");
+	if (!fs::is_symlink(st)) return;
+	if (!fs::remove(path, ec) || ec)
+		throw std::runtime_error(
+		    path + ": cannot replace the symbolic link: " + ec.message());
+}
+
+PartialFile::PartialFile(std::string finalPath)
+    : final_(std::move(finalPath)), partial_(final_ + ".partial")
+{
+	if (final_.empty()) throw UsageError("the output path is empty");
+	replaceSymlink(partial_);
+	std::error_code ec;
+	if (fs::is_directory(fs::symlink_status(final_, ec)))
+		throw std::runtime_error(final_ + ": is a folder, cannot write a file");
+}
+
+PartialFile::~PartialFile()
+{
+	if (!done_) std::remove(partial_.c_str());
+}
+
+void PartialFile::commit()
+{
+	if (done_) return;
+	if (std::rename(partial_.c_str(), final_.c_str()) != 0)
+		throw std::runtime_error(final_ + ": cannot rename " + partial_ +
+		                         " to it: " + std::strerror(errno));
+	done_ = true;
+}
+
+void writeFileAtomically(const std::string& path, const std::string& bytes)
+{
+	PartialFile part(path);
+	const int fd = ::open(part.path().c_str(),
+	                      O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+	if (fd < 0) throw systemError(path, "cannot create");
+	size_t done = 0;
+	while (done < bytes.size())
+	{
+		const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+		if (n < 0 && errno == EINTR) continue;
+		if (n <= 0)
+		{
+			const auto e = systemError(path, "write failed");
+			::close(fd);
+			throw e;
+		}
+		done += static_cast<size_t>(n);
+	}
+	if (::close(fd) != 0) throw systemError(path, "write failed on close");
+	part.commit();
+}
+
+AppendFile::AppendFile(std::string path) : path_(std::move(path))
+{
+	replaceSymlink(path_);
+	fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+	if (fd_ < 0) throw systemError(path_, "cannot create");
+}
+
+AppendFile::~AppendFile()
+{
+	if (fd_ >= 0) ::close(fd_);
+}
+
+void AppendFile::append(const void* data, size_t n)
+{
+	if (fd_ < 0) throw std::runtime_error(path_ + ": write after close");
+	const char* p = static_cast<const char*>(data);
+	size_t done = 0;
+	while (done < n)
+	{
+		const ssize_t k = ::write(fd_, p + done, n - done);
+		if (k < 0 && errno == EINTR) continue;
+		if (k <= 0)
+		{
+			const auto e = systemError(path_, "write failed");
+			// back to the last whole record (shrinking is always allowed)
+			if (::ftruncate(fd_, static_cast<off_t>(size_)) == 0)
+				::lseek(fd_, static_cast<off_t>(size_), SEEK_SET);
+			throw e;
+		}
+		done += static_cast<size_t>(k);
+	}
+	size_ += n;
+}
+
+void AppendFile::close()
+{
+	if (fd_ < 0) return;
+	const int fd = fd_;
+	fd_ = -1;
+	if (::close(fd) != 0) throw systemError(path_, "write failed on close");
+}
+
+void writeImageFile(const std::string& path, const cv::Mat& img)
+{
+	std::vector<uchar> bytes;
+	bool ok = false;
+	try
+	{
+		ok = cv::imencode(fs::path(path).extension().string(), img, bytes);
+	}
+	catch (const cv::Exception& e)
+	{
+		throw std::runtime_error(path + ": cannot encode image: " + e.what());
+	}
+	if (!ok) throw std::runtime_error(path + ": cannot encode image");
+	writeFileAtomically(path, std::string(bytes.begin(), bytes.end()));
+}
+
+}  // namespace bims
