@@ -8,7 +8,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake pkg-config clang-format ccache
   libmrpt-dev mrpt-apps
-  libopencv-dev libeigen3-dev nlohmann-json3-dev
+  libopencv-dev libeigen3-dev nlohmann-json3-dev zlib1g-dev
   libopenni2-dev openni2-utils
   libwxgtk3.2-dev
   liboctomap-dev

@@ -272,6 +272,13 @@ int main(int argc, char** argv)
 			    std::fprintf(stderr,
 			                 "bims-odom: no --masks: moving content is left to "
 			                 "the robust alignment (no mask)\n");
+		    if (st.imuRejected)
+			    std::fprintf(
+			        stderr,
+			        "bims-odom: %zu IMU samples not used (a value not "
+			        "finite or beyond any sensor's range); their frames "
+			        "are flagged imu_rejected\n",
+			        st.imuRejected);
 		    return 0;
 	    });
 }

@@ -1,6 +1,8 @@
 #include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
 
+#include <zlib.h>
+
 #include <mrpt/img/CImage.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CSensoryFrame.h>
@@ -206,10 +208,13 @@ mrpt::obs::CObservation::Ptr RawlogReader::next()
 		mrpt::serialization::CSerializable::Ptr obj;
 		auto& arch = static_cast<BufferedInArchive&>(*arch_);
 		const uint64_t pos0 = arch.position();
-		const std::string bad =
-		    checkSerializedSizes([&arch](size_t n) { return arch.peek(n); });
+		bool cut = false;
+		const std::string bad = checkSerializedSizes(
+		    [&arch](size_t n) { return arch.peek(n); }, &cut);
 		if (!bad.empty())
-			throw RawlogError(path_ + ": corrupt rawlog at entry " +
+			throw RawlogError(path_ +
+			                  (cut ? ": truncated or corrupt rawlog at entry "
+			                       : ": corrupt rawlog at entry ") +
 			                  std::to_string(entry_ + 1) + " (" +
 			                  std::to_string(nObs_) +
 			                  " observations read before): " + bad);
@@ -256,6 +261,19 @@ mrpt::obs::CObservation::Ptr RawlogReader::next()
 	return o;
 }
 
+namespace
+{
+/** zlib's text of the last error of \a f (errno's when it is a file
+ * error). */
+std::string gzipError(gzFile f)
+{
+	int code = 0;
+	const char* msg = gzerror(f, &code);
+	if (code == Z_ERRNO) return std::strerror(errno);
+	return msg && *msg ? msg : "zlib error " + std::to_string(code);
+}
+}  // namespace
+
 RawlogWriter::RawlogWriter(const std::string& path, int gzLevel) : path_(path)
 {
 	if (gzLevel < 0 || gzLevel > 9)
@@ -274,9 +292,11 @@ RawlogWriter::RawlogWriter(const std::string& path, int gzLevel) : path_(path)
 	else
 	{
 		replaceSymlink(path);
-		if (!gz_.open(path, gzLevel, std::nullopt,
-		              mrpt::io::OpenMode::TRUNCATE))
-			throw RawlogError(path + ": cannot create rawlog file");
+		// zlib directly (MRPT's CFileGZOutputStream, the same bytes, does
+		// not report a failed close: the buffered tail of a full disk)
+		const std::string mode = "wb" + std::to_string(gzLevel);
+		gz_ = gzopen(path.c_str(), mode.c_str());
+		if (!gz_) throw RawlogError(path + ": cannot create rawlog file");
 	}
 	arch_ = std::make_unique<VectorArchive>(buf_);
 	open_ = true;
@@ -317,8 +337,9 @@ void RawlogWriter::write(const mrpt::obs::CObservation& obs)
 			throw RawlogError(e.what());
 		}
 	}
-	else if (gz_.Write(buf_.data(), n) != n)
-		throw RawlogError(path_ + ": write failed (disk full?)");
+	else if (n > 0 && gzwrite(gz_, buf_.data(), static_cast<unsigned>(n)) !=
+	                      static_cast<int>(n))
+		throw RawlogError(path_ + ": write failed: " + gzipError(gz_));
 	++n_;
 }
 
@@ -344,7 +365,17 @@ void RawlogWriter::close()
 			throw RawlogError(e.what());
 		}
 	}
-	if (gz_.fileOpenCorrectly()) gz_.close();
+	if (gz_)
+	{
+		gzFile f = gz_;
+		gz_ = nullptr;
+		const int rc = gzclose(f);
+		if (rc != Z_OK)
+			throw RawlogError(path_ + ": closing failed: " +
+			                  (rc == Z_ERRNO
+			                       ? std::string(std::strerror(errno))
+			                       : "zlib error " + std::to_string(rc)));
+	}
 }
 
 }  // namespace bims

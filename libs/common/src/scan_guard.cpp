@@ -95,6 +95,7 @@ class ObservationWalker
  public:
 	explicit ObservationWalker(const PeekFn& peek) : c_(peek) {}
 	std::string problem;
+	bool truncated = false;  ///< the problem is the end of the file
 
 	bool run()
 	{
@@ -166,7 +167,9 @@ class ObservationWalker
 				return false;
 			}
 			// x, y, z as float, pixel column and row as uint16
-			c_.skip(uint64_t{n} * (3 * sizeof(float) + 2 * sizeof(uint16_t)));
+			if (!block("stored points", uint64_t{n} * (3 * sizeof(float) +
+			                                           2 * sizeof(uint16_t))))
+				return false;
 		}
 		const bool hasRange = c_.read<uint8_t>();
 		c_.skip(sizeof(float));  // rangeUnits
@@ -206,8 +209,7 @@ class ObservationWalker
 			problem = tooLarge(what, rows, cols);
 			return false;
 		}
-		c_.skip(rows * cols * elem);
-		return c_.ok();
+		return block(what, rows * cols * elem);
 	}
 	/** A string or byte block: its length (uint32), then the bytes. */
 	bool string(const std::string& what)
@@ -221,8 +223,20 @@ class ObservationWalker
 			          std::to_string(kMaxStringBytes) + " a rawlog may hold";
 			return false;
 		}
-		c_.skip(n);
-		return c_.ok();
+		return block(what, n);
+	}
+	/** \a bytes of a block the object declared: when the file ends before
+	 * them, that is the problem (truncated), found before MRPT allocates
+	 * the block. */
+	bool block(const std::string& what, uint64_t bytes)
+	{
+		if (!c_.ok()) return false;
+		c_.skip(bytes);
+		if (c_.ok()) return true;
+		problem = "the " + what_ + "'s " + what + " (" + std::to_string(bytes) +
+		          " bytes) runs past the end of the file";
+		truncated = true;
+		return false;
 	}
 	/** An object's end flag. */
 	bool end()
@@ -289,8 +303,7 @@ class ObservationWalker
 				return false;
 			}
 			if (c_.read<uint8_t>()) return false;  // zip: MRPT refuses it
-			c_.skip(size);
-			return end();
+			return block(what, size) && end();
 		}
 		const auto w = c_.read<int32_t>(), h = c_.read<int32_t>();
 		if (!c_.ok()) return false;
@@ -303,7 +316,7 @@ class ObservationWalker
 				problem = tooLarge(what, rh, rw);
 				return false;
 			}
-			c_.skip(3 * rw * rh);
+			if (!block(what, 3 * rw * rh)) return false;
 		}
 		return end();
 	}
@@ -321,10 +334,11 @@ class ObservationWalker
 };
 }  // namespace
 
-std::string checkSerializedSizes(const PeekFn& peek)
+std::string checkSerializedSizes(const PeekFn& peek, bool* truncated)
 {
 	ObservationWalker w(peek);
 	w.run();
+	if (truncated) *truncated = w.truncated;
 	return w.problem;
 }
 

@@ -37,7 +37,8 @@ using PeekFn = std::function<std::pair<const uint8_t*, size_t>(size_t n)>;
  * the length of one of its strings ("" when they are sane, when the object
  * is of another class or version or holds a layout the walk does not know,
  * or when the file ends first: MRPT's reader then reports the
- * truncation). */
-std::string checkSerializedSizes(const PeekFn& peek);
+ * truncation), or, with *truncated = true, that a block it declares (points,
+ * an image, a string) runs past the end of the file. */
+std::string checkSerializedSizes(const PeekFn& peek, bool* truncated = nullptr);
 
 }  // namespace bims

@@ -5,6 +5,11 @@
 #include <mrpt/system/filesystem.h>
 #include "tmp_path.h"
 
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 
@@ -106,4 +111,52 @@ TEST(Rawlog, ImagesDirectoryKeepsTheSlash)
 {
 	EXPECT_EQ(bims::rawlogImagesDirectory("dir/foo.rawlog"), "dir/foo_Images");
 	EXPECT_EQ(bims::rawlogImagesDirectory("foo.rawlog"), "foo_Images");
+}
+
+TEST(Rawlog, AGzipRawlogWhoseTailFailsAtCloseIsAnError)
+{
+	// 15 IMU observations with 400 random bytes of label each (6 kB that do
+	// not compress: all of it still in zlib's buffers at close) in a child
+	// limited to 1000-byte files (SIGXFSZ ignored: the write fails with
+	// EFBIG, as on a full disk): close() must report it (MRPT's gzip stream
+	// did not)
+	const auto p = tmpPath("gz_close_limit.rawlog");
+	const pid_t pid = fork();
+	ASSERT_GE(pid, 0);
+	if (pid == 0)
+	{
+		std::signal(SIGXFSZ, SIG_IGN);
+		const rlimit lim{1000, 1000};
+		setrlimit(RLIMIT_FSIZE, &lim);
+		try
+		{
+			bims::RawlogWriter w(p, 9);
+			uint32_t x = 12345;
+			for (int i = 0; i < 15; i++)
+			{
+				mrpt::obs::CObservationIMU imu;
+				for (int k = 0; k < 400; k++)
+				{
+					x = x * 1664525u + 1013904223u;
+					imu.sensorLabel += static_cast<char>(x >> 24);
+				}
+				w.write(imu);
+			}
+			w.close();
+			_exit(0);
+		}
+		catch (const bims::RawlogError& e)
+		{
+			const std::string m = e.what();
+			_exit(m.find(p + ": ") == 0 &&
+			              m.find("File too large") != std::string::npos
+			          ? 3
+			          : 4);
+		}
+	}
+	int status = 0;
+	waitpid(pid, &status, 0);
+	std::filesystem::remove(p);
+	ASSERT_TRUE(WIFEXITED(status));
+	EXPECT_EQ(WEXITSTATUS(status), 3);
 }

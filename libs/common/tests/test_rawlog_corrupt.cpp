@@ -392,3 +392,22 @@ TEST(RawlogCorrupt, AnObjectOfAnUnknownClassIsAnError)
 	          std::string::npos)
 	    << readError(p);
 }
+
+TEST(RawlogCorrupt,
+     ABlockRunningPastTheEndOfTheFileIsFoundBeforeMrptAllocatesIt)
+{
+	// a scan cut inside its depth image: the guard sees the image's bytes
+	// end with the file and says so (MRPT would allocate the whole image
+	// first, whatever size the bytes declare)
+	const auto p = tmpPath("cut_depth.rawlog");
+	auto bytes = scanRawlog(p, 0);
+	const size_t at = findPair(bytes, 37, 53);  // the depth image's size
+	bytes.resize(at + 8 + 100);
+	writeBytes(p, bytes);
+	EXPECT_NE(readError(p).find(
+	              "truncated or corrupt rawlog at entry 0 (0 observations read "
+	              "before): the 3D scan's depth image (3922 bytes) runs past "
+	              "the end of the file"),
+	          std::string::npos)
+	    << readError(p);
+}

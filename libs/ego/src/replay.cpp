@@ -1,4 +1,5 @@
 #include <bims/common/frame_files.h>
+#include <bims/common/imu_check.h>
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
 #include <bims/ego/depth_correction.h>
@@ -32,6 +33,9 @@ ReplayStats replayRawlog(const std::string& path, Odometry& odo,
 	std::deque<std::pair<CObservation3DRangeScan::Ptr, long>> pending;
 	long nScans = 0;
 	cv::Mat mask;
+	// stamps of the IMU samples not used (bims::imuSampleProblem): the
+	// frame whose interval held one is flagged imu_rejected, as in bims-run
+	std::deque<double> rejectedImuT;
 	DepthCorrection depthCorrection(cfg.depth_correction);
 	ProgressBar bar("bims-odom", 0, opt.progress);
 	bool done = false;
@@ -56,8 +60,12 @@ ReplayStats replayRawlog(const std::string& path, Odometry& odo,
 				++st.masksUsed;
 			}
 		}
-		const FrameEgomotion r =
-		    odo.processFrame(*o, mask.empty() ? nullptr : &mask);
+		FrameEgomotion r = odo.processFrame(*o, mask.empty() ? nullptr : &mask);
+		while (!rejectedImuT.empty() && rejectedImuT.front() <= r.t + offset)
+		{
+			r.flags |= kFlagImuRejected;
+			rejectedImuT.pop_front();
+		}
 		++st.frames;
 		if (!r.ok() && !(r.flags & kFlagFirstFrame)) ++st.flagged;
 		if (onFrame) onFrame(r, *o);
@@ -89,6 +97,17 @@ ReplayStats replayRawlog(const std::string& path, Odometry& odo,
 			    imu->sensorLabel != cfg.sensors.imu_label)
 			{
 				++st.otherLabel;
+				continue;
+			}
+			if (const std::string bad = imuSampleProblem(*imu); !bad.empty())
+			{
+				++st.imuRejected;
+				rejectedImuT.push_back(t);
+				std::fprintf(stderr,
+				             "bims-odom: warning: %s: observation #%zu (IMU, t "
+				             "%.6f): %s; sample not used (%zu so far)\n",
+				             path.c_str(), reader.observationsRead() - 1, t,
+				             bad.c_str(), st.imuRejected);
 				continue;
 			}
 			const ImuSample s = imuSampleFrom(*imu);

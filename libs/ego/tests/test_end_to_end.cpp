@@ -2,7 +2,9 @@
 // 150 frames 320x240 with IMU, made by bims-sim): the drift of T_C0C against
 // the ground truth (from frame 30 on) stays below bounds measured when this
 // test was written (docs/results.md, "Egomotion"), in both modes.
+#include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
+#include <bims/ego/flags.h>
 #include <bims/ego/replay.h>
 #include <bims/ego/so3.h>
 #include <gtest/gtest.h>
@@ -11,6 +13,7 @@
 #include <mrpt/system/filesystem.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include <cmath>
 #include <filesystem>
 
 using namespace bims::ego;
@@ -145,4 +148,58 @@ TEST(EndToEnd, MasksFolderReachesTheTrackerAsThePreviousFramesMask)
 		EXPECT_NE(std::string(e.what()).find("000000.png"), std::string::npos)
 		    << e.what();
 	}
+}
+
+TEST(EndToEnd, ReplayDropsAnImuSampleThatIsNotFiniteAndFlagsItsFrame)
+{
+	// The bundled sample's first 12 frames, one gyro reading made NaN (and
+	// one accelerometer reading 1e300): both samples are not used, counted,
+	// their frames flagged imu_rejected, and every pose stays finite.
+	const std::string in = kDir + "pendulum_slow.rawlog";
+	if (!mrpt::system::fileExists(in)) GTEST_SKIP() << "bundled sample missing";
+	const std::string p =
+	    (std::filesystem::temp_directory_path() / "bims_replay_bad_imu.rawlog")
+	        .string();
+	{
+		bims::RawlogReader r(in);
+		bims::RawlogWriter w(p, 0);
+		int scans = 0, imus = 0;
+		while (auto o = r.next())
+		{
+			if (auto imu =
+			        std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(o))
+			{
+				if (++imus == 20) imu->set(mrpt::obs::IMU_WX, std::nan(""));
+				if (imus == 25) imu->set(mrpt::obs::IMU_X_ACC, 1e300);
+			}
+			else if (++scans > 12)
+				break;
+			w.write(*o);
+		}
+	}
+	mrpt::config::CConfigFile cal(kDir + "pendulum_slow_gt/calibration.ini");
+	EgoConfig cfg;
+	cfg.calibration.loadFromConfigFile(cal);
+	cfg.camera.loadFromConfigFile(cal);
+	cfg.sensors.loadFromConfigFile(cal);
+	Odometry odo(cfg);
+	ReplayOptions ro;
+	ro.progress = false;
+	size_t flagged = 0;
+	bool finite = true;
+	const auto st = replayRawlog(
+	    p, odo,
+	    [&](const FrameEgomotion& r, const auto&)
+	    {
+		    flagged += (r.flags & kFlagImuRejected) ? 1 : 0;
+		    finite = finite && std::isfinite(r.T_WC.x()) &&
+		             std::isfinite(r.T_WC.yaw());
+	    },
+	    ro);
+	std::filesystem::remove(p);
+	EXPECT_EQ(st.frames, 12u);
+	EXPECT_EQ(st.imuRejected, 2u);
+	EXPECT_GE(flagged, 1u);
+	EXPECT_LE(flagged, 2u);
+	EXPECT_TRUE(finite);
 }

@@ -42,6 +42,7 @@ void writePointsPly(const std::string& path,
 		std::memcpy(b, v, 16);  // x86/ARM little endian hosts
 		f.write(reinterpret_cast<const char*>(b), 16);
 	}
+	f.close();  // (the last bytes reach the file here: checked too)
 	if (!f) throw std::runtime_error("error writing PLY file '" + path + "'");
 }
 

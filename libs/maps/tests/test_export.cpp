@@ -9,7 +9,13 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
+#include <csignal>
+#include <cstdio>
 #include <fstream>
+
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "scene_raycaster.h"
 
@@ -129,4 +135,40 @@ TEST(Export, VisualisationUsesThePaperColours)
 	EXPECT_EQ(colourOf(o0), mrpt::img::TColor(0, 0, 255, 255));
 	EXPECT_EQ(colourOf(o1), mrpt::img::TColor(255, 255, 0, 255));
 	EXPECT_EQ(colourOf(o2), mrpt::img::TColor(255, 0, 0, 255));
+}
+
+TEST(Export, APlyWriteThatFailsOnlyAtCloseIsAnError)
+{
+	// 200 points (3.4 kB, all in the stream's buffer until it is closed) in
+	// a child limited to 1000-byte files (SIGXFSZ ignored: the write fails
+	// with EFBIG, as on a full disk): the failure comes at close and must
+	// not pass silently
+	const std::string path =
+	    mrpt::system::getTempFileName() + "_close_limit.ply";
+	const pid_t pid = fork();
+	ASSERT_GE(pid, 0);
+	if (pid == 0)
+	{
+		std::signal(SIGXFSZ, SIG_IGN);
+		const rlimit lim{1000, 1000};
+		setrlimit(RLIMIT_FSIZE, &lim);
+		try
+		{
+			writePointsPly(path,
+			               std::vector<mrpt::math::TPoint3D>(200, {1, 2, 3}),
+			               std::vector<float>(200, 0.5f));
+			_exit(0);
+		}
+		catch (const std::exception& e)
+		{
+			const std::string m = e.what();
+			_exit(m.find("error writing PLY file") != std::string::npos ? 3
+			                                                            : 4);
+		}
+	}
+	int status = 0;
+	waitpid(pid, &status, 0);
+	std::remove(path.c_str());
+	ASSERT_TRUE(WIFEXITED(status));
+	EXPECT_EQ(WEXITSTATUS(status), 3);
 }

@@ -7,7 +7,6 @@
 
 #include <bims/common/output_paths.h>
 #include <mrpt/io/CFileGZInputStream.h>
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CObservation.h>
 #include <mrpt/serialization/CArchive.h>
 
@@ -17,6 +16,8 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+struct gzFile_s;  // zlib's gzFile
 
 namespace bims
 {
@@ -81,7 +82,7 @@ class RawlogWriter
 	 * written, so a kill loses at most the last object). */
 	void flush();
 	/** Closes the file; throws RawlogError naming it if the last bytes
-	 * could not be written (plain rawlogs). */
+	 * could not be written (plain and gzip rawlogs). */
 	void close();
 	size_t written() const { return n_; }
 	const std::string& path() const { return path_; }
@@ -89,8 +90,8 @@ class RawlogWriter
  private:
 	std::string path_;
 	std::unique_ptr<AppendFile> plain_;  ///< a plain rawlog
-	mrpt::io::CFileGZOutputStream gz_;
-	std::vector<uint8_t> buf_;  ///< the object being written
+	gzFile_s* gz_ = nullptr;             ///< a gzip rawlog (zlib's gzFile)
+	std::vector<uint8_t> buf_;           ///< the object being written
 	std::unique_ptr<mrpt::serialization::CArchive> arch_;
 	bool open_ = false;
 	size_t n_ = 0;

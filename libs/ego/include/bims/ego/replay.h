@@ -32,6 +32,10 @@ struct ReplayStats
 	size_t flagged = 0;     ///< frames with a failure flag (!ok())
 	size_t otherLabel = 0;  ///< observations skipped for their label
 	size_t masksUsed = 0;   ///< frames given a mask from masks_dir
+	/** IMU samples not used: a field not finite or beyond any sensor's range
+	 * (bims::imuSampleProblem; a warning each, the frame flagged
+	 * imu_rejected). */
+	size_t imuRejected = 0;
 };
 
 using FrameCallback = std::function<void(
