@@ -3,6 +3,7 @@
 #include <mrpt/rtti/CObject.h>
 
 #include <cstring>
+#include <optional>
 
 namespace bims
 {
@@ -131,20 +132,8 @@ class ObservationWalker
 	bool imu(uint8_t version)
 	{
 		if (version != 4 || !pose()) return false;
-		// each flag a bool: any other byte is undefined behaviour in MRPT's
-		// accessors (found by the fuzzer)
 		for (int k = 0; k < 31; k++)
-		{
-			const auto b = c_.read<uint8_t>();
-			if (!c_.ok()) return false;
-			if (b > 1)
-			{
-				problem = "the IMU observation's data-present flag " +
-				          std::to_string(k) + " is " + std::to_string(b) +
-				          ", not 0 or 1";
-				return false;
-			}
-		}
+			if (!flag("data-present flag " + std::to_string(k))) return false;
 		c_.skip(sizeof(uint64_t) + 31 * sizeof(double));
 		return string("sensor label") && end();
 	}
@@ -154,7 +143,9 @@ class ObservationWalker
 		if (version != 9 && version != 10) return false;
 		c_.skip(sizeof(float));  // maxRange
 		if (!pose()) return false;
-		if (c_.read<uint8_t>())  // hasPoints3D
+		const auto hasPoints = flag("has-points flag");
+		if (!hasPoints) return false;
+		if (*hasPoints)
 		{
 			const auto n = c_.read<uint32_t>();
 			if (!c_.ok()) return false;
@@ -171,23 +162,30 @@ class ObservationWalker
 			                                           2 * sizeof(uint16_t))))
 				return false;
 		}
-		const bool hasRange = c_.read<uint8_t>();
+		const auto hasRange = flag("has-range flag");
+		if (!hasRange) return false;
 		c_.skip(sizeof(float));  // rangeUnits
-		if (hasRange && !matrix("depth image", sizeof(uint16_t))) return false;
-		if (c_.read<uint8_t>() && !image("intensity image")) return false;
-		if (c_.read<uint8_t>() && !image("confidence image")) return false;
+		if (*hasRange && !matrix("depth image", sizeof(uint16_t))) return false;
+		const auto hasIntensity = flag("has-intensity flag");
+		if (!hasIntensity || (*hasIntensity && !image("intensity image")))
+			return false;
+		const auto hasConfidence = flag("has-confidence flag");
+		if (!hasConfidence || (*hasConfidence && !image("confidence image")))
+			return false;
 		if (!camera() || !camera() || !pose()) return false;
 		c_.skip(sizeof(float) + sizeof(uint64_t));  // stdError, timestamp
 		if (!string("sensor label")) return false;
 		for (int k = 0; k < 2; k++)  // external points / range image files
-		{
-			c_.skip(1);
-			if (!string("external file name")) return false;
-		}
-		c_.skip(2);  // range_is_depth, intensityImageChannel
+			if (!flag("externally-stored flag") ||
+			    !string("external file name"))
+				return false;
+		if (!flag("range-is-depth flag")) return false;
+		c_.skip(1);  // intensityImageChannel
 		// pixel labels: their names (a typed map) follow the image; the
 		// walk stops there, leaving extra depth layers after labels unchecked
-		if (c_.read<uint8_t>()) return labels() && false;
+		const auto hasLabels = flag("has-labels flag");
+		if (!hasLabels) return false;
+		if (*hasLabels) return labels() && false;
 		if (version >= 10)
 		{
 			const auto layers = c_.read<uint8_t>();
@@ -237,6 +235,21 @@ class ObservationWalker
 		          " bytes) runs past the end of the file";
 		truncated = true;
 		return false;
+	}
+	/** A bool the object stores as a byte: 0 or 1 (MRPT reads it into a
+	 * bool, any other byte is undefined behaviour where it is read: found
+	 * by the fuzzer). nullopt: stop (the problem set, or the bytes end). */
+	std::optional<bool> flag(const std::string& what)
+	{
+		const auto b = c_.read<uint8_t>();
+		if (!c_.ok()) return std::nullopt;
+		if (b > 1)
+		{
+			problem = "the " + what_ + "'s " + what + " is " +
+			          std::to_string(b) + ", not 0 or 1";
+			return std::nullopt;
+		}
+		return b == 1;
 	}
 	/** An object's end flag. */
 	bool end()

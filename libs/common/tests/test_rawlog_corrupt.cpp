@@ -411,3 +411,24 @@ TEST(RawlogCorrupt,
 	          std::string::npos)
 	    << readError(p);
 }
+
+TEST(RawlogCorrupt, AScanFlagThatIsNoBoolIsAnError)
+{
+	// Found by the rawlog fuzz target (tests/fuzz/corpus/rawlog/
+	// ub-scan-flag-not-bool): a scan's flag stored as 121, read by MRPT into
+	// a bool, undefined behaviour where bims reads it. Here range_is_depth:
+	// after the label "RGBD" and two (flag, empty file name) pairs.
+	const auto p = tmpPath("scan_flag.rawlog");
+	auto bytes = scanRawlog(p, 0);
+	const char* label = "RGBD";
+	const auto at = std::search(bytes.begin(), bytes.end(), label, label + 4) -
+	                bytes.begin();
+	ASSERT_LT(static_cast<size_t>(at) + 14, bytes.size());
+	ASSERT_EQ(bytes[static_cast<size_t>(at) + 14], 1);  // range_is_depth
+	bytes[static_cast<size_t>(at) + 14] = 121;
+	writeBytes(p, bytes);
+	EXPECT_NE(readError(p).find(
+	              "the 3D scan's range-is-depth flag is 121, not 0 or 1"),
+	          std::string::npos)
+	    << readError(p);
+}
