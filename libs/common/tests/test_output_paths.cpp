@@ -3,8 +3,8 @@
 #include <bims/common/app.h>
 #include <bims/common/output_paths.h>
 #include <gtest/gtest.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
+
+#include <bims_test/file_size_limit.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -148,29 +148,24 @@ TEST(OutputPaths, AFailedAppendLeavesTheFileAtItsLastWholeRecord)
 	// EFBIG, as on a full disk) appends 18-byte records
 	const auto d = fresh("append_limit");
 	const std::string path = d + "/records.txt";
-	const pid_t pid = fork();
-	ASSERT_GE(pid, 0);
-	if (pid == 0)
-	{
-		std::signal(SIGXFSZ, SIG_IGN);
-		const rlimit lim{100, 100};
-		setrlimit(RLIMIT_FSIZE, &lim);
-		try
-		{
-			bims::AppendFile f(path);
-			for (int i = 0; i < 100; i++) f.append("record 0123456789\n");
-			_exit(0);
-		}
-		catch (const std::exception& e)
-		{
-			const std::string m = e.what();
-			_exit(m.find(path + ": write failed: File too large") == 0 ? 3 : 4);
-		}
-	}
-	int status = 0;
-	waitpid(pid, &status, 0);
-	ASSERT_TRUE(WIFEXITED(status));
-	EXPECT_EQ(WEXITSTATUS(status), 3);
+	const int code = bims::test::exitOfChildWithFileSizeLimit(
+	    100,
+	    [&]
+	    {
+		    try
+		    {
+			    bims::AppendFile f(path);
+			    for (int i = 0; i < 100; i++) f.append("record 0123456789\n");
+			    return 0;
+		    }
+		    catch (const std::exception& e)
+		    {
+			    const std::string m = e.what();
+			    return m.find(path + ": write failed: File too large") == 0 ? 3
+			                                                                : 4;
+		    }
+	    });
+	EXPECT_EQ(code, 3);
 	EXPECT_EQ(fs::file_size(path), 90u);  // 5 whole records
 	EXPECT_EQ(slurp(path).back(), '\n');
 }

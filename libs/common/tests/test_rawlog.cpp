@@ -1,15 +1,12 @@
 #include <bims/common/rawlog.h>
 #include <gtest/gtest.h>
 
+#include <bims_test/file_size_limit.h>
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/system/filesystem.h>
+
 #include "tmp_path.h"
 
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <csignal>
 #include <filesystem>
 #include <fstream>
 
@@ -121,42 +118,36 @@ TEST(Rawlog, AGzipRawlogWhoseTailFailsAtCloseIsAnError)
 	// EFBIG, as on a full disk): close() must report it (MRPT's gzip stream
 	// did not)
 	const auto p = tmpPath("gz_close_limit.rawlog");
-	const pid_t pid = fork();
-	ASSERT_GE(pid, 0);
-	if (pid == 0)
-	{
-		std::signal(SIGXFSZ, SIG_IGN);
-		const rlimit lim{1000, 1000};
-		setrlimit(RLIMIT_FSIZE, &lim);
-		try
-		{
-			bims::RawlogWriter w(p, 9);
-			uint32_t x = 12345;
-			for (int i = 0; i < 15; i++)
-			{
-				mrpt::obs::CObservationIMU imu;
-				for (int k = 0; k < 400; k++)
-				{
-					x = x * 1664525u + 1013904223u;
-					imu.sensorLabel += static_cast<char>(x >> 24);
-				}
-				w.write(imu);
-			}
-			w.close();
-			_exit(0);
-		}
-		catch (const bims::RawlogError& e)
-		{
-			const std::string m = e.what();
-			_exit(m.find(p + ": ") == 0 &&
-			              m.find("File too large") != std::string::npos
-			          ? 3
-			          : 4);
-		}
-	}
-	int status = 0;
-	waitpid(pid, &status, 0);
+	const int code = bims::test::exitOfChildWithFileSizeLimit(
+	    1000,
+	    [&]
+	    {
+		    try
+		    {
+			    bims::RawlogWriter w(p, 9);
+			    uint32_t x = 12345;
+			    for (int i = 0; i < 15; i++)
+			    {
+				    mrpt::obs::CObservationIMU imu;
+				    for (int k = 0; k < 400; k++)
+				    {
+					    x = x * 1664525u + 1013904223u;
+					    imu.sensorLabel += static_cast<char>(x >> 24);
+				    }
+				    w.write(imu);
+			    }
+			    w.close();
+			    return 0;
+		    }
+		    catch (const bims::RawlogError& e)
+		    {
+			    const std::string m = e.what();
+			    return m.find(p + ": ") == 0 &&
+			                   m.find("File too large") != std::string::npos
+			               ? 3
+			               : 4;
+		    }
+	    });
 	std::filesystem::remove(p);
-	ASSERT_TRUE(WIFEXITED(status));
-	EXPECT_EQ(WEXITSTATUS(status), 3);
+	EXPECT_EQ(code, 3);
 }

@@ -98,6 +98,17 @@ std::string readError(const std::string& path)
 	return {};
 }
 
+/** A plain rawlog of one default IMU observation; its bytes. */
+std::vector<uint8_t> imuRawlog(const std::string& path)
+{
+	{
+		mrpt::obs::CObservationIMU imu;
+		bims::RawlogWriter w(path, 0);
+		w.write(imu);
+	}
+	return readBytes(path);
+}
+
 void putU32(std::vector<uint8_t>& b, size_t at, uint32_t v)
 {
 	std::memcpy(&b[at], &v, 4);
@@ -326,13 +337,7 @@ TEST(RawlogCorrupt, AnImuFlagThatIsNoBoolIsAnError)
 	// ub-imu-flag-not-bool): a data-present flag stored as 10 is read into
 	// a bool by MRPT, undefined behaviour in its accessors.
 	const auto p = tmpPath("imu_flag.rawlog");
-	{
-		mrpt::obs::CObservationIMU imu;
-		imu.sensorLabel = "IMU";
-		bims::RawlogWriter w(p, 0);
-		w.write(imu);
-	}
-	auto bytes = readBytes(p);
+	auto bytes = imuRawlog(p);
 	EXPECT_EQ(readError(p), "");
 	// the flags follow the sensor pose's end byte 0x88 (its 12 doubles of a
 	// default pose hold no 0x88)
@@ -352,12 +357,7 @@ TEST(RawlogCorrupt, AnInnerObjectOfAnotherClassIsAnError)
 	// oom-imu-pose-class-name): an IMU observation whose sensor pose is
 	// named "mrpt::posei::CPose3D"; MRPT read on and allocated 4 GB.
 	const auto p = tmpPath("imu_pose_class.rawlog");
-	{
-		mrpt::obs::CObservationIMU imu;
-		bims::RawlogWriter w(p, 0);
-		w.write(imu);
-	}
-	auto bytes = readBytes(p);
+	auto bytes = imuRawlog(p);
 	const char* name = "mrpt::poses::";
 	auto at = std::search(bytes.begin(), bytes.end(), name, name + 13);
 	ASSERT_NE(at, bytes.end());
@@ -375,12 +375,7 @@ TEST(RawlogCorrupt, AnObjectOfAnUnknownClassIsAnError)
 	// oom-unknown-class-name): a top-level object named
 	// "mbpt::obs::CObservationIMU"; MRPT read on and allocated 4 GB.
 	const auto p = tmpPath("unknown_class.rawlog");
-	{
-		mrpt::obs::CObservationIMU imu;
-		bims::RawlogWriter w(p, 0);
-		w.write(imu);
-	}
-	auto bytes = readBytes(p);
+	auto bytes = imuRawlog(p);
 	EXPECT_TRUE(mrpt::rtti::findRegisteredClass("CObservationIMU", true))
 	    << "a name without namespace is looked up as MRPT does";
 	ASSERT_EQ(bytes[2], 'r');

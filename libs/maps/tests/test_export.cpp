@@ -9,13 +9,10 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
-#include <csignal>
 #include <cstdio>
 #include <fstream>
 
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
+#include <bims_test/file_size_limit.h>
 
 #include "scene_raycaster.h"
 
@@ -145,30 +142,25 @@ TEST(Export, APlyWriteThatFailsOnlyAtCloseIsAnError)
 	// not pass silently
 	const std::string path =
 	    mrpt::system::getTempFileName() + "_close_limit.ply";
-	const pid_t pid = fork();
-	ASSERT_GE(pid, 0);
-	if (pid == 0)
-	{
-		std::signal(SIGXFSZ, SIG_IGN);
-		const rlimit lim{1000, 1000};
-		setrlimit(RLIMIT_FSIZE, &lim);
-		try
-		{
-			writePointsPly(path,
-			               std::vector<mrpt::math::TPoint3D>(200, {1, 2, 3}),
-			               std::vector<float>(200, 0.5f));
-			_exit(0);
-		}
-		catch (const std::exception& e)
-		{
-			const std::string m = e.what();
-			_exit(m.find("error writing PLY file") != std::string::npos ? 3
-			                                                            : 4);
-		}
-	}
-	int status = 0;
-	waitpid(pid, &status, 0);
+	const int code = bims::test::exitOfChildWithFileSizeLimit(
+	    1000,
+	    [&]
+	    {
+		    try
+		    {
+			    writePointsPly(
+			        path, std::vector<mrpt::math::TPoint3D>(200, {1, 2, 3}),
+			        std::vector<float>(200, 0.5f));
+			    return 0;
+		    }
+		    catch (const std::exception& e)
+		    {
+			    const std::string m = e.what();
+			    return m.find("error writing PLY file") != std::string::npos
+			               ? 3
+			               : 4;
+		    }
+	    });
 	std::remove(path.c_str());
-	ASSERT_TRUE(WIFEXITED(status));
-	EXPECT_EQ(WEXITSTATUS(status), 3);
+	EXPECT_EQ(code, 3);
 }
