@@ -1,6 +1,7 @@
 #include "scan_guard.h"
 
 #include <mrpt/rtti/CObject.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include <cstring>
 #include <optional>
@@ -29,6 +30,13 @@ class Cursor
 	void skip(uint64_t n)
 	{
 		if (need(n)) at_ += n;
+	}
+	/** The bytes from offset \a from to \a to (already walked past), or
+	 * nullptr. */
+	const uint8_t* bytes(size_t from, size_t to)
+	{
+		if (!ok_ || to > size_ || from > to) return nullptr;
+		return data_ + from;
 	}
 	/** An object header: class name (length byte with the high bit set,
 	 * then the name) and the version byte; "" if not in that form. */
@@ -141,6 +149,7 @@ class ObservationWalker
 	bool scan(uint8_t version)
 	{
 		if (version != 9 && version != 10) return false;
+		scanVersion_ = version;
 		c_.skip(sizeof(float));  // maxRange
 		if (!pose()) return false;
 		const auto hasPoints = flag("has-points flag");
@@ -223,6 +232,32 @@ class ObservationWalker
 		}
 		return block(what, n);
 	}
+	/** A JPEG-stored image: its bytes must decode (OpenCV, whose libjpeg
+	 * error handler returns): MRPT decodes them with libjpeg's default
+	 * handler, which ends the whole process on bytes that are no JPEG
+	 * (found by the fuzzer). */
+	bool jpeg(const std::string& what)
+	{
+		const auto start = c_.offset();
+		if (!string(what)) return false;
+		const auto bytes = c_.bytes(start + sizeof(uint32_t), c_.offset());
+		if (!bytes) return false;
+		const cv::Mat raw(1, static_cast<int>(c_.offset() - start - 4), CV_8UC1,
+		                  const_cast<uint8_t*>(bytes));
+		bool ok = false;
+		try
+		{
+			ok = !raw.empty() &&
+			     !cv::imdecode(raw, cv::IMREAD_UNCHANGED).empty();
+		}
+		catch (const cv::Exception&)
+		{
+		}
+		if (ok) return true;
+		problem = "the " + what_ + "'s " + what +
+		          " is stored as JPEG but its bytes do not decode";
+		return false;
+	}
 	/** \a bytes of a block the object declared: when the file ends before
 	 * them, that is the problem (truncated), found before MRPT allocates
 	 * the block. */
@@ -300,7 +335,15 @@ class ObservationWalker
 		const size_t at = c_.offset();
 		if (c_.header(v) != "mrpt::img::CImage")
 			return mismatch("a CImage", at);
-		if (v != 9) return false;  // another MRPT's: MRPT decides
+		// another MRPT's: MRPT decides; but a scan of version 10 (MRPT
+		// 2.1 on) holds MRPT 2.x's images only (an older image version
+		// made MRPT decode bytes as JPEG with libjpeg's exiting error
+		// handler: found by the fuzzer)
+		if (v != 9)
+			return scanVersion_ >= 10
+			           ? mismatch("a CImage of version 9, as MRPT 2.x writes",
+			                      at)
+			           : false;
 		if (c_.read<uint8_t>())
 			return string(what + " file name") && end();  // external file
 		if (!c_.read<uint8_t>())  // grey: w h origin size depth zip data
@@ -320,8 +363,8 @@ class ObservationWalker
 		}
 		const auto w = c_.read<int32_t>(), h = c_.read<int32_t>();
 		if (!c_.ok()) return false;
-		if (w >= 1 && h >= 1) return string(what) && end();  // JPEG bytes
-		if (w < 0 && h < 0)                                  // raw BGR
+		if (w >= 1 && h >= 1) return jpeg(what) && end();
+		if (w < 0 && h < 0)  // raw BGR
 		{
 			const uint64_t rw = -int64_t{w}, rh = -int64_t{h};
 			if (!saneSize(rh, rw))
@@ -343,7 +386,8 @@ class ObservationWalker
 	}
 
 	Cursor c_;
-	std::string what_;  ///< "3D scan", "IMU observation"
+	std::string what_;     ///< "3D scan", "IMU observation"
+	int scanVersion_ = 0;  ///< of the 3D scan walked
 };
 }  // namespace
 

@@ -427,3 +427,28 @@ TEST(RawlogCorrupt, AScanFlagThatIsNoBoolIsAnError)
 	          std::string::npos)
 	    << readError(p);
 }
+
+TEST(RawlogCorrupt, AJpegImageWhoseBytesDoNotDecodeIsAnErrorNotAnExit)
+{
+	// Found by the rawlog fuzz target (tests/fuzz/corpus/rawlog/
+	// exit-jpeg-not-decodable, there through an image of an older version
+	// inside a scan of version 10, now refused): MRPT decodes a JPEG-stored
+	// image with libjpeg's default error handler, which ends the whole
+	// process ("Not a JPEG file") instead of throwing.
+	const auto p = tmpPath("jpeg.rawlog");
+	const bool was = mrpt::img::CImage::DISABLE_JPEG_COMPRESSION();
+	mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
+	scanRawlog(p, 0, true);  // its RGB image stored as JPEG
+	mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(was);
+	auto bytes = readBytes(p);
+	EXPECT_EQ(readError(p), "");
+	const uint8_t soi[3] = {0xff, 0xd8, 0xff};
+	const auto at = std::search(bytes.begin(), bytes.end(), soi, soi + 3);
+	ASSERT_NE(at, bytes.end()) << "no JPEG in the scan";
+	std::fill(at, at + 3, 0);
+	writeBytes(p, bytes);
+	EXPECT_NE(readError(p).find("the 3D scan's intensity image is stored as "
+	                            "JPEG but its bytes do not decode"),
+	          std::string::npos)
+	    << readError(p);
+}
