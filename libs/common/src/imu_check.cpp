@@ -75,4 +75,30 @@ std::string imuSampleProblem(const mrpt::obs::CObservationIMU& imu)
 	return {};
 }
 
+std::string RejectedImuSamples::check(const mrpt::obs::CObservationIMU& imu,
+                                      double t, const char* prog,
+                                      const std::string& path, size_t obsIndex)
+{
+	std::string bad = imuSampleProblem(imu);
+	if (bad.empty()) return bad;
+	++n_;
+	stamps_.push_back(t);
+	std::fprintf(stderr,
+	             "%s: warning: %s: observation #%zu (IMU, t %.6f): %s; sample "
+	             "not used (%zu so far)\n",
+	             prog, path.c_str(), obsIndex, t, bad.c_str(), n_);
+	return bad;
+}
+
+bool RejectedImuSamples::upTo(double t)
+{
+	bool any = false;
+	while (!stamps_.empty() && stamps_.front() <= t)
+	{
+		any = true;
+		stamps_.pop_front();
+	}
+	return any;
+}
+
 }  // namespace bims

@@ -357,12 +357,11 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		double excluded = 0;
 		if (mask)
 		{
-			exclude =
-			    cfg_.anchor.predict_mask
-			        ? predictMovingMask(*mask, depthPrev_, f.K,
-			                            R_rel_gyro ? *R_rel_gyro : lastR_rel_,
-			                            lastT_rel_, cfg_.anchor.mask_margin_px)
-			        : *mask;
+			exclude = cfg_.anchor.predict_mask
+			              ? predictMovingMask(*mask, depthPrev_, f.K,
+			                                  predictRotation(f.t), lastT_rel_,
+			                                  cfg_.anchor.mask_margin_px)
+			              : *mask;
 			if (tooLarge(exclude, &excluded))
 			{
 				r.flags |= kFlagMaskIgnored;

@@ -33,9 +33,7 @@ ReplayStats replayRawlog(const std::string& path, Odometry& odo,
 	std::deque<std::pair<CObservation3DRangeScan::Ptr, long>> pending;
 	long nScans = 0;
 	cv::Mat mask;
-	// stamps of the IMU samples not used (bims::imuSampleProblem): the
-	// frame whose interval held one is flagged imu_rejected, as in bims-run
-	std::deque<double> rejectedImuT;
+	RejectedImuSamples rejectedImu;  // as bims-run
 	DepthCorrection depthCorrection(cfg.depth_correction);
 	ProgressBar bar("bims-odom", 0, opt.progress);
 	bool done = false;
@@ -61,11 +59,7 @@ ReplayStats replayRawlog(const std::string& path, Odometry& odo,
 			}
 		}
 		FrameEgomotion r = odo.processFrame(*o, mask.empty() ? nullptr : &mask);
-		while (!rejectedImuT.empty() && rejectedImuT.front() <= r.t + offset)
-		{
-			r.flags |= kFlagImuRejected;
-			rejectedImuT.pop_front();
-		}
+		if (rejectedImu.upTo(r.t + offset)) r.flags |= kFlagImuRejected;
 		++st.frames;
 		if (!r.ok() && !(r.flags & kFlagFirstFrame)) ++st.flagged;
 		if (onFrame) onFrame(r, *o);
@@ -99,15 +93,12 @@ ReplayStats replayRawlog(const std::string& path, Odometry& odo,
 				++st.otherLabel;
 				continue;
 			}
-			if (const std::string bad = imuSampleProblem(*imu); !bad.empty())
+			if (!rejectedImu
+			         .check(*imu, t, "bims-odom", path,
+			                reader.observationsRead() - 1)
+			         .empty())
 			{
-				++st.imuRejected;
-				rejectedImuT.push_back(t);
-				std::fprintf(stderr,
-				             "bims-odom: warning: %s: observation #%zu (IMU, t "
-				             "%.6f): %s; sample not used (%zu so far)\n",
-				             path.c_str(), reader.observationsRead() - 1, t,
-				             bad.c_str(), st.imuRejected);
+				st.imuRejected = rejectedImu.count();
 				continue;
 			}
 			const ImuSample s = imuSampleFrom(*imu);

@@ -160,7 +160,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 
 	std::map<std::string, std::vector<double>> stage;
 	std::deque<PendingScan> pending;
-	std::deque<double> rejectedImuT;  ///< stamps of rejected IMU samples
+	RejectedImuSamples rejectedImu;
 	/** A scan stamped far after the previous one, until the next scan says
 	 * whether the recording jumped or the stamp is stray. */
 	std::optional<PendingScan> held;
@@ -184,11 +184,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		checkFiniteOutputs(r);
 		// IMU samples rejected up to this frame's time flag it
 		uint32_t flags = r.ego.flags;
-		while (!rejectedImuT.empty() && rejectedImuT.front() <= r.t)
-		{
-			flags |= ego::kFlagImuRejected;
-			rejectedImuT.pop_front();
-		}
+		if (rejectedImu.upTo(r.t)) flags |= ego::kFlagImuRejected;
 		sum.framesProcessed++;
 		if (r.flowAhead) sum.framesFlowAhead++;
 		if (flags & ~static_cast<uint32_t>(ego::kFlagFirstFrame))
@@ -310,23 +306,13 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 					continue;
 				}
 				sum.imuRead++;
-				const std::string bad = imuSampleProblem(*imu);
-				if (bad.empty())
+				if (rejectedImu.check(*imu, t, "bims-run", path, obsIndex)
+				        .empty())
 				{
 					pipe.addImu(*imu);
 					lastImuT = std::max(lastImuT, t);
 				}
-				else
-				{
-					sum.imuRejected++;
-					rejectedImuT.push_back(t);
-					std::fprintf(
-					    stderr,
-					    "bims-run: warning: %s: observation #%zu (IMU, "
-					    "t %.6f): %s; sample not used (%zu so far)\n",
-					    path.c_str(), obsIndex, t, bad.c_str(),
-					    sum.imuRejected);
-				}
+				sum.imuRejected = rejectedImu.count();
 				if (out)
 				{
 					if (held)

@@ -4,6 +4,8 @@
 
 #include <mrpt/obs/CObservationIMU.h>
 
+#include <cstddef>
+#include <deque>
 #include <string>
 
 namespace bims
@@ -16,5 +18,27 @@ namespace bims
  * m/s, position and altitude 1e8 m, magnetic field 1e4, pressure 1e7 Pa,
  * temperature 1000 degC. */
 std::string imuSampleProblem(const mrpt::obs::CObservationIMU& imu);
+
+/** The IMU samples a replay does not use (imuSampleProblem), for bims-run
+ * and bims-odom alike: each is counted and warned about, naming the rawlog
+ * and the observation, and the frame whose interval held one is flagged. */
+class RejectedImuSamples
+{
+ public:
+	/** imuSampleProblem(imu); when not empty, a warning on stderr ("PROG:
+	 * warning: PATH: observation #N (IMU, t T): PROBLEM; sample not used")
+	 * and \a t [s] remembered. */
+	std::string check(const mrpt::obs::CObservationIMU& imu, double t,
+	                  const char* prog, const std::string& path,
+	                  size_t obsIndex);
+	/** Whether samples stamped at or before \a t were rejected since the
+	 * last call (each sample answers once). */
+	bool upTo(double t);
+	size_t count() const { return n_; }
+
+ private:
+	std::deque<double> stamps_;
+	size_t n_ = 0;
+};
 
 }  // namespace bims
