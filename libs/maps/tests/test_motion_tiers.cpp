@@ -293,6 +293,9 @@ namespace
 std::vector<uint8_t> bytesOf(const mrpt::serialization::CSerializable& o)
 {
 	mrpt::io::CMemoryStream buf;
+	// MRPT grows the buffer 4 KiB at a time, a copy each: quadratic in the
+	// grid's size (minutes under AddressSanitizer, whose realloc copies)
+	buf.setAllocBlockSize(size_t{1} << 24);
 	auto arch = mrpt::serialization::archiveFrom(buf);
 	arch << o;
 	const auto* d = static_cast<const uint8_t*>(buf.getRawBufferData());
