@@ -190,11 +190,8 @@ class ObservationWalker
 				return false;
 		if (!flag("range-is-depth flag")) return false;
 		c_.skip(1);  // intensityImageChannel
-		// pixel labels: their names (a typed map) follow the image; the
-		// walk stops there, leaving extra depth layers after labels unchecked
 		const auto hasLabels = flag("has-labels flag");
-		if (!hasLabels) return false;
-		if (*hasLabels) return labels() && false;
+		if (!hasLabels || (*hasLabels && !labels())) return false;
 		if (version >= 10)
 		{
 			const auto layers = c_.read<uint8_t>();
@@ -376,13 +373,54 @@ class ObservationWalker
 		}
 		return end();
 	}
+	/** Pixel labels: version, bytes per pixel (1, 2, 4 or 8), the label
+	 * image (rows, cols, then that many elements), then the label names as
+	 * MRPT writes a std::map<uint32_t, std::string>: "std::map", the key and
+	 * value type names, the count, then key and name per entry. MRPT's
+	 * reader allocates the label image with `new` before reading on, and
+	 * leaks it (up to 15 MB) when anything after it throws: every part is
+	 * checked here so that it does not. */
 	bool labels()
 	{
-		// two header bytes (version, bytes per pixel), then the label
-		// image; the walk stops after its size, so the element size does
-		// not matter here
-		c_.skip(2);
-		return matrix("pixel-label image", 1);
+		const auto version = c_.read<uint8_t>();
+		const auto bytes = c_.read<uint8_t>();
+		if (!c_.ok()) return false;
+		if (version != 1) return false;  // another MRPT's: MRPT decides
+		if (bytes != 1 && bytes != 2 && bytes != 4 && bytes != 8)
+		{
+			problem = "the " + what_ + "'s pixel labels declare " +
+			          std::to_string(bytes) +
+			          " bytes per pixel, not 1, 2, 4 or 8";
+			return false;
+		}
+		if (!matrix("pixel-label image", bytes)) return false;
+		for (const char* type : {"std::map", "uint32_t", "std::string"})
+		{
+			const auto at = c_.offset();
+			const uint64_t n = c_.read<uint32_t>();
+			if (!c_.ok()) return false;
+			const std::string expected =
+			    std::string("the pixel-label names' type '") + type + "'";
+			if (n != std::strlen(type)) return mismatch(expected, at);
+			const auto from = c_.offset();
+			c_.skip(n);
+			const auto name = c_.bytes(from, c_.offset());
+			if (!name) return false;  // the bytes end
+			if (std::memcmp(name, type, n)) return mismatch(expected, at);
+		}
+		const uint64_t names = c_.read<uint32_t>();
+		for (uint64_t k = 0; k < names && c_.ok(); k++)
+		{
+			c_.skip(sizeof(uint32_t));  // the label's bit
+			if (!string("pixel-label name")) break;
+		}
+		if (c_.ok() || !problem.empty()) return c_.ok();
+		problem = "the " + what_ + "'s pixel-label names (" +
+		          std::to_string(names) +
+		          " declared) run past the end of "
+		          "the file";
+		truncated = true;
+		return false;
 	}
 
 	Cursor c_;
