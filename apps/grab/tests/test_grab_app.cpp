@@ -197,3 +197,34 @@ TEST(GrabApp, CtrlCStopsCleanlyAndKillLosesAtMostTheLastFrame)
 		// last frame at most shows as a truncated tail).
 	}
 }
+
+TEST(GrabApp, AFullDiskOrAnUnwritableOutputStopsWithAnErrorNamingTheFile)
+{
+	ASSERT_EQ(run("mkdir -p '" + kOut + "'"), 0);
+	// files limited to 1 MiB (SIGXFSZ ignored: writes fail with EFBIG, as
+	// on a full disk): the frames before stay readable
+	const std::string out = kOut + "/full.rawlog", log = kOut + "/full.log";
+	std::remove(out.c_str());
+	EXPECT_EQ(
+	    run("bash -c \"ulimit -f 1024; trap '' XFSZ; exec '" + kGrab + "' '" +
+	        kIni + "' -o '" + out + "' --frames 200\" > '" + log + "' 2>&1"),
+	    1)
+	    << slurp(log);
+	EXPECT_NE(
+	    slurp(log).find("error: grabbing stopped: " + out + ": write failed"),
+	    std::string::npos)
+	    << slurp(log);
+	const Content c = readBack(out);
+	EXPECT_GE(c.scans, 1u);
+	EXPECT_LT(c.scans, 200u);
+	EXPECT_EQ(c.backwards, 0u);
+	// an output folder that is a file
+	const std::string file = kOut + "/a_file";
+	std::ofstream(file) << "x";
+	EXPECT_EQ(run("'" + kGrab + "' '" + kIni + "' -o '" + file +
+	              "/x.rawlog' --frames 5 > '" + log + "' 2>&1"),
+	          1);
+	EXPECT_NE(slurp(log).find(file + "/x.rawlog: cannot create"),
+	          std::string::npos)
+	    << slurp(log);
+}
