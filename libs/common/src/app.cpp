@@ -1,8 +1,10 @@
 #include <bims/common/app.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -23,6 +25,83 @@ void keepFreedMemoryForReuse()
 	mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
 	mallopt(M_TRIM_THRESHOLD, 1024 * 1024 * 1024);
 #endif
+}
+
+namespace
+{
+/** Edit distance (insertions, deletions, substitutions) of two words. */
+size_t editDistance(const std::string& a, const std::string& b)
+{
+	std::vector<size_t> row(b.size() + 1);
+	for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+	for (size_t i = 1; i <= a.size(); ++i)
+	{
+		size_t diag = row[0];
+		row[0] = i;
+		for (size_t j = 1; j <= b.size(); ++j)
+		{
+			const size_t up = row[j];
+			row[j] = std::min({row[j] + 1, row[j - 1] + 1,
+			                   diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+			diag = up;
+		}
+	}
+	return row[b.size()];
+}
+
+bool isNumber(const std::string& s)
+{
+	char* end = nullptr;
+	std::strtod(s.c_str(), &end);
+	return end && *end == '\0';
+}
+}  // namespace
+
+void checkOptionNames(int argc, char** argv,
+                      const std::vector<OptionName>& known)
+{
+	const auto find = [&](const std::string& n) -> const OptionName*
+	{
+		for (const auto& k : known)
+			if (k.name == n) return &k;
+		return nullptr;
+	};
+	for (int i = 1; i < argc; ++i)
+	{
+		const std::string word = argv[i];
+		if (word == "--") return;  // the rest is positional
+		if (word.size() < 2 || word[0] != '-' || isNumber(word)) continue;
+		const std::string name = word.substr(0, word.find('='));
+		if (const auto* k = find(name))
+		{
+			if (name.size() != word.size())  // TCLAP takes no "--x=v"
+				throw UsageError(
+				    "'" + word + "': give the value after a space (" + name +
+				    " " + word.substr(name.size() + 1) + "); see --help");
+			if (k->takesValue) ++i;  // its value
+			continue;
+		}
+		if (word[1] != '-')  // combined short switches, "-qv"
+		{
+			bool all = true;
+			for (size_t c = 1; c < word.size() && all; ++c)
+			{
+				const auto* k = find(std::string("-") + word[c]);
+				all = k && !k->takesValue;
+			}
+			if (all) continue;
+		}
+		std::string msg = "unknown option '" + name + "'";
+		const OptionName* best = nullptr;
+		size_t bestD = 3;  // suggest within two edits
+		for (const auto& k : known)
+		{
+			const size_t d = editDistance(name, k.name);
+			if (k.name.size() > 2 && d < bestD) best = &k, bestD = d;
+		}
+		if (best) msg += " (did you mean " + best->name + "?)";
+		throw UsageError(msg + "; see --help");
+	}
 }
 
 int runApp(const std::string& program, const std::function<int()>& body)

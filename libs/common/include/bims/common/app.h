@@ -28,14 +28,52 @@ struct ExitRequest
 	int code = 0;
 };
 
+/** One option a program declares: "--frames" or "-o", and whether a value
+ * follows it. */
+struct OptionName
+{
+	std::string name;
+	bool takesValue = false;
+};
+
+/** Throws UsageError for the first word of \a argv that looks like an
+ * option ("-x", "--xyz", "--xyz=v"; not a number, not after "--") but is
+ * none of \a known, naming it and the closest known one ("did you mean"),
+ * or a known one written "--x=v" (TCLAP would take the word as an input).
+ * Combined short switches ("-qv") pass when each letter is known. TCLAP
+ * alone takes an unknown "--frmes" as an input file when the program
+ * accepts several. */
+void checkOptionNames(int argc, char** argv,
+                      const std::vector<OptionName>& known);
+
 /** Parses the command line with MRPT's TCLAP (CmdLine in
  * mrpt/3rdparty/tclap/CmdLine.h), which prints --help, --version and parse
  * errors itself and then returns false instead of exiting: throws
  * ExitRequest{0} after --help or --version, ExitRequest{2} after a parse
- * error, so that no program goes on with empty arguments. */
+ * error, so that no program goes on with empty arguments. An unknown or
+ * mistyped option is a UsageError before anything else (checkOptionNames). */
 template <class CmdLine>
 void parseCommandLine(CmdLine& cmd, int argc, char** argv)
 {
+	std::vector<OptionName> known;
+	for (const auto* a : cmd.getArgList())
+	{
+		// positional arguments print as "<NAME>", options as "-f <N>"
+		// ("[-f <N>]" when optional)
+		const std::string id = a->shortID();
+		if (id.rfind("-", 0) != 0 && id.rfind("[-", 0) != 0) continue;
+		if (!a->getFlag().empty())
+			known.push_back({"-" + a->getFlag(), a->isValueRequired()});
+		if (!a->getName().empty())
+			known.push_back({"--" + a->getName(), a->isValueRequired()});
+	}
+	bool help = false;
+	for (int i = 1; i < argc; ++i)
+	{
+		const std::string a = argv[i];
+		help |= a == "-h" || a == "--help" || a == "--version";
+	}
+	if (!help) checkOptionNames(argc, argv, known);
 	if (cmd.parse(argc, argv)) return;
 	for (int i = 1; i < argc; ++i)
 	{
