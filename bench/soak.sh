@@ -39,6 +39,7 @@ if [ -z "$INPUT" ]; then
 	WHAT="simulated pendulum_slow $RES"
 else
 	[ -f "$INPUT" ] || { echo "soak.sh: $INPUT: no such file" >&2; exit 2; }
+	INPUT=$(realpath "$INPUT")
 	per=$("$BIN/bims-info" "$INPUT" | awk '/CObservation3DRangeScan/ {print $3; exit}')
 	[[ ${per:-0} -gt 0 ]] || { echo "soak.sh: $INPUT: no RGB-D frames found by bims-info" >&2; exit 2; }
 	command -v rawlog-edit > /dev/null || { echo "soak.sh: needs MRPT's rawlog-edit (mrpt-apps)" >&2; exit 2; }
