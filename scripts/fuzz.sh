@@ -39,7 +39,7 @@ mkdir -p "$WORK" "$FOUND"
 SEEDS=("$ROOT/tests/fuzz/corpus/$TARGET")
 [ "$TARGET" = ini ] && SEEDS+=("$ROOT/config" "$ROOT/config/sim")
 # MRPT-internal leaks only, each named and explained in the file
-export LSAN_OPTIONS="suppressions=$ROOT/tests/fuzz/lsan.supp:print_suppressions=0"
+export LSAN_OPTIONS="suppressions=$ROOT/tests/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1"
 echo "fuzz.sh: $TARGET for $SECONDS_TOTAL s, $JOBS job(s); corpus $WORK; findings $FOUND"
 PAR=()

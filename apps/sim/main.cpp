@@ -14,6 +14,7 @@
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/config/CConfigFile.h>
 
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -133,9 +134,11 @@ int main(int argc, char** argv)
 			    throw bims::UsageError(
 			        "--preview must be a frame index in [0, " +
 			        std::to_string(cfg.seq.frames - 1) + "]");
-		    const auto st =
-		        bims::sim::runSimulation(cfg, out.getValue(), seed.getValue(),
-		                                 !quiet.getValue(), preview.getValue());
+		    // SIGINT / SIGTERM: stop after the current frame, write it all
+		    const auto& stop = bims::installStopSignals();
+		    const auto st = bims::sim::runSimulation(
+		        cfg, out.getValue(), seed.getValue(), !quiet.getValue(),
+		        preview.getValue(), &stop);
 		    std::fprintf(stderr,
 		                 "bims-sim: %zu frames %dx%d + %zu IMU samples in %.2f "
 		                 "s wall, %.2f s CPU "
@@ -148,6 +151,18 @@ int main(int argc, char** argv)
 		                 st.frames / std::max(1e-9, st.cpuSeconds),
 		                 st.frames / std::max(1e-9, st.renderSeconds),
 		                 100 * st.movingFraction, st.gtDir.c_str());
+		    if (st.interrupted)
+		    {
+			    const int sig = bims::stopSignal();
+			    std::fprintf(
+			        stderr,
+			        "bims-sim: interrupted by %s after %zu of %d frames: "
+			        "the rawlog and ground truth hold those frames, "
+			        "complete\n",
+			        sig == SIGTERM ? "SIGTERM" : "SIGINT", st.frames,
+			        cfg.seq.frames);
+			    return 128 + (sig ? sig : SIGINT);
+		    }
 		    return 0;
 	    });
 }

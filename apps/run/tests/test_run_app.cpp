@@ -4,10 +4,7 @@
 #include <bims/common/json.h>
 #include <bims_test/run_command.h>
 #include <bims_test/tmp_dir.h>
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <csignal>
 #include <tuple>
@@ -195,24 +192,10 @@ namespace
  * was killed); its output goes to DIR/log. */
 int interruptedRun(const std::string& dir, int sig)
 {
-	const std::string bin = kBin + "/bims-run", out = dir + "/out",
-	                  log = dir + "/log";
-	const pid_t pid = fork();
-	if (pid == 0)
-	{
-		const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-		dup2(fd, 1);
-		dup2(fd, 2);
-		execl(bin.c_str(), bin.c_str(), kConfig.c_str(), kSample.c_str(),
-		      kSample.c_str(), "-o", out.c_str(), "-q", nullptr);
-		_exit(127);
-	}
-	for (int i = 0; i < 4000 && !fs::exists(out + "/masks/000005.png"); i++)
-		usleep(2000);
-	kill(pid, sig);
-	int st = 0;
-	waitpid(pid, &st, 0);
-	return WIFEXITED(st) ? WEXITSTATUS(st) : -WTERMSIG(st);
+	return bims::test::signalWhenExists({kBin + "/bims-run", kConfig, kSample,
+	                                     kSample, "-o", dir + "/out", "-q"},
+	                                    dir + "/log",
+	                                    dir + "/out/masks/000005.png", sig);
 }
 }  // namespace
 

@@ -159,7 +159,8 @@ std::string groundTruthDirFor(const std::string& rawlogPath)
 }
 
 SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
-                       uint64_t seed, bool progress, int previewFrame)
+                       uint64_t seed, bool progress, int previewFrame,
+                       const std::atomic<bool>* stop)
 {
 	const auto tStart = std::chrono::steady_clock::now();
 	const std::clock_t cpuStart = std::clock();
@@ -185,7 +186,6 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	        "255 for any id > 0)\n";
 
 	const double t0 = cfg.seq.startTime;
-	const double duration = double(cfg.seq.frames - 1) / cfg.seq.fps;
 	size_t nextImu = 0;
 	auto writeImuUntil = [&](double tSeq)
 	{
@@ -203,8 +203,10 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	ProgressBar bar("bims-sim", size_t(cfg.seq.frames), progress);
 	RenderedFrame frame;
 	double movingSum = 0;
-	for (int j = 0; j < cfg.seq.frames; j++)
+	int done = 0;  // frames written
+	for (; done < cfg.seq.frames && !(stop && *stop); done++)
 	{
+		const int j = done;
 		const double tSeq = double(j) / cfg.seq.fps;
 		writeImuUntil(tSeq);
 		const Kinematics k = motion.at(tSeq);
@@ -235,8 +237,10 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 		}
 		bar.update(size_t(j + 1));
 	}
-	writeImuUntil(duration +
-	              0.5 / cfg.seq.fps);  // IMU a little past the last frame
+	st.interrupted = done < cfg.seq.frames;
+	// IMU a little past the last frame written
+	writeImuUntil(double(std::max(0, done - 1)) / cfg.seq.fps +
+	              0.5 / cfg.seq.fps);
 	out.close();
 	part.commit();
 	bar.finish();
@@ -248,9 +252,9 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	writeCalibration(cfg, st.gtDir + "/calibration.ini");
 	writeFileAtomically(st.gtDir + "/objects.txt", objs.str());
 
-	st.frames = size_t(cfg.seq.frames);
+	st.frames = size_t(done);
 	st.imuSamples = imuTruth.size();
-	st.movingFraction = movingSum / std::max(1, cfg.seq.frames);
+	st.movingFraction = movingSum / std::max(1, done);
 	st.cpuSeconds = double(std::clock() - cpuStart) / CLOCKS_PER_SEC;
 	st.seconds =
 	    std::chrono::duration<double>(std::chrono::steady_clock::now() - tStart)

@@ -5,6 +5,7 @@
 #include <bims/common/trajectory.h>
 #include <bims/sim/scene.h>
 #include <bims/sim/simulator.h>
+#include <bims_test/run_command.h>
 #include <gtest/gtest.h>
 #include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -15,6 +16,7 @@
 
 #include <sys/wait.h>
 
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -22,6 +24,7 @@
 #include <map>
 #include <regex>
 #include <sstream>
+#include <tuple>
 
 namespace
 {
@@ -422,4 +425,46 @@ TEST(BimsSim, AFullDiskIsAnErrorAndLeavesNoRawlogUnderItsName)
 	    << out;
 	EXPECT_FALSE(std::filesystem::exists(d + "/x.rawlog"));
 	EXPECT_FALSE(std::filesystem::exists(d + "/x.rawlog.partial"));
+}
+
+TEST(BimsSim, SigintAndSigtermEndACompleteShorterSequence)
+{
+	for (const auto& [sig, code, name] :
+	     {std::tuple{SIGINT, 130, "SIGINT"}, {SIGTERM, 143, "SIGTERM"}})
+	{
+		const std::string d = tmpDir(name);
+		const int rc = bims::test::signalWhenExists(
+		    {kBin + "/bims-sim", kSrc + "/rawlogs/pendulum_slow.ini", "-o",
+		     d + "/x.rawlog", "--frames", "3000", "-q"},
+		    d + "/log", d + "/x_gt/masks/000005.png", sig);
+		const std::string log = readFile(d + "/log");
+		EXPECT_EQ(rc, code) << log;
+		EXPECT_NE(log.find(std::string("interrupted by ") + name + " after "),
+		          std::string::npos)
+		    << log;
+		// the rawlog under its name, whole (a torn file throws), as long as
+		// the ground truth
+		bims::RawlogReader r(d + "/x.rawlog");
+		size_t scans = 0;
+		double tLastScan = 0, tLastImu = 0;
+		while (auto o = r.next())
+		{
+			const double t = mrpt::Clock::toDouble(o->timestamp);
+			if (IS_CLASS(*o, mrpt::obs::CObservation3DRangeScan))
+				scans++, tLastScan = t;
+			else
+				tLastImu = t;
+		}
+		EXPECT_GE(scans, 5u);  // masks/000005.png was being written
+		EXPECT_LT(scans, 3000u);
+		EXPECT_GT(tLastImu, tLastScan);  // the IMU passes the last frame
+		EXPECT_EQ(bims::loadTumTrajectory(d + "/x_gt/groundtruth.txt").size(),
+		          scans);
+		size_t masks = 0;
+		for ([[maybe_unused]] const auto& e :
+		     std::filesystem::directory_iterator(d + "/x_gt/masks"))
+			masks++;
+		EXPECT_EQ(masks, scans);
+		EXPECT_FALSE(std::filesystem::exists(d + "/x.rawlog.partial"));
+	}
 }

@@ -15,6 +15,7 @@
 #include <bims/sim/objects.h>
 #include <bims/sim/renderer.h>
 
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -70,6 +71,7 @@ struct SimStats
 	                            ///< (single-threaded: the work done)
 	double movingFraction = 0;  ///< mean fraction of pixels on moving objects
 	std::string gtDir;          ///< ground-truth folder
+	bool interrupted = false;   ///< stopped early by \a stop (frames < asked)
 };
 
 /** Folder of the ground truth of a rawlog: "<path without .rawlog>_gt". */
@@ -81,9 +83,13 @@ std::string groundTruthDirFor(const std::string& rawlogPath);
  * masks/NNNNNN.png, calibration.ini. Deterministic in (config, seed). \param
  * progress print a progress bar on stderr. \param previewFrame if >= 0, also
  * writes preview.png (RGB | depth | mask) of that frame into the ground-truth
- * folder. */
+ * folder. \param stop when it turns true (e.g. bims::installStopSignals), the
+ * run ends after the current frame and writes everything for the frames done:
+ * a complete, shorter sequence (the IMU up to half a frame past its last
+ * frame, as a full run), SimStats::interrupted set. */
 SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
                        uint64_t seed, bool progress = true,
-                       int previewFrame = -1);
+                       int previewFrame = -1,
+                       const std::atomic<bool>* stop = nullptr);
 
 }  // namespace bims::sim
