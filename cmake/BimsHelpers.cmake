@@ -9,19 +9,29 @@ function(bims_target_defaults tgt)
   target_compile_options(${tgt} PRIVATE -Wall -Wextra -ffp-contract=off)
 endfunction()
 
-# bims_add_library(NAME sim SOURCES ... DEPS ...)
+# bims_add_library(NAME sim SOURCES ... DEPS ... [NO_INSTALL])
 # Creates static library bims_<NAME> with alias bims::<NAME>; public headers in
-# libs/<NAME>/include/bims/<NAME>/.
+# libs/<NAME>/include/bims/<NAME>/. Unless NO_INSTALL, the library joins the
+# exported package (bims::<NAME> for find_package(bims), cmake/BimsInstall.cmake)
+# and its headers are installed into include/bims/<NAME>/.
 function(bims_add_library)
-  cmake_parse_arguments(A "" "NAME" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
+  cmake_parse_arguments(A "NO_INSTALL" "NAME" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
   set(tgt bims_${A_NAME})
   add_library(${tgt} STATIC ${A_SOURCES})
   add_library(bims::${A_NAME} ALIAS ${tgt})
   target_include_directories(${tgt} PUBLIC
-    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   target_link_libraries(${tgt} PUBLIC ${A_DEPS} PRIVATE ${A_PRIVATE_DEPS})
-  set_target_properties(${tgt} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  set_target_properties(${tgt} PROPERTIES POSITION_INDEPENDENT_CODE ON
+                                          EXPORT_NAME ${A_NAME})
   bims_target_defaults(${tgt})
+  if(NOT A_NO_INSTALL)
+    install(TARGETS ${tgt} EXPORT bimsTargets
+            ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+    install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/include/
+            DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  endif()
 endfunction()
 
 # bims_add_app(NAME bims-sim SOURCES ... DEPS ...): an executable in build/bin.
@@ -30,7 +40,7 @@ function(bims_add_app)
   add_executable(${A_NAME} ${A_SOURCES})
   target_link_libraries(${A_NAME} PRIVATE ${A_DEPS})
   bims_target_defaults(${A_NAME})
-  install(TARGETS ${A_NAME} RUNTIME DESTINATION bin)
+  install(TARGETS ${A_NAME} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 endfunction()
 
 # bims_add_gtest(NAME test_x SOURCES ... DEPS ... [LABELS ...] [TIMEOUT s])

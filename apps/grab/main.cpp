@@ -10,6 +10,7 @@
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/output_paths.h>
+#include <bims/common/share.h>
 #include <bims/grab/grabber.h>
 #include <bims/pipeline/pipeline.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
@@ -69,8 +70,8 @@ int main(int argc, char** argv)
 		                          cmd);
 		    TCLAP::ValueArg<std::string> aExp(
 		        "", "experiment",
-		        "experiment .ini for --live-segmentation (default: built-in "
-		        "defaults)",
+		        "experiment .ini for --live-segmentation (default: "
+		        "share/bims/default.ini)",
 		        false, "", "EXP.ini", cmd);
 		    TCLAP::SwitchArg aViewer("", "viewer",
 		                             "show the RGB frames (with the moving "
@@ -96,8 +97,13 @@ int main(int argc, char** argv)
 		    std::unique_ptr<bims::pipeline::Pipeline> pipe;
 		    if (aSeg.getValue())
 		    {
+			    const std::string expIni = aExp.getValue().empty()
+			                                   ? bims::defaultExperimentIni()
+			                                   : aExp.getValue();
 			    bims::pipeline::ExperimentConfig exp;
-			    if (!aExp.getValue().empty()) exp.loadFromFile(aExp.getValue());
+			    if (!expIni.empty()) exp.loadFromFile(expIni);
+			    std::cerr << "bims-grab: live segmentation: "
+			              << bims::parametersSource(expIni) << "\n";
 			    pipe = std::make_unique<bims::pipeline::Pipeline>(exp);
 		    }
 		    mrpt::gui::CDisplayWindow::Ptr win;

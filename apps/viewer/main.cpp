@@ -10,8 +10,8 @@
 // --screenshot writes the 3D view as shown in the window and quits.
 #include <bims/common/app.h>
 #include <bims/common/output_paths.h>
+#include <bims/common/share.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
-#include <mrpt/system/filesystem.h>
 
 #include <cstdio>
 #include <fstream>
@@ -63,7 +63,7 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<std::string> aCfg(
 		        "", "config",
 		        "experiment .ini for the pipeline (default: "
-		        "built-in defaults)",
+		        "share/bims/default.ini)",
 		        false, "", "CONFIG.ini", cmd);
 		    TCLAP::ValueArg<std::string> aGt(
 		        "", "gt",
@@ -103,23 +103,11 @@ int main(int argc, char** argv)
 		                                  bims::givenValues(aShot, aSeq));
 
 		    auto& o = gOptions;
-		    if (aCfg.getValue().empty())
-		    {
-			    // "Default parameters": the project's config/default.ini,
-			    // found next to the build tree or the installed share dir.
-			    const std::string exeDir =
-			        mrpt::system::extractFileDirectory(argv[0]);
-			    for (const std::string& c :
-			         {exeDir + "/../../config/default.ini",
-			          exeDir + "/../share/bims/default.ini"})
-				    if (mrpt::system::fileExists(c))
-				    {
-					    o.viewer.configPath = c;
-					    break;
-				    }
-		    }
-		    else
-			    o.viewer.configPath = aCfg.getValue();
+		    // Default parameters: share/bims/default.ini of the build tree or
+		    // the install prefix.
+		    o.viewer.configPath = aCfg.getValue().empty()
+		                              ? bims::defaultExperimentIni()
+		                              : aCfg.getValue();
 		    o.viewer.rawlog = aIn.getValue();
 		    o.viewer.resultsDir = aRes.getValue();
 		    o.viewer.groundTruth = aGt.getValue();
@@ -146,10 +134,8 @@ int main(int argc, char** argv)
 				                             o.viewer.rawlog + "'");
 		    }
 
-		    std::cerr << "bims-viewer: parameters from "
-		              << (o.viewer.configPath.empty() ? "built-in defaults"
-		                                              : o.viewer.configPath)
-		              << "\n";
+		    std::cerr << "bims-viewer: "
+		              << bims::parametersSource(o.viewer.configPath) << "\n";
 		    int wxArgc = 1;
 		    char* wxArgv[] = {argv[0], nullptr};
 		    const int rc = wxEntry(wxArgc, wxArgv);

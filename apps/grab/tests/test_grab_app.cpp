@@ -11,6 +11,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -114,6 +115,27 @@ TEST(GrabApp, GrabsNFramesFromTheDummyDeviceWithTheReplayedImu)
 	                       std::chrono::system_clock::now().time_since_epoch())
 	                       .count();
 	EXPECT_NEAR(c.t1, now, 60.0);
+}
+
+TEST(GrabApp, LiveSegmentationWithoutExperimentUsesShareBimsDefaultIni)
+{
+	ASSERT_EQ(run("mkdir -p '" + kOut + "'"), 0);
+	const std::string out = kOut + "/seg.rawlog", log = kOut + "/seg.log";
+	ASSERT_EQ(run("'" + kGrab + "' '" + kIni + "' -o '" + out +
+	              "' --frames 3 --live-segmentation > '" + log + "' 2>&1"),
+	          0)
+	    << slurp(log);
+	// build/bin/bims-grab -> build/share/bims/default.ini, named
+	const std::string msg = slurp(log);
+	const std::string head = "bims-grab: live segmentation: parameters from ";
+	const auto at = msg.find(head);
+	ASSERT_NE(at, std::string::npos) << msg;
+	const auto from = at + head.size();
+	const std::string used = msg.substr(from, msg.find('\n', from) - from);
+	ASSERT_TRUE(std::filesystem::exists(used)) << msg;
+	EXPECT_TRUE(std::filesystem::equivalent(
+	    used, std::string(BIMS_BINARY_DIR) + "/share/bims/default.ini"))
+	    << used;
 }
 
 TEST(GrabApp, NoDeviceIsAClearErrorNotAnAbort)

@@ -6,6 +6,7 @@
 
 #include <sys/wait.h>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
@@ -114,4 +115,25 @@ TEST(GuiViewer, MissingRawlogIsAnErrorBeforeAnyWindow)
 	EXPECT_NE(slurp(log).find("cannot open rawlog '/nonexistent/x.rawlog'"),
 	          std::string::npos)
 	    << slurp(log);
+}
+
+TEST(GuiViewer, WithoutConfigItUsesShareBimsDefaultIniAndSaysWhich)
+{
+	// The parameters line comes before any window (none opens here).
+	const std::string log = kOut + "/viewer_default_ini.log";
+	ASSERT_EQ(run("mkdir -p '" + kOut + "'"), 0);
+	run("env -u DISPLAY -u WAYLAND_DISPLAY '" + kViewer + "' > '" + log +
+	    "' 2>&1");
+	const std::string msg = slurp(log);
+	const std::string head = "bims-viewer: parameters from ";
+	const auto at = msg.find(head);
+	ASSERT_NE(at, std::string::npos) << msg;
+	const auto from = at + head.size();
+	const std::string used = msg.substr(from, msg.find('\n', from) - from);
+	// build/bin/bims-viewer -> build/share/bims/default.ini
+	ASSERT_TRUE(std::filesystem::exists(used)) << msg;
+	EXPECT_TRUE(std::filesystem::equivalent(
+	    used, std::string(BIMS_BINARY_DIR) + "/share/bims/default.ini"))
+	    << used;
+	EXPECT_NE(used.find("/share/bims/default.ini"), std::string::npos) << used;
 }

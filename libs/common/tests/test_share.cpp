@@ -1,0 +1,101 @@
+// share/bims found at run time: next to the program (the build tree's
+// build/share/bims, an install prefix's PREFIX/share/bims), then in the
+// install prefix compiled in.
+#include <bims/common/share.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "tmp_path.h"
+
+namespace fs = std::filesystem;
+
+namespace
+{
+std::string slurp(const std::string& p)
+{
+	std::ifstream f(p);
+	std::stringstream s;
+	s << f.rdbuf();
+	return s.str();
+}
+}  // namespace
+
+TEST(Share, ExecutableDirIsTheFolderOfThisTest)
+{
+	// test_common lives in build/bin with the programs
+	ASSERT_FALSE(bims::executableDir().empty());
+	EXPECT_TRUE(fs::equivalent(bims::executableDir(), BIMS_BIN_DIR));
+}
+
+TEST(Share, TheBuildTreeHoldsTheConfigsOfTheSourceTree)
+{
+	// build/bin/../share/bims: the build mirrors the installed layout
+	for (const std::string name :
+	     {"default.ini", "bonn.ini", "sim/crowded.ini", "README.md"})
+	{
+		const std::string p = bims::findShareFile(name);
+		ASSERT_FALSE(p.empty()) << name;
+		EXPECT_TRUE(fs::equivalent(
+		    p, fs::path(BIMS_BIN_DIR) / ".." / "share" / "bims" / name))
+		    << p;
+		EXPECT_EQ(p, fs::path(p).lexically_normal().string());
+	}
+	EXPECT_EQ(slurp(bims::findShareFile("default.ini")),
+	          slurp(std::string(BIMS_SOURCE_DIR) + "/config/default.ini"));
+	EXPECT_EQ(slurp(bims::findShareFile("sim/crowded.ini")),
+	          slurp(std::string(BIMS_SOURCE_DIR) + "/config/sim/crowded.ini"));
+}
+
+TEST(Share, AbsentFileOrAFolderIsEmpty)
+{
+	EXPECT_EQ(bims::findShareFile("no_such_file_in_share.ini"), "");
+	EXPECT_EQ(bims::findShareFile("sim"), "");  // a folder, not a file
+	EXPECT_EQ(bims::findShareFile(""), "");
+}
+
+TEST(Share, AnyPrefixIsFoundFromItsBinFolderAndMayBeMoved)
+{
+	// An install prefix anywhere (not the one compiled in): found from its
+	// bin/ folder, and only from there.
+	const fs::path prefix = bims::test::tmpPath("share_prefix");
+	fs::remove_all(prefix);
+	fs::create_directories(prefix / "bin");
+	fs::create_directories(prefix / "share" / "bims" / "sim");
+	std::ofstream(prefix / "share" / "bims" / "sim" / "only_here.ini")
+	    << "[x]\n";
+	const std::string found =
+	    bims::findShareFile("sim/only_here.ini", (prefix / "bin").string());
+	EXPECT_EQ(found,
+	          (prefix / "share" / "bims" / "sim" / "only_here.ini").string());
+	// Moved: the program's new folder finds it there.
+	const fs::path moved = bims::test::tmpPath("share_prefix_moved");
+	fs::remove_all(moved);
+	fs::rename(prefix, moved);
+	EXPECT_EQ(
+	    bims::findShareFile("sim/only_here.ini", (moved / "bin").string()),
+	    (moved / "share" / "bims" / "sim" / "only_here.ini").string());
+	EXPECT_EQ(
+	    bims::findShareFile("sim/only_here.ini", (prefix / "bin").string()),
+	    "");
+	fs::remove_all(moved);
+}
+
+TEST(Share, TheInstalledShareDirIsAnAbsolutePathEndingInBims)
+{
+	const fs::path d = bims::installedShareDir();
+	EXPECT_TRUE(d.is_absolute()) << d;
+	EXPECT_EQ(d.filename(), "bims") << d;
+}
+
+TEST(Share, ProgramsWithoutAnIniUseDefaultIniAndSayWhichFile)
+{
+	const std::string ini = bims::defaultExperimentIni();
+	EXPECT_EQ(ini, bims::findShareFile("default.ini"));
+	EXPECT_EQ(bims::parametersSource(ini), "parameters from " + ini);
+	EXPECT_EQ(bims::parametersSource(""),
+	          "parameters from built-in defaults (no share/bims/default.ini "
+	          "found)");
+}
