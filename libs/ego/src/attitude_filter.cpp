@@ -338,7 +338,7 @@ std::optional<Eigen::Quaterniond> AttitudeFilter::lookup(double t,
 	return out;
 }
 
-std::string flagsToString(uint32_t flags)
+std::vector<const char*> flagNames(uint32_t flags)
 {
 	static const std::pair<uint32_t, const char*> names[] = {
 	    {kFlagFirstFrame, "first_frame"},
@@ -359,9 +359,17 @@ std::string flagsToString(uint32_t flags)
 	    {kFlagMaskIgnored, "mask_ignored"},
 	    {kFlagAnchorRelocalised, "anchor_relocalised"},
 	    {kFlagImuRejected, "imu_rejected"}};
-	std::string s;
+	std::vector<const char*> out;
 	for (const auto& [bit, name] : names)
-		if (flags & bit) s += (s.empty() ? "" : "|") + std::string(name);
+		if (flags & bit) out.push_back(name);
+	return out;
+}
+
+std::string flagsToString(uint32_t flags)
+{
+	std::string s;
+	for (const char* name : flagNames(flags))
+		s += (s.empty() ? "" : "|") + std::string(name);
 	return s.empty() ? "ok" : s;
 }
 

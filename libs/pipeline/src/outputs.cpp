@@ -7,6 +7,7 @@
 
 #include <bims/common/app.h>
 #include <bims/common/pixel_labels.h>
+#include <bims/ego/flags.h>
 #include <bims/common/trajectory.h>
 #include <bims/maps/export.h>
 #include <mrpt/obs/TPixelLabelInfo.h>
@@ -72,7 +73,7 @@ OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
 	csv_->append(
 	    "index,t,ego_flags,correspondences,inliers,residual_m,hit_voxels,"
 	    "moving_voxels,moving_px,diff_px,notdiff_px,"
-	    "ms_input,ms_ego,ms_flow,ms_grids,ms_total\n");
+	    "ms_input,ms_ego,ms_flow,ms_grids,ms_total,ego_flag_names\n");
 	if (p_.labelled_rawlog)
 		rawlog_ = std::make_unique<RawlogWriter>(dir_ + "/segmented.rawlog",
 		                                         p_.labelled_rawlog_gz_level);
@@ -134,13 +135,15 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 	// output
 	traj_->append(tumLine(r.t, r.T_WC) + "\n");
 	char buf[512];
-	std::snprintf(
-	    buf, sizeof(buf),
-	    "%zu,%.6f,%u,%d,%d,%.5f,%zu,%zu,%d,%zu,%zu,%.3f,%.3f,%.3f,%.3f,%.3f\n",
-	    r.index, r.t, r.ego.flags, r.ego.correspondences, r.ego.inliers,
-	    r.ego.residual_rms_m, r.hitVoxels, r.movingVoxels,
-	    cv::countNonZero(r.mask), r.labelStats.diff, r.labelStats.notDiff,
-	    r.ms.input, r.ms.ego, r.ms.flow, r.ms.grids, r.ms.total);
+	std::snprintf(buf, sizeof(buf),
+	              "%zu,%.6f,%u,%d,%d,%.5f,%zu,%zu,%d,%zu,%zu,%.3f,%.3f,%.3f,%."
+	              "3f,%.3f,%s\n",
+	              r.index, r.t, r.ego.flags, r.ego.correspondences,
+	              r.ego.inliers, r.ego.residual_rms_m, r.hitVoxels,
+	              r.movingVoxels, cv::countNonZero(r.mask), r.labelStats.diff,
+	              r.labelStats.notDiff, r.ms.input, r.ms.ego, r.ms.flow,
+	              r.ms.grids, r.ms.total,
+	              ego::flagsToString(r.ego.flags).c_str());
 	csv_->append(buf);
 }
 
@@ -218,6 +221,8 @@ void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
 	j["config"] = pipe.config().source;
 	j["frames_processed"] = sum.framesProcessed;
 	j["frames_flagged"] = sum.framesFlagged;
+	j["frames_flagged_by"] = sum.framesFlaggedBy;
+	j["notes"] = sum.notes;
 	j["scans_read"] = sum.scansRead;
 	j["imu_read"] = sum.imuRead;
 	j["scans_out_of_order"] = sum.scansOutOfOrder;

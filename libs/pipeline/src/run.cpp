@@ -187,8 +187,11 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		if (rejectedImu.upTo(r.t)) flags |= ego::kFlagImuRejected;
 		sum.framesProcessed++;
 		if (r.flowAhead) sum.framesFlowAhead++;
-		if (flags & ~static_cast<uint32_t>(ego::kFlagFirstFrame))
-			sum.framesFlagged++;
+		const uint32_t counted =
+		    flags & ~static_cast<uint32_t>(ego::kFlagFirstFrame);
+		if (counted) sum.framesFlagged++;
+		for (const char* name : ego::flagNames(counted))
+			sum.framesFlaggedBy[name]++;
 		stage["read"].push_back(p.readMs);
 		stage["read_cpu"].push_back(p.readCpuMs);
 		stage["wait_input"].push_back(p.inWaitMs);
@@ -429,6 +432,16 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		stage["outputs"] = out->frameMs();
 		stage["outputs_cpu"] = out->frameCpuMs();
 	}
+	if (sum.framesProcessed > 0 && sum.imuRead == 0 &&
+	    cfg.ego.odometry.mode == "imu")
+		sum.notes.push_back(
+		    "no IMU samples in the input" +
+		    (imuLabel.empty() ? std::string()
+		                      : " with sensor label '" + imuLabel + "'") +
+		    ": [odometry] mode=imu fell back to vision on every frame "
+		    "(rotation and translation from the tracked 3D features, the "
+		    "tracker seeded at constant velocity), each flagged "
+		    "imu_missing");
 	for (auto& [name, v] : stage) sum.stageMs[name] = Percentiles::of(v);
 	sum.dataSeconds = std::isnan(firstT) ? 0 : lastT - firstT;
 	sum.meanMovingPixelFraction =
@@ -481,6 +494,20 @@ std::string formatSummary(const RunSummary& s)
 		              it->second.median, it->second.p95, it->second.mean);
 		o << buf;
 	}
+	if (!s.framesFlaggedBy.empty())
+	{
+		// most frequent first
+		std::vector<std::pair<std::string, size_t>> by(
+		    s.framesFlaggedBy.begin(), s.framesFlaggedBy.end());
+		std::stable_sort(by.begin(), by.end(),
+		                 [](const auto& a, const auto& b)
+		                 { return a.second > b.second; });
+		o << "flagged frames by egomotion flag:";
+		for (size_t k = 0; k < by.size(); ++k)
+			o << (k ? ", " : " ") << by[k].first << " " << by[k].second;
+		o << " (docs/ego.md)\n";
+	}
+	for (const auto& note : s.notes) o << "note: " << note << "\n";
 	if (s.imuRejected || s.scansBadStamp || s.scansOutOfOrder)
 	{
 		std::snprintf(buf, sizeof(buf),

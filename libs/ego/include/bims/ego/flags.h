@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace bims::ego
 {
@@ -50,6 +51,10 @@ enum EgoFlag : uint32_t
 	 * not used. Set by bims-run. */
 	kFlagImuRejected = 1u << 17,
 };
+
+/** The names of the set bits, in bit order ("imu_gap", "too_few_tracks");
+ * the one table of flag names. */
+std::vector<const char*> flagNames(uint32_t flags);
 
 /** "imu_gap|too_few_tracks" style text ("ok" for none). */
 std::string flagsToString(uint32_t flags);

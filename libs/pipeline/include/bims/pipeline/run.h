@@ -36,7 +36,13 @@ struct Percentiles
 struct RunSummary
 {
 	size_t scansRead = 0, framesProcessed = 0, imuRead = 0, otherSkipped = 0;
-	size_t framesFlagged = 0;    ///< frames with an egomotion flag
+	size_t framesFlagged = 0;  ///< frames with an egomotion flag
+	/** Frames per egomotion flag by name (ego::flagNames; first_frame not
+	 * counted). */
+	std::map<std::string, size_t> framesFlaggedBy;
+	/** What the user should know about how the run went, one sentence
+	 * each (e.g. no IMU in the input and the mode it fell back to). */
+	std::vector<std::string> notes;
 	size_t scansOutOfOrder = 0;  ///< dropped: timestamp not increasing
 	/** dropped: timestamp more than kMaxScanGapS after the previous scan's
 	 * and the next scan's not close to it (a stray stamp) */
