@@ -55,6 +55,9 @@ function(bims_add_gtest)
   if(NOT A_TIMEOUT)
     set(A_TIMEOUT 300)
   endif()
+  if(BIMS_SANITIZE)  # the sanitizer suite runs 3-10x slower
+    math(EXPR A_TIMEOUT "${A_TIMEOUT} * 5")
+  endif()
   add_executable(${A_NAME} ${A_SOURCES})
   target_link_libraries(${A_NAME} PRIVATE ${A_DEPS} GTest::gtest GTest::gtest_main)
   target_compile_definitions(${A_NAME} PRIVATE
