@@ -34,7 +34,7 @@ int main(int argc, char** argv)
 		    TCLAP::CmdLine cmd(
 		        "Fits the depth sensor's smooth distortion to a static stretch "
 		        "of a recording and writes a [depth_correction] section.",
-		        ' ', "0.1");
+		        ' ', bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> cfgArg(
 		        "CONFIG", "experiment .ini ([camera], [sensors])", true, "",
 		        "CONFIG.ini", cmd);

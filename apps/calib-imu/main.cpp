@@ -33,7 +33,7 @@ int main(int argc, char** argv)
 		    TCLAP::CmdLine cmd(
 		        "Estimates the IMU-camera rotation R_IC from gyro vs visual "
 		        "inter-frame rotations.",
-		        ' ', "0.1");
+		        ' ', bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> cfgArg(
 		        "CONFIG", "experiment .ini", true, "", "CONFIG.ini", cmd);
 		    TCLAP::UnlabeledValueArg<std::string> inArg(

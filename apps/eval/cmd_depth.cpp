@@ -23,7 +23,7 @@ int cmdDepthConsistency(int argc, char** argv)
 	    "compared "
 	    "with that scan's depth. Prints the median |dz| over all pairs, and "
 	    "the same assuming no motion as a baseline.",
-	    ' ', "0.1");
+	    ' ', bims::version());
 	TCLAP::UnlabeledValueArg<std::string> rawlog(
 	    "RAWLOG", "rawlog with 3D scans", true, "", "IN.rawlog", cmd);
 	TCLAP::UnlabeledValueArg<std::string> gtArg(

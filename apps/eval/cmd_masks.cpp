@@ -77,7 +77,7 @@ int cmdMasks(int argc, char** argv)
 	    "(e.g. a TUM/Bonn folder's depth stamps) pair by time with the run's "
 	    "frames.csv. The last line is 'total precision P recall R F1 F IoU "
 	    "I'.",
-	    ' ', "0.1");
+	    ' ', bims::version());
 	TCLAP::UnlabeledValueArg<std::string> gtArg(
 	    "GT_MASK_DIR", "labels (ground truth)", true, "", "GT_MASK_DIR", cmd);
 	TCLAP::UnlabeledValueArg<std::string> predArg(

@@ -33,7 +33,7 @@ int cmdTraj(int argc, char** argv)
 	    "ATE RMSE (after SE(3) Horn alignment) and RPE (m/s, deg/s) of an "
 	    "estimated TUM trajectory against ground truth, as the TUM RGB-D "
 	    "benchmark tools; writes a PNG plot.",
-	    ' ', "0.1");
+	    ' ', bims::version());
 	TCLAP::UnlabeledValueArg<std::string> gtArg(
 	    "GT", "ground-truth trajectory (TUM format)", true, "", "GT.txt", cmd);
 	TCLAP::UnlabeledValueArg<std::string> estArg(

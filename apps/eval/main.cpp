@@ -29,6 +29,11 @@ int main(int argc, char** argv)
 			    std::printf("%s\n", usage.c_str());
 			    return 0;
 		    }
+		    if (sub == "--version")
+		    {
+			    std::printf("bims-eval version: %s\n", bims::version());
+			    return 0;
+		    }
 		    // The sub-command sees "bims-eval <sub>" as its program name.
 		    std::string prog = std::string("bims-eval ") + sub;
 		    argv[1] = prog.data();

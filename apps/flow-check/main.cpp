@@ -106,7 +106,7 @@ int main(int argc, char** argv)
 	    {
 		    TCLAP::CmdLine cmd(
 		        "bims: flow-label false positives per relative pose source",
-		        ' ', "0.1");
+		        ' ', bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> aCfg(
 		        "config", "experiment .ini", true, "", "CONFIG.ini", cmd);
 		    TCLAP::UnlabeledValueArg<std::string> aIn(

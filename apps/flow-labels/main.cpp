@@ -53,7 +53,7 @@ int main(int argc, char** argv)
 		    TCLAP::CmdLine cmd(
 		        "Optical-flow consistency labels (Diff/notDiff) for one RGB-D "
 		        "pair",
-		        ' ', "0.1");
+		        ' ', bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> aRgb0(
 		        "rgb0", "previous RGB image", true, "", "RGB0.png", cmd);
 		    TCLAP::UnlabeledValueArg<std::string> aRgb1(

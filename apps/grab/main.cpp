@@ -53,7 +53,7 @@ int main(int argc, char** argv)
 	    {
 		    TCLAP::CmdLine cmd(
 		        "bims-grab: grab RGB-D (OpenNI2) + IMU (Xsens) into a rawlog",
-		        ' ', "0.1");
+		        ' ', bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> aCfg(
 		        "config", "grab .ini (config/grab/*.ini)", true, "",
 		        "CONFIG.ini", cmd);

@@ -63,7 +63,7 @@ int main(int argc, char** argv)
 		        "accelerometer.txt, groundtruth.txt) into a rawlog of "
 		        "registered "
 		        "RGB-D frames plus ground truth in OUT_gt/.",
-		        ' ', "0.1");
+		        ' ', bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> folder(
 		        "FOLDER", "TUM RGB-D folder", true, "", "FOLDER", cmd);
 		    TCLAP::ValueArg<std::string> out(

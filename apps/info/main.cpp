@@ -13,7 +13,8 @@ int main(int argc, char** argv)
 	    "bims-info",
 	    [&]()
 	    {
-		    TCLAP::CmdLine cmd("Summary of an MRPT rawlog.", ' ', "0.1");
+		    TCLAP::CmdLine cmd("Summary of an MRPT rawlog.", ' ',
+		                       bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> in(
 		        "rawlog", "Input rawlog", true, "", "IN.rawlog", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);

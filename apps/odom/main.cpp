@@ -46,7 +46,7 @@ int main(int argc, char** argv)
 		        "Egomotion (IMU attitude + gyro-aided KLT + robust "
 		        "translation) "
 		        "of an RGB-D(+IMU) rawlog; TUM trajectory output.",
-		        ' ', "0.1");
+		        ' ', bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> cfgArg(
 		        "CONFIG", "experiment .ini", true, "", "CONFIG.ini", cmd);
 		    TCLAP::UnlabeledValueArg<std::string> inArg(

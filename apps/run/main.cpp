@@ -25,7 +25,7 @@ int main(int argc, char** argv)
 		    TCLAP::CmdLine cmd(
 		        "bims: Bayesian independent motion segmentation of RGB-D + IMU "
 		        "rawlogs",
-		        ' ', "0.1");
+		        ' ', bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> aCfg(
 		        "config", "experiment .ini (config/default.ini)", true, "",
 		        "CONFIG.ini", cmd);

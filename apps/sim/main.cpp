@@ -64,7 +64,7 @@ int main(int argc, char** argv)
 		    TCLAP::CmdLine cmd(
 		        "Synthetic RGB-D + IMU sequences with ground truth (rawlog + "
 		        "OUT_gt/).",
-		        ' ', "0.1");
+		        ' ', bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> scene(
 		        "scene", "Scene .ini (see config/sim/)", false, "", "SCENE.ini",
 		        cmd);

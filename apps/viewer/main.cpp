@@ -51,7 +51,7 @@ int main(int argc, char** argv)
 		        "segmentation (3D view: cloud, tier 0 blue, tier 1 yellow, "
 		        "tier 2 red, trajectories; 2D panels: RGB + mask, depth, "
 		        "observed/expected flow, Diff labels)",
-		        ' ', "0.1");
+		        ' ', bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> aIn(
 		        "rawlog", "input rawlog (optional: File > Open)", false, "",
 		        "IN.rawlog", cmd);

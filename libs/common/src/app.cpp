@@ -104,6 +104,11 @@ void checkOptionNames(int argc, char** argv,
 	}
 }
 
+const char* version()
+{
+	return BIMS_VERSION;
+}
+
 int runApp(const std::string& program, const std::function<int()>& body)
 {
 	try

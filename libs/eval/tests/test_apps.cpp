@@ -1,4 +1,5 @@
 // End-to-end tests of bims-import-tum and bims-eval (run the built programs).
+#include <bims/common/app.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/eval/tum_import.h>
@@ -435,8 +436,14 @@ TEST(Apps, HelpExitsCleanlyAndBadOptionsAreUsageErrors)
 	for (const std::string app :
 	     {"bims-run", "bims-odom", "bims-sim", "bims-import-tum",
 	      "bims-flow-check", "bims-flow-labels", "bims-calib-imu",
+	      "bims-calib-depth", "bims-info", "bims-maps-figure", "bims-grab",
 	      "bims-eval masks", "bims-eval traj", "bims-eval depth-consistency"})
 	{
+		if (!fs::exists(kBin + "/" + app.substr(0, app.find(' '))))
+			continue;  // bims-grab without OpenNI2
+		const ::Run v = run(kBin + "/" + app + " --version");
+		EXPECT_EQ(v.code, 0) << app << "\n" << v.out;
+		EXPECT_NE(v.out.find(bims::version()), std::string::npos) << app;
 		const ::Run h = run(kBin + "/" + app + " --help");
 		EXPECT_EQ(h.code, 0) << app << "\n" << h.out;
 		EXPECT_NE(h.out.find("USAGE"), std::string::npos) << app;
@@ -449,6 +456,9 @@ TEST(Apps, HelpExitsCleanlyAndBadOptionsAreUsageErrors)
 		    << app << "\n"
 		    << b.out;
 	}
+	const ::Run v = run(kBin + "/bims-eval --version");
+	EXPECT_EQ(v.code, 0) << v.out;
+	EXPECT_NE(v.out.find(bims::version()), std::string::npos) << v.out;
 }
 
 TEST(Apps, AMistypedOptionIsAnErrorBeforeAnyWork)

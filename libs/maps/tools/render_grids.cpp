@@ -4,15 +4,17 @@
 // the flow labels (Diff on the mask, notDiff elsewhere): a picture of the
 // grids, not of the flow module.
 //
-//   bims-maps-figure RAWLOG GT_DIR OUT.png [--frames N] [--voxel M]
+//   bims-maps-figure RAWLOG GT_DIR OUT.png [--max-frames N] [--voxel M]
 #include <bims/common/app.h>
 #include <bims/common/frame_files.h>
 #include <bims/common/frames.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/maps/export.h>
 #include <bims/maps/motion_grids.h>
 
+#include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/opengl/CFBORender.h>
@@ -31,31 +33,40 @@ int main(int argc, char** argv)
 	    "bims-maps-figure",
 	    [&]
 	    {
-		    if (argc < 4)
-			    throw bims::UsageError(
-			        "usage: bims-maps-figure RAWLOG GT_DIR OUT.png [--frames "
-			        "N] "
-			        "[--voxel M]");
-		    int frames = 60;
-		    double voxel = 0.05;
-		    for (int i = 4; i + 1 < argc; i += 2)
-		    {
-			    const std::string a = argv[i];
-			    if (a == "--frames")
-				    frames = std::stoi(argv[i + 1]);
-			    else if (a == "--voxel")
-				    voxel = std::stod(argv[i + 1]);
-			    else
-				    throw bims::UsageError("unknown option " + a);
-		    }
-		    const std::string gt = argv[2];
+		    TCLAP::CmdLine cmd(
+		        "Runs the three grids over a rawlog with ground-truth poses "
+		        "and "
+		        "masks (bims-sim's OUT_gt/) and renders the paper's Fig. 4 "
+		        "colouring to a PNG.",
+		        ' ', bims::version());
+		    TCLAP::UnlabeledValueArg<std::string> aIn(
+		        "rawlog", "Input rawlog", true, "", "IN.rawlog", cmd);
+		    TCLAP::UnlabeledValueArg<std::string> aGt(
+		        "gt", "Ground-truth folder (groundtruth.txt, masks/)", true, "",
+		        "GT_DIR", cmd);
+		    TCLAP::UnlabeledValueArg<std::string> aOut(
+		        "out", "Output PNG", true, "", "OUT.png", cmd);
+		    TCLAP::ValueArg<int> aFrames("", "max-frames",
+		                                 "Frames to integrate (default 60)",
+		                                 false, 60, "N", cmd);
+		    TCLAP::ValueArg<double> aVoxel("", "voxel",
+		                                   "Voxel size [m] (default 0.05)",
+		                                   false, 0.05, "M", cmd);
+		    bims::parseCommandLine(cmd, argc, argv);
+		    const int frames = aFrames.getValue();
+		    const double voxel = aVoxel.getValue();
+		    if (frames < 1) throw bims::UsageError("--max-frames must be >= 1");
+		    if (!(voxel > 0)) throw bims::UsageError("--voxel must be > 0");
+		    bims::checkOutputsSpareInputs({aIn.getValue(), aGt.getValue()},
+		                                  {aOut.getValue()});
+		    const std::string gt = aGt.getValue();
 		    const auto traj = bims::loadTumTrajectory(gt + "/groundtruth.txt");
 		    bims::maps::GridParams p;
 		    p.voxel_size = voxel;
 		    p.decay = bims::maps::DecayMode::Raycast;
 		    p.raycast_target = bims::maps::RayTarget::Voxels;
 		    bims::maps::MotionGrids grids(p);
-		    bims::RawlogReader r(argv[1]);
+		    bims::RawlogReader r(aIn.getValue());
 		    int k = 0;
 		    while (auto obs = r.next())
 		    {
@@ -127,11 +138,11 @@ int main(int argc, char** argv)
 		    cam.setElevationDegrees(25);
 		    mrpt::img::CImage img;
 		    fbo.render_RGB(scene, img);
-		    img.saveToFile(argv[3]);
+		    img.saveToFile(aOut.getValue());
 		    std::cout << k << " frames; " << grids.occupancy()->asString()
 		              << "\n"
-		              << grids.flow()->asString() << "\nwrote " << argv[3]
-		              << "\n";
+		              << grids.flow()->asString() << "\nwrote "
+		              << aOut.getValue() << "\n";
 		    return 0;
 	    });
 }

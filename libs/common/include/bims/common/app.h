@@ -15,6 +15,9 @@ namespace bims
  * main() decides to exit. */
 int runApp(const std::string& program, const std::function<int()>& body);
 
+/** bims's version (the CMake project's), for every program's --version. */
+const char* version();
+
 /** Thrown for wrong command-line usage (exit code 2). */
 struct UsageError : std::runtime_error
 {
