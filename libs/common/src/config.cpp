@@ -257,6 +257,34 @@ std::vector<double> ConfigSection::getDoubles(const std::string& key,
 	return out;
 }
 
+std::vector<std::string> ConfigSection::getWords(const std::string& key)
+{
+	std::istringstream ss(getString(key, ""));
+	std::vector<std::string> out;
+	for (std::string w; ss >> w;) out.push_back(w);
+	return out;
+}
+
+std::vector<std::string> ConfigSection::getList(const std::string& key)
+{
+	if (!has(key))
+	{
+		allow(key);
+		return {};
+	}
+	const std::string v = getString(key, "");
+	std::vector<std::string> out;
+	for (size_t b = 0;;)
+	{
+		const size_t e = v.find(',', b);
+		out.push_back(trim(v.substr(b, e == std::string::npos ? e : e - b)));
+		if (out.back().empty())
+			fail(key, "'" + v + "': an empty item in the comma-separated list");
+		if (e == std::string::npos) return out;
+		b = e + 1;
+	}
+}
+
 void ConfigSection::finish() const
 {
 	if (!exists_) return;

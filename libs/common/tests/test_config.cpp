@@ -44,6 +44,26 @@ TEST(ConfigSection, ReadsTypedValuesAndDefaults)
 	EXPECT_NO_THROW(s.finish());
 }
 
+TEST(ConfigSection, ListsOfWordsAndOfCommaSeparatedItems)
+{
+	mrpt::config::CConfigFileMemory cfg(
+	    "[a]\nfiles =  x.ini\ty.ini  z.ini\nvalues = fused , flow-only,0.5\n"
+	    "gap = a,,b\nend = a, b,\nblank =\n");
+	ConfigSection s(cfg, "a");
+	EXPECT_EQ(s.getWords("files"),
+	          (std::vector<std::string>{"x.ini", "y.ini", "z.ini"}));
+	EXPECT_EQ(s.getList("values"),
+	          (std::vector<std::string>{"fused", "flow-only", "0.5"}));
+	EXPECT_TRUE(s.getWords("absent").empty());
+	EXPECT_TRUE(s.getList("absent2").empty());
+	for (const char* k : {"gap", "end", "blank"})
+		EXPECT_NE(errorOf([&] { s.getList(k); })
+		              .find(std::string("[a] ") + k + ": '"),
+		          std::string::npos)
+		    << k;
+	EXPECT_NO_THROW(s.finish());
+}
+
 TEST(ConfigSection, UnknownKeyIsAnErrorNamingSectionAndKey)
 {
 	mrpt::config::CConfigFileMemory cfg("[a]\nx = 1\nxx = 2\n");

@@ -117,6 +117,193 @@ cv::Mat plotTrajectories(const Trajectory& gt, const Trajectory& estAligned,
 	return img;
 }
 
+namespace
+{
+const cv::Scalar kGridColour(225, 225, 225), kMissingColour(0, 0, 200);
+const int kFont = cv::FONT_HERSHEY_SIMPLEX;
+
+/** Series colours (BGR), as the usual categorical palettes. */
+cv::Scalar seriesColour(size_t i)
+{
+	static const cv::Scalar c[] = {
+	    {180, 119, 31},  {14, 127, 255}, {44, 160, 44},   {40, 39, 214},
+	    {189, 103, 148}, {75, 86, 140},  {194, 119, 227}, {127, 127, 127},
+	    {34, 189, 188},  {207, 190, 23}};
+	return c[i % (sizeof(c) / sizeof(c[0]))];
+}
+
+int textWidth(const std::string& t, double scale)
+{
+	int base = 0;
+	return cv::getTextSize(t, kFont, scale, 1, &base).width;
+}
+
+std::vector<std::string> lines(const std::string& text)
+{
+	std::vector<std::string> out;
+	size_t b = 0;
+	for (size_t e; (e = text.find('\n', b)) != std::string::npos; b = e + 1)
+		out.push_back(text.substr(b, e - b));
+	out.push_back(text.substr(b));
+	return out;
+}
+
+void putLabel(cv::Mat& img, const std::string& t, cv::Point at, double scale)
+{
+	cv::putText(img, t, at, kFont, scale, kTextColour, 1, cv::LINE_AA);
+}
+}  // namespace
+
+cv::Mat plotGroupedBars(const GroupedBars& c)
+{
+	const size_t nG = c.groups.size(), nS = c.series.size();
+	if (c.values.size() != nG)
+		throw std::invalid_argument("plotGroupedBars: one row per group");
+	for (const auto& row : c.values)
+		if (row.size() != nS)
+			throw std::invalid_argument(
+			    "plotGroupedBars: one value per series in each group");
+	const double labelScale = 0.45, valueScale = 0.38;
+	const int barMin = 28, barMax = 64, groupGap = 24, left = 96, right = 30;
+	const int height = 640, minWidth = 1024;
+
+	// Group widths: the bars or the longest label line, whichever is wider.
+	std::vector<int> natural(nG);
+	size_t labelLines = 1;
+	for (size_t g = 0; g < nG; g++)
+	{
+		int w = static_cast<int>(std::max<size_t>(nS, 1)) * barMin;
+		const auto ls = lines(c.groups[g]);
+		labelLines = std::max(labelLines, ls.size());
+		for (const auto& l : ls) w = std::max(w, textWidth(l, labelScale));
+		natural[g] = w + groupGap;
+	}
+	int sum = 0;
+	for (int w : natural) sum += w;
+	const int width = std::max(minWidth, left + right + sum);
+	const double stretch =
+	    sum > 0 ? static_cast<double>(width - left - right) / sum : 1.0;
+	int barW = barMax;
+	for (size_t g = 0; g < nG; g++)
+		barW =
+		    std::min(barW, static_cast<int>((natural[g] * stretch - groupGap) /
+		                                    std::max<size_t>(nS, 1)));
+
+	cv::Mat img(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
+	putLabel(img, c.title, {12, 28}, 0.65);
+
+	// Legend: a row of swatches under the title, wrapped.
+	bool anyMissing = false;
+	for (const auto& row : c.values)
+		for (double v : row) anyMissing |= !std::isfinite(v);
+	int lx = left, ly = 52;
+	auto legendRoom = [&](const std::string& t)
+	{
+		const int w = 22 + textWidth(t, labelScale) + 20;
+		if (lx + w > width - right && lx > left) lx = left, ly += 22;
+		return w;
+	};
+	for (size_t s = 0; s < nS; s++)
+	{
+		const int w = legendRoom(c.series[s]);
+		cv::rectangle(img, {lx, ly - 12}, {lx + 14, ly + 2}, seriesColour(s),
+		              cv::FILLED);
+		putLabel(img, c.series[s], {lx + 22, ly}, labelScale);
+		lx += w;
+	}
+	if (anyMissing)
+	{
+		const std::string& t = c.missingLabel;
+		const int w = legendRoom(t);
+		cv::line(img, {lx + 1, ly - 11}, {lx + 13, ly + 1}, kMissingColour, 2);
+		cv::line(img, {lx + 1, ly + 1}, {lx + 13, ly - 11}, kMissingColour, 2);
+		putLabel(img, t, {lx + 22, ly}, labelScale);
+		lx += w;
+	}
+
+	// Plot area and value scale.
+	const int top = ly + 30;
+	const int bottom = height - 16 - 18 * static_cast<int>(labelLines) - 36;
+	double lo = 0, hi = 0;
+	for (const auto& row : c.values)
+		for (double v : row)
+			if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+	if (!(hi > lo)) hi = lo + 1;
+	const double step = niceLength((hi - lo) / 5);
+	lo = std::floor(lo / step) * step;
+	hi = std::ceil(hi * 1.06 / step) * step;  // room for the value labels
+	auto py = [&](double v)
+	{
+		return static_cast<int>(
+		    std::lround(bottom - (v - lo) / (hi - lo) * (bottom - top)));
+	};
+	char txt[64];
+	for (double t = lo; t <= hi + 0.5 * step; t += step)
+	{
+		const int y = py(t);
+		cv::line(img, {left, y}, {width - right, y}, kGridColour, 1);
+		std::snprintf(txt, sizeof(txt), "%g", std::abs(t) < 1e-12 ? 0.0 : t);
+		putLabel(img, txt, {left - 8 - textWidth(txt, labelScale), y + 5},
+		         labelScale);
+	}
+	cv::line(img, {left, top}, {left, bottom}, kTextColour, 1);
+	cv::line(img, {left, py(0)}, {width - right, py(0)}, kTextColour, 1);
+
+	// The vertical axis' name, turned by 90 degrees.
+	{
+		const int tw = textWidth(c.yLabel, 0.5) + 8;
+		cv::Mat t(24, tw, CV_8UC3, cv::Scalar(255, 255, 255));
+		cv::putText(t, c.yLabel, {4, 17}, kFont, 0.5, kTextColour, 1,
+		            cv::LINE_AA);
+		cv::rotate(t, t, cv::ROTATE_90_COUNTERCLOCKWISE);
+		const int y0 = std::max(0, (top + bottom) / 2 - t.rows / 2);
+		const int h = std::min(t.rows, height - y0);
+		t(cv::Rect(0, 0, t.cols, h)).copyTo(img(cv::Rect(8, y0, t.cols, h)));
+	}
+
+	// Bars, values, group labels.
+	double x = left;
+	for (size_t g = 0; g < nG; g++)
+	{
+		const double gw = natural[g] * stretch;
+		const int cx = static_cast<int>(std::lround(x + gw / 2));
+		const int x0 = cx - static_cast<int>(nS) * barW / 2;
+		for (size_t s = 0; s < nS; s++)
+		{
+			const int bx = x0 + static_cast<int>(s) * barW;
+			const double v = c.values[g][s];
+			if (!std::isfinite(v))
+			{
+				const int mx = bx + barW / 2, my = py(0) - 8;
+				cv::line(img, {mx - 6, my - 6}, {mx + 6, my + 6},
+				         kMissingColour, 2);
+				cv::line(img, {mx - 6, my + 6}, {mx + 6, my - 6},
+				         kMissingColour, 2);
+				continue;
+			}
+			cv::rectangle(img, {bx + 2, py(v)}, {bx + barW - 2, py(0)},
+			              seriesColour(s), cv::FILLED);
+			std::snprintf(txt, sizeof(txt), "%.3g", v);
+			putLabel(img, txt,
+			         {bx + barW / 2 - textWidth(txt, valueScale) / 2,
+			          py(std::max(v, 0.0)) - 5},
+			         valueScale);
+		}
+		const auto ls = lines(c.groups[g]);
+		for (size_t i = 0; i < ls.size(); i++)
+			putLabel(img, ls[i],
+			         {cx - textWidth(ls[i], labelScale) / 2,
+			          bottom + 20 + 18 * static_cast<int>(i)},
+			         labelScale);
+		x += gw;
+	}
+	putLabel(img, c.xLabel,
+	         {left + (width - left - right) / 2 - textWidth(c.xLabel, 0.5) / 2,
+	          height - 14},
+	         0.5);
+	return img;
+}
+
 cv::Mat imageStrip(const std::vector<cv::Mat>& images, double scale)
 {
 	if (images.empty()) throw std::invalid_argument("a strip of no image");

@@ -68,6 +68,14 @@ class ConfigSection
 	                               const std::vector<double>& def, size_t n,
 	                               double min, double max);
 
+	/** The value's words (separated by spaces or tabs), e.g. a list of
+	 * files; empty if absent. */
+	std::vector<std::string> getWords(const std::string& key);
+	/** The value's comma-separated items, each trimmed, e.g. "fused,
+	 * flow-only"; empty if absent. An empty item (",,", a comma at either
+	 * end, or an empty value) is an error naming the key. */
+	std::vector<std::string> getList(const std::string& key);
+
 	/** Marks a key as known without reading it (e.g. read by MRPT code). */
 	void allow(const std::string& key);
 

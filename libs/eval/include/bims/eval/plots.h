@@ -23,6 +23,31 @@ cv::Mat plotTrajectories(const Trajectory& gt, const Trajectory& estAligned,
  * std::invalid_argument otherwise or when there is none. */
 cv::Mat imageStrip(const std::vector<cv::Mat>& images, double scale);
 
+/** Values drawn as bars in groups: one group per category along the
+ * horizontal axis, one bar per series in each group (a colour each, named in
+ * the legend). */
+struct GroupedBars
+{
+	std::string title;
+	std::string yLabel;  ///< the vertical axis (the values' name and unit)
+	std::string xLabel;  ///< what the groups are
+	/** One label per group; '\n' breaks it into lines under the group. */
+	std::vector<std::string> groups;
+	std::vector<std::string> series;  ///< legend entries
+	/** values[group][series]; NaN: no value (drawn as a red x on the axis,
+	 * explained in the legend by missingLabel). */
+	std::vector<std::vector<double>> values;
+	std::string missingLabel = "no value";
+};
+
+/** Bar chart of \a c: white background, y axis from 0 (or the lowest
+ * value, when negative) with ticks at 1, 2 or 5 times a power of ten, the
+ * value above each bar, the group labels under the axis, legend top right.
+ * 1024 x 640 pixels, wider (never narrower) when the groups and their
+ * labels need more room. Throws std::invalid_argument when values does not
+ * hold one row per group and one value per series. */
+cv::Mat plotGroupedBars(const GroupedBars& c);
+
 /** Writes an image; throws std::runtime_error naming the file on failure. */
 void writePng(const std::string& path, const cv::Mat& img);
 

@@ -1,0 +1,34 @@
+// bims-sweep (docs/sweep.md): a set of bims-run experiments, configs x
+// [grid] overrides x rawlogs, run a few at a time or written as a jobs file,
+// gathered into one table and a plot.
+#pragma once
+
+#include <atomic>
+#include <string>
+
+namespace bims::sweep
+{
+struct SweepOptions
+{
+	std::string sweepFile;  ///< SWEEP.ini ("" with collect)
+	std::string outDir;     ///< -o OUTDIR
+	/** Runs at once; 0 = one per core. */
+	int jobs = 1;
+	std::string jobsFile;  ///< write the jobs there instead of running them
+	bool dryRun = false;   ///< check and print the runs; write nothing
+	bool quiet = false;    ///< no line per finished run
+	std::string plotMetric = "fps";
+	/** Gather the results of OUTDIR (runs done elsewhere) instead. */
+	std::string collect;
+	/** SIGINT/SIGTERM (bims::installStopSignals): launch no more runs, pass
+	 * the signal on to the running ones. */
+	const std::atomic<bool>* stop = nullptr;
+};
+
+/** The whole program; returns its exit code: 0 when every run is ok, 1
+ * when one is not (a summary names them), 128 + the signal when stopped.
+ * Throws UsageError for options that do not fit together, ConfigError
+ * for a bad SWEEP.ini or config, before any run starts. */
+int runSweep(const SweepOptions& opt);
+
+}  // namespace bims::sweep

@@ -1,0 +1,337 @@
+#include <bims/common/json.h>
+#include <bims/common/output_paths.h>
+#include <bims/eval/plots.h>
+#include <bims/sweep/results.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+namespace fs = std::filesystem;
+
+namespace bims::sweep
+{
+namespace
+{
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/** The numbers of \a j by path: objects descended, arrays left out. */
+void flatten(const Json& j, const std::string& path,
+             std::vector<std::pair<std::string, double>>& out)
+{
+	if (j.is_object())
+		for (const auto& [k, v] : j.items())
+			flatten(v, path.empty() ? k : path + "." + k, out);
+	else if (j.is_number())
+		out.emplace_back(path, j.get<double>());
+	else if (j.is_null() && !path.empty())
+		out.emplace_back(path, kNaN);
+}
+
+Json readJson(const std::string& path)
+{
+	std::ifstream f(path);
+	if (!f) throw std::runtime_error(path + ": cannot open");
+	try
+	{
+		return Json::parse(f);
+	}
+	catch (const std::exception& e)
+	{
+		throw std::runtime_error(path + ": not JSON: " + e.what());
+	}
+}
+
+/** "" for NaN; whole numbers without decimals; else \a digits significant
+ * digits. */
+std::string number(double v, int digits)
+{
+	if (!std::isfinite(v)) return "";
+	char b[64];
+	if (v == std::round(v) && std::abs(v) < 1e15)
+		std::snprintf(b, sizeof(b), "%.0f", v);
+	else
+		std::snprintf(b, sizeof(b), "%.*g", digits, v);
+	return b;
+}
+
+std::string csvCell(const std::string& s)
+{
+	if (s.find_first_of(",\"\r\n") == std::string::npos &&
+	    (s.empty() || (s.front() != ' ' && s.back() != ' ')))
+		return s;
+	std::string q = "\"";
+	for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+	return q + "\"";
+}
+
+std::string mdCell(const std::string& s)
+{
+	std::string out;
+	for (char c : s)
+		out += c == '|' ? std::string("\\|")
+		                : std::string(1, c == '\n' || c == '\r' ? ' ' : c);
+	return out;
+}
+
+bool isScore(const std::string& name)
+{
+	const std::string leaf = name.substr(name.rfind('.') + 1);
+	return leaf == "rmse" || leaf == "f1" || leaf == "iou" ||
+	       leaf == "precision" || leaf == "recall";
+}
+
+/** A readable name for the plot's vertical axis. */
+std::string axisName(const std::string& metric)
+{
+	static const std::map<std::string, std::string> known = {
+	    {"fps", "fps: frames/s end to end"},
+	    {"wall_seconds", "wall_seconds: s per run"},
+	    {"cpu_seconds", "cpu_seconds: CPU s per run"},
+	    {"peak_resident_mib", "peak_resident_mib: MiB"}};
+	const auto it = known.find(metric);
+	if (it != known.end()) return it->second;
+	return metric.rfind("stage_ms.", 0) == 0 ? metric + " (ms per frame)"
+	                                         : metric;
+}
+}  // namespace
+
+double RunResult::metric(const std::string& name) const
+{
+	for (const auto& [k, v] : metrics)
+		if (k == name) return v;
+	return kNaN;
+}
+
+RunResult collectRun(const RunSpec& run, const std::string& outDir,
+                     const JobOutcome* outcome)
+{
+	RunResult r;
+	r.run = run;
+	r.run.configText.clear();
+	if (outcome && outcome->started)
+	{
+		r.exitCode = outcome->exitCode;
+		r.seconds = outcome->seconds;
+	}
+	const std::string dir = runDir(outDir, run.id);
+	const std::string mpath = runOutDir(outDir, run.id) + "/metrics.json";
+	std::error_code ec;
+	if (!fs::exists(mpath, ec))
+	{
+		r.status = !outcome           ? "missing"
+		           : outcome->started ? "failed"
+		                              : "not run";
+		if (outcome && outcome->started)
+			r.error = "no metrics.json (exit code " +
+			          std::to_string(outcome->exitCode) + "; see " + dir +
+			          "/log.txt)";
+		return r;
+	}
+	try
+	{
+		const Json m = readJson(mpath);
+		r.status = m.value("status", std::string("?"));
+		r.error = m.value("error", std::string());
+		flatten(m, "", r.metrics);
+	}
+	catch (const std::exception& e)
+	{
+		r.status = "failed";
+		r.error = e.what();
+		return r;
+	}
+	std::vector<fs::path> more;
+	for (const auto& e : fs::directory_iterator(dir, ec))
+		if (e.path().extension() == ".json" && e.is_regular_file(ec))
+			more.push_back(e.path());
+	std::sort(more.begin(), more.end());
+	for (const auto& p : more)
+	{
+		try
+		{
+			flatten(readJson(p.string()), p.stem().string(), r.metrics);
+		}
+		catch (const std::exception& e)
+		{
+			r.error += (r.error.empty() ? "" : "; ") + std::string(e.what());
+		}
+	}
+	return r;
+}
+
+std::vector<std::string> ResultTable::metricNames() const
+{
+	std::vector<std::string> names;
+	std::set<std::string> seen;
+	for (const auto& r : rows)
+		for (const auto& [k, v] : r.metrics)
+			if (seen.insert(k).second) names.push_back(k);
+	return names;
+}
+
+size_t ResultTable::failures() const
+{
+	size_t n = 0;
+	for (const auto& r : rows) n += !r.ok();
+	return n;
+}
+
+std::string csvText(const ResultTable& t)
+{
+	const auto metrics = t.metricNames();
+	std::vector<std::string> head = {"id", "config", "rawlog"};
+	head.insert(head.end(), t.plan.gridKeys.begin(), t.plan.gridKeys.end());
+	head.insert(head.end(), {"status", "exit_code", "run_seconds"});
+	head.insert(head.end(), metrics.begin(), metrics.end());
+	head.push_back("error");
+	std::string out;
+	auto line = [&](const std::vector<std::string>& cells)
+	{
+		for (size_t i = 0; i < cells.size(); i++)
+			out += (i ? "," : "") + csvCell(cells[i]);
+		out += "\n";
+	};
+	line(head);
+	for (const auto& r : t.rows)
+	{
+		std::vector<std::string> c = {r.run.id, r.run.config.written,
+		                              r.run.rawlog.written};
+		for (const auto& [k, v] : r.run.overrides) c.push_back(v);
+		c.push_back(r.status);
+		c.push_back(r.exitCode ? std::to_string(*r.exitCode) : "");
+		c.push_back(r.seconds ? number(*r.seconds, 4) : "");
+		for (const auto& m : metrics) c.push_back(number(r.metric(m), 9));
+		c.push_back(r.error);
+		line(c);
+	}
+	return out;
+}
+
+std::string markdownText(const ResultTable& t, const std::string& plotMetric)
+{
+	std::vector<std::string> metrics;
+	const auto all = t.metricNames();
+	auto add = [&](const std::string& m)
+	{
+		if (std::find(all.begin(), all.end(), m) != all.end() &&
+		    std::find(metrics.begin(), metrics.end(), m) == metrics.end())
+			metrics.push_back(m);
+	};
+	for (const char* m :
+	     {"frames_processed", "fps", "wall_seconds", "cpu_seconds",
+	      "peak_resident_mib", "stage_ms.total.median"})
+		add(m);
+	add(plotMetric);
+	for (const auto& m : all)
+		if (isScore(m)) add(m);
+
+	std::string out = "# Sweep " + mdCell(t.plan.name) + "\n\n";
+	out += std::to_string(t.rows.size()) + " runs, " +
+	       std::to_string(t.rows.size() - t.failures()) + " ok, " +
+	       std::to_string(t.failures()) + " not (from " +
+	       mdCell(t.plan.sweepFile) +
+	       (t.plan.frames.empty() ? "" : ", frames " + t.plan.frames) +
+	       "). Every column in results.csv, " + mdCell(plotMetric) +
+	       " per run in results.png.\n\n";
+	std::vector<std::string> head = {"id", "config", "rawlog"};
+	head.insert(head.end(), t.plan.gridKeys.begin(), t.plan.gridKeys.end());
+	head.insert(head.end(), {"status", "exit", "s"});
+	head.insert(head.end(), metrics.begin(), metrics.end());
+	std::string rule;
+	for (const auto& h : head)
+	{
+		out += "| " + mdCell(h) + " ";
+		rule += "|---";
+	}
+	out += "|\n" + rule + "|\n";
+	for (const auto& r : t.rows)
+	{
+		std::vector<std::string> c = {r.run.id, r.run.config.written,
+		                              r.run.rawlog.written};
+		for (const auto& [k, v] : r.run.overrides) c.push_back(v);
+		c.push_back(r.status);
+		c.push_back(r.exitCode ? std::to_string(*r.exitCode) : "");
+		c.push_back(r.seconds ? number(*r.seconds, 3) : "");
+		for (const auto& m : metrics) c.push_back(number(r.metric(m), 4));
+		for (const auto& x : c) out += "| " + mdCell(x) + " ";
+		out += "|\n";
+	}
+	if (t.failures())
+	{
+		out += "\n## Runs not ok\n\n";
+		for (const auto& r : t.rows)
+			if (!r.ok())
+				out += "- " + mdCell(r.run.id) + ": " + r.status +
+				       (r.exitCode ? ", exit " + std::to_string(*r.exitCode)
+				                   : "") +
+				       (r.error.empty() ? "" : ": " + mdCell(r.error)) + "\n";
+	}
+	return out;
+}
+
+cv::Mat plotResults(const ResultTable& t, const std::string& metric)
+{
+	const auto all = t.metricNames();
+	if (!all.empty() && std::find(all.begin(), all.end(), metric) == all.end())
+	{
+		std::string list;
+		for (const auto& m : all)
+			if (m.find("stage_ms.") != 0 ||
+			    m.find(".median") != std::string::npos)
+				list += (list.empty() ? "" : ", ") + m;
+		throw std::invalid_argument("no run has the metric '" + metric +
+		                            "' (some there are: " + list + ")");
+	}
+	eval::GroupedBars c;
+	c.title = t.plan.name + ": " + metric + " per run";
+	c.yLabel = axisName(metric);
+	c.xLabel =
+	    t.plan.gridKeys.empty() ? "(no [grid] overrides)" : "[grid] overrides";
+	c.missingLabel = "no value (run not ok)";
+	const auto shortKeys = shortGridKeys(t.plan.gridKeys);
+	std::set<std::string> configs, rawlogs;
+	for (const auto& r : t.rows)
+	{
+		configs.insert(r.run.config.written);
+		rawlogs.insert(r.run.rawlog.written);
+	}
+	// each row's group (its grid values) and series (config, rawlog)
+	std::map<std::string, size_t> group, series;
+	std::vector<std::pair<size_t, size_t>> cell;
+	for (const auto& r : t.rows)
+	{
+		std::string g;
+		for (size_t i = 0; i < r.run.overrides.size(); i++)
+			g += (i ? "\n" : "") + shortKeys[i] + "=" +
+			     r.run.overrides[i].second;
+		std::string s = configs.size() > 1 ? r.run.config.written : "";
+		if (rawlogs.size() > 1 || s.empty())
+			s += (s.empty() ? "" : ", ") + r.run.rawlog.written;
+		if (group.emplace(g, c.groups.size()).second) c.groups.push_back(g);
+		if (series.emplace(s, c.series.size()).second) c.series.push_back(s);
+		cell.emplace_back(group[g], series[s]);
+	}
+	c.values.assign(c.groups.size(),
+	                std::vector<double>(c.series.size(), kNaN));
+	for (size_t i = 0; i < t.rows.size(); i++)
+		if (t.rows[i].ok())
+			c.values[cell[i].first][cell[i].second] = t.rows[i].metric(metric);
+	return eval::plotGroupedBars(c);
+}
+
+void writeResults(const ResultTable& t, const std::string& outDir,
+                  const std::string& plotMetric)
+{
+	writeFileAtomically(outDir + "/results.csv", csvText(t));
+	writeFileAtomically(outDir + "/results.md", markdownText(t, plotMetric));
+	writeImageFile(outDir + "/results.png", plotResults(t, plotMetric));
+}
+
+}  // namespace bims::sweep
