@@ -16,7 +16,7 @@ int main(int argc, char** argv)
 	    {
 		    TCLAP::CmdLine cmd(
 		        "bims: run a sweep of bims-run experiments (docs/sweep.md)",
-		        ' ', "0.1");
+		        ' ', bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> aSweep(
 		        "sweep", "sweep description (config/sweep_example.ini)", false,
 		        "", "SWEEP.ini", cmd);

@@ -437,7 +437,8 @@ TEST(Apps, HelpExitsCleanlyAndBadOptionsAreUsageErrors)
 	     {"bims-run", "bims-odom", "bims-sim", "bims-import-tum",
 	      "bims-flow-check", "bims-flow-labels", "bims-calib-imu",
 	      "bims-calib-depth", "bims-info", "bims-maps-figure", "bims-grab",
-	      "bims-eval masks", "bims-eval traj", "bims-eval depth-consistency"})
+	      "bims-sweep", "bims-eval masks", "bims-eval traj",
+	      "bims-eval depth-consistency"})
 	{
 		if (!fs::exists(kBin + "/" + app.substr(0, app.find(' '))))
 			continue;  // bims-grab without OpenNI2
