@@ -183,6 +183,26 @@ size_t ResultTable::failures() const
 	return n;
 }
 
+namespace
+{
+/** One run's cells of the results table: id, config, rawlog, the override
+ * values, status, exit code, seconds and \a metrics (with these digits). */
+std::vector<std::string> rowCells(const RunResult& r,
+                                  const std::vector<std::string>& metrics,
+                                  int secondsDigits, int metricDigits)
+{
+	std::vector<std::string> c = {r.run.id, r.run.config.written,
+	                              r.run.rawlog.written};
+	for (const auto& [k, v] : r.run.overrides) c.push_back(v);
+	c.push_back(r.status);
+	c.push_back(r.exitCode ? std::to_string(*r.exitCode) : "");
+	c.push_back(r.seconds ? number(*r.seconds, secondsDigits) : "");
+	for (const auto& m : metrics)
+		c.push_back(number(r.metric(m), metricDigits));
+	return c;
+}
+}  // namespace
+
 std::string csvText(const ResultTable& t)
 {
 	const auto metrics = t.metricNames();
@@ -201,13 +221,7 @@ std::string csvText(const ResultTable& t)
 	line(head);
 	for (const auto& r : t.rows)
 	{
-		std::vector<std::string> c = {r.run.id, r.run.config.written,
-		                              r.run.rawlog.written};
-		for (const auto& [k, v] : r.run.overrides) c.push_back(v);
-		c.push_back(r.status);
-		c.push_back(r.exitCode ? std::to_string(*r.exitCode) : "");
-		c.push_back(r.seconds ? number(*r.seconds, 4) : "");
-		for (const auto& m : metrics) c.push_back(number(r.metric(m), 9));
+		auto c = rowCells(r, metrics, 4, 9);
 		c.push_back(r.error);
 		line(c);
 	}
@@ -253,14 +267,8 @@ std::string markdownText(const ResultTable& t, const std::string& plotMetric)
 	out += "|\n" + rule + "|\n";
 	for (const auto& r : t.rows)
 	{
-		std::vector<std::string> c = {r.run.id, r.run.config.written,
-		                              r.run.rawlog.written};
-		for (const auto& [k, v] : r.run.overrides) c.push_back(v);
-		c.push_back(r.status);
-		c.push_back(r.exitCode ? std::to_string(*r.exitCode) : "");
-		c.push_back(r.seconds ? number(*r.seconds, 3) : "");
-		for (const auto& m : metrics) c.push_back(number(r.metric(m), 4));
-		for (const auto& x : c) out += "| " + mdCell(x) + " ";
+		for (const auto& x : rowCells(r, metrics, 3, 4))
+			out += "| " + mdCell(x) + " ";
 		out += "|\n";
 	}
 	if (t.failures())
