@@ -1,6 +1,7 @@
 // bims-grab end to end without hardware: OpenNI2's Dummy device + the
 // simulated IMU of the bundled sample replayed in real time.
 #include <bims/common/rawlog.h>
+#include <bims_test/text.h>
 #include <gtest/gtest.h>
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -127,11 +128,9 @@ TEST(GrabApp, LiveSegmentationWithoutExperimentUsesShareBimsDefaultIni)
 	    << slurp(log);
 	// build/bin/bims-grab -> build/share/bims/default.ini, named
 	const std::string msg = slurp(log);
-	const std::string head = "bims-grab: live segmentation: parameters from ";
-	const auto at = msg.find(head);
-	ASSERT_NE(at, std::string::npos) << msg;
-	const auto from = at + head.size();
-	const std::string used = msg.substr(from, msg.find('\n', from) - from);
+	const std::string used = bims::test::restOfLineAfter(
+	    msg, "bims-grab: live segmentation: parameters from ");
+	ASSERT_FALSE(used.empty()) << msg;
 	ASSERT_TRUE(std::filesystem::exists(used)) << msg;
 	EXPECT_TRUE(std::filesystem::equivalent(
 	    used, std::string(BIMS_BINARY_DIR) + "/share/bims/default.ini"))

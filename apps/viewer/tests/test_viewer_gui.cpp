@@ -2,6 +2,7 @@
 // bundled rawlog, steps frames with the pipeline, and the 3D view it drew
 // (read back from the canvas) shows the three tier colours.
 #include <bims/viewer/panels.h>
+#include <bims_test/text.h>
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -125,11 +126,9 @@ TEST(GuiViewer, WithoutConfigItUsesShareBimsDefaultIniAndSaysWhich)
 	run("env -u DISPLAY -u WAYLAND_DISPLAY '" + kViewer + "' > '" + log +
 	    "' 2>&1");
 	const std::string msg = slurp(log);
-	const std::string head = "bims-viewer: parameters from ";
-	const auto at = msg.find(head);
-	ASSERT_NE(at, std::string::npos) << msg;
-	const auto from = at + head.size();
-	const std::string used = msg.substr(from, msg.find('\n', from) - from);
+	const std::string used =
+	    bims::test::restOfLineAfter(msg, "bims-viewer: parameters from ");
+	ASSERT_FALSE(used.empty()) << msg;
 	// build/bin/bims-viewer -> build/share/bims/default.ini
 	ASSERT_TRUE(std::filesystem::exists(used)) << msg;
 	EXPECT_TRUE(std::filesystem::equivalent(
