@@ -110,15 +110,6 @@ std::vector<mrpt::math::TPoint3D> COccupancyBayesGrid::cellsAbove(
 	return out;
 }
 
-void COccupancyBayesGrid::applyMiss(Cell& c, uint32_t F) const
-{
-	if (c.stamp == F) return;  // hit (or already missed) in this frame
-	startIfUnobserved(c, c.stamp);
-	c.lPrev = c.l;
-	c.l = std::max<LogOddsFx>(c.l - miss_, lmin_);
-	c.stamp = F;
-}
-
 void COccupancyBayesGrid::checkFrame(const FrameCloud& f,
                                      const char* what) const
 {

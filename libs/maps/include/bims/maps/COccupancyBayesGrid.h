@@ -3,10 +3,12 @@
 
 #include <bims/maps/CBayesVoxelGridBase.h>
 #include <bims/maps/logodds_fixed.h>
+#include <bims/maps/ray_marks.h>
 #include <bims/maps/sparse_voxel_grid.h>
 
 #include <mrpt/maps/TMetricMapInitializer.h>
 
+#include <algorithm>
 #include <optional>
 
 namespace bims::maps
@@ -123,7 +125,28 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 	LogOddsFx currentFixed(const Cell& c) const;
 	void decayFrustum(const FrameCloud& f, uint32_t F);
 	void decayRaycast(const FrameCloud& f, uint32_t F);
-	void applyMiss(Cell& c, uint32_t F) const;
+	/** The ends of decayRaycast()'s rays, into rayEnds_ (tile order). */
+	void collectRayEnds(const FrameCloud& f, double inv);
+	/** The rays through the voxel bitsets of \a box (ray_marks.h): each
+	 * crossed voxel found once, then missed once. Returns the steps into
+	 * blocks over the memory budget. */
+	size_t castMarked(const double a[3], const RayBox& box, uint32_t F);
+	/** The rays one voxel at a time through a cached-block accessor (boxes
+	 * too large for the bitsets). Returns the steps over the budget. */
+	size_t castPlain(const double a[3], uint32_t F);
+	/** The missed cells of castMarked(), from the crossed bits of \a m;
+	 * \a tab: the cells of each block of \a box, nullptr if not stored. */
+	void applyRayMarks(const RayBox& box, const RayMarks& m, Cell* const* tab,
+	                   uint32_t F);
+	/** One miss in frame F, unless the cell was hit or missed in it. */
+	void applyMiss(Cell& c, uint32_t F) const
+	{
+		if (c.stamp == F) return;
+		startIfUnobserved(c, c.stamp);
+		c.lPrev = c.l;
+		c.l = std::max<LogOddsFx>(c.l - miss_, lmin_);
+		c.stamp = F;
+	}
 	/** The update of integrate(): of the cells in cellPtr_ if \a resolved
 	 * (beginFrame() found them), else finding them on the way. */
 	void applyFrame(const FrameCloud& f, std::vector<float>* priorOut,
@@ -138,13 +161,10 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 
 	Storage grid_;
 	// Scratch of decayRaycast(), reused across frames.
-	struct RayEnd
-	{
-		double p[3];  // end point in voxel units
-	};
 	std::vector<RayEnd> rayEnds_;
 	std::vector<uint32_t> tileStart_;
 	std::vector<Cell*> blockTable_;
+	std::vector<RayMarks> rayMarks_;  // one per thread
 	// Scratch of decayFrustum(): per-tile depth bounds.
 	std::vector<float> tileMax_, tileMinPos_;
 	std::vector<uint8_t> tileZero_;

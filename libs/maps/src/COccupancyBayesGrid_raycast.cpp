@@ -1,0 +1,272 @@
+// Tier 0: the miss update for decay = raycast (docs/maps.md, "Decay
+// modes"). The model: every voxel that the DDA of traverseRay() crosses
+// from the sensor origin to a reading, not hit in this frame, gets one
+// miss. The hits are applied first (COccupancyBayesGrid::applyFrame) and
+// stamped, so that which ray crosses a voxel, how often, and in which order
+// does not matter for its value. What the order of the rays does decide is
+// the order in which missing blocks are created (the order of the storage)
+// and, over the memory budget, which ones: that order is the one of a plain
+// walk, ray after ray, step after step.
+//
+// The fast path (castMarked): the rays are walked once, marking the voxels
+// they cross in a per-frame bitset of the rays' bounding box (no cell is
+// read or written during the walk, so any number of threads can walk); the
+// missing blocks the rays enter are then created in the order of their
+// first visit (ray, step), and each crossed cell gets its miss once, block
+// row by block row.
+#include <bims/maps/COccupancyBayesGrid.h>
+#include <bims/maps/dda.h>
+#include <bims/maps/ray_marks.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <thread>
+#include <utility>
+
+namespace bims::maps
+{
+namespace
+{
+// Rays are cast tile by tile of the image (kTile x kTile pixels): the rays
+// of a tile cross nearly the same voxels, which then stay in cache.
+constexpr int kTile = 8;
+// Largest bounding box of the rays for the bitsets (voxels, one bit each in
+// two bitsets per thread: 32 MiB); beyond it (huge extents at fine voxels)
+// the rays are walked voxel by voxel (castPlain).
+constexpr size_t kMaxMarkedVoxels = size_t(1) << 27;
+// Rays per work item of a thread (32 tiles).
+constexpr size_t kChunk = 2048;
+}  // namespace
+
+void COccupancyBayesGrid::collectRayEnds(const FrameCloud& f, double inv)
+{
+	auto& ends = rayEnds_;
+	ends.clear();
+	const int dec = params_.raycast_decimation;
+	if (params_.raycast_target == RayTarget::Voxels)
+	{
+		for (size_t i = 0; i < f.cells.size(); ++i)
+		{
+			if (dec > 1 && i % size_t(dec * dec) != 0) continue;
+			const auto& k = f.cells[i];
+			ends.push_back({{k.x + 0.5, k.y + 0.5, k.z + 0.5}});
+		}
+		return;
+	}
+	const int W = f.K.width, H = f.K.height;
+	const bool organised = W > 0 && H > 0;
+	auto keep = [&](size_t i)
+	{
+		if (dec <= 1) return true;
+		if (!organised) return i % size_t(dec) == 0;
+		const uint32_t px = f.pixel[i];
+		return (px % W) % dec == 0 && (px / W) % dec == 0;
+	};
+	auto end = [&](size_t i)
+	{
+		const auto& p = f.points_W[i];
+		return RayEnd{{p.x * inv, p.y * inv, p.z * inv}};
+	};
+	if (!organised)
+	{
+		for (size_t i = 0; i < f.points_W.size(); ++i)
+			if (keep(i)) ends.push_back(end(i));
+		return;
+	}
+	// Counting sort of the readings by tile.
+	const int tw = (W + kTile - 1) / kTile, th = (H + kTile - 1) / kTile;
+	auto& start = tileStart_;
+	start.assign(size_t(tw) * th + 1, 0);
+	auto tileOf = [&](uint32_t px)
+	{ return (px / W / kTile) * tw + (px % W) / kTile; };
+	for (size_t i = 0; i < f.points_W.size(); ++i)
+		if (keep(i)) start[tileOf(f.pixel[i]) + 1]++;
+	for (size_t t = 1; t < start.size(); ++t) start[t] += start[t - 1];
+	ends.resize(start.back());
+	for (size_t i = 0; i < f.points_W.size(); ++i)
+		if (keep(i)) ends[start[tileOf(f.pixel[i])]++] = end(i);
+}
+
+void COccupancyBayesGrid::decayRaycast(const FrameCloud& f, uint32_t F)
+{
+	const double inv = 1 / params_.voxel_size;
+	const auto& o = f.origin_W;
+	const double ext = params_.extent;
+	if (std::abs(o.x) > ext || std::abs(o.y) > ext || std::abs(o.z) > ext)
+	{
+		FrameStats st;
+		st.outsideExtent = f.points_W.size();
+		accountFrame(st);
+		return;  // keys along the rays could leave the key range
+	}
+	const double a[3] = {o.x * inv, o.y * inv, o.z * inv};
+	collectRayEnds(f, inv);
+	if (rayEnds_.empty()) return;
+
+	// Bounding box of the rays in blocks (one block of margin: a DDA may
+	// round one voxel past its end on an axis).
+	int32_t lo[3], hi[3];
+	for (int k = 0; k < 3; ++k) lo[k] = hi[k] = int32_t(std::floor(a[k]));
+	for (const auto& e : rayEnds_)
+		for (int k = 0; k < 3; ++k)
+		{
+			const int32_t v = int32_t(std::floor(e.p[k]));
+			lo[k] = std::min(lo[k], v);
+			hi[k] = std::max(hi[k], v);
+		}
+	for (int k = 0; k < 3; ++k)
+	{
+		lo[k] = (lo[k] >> 3) - 1;
+		hi[k] = (hi[k] >> 3) + 1;
+	}
+	const RayBox box(lo, hi);
+	const size_t over = box.words() * 64 <= kMaxMarkedVoxels
+	                        ? castMarked(a, box, F)
+	                        : castPlain(a, F);
+	if (over)
+	{
+		FrameStats st;
+		st.overBudget = over;
+		accountFrame(st);
+	}
+}
+
+size_t COccupancyBayesGrid::castPlain(const double a[3], uint32_t F)
+{
+	size_t over = 0;
+	Storage::Accessor acc(grid_);
+	for (const auto& e : rayEnds_)
+		traverseRay(a, e.p,
+		            [&](int32_t x, int32_t y, int32_t z)
+		            {
+			            Cell* c = acc.get(x, y, z);
+			            if (c)
+				            applyMiss(*c, F);
+			            else
+				            ++over;
+		            });
+	return over;
+}
+
+size_t COccupancyBayesGrid::castMarked(const double a[3], const RayBox& box,
+                                       uint32_t F)
+{
+	const auto& ends = rayEnds_;
+	const size_t threads =
+	    std::clamp<size_t>(size_t(params_.raycast_threads), 1,
+	                       (ends.size() + kChunk - 1) / kChunk);
+	rayMarks_.resize(threads);
+	// 1. The walk: crossed voxels, blocks stored or not, first visits.
+	const BlockStored stored =
+	    [](const void* g, int32_t bx, int32_t by, int32_t bz)
+	{
+		return static_cast<const Storage*>(g)->findBlock(packKey(bx, by, bz)) !=
+		       nullptr;
+	};
+	std::atomic<size_t> next{0};
+	auto worker = [&](size_t t)
+	{
+		RayMarks& m = rayMarks_[t];
+		m.reset(box);
+		for (;;)
+		{
+			const size_t r0 = next.fetch_add(kChunk);
+			if (r0 >= ends.size()) break;
+			markRays(a, ends.data(), r0, std::min(ends.size(), r0 + kChunk),
+			         box, stored, &grid_, m);
+		}
+	};
+	if (threads == 1)
+		worker(0);
+	else
+	{
+		std::vector<std::thread> pool;
+		for (size_t t = 1; t < threads; ++t) pool.emplace_back(worker, t);
+		worker(0);
+		for (auto& th : pool) th.join();
+	}
+	RayMarks& m = rayMarks_[0];
+	for (size_t t = 1; t < threads; ++t) mergeRayMarks(m, rayMarks_[t]);
+
+	// 2. The cells of each block entered; the missing blocks created in
+	// the order of their first visit, as a plain walk creates them.
+	auto& tab = blockTable_;
+	tab.assign(box.blocks(), nullptr);
+	std::vector<std::pair<uint64_t, size_t>> missing;
+	auto blockKeyOf = [&](size_t b)
+	{
+		const size_t bx = b % box.n[0], by = (b / box.n[0]) % box.n[1],
+		             bz = b / box.n[0] / box.n[1];
+		return packKey(box.lo[0] + int32_t(bx), box.lo[1] + int32_t(by),
+		               box.lo[2] + int32_t(bz));
+	};
+	for (size_t b = 0; b < box.blocks(); ++b)
+	{
+		if (m.state[b] == RayMarks::kStored)
+			tab[b] = grid_.findBlock(blockKeyOf(b))->cells;
+		else if (m.state[b] == RayMarks::kMissing)
+			missing.emplace_back(m.firstVisit[b], b);
+	}
+	std::sort(missing.begin(), missing.end());
+	bool budgetHit = false;
+	for (const auto& [visit, b] : missing)
+	{
+		const uint32_t id = grid_.findOrCreateBlock(blockKeyOf(b));
+		if (id == FlatHashMap::kNotFound)
+			budgetHit = true;
+		else
+			tab[b] = grid_.block(id).cells;
+	}
+
+	// 3. One miss per crossed cell.
+	applyRayMarks(box, m, tab.data(), F);
+
+	// Over the budget: the steps into blocks that could not be created, as
+	// a plain walk counts them (every step).
+	size_t over = 0;
+	if (budgetHit)
+		for (const auto& e : ends)
+			traverseRay(
+			    a, e.p,
+			    [&](int32_t x, int32_t y, int32_t z)
+			    {
+				    over += !tab[box.blockIndex(size_t((x >> 3) - box.lo[0]),
+				                                size_t((y >> 3) - box.lo[1]),
+				                                size_t((z >> 3) - box.lo[2]))];
+			    });
+	return over;
+}
+
+void COccupancyBayesGrid::applyRayMarks(const RayBox& box, const RayMarks& m,
+                                        Cell* const* tab, uint32_t F)
+{
+	const size_t ny = box.n[1] * 8, nz = box.n[2] * 8;
+	const uint64_t* bits = m.bits.data();
+	for (size_t z = 0; z < nz; ++z)
+		for (size_t y = 0; y < ny; ++y)
+		{
+			const size_t row = z * ny + y;
+			const size_t blockRow = box.blockIndex(0, y >> 3, z >> 3);
+			const size_t cellRow = ((z & 7) << 6) | ((y & 7) << 3);
+			for (size_t w = 0; w < box.rowWords; ++w)
+			{
+				uint64_t v = bits[2 * (row * box.rowWords + w)];
+				while (v)
+				{
+					// The crossed voxels of one block in this word.
+					const unsigned j = unsigned(__builtin_ctzll(v)) >> 3;
+					uint32_t byte = uint32_t(v >> (8 * j)) & 0xff;
+					v &= ~(uint64_t(0xff) << (8 * j));
+					Cell* blk = tab[blockRow + w * 8 + j];
+					if (!blk) continue;  // over the memory budget
+					Cell* cells = blk + cellRow;
+					for (; byte; byte &= byte - 1)
+						applyMiss(cells[__builtin_ctz(byte)], F);
+				}
+			}
+		}
+}
+
+}  // namespace bims::maps
