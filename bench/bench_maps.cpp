@@ -9,6 +9,7 @@
 //
 //   bench_maps [--bonn_depth=PNG] [--sim_rawlog=RAWLOG] [--sim_frame=N]
 //              [--voxels=0.02,0.05] [benchmark flags]
+#include <bims/common/json.h>
 #include <bims/common/rawlog.h>
 #include <bims/maps/dda.h>
 #include <bims/maps/motion_grids.h>
@@ -410,6 +411,47 @@ void benchStorageUnordered(bm::State& st, const Cloud& c, double voxel)
 	    1048576.0;
 }
 
+// The speed-ups of our ray casts over MRPT's two maps on the same cloud,
+// from the measurements of this run: one JSON object per ray cast, cloud
+// and voxel size ("ratio/tier0/raycast/bonn/2cm": MRPT's time / ours, CPU
+// and wall), and a table on stderr.
+void printRatios(const bims::bench::Results& res)
+{
+	auto find =
+	    [&](const std::string& n) -> const std::map<std::string, double>*
+	{
+		auto it = res.find(n);
+		return it == res.end() ? nullptr : &it->second;
+	};
+	for (const auto& [name, f] : res)
+	{
+		if (name.rfind("tier0/raycast", 0) != 0) continue;
+		// tier0/<decay>/<cloud>/<voxel>: the MRPT maps of /<cloud>/<voxel>
+		const std::string where = name.substr(name.find('/', 6));
+		const auto* grid3d = find("mrpt_grid3d_dec1" + where);
+		const auto* octo = find("mrpt_octomap" + where);
+		if (!grid3d && !octo) continue;
+		bims::Json j;
+		j["name"] = "ratio/" + name;
+		std::cerr << name << ": " << f.at("cpu_ms_median") << " ms CPU, "
+		          << f.at("ms_median") << " ms wall";
+		auto add = [&](const char* key, const auto* m)
+		{
+			if (!m) return;
+			const double cpu = m->at("cpu_ms_median") / f.at("cpu_ms_median");
+			const double wall = m->at("ms_median") / f.at("ms_median");
+			j[std::string(key) + "_over_ours_cpu"] = bims::jsonNumber(cpu);
+			j[std::string(key) + "_over_ours_wall"] = bims::jsonNumber(wall);
+			std::cerr << "; " << key << " / ours " << cpu << "x CPU, " << wall
+			          << "x wall";
+		};
+		add("grid3d_dec1", grid3d);
+		add("octomap", octo);
+		std::cerr << "\n";
+		std::cout << bims::jsonLine(j) << std::endl;
+	}
+}
+
 std::string findFirstPng(const std::string& dir)
 {
 	std::vector<std::string> f;
@@ -552,7 +594,10 @@ int main(int argc, char** argv)
 			          << "x" << c.scan->rangeImage.rows() << "\n";
 		registerAll();
 		int n = int(rest.size());
-		return bims::bench::runWithJsonLines(n, rest.data());
+		bims::bench::Results res;
+		const int rc = bims::bench::runWithJsonLines(n, rest.data(), &res);
+		printRatios(res);
+		return rc;
 	}
 	catch (const std::exception& e)
 	{

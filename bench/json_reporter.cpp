@@ -82,6 +82,7 @@ void JsonLinesReporter::flush(const std::string& key)
 	for (const auto& [k, v] : it->second.fields)
 		if (k != "voxel_m") j[k] = jsonNumber(v);
 	std::cout << jsonLine(j) << std::endl;
+	if (results_) (*results_)[it->second.name] = it->second.fields;
 	pending_.erase(it);
 }
 
@@ -91,11 +92,11 @@ void JsonLinesReporter::Finalize()
 	order_.clear();
 }
 
-int runWithJsonLines(int argc, char** argv)
+int runWithJsonLines(int argc, char** argv, Results* results)
 {
 	benchmark::Initialize(&argc, argv);
 	if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-	JsonLinesReporter json;
+	JsonLinesReporter json(results);
 	benchmark::RunSpecifiedBenchmarks(&json);
 	benchmark::Shutdown();
 	return 0;

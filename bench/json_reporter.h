@@ -14,9 +14,16 @@
 
 namespace bims::bench
 {
+/** The fields of each measurement printed, by benchmark name. */
+using Results = std::map<std::string, std::map<std::string, double>>;
+
 class JsonLinesReporter : public benchmark::BenchmarkReporter
 {
  public:
+	/** \param results if given, receives every measurement printed. */
+	explicit JsonLinesReporter(Results* results = nullptr) : results_(results)
+	{
+	}
 	bool ReportContext(const Context& context) override;
 	void ReportRuns(const std::vector<Run>& runs) override;
 	void Finalize() override;
@@ -27,14 +34,16 @@ class JsonLinesReporter : public benchmark::BenchmarkReporter
 		std::map<std::string, double> fields;
 		std::string name;
 	};
+	Results* results_;
 	std::map<std::string, Acc> pending_;
 	std::vector<std::string> order_;
 	void flush(const std::string& key);
 };
 
 /** Runs the registered benchmarks with JsonLinesReporter on stdout (and
- * Google Benchmark's console table on stderr). */
-int runWithJsonLines(int argc, char** argv);
+ * Google Benchmark's console table on stderr); \a results, if given,
+ * receives the measurements. */
+int runWithJsonLines(int argc, char** argv, Results* results = nullptr);
 
 /** The value of a "--key=value" argument: a pointer into \a arg after
  * "key=", or nullptr if \a arg is not that option. The benchmarks' own
