@@ -38,7 +38,11 @@ void RayMarks::reset(const RayBox& box)
 namespace
 {
 /** The slow part of a visit: the first visit of a voxel whose block this
- * thread has not looked up, or a visit of a block that is not stored. */
+ * thread has not looked up, or a visit of a block that is not stored. A
+ * block no longer needs slow visits once it is stored, or once it is
+ * missing and visited by the oldest ray in flight: every later visit by
+ * this thread is then of that ray's later steps or of younger rays, with
+ * later (ray, step). */
 struct Resolver
 {
 	const RayBox& box;
@@ -46,7 +50,7 @@ struct Resolver
 	const void* ctx;
 	RayMarks& m;
 
-	void visit(uint64_t g, uint32_t ray, uint32_t step)
+	void visit(uint64_t g, uint32_t ray, uint32_t step, uint32_t oldest)
 	{
 		const uint64_t row = g / box.rowBits(), ny = box.n[1] * 8;
 		const size_t x = size_t(g % box.rowBits()), y = size_t(row % ny),
@@ -63,8 +67,11 @@ struct Resolver
 			if (st == RayMarks::kStored) clearUnresolved(bx, by, bz);
 		}
 		if (st == RayMarks::kMissing)
+		{
 			m.firstVisit[bi] =
 			    std::min(m.firstVisit[bi], (uint64_t(ray) << 32) | step);
+			if (ray == oldest) clearUnresolved(bx, by, bz);
+		}
 	}
 	/** The block's voxels need no more slow visits. */
 	void clearUnresolved(size_t bx, size_t by, size_t bz)
@@ -80,13 +87,14 @@ struct Resolver
 	}
 };
 
-/** Marks voxel bit \a g, visited by \a ray at its \a step. */
-inline void mark(uint64_t g, uint32_t ray, uint32_t step, uint64_t* bits,
-                 Resolver& res)
+/** Marks voxel bit \a g, visited by \a ray at its \a step (\a oldest: the
+ * oldest ray this thread walks at the time). */
+inline void mark(uint64_t g, uint32_t ray, uint32_t step, uint32_t oldest,
+                 uint64_t* bits, Resolver& res)
 {
 	const uint64_t bit = uint64_t(1) << (g & 63);
 	uint64_t* q = bits + 2 * (g >> 6);
-	if (q[1] & bit) res.visit(g, ray, step);
+	if (q[1] & bit) res.visit(g, ray, step, oldest);
 	q[0] |= bit;
 }
 
@@ -159,12 +167,13 @@ void markRaysSse2(const double a[3], const RayEnd* ends, size_t r0, size_t r1,
 		              S1 = _mm_set_epi64x(B.inc[1], A.inc[1]),
 		              S2 = _mm_set_epi64x(B.inc[2], A.inc[2]);
 		__m128i G = _mm_set_epi64x(int64_t(B.g), int64_t(A.g));
-		const uint32_t k = std::min(A.n, B.n);
+		const uint32_t k = std::min(A.n, B.n), oldest = std::min(A.ray, B.ray);
 		for (uint32_t i = 0; i < k; ++i)
 		{
-			mark(uint64_t(_mm_cvtsi128_si64(G)), A.ray, A.step + i, bits, res);
+			mark(uint64_t(_mm_cvtsi128_si64(G)), A.ray, A.step + i, oldest,
+			     bits, res);
 			mark(uint64_t(_mm_cvtsi128_si64(_mm_unpackhi_epi64(G, G))), B.ray,
-			     B.step + i, bits, res);
+			     B.step + i, oldest, bits, res);
 			// The step of traverseRay() in both lanes.
 			const __m128d lxy = _mm_cmplt_pd(T0, T1),
 			              lxz = _mm_cmplt_pd(T0, T2),
@@ -220,9 +229,10 @@ void markRays(const double a[3], const RayEnd* ends, size_t r0, size_t r1,
 	{
 		uint32_t step = 0;
 		traverseRay(a, ends[r].p,
-		            [&](int32_t x, int32_t y, int32_t z) {
+		            [&](int32_t x, int32_t y, int32_t z)
+		            {
 			            mark(box.bitOf(x, y, z), uint32_t(r), step++,
-			                 m.bits.data(), res);
+			                 uint32_t(r), m.bits.data(), res);
 		            });
 	}
 #endif
