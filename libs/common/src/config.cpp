@@ -225,6 +225,16 @@ std::string ConfigSection::getEnum(const std::string& key,
 	return v;
 }
 
+std::string ConfigSection::getChoice(const std::string& key,
+                                     const std::string& def,
+                                     const std::vector<std::string>& names)
+{
+	const std::string v = getString(key, def);
+	if (std::find(names.begin(), names.end(), v) == names.end())
+		fail(key, badChoiceMessage(v, names));
+	return v;
+}
+
 std::vector<double> ConfigSection::getDoubles(const std::string& key,
                                               const std::vector<double>& def,
                                               size_t n, double min, double max)
