@@ -60,9 +60,6 @@ class ConfigSection
 	bool getBool(const std::string& key, bool def);
 	std::string getString(const std::string& key, const std::string& def);
 	std::string requireString(const std::string& key);
-	/** One of \a allowed (exact match); default if absent. */
-	std::string getEnum(const std::string& key, const std::string& def,
-	                    const std::vector<std::string>& allowed);
 	/** One of \a names (exact match); default if absent. Any other value
 	 * is an error naming file, section, key, the value and the names. */
 	std::string getChoice(const std::string& key, const std::string& def,
