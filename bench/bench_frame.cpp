@@ -251,7 +251,7 @@ void benchDisWarped(bm::State& st)
 {
 	bims::flow::FlowParams p = g_flow;  // DIS alone: no tensor
 	p.visible_change_grey = 0;
-	p.refine_pose = "none";
+	p.refine_pose = bims::flow::RefinePose::None;
 	bims::flow::ObservedFlow of(p);
 	const cv::Mat w = warpedPrev();
 	ProcCpu cpu(st);
@@ -262,7 +262,7 @@ void benchCompose(bm::State& st)
 {
 	bims::flow::FlowParams p = g_flow;
 	p.visible_change_grey = 0;
-	p.refine_pose = "none";
+	p.refine_pose = bims::flow::RefinePose::None;
 	bims::flow::ObservedFlow of(p);
 	const cv::Mat residual = of.compute(warpedPrev(), g_pair.cur.grey);
 	const cv::Matx33d H = derotation();
@@ -319,8 +319,9 @@ void registerAll()
 	for (const char* preset : {"ultrafast", "fast", "medium"})
 		for (int ds : {1, 2})
 		{
-			bims::flow::FlowParams p;
-			p.dis_preset = preset;
+			bims::flow::FlowParams p;  // DIS alone: no tensor
+			p.visible_change_grey = 0;
+			p.dis_preset = bims::parseChoice<bims::flow::DisPreset>(preset);
 			p.downscale = ds;
 			reg(std::string("observed/dis_") + preset + "/ds" +
 			        std::to_string(ds),

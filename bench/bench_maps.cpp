@@ -14,6 +14,7 @@
 #include <bims/maps/dda.h>
 #include <bims/maps/motion_grids.h>
 
+#include <mrpt/config/CConfigFile.h>
 #include <mrpt/maps/COccupancyGridMap3D.h>
 #include <mrpt/maps/COctoMap.h>
 #include <mrpt/maps/CSimplePointsMap.h>
@@ -84,7 +85,12 @@ std::vector<double> g_voxels = {0.02, 0.05};
 
 GridParams paramsFor(double voxel, const std::string& decay)
 {
+	// the paper's model (config/paper.ini), the baselines' model
 	GridParams p;
+	p.loadFromConfigFile(
+	    mrpt::config::CConfigFile(std::string(BIMS_SOURCE_DIR) +
+	                              "/config/paper.ini"),
+	    "grids");
 	p.voxel_size = voxel;
 	p.max_range = 8;
 	p.decay = decay == "all"       ? DecayMode::All

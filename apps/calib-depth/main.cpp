@@ -68,7 +68,7 @@ int main(int argc, char** argv)
 		    ego::EgoConfig ec;
 		    ec.loadFromFile(cfgPath);
 		    // raw depth, frame-to-frame vision odometry
-		    ec.odometry.mode = "vision";
+		    ec.odometry.mode = ego::OdometryMode::Vision;
 		    ec.anchor.enable = false;
 		    ec.depth_correction.enable = false;
 		    // (the same A:B rule as bims-run's)

@@ -78,7 +78,7 @@ int main(int argc, char** argv)
 		    const Eigen::Matrix3d R_ref = ec.calibration.R_IC;
 		    // Vision only, and R_IC unknown to the odometry (no gyro aid from
 		    // it).
-		    ec.odometry.mode = "vision";
+		    ec.odometry.mode = ego::OdometryMode::Vision;
 		    ec.calibration.has_R_IC = false;
 		    ego::Odometry odo(ec);
 

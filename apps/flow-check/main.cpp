@@ -69,9 +69,7 @@ PoseScore score(const cv::Mat& obs, const cv::Mat& depth,
                 const bims::flow::FlowParams& fp, double validPx,
                 const cv::Mat& tensor, cv::Mat* labelsOut = nullptr)
 {
-	const cv::Mat exp = fp.expected == "linear"
-	                        ? bims::flow::expectedFlowLinear(depth, cam, T)
-	                        : bims::flow::expectedFlowExact(depth, cam, T);
+	const cv::Mat exp = bims::flow::expectedFlow(fp.expected, depth, cam, T);
 	bims::flow::LabelStats st;
 	const cv::Mat lab =
 	    bims::flow::labelConsistency(obs, exp, depth, cam, T, fp, &st, &tensor);
@@ -136,8 +134,8 @@ int main(int argc, char** argv)
 		    cfg.loadFromFile(aCfg.getValue());
 		    try
 		    {
-			    cfg.setVariant(
-			        bims::pipeline::variantFromString(aVariant.getValue()));
+			    cfg.setVariant(bims::parseChoice<bims::pipeline::Variant>(
+			        aVariant.getValue()));
 		    }
 		    catch (const std::invalid_argument& e)
 		    {
@@ -176,7 +174,7 @@ int main(int argc, char** argv)
 		    std::vector<std::vector<double>> cols;
 		    auto fp = cfg.flow;
 		    bims::flow::FlowParams fpSE3 = fp;
-		    fpSE3.refine_pose = "se3";
+		    fpSE3.refine_pose = bims::flow::RefinePose::SE3;
 		    const auto refineP = bims::flow::flowPoseParamsFrom(fpSE3);
 		    opt.onFrame = [&](const bims::pipeline::FrameResult& r,
 		                      const mrpt::obs::CObservation3DRangeScan& scan)

@@ -139,10 +139,8 @@ int main(int argc, char** argv)
 		    const cv::Mat obs = of.compute(g0, g1);
 		    const double tObs = msSince(t0);
 		    t0 = std::chrono::steady_clock::now();
-		    const cv::Mat exp =
-		        params.expected == "linear"
-		            ? bims::flow::expectedFlowLinear(depth, cam, T_prev_cur)
-		            : bims::flow::expectedFlowExact(depth, cam, T_prev_cur);
+		    const cv::Mat exp = bims::flow::expectedFlow(params.expected, depth,
+		                                                 cam, T_prev_cur);
 		    const double tExp = msSince(t0);
 		    t0 = std::chrono::steady_clock::now();
 		    bims::flow::LabelStats st;
@@ -176,7 +174,7 @@ int main(int argc, char** argv)
 		    std::printf(
 		        "ms: observed flow (%s) %.1f  expected flow %.1f  labels "
 		        "%.1f\n",
-		        params.method.c_str(), tObs, tExp, tLab);
+		        bims::choiceName(params.method), tObs, tExp, tLab);
 		    std::printf("pictures in %s/\n", out.c_str());
 		    return 0;
 	    });

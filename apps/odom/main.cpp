@@ -108,10 +108,15 @@ int main(int argc, char** argv)
 		    }
 		    if (modeArg.isSet())
 		    {
-			    if (modeArg.getValue() != "imu" &&
-			        modeArg.getValue() != "vision")
-				    throw UsageError("--mode must be imu or vision");
-			    ec.odometry.mode = modeArg.getValue();
+			    try
+			    {
+				    ec.odometry.mode = bims::parseChoice<ego::OdometryMode>(
+				        modeArg.getValue());
+			    }
+			    catch (const std::invalid_argument& e)
+			    {
+				    throw UsageError(std::string("--mode: ") + e.what());
+			    }
 		    }
 		    if (aidArg.isSet())
 		    {
@@ -120,7 +125,8 @@ int main(int argc, char** argv)
 				    throw UsageError("--gyro-aid must be true or false");
 			    ec.odometry.gyro_aid = (a == "true");
 		    }
-		    if (ec.odometry.mode == "imu" && !ec.calibration.has_R_IC)
+		    if (ec.odometry.mode == ego::OdometryMode::Imu &&
+		        !ec.calibration.has_R_IC)
 			    throw ConfigError(
 			        cfgPath +
 			        ": [calibration] R_IC missing (needed by [odometry] mode = "
@@ -250,7 +256,8 @@ int main(int argc, char** argv)
 		    if (csv) csv->close();
 		    saveTumTrajectory(
 		        outArg.getValue(), traj,
-		        "bims-odom mode=" + ec.odometry.mode +
+		        std::string("bims-odom mode=") +
+		            bims::choiceName(ec.odometry.mode) +
 		            " gyro_aid=" + (ec.odometry.gyro_aid ? "true" : "false"));
 		    std::fprintf(
 		        stderr,
@@ -258,7 +265,8 @@ int main(int argc, char** argv)
 		        "gyro_aid=%s\n"
 		        "bims-odom: ms/frame median (p95): input %.2f (%.2f), tracking "
 		        "%.2f (%.2f), motion %.2f (%.2f), egomotion %.2f (%.2f)\n",
-		        st.frames, st.flagged, st.imu, ec.odometry.mode.c_str(),
+		        st.frames, st.flagged, st.imu,
+		        bims::choiceName(ec.odometry.mode),
 		        ec.odometry.gyro_aid ? "true" : "false", percentile(msIn, 0.5),
 		        percentile(msIn, 0.95), percentile(msTrack, 0.5),
 		        percentile(msTrack, 0.95), percentile(msMotion, 0.5),

@@ -2,11 +2,14 @@
 //
 //   bims-run CONFIG.ini IN.rawlog [MORE.rawlog...] -o OUTDIR [--frames A:B]
 //            [--variant bottom-only|flow-only|fused|fused-raycast] [--quiet]
+//   bims-run --print-config [CONFIG.ini]
 //
 // Writes OUTDIR/trajectory.txt (TUM), masks/NNNNNN.png (255 = moving,
 // NNNNNN = 3D-scan index), moving_voxels/NNNNNN.ply, static_map.{ply,bt},
-// segmented.rawlog (masks as pixel labels), frames.csv, metrics.json, and
-// prints a summary table. See docs/pipeline.md.
+// segmented.rawlog (masks as pixel labels), frames.csv, metrics.json,
+// effective.ini (every parameter used), and prints a summary table.
+// --print-config prints that effective.ini (of CONFIG.ini, or of the built-in
+// defaults) and exits. See docs/pipeline.md and docs/config.md.
 #include <bims/common/app.h>
 #include <bims/common/output_paths.h>
 #include <bims/pipeline/run.h>
@@ -22,6 +25,8 @@ int main(int argc, char** argv)
 	    "bims-run",
 	    [&]()
 	    {
+		    if (const auto rc = bims::pipeline::printConfigIfAsked(argc, argv))
+			    return *rc;
 		    TCLAP::CmdLine cmd(
 		        "bims: Bayesian independent motion segmentation of RGB-D + IMU "
 		        "rawlogs",
@@ -43,6 +48,12 @@ int main(int argc, char** argv)
 		        "[pipeline] variant)",
 		        false, "", "VARIANT", cmd);
 		    TCLAP::SwitchArg aQuiet("q", "quiet", "no progress line", cmd);
+		    TCLAP::SwitchArg aPrintConfig(
+		        "", "print-config",
+		        "print every parameter (of CONFIG.ini, or the built-in "
+		        "defaults) as .ini and exit: bims-run --print-config "
+		        "[CONFIG.ini]",
+		        cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
 		    auto inputs = aIn.getValue();
 		    inputs.push_back(aCfg.getValue());
@@ -54,8 +65,8 @@ int main(int argc, char** argv)
 		    {
 			    try
 			    {
-				    cfg.setVariant(
-				        bims::pipeline::variantFromString(aVariant.getValue()));
+				    cfg.setVariant(bims::parseChoice<bims::pipeline::Variant>(
+				        aVariant.getValue()));
 			    }
 			    catch (const std::invalid_argument& e)
 			    {

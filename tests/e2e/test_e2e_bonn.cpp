@@ -42,7 +42,7 @@ ExperimentConfig visionConfig()
 {
 	ExperimentConfig cfg;
 	cfg.loadFromFile(kConfig);
-	cfg.ego.odometry.mode = "vision";
+	cfg.ego.odometry.mode = bims::ego::OdometryMode::Vision;
 	cfg.ego.odometry.gyro_aid = false;
 	return cfg;
 }

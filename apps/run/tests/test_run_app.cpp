@@ -160,13 +160,14 @@ size_t framesWhenFull(const std::string& dir, const std::string& config,
 TEST(RunApp, AFullDiskStopsTheRunAtTheFirstFailedWriteNamingTheFile)
 {
 	// masks, trajectory and CSV only: trajectory.txt or frames.csv (lines of
-	// similar length) passes 6 KiB first
+	// similar length, ~16 KiB for the whole sample) passes 14 KiB first
+	// (effective.ini, ~11 KiB, is written whole at the start)
 	const auto d = tmpDir("full_disk");
 	const auto ini = configWithOutput(
 	    d, "labelled_rawlog=false\nmoving_ply=false\nstatic_map=false\n");
 	std::string full;
 	const size_t frames =
-	    framesWhenFull(d, ini, 6, {"trajectory.txt", "frames.csv"}, &full);
+	    framesWhenFull(d, ini, 14, {"trajectory.txt", "frames.csv"}, &full);
 	EXPECT_GT(frames, 5u);
 	// every file holds whole lines, the same frames; every mask is whole
 	const std::string traj = slurp(d + "/out/trajectory.txt");
@@ -272,4 +273,35 @@ TEST(RunApp, AfterSigkillEveryFileIsWholeAndNoMetricsSaysDone)
 	EXPECT_GE(frames, 5u);  // masks/000005.png was being written
 	for (const auto& e : fs::directory_iterator(d + "/out/moving_voxels"))
 		EXPECT_GT(fs::file_size(e.path()), 0u) << e.path();
+}
+
+TEST(RunApp, PrintConfigIsTheEffectiveIniOfARun)
+{
+	const std::string paper = kSrc + "/config/paper.ini";
+	const auto builtIn = run("--print-config");
+	ASSERT_EQ(builtIn.code, 0) << builtIn.out;
+	// the built-in defaults are config/default.ini's model
+	const auto file = run("--print-config " + q(kConfig));
+	ASSERT_EQ(file.code, 0) << file.out;
+	EXPECT_EQ(file.out, builtIn.out);
+	EXPECT_NE(file.out.find("[grids]\nvoxel_size = 0.05 // "),
+	          std::string::npos)
+	    << file.out;
+	EXPECT_NE(file.out.find("\ndecay = frustum // "), std::string::npos);
+	const auto p = run(q(paper) + " --print-config");
+	ASSERT_EQ(p.code, 0) << p.out;
+	EXPECT_NE(p.out.find("\ndecay = all // "), std::string::npos);
+	// what a run writes beside metrics.json
+	const auto d = tmpDir("print_config");
+	const auto r = run(q(paper) + " " + q(kSample) + " --frames 0:1 -q -o " +
+	                   q(d + "/out"));
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_EQ(slurp(d + "/out/effective.ini"), p.out);
+	// usage errors
+	const auto two = run("--print-config " + q(kConfig) + " " + q(kConfig));
+	EXPECT_EQ(two.code, 2) << two.out;
+	const auto bad = run("--print-config " + q(d + "/none.ini"));
+	EXPECT_EQ(bad.code, 1) << bad.out;
+	EXPECT_NE(bad.out.find("none.ini: no such config file"), std::string::npos)
+	    << bad.out;
 }

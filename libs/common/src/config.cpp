@@ -211,17 +211,13 @@ std::string ConfigSection::requireString(const std::string& key)
 	return v;
 }
 
-std::string ConfigSection::getEnum(const std::string& key,
-                                   const std::string& def,
-                                   const std::vector<std::string>& allowed)
+std::string ConfigSection::getChoice(const std::string& key,
+                                     const std::string& def,
+                                     const std::vector<std::string>& names)
 {
 	const std::string v = getString(key, def);
-	if (std::find(allowed.begin(), allowed.end(), v) == allowed.end())
-	{
-		std::string list;
-		for (const auto& a : allowed) list += (list.empty() ? "" : "|") + a;
-		fail(key, "'" + v + "' is not one of " + list);
-	}
+	if (std::find(names.begin(), names.end(), v) == names.end())
+		fail(key, badChoiceMessage(v, names));
 	return v;
 }
 

@@ -37,7 +37,7 @@ TEST(ConfigSection, ReadsTypedValuesAndDefaults)
 	EXPECT_EQ(s.getInt("n", 0, 0, 10), 7);
 	EXPECT_TRUE(s.getBool("flag", false));
 	EXPECT_EQ(s.getString("name", ""), "hello");
-	EXPECT_EQ(s.getEnum("mode", "slow", {"slow", "fast"}), "fast");
+	EXPECT_EQ(s.getChoice("mode", "slow", {"slow", "fast"}), "fast");
 	EXPECT_EQ(s.getDoubles("v", {}, 3, -10, 10),
 	          (std::vector<double>{1, 2, 3}));
 	EXPECT_DOUBLE_EQ(s.getDouble("absent", 4.25, 0, 10), 4.25);
@@ -89,7 +89,7 @@ TEST(ConfigSection, OutOfRangeAndMalformedValuesAreErrors)
 	          std::string::npos);
 	EXPECT_NE(errorOf(
 	              [&] {
-		              s.getEnum("m", "a", {"a", "b"});
+		              s.getChoice("m", "a", {"a", "b"});
 	              })
 	              .find("a|b"),
 	          std::string::npos);

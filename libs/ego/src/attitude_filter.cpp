@@ -47,7 +47,7 @@ ImuSample imuSampleFrom(const CObservationIMU& o)
 
 AttitudeFilter::AttitudeFilter(const AttitudeParams& p) : p_(p)
 {
-	if (p_.mag_reference == "fixed")
+	if (p_.mag_reference == MagReference::Fixed)
 	{
 		magRefReady_ = true;
 		magNormRef_ = p_.mag_norm;

@@ -19,19 +19,21 @@ std::array<double, kDepthCorrectionTerms> depthCorrectionBasis(double x,
 	        x2 * y, x * y2, y2 * y, x2 * x2, y2 * y2, x2 * y2};
 }
 
+void DepthCorrectionParams::describe(OptionVisitor& v)
+{
+	v.flag("enable", enable, "correct the depth readings: z (1 + delta(x, y))");
+	v.reals("coefficients", coefficients.data(), coefficients.size(), -10, 10,
+	        "delta = sum c_i term_i(x, y); terms x y x^2 xy y^2 x^3 x^2y xy^2 "
+	        "y^3 x^4 y^4 x^2y^2 (docs/ego.md)");
+	v.other("fitted_on");  // informative keys written by bims-calib-depth
+	v.other("rms_before_m");
+	v.other("rms_after_m");
+}
+
 void DepthCorrectionParams::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& cfg, const std::string& section)
 {
-	ConfigSection s(cfg, section);
-	enable = s.getBool("enable", enable);
-	const std::vector<double> def(coefficients.begin(), coefficients.end());
-	const auto c =
-	    s.getDoubles("coefficients", def, kDepthCorrectionTerms, -10, 10);
-	for (int i = 0; i < kDepthCorrectionTerms; i++) coefficients[i] = c[i];
-	s.allow("fitted_on");  // informative keys written by bims-calib-depth
-	s.allow("rms_before_m");
-	s.allow("rms_after_m");
-	s.finish();
+	readOptions(*this, cfg, section);
 }
 
 std::string DepthCorrectionParams::toIni(const std::string& comment) const

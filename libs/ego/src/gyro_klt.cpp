@@ -189,7 +189,7 @@ void GyroAidedKLT::replenish(const cv::Mat& grey, const cv::Mat* movingMask)
 		cv::circle(allow, q, r, cv::Scalar(0), cv::FILLED);
 
 	std::vector<cv::KeyPoint> kps;
-	if (p_.detector == "fast")
+	if (p_.detector == FeatureDetector::Fast)
 		cv::FAST(grey, kps, p_.fast_threshold, true);
 	else
 	{

@@ -162,7 +162,7 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	// The previous frame becomes a keyframe now that its moving mask is
 	// known (the same mask, after the same guard).
 	if (anchoring && anchor_.addPending(moving)) r.flags |= kFlagNewKeyframe;
-	const bool imuMode = cfg_.odometry.mode == "imu";
+	const bool imuMode = cfg_.odometry.mode == OdometryMode::Imu;
 	uint32_t imuFlags = 0;
 	const auto R_WC_imu = imuRotation(f.t, &imuFlags);
 	const auto R_WC_gyro = imuRotation(f.t, nullptr, true);
@@ -274,9 +274,9 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		m = est_.estimateTranslation(corr, R_rel);
 		r.R_source = RotationSource::Imu;
 		if (m.ok && cfg_.translation.reprojection &&
-		    cfg_.translation.refine != "se3")
+		    cfg_.translation.refine != TranslationRefine::SE3)
 			m = est_.refineReprojection(corr, m, f.K, false);
-		if (m.ok && cfg_.translation.refine == "se3")
+		if (m.ok && cfg_.translation.refine == TranslationRefine::SE3)
 		{
 			m = est_.refineSE3(
 			    corr, m, R_rel,

@@ -28,168 +28,247 @@ Eigen::Matrix3d orthonormalize(const Eigen::Matrix3d& M)
 	return R;
 }
 
+void AttitudeParams::describe(OptionVisitor& v)
+{
+	v.real("kp", kp, 0, 100, "proportional correction gain [1/s]");
+	v.real("ki", ki, 0, 100, "gyro-bias integral gain [1/s^2]");
+	v.real("kp_init", kp_init, 0, 1000,
+	       "gain during the first init_time_s [1/s]");
+	v.real("init_time_s", init_time_s, 0, 3600,
+	       "fast-convergence phase length [s]");
+	v.flag("use_magnetometer", use_magnetometer,
+	       "false: heading from the gyro only");
+	v.flag("use_sensor_orientation", use_sensor_orientation,
+	       "take R_WI from the sensor's own orientation quaternion when "
+	       "present instead of filtering");
+	v.real("gravity", gravity, 9.7, 9.9, "local gravity magnitude [m/s^2]");
+	v.real("accel_gate", accel_gate, 0, 100,
+	       "accelerometer used only if | |f| - gravity | is below this "
+	       "[m/s^2]");
+	v.real("accel_angle_gate_deg", accel_angle_gate_deg, 0, 180,
+	       "... and if measured and predicted gravity differ by less than "
+	       "this [deg]");
+	v.real("accel_gate_max_s", accel_gate_max_s, 0, 3600,
+	       "... unless they have disagreed for longer than this [s]");
+	v.real("mag_norm_gate", mag_norm_gate, 0, 10,
+	       "magnetometer used only if | |m| / m_ref - 1 | is below this");
+	v.real("mag_dip_gate_deg", mag_dip_gate_deg, 0, 180,
+	       "... and if |dip - dip_ref| is below this [deg]");
+	v.real("mag_heading_gate_deg", mag_heading_gate_deg, 0, 180,
+	       "... and if its heading innovation is below this [deg]");
+	v.real("mag_gate_max_s", mag_gate_max_s, 0, 1e6,
+	       "... unless that has lasted this long [s]");
+	v.real("kp_mag", kp_mag, 0, 100, "heading correction gain [1/s]");
+	v.choice("mag_reference", mag_reference,
+	         "auto: norm and dip learnt from the first samples; fixed: "
+	         "mag_norm and mag_dip_deg");
+	v.integer("mag_reference_samples", mag_reference_samples, 1, 100000,
+	          "samples that learn the reference field (auto)");
+	v.real("mag_norm", mag_norm, 1e-9, 1e9,
+	       "reference |m| in sensor units (fixed)");
+	v.real("mag_dip_deg", mag_dip_deg, -90, 90,
+	       "reference dip below horizontal [deg] (fixed)");
+	v.real("max_gap_s", max_gap_s, 1e-4, 100,
+	       "a gap between IMU samples longer than this is flagged [s]");
+	v.real("history_s", history_s, 0.1, 3600,
+	       "attitude history kept for queries [s]");
+}
+
 void AttitudeParams::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& cfg, const std::string& section)
 {
-	ConfigSection s(cfg, section);
-	kp = s.getDouble("kp", kp, 0, 100);
-	ki = s.getDouble("ki", ki, 0, 100);
-	kp_init = s.getDouble("kp_init", kp_init, 0, 1000);
-	init_time_s = s.getDouble("init_time_s", init_time_s, 0, 3600);
-	use_magnetometer = s.getBool("use_magnetometer", use_magnetometer);
-	use_sensor_orientation =
-	    s.getBool("use_sensor_orientation", use_sensor_orientation);
-	gravity = s.getDouble("gravity", gravity, 9.7, 9.9);
-	accel_gate = s.getDouble("accel_gate", accel_gate, 0, 100);
-	accel_angle_gate_deg =
-	    s.getDouble("accel_angle_gate_deg", accel_angle_gate_deg, 0, 180);
-	accel_gate_max_s =
-	    s.getDouble("accel_gate_max_s", accel_gate_max_s, 0, 3600);
-	mag_norm_gate = s.getDouble("mag_norm_gate", mag_norm_gate, 0, 10);
-	mag_dip_gate_deg =
-	    s.getDouble("mag_dip_gate_deg", mag_dip_gate_deg, 0, 180);
-	mag_heading_gate_deg =
-	    s.getDouble("mag_heading_gate_deg", mag_heading_gate_deg, 0, 180);
-	mag_gate_max_s = s.getDouble("mag_gate_max_s", mag_gate_max_s, 0, 1e6);
-	kp_mag = s.getDouble("kp_mag", kp_mag, 0, 100);
-	mag_reference =
-	    s.getEnum("mag_reference", mag_reference, {"auto", "fixed"});
-	mag_reference_samples = static_cast<int>(
-	    s.getInt("mag_reference_samples", mag_reference_samples, 1, 100000));
-	mag_norm = s.getDouble("mag_norm", mag_norm, 1e-9, 1e9);
-	mag_dip_deg = s.getDouble("mag_dip_deg", mag_dip_deg, -90, 90);
-	max_gap_s = s.getDouble("max_gap_s", max_gap_s, 1e-4, 100);
-	history_s = s.getDouble("history_s", history_s, 0.1, 3600);
-	s.finish();
+	readOptions(*this, cfg, section);
+}
+
+void TrackerParams::describe(OptionVisitor& v)
+{
+	v.integer("max_features", max_features, 8, 100000,
+	          "features kept per frame");
+	v.integer("grid_cols", grid_cols, 1, 100, "replenishment grid columns");
+	v.integer("grid_rows", grid_rows, 1, 100, "replenishment grid rows");
+	v.real("min_distance_px", min_distance_px, 1, 1000,
+	       "least spacing of new features [px]");
+	v.choice("detector", detector, "corner detector of new features");
+	v.integer("fast_threshold", fast_threshold, 1, 255,
+	          "FAST intensity threshold [grey levels]");
+	v.real("gftt_quality", gftt_quality, 1e-6, 1,
+	       "goodFeaturesToTrack quality level");
+	v.integer("window", window, 5, 101, "LK window side [px] (odd)");
+	v.rule(window % 2 == 1, "window", "must be odd");
+	v.integer("pyramid_levels", pyramid_levels, 0, 8,
+	          "LK max pyramid level (0 = none)");
+	v.integer("max_iterations", max_iterations, 1, 1000,
+	          "LK iterations per level");
+	v.real("epsilon", epsilon, 1e-6, 10, "LK convergence [px]");
+	v.real("fb_threshold_px", fb_threshold_px, 0.01, 100,
+	       "forward-backward error limit [px]");
+	v.real("border_px", border_px, 0, 200,
+	       "tracks closer to the border are dropped [px]");
+	v.integer("mask_dilate_px", mask_dilate_px, 0, 200,
+	          "growth of the moving-region mask [px]");
 }
 
 void TrackerParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
                                        const std::string& section)
 {
-	ConfigSection s(cfg, section);
-	max_features =
-	    static_cast<int>(s.getInt("max_features", max_features, 8, 100000));
-	grid_cols = static_cast<int>(s.getInt("grid_cols", grid_cols, 1, 100));
-	grid_rows = static_cast<int>(s.getInt("grid_rows", grid_rows, 1, 100));
-	min_distance_px = s.getDouble("min_distance_px", min_distance_px, 1, 1000);
-	detector = s.getEnum("detector", detector, {"fast", "gftt"});
-	fast_threshold =
-	    static_cast<int>(s.getInt("fast_threshold", fast_threshold, 1, 255));
-	gftt_quality = s.getDouble("gftt_quality", gftt_quality, 1e-6, 1);
-	window = static_cast<int>(s.getInt("window", window, 5, 101));
-	if (window % 2 == 0) s.fail("window", "must be odd");
-	pyramid_levels =
-	    static_cast<int>(s.getInt("pyramid_levels", pyramid_levels, 0, 8));
-	max_iterations =
-	    static_cast<int>(s.getInt("max_iterations", max_iterations, 1, 1000));
-	epsilon = s.getDouble("epsilon", epsilon, 1e-6, 10);
-	fb_threshold_px =
-	    s.getDouble("fb_threshold_px", fb_threshold_px, 0.01, 100);
-	border_px = s.getDouble("border_px", border_px, 0, 200);
-	mask_dilate_px =
-	    static_cast<int>(s.getInt("mask_dilate_px", mask_dilate_px, 0, 200));
-	s.finish();
+	readOptions(*this, cfg, section);
+}
+
+void TranslationParams::describe(OptionVisitor& v)
+{
+	v.choice("method", method, "robust estimator");
+	v.integer("iterations", iterations, 1, 1000000,
+	          "hypotheses of the 1-point translation model");
+	v.integer("vision_iterations", vision_iterations, 1, 1000000,
+	          "hypotheses of the 3-point SE(3) model");
+	v.real("inlier_threshold_m", inlier_threshold_m, 1e-5, 10,
+	       "inlier threshold on the 3D residual, a of a + b z^2 [m]");
+	v.real("inlier_threshold_z2", inlier_threshold_z2, 0, 10,
+	       "b of a + b z^2 [1/m]");
+	v.integer("min_inliers", min_inliers, 3, 100000,
+	          "fewer inliers: the frame is flagged failed");
+	v.real("min_depth_m", min_depth_m, 0, 100,
+	       "depth readings below this are unused [m]");
+	v.real("max_depth_m", max_depth_m, 0.01, 1000,
+	       "depth readings above this are unused [m]");
+	v.rule(max_depth_m > min_depth_m, "max_depth_m",
+	       "must be greater than min_depth_m");
+	v.choice("refine", refine,
+	         "none: IMU rotation kept; se3: Gauss-Newton over R and t with "
+	         "the IMU rotation as a prior");
+	v.real("rotation_prior_sigma_deg", rotation_prior_sigma_deg, 1e-4, 180,
+	       "IMU rotation std. dev. (refine = se3) [deg]");
+	v.real("point_sigma_m", point_sigma_m, 1e-6, 10,
+	       "3D residual std. dev. at 1 m [m]");
+	v.flag("reprojection", reprojection,
+	       "final reprojection refinement of the robust 3D estimate");
+	v.real("reprojection_sigma_px", reprojection_sigma_px, 1e-3, 100,
+	       "pixel noise (Huber scale) [px]");
+	v.real("reprojection_threshold_px", reprojection_threshold_px, 0.1, 1000,
+	       "reprojection inlier limit [px]");
+	v.integer("seed", seed, 0, 4294967295L,
+	          "RANSAC random seed (results are repeatable)");
 }
 
 void TranslationParams::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& cfg, const std::string& section)
 {
-	ConfigSection s(cfg, section);
-	method = s.getEnum("method", method, {"ransac", "lmeds"});
-	iterations = static_cast<int>(s.getInt("iterations", iterations, 1, 1e6));
-	vision_iterations = static_cast<int>(
-	    s.getInt("vision_iterations", vision_iterations, 1, 1e6));
-	inlier_threshold_m =
-	    s.getDouble("inlier_threshold_m", inlier_threshold_m, 1e-5, 10);
-	inlier_threshold_z2 =
-	    s.getDouble("inlier_threshold_z2", inlier_threshold_z2, 0, 10);
-	min_inliers =
-	    static_cast<int>(s.getInt("min_inliers", min_inliers, 3, 100000));
-	min_depth_m = s.getDouble("min_depth_m", min_depth_m, 0, 100);
-	max_depth_m = s.getDouble("max_depth_m", max_depth_m, 0.01, 1000);
-	if (max_depth_m <= min_depth_m)
-		s.fail("max_depth_m", "must be greater than min_depth_m");
-	refine = s.getEnum("refine", refine, {"none", "se3"});
-	rotation_prior_sigma_deg = s.getDouble("rotation_prior_sigma_deg",
-	                                       rotation_prior_sigma_deg, 1e-4, 180);
-	point_sigma_m = s.getDouble("point_sigma_m", point_sigma_m, 1e-6, 10);
-	reprojection = s.getBool("reprojection", reprojection);
-	reprojection_sigma_px =
-	    s.getDouble("reprojection_sigma_px", reprojection_sigma_px, 1e-3, 100);
-	reprojection_threshold_px = s.getDouble(
-	    "reprojection_threshold_px", reprojection_threshold_px, 0.1, 1000);
-	seed = static_cast<uint32_t>(s.getInt("seed", seed, 0, 4294967295L));
-	s.finish();
+	readOptions(*this, cfg, section);
+}
+
+void OdometryParams::describe(OptionVisitor& v)
+{
+	v.choice("mode", mode,
+	         "imu: rotation from the attitude filter, translation from "
+	         "vision (the paper); vision: full SE(3) from the tracks");
+	v.flag("gyro_aid", gyro_aid,
+	       "seed KLT with the gyro-predicted feature positions");
+	v.integer("min_tracks", min_tracks, 3, 1000000,
+	          "fewer 3D matches: the frame is flagged");
+	v.real("attitude_blend", attitude_blend, 0, 1,
+	       "mode = imu: fraction of the difference to the filter's attitude "
+	       "R_WC is pulled by per frame");
+	v.flag("follow_converging_attitude", follow_converging_attitude,
+	       "mode = imu: R_WC follows the filter while it converges "
+	       "(docs/ego.md)");
 }
 
 void OdometryParams::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& cfg, const std::string& section)
 {
-	ConfigSection s(cfg, section);
-	mode = s.getEnum("mode", mode, {"imu", "vision"});
-	gyro_aid = s.getBool("gyro_aid", gyro_aid);
-	min_tracks = static_cast<int>(s.getInt("min_tracks", min_tracks, 3, 1e6));
-	attitude_blend = s.getDouble("attitude_blend", attitude_blend, 0, 1);
-	follow_converging_attitude =
-	    s.getBool("follow_converging_attitude", follow_converging_attitude);
-	s.finish();
+	readOptions(*this, cfg, section);
+}
+
+void AnchorParams::describe(OptionVisitor& v)
+{
+	v.flag("enable", enable,
+	       "map-anchored tracking (false: frame-to-frame egomotion only)");
+	v.integer("finest_level", finest_level, 0, 6,
+	          "finest pyramid level aligned (0 = full size)");
+	v.integer("coarsest_level", coarsest_level, 0, 6,
+	          "coarsest pyramid level aligned");
+	v.rule(coarsest_level >= finest_level, "coarsest_level",
+	       "must be >= finest_level");
+	v.integer("iterations", iterations, 1, 100,
+	          "Levenberg-Marquardt steps per level (max)");
+	v.integer("stride_px", stride_px, 1, 16,
+	          "pixel sampling step at the finest level");
+	v.real("geo_sigma_m", geo_sigma_m, 1e-5, 1,
+	       "geometric residual scale, a of a + b z^2 [m]");
+	v.real("geo_sigma_z2", geo_sigma_z2, 0, 1, "b of a + b z^2 [1/m]");
+	v.real("gate_m", gate_m, 1e-3, 10,
+	       "depth difference beyond a + b z^2 is not associated, a [m]");
+	v.real("gate_z2", gate_z2, 0, 10, "b of the gate [1/m]");
+	v.real("photo_sigma_grey", photo_sigma_grey, 0.01, 255,
+	       "least photometric residual scale [grey levels]");
+	v.real("photo_weight", photo_weight, 0, 100,
+	       "weight of the photometric term (0: off)");
+	v.real("tukey_c", tukey_c, 1, 100, "Tukey biweight limit [scales]");
+	v.real("rotation_prior_sigma_deg", rotation_prior_sigma_deg, 0, 180,
+	       "mode = imu: std. dev. of the IMU rotation prior (0: translation "
+	       "only) [deg]");
+	v.integer("min_inliers", min_inliers, 6, 10000000,
+	          "fewer inliers at the finest level: failed");
+	v.real("min_inlier_fraction", min_inlier_fraction, 0, 1,
+	       "smaller share of inliers among associated points: failed");
+	v.real("max_correction_m", max_correction_m, 1e-4, 100,
+	       "anchored pose farther from the frame-to-frame one: rejected [m]");
+	v.real("max_correction_deg", max_correction_deg, 1e-3, 180,
+	       "... or turned more than this: rejected [deg]");
+	v.real("relocalise_inlier_fraction", relocalise_inlier_fraction, 0, 1.01,
+	       "... unless the inlier fraction is at least this");
+	v.real("relocalise_overlap", relocalise_overlap, 0, 1.01,
+	       "... and the overlap (inliers / points) at least this");
+	v.real("keyframe_distance_m", keyframe_distance_m, 0.001, 100,
+	       "new keyframe beyond this distance from the keyframe [m]");
+	v.real("keyframe_angle_deg", keyframe_angle_deg, 0.01, 180,
+	       "... or this angle [deg]");
+	v.real("keyframe_min_overlap", keyframe_min_overlap, 0, 1,
+	       "... or when the keyframe covers less than this of the points");
+	v.integer("max_keyframes", max_keyframes, 1, 100000,
+	          "oldest keyframes dropped beyond this");
+	v.integer("lost_frames", lost_frames, 1, 1000000,
+	          "frames in a row without an accepted alignment: new keyframe "
+	          "(lost)");
+	v.real("max_excluded_fraction", max_excluded_fraction, 0, 1,
+	       "a moving mask covering more than this share is not used");
+	v.flag("predict_mask", predict_mask,
+	       "predict the previous moving mask into the frame");
+	v.integer("mask_margin_px", mask_margin_px, 0, 100,
+	          "growth of the predicted mask [px]");
+	v.real("min_depth_m", min_depth_m, 0, 100,
+	       "depth below this is unused [m]");
+	v.real("max_depth_m", max_depth_m, 0.01, 1000,
+	       "depth above this is unused [m]");
+	v.rule(max_depth_m > min_depth_m, "max_depth_m",
+	       "must be greater than min_depth_m");
 }
 
 void AnchorParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
                                       const std::string& section)
 {
-	ConfigSection s(cfg, section);
-	enable = s.getBool("enable", enable);
-	finest_level =
-	    static_cast<int>(s.getInt("finest_level", finest_level, 0, 6));
-	coarsest_level =
-	    static_cast<int>(s.getInt("coarsest_level", coarsest_level, 0, 6));
-	if (coarsest_level < finest_level)
-		s.fail("coarsest_level", "must be >= finest_level");
-	iterations = static_cast<int>(s.getInt("iterations", iterations, 1, 100));
-	stride_px = static_cast<int>(s.getInt("stride_px", stride_px, 1, 16));
-	geo_sigma_m = s.getDouble("geo_sigma_m", geo_sigma_m, 1e-5, 1);
-	geo_sigma_z2 = s.getDouble("geo_sigma_z2", geo_sigma_z2, 0, 1);
-	gate_m = s.getDouble("gate_m", gate_m, 1e-3, 10);
-	gate_z2 = s.getDouble("gate_z2", gate_z2, 0, 10);
-	photo_sigma_grey =
-	    s.getDouble("photo_sigma_grey", photo_sigma_grey, 0.01, 255);
-	photo_weight = s.getDouble("photo_weight", photo_weight, 0, 100);
-	tukey_c = s.getDouble("tukey_c", tukey_c, 1, 100);
-	rotation_prior_sigma_deg = s.getDouble("rotation_prior_sigma_deg",
-	                                       rotation_prior_sigma_deg, 0, 180);
-	min_inliers =
-	    static_cast<int>(s.getInt("min_inliers", min_inliers, 6, 10000000));
-	min_inlier_fraction =
-	    s.getDouble("min_inlier_fraction", min_inlier_fraction, 0, 1);
-	max_correction_m =
-	    s.getDouble("max_correction_m", max_correction_m, 1e-4, 100);
-	max_correction_deg =
-	    s.getDouble("max_correction_deg", max_correction_deg, 1e-3, 180);
-	relocalise_inlier_fraction = s.getDouble(
-	    "relocalise_inlier_fraction", relocalise_inlier_fraction, 0, 1.01);
-	relocalise_overlap =
-	    s.getDouble("relocalise_overlap", relocalise_overlap, 0, 1.01);
-	keyframe_distance_m =
-	    s.getDouble("keyframe_distance_m", keyframe_distance_m, 0.001, 100);
-	keyframe_angle_deg =
-	    s.getDouble("keyframe_angle_deg", keyframe_angle_deg, 0.01, 180);
-	keyframe_min_overlap =
-	    s.getDouble("keyframe_min_overlap", keyframe_min_overlap, 0, 1);
-	max_keyframes =
-	    static_cast<int>(s.getInt("max_keyframes", max_keyframes, 1, 100000));
-	lost_frames =
-	    static_cast<int>(s.getInt("lost_frames", lost_frames, 1, 1e6));
-	max_excluded_fraction =
-	    s.getDouble("max_excluded_fraction", max_excluded_fraction, 0, 1);
-	predict_mask = s.getBool("predict_mask", predict_mask);
-	mask_margin_px =
-	    static_cast<int>(s.getInt("mask_margin_px", mask_margin_px, 0, 100));
-	min_depth_m = s.getDouble("min_depth_m", min_depth_m, 0, 100);
-	max_depth_m = s.getDouble("max_depth_m", max_depth_m, 0.01, 1000);
-	if (max_depth_m <= min_depth_m)
-		s.fail("max_depth_m", "must be greater than min_depth_m");
-	s.finish();
+	readOptions(*this, cfg, section);
+}
+
+void CalibrationParams::describe(OptionVisitor& v)
+{
+	double r[9];
+	for (int i = 0; i < 9; i++) r[i] = R_IC(i / 3, i % 3);
+	v.reals("R_IC", r, 9, -1.0001, 1.0001,
+	        "camera optical frame in the IMU frame, p_I = R_IC p_C (row "
+	        "major); a file with [odometry] mode = imu must give it");
+	const Eigen::Matrix3d M =
+	    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(r);
+	const double err = (M * M.transpose() - Eigen::Matrix3d::Identity()).norm();
+	std::ostringstream os;
+	os << "not a rotation matrix (|R R^T - I| = " << err
+	   << ", det = " << M.determinant() << ")";
+	// re-orthonormalised, unless it is a rotation to double precision
+	// already (so that an R_IC written out reads back the same)
+	if (v.rule(err <= 1e-3 && M.determinant() >= 0, "R_IC", os.str()))
+		R_IC = err <= 1e-12 ? M : orthonormalize(M);
+	v.real("time_offset_s", time_offset_s, -10, 10,
+	       "IMU stamp = camera stamp + this for the same instant [s]");
 }
 
 void CalibrationParams::loadFromConfigFile(
@@ -202,70 +281,51 @@ void CalibrationParams::loadFromConfigFile(
 		s.fail("R_IC",
 		       "missing: the IMU-to-camera rotation (9 reals, row major, p_I = "
 		       "R_IC p_C) is needed when [odometry] mode = imu");
-	if (has_R_IC)
-	{
-		const auto v = s.getDoubles("R_IC", {}, 9, -1.0001, 1.0001);
-		Eigen::Matrix3d M;
-		M << v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8];
-		const double err =
-		    (M * M.transpose() - Eigen::Matrix3d::Identity()).norm();
-		if (err > 1e-3 || M.determinant() < 0)
-		{
-			std::ostringstream os;
-			os << "not a rotation matrix (|R R^T - I| = " << err
-			   << ", det = " << M.determinant() << ")";
-			s.fail("R_IC", os.str());
-		}
-		R_IC = orthonormalize(M);
-	}
-	time_offset_s = s.getDouble("time_offset_s", time_offset_s, -10, 10);
+	OptionReader r(s);
+	describe(r);
 	s.finish();
+}
+
+void CameraParams::describe(OptionVisitor& v)
+{
+	given = v.group({"fx", "fy", "cx", "cy", "width", "height"}, given);
+	if (given)
+	{
+		v.real("fx", fx, 1, 1e5,
+		       "focal length [px]; fx fy cx cy width height: all or none "
+		       "(none: each observation's own intrinsics)");
+		v.real("fy", fy, 1, 1e5, "focal length [px]");
+		v.real("cx", cx, -1e5, 1e5, "principal point [px]");
+		v.real("cy", cy, -1e5, 1e5, "principal point [px]");
+		v.integer("width", width, 1, 100000, "image width [px]");
+		v.integer("height", height, 1, 100000, "image height [px]");
+	}
+	// Keys bims-import-tum reads from the same section.
+	for (const char* k : {"depth_scale", "max_range", "depth_units", "k1", "k2",
+	                      "p1", "p2", "k3"})
+		v.other(k);
 }
 
 void CameraParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
                                       const std::string& section)
 {
-	ConfigSection s(cfg, section);
-	const char* keys[] = {"fx", "fy", "cx", "cy", "width", "height"};
-	int n = 0;
-	for (const char* k : keys) n += s.has(k) ? 1 : 0;
-	if (n > 0 && n < 6)
-		for (const char* k : keys)
-			if (!s.has(k))
-				s.fail(k,
-				       "missing: give all of fx fy cx cy width height, "
-				       "or none to use the observations' own intrinsics");
-	given = (n == 6);
-	if (given)
-	{
-		fx = s.requireDouble("fx", 1, 1e5);
-		fy = s.requireDouble("fy", 1, 1e5);
-		cx = s.requireDouble("cx", -1e5, 1e5);
-		cy = s.requireDouble("cy", -1e5, 1e5);
-		width = static_cast<int>(s.requireInt("width", 1, 100000));
-		height = static_cast<int>(s.requireInt("height", 1, 100000));
-	}
-	// Keys other modules read from the same section.
-	s.allow("depth_scale");
-	s.allow("max_range");
-	s.allow("depth_units");
-	s.allow("k1");
-	s.allow("k2");
-	s.allow("p1");
-	s.allow("p2");
-	s.allow("k3");
-	s.finish();
+	readOptions(*this, cfg, section);
+}
+
+void SensorsParams::describe(OptionVisitor& v)
+{
+	v.text("rgbd_label", rgbd_label,
+	       "sensor label of the 3D scans used (empty: any)");
+	v.text("imu_label", imu_label,
+	       "sensor label of the IMU observations used (empty: any)");
+	v.other("rgbd_rate_hz");  // informative keys written by bims-sim
+	v.other("imu_rate_hz");
 }
 
 void SensorsParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
                                        const std::string& section)
 {
-	ConfigSection s(cfg, section);
-	rgbd_label = s.getString("rgbd_label", rgbd_label);
-	imu_label = s.getString("imu_label", imu_label);
-	s.allow("rgbd_rate_hz");  // informative keys written by bims-sim
-	s.allow("imu_rate_hz");
-	s.finish();
+	readOptions(*this, cfg, section);
 }
 
 void EgoConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
@@ -278,7 +338,8 @@ void EgoConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	anchor.loadFromConfigFile(cfg);
 	depth_correction.loadFromConfigFile(cfg);
 	calibration.loadFromConfigFile(
-	    cfg, "calibration", requireCalibration && odometry.mode == "imu");
+	    cfg, "calibration",
+	    requireCalibration && odometry.mode == OdometryMode::Imu);
 	camera.loadFromConfigFile(cfg);
 	sensors.loadFromConfigFile(cfg);
 }

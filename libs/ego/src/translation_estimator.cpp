@@ -123,7 +123,7 @@ MotionEstimate TranslationEstimator::estimateTranslation(
 		std::shuffle(hyp.begin(), hyp.end(), rng);
 		hyp.resize(p_.iterations);
 	}
-	const bool lmeds = p_.method == "lmeds";
+	const bool lmeds = p_.method == RobustMethod::Lmeds;
 	double bestCost = std::numeric_limits<double>::infinity();
 	Eigen::Vector3d best = d[hyp[0]];
 	std::vector<double> e2(n);

@@ -154,7 +154,7 @@ namespace
 double driftWithABoard(bool anchor, int n, int* anchored = nullptr)
 {
 	EgoConfig cfg;
-	cfg.odometry.mode = "vision";
+	cfg.odometry.mode = OdometryMode::Vision;
 	cfg.anchor = params320();
 	cfg.anchor.enable = anchor;
 	Odometry odo(cfg);
@@ -193,7 +193,7 @@ TEST(KeyframeAnchor, TrackingAgainstTheKeyframeHoldsWhenABoardDominates)
 TEST(KeyframeAnchor, LostTrackingIsFlaggedAndRecovers)
 {
 	EgoConfig cfg;
-	cfg.odometry.mode = "vision";
+	cfg.odometry.mode = OdometryMode::Vision;
 	cfg.anchor = params320();
 	cfg.anchor.lost_frames = 3;
 	Odometry odo(cfg);
@@ -219,7 +219,7 @@ TEST(KeyframeAnchor, LostTrackingIsFlaggedAndRecovers)
 TEST(KeyframeAnchor, AnImuThatStopsIsFlaggedAndTheAnchorCarriesOn)
 {
 	EgoConfig cfg;
-	cfg.odometry.mode = "imu";
+	cfg.odometry.mode = OdometryMode::Imu;
 	cfg.calibration.has_R_IC = true;
 	cfg.calibration.R_IC = expSO3(Eigen::Vector3d(0.3, -0.2, 0.1));
 	cfg.anchor = params320();
@@ -252,7 +252,7 @@ TEST(KeyframeAnchor, AnImuThatStopsIsFlaggedAndTheAnchorCarriesOn)
 TEST(KeyframeAnchor, AMaskOverMostOfTheImageIsCountedAndNotUsed)
 {
 	EgoConfig cfg;
-	cfg.odometry.mode = "vision";
+	cfg.odometry.mode = OdometryMode::Vision;
 	cfg.anchor = params320();
 	Odometry odo(cfg);
 	test::Motion m;

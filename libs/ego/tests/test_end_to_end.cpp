@@ -32,7 +32,7 @@ Drift run(const std::string& mode)
 {
 	mrpt::config::CConfigFile cal(kDir + "pendulum_slow_gt/calibration.ini");
 	EgoConfig cfg;
-	cfg.odometry.mode = mode;
+	cfg.odometry.mode = bims::parseChoice<OdometryMode>(mode);
 	cfg.calibration.loadFromConfigFile(cal);
 	cfg.camera.loadFromConfigFile(cal);
 	cfg.sensors.loadFromConfigFile(cal);

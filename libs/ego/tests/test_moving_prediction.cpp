@@ -174,7 +174,7 @@ TEST(MovingPrediction, TheOdometryExcludesThePredictedMaskWhenAskedTo)
 	for (const bool predict : {false, true})
 	{
 		EgoConfig cfg;
-		cfg.odometry.mode = "vision";
+		cfg.odometry.mode = OdometryMode::Vision;
 		cfg.anchor.predict_mask = predict;
 		cfg.anchor.mask_margin_px = 0;
 		Odometry odo(cfg);

@@ -72,7 +72,7 @@ RunResult run(EgoConfig cfg, bool withImu, int frames = 30)
 TEST(Odometry, ImuRotationPlusVisualTranslation)
 {
 	EgoConfig cfg;
-	cfg.odometry.mode = "imu";
+	cfg.odometry.mode = OdometryMode::Imu;
 	const RunResult r = run(cfg, true);
 	EXPECT_EQ(r.failed, 0);
 	EXPECT_LT(r.maxRotErr_deg, 0.3);
@@ -82,7 +82,7 @@ TEST(Odometry, ImuRotationPlusVisualTranslation)
 TEST(Odometry, VisionOnlyWithoutImu)
 {
 	EgoConfig cfg;
-	cfg.odometry.mode = "vision";
+	cfg.odometry.mode = OdometryMode::Vision;
 	const RunResult r = run(cfg, false);
 	EXPECT_EQ(r.failed, 0);
 	EXPECT_LT(r.maxRotErr_deg, 1.0);
@@ -92,8 +92,8 @@ TEST(Odometry, VisionOnlyWithoutImu)
 TEST(Odometry, RefinedImuRotation)
 {
 	EgoConfig cfg;
-	cfg.odometry.mode = "imu";
-	cfg.translation.refine = "se3";
+	cfg.odometry.mode = OdometryMode::Imu;
+	cfg.translation.refine = TranslationRefine::SE3;
 	const RunResult r = run(cfg, true);
 	EXPECT_EQ(r.failed, 0);
 	EXPECT_LT(r.maxRotErr_deg, 0.3);
@@ -118,7 +118,7 @@ TEST(Odometry, ImuModeWithoutImuDataFallsBackToVisionAndFlags)
 TEST(Odometry, FlagsBadInputAndKeepsGoing)
 {
 	EgoConfig cfg;
-	cfg.odometry.mode = "vision";
+	cfg.odometry.mode = OdometryMode::Vision;
 	Odometry odo(cfg);
 	test::Motion m;
 	RgbdFrame f0 = test::render(m.R(0), m.p(0), K320(), 320, 240, 0);
@@ -175,7 +175,7 @@ TEST(Odometry, MissingCalibrationKeyIsAClearError)
 TEST(Odometry, CorrectLastMotionReplacesThePoseAndTheFallback)
 {
 	EgoConfig cfg;
-	cfg.odometry.mode = "vision";
+	cfg.odometry.mode = OdometryMode::Vision;
 	cfg.anchor.enable = false;  // (an anchored pose is not corrected)
 	Odometry odo(cfg);
 	test::Motion m;
@@ -212,7 +212,7 @@ namespace
 double maxChainInconsistencyDeg(bool followConverging)
 {
 	EgoConfig cfg;
-	cfg.odometry.mode = "imu";
+	cfg.odometry.mode = OdometryMode::Imu;
 	cfg.odometry.follow_converging_attitude = followConverging;
 	cfg.anchor.enable = false;  // (anchored poses chain by construction)
 	cfg.calibration.R_IC = kR_IC;
@@ -259,7 +259,7 @@ TEST(Odometry, WorldRotationIntegratesTheGyroWhileTheFilterConverges)
 TEST(Odometry, PredictedRotationIsTheGyroRotationOfTheNextFrame)
 {
 	EgoConfig cfg;
-	cfg.odometry.mode = "imu";
+	cfg.odometry.mode = OdometryMode::Imu;
 	cfg.calibration.R_IC = kR_IC;
 	cfg.calibration.has_R_IC = true;
 	Odometry odo(cfg);

@@ -53,7 +53,7 @@ TEST(TranslationEstimator, RecoversTranslationWith40PercentOutliers)
 	for (const char* method : {"ransac", "lmeds"})
 	{
 		TranslationParams p;
-		p.method = method;
+		p.method = bims::parseChoice<RobustMethod>(method);
 		const MotionEstimate m =
 		    TranslationEstimator(p).estimateTranslation(d.c, kR);
 		ASSERT_TRUE(m.ok) << method;

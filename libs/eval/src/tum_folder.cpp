@@ -106,7 +106,7 @@ TumFolder readTumFolder(const std::string& folder, const ImportParams& params)
 		TumFrame f;
 		f.tRgb = rgb[i].t;
 		f.tDepth = depth[j].t;
-		f.t = params.timestampFrom == "rgb" ? f.tRgb : f.tDepth;
+		f.t = params.timestampFrom == TimestampSource::Rgb ? f.tRgb : f.tDepth;
 		f.rgbPath = rgb[i].path;
 		f.depthPath = depth[j].path;
 		out.frames.push_back(f);

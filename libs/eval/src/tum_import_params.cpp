@@ -43,7 +43,7 @@ void ImportParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg)
 	ConfigSection im(cfg, "import");
 	maxTimeGap = im.getDouble("max_time_gap_s", maxTimeGap, 0.0, 10.0);
 	bonnGt = im.getBool("bonn_gt", bonnGt);
-	timestampFrom = im.getEnum("timestamp", timestampFrom, {"depth", "rgb"});
+	timestampFrom = im.getChoice("timestamp", timestampFrom);
 	gtMaxGap = im.getDouble("gt_max_gap_s", gtMaxGap, 0.0, 60.0);
 	rangeUnits = im.getDouble("range_units", rangeUnits, 1e-6, 0.1);
 	im.finish();

@@ -139,6 +139,15 @@ cv::Mat expectedFlowExact(const cv::Mat& depth, const mrpt::img::TCamera& cam,
 	return flow;
 }
 
+cv::Mat expectedFlow(ExpectedFlowModel model, const cv::Mat& depth,
+                     const mrpt::img::TCamera& cam,
+                     const mrpt::poses::CPose3D& T_prev_cur)
+{
+	return model == ExpectedFlowModel::Linear
+	           ? expectedFlowLinear(depth, cam, T_prev_cur)
+	           : expectedFlowExact(depth, cam, T_prev_cur);
+}
+
 cv::Mat expectedFlowLinear(const cv::Mat& depth, const mrpt::img::TCamera& cam,
                            const mrpt::poses::CPose3D& T_prev_cur)
 {

@@ -39,18 +39,14 @@ struct Sample
 };
 }  // namespace
 
-FlowPoseMode flowPoseModeFromString(const std::string& s)
-{
-	if (s == "translation") return FlowPoseMode::Translation;
-	if (s == "se3") return FlowPoseMode::SE3;
-	throw std::invalid_argument("unknown flow pose mode '" + s +
-	                            "' (translation|se3)");
-}
-
 FlowPoseParams flowPoseParamsFrom(const FlowParams& f)
 {
 	FlowPoseParams p;
-	p.mode = flowPoseModeFromString(f.refine_pose);
+	if (f.refine_pose == RefinePose::None)
+		throw std::invalid_argument("flowPoseParamsFrom: refine_pose = none");
+	p.mode = f.refine_pose == RefinePose::Translation
+	             ? FlowPoseMode::Translation
+	             : FlowPoseMode::SE3;
 	p.step_px = f.refine_step_px;
 	p.iterations = f.refine_iterations;
 	p.max_depth_m = f.max_depth_m;

@@ -19,25 +19,16 @@ bool soleReference(const cv::Mat& m)
 }
 }  // namespace
 
-std::string disPresetFor(const std::string& preset, int width)
+DisPreset disPresetFor(DisPreset preset, int width)
 {
-	if (preset != "auto") return preset;
-	return width >= kDisUltrafastMinWidth ? "ultrafast" : "fast";
+	if (preset != DisPreset::Auto) return preset;
+	return width >= kDisUltrafastMinWidth ? DisPreset::Ultrafast
+	                                      : DisPreset::Fast;
 }
 
 ObservedFlow::ObservedFlow(const FlowParams& p) : p_(p)
 {
-	if (p_.method == "dis")
-	{
-		if (p_.dis_preset != "auto" && p_.dis_preset != "ultrafast" &&
-		    p_.dis_preset != "fast" && p_.dis_preset != "medium")
-			throw std::invalid_argument("observed flow: unknown DIS preset '" +
-			                            p_.dis_preset + "'");
-		// (created by the first compute(): "auto" depends on the width)
-	}
-	else if (p_.method != "farneback")
-		throw std::invalid_argument("observed flow: unknown method '" +
-		                            p_.method + "'");
+	// (DIS is created by the first compute(): "auto" depends on the width)
 	if (p_.downscale < 1)
 		throw std::invalid_argument("observed flow: downscale must be >= 1");
 }
@@ -53,7 +44,7 @@ cv::Mat ObservedFlow::compute(const cv::Mat& prev, const cv::Mat& cur)
 	// one before it is written again only if nobody else holds it.
 	std::swap(tensor_, spareTensor_);
 	if (!soleReference(tensor_)) tensor_.release();
-	if (p_.visible_change_grey > 0 || p_.refine_pose != "none")
+	if (p_.visible_change_grey > 0 || p_.refine_pose != RefinePose::None)
 		structureTensor(cur, p_.texture_window_px, tensor_, tensorBuf_);
 	else
 		tensor_.release();
@@ -65,15 +56,17 @@ cv::Mat ObservedFlow::compute(const cv::Mat& prev, const cv::Mat& cur)
 		cv::resize(prev, b, s, 0, 0, cv::INTER_AREA);
 	}
 	cv::Mat flow;
-	if (p_.method == "dis")
+	if (p_.method == FlowMethod::Dis)
 	{
-		const std::string preset = disPresetFor(p_.dis_preset, a.cols);
+		const DisPreset preset = disPresetFor(p_.dis_preset, a.cols);
 		if (!dis_ || preset != disPreset_)
 		{
 			dis_ = cv::DISOpticalFlow::create(
-			    preset == "ultrafast" ? cv::DISOpticalFlow::PRESET_ULTRAFAST
-			    : preset == "medium"  ? cv::DISOpticalFlow::PRESET_MEDIUM
-			                          : cv::DISOpticalFlow::PRESET_FAST);
+			    preset == DisPreset::Ultrafast
+			        ? cv::DISOpticalFlow::PRESET_ULTRAFAST
+			    : preset == DisPreset::Medium
+			        ? cv::DISOpticalFlow::PRESET_MEDIUM
+			        : cv::DISOpticalFlow::PRESET_FAST);
 			disPreset_ = preset;
 		}
 		dis_->calc(a, b, flow);

@@ -2,6 +2,7 @@
 #include <bims/flow/consistency.h>
 #include <bims/flow/expected_flow.h>
 #include <bims/flow/observed_flow.h>
+#include <bims_test/presets.h>
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
 
@@ -31,7 +32,8 @@ TEST(Consistency, MovingPatchIsDiffAndStaticBackgroundIsNot)
 
 	cv::Mat depth(H, W, CV_32FC1, cv::Scalar(static_cast<float>(z)));
 	depth(cv::Rect(0, 0, W, 4)).setTo(0.0f);  // a strip without depth
-	FlowParams p;
+	// the paper's labels: no visibility gate, a 1.5 px threshold
+	auto p = bims::test::paperPreset<FlowParams>("flow");
 	ObservedFlow of(p);
 	const cv::Mat obs = of.compute(prev, cur);
 	const cv::Mat exp = expectedFlowExact(depth, cam, T_prev_cur);
@@ -74,7 +76,7 @@ TEST(Consistency, ParamsRejectUnknownKeysAndBadValues)
 	mrpt::config::CConfigFileMemory ok(
 	    "[flow]\nmethod = farneback\ndiff_threshold_px = 2.5\n");
 	p.loadFromConfigFile(ok);
-	EXPECT_EQ(p.method, "farneback");
+	EXPECT_EQ(p.method, FlowMethod::Farneback);
 	EXPECT_DOUBLE_EQ(p.diff_threshold_px, 2.5);
 	mrpt::config::CConfigFileMemory typo("[flow]\ndiff_treshold_px = 2.5\n");
 	EXPECT_THROW(p.loadFromConfigFile(typo), bims::ConfigError);

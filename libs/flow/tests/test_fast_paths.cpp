@@ -254,7 +254,9 @@ TEST(ObservedFlow, KeepsTheTensorAndFlowItReturned)
 		          0.0);
 	}
 	// without the gate (and refine_pose none) no tensor
-	ObservedFlow plain;
+	FlowParams off;
+	off.visible_change_grey = 0;
+	ObservedFlow plain(off);
 	plain.compute(a, b);
 	EXPECT_TRUE(plain.tensor().empty());
 }

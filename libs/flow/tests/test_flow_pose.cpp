@@ -147,7 +147,9 @@ TEST(FlowPose, BadInputThrows)
 	p.step_px = 0;
 	EXPECT_THROW(refinePoseWithFlow(obs, depth, cam, kInit, p),
 	             std::invalid_argument);
-	EXPECT_THROW(flowPoseModeFromString("rotation"), std::invalid_argument);
+	FlowParams none;
+	none.refine_pose = RefinePose::None;  // nothing to refine
+	EXPECT_THROW(flowPoseParamsFrom(none), std::invalid_argument);
 	EXPECT_THROW(structureTensor(cv::Mat(), 9), std::invalid_argument);
 	EXPECT_THROW(depthEdgeMask(obs, 0.05, 2), std::invalid_argument);
 }
@@ -208,6 +210,7 @@ TEST(Consistency, DepthEdgesGetNoLabel)
 	const cv::Mat exp = expectedFlowExact(depth, cam, T);
 	const cv::Mat obs(H, W, CV_32FC2, cv::Scalar(0.0f, 0.0f));
 	FlowParams p;
+	p.visible_change_grey = 0;  // no tensor: the gate off
 	p.depth_edge_rel = 0.05;
 	const cv::Mat lab = labelConsistency(obs, exp, depth, cam, T, p);
 	EXPECT_EQ(lab.at<int8_t>(H / 2, W / 2), kNoLabel);

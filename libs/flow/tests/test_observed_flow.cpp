@@ -1,6 +1,8 @@
+#include <bims/common/config.h>
 #include <bims/flow/expected_flow.h>
 #include <bims/flow/observed_flow.h>
 #include <gtest/gtest.h>
+#include <mrpt/config/CConfigFileMemory.h>
 
 #include <algorithm>
 #include <vector>
@@ -40,7 +42,7 @@ TEST(ObservedFlow, RecoversASubpixelShiftWithEveryMethod)
 	                      Case{"dis", 2, 0.35}})
 	{
 		FlowParams p;
-		p.method = c.method;
+		p.method = bims::parseChoice<FlowMethod>(c.method);
 		p.downscale = c.downscale;
 		ObservedFlow of(p);
 		const cv::Mat flow = of.compute(prev, cur);
@@ -133,17 +135,17 @@ TEST(ObservedFlow, DerotationRecoversAFastRotationThatPlainDisMisses)
 
 TEST(ObservedFlow, AutoPresetIsUltrafastOnVgaAndFastBelow)
 {
-	EXPECT_EQ(disPresetFor("auto", 640), "ultrafast");
-	EXPECT_EQ(disPresetFor("auto", 639), "fast");
-	EXPECT_EQ(disPresetFor("auto", 320), "fast");
-	EXPECT_EQ(disPresetFor("medium", 640), "medium");
-	EXPECT_EQ(disPresetFor("fast", 1280), "fast");
+	EXPECT_EQ(disPresetFor(DisPreset::Auto, 640), DisPreset::Ultrafast);
+	EXPECT_EQ(disPresetFor(DisPreset::Auto, 639), DisPreset::Fast);
+	EXPECT_EQ(disPresetFor(DisPreset::Auto, 320), DisPreset::Fast);
+	EXPECT_EQ(disPresetFor(DisPreset::Medium, 640), DisPreset::Medium);
+	EXPECT_EQ(disPresetFor(DisPreset::Fast, 1280), DisPreset::Fast);
 	// and ObservedFlow runs that preset: the same flow, bit for bit, on the
 	// images it is given (after downscale)
 	auto flowWith = [](const std::string& preset, int w, int h, int ds)
 	{
 		FlowParams p;
-		p.dis_preset = preset;
+		p.dis_preset = bims::parseChoice<DisPreset>(preset);
 		p.downscale = ds;
 		ObservedFlow of(p);
 		const cv::Mat prev = test::texture(w, h, 3);
@@ -159,7 +161,21 @@ TEST(ObservedFlow, AutoPresetIsUltrafastOnVgaAndFastBelow)
 	    same(flowWith("auto", 320, 240, 1), flowWith("fast", 320, 240, 1)));
 	EXPECT_TRUE(
 	    same(flowWith("auto", 640, 480, 2), flowWith("fast", 640, 480, 2)));
-	FlowParams bad;
-	bad.dis_preset = "quick";
-	EXPECT_THROW(ObservedFlow{bad}, std::invalid_argument);
+	// an unknown preset is refused when the .ini is read, naming the key,
+	// the value and the names
+	mrpt::config::CConfigFileMemory bad(
+	    std::string("[flow]\ndis_preset = quick\n"));
+	try
+	{
+		FlowParams().loadFromConfigFile(bad);
+		ADD_FAILURE() << "expected ConfigError";
+	}
+	catch (const bims::ConfigError& e)
+	{
+		EXPECT_NE(std::string(e.what()).find(
+		              "[flow] dis_preset: 'quick' is not one of "
+		              "auto|ultrafast|fast|medium"),
+		          std::string::npos)
+		    << e.what();
+	}
 }

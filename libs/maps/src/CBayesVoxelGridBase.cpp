@@ -111,7 +111,14 @@ void CBayesVoxelGridBase::writeBase(mrpt::serialization::CArchive& out) const
 void CBayesVoxelGridBase::readBase(mrpt::serialization::CArchive& in,
                                    uint8_t version)
 {
+	// Keys a version does not hold were not options yet: the map was
+	// built with the paper's model there (config/paper.ini), whatever the
+	// defaults are now.
 	GridParams p;
+	p.p_unknown = 0;
+	p.bg_neighbourhood = BgNeighbourhood::None;
+	p.exclude_moving = false;
+	p.exclude_by = ExcludeBy::Decision;
 	uint8_t decay, ev, tgt;
 	int32_t dec;
 	in >> p.voxel_size >> decay >> p.p_miss >> p.reading_lambda >> p.p_min >>

@@ -126,7 +126,7 @@ std::string COccupancyBayesGrid::asString() const
 {
 	std::ostringstream s;
 	s << "COccupancyBayesGrid (tier 0): voxel " << params_.voxel_size
-	  << " m, decay=" << toString(params_.decay) << ", " << frameCount_
+	  << " m, decay=" << choiceName(params_.decay) << ", " << frameCount_
 	  << " frames, " << grid_.numBlocks() << " blocks, "
 	  << grid_.memoryBytes() / 1048576.0 << " MiB";
 	return s.str();

@@ -7,57 +7,6 @@
 
 namespace bims::maps
 {
-const char* toString(DecayMode m)
-{
-	switch (m)
-	{
-		case DecayMode::All:
-			return "all";
-		case DecayMode::Frustum:
-			return "frustum";
-		case DecayMode::Raycast:
-			return "raycast";
-	}
-	return "?";
-}
-const char* toString(FlowEvidence e)
-{
-	return e == FlowEvidence::Veto ? "veto" : "symmetric";
-}
-const char* toString(RayTarget t)
-{
-	return t == RayTarget::Voxels ? "voxels" : "points";
-}
-const char* toString(ExcludeBy e)
-{
-	switch (e)
-	{
-		case ExcludeBy::Decision:
-			return "decision";
-		case ExcludeBy::Either:
-			return "either";
-		case ExcludeBy::Auto:
-			return "auto";
-	}
-	return "?";
-}
-
-const char* toString(BgNeighbourhood n)
-{
-	switch (n)
-	{
-		case BgNeighbourhood::None:
-			return "none";
-		case BgNeighbourhood::Ray:
-			return "ray";
-		case BgNeighbourhood::Faces:
-			return "faces";
-		case BgNeighbourhood::Block:
-			return "block";
-	}
-	return "?";
-}
-
 namespace
 {
 void check(bool ok, const char* name, const std::string& what)
@@ -97,52 +46,66 @@ void GridParams::validate() const
 	      "must be in [1, 64]");
 }
 
+void GridParams::describe(OptionVisitor& v)
+{
+	v.real("voxel_size", voxel_size, 1e-3, 10, "edge of a cubic voxel [m]");
+	v.choice("decay", decay,
+	         "tier-0 cells without a reading that get the miss update: "
+	         "every one (the paper), those in the view frustum, or those a "
+	         "ray crosses");
+	v.real("p_miss", p_miss, 1e-9, 1 - 1e-9,
+	       "P(D = 0), the sensor misses an occupied cell; decay per frame "
+	       "log(2 - p_miss)");
+	v.real("reading_lambda", reading_lambda, 1, 1e300,
+	       "tier 0/1 likelihood ratio of a reading (1: a hit only)");
+	v.real("p_min", p_min, 1e-9, 0.5 - 1e-9,
+	       "tier-0 clamping of the occupancy probability, lower");
+	v.real("p_max", p_max, 0.5 + 1e-9, 1 - 1e-9,
+	       "tier-0 clamping of the occupancy probability, upper");
+	v.real("bg_transition_eps", bg_transition_eps, 1e-12, 0.5 - 1e-9,
+	       "tier 1: eps = P(I=1 | O-=1)");
+	v.real("p_unknown", p_unknown, 0, 1 - 1e-9,
+	       "tier-0 prior of a voxel never observed (0: the paper's 0.5, "
+	       "decayed)");
+	v.choice("bg_neighbourhood", bg_neighbourhood,
+	         "tier 1: observed neighbours whose prior can explain a hit as "
+	         "background");
+	v.real("flow_transition_tau", flow_transition_tau, 1e-12, 0.5 - 1e-9,
+	       "tier 2: tau = P(Diff_C != I)");
+	v.real("flow_lambda", flow_lambda, 1 + 1e-9, 1e300,
+	       "tier-2 likelihood ratio of a reading (> 1)");
+	v.choice("flow_evidence", flow_evidence,
+	         "tier 2: Diff readings count for Diff_C = 1 only (symmetric) or "
+	         "not at all (veto)");
+	v.real("max_range", max_range, 1e-3, 1e4,
+	       "readings farther than this are skipped [m]");
+	v.real("extent", extent, 1e-2, 1e6,
+	       "readings and rays confined to |x|,|y|,|z| <= extent in {W} [m]");
+	v.real("max_memory_mb", max_memory_mb, 1, 1e7,
+	       "memory budget of one grid's voxels [MiB]");
+	v.integer("raycast_decimation", raycast_decimation, 1, 64,
+	          "decay = raycast: every k-th pixel in u and v casts a ray");
+	v.choice("raycast_target", raycast_target,
+	         "decay = raycast: rays to each reading or to each hit voxel");
+	v.flag("exclude_moving", exclude_moving,
+	       "tier 0 integrates only the voxels called static (false: the "
+	       "paper)");
+	v.choice("exclude_by", exclude_by,
+	         "exclude_moving: left out are the decision tier's moving voxels, "
+	         "tier 1's too (either), or auto (decision with raycast, either "
+	         "otherwise)");
+	v.integer("raycast_threads", raycast_threads, 1, 64,
+	          "decay = raycast: threads casting rays (same result)");
+}
+
 void GridParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
                                     const std::string& section,
                                     const std::vector<std::string>& alsoAllowed)
 {
 	bims::ConfigSection s(cfg, section);
 	for (const auto& k : alsoAllowed) s.allow(k);
-	voxel_size = s.getDouble("voxel_size", voxel_size, 1e-3, 10);
-	const auto d =
-	    s.getEnum("decay", toString(decay), {"all", "frustum", "raycast"});
-	decay = d == "all"
-	            ? DecayMode::All
-	            : (d == "frustum" ? DecayMode::Frustum : DecayMode::Raycast);
-	p_miss = s.getDouble("p_miss", p_miss, 1e-9, 1 - 1e-9);
-	reading_lambda = s.getDouble("reading_lambda", reading_lambda, 1, 1e300);
-	p_min = s.getDouble("p_min", p_min, 1e-9, 0.5 - 1e-9);
-	p_max = s.getDouble("p_max", p_max, 0.5 + 1e-9, 1 - 1e-9);
-	bg_transition_eps =
-	    s.getDouble("bg_transition_eps", bg_transition_eps, 1e-12, 0.5 - 1e-9);
-	p_unknown = s.getDouble("p_unknown", p_unknown, 0, 1 - 1e-9);
-	const auto nb = s.getEnum("bg_neighbourhood", toString(bg_neighbourhood),
-	                          {"none", "ray", "faces", "block"});
-	bg_neighbourhood = nb == "ray"     ? BgNeighbourhood::Ray
-	                   : nb == "faces" ? BgNeighbourhood::Faces
-	                   : nb == "block" ? BgNeighbourhood::Block
-	                                   : BgNeighbourhood::None;
-	flow_transition_tau = s.getDouble("flow_transition_tau",
-	                                  flow_transition_tau, 1e-12, 0.5 - 1e-9);
-	flow_lambda = s.getDouble("flow_lambda", flow_lambda, 1 + 1e-9, 1e300);
-	const auto e = s.getEnum("flow_evidence", toString(flow_evidence),
-	                         {"symmetric", "veto"});
-	flow_evidence = e == "veto" ? FlowEvidence::Veto : FlowEvidence::Symmetric;
-	max_range = s.getDouble("max_range", max_range, 1e-3, 1e4);
-	extent = s.getDouble("extent", extent, 1e-2, 1e6);
-	max_memory_mb = s.getDouble("max_memory_mb", max_memory_mb, 1, 1e7);
-	raycast_decimation =
-	    int(s.getInt("raycast_decimation", raycast_decimation, 1, 64));
-	const auto t = s.getEnum("raycast_target", toString(raycast_target),
-	                         {"points", "voxels"});
-	raycast_target = t == "voxels" ? RayTarget::Voxels : RayTarget::Points;
-	exclude_moving = s.getBool("exclude_moving", exclude_moving);
-	const auto xb = s.getEnum("exclude_by", toString(exclude_by),
-	                          {"decision", "either", "auto"});
-	exclude_by = xb == "either" ? ExcludeBy::Either
-	             : xb == "auto" ? ExcludeBy::Auto
-	                            : ExcludeBy::Decision;
-	raycast_threads = int(s.getInt("raycast_threads", raycast_threads, 1, 64));
+	OptionReader r(s);
+	describe(r);
 	s.finish();
 	try
 	{
@@ -156,39 +119,16 @@ void GridParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 
 void GridParams::dump(std::ostream& o) const
 {
-	o << "voxel_size=" << voxel_size << "\ndecay=" << toString(decay)
-	  << "\np_miss=" << p_miss << "\nreading_lambda=" << reading_lambda
-	  << "\np_min=" << p_min << "\np_max=" << p_max
-	  << "\nbg_transition_eps=" << bg_transition_eps
-	  << "\np_unknown=" << p_unknown
-	  << "\nbg_neighbourhood=" << toString(bg_neighbourhood)
-	  << "\nflow_transition_tau=" << flow_transition_tau
-	  << "\nflow_lambda=" << flow_lambda
-	  << "\nflow_evidence=" << toString(flow_evidence)
-	  << "\nmax_range=" << max_range << "\nextent=" << extent
-	  << "\nmax_memory_mb=" << max_memory_mb
-	  << "\nraycast_decimation=" << raycast_decimation
-	  << "\nraycast_target=" << toString(raycast_target)
-	  << "\nexclude_moving=" << (exclude_moving ? "true" : "false")
-	  << "\nexclude_by=" << toString(exclude_by)
-	  << "\nraycast_threads=" << raycast_threads << "\n";
+	for (const auto& r : optionRows(*this))
+		o << r.key << "=" << r.value << "\n";
 }
 
 bool GridParams::operator==(const GridParams& o) const
 {
-	return voxel_size == o.voxel_size && decay == o.decay &&
-	       p_miss == o.p_miss && reading_lambda == o.reading_lambda &&
-	       p_min == o.p_min && p_max == o.p_max &&
-	       bg_transition_eps == o.bg_transition_eps &&
-	       p_unknown == o.p_unknown && bg_neighbourhood == o.bg_neighbourhood &&
-	       flow_transition_tau == o.flow_transition_tau &&
-	       flow_lambda == o.flow_lambda && flow_evidence == o.flow_evidence &&
-	       max_range == o.max_range && extent == o.extent &&
-	       max_memory_mb == o.max_memory_mb &&
-	       raycast_decimation == o.raycast_decimation &&
-	       raycast_target == o.raycast_target &&
-	       exclude_moving == o.exclude_moving && exclude_by == o.exclude_by &&
-	       raycast_threads == o.raycast_threads;
+	const auto a = optionRows(*this), b = optionRows(o);
+	for (size_t i = 0; i < a.size(); i++)
+		if (a[i].value != b[i].value) return false;
+	return true;
 }
 
 }  // namespace bims::maps

@@ -6,12 +6,13 @@
 #include <limits>
 
 #include "scene_raycaster.h"
+#include "test_util.h"
 
 using namespace bims::maps;
 
 TEST(BadInput, NonFiniteFarAndHugePointsAreSkippedAndCounted)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.max_range = 5;
 	p.extent = 100;
 	COccupancyBayesGrid g(p);
@@ -34,7 +35,7 @@ TEST(BadInput, NonFiniteFarAndHugePointsAreSkippedAndCounted)
 TEST(BadInput, NanPoseSkipsTheFrame)
 {
 	using namespace bims::maps::test;
-	GridParams p;
+	GridParams p = test::paperGrids();
 	CBackgroundSubtractionGrid t1(p);
 	COccupancyBayesGrid t0(p);
 	auto scan = renderScan(room(), mrpt::poses::CPose3D(0, 0, 1, 0, 0, 0), 32,
@@ -53,7 +54,7 @@ TEST(BadInput, NanPoseSkipsTheFrame)
 TEST(BadInput, ZeroDepthAndWrongCameraSize)
 {
 	using namespace bims::maps::test;
-	GridParams p;
+	GridParams p = test::paperGrids();
 	auto scan = renderScan(room(), mrpt::poses::CPose3D(0, 0, 1, 0, 0, 0), 32,
 	                       24, 60, 0);
 	for (int u = 0; u < 32; ++u) scan->rangeImage(0, u) = 0;
@@ -72,7 +73,7 @@ TEST(BadInput, ZeroDepthAndWrongCameraSize)
 
 TEST(BadInput, MemoryStaysWithinTheBudget)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.voxel_size = 0.01;
 	p.max_memory_mb = 1;
 	p.decay = DecayMode::Raycast;
@@ -92,13 +93,13 @@ TEST(BadInput, MemoryStaysWithinTheBudget)
 
 TEST(BadInput, InvalidParametersAreRejected)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.flow_lambda = 1;
 	EXPECT_THROW(COccupancyBayesGrid{p}, std::invalid_argument);
-	p = GridParams();
+	p = test::paperGrids();
 	p.p_min = 0.6;
 	EXPECT_THROW(p.validate(), std::invalid_argument);
-	p = GridParams();
+	p = test::paperGrids();
 	p.voxel_size = 0.001;
 	p.extent = 1e5;
 	EXPECT_THROW(p.validate(), std::invalid_argument);

@@ -15,6 +15,7 @@
 #include <bims_test/file_size_limit.h>
 
 #include "scene_raycaster.h"
+#include "test_util.h"
 
 using namespace bims::maps;
 using namespace bims::maps::test;
@@ -27,7 +28,7 @@ MotionGrids& scenario()
 	static MotionGrids mg(
 	    []
 	    {
-		    GridParams p;
+		    GridParams p = test::paperGrids();
 		    p.decay = DecayMode::Raycast;
 		    p.voxel_size = 0.1;
 		    return p;

@@ -18,6 +18,8 @@
 #include <random>
 #include <tuple>
 
+#include "test_util.h"
+
 using namespace bims::maps;
 
 namespace
@@ -201,7 +203,7 @@ TEST(FrameCloud, BuildFromAScanEqualsThePlainUnprojectionBitForBit)
 	size_t fast = 0, checked[5] = {0, 0, 0, 0, 0};
 	for (int trial = 0; trial < 120; ++trial)
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.voxel_size = trial % 3 == 0 ? 0.02 : (trial % 3 == 1 ? 0.05 : 0.3);
 		const int kind = trial % 6;
 		float units = 1.0f / 5000;
@@ -273,7 +275,7 @@ TEST(FrameCloud, CellsOfSparseFramesSpanningManyBlocks)
 {
 	for (int wide = 0; wide < 2; ++wide)
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.voxel_size = wide ? 0.01 : 0.02;
 		p.max_range = wide ? 5000 : 30;
 		p.extent = wide ? 4000 : 500;
@@ -306,7 +308,7 @@ TEST(FrameCloud, VgaFramesWithReusedBuffersEqualThePlainDefinition)
 {
 	std::mt19937 rng(23);
 	std::uniform_real_distribution<double> U(-1, 1);
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.max_range = 6;
 	FrameCloudBuilder b(p);
 	FrameCloud f;

@@ -33,7 +33,7 @@ TEST(ModelOptions, UnknownPriorIsTheValueOfUnseenSpace)
 {
 	for (auto mode : {DecayMode::All, DecayMode::Frustum, DecayMode::Raycast})
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.decay = mode;
 		p.p_max = 0.999;
 		p.p_unknown = 0.97;
@@ -44,7 +44,7 @@ TEST(ModelOptions, UnknownPriorIsTheValueOfUnseenSpace)
 			mg.processFrame(frameAt(p, {a}, {3}, {0, 0, 0}, f), nullptr);
 		const double lu = logit(0.97);
 		EXPECT_NEAR(fromFixed(mg.occupancy()->logOddsFixed(b)), lu, 1e-5)
-		    << toString(mode);
+		    << bims::choiceName(mode);
 		// b's first hit: tier 0 starts from p_unknown (not from 0.5 decayed
 		// by 5 frames), tier 1 reads it as O-.
 		mg.processFrame(frameAt(p, {b}, {3}, {0, 0, 0}, 6), nullptr);
@@ -60,7 +60,7 @@ TEST(ModelOptions, UnknownPriorIsTheValueOfUnseenSpace)
 
 TEST(ModelOptions, PaperPriorOfUnseenSpaceDecaysUnderDecayAll)
 {
-	GridParams p;  // p_unknown = 0: the paper
+	GridParams p = test::paperGrids();  // p_unknown = 0: the paper
 	MotionGrids mg(p);
 	const VoxelKey a{0, 0, 10}, b{3, 0, 10};
 	for (int f = 1; f <= 5; ++f)
@@ -82,7 +82,7 @@ TEST(ModelOptions, RayNeighbourExplainsDepthNoiseInFrontOfASurface)
 	for (auto nb : {BgNeighbourhood::None, BgNeighbourhood::Ray,
 	                BgNeighbourhood::Faces, BgNeighbourhood::Block})
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.decay = DecayMode::All;
 		p.bg_neighbourhood = nb;
 		MotionGrids mg(p);
@@ -112,8 +112,9 @@ TEST(ModelOptions, RayNeighbourExplainsDepthNoiseInFrontOfASurface)
 			    post[i],
 			    backgroundPosterior(o, p.bg_transition_eps, p.p_miss, 0, n),
 			    1e-5)
-			    << toString(nb) << " cell " << i;
-			EXPECT_EQ(post[i] > 0, !explained) << toString(nb) << " cell " << i;
+			    << bims::choiceName(nb) << " cell " << i;
+			EXPECT_EQ(post[i] > 0, !explained)
+			    << bims::choiceName(nb) << " cell " << i;
 		}
 	}
 }
@@ -128,7 +129,7 @@ TEST(ModelOptions, ExcludeMovingKeepsAStoppedObjectFlagged)
 	const VoxelKey wall{0, 0, 40}, obj{0, 0, 20};
 	for (bool exclude : {false, true})
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.decay = DecayMode::All;
 		p.p_unknown = 0.97;
 		p.exclude_moving = exclude;
@@ -176,7 +177,7 @@ TEST(ModelOptions, ExcludeMovingFollowsTheDecisionTier)
 {
 	// Tier 2 with Diff labels on the object flags it even where tier 1 does
 	// not; the static map then leaves it out.
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.exclude_moving = true;
 	p.p_unknown = 0.97;
 	p.p_max = 0.999;
@@ -209,7 +210,7 @@ TEST(ModelOptions, ExcludeMovingFollowsTheDecisionTier)
 
 TEST(ModelOptions, NewParametersSurviveSerialisationAndIni)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.p_unknown = 0.9;
 	p.bg_neighbourhood = BgNeighbourhood::Ray;
 	p.exclude_moving = true;
@@ -227,7 +228,7 @@ TEST(ModelOptions, NewParametersSurviveSerialisationAndIni)
 	mrpt::config::CConfigFileMemory ini(
 	    "[grids]\np_unknown=0.9\nbg_neighbourhood=ray\nexclude_moving=true\n"
 	    "exclude_by=either\n");
-	GridParams q;
+	GridParams q = test::paperGrids();
 	q.loadFromConfigFile(ini, "grids");
 	EXPECT_EQ(q, p);
 	mrpt::config::CConfigFileMemory bad("[grids]\nbg_neighbourhood=sphere\n");
@@ -249,7 +250,7 @@ TEST(ModelOptions, ExcludeByEitherHoldsWhatTier1CallsMovingAgainstTheFlow)
 	for (const ExcludeBy by :
 	     {ExcludeBy::Decision, ExcludeBy::Either, ExcludeBy::Auto})
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.decay = DecayMode::All;
 		p.p_unknown = 0.97;
 		p.exclude_moving = true;
@@ -273,12 +274,13 @@ TEST(ModelOptions, ExcludeByEitherHoldsWhatTier1CallsMovingAgainstTheFlow)
 		for (size_t i = 0; i < cells.size(); ++i)
 			if (cells[i] == obj) io = i;
 		ASSERT_LT(io, cells.size());
-		EXPECT_GT(mg.background()->lastPosterior()[io], 0) << toString(by);
-		EXPECT_LT(mg.flow()->lastPosterior()[io], 0) << toString(by);
+		EXPECT_GT(mg.background()->lastPosterior()[io], 0)
+		    << bims::choiceName(by);
+		EXPECT_LT(mg.flow()->lastPosterior()[io], 0) << bims::choiceName(by);
 		if (by == ExcludeBy::Decision)
 			EXPECT_GT(mg.occupancy()->logOddsFixed(obj), before);
 		else  // either, and auto without ray casting
 			EXPECT_EQ(mg.occupancy()->logOddsFixed(obj), before)
-			    << toString(by);
+			    << bims::choiceName(by);
 	}
 }

@@ -18,7 +18,7 @@ using bims::maps::test::frameAt;
 
 TEST(BackgroundGrid, PosteriorUsesOccupancyBeforeThisFrame)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	MotionGrids mg(p);
 	const VoxelKey k{1, 2, 3};
 	std::vector<double> expected;
@@ -40,7 +40,7 @@ TEST(BackgroundGrid, PosteriorUsesOccupancyBeforeThisFrame)
 
 TEST(BackgroundGrid, LinkedTier0OrderDoesNotMatter)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	auto t0a = std::make_shared<COccupancyBayesGrid>(p);
 	auto t0b = std::make_shared<COccupancyBayesGrid>(p);
 	CBackgroundSubtractionGrid before(p), after(p);
@@ -63,7 +63,7 @@ TEST(BackgroundGrid, LinkedTier0OrderDoesNotMatter)
 
 TEST(MotionGrids, SameResultAsIndividualMapsThroughInsertObservation)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	MotionGrids mg(p);
 	CBackgroundSubtractionGrid t1(p);  // private tier-0 map
 	CFlowConsistencyGrid t2(p);
@@ -94,7 +94,7 @@ TEST(MotionGrids, SameResultAsIndividualMapsThroughInsertObservation)
 // the maps keep theirs after the next frames.
 TEST(MotionGrids, SharedCellsOfTheLastFrameAreNeverOverwritten)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	MotionGrids mg(p);
 	using namespace bims::maps::test;
 	const auto scene = room();
@@ -124,7 +124,7 @@ TEST(MotionGrids, SharedCellsOfTheLastFrameAreNeverOverwritten)
 // leaves the cells the tiers hold alone (it builds into another buffer).
 TEST(MotionGrids, LastFrameCellsAndMasksAreHandedOverWithoutACopy)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	MotionGrids mg(p);
 	using namespace bims::maps::test;
 	const auto scene = room();
@@ -169,7 +169,7 @@ TEST(MotionGrids, LastFrameCellsAndMasksAreHandedOverWithoutACopy)
 // frame hit it, nullopt otherwise (also for a voxel hit only before).
 TEST(MotionGrids, TierProbabilityIsTheLastFramesPosterior)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.voxel_size = 0.1;
 	MotionGrids mg(p);
 	const VoxelKey a{3, 0, 0}, b{5, 1, 0};
@@ -200,7 +200,7 @@ TEST(MotionGrids, TierProbabilityIsTheLastFramesPosterior)
 // sides of the packing limit.
 TEST(FlowGrid, PosteriorCountsTheLabelsAsCountLabelsOnBothSidesOf65536)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.voxel_size = 0.1;
 	CFlowConsistencyGrid g(p);
 	const double logLambda = std::log(p.flow_lambda);
@@ -256,7 +256,7 @@ TEST(FlowGrid, PosteriorCountsTheLabelsAsCountLabelsOnBothSidesOf65536)
 
 TEST(FlowGrid, LabelsMoveTheDecisionAsTheModelSays)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.flow_transition_tau = 0.05;
 	MotionGrids mg(p);
 	const VoxelKey k{0, 0, 0};
@@ -330,7 +330,7 @@ TEST(MotionGrids, StorePairEqualsTwoStores)
 {
 	for (const double mb : {256.0, 1.0})
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.voxel_size = 0.01;
 		p.max_memory_mb = mb;
 		CBackgroundSubtractionGrid a1(p), b1(p);
@@ -380,7 +380,7 @@ TEST(OccupancyGrid, IntegrateEqualsBeginFrameThenPending)
 {
 	for (const double mb : {256.0, 1.0})
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.voxel_size = 0.01;
 		p.max_memory_mb = mb;
 		COccupancyBayesGrid a(p), b(p);

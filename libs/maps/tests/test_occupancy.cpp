@@ -16,7 +16,7 @@ using bims::maps::test::frameAt;
 
 TEST(OccupancyGrid, OneFrameAppliesTheClosedFormOncePerVoxel)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.reading_lambda = 3;  // so that the count n matters
 	COccupancyBayesGrid g(p);
 	const VoxelKey k{3, -2, 5};
@@ -35,7 +35,7 @@ TEST(OccupancyGrid, OneFrameAppliesTheClosedFormOncePerVoxel)
 
 TEST(OccupancyGrid, HitEveryFrameSaturatesAtLmax)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	COccupancyBayesGrid g(p);
 	const VoxelKey k{0, 0, 0};
 	for (int f = 0; f < 10; ++f) g.integrate(frameAt(p, {k}, {1}));
@@ -45,8 +45,8 @@ TEST(OccupancyGrid, HitEveryFrameSaturatesAtLmax)
 
 TEST(OccupancyGrid, NeverHitDecaysByExactlyLog2MinusPmissPerFrame)
 {
-	GridParams p;     // decay = all
-	p.p_min = 0.001;  // room for many steps
+	GridParams p = test::paperGrids();  // decay = all
+	p.p_min = 0.001;                    // room for many steps
 	COccupancyBayesGrid g(p);
 	EXPECT_NEAR(fromFixed(g.missFixed()), std::log(2 - p.p_miss), 1e-6);
 	const VoxelKey far{100, 100, 100}, other{0, 0, 0};
@@ -64,7 +64,7 @@ TEST(OccupancyGrid, NeverHitDecaysByExactlyLog2MinusPmissPerFrame)
 
 TEST(OccupancyGrid, LazyDecayEqualsEagerDecayBitForBit)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.reading_lambda = 1.7;
 	COccupancyBayesGrid g(p);
 	std::mt19937 r(42);
@@ -107,7 +107,7 @@ TEST(OccupancyGrid, LazyDecayEqualsEagerDecayBitForBit)
 
 TEST(OccupancyGrid, RaycastFreesBeforeTheHitAndNothingBehindIt)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.decay = DecayMode::Raycast;
 	COccupancyBayesGrid g(p);
 	// Sensor in voxel (0,0,0), readings at voxels 20 and 30 along x.
@@ -129,7 +129,7 @@ TEST(OccupancyGrid, RaycastFreesBeforeTheHitAndNothingBehindIt)
 
 TEST(OccupancyGrid, RaycastDiagonalRayIsSixConnected)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.decay = DecayMode::Raycast;
 	COccupancyBayesGrid g(p);
 	const mrpt::math::TPoint3D o(0.01, 0.02, 0.03);
@@ -145,7 +145,7 @@ TEST(OccupancyGrid, RaycastDiagonalRayIsSixConnected)
 TEST(OccupancyGrid, FrustumDecaysOnlyInViewAndInFrontOfDepth)
 {
 	using namespace bims::maps::test;
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.decay = DecayMode::Frustum;
 	p.voxel_size = 0.1;
 	COccupancyBayesGrid g(p);

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "scene_raycaster.h"
+#include "test_util.h"
 
 using namespace bims::maps;
 using namespace bims::maps::test;
@@ -20,7 +21,7 @@ TEST(Scenes, StaticSceneTier1FlagsUnderOnePercentAfterNFrames)
 {
 	for (auto mode : {DecayMode::All, DecayMode::Frustum, DecayMode::Raycast})
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.decay = mode;
 		MotionGrids mg(p);
 		auto scene = room();
@@ -39,7 +40,7 @@ TEST(Scenes, StaticSceneTier1FlagsUnderOnePercentAfterNFrames)
 			}
 		}
 		ASSERT_GT(hit, 1000u);
-		EXPECT_LT(double(flagged) / hit, 0.01) << toString(mode);
+		EXPECT_LT(double(flagged) / hit, 0.01) << bims::choiceName(mode);
 	}
 }
 
@@ -47,7 +48,7 @@ TEST(Scenes, BoxMovingIntoFreeSpaceIsFlagged)
 {
 	for (auto mode : {DecayMode::All, DecayMode::Frustum, DecayMode::Raycast})
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.decay = mode;
 		MotionGrids mg(p);
 		const auto scene = room();
@@ -82,9 +83,9 @@ TEST(Scenes, BoxMovingIntoFreeSpaceIsFlagged)
 				}
 			ASSERT_GT(boxPx, 50u);
 			EXPECT_GT(double(boxFlagged) / boxPx, 0.9)
-			    << toString(mode) << " f" << f;
+			    << bims::choiceName(mode) << " f" << f;
 			EXPECT_LT(double(restFlagged) / restPx, 0.01)
-			    << toString(mode) << " f" << f;
+			    << bims::choiceName(mode) << " f" << f;
 			EXPECT_GT(r.movingTier1, 0u);
 		}
 	}
@@ -97,7 +98,7 @@ TEST(Scenes, RaycastRemembersAStaticObjectThatLeftTheView)
 	int i = 0;
 	for (auto mode : {DecayMode::All, DecayMode::Frustum, DecayMode::Raycast})
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.decay = mode;
 		MotionGrids mg(p);
 		auto scene = room();

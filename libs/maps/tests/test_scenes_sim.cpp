@@ -13,6 +13,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test_util.h"
+
 using namespace bims::maps;
 namespace sim = bims::sim;
 
@@ -97,7 +99,7 @@ TEST(SimScenes, StaticSceneTier1FlagsUnderOnePercentAfterNFrames)
 	const mrpt::poses::CPose3D T(-1.5, 0, 1.3, 0, 5 * M_PI / 180, 0);
 	for (auto mode : kModes)
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.decay = mode;
 		MotionGrids mg(p);
 		SimCamera cam;
@@ -114,7 +116,7 @@ TEST(SimScenes, StaticSceneTier1FlagsUnderOnePercentAfterNFrames)
 			}
 		}
 		ASSERT_GT(hit, 10000u);
-		EXPECT_LT(double(flagged) / hit, 0.01) << toString(mode);
+		EXPECT_LT(double(flagged) / hit, 0.01) << bims::choiceName(mode);
 	}
 }
 
@@ -140,7 +142,7 @@ TEST(SimScenes, BoxMovingIntoFreeSpaceIsFlagged)
 	const mrpt::poses::CPose3D T(-2, 0, 1.2, 0, 0, 0);
 	for (auto mode : kModes)
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.decay = mode;
 		MotionGrids mg(p);
 		SimCamera cam;
@@ -163,9 +165,9 @@ TEST(SimScenes, BoxMovingIntoFreeSpaceIsFlagged)
 			}
 			ASSERT_GT(boxPx, 200u) << "t " << t;
 			EXPECT_GT(double(boxFlagged) / boxPx, 0.9)
-			    << toString(mode) << " t " << t;
+			    << bims::choiceName(mode) << " t " << t;
 			EXPECT_LT(double(restFlagged) / restPx, 0.01)
-			    << toString(mode) << " t " << t;
+			    << bims::choiceName(mode) << " t " << t;
 		}
 	}
 }
@@ -185,14 +187,15 @@ TEST(SimScenes, RaycastRemembersAStaticObjectThatLeftTheView)
 	int i = 0;
 	for (auto mode : kModes)
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.decay = mode;
 		MotionGrids mg(p);
 		SimCamera cam;
 		const mrpt::poses::CPose3D look(-1, 0, 1.0, 0, 0, 0);
 		for (int f = 0; f < 5; ++f)
 			mg.processFrame(*cam.render(scene, 0, look, f), look, nullptr);
-		EXPECT_GT(mg.occupancy()->probabilityAt(onFace), 0.9) << toString(mode);
+		EXPECT_GT(mg.occupancy()->probabilityAt(onFace), 0.9)
+		    << bims::choiceName(mode);
 		const mrpt::poses::CPose3D away(-1, 0, 1.0, M_PI, 0, 0);
 		for (int f = 5; f < 25; ++f)
 			mg.processFrame(*cam.render(scene, 0, away, f), away, nullptr);

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "scene_raycaster.h"
+#include "test_util.h"
 
 using namespace bims::maps;
 
@@ -45,7 +46,7 @@ TEST(Serialization, OccupancyRoundTripIsExactAndKeepsWorking)
 {
 	for (auto mode : {DecayMode::All, DecayMode::Frustum, DecayMode::Raycast})
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.decay = mode;
 		p.voxel_size = 0.1;
 		MotionGrids mg(p);
@@ -73,7 +74,7 @@ TEST(Serialization, OccupancyRoundTripIsExactAndKeepsWorking)
 
 TEST(Serialization, MotionTiersRoundTrip)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.voxel_size = 0.1;
 	MotionGrids mg(p);
 	feed(mg, 4);
@@ -158,7 +159,7 @@ class Tier1WrittenAsVersion2 : public CBackgroundSubtractionGrid
 
 TEST(Serialization, Tier1OfVersion2IsRead)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.voxel_size = 0.1;
 	MotionGrids mg(p);
 	feed(mg, 4);
@@ -192,7 +193,7 @@ TEST(Serialization, Tier1OfVersion2IsRead)
 TEST(Serialization, StandaloneTier1KeepsItsPrivateTier0)
 {
 	using namespace bims::maps::test;
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.voxel_size = 0.1;
 	CBackgroundSubtractionGrid a(p);
 	const auto scene = room();
@@ -211,7 +212,7 @@ TEST(Serialization, StandaloneTier1KeepsItsPrivateTier0)
 
 TEST(Serialization, CorruptStreamThrows)
 {
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.voxel_size = 0.1;
 	MotionGrids mg(p);
 	feed(mg, 1);

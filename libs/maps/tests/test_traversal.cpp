@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "scene_raycaster.h"
+#include "test_util.h"
 
 #include <map>
 #include <random>
@@ -21,7 +22,7 @@ TEST(FrameCloud, CellsAreTheDistinctVoxelsOfTheReadingsInBlockOrder)
 {
 	for (double voxel : {0.02, 0.05, 0.3})
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.voxel_size = voxel;
 		p.max_range = 6;
 		std::mt19937 rng(3);
@@ -83,7 +84,7 @@ TEST(Raycast, SameResultAsAPlainDdaOnAMapWithAnyThreadCount)
 	const mrpt::poses::CPose3D poses[] = {{-1, 0.3, 1.2, 0.2, 0.1, 0},
 	                                      {-0.5, -0.4, 1.0, -0.6, 0.0, 0.1},
 	                                      {-1, 0.3, 1.2, 2.0, -0.2, 0}};
-	GridParams p;
+	GridParams p = test::paperGrids();
 	p.decay = DecayMode::Raycast;
 	p.voxel_size = 0.04;
 	COccupancyBayesGrid g1(p);
@@ -159,7 +160,7 @@ TEST(Frustum, SameResultAsThePlainRuleOnEveryStoredCell)
 	size_t decayed = 0, kept = 0;
 	for (double voxel : {0.03, 0.05, 0.1})
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.decay = DecayMode::Frustum;
 		p.voxel_size = voxel;
 		p.max_range = 7;
@@ -268,7 +269,7 @@ TEST(OccupancyGrid, BeginFrameThenIntegratePendingEqualsPriorThenIntegrate)
 {
 	for (int variant = 0; variant < 3; ++variant)
 	{
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.voxel_size = 0.05;
 		p.reading_lambda = 1.5;
 		if (variant == 1) p.p_unknown = 0.9;
@@ -355,7 +356,7 @@ TEST(Raycast, SameCellsBlocksAndOrderAsThePerCellWalk)
 	{
 		SCOPED_TRACE("voxel " + std::to_string(cs.voxel) + " kind " +
 		             std::to_string(cs.kind) + " mb " + std::to_string(cs.mb));
-		GridParams p;
+		GridParams p = test::paperGrids();
 		p.decay = DecayMode::Raycast;
 		p.voxel_size = cs.voxel;
 		p.p_unknown = cs.p_unknown;

@@ -2,11 +2,19 @@
 #pragma once
 
 #include <bims/maps/frame_cloud.h>
+#include <bims_test/presets.h>
 
 #include <vector>
 
 namespace bims::maps::test
 {
+/** The paper's literal model (config/paper.ini [grids]), which these tests
+ * were written against: the built-in defaults are config/default.ini's. */
+inline GridParams paperGrids()
+{
+	return bims::test::paperPreset<GridParams>("grids");
+}
+
 /** A frame with \a counts[i] readings at the centre of voxel keys[i], seen
  * from \a origin (an unorganised cloud, no intrinsics). */
 inline FrameCloud frameAt(const GridParams& p,

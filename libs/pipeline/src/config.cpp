@@ -1,73 +1,163 @@
+#include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
 #include <bims/pipeline/config.h>
 #include <mrpt/config/CConfigFile.h>
+#include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/system/filesystem.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <stdexcept>
+#include <vector>
 
 namespace bims::pipeline
 {
-const char* toString(Variant v)
+void PipelineParams::describe(OptionVisitor& v)
 {
-	switch (v)
-	{
-		case Variant::BottomOnly:
-			return "bottom-only";
-		case Variant::FlowOnly:
-			return "flow-only";
-		case Variant::Fused:
-			return "fused";
-		case Variant::FusedRaycast:
-			return "fused-raycast";
-	}
-	return "?";
-}
-
-Variant variantFromString(const std::string& s)
-{
-	for (Variant v : {Variant::BottomOnly, Variant::FlowOnly, Variant::Fused,
-	                  Variant::FusedRaycast})
-		if (s == toString(v)) return v;
-	throw std::invalid_argument(
-	    "unknown variant '" + s +
-	    "' (one of bottom-only|flow-only|fused|fused-raycast)");
+	v.choice("variant", variant,
+	         "the decision of the output mask and of the tracker's feedback");
+	v.integer("warmup_frames", warmup_frames, 0, 100000,
+	          "the first frames only build the map (empty masks)");
+	v.flag("feedback_mask", feedback_mask,
+	       "feed the moving mask back to the tracker of the next frame");
+	v.real("imu_wait_s", imu_wait_s, 0.0, 10.0,
+	       "a camera frame waits at most this long (data time) for its IMU "
+	       "samples [s]");
+	v.flag("read_ahead", read_ahead, "read and decode the input on a thread");
+	v.flag("flow_thread", flow_thread,
+	       "the observed flow on a thread of its own (same results)");
+	v.flag("flow_lookahead", flow_lookahead,
+	       "and the next frame's observed flow during this frame's grids");
+	v.flag("cloud_thread", cloud_thread,
+	       "the voxel cloud built on a thread beside the labels");
+	v.integer("opencv_threads", opencv_threads, 0, 64,
+	          "OpenCV's thread pool (0 = its default, 1 = none)");
 }
 
 void PipelineParams::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& cfg, const std::string& section)
 {
-	ConfigSection s(cfg, section);
-	variant = variantFromString(
-	    s.getEnum("variant", toString(variant),
-	              {"bottom-only", "flow-only", "fused", "fused-raycast"}));
-	warmup_frames =
-	    static_cast<int>(s.getInt("warmup_frames", warmup_frames, 0, 100000));
-	feedback_mask = s.getBool("feedback_mask", feedback_mask);
-	imu_wait_s = s.getDouble("imu_wait_s", imu_wait_s, 0.0, 10.0);
-	read_ahead = s.getBool("read_ahead", read_ahead);
-	flow_thread = s.getBool("flow_thread", flow_thread);
-	flow_lookahead = s.getBool("flow_lookahead", flow_lookahead);
-	cloud_thread = s.getBool("cloud_thread", cloud_thread);
-	opencv_threads =
-	    static_cast<int>(s.getInt("opencv_threads", opencv_threads, 0, 64));
-	s.finish();
+	readOptions(*this, cfg, section);
+}
+
+void OutputParams::describe(OptionVisitor& v)
+{
+	v.flag("moving_ply", moving_ply, "moving_voxels/NNNNNN.ply per frame");
+	v.flag("static_map", static_map,
+	       "static_map.ply and static_map.bt at the end");
+	v.flag("labelled_rawlog", labelled_rawlog,
+	       "segmented.rawlog with the masks as pixel labels");
+	v.integer("labelled_rawlog_gz_level", labelled_rawlog_gz_level, 0, 9,
+	          "0 = plain, 1..9 = gzip");
+	v.flag("flow_labels", flow_labels, "flow_labels/NNNNNN.png (Diff red)");
+	v.real("static_p_occupied", static_p_occupied, 0.5, 0.999,
+	       "occupancy probability above which a voxel is in the static map");
+	v.flag("writer_thread", writer_thread,
+	       "write the per-frame outputs on a thread");
 }
 
 void OutputParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
                                       const std::string& section)
 {
-	ConfigSection s(cfg, section);
-	moving_ply = s.getBool("moving_ply", moving_ply);
-	static_map = s.getBool("static_map", static_map);
-	labelled_rawlog = s.getBool("labelled_rawlog", labelled_rawlog);
-	labelled_rawlog_gz_level = static_cast<int>(
-	    s.getInt("labelled_rawlog_gz_level", labelled_rawlog_gz_level, 0, 9));
-	flow_labels = s.getBool("flow_labels", flow_labels);
-	static_p_occupied =
-	    s.getDouble("static_p_occupied", static_p_occupied, 0.5, 0.999);
-	writer_thread = s.getBool("writer_thread", writer_thread);
-	s.finish();
+	readOptions(*this, cfg, section);
+}
+
+namespace
+{
+/** Every section of the experiment with its options and a title, in file
+ * order: f(section, title, options). */
+template <typename Config, typename F>
+void forEachSection(Config& c, F&& f)
+{
+	f("sensors", "sensor labels in the rawlog", c.ego.sensors);
+	f("calibration", "IMU-camera extrinsics", c.ego.calibration);
+	f("camera", "intrinsics", c.ego.camera);
+	f("depth_correction", "the depth sensor's smooth distortion",
+	  c.ego.depth_correction);
+	f("attitude", "IMU attitude filter", c.ego.attitude);
+	f("tracker", "gyro-aided KLT", c.ego.tracker);
+	f("translation", "robust translation and refinement", c.ego.translation);
+	f("odometry", "the egomotion's mode", c.ego.odometry);
+	f("anchor", "map-anchored (keyframe) tracking", c.ego.anchor);
+	f("flow", "observed and expected flow, Diff labels", c.flow);
+	f("grids", "the three Bayesian grids", c.grids);
+	f("pipeline", "orchestration, variant", c.pipeline);
+	f("output", "what bims-run writes", c.output);
+}
+
+/** A table cell: no line breaks, '|' escaped. */
+std::string cell(const std::string& s)
+{
+	std::string o;
+	for (char ch : s) o += ch == '|' ? std::string("\\|") : std::string(1, ch);
+	return o;
+}
+}  // namespace
+
+void ExperimentConfig::saveToConfigFile(
+    mrpt::config::CConfigFileBase& out) const
+{
+	forEachSection(*this,
+	               [&](const char* section, const char*, const auto& opts)
+	               { writeOptions(opts, out, section); });
+}
+
+std::string ExperimentConfig::effectiveIni() const
+{
+	mrpt::config::CConfigFileMemory mem;
+	saveToConfigFile(mem);
+	return "# bims: the parameters in use, every section and key "
+	       "(docs/config.md)\n" +
+	       mem.getContent();
+}
+
+std::string configReference()
+{
+	std::string md =
+	    "# Configuration reference\n\n"
+	    "Every section and key of an experiment `.ini` that `bims-run` "
+	    "reads, with its\nbuilt-in default, its range or choices and its "
+	    "meaning. Generated from the\noption structs' `describe()` "
+	    "(`bims/common/options.h`), the source of\n`bims-run --print-config` "
+	    "and of every run's `effective.ini` too: the test\n"
+	    "`ConfigReference.DocsConfigMdIsUpToDate` fails when this file "
+	    "differs.\n\n"
+	    "The built-in defaults are the tuned model of `config/default.ini`; "
+	    "`config/paper.ini`\nis the paper's literal model. An absent key "
+	    "keeps its default, an unknown key\nor a value out of range is an "
+	    "error naming the file, the section and the key.\n"
+	    "`[import]` (read by `bims-import-tum` only) and MRPT map "
+	    "definitions (`[map...]`)\nare not listed.\n";
+	const ExperimentConfig defaults;
+	forEachSection(defaults,
+	               [&](const char* section, const char* title, const auto& opts)
+	               {
+		               md += std::string("\n## [") + section + "]: " + title +
+		                     "\n\n| key | default | range | meaning |\n"
+		                     "|---|---|---|---|\n";
+		               for (const auto& r : optionRows(opts))
+			               md += "| `" + r.key + "` | `" + cell(r.value) +
+			                     "` | " + cell(r.range) + " | " + cell(r.doc) +
+			                     " |\n";
+	               });
+	return md;
+}
+
+std::optional<int> printConfigIfAsked(int argc, char** argv)
+{
+	std::vector<std::string> args(argv + 1, argv + argc);
+	const auto it = std::find(args.begin(), args.end(), "--print-config");
+	if (it == args.end()) return std::nullopt;
+	args.erase(it);
+	if (args.size() > 1 || (args.size() == 1 && args[0].rfind("-", 0) == 0))
+		throw UsageError(
+		    "--print-config takes at most one experiment .ini and nothing "
+		    "else: bims-run --print-config [CONFIG.ini]");
+	ExperimentConfig cfg;
+	if (!args.empty()) cfg.loadFromFile(args[0]);
+	std::printf("%s", cfg.effectiveIni().c_str());
+	return 0;
 }
 
 void ExperimentConfig::loadFromConfigFile(

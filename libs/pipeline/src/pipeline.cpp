@@ -205,8 +205,8 @@ const FrameResult& Pipeline::processFrame(
 	r.ms.ego = msSince(t);
 	// A refinement may still correct the egomotion (and so the next
 	// prediction): then the look-ahead starts after it.
-	const bool mayCorrect =
-	    cfg_.flow.refine_pose != "none" && cfg_.flow.refine_to_ego;
+	const bool mayCorrect = cfg_.flow.refine_pose != flow::RefinePose::None &&
+	                        cfg_.flow.refine_to_ego;
 	// The grids take MRPT's scan frame {S} in {W}; the cloud needs nothing
 	// else (its build touches nothing the labels use).
 	mrpt::poses::CPose3D T_WS;
@@ -238,7 +238,7 @@ const FrameResult& Pipeline::processFrame(
 		const Observed o = observing.valid() ? observing.get() : observeHere();
 		r.ms.observed = o.ms;
 		const cv::Mat& obs = o.flow;
-		if (cfg_.flow.refine_pose != "none")
+		if (cfg_.flow.refine_pose != flow::RefinePose::None)
 		{
 			r.flowPose = flow::refinePoseWithFlow(
 			    obs, cur_.depth, cam, r.T_CprevC,
@@ -251,9 +251,7 @@ const FrameResult& Pipeline::processFrame(
 			}
 		}
 		const cv::Mat exp =
-		    cfg_.flow.expected == "linear"
-		        ? flow::expectedFlowLinear(cur_.depth, cam, r.T_CprevC)
-		        : flow::expectedFlowExact(cur_.depth, cam, r.T_CprevC);
+		    flow::expectedFlow(cfg_.flow.expected, cur_.depth, cam, r.T_CprevC);
 		r.labels = flow::labelConsistency(obs, exp, cur_.depth, cam, r.T_CprevC,
 		                                  cfg_.flow, &r.labelStats, &o.tensor);
 		r.maskFlow.setTo(255, r.labels == static_cast<int8_t>(flow::kDiff));

@@ -148,7 +148,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	const auto wall0 = std::chrono::steady_clock::now();
 	const double cpu0 = processCpuMs();
 	RunSummary sum;
-	sum.variant = toString(cfg.pipeline.variant);
+	sum.variant = choiceName(cfg.pipeline.variant);
 	if (opt.rawlogs.empty())
 		throw std::invalid_argument("no input rawlog given");
 
@@ -156,7 +156,10 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	Pipeline pipe(cfg);
 	std::unique_ptr<OutputWriter> out;
 	if (!opt.outDir.empty())
+	{
 		out = std::make_unique<OutputWriter>(opt.outDir, cfg.output);
+		writeFileAtomically(opt.outDir + "/effective.ini", cfg.effectiveIni());
+	}
 
 	std::map<std::string, std::vector<double>> stage;
 	std::deque<PendingScan> pending;
@@ -433,7 +436,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		stage["outputs_cpu"] = out->frameCpuMs();
 	}
 	if (sum.framesProcessed > 0 && sum.imuRead == 0 &&
-	    cfg.ego.odometry.mode == "imu")
+	    cfg.ego.odometry.mode == ego::OdometryMode::Imu)
 		sum.notes.push_back(
 		    "no IMU samples in the input" +
 		    (imuLabel.empty() ? std::string()

@@ -52,7 +52,7 @@ void CameraParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
                                       const std::string& section)
 {
 	ConfigSection s(cfg, section);
-	setResolution(s.getEnum("resolution", "640x480", {"640x480", "320x240"}));
+	setResolution(s.getChoice("resolution", "640x480", {"640x480", "320x240"}));
 	fx = s.getDouble("fx", fx, 50, 5000);
 	fy = s.getDouble("fy", fy, 50, 5000);
 	cx = s.getDouble("cx", cx, 0, 639);

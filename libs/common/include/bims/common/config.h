@@ -5,6 +5,7 @@
 // the file, the section and the key, never a silently ignored setting.
 #pragma once
 
+#include <bims/common/choice.h>
 #include <mrpt/config/CConfigFileBase.h>
 
 #include <set>
@@ -59,9 +60,17 @@ class ConfigSection
 	bool getBool(const std::string& key, bool def);
 	std::string getString(const std::string& key, const std::string& def);
 	std::string requireString(const std::string& key);
-	/** One of \a allowed (exact match); default if absent. */
-	std::string getEnum(const std::string& key, const std::string& def,
-	                    const std::vector<std::string>& allowed);
+	/** One of \a names (exact match); default if absent. Any other value
+	 * is an error naming file, section, key, the value and the names. */
+	std::string getChoice(const std::string& key, const std::string& def,
+	                      const std::vector<std::string>& names);
+	/** The same for a choice enum, by its table (bims/common/choice.h). */
+	template <typename E>
+	E getChoice(const std::string& key, E def)
+	{
+		const auto c = choices(def);
+		return *c.find(getChoice(key, c.name(def), c.names()));
+	}
 	/** A whitespace/comma separated list of exactly \a n reals (or the
 	 * default if absent), each in [min, max]. */
 	std::vector<double> getDoubles(const std::string& key,

@@ -2,12 +2,17 @@
 // experiment file ([attitude], [tracker], [translation], [odometry],
 // [calibration], [camera], [sensors]; see bims/common/experiment.h).
 //
-// Each struct has defaults and loadFromConfigFile(cfg, section), which reads
-// through bims::ConfigSection: out-of-range values and unknown keys are
-// ConfigError naming the file, the section and the key. Derivations of the
-// filter and the gating rules: docs/attitude.md; the rest: docs/ego.md.
+// Each struct has defaults (config/default.ini's values: the built-in
+// defaults are that file's model), describe() naming every key once
+// (bims/common/options.h: reading, effective.ini, docs/config.md) and
+// loadFromConfigFile(cfg, section), which reads through it: out-of-range
+// values, bad choices and unknown keys are ConfigError naming the file, the
+// section and the key. Derivations of the filter and the gating rules:
+// docs/attitude.md; the rest: docs/ego.md.
 #pragma once
 
+#include <bims/common/choice.h>
+#include <bims/common/options.h>
 #include <mrpt/config/CConfigFileBase.h>
 
 #include <Eigen/Core>
@@ -18,6 +23,71 @@
 
 namespace bims::ego
 {
+/** [attitude] mag_reference: where the magnetometer's reference comes from. */
+enum class MagReference
+{
+	Auto,  ///< norm and dip learnt from the first undisturbed samples
+	Fixed  ///< mag_norm / mag_dip_deg
+};
+inline Choices<MagReference> choices(MagReference)
+{
+	static constexpr ChoiceName<MagReference> t[] = {
+	    {MagReference::Auto, "auto"}, {MagReference::Fixed, "fixed"}};
+	return t;
+}
+
+/** [tracker] detector: the corners new tracks start from. */
+enum class FeatureDetector
+{
+	Fast,  ///< FAST corners
+	Gftt   ///< OpenCV goodFeaturesToTrack (Shi-Tomasi)
+};
+inline Choices<FeatureDetector> choices(FeatureDetector)
+{
+	static constexpr ChoiceName<FeatureDetector> t[] = {
+	    {FeatureDetector::Fast, "fast"}, {FeatureDetector::Gftt, "gftt"}};
+	return t;
+}
+
+/** [translation] method: the robust estimator. */
+enum class RobustMethod
+{
+	Ransac,  ///< most inliers
+	Lmeds    ///< least median of squares
+};
+inline Choices<RobustMethod> choices(RobustMethod)
+{
+	static constexpr ChoiceName<RobustMethod> t[] = {
+	    {RobustMethod::Ransac, "ransac"}, {RobustMethod::Lmeds, "lmeds"}};
+	return t;
+}
+
+/** [translation] refine: what follows the robust estimate. */
+enum class TranslationRefine
+{
+	None,  ///< the IMU rotation kept as it is
+	SE3    ///< Gauss-Newton over R and t, the IMU rotation as a prior
+};
+inline Choices<TranslationRefine> choices(TranslationRefine)
+{
+	static constexpr ChoiceName<TranslationRefine> t[] = {
+	    {TranslationRefine::None, "none"}, {TranslationRefine::SE3, "se3"}};
+	return t;
+}
+
+/** [odometry] mode: where the rotation comes from. */
+enum class OdometryMode
+{
+	Imu,    ///< rotation from the attitude filter, translation from vision
+	Vision  ///< full SE(3) from the tracked 3D features
+};
+inline Choices<OdometryMode> choices(OdometryMode)
+{
+	static constexpr ChoiceName<OdometryMode> t[] = {
+	    {OdometryMode::Imu, "imu"}, {OdometryMode::Vision, "vision"}};
+	return t;
+}
+
 /** [attitude]: the accelerometer + magnetometer + gyro attitude filter. */
 struct AttitudeParams
 {
@@ -52,7 +122,7 @@ struct AttitudeParams
 	/** Reference field: "auto" learns norm and dip from the first
 	 * mag_reference_samples undisturbed-looking samples; "fixed" uses
 	 * mag_norm / mag_dip_deg. */
-	std::string mag_reference = "auto";
+	MagReference mag_reference = MagReference::Auto;
 	int mag_reference_samples = 50;
 	double mag_norm = 1.0;      ///< reference |m| (sensor units), when fixed
 	double mag_dip_deg = 60.0;  ///< reference dip below horizontal [deg]
@@ -60,6 +130,8 @@ struct AttitudeParams
 	double max_gap_s = 0.1;
 	double history_s = 10.0;  ///< attitude history kept for queries [s]
 
+	/** Every key of the section (bims/common/options.h). */
+	void describe(OptionVisitor& v);
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "attitude");
 };
@@ -67,22 +139,24 @@ struct AttitudeParams
 /** [tracker]: the gyro-aided pyramidal KLT tracker. */
 struct TrackerParams
 {
-	int max_features = 200;         ///< features kept per frame
-	int grid_cols = 8;              ///< replenishment grid (columns)
-	int grid_rows = 6;              ///< replenishment grid (rows)
-	double min_distance_px = 12;    ///< min spacing of new features [px]
-	std::string detector = "fast";  ///< "fast" or "gftt"
-	int fast_threshold = 15;        ///< FAST intensity threshold [grey levels]
-	double gftt_quality = 0.01;     ///< goodFeaturesToTrack quality level
-	int window = 15;                ///< LK window side [px] (odd)
-	int pyramid_levels = 2;         ///< LK max pyramid level (0 = none); small
-	                         ///< because the gyro aid gives a close guess
+	int max_features = 200;       ///< features kept per frame
+	int grid_cols = 8;            ///< replenishment grid (columns)
+	int grid_rows = 6;            ///< replenishment grid (rows)
+	double min_distance_px = 12;  ///< min spacing of new features [px]
+	FeatureDetector detector = FeatureDetector::Fast;
+	int fast_threshold = 15;       ///< FAST intensity threshold [grey levels]
+	double gftt_quality = 0.01;    ///< goodFeaturesToTrack quality level
+	int window = 15;               ///< LK window side [px] (odd)
+	int pyramid_levels = 2;        ///< LK max pyramid level (0 = none); small
+	                               ///< because the gyro aid gives a close guess
 	int max_iterations = 30;       ///< LK iterations per level
 	double epsilon = 0.01;         ///< LK convergence [px]
 	double fb_threshold_px = 1.0;  ///< forward-backward error limit [px]
 	double border_px = 8;    ///< tracks closer to the border are dropped [px]
 	int mask_dilate_px = 8;  ///< growth of the moving-region mask [px]
 
+	/** Every key of the section (bims/common/options.h). */
+	void describe(OptionVisitor& v);
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "tracker");
 };
@@ -90,7 +164,7 @@ struct TrackerParams
 /** [translation]: robust translation (and optional SE(3) refinement). */
 struct TranslationParams
 {
-	std::string method = "ransac";  ///< "ransac" or "lmeds"
+	RobustMethod method = RobustMethod::Ransac;
 	int iterations = 60;  ///< hypotheses for the 1-point translation model
 	int vision_iterations = 200;  ///< hypotheses for the 3-point SE(3) model
 	/** Inlier threshold on the 3D residual: a + b z^2 [m], z = depth [m]. */
@@ -99,9 +173,8 @@ struct TranslationParams
 	int min_inliers = 8;       ///< fewer inliers: frame flagged as failed
 	double min_depth_m = 0.3;  ///< depth readings outside [min,max] unused
 	double max_depth_m = 8.0;
-	/** "none": IMU rotation kept as is; "se3": Gauss-Newton refinement of
-	 * R and t over the inliers with the IMU rotation as a prior. */
-	std::string refine = "none";
+	/** Refinement of R and t over the inliers (TranslationRefine). */
+	TranslationRefine refine = TranslationRefine::None;
 	double rotation_prior_sigma_deg = 0.3;  ///< IMU rotation std. dev. [deg]
 	double point_sigma_m = 0.01;  ///< 3D residual std. dev. at 1 m [m]
 	/** Final reprojection refinement of the robust 3D estimate (t only in
@@ -111,6 +184,8 @@ struct TranslationParams
 	double reprojection_threshold_px = 3.0;  ///< inlier limit [px]
 	uint32_t seed = 1;  ///< RANSAC random seed (results are repeatable)
 
+	/** Every key of the section (bims/common/options.h). */
+	void describe(OptionVisitor& v);
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "translation");
 };
@@ -118,9 +193,9 @@ struct TranslationParams
 /** [odometry]: where the rotation comes from and whether the gyro aids. */
 struct OdometryParams
 {
-	/** "imu": rotation from the attitude filter, translation from vision
-	 * (the paper); "vision": full SE(3) from the tracked 3D features. */
-	std::string mode = "imu";
+	/** Imu: rotation from the attitude filter, translation from vision
+	 * (the paper); Vision: full SE(3) from the tracked 3D features. */
+	OdometryMode mode = OdometryMode::Imu;
 	/** Seed KLT with the gyro-predicted feature positions (when IMU data
 	 * exist; otherwise with the previous frame's rotation rate). */
 	bool gyro_aid = true;
@@ -129,7 +204,7 @@ struct OdometryParams
 	 * the absolute R_WC is pulled towards the attitude filter's by this
 	 * fraction of their difference per frame [0..1] (1 = R_WC is the
 	 * filter's, with its correction noise in every inter-frame rotation). */
-	double attitude_blend = 0.01;
+	double attitude_blend = 0.002;
 	/** mode = imu, while the attitude filter converges (its first
 	 * init_time_s): true, the absolute R_WC follows the filter (gravity and
 	 * north from the start, but every frame of that phase registers the
@@ -139,6 +214,8 @@ struct OdometryParams
 	 * rotation (docs/ego.md). */
 	bool follow_converging_attitude = false;
 
+	/** Every key of the section (bims/common/options.h). */
+	void describe(OptionVisitor& v);
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "odometry");
 };
@@ -220,6 +297,8 @@ struct AnchorParams
 	double min_depth_m = 0.3;  ///< depth outside [min,max] unused [m]
 	double max_depth_m = 6.0;
 
+	/** Every key of the section (bims/common/options.h). */
+	void describe(OptionVisitor& v);
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "anchor");
 };
@@ -231,13 +310,20 @@ struct AnchorParams
  * t_cam. */
 struct CalibrationParams
 {
-	Eigen::Matrix3d R_IC = Eigen::Matrix3d::Identity();
-	bool has_R_IC = false;     ///< R_IC was given in the file
+	/** The simulator's mounting (config/default.ini): IMU x forward, y
+	 * left, z up on the camera's optical axes. */
+	Eigen::Matrix3d R_IC =
+	    (Eigen::Matrix3d() << 0, 0, 1, -1, 0, 0, 0, -1, 0).finished();
+	/** R_IC is known: the built-in one, or read from a file that gives it
+	 * (a file without R_IC leaves it unknown: no IMU rotation). */
+	bool has_R_IC = true;
 	double time_offset_s = 0;  ///< t_imu = t_cam + time_offset_s [s]
 
 	/** Keys: R_IC = 9 reals, row major (checked orthonormal to 1e-3, then
-	 * re-orthonormalised); time_offset_s. \param requireR throws
-	 * ConfigError naming file/section/key when R_IC is missing. */
+	 * re-orthonormalised); time_offset_s. */
+	void describe(OptionVisitor& v);
+	/** \param requireR throws ConfigError naming file/section/key when the
+	 * file gives no R_IC. */
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "calibration",
 	                        bool requireR = false);
@@ -251,6 +337,8 @@ struct CameraParams
 	double fx = 0, fy = 0, cx = 0, cy = 0;  ///< [px]
 	int width = 0, height = 0;              ///< [px]
 
+	/** Every key of the section (bims/common/options.h). */
+	void describe(OptionVisitor& v);
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "camera");
 };
@@ -258,9 +346,11 @@ struct CameraParams
 /** [sensors]: sensor labels in the rawlog (empty = accept any). */
 struct SensorsParams
 {
-	std::string rgbd_label;
-	std::string imu_label;
+	std::string rgbd_label = "RGBD";
+	std::string imu_label = "IMU";
 
+	/** Every key of the section (bims/common/options.h). */
+	void describe(OptionVisitor& v);
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "sensors");
 };
@@ -276,6 +366,8 @@ struct DepthCorrectionParams
 	bool enable = false;
 	std::array<double, kDepthCorrectionTerms> coefficients{};
 
+	/** Every key of the section (bims/common/options.h). */
+	void describe(OptionVisitor& v);
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "depth_correction");
 	/** The section as .ini text (what bims-calib-depth writes). */

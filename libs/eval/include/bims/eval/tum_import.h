@@ -3,6 +3,7 @@
 // into a bims rawlog plus ground truth in OUT_gt/ (the simulator's layout).
 #pragma once
 
+#include <bims/common/choice.h>
 #include <bims/common/trajectory.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/img/TCamera.h>
@@ -37,6 +38,19 @@ struct CameraIntrinsics
 
 /** Everything bims-import-tum reads from an experiment .ini: sections
  * [camera], [import], [sensors]. */
+/** [import] timestamp: which of a frame's stamps it takes. */
+enum class TimestampSource
+{
+	Depth,
+	Rgb
+};
+inline Choices<TimestampSource> choices(TimestampSource)
+{
+	static constexpr ChoiceName<TimestampSource> t[] = {
+	    {TimestampSource::Depth, "depth"}, {TimestampSource::Rgb, "rgb"}};
+	return t;
+}
+
 struct ImportParams
 {
 	CameraIntrinsics camera;
@@ -44,9 +58,9 @@ struct ImportParams
 	double maxTimeGap = 0.02;
 	/** [import] bonn_gt: apply bonnMarkerToCamera() to groundtruth.txt. */
 	bool bonnGt = false;
-	/** [import] timestamp: stamp of a frame, "depth" or "rgb". The depth
-	 * stamp is the default: the geometry (and the pose) belongs to it. */
-	std::string timestampFrom = "depth";
+	/** [import] timestamp: the stamp of a frame. The depth stamp is the
+	 * default: the geometry (and the pose) belongs to it. */
+	TimestampSource timestampFrom = TimestampSource::Depth;
 	/** [import] gt_max_gap_s: ground truth is interpolated at each frame's
 	 * stamp only between poses at most this far apart [s]. */
 	double gtMaxGap = 0.1;

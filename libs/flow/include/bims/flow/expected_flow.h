@@ -6,6 +6,7 @@
 // with the current depth. Frames are optical ({C}: x right, y down, z fwd).
 #pragma once
 
+#include <bims/flow/params.h>
 #include <mrpt/img/TCamera.h>
 #include <mrpt/math/TPoint3D.h>
 #include <mrpt/poses/CPose3D.h>
@@ -45,6 +46,12 @@ cv::Mat expectedFlowExact(const cv::Mat& depth, const mrpt::img::TCamera& cam,
  * Same conventions as expectedFlowExact(). */
 cv::Mat expectedFlowLinear(const cv::Mat& depth, const mrpt::img::TCamera& cam,
                            const mrpt::poses::CPose3D& T_prev_cur);
+
+/** The expected flow of [flow] expected: expectedFlowExact() or
+ * expectedFlowLinear(). */
+cv::Mat expectedFlow(ExpectedFlowModel model, const cv::Mat& depth,
+                     const mrpt::img::TCamera& cam,
+                     const mrpt::poses::CPose3D& T_prev_cur);
 
 /** Flow of a pure rotation R_prev_cur, independent of depth: the infinite
  * homography H = K R K^-1 applied to every pixel (CV_32FC2, width x height of

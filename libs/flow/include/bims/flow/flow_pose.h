@@ -73,9 +73,6 @@ FlowPoseResult refinePoseWithFlow(const cv::Mat& observed, const cv::Mat& depth,
  * which must not be "none"; depth range up to max_depth_m). */
 FlowPoseParams flowPoseParamsFrom(const FlowParams& p);
 
-/** "translation" / "se3" -> FlowPoseMode; throws std::invalid_argument. */
-FlowPoseMode flowPoseModeFromString(const std::string& s);
-
 /** Marks depth discontinuities: 255 where the depth of a pixel and one of its
  * 8 neighbours within \a radius px differ by more than \a rel times the
  * nearer one, or where a neighbour has no reading (0 / NaN) and the pixel

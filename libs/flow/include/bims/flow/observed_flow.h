@@ -23,7 +23,7 @@ struct TensorBuffers
 constexpr int kDisUltrafastMinWidth = 640;
 /** The DIS preset ObservedFlow uses for \a preset on images \a width wide
  * (the images DIS sees: after [flow] downscale). */
-std::string disPresetFor(const std::string& preset, int width);
+DisPreset disPresetFor(DisPreset preset, int width);
 
 class ObservedFlow
 {
@@ -62,7 +62,7 @@ class ObservedFlow
 	TensorBuffers tensorBuf_;  ///< scratch, reused
 	cv::Mat warped_;           ///< scratch: prev derotated, reused
 	cv::Ptr<cv::DISOpticalFlow> dis_;
-	std::string disPreset_;  ///< the preset dis_ was created with
+	DisPreset disPreset_ = DisPreset::Auto;  ///< the preset dis_ has
 };
 
 /** The flow of a derotated measurement composed back: for the residual flow

@@ -1,8 +1,11 @@
 // Parameters of the three Bayesian voxel grids (experiment .ini section
 // [grids], or the creationOpts section of an MRPT map definition).
-// The model and the reasons for every default: docs/model.md.
+// The model and the reasons for every default: docs/model.md. The defaults
+// are config/default.ini's model; config/paper.ini is the paper's literal one.
 #pragma once
 
+#include <bims/common/choice.h>
+#include <bims/common/options.h>
 #include <mrpt/config/CConfigFileBase.h>
 
 #include <cstddef>
@@ -24,6 +27,14 @@ enum class DecayMode
 	/** Cells traversed by a sensor ray (3D DDA) before its hit. */
 	Raycast
 };
+inline Choices<DecayMode> choices(DecayMode)
+{
+	static constexpr ChoiceName<DecayMode> t[] = {
+	    {DecayMode::All, "all"},
+	    {DecayMode::Frustum, "frustum"},
+	    {DecayMode::Raycast, "raycast"}};
+	return t;
+}
 
 /** How tier 2 reads a Diff-labelled reading (docs/model.md, tier 2). */
 enum class FlowEvidence
@@ -34,6 +45,12 @@ enum class FlowEvidence
 	 * consistent flow carries evidence (tier 2 can only filter tier 1). */
 	Veto
 };
+inline Choices<FlowEvidence> choices(FlowEvidence)
+{
+	static constexpr ChoiceName<FlowEvidence> t[] = {
+	    {FlowEvidence::Symmetric, "symmetric"}, {FlowEvidence::Veto, "veto"}};
+	return t;
+}
 
 /** Which observed tier-0 voxels next to a hit voxel can explain its
  * readings as background (tier 1's O- is their largest prior). */
@@ -49,6 +66,15 @@ enum class BgNeighbourhood
 	/** The 26 neighbours of the 3x3x3 block. */
 	Block
 };
+inline Choices<BgNeighbourhood> choices(BgNeighbourhood)
+{
+	static constexpr ChoiceName<BgNeighbourhood> t[] = {
+	    {BgNeighbourhood::None, "none"},
+	    {BgNeighbourhood::Ray, "ray"},
+	    {BgNeighbourhood::Faces, "faces"},
+	    {BgNeighbourhood::Block, "block"}};
+	return t;
+}
 
 /** Which end point a free-space ray goes to (decay = raycast). */
 enum class RayTarget
@@ -59,6 +85,12 @@ enum class RayTarget
 	 * "discretize" option): fewer rays, same hit cells. */
 	Voxels
 };
+inline Choices<RayTarget> choices(RayTarget)
+{
+	static constexpr ChoiceName<RayTarget> t[] = {
+	    {RayTarget::Points, "points"}, {RayTarget::Voxels, "voxels"}};
+	return t;
+}
 
 /** MotionGrids with exclude_moving: which voxels tier 0 leaves out. */
 enum class ExcludeBy
@@ -68,12 +100,14 @@ enum class ExcludeBy
 	Either,    ///< those tier 1 or the decision tier calls moving
 	Auto       ///< Either, but Decision with decay = raycast (docs/model.md)
 };
-
-const char* toString(DecayMode m);
-const char* toString(FlowEvidence e);
-const char* toString(RayTarget t);
-const char* toString(BgNeighbourhood n);
-const char* toString(ExcludeBy e);
+inline Choices<ExcludeBy> choices(ExcludeBy)
+{
+	static constexpr ChoiceName<ExcludeBy> t[] = {
+	    {ExcludeBy::Decision, "decision"},
+	    {ExcludeBy::Either, "either"},
+	    {ExcludeBy::Auto, "auto"}};
+	return t;
+}
 
 /** All parameters of the grids. Probabilities are in (0, 1); log-odds are
  * natural logarithms. Defaults are explained in docs/model.md. */
@@ -82,7 +116,7 @@ struct GridParams
 	/** Edge of a cubic voxel [m]. */
 	double voxel_size = 0.05;
 	/** Which unobserved cells decay (tier 0). */
-	DecayMode decay = DecayMode::All;
+	DecayMode decay = DecayMode::Frustum;
 	/** P(D = 0): probability that the sensor misses an occupied cell. Also
 	 * sets the decay per frame, log(2 - p_miss). */
 	double p_miss = 0.1;
@@ -91,21 +125,21 @@ struct GridParams
 	double reading_lambda = 1.0;
 	/** Tier-0 clamping of the occupancy probability: [p_min, p_max]. */
 	double p_min = 0.12;
-	double p_max = 0.97;
+	double p_max = 0.999;
 	/** Tier 1: eps = P(I=1 | O-=1) = 1 - P(I=1 | O-=0). */
-	double bg_transition_eps = 0.01;
+	double bg_transition_eps = 0.001;
 	/** Tier 0: occupancy prior of a voxel never observed (its value when
 	 * its first hit or miss arrives, O- for tier 1 and the query value of
 	 * unseen space). 0 = the paper: 0.5, decayed by every frame so far
 	 * under decay = all. A value near 1 reads unseen space as static scene,
 	 * so that tier 1 does not flag every newly seen surface and the flow
 	 * decides there (docs/model.md). */
-	double p_unknown = 0;
+	double p_unknown = 0.97;
 	/** Tier 1: O- of a hit voxel is the largest tier-0 prior over the voxel
 	 * and these observed neighbours (docs/model.md). */
-	BgNeighbourhood bg_neighbourhood = BgNeighbourhood::None;
+	BgNeighbourhood bg_neighbourhood = BgNeighbourhood::Ray;
 	/** Tier 2: tau = P(Diff_C != I). */
-	double flow_transition_tau = 0.1;
+	double flow_transition_tau = 0.03;
 	/** Tier 2 per-reading likelihood ratio (must be > 1). */
 	double flow_lambda = 4.0;
 	/** Tier 2 reading of Diff labels. */
@@ -122,14 +156,14 @@ struct GridParams
 	 * ray (hits always use every pixel). 1 = full resolution. */
 	int raycast_decimation = 1;
 	/** decay = raycast: rays to each reading or to each hit voxel. */
-	RayTarget raycast_target = RayTarget::Points;
+	RayTarget raycast_target = RayTarget::Voxels;
 	/** MotionGrids: tier 0 (the background of tier 1) integrates only the
 	 * voxels that the motion decision of this frame calls static; a voxel
 	 * labelled moving keeps its belief (no hit, no miss). false = the
 	 * paper: every reading is folded into tier 0. */
-	bool exclude_moving = false;
+	bool exclude_moving = true;
 	/** exclude_moving: the voxels left out (see ExcludeBy). */
-	ExcludeBy exclude_by = ExcludeBy::Decision;
+	ExcludeBy exclude_by = ExcludeBy::Auto;
 	/** decay = raycast: threads casting the free-space rays of a frame
 	 * (the result does not depend on it). A setting of the process, not of
 	 * the map: not serialised (a loaded map has 1). */
@@ -138,6 +172,9 @@ struct GridParams
 	/** Throws std::invalid_argument naming the parameter if inconsistent. */
 	void validate() const;
 
+	/** Every key of the section (bims/common/options.h). */
+	void describe(OptionVisitor& v);
+
 	/** Reads the keys above from \a section (strict: unknown keys throw
 	 * bims::ConfigError naming file, section and key). Keys in
 	 * \a alsoAllowed are accepted without being read. */
@@ -145,9 +182,10 @@ struct GridParams
 	                        const std::string& section,
 	                        const std::vector<std::string>& alsoAllowed = {});
 
-	/** Writes every key (for dumps, serialisation checks). */
+	/** Writes every key as key=value lines (for dumps). */
 	void dump(std::ostream& out) const;
 
+	/** Every key has the same value. */
 	bool operator==(const GridParams& o) const;
 	bool operator!=(const GridParams& o) const { return !(*this == o); }
 };

@@ -1,14 +1,20 @@
 // The whole experiment read from one .ini (see config/default.ini): the
 // egomotion sections, [flow], [grids], [pipeline] and [output]. Unknown
 // sections and keys are errors naming the file, the section and the key.
+// The built-in defaults are config/default.ini's model; the configuration in
+// use is written back as an .ini (effective.ini, bims-run --print-config)
+// and the reference docs/config.md is generated from the same description.
 #pragma once
 
+#include <bims/common/choice.h>
+#include <bims/common/options.h>
 #include <bims/ego/params.h>
 #include <bims/flow/params.h>
 #include <bims/maps/grid_params.h>
 
 #include <mrpt/config/CConfigFileBase.h>
 
+#include <optional>
 #include <string>
 
 namespace bims::pipeline
@@ -22,10 +28,15 @@ enum class Variant
 	Fused,        ///< tier-2 MAP (the paper)
 	FusedRaycast  ///< tier-2 MAP with decay = raycast
 };
-const char* toString(Variant v);
-/** "bottom-only", "flow-only", "fused", "fused-raycast"; throws
- * std::invalid_argument listing the choices otherwise. */
-Variant variantFromString(const std::string& s);
+inline Choices<Variant> choices(Variant)
+{
+	static constexpr ChoiceName<Variant> t[] = {
+	    {Variant::BottomOnly, "bottom-only"},
+	    {Variant::FlowOnly, "flow-only"},
+	    {Variant::Fused, "fused"},
+	    {Variant::FusedRaycast, "fused-raycast"}};
+	return t;
+}
 
 /** [pipeline] */
 struct PipelineParams
@@ -59,6 +70,8 @@ struct PipelineParams
 	 * default (one per core). */
 	int opencv_threads = 0;
 
+	/** Every key of the section (bims/common/options.h). */
+	void describe(OptionVisitor& v);
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "pipeline");
 };
@@ -79,6 +92,8 @@ struct OutputParams
 	 * run waits for them before it ends). */
 	bool writer_thread = true;
 
+	/** Every key of the section (bims/common/options.h). */
+	void describe(OptionVisitor& v);
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "output");
 };
@@ -100,6 +115,25 @@ struct ExperimentConfig
 	/** Applies a variant: sets pipeline.variant and, for fused-raycast,
 	 * grids.decay = raycast. */
 	void setVariant(Variant v);
+
+	/** Every section and key with the value in use, as .ini text written
+	 * with MRPT's config classes, each key's meaning as a comment:
+	 * effective.ini of a run, bims-run --print-config. Read back, it gives
+	 * this configuration again (R_IC included). */
+	std::string effectiveIni() const;
+	/** The same into \a out (sections of the experiment file). */
+	void saveToConfigFile(mrpt::config::CConfigFileBase& out) const;
 };
+
+/** docs/config.md: every section and key of the experiment file with its
+ * built-in default (config/default.ini's), its range or choices and its
+ * meaning, from the same description as effectiveIni(). */
+std::string configReference();
+
+/** bims-run --print-config [CONFIG.ini]: when \a argv holds
+ * "--print-config", prints the effective configuration of CONFIG.ini (or of
+ * the built-in defaults) on stdout and returns 0; nullopt otherwise. Any
+ * other argument is a bims::UsageError. */
+std::optional<int> printConfigIfAsked(int argc, char** argv);
 
 }  // namespace bims::pipeline
