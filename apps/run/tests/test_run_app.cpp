@@ -265,10 +265,11 @@ namespace
  * was killed); its output goes to DIR/log. */
 int interruptedRun(const std::string& dir, int sig)
 {
-	return bims::test::signalWhenExists({kBin + "/bims-run", kConfig, kSample,
-	                                     kSample, "-o", dir + "/out", "-q"},
-	                                    dir + "/log",
-	                                    dir + "/out/masks/000005.png", sig);
+	// --overwrite: a stale metrics.json may be there (AfterSigkill...)
+	return bims::test::signalWhenExists(
+	    {kBin + "/bims-run", kConfig, kSample, kSample, "-o", dir + "/out",
+	     "--overwrite", "-q"},
+	    dir + "/log", dir + "/out/masks/000005.png", sig);
 }
 }  // namespace
 

@@ -54,7 +54,6 @@ FrameRange FrameRange::parse(const std::string& s)
 		return static_cast<size_t>(v);
 	};
 	FrameRange r;
-	r.text = s;
 	r.first = num(s.substr(0, colon), 0);
 	r.last = num(s.substr(colon + 1), static_cast<size_t>(-1));
 	if (r.first > r.last)
@@ -68,12 +67,22 @@ void checkFrameRangeInInputs(const FrameRange& range,
 {
 	if (range.first == 0 && !range.bounded()) return;
 	const size_t need = (range.bounded() ? range.last : range.first) + 1;
-	const size_t n = count3DScans(rawlogs, rgbdLabel, need);
+	size_t n = 0;
+	try
+	{
+		n = count3DScans(rawlogs, rgbdLabel, need);
+	}
+	catch (const std::exception&)
+	{
+		// a missing or truncated input: the run meets it as it does without
+		// a range (the frames read whole processed, the error reported)
+		return;
+	}
 	if (n >= need) return;
 	std::string files;
 	for (const auto& f : rawlogs) files += (files.empty() ? "" : ", ") + f;
 	std::string msg =
-	    "--frames " + range.text + ": the input (" + files + ") has " +
+	    "--frames " + range.toString() + ": the input (" + files + ") has " +
 	    (n == 0 ? std::string("no 3D scan")
 	            : std::to_string(n) + " 3D scans (0 to " +
 	                  std::to_string(n - 1) + ")") +

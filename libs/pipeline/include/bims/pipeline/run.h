@@ -20,10 +20,15 @@ struct FrameRange
 {
 	size_t first = 0;
 	size_t last = static_cast<size_t>(-1);
-	std::string text;  ///< as given ("A:B"), for messages
 	bool contains(size_t i) const { return i >= first && i <= last; }
 	/** B given (not "A:"). */
 	bool bounded() const { return last != static_cast<size_t>(-1); }
+	/** "A:B" ("A:" when open-ended), for messages. */
+	std::string toString() const
+	{
+		return std::to_string(first) + ":" +
+		       (bounded() ? std::to_string(last) : std::string());
+	}
 	/** Parses "A:B"; throws std::invalid_argument on bad text or A > B. */
 	static FrameRange parse(const std::string& s);
 };
@@ -32,7 +37,9 @@ struct FrameRange
  * and the inputs' 3D-scan count unless \a rawlogs hold the scans A to B
  * (A, when open-ended). Reads them up to that scan (bims::count3DScans),
  * counting the scans with label \a rgbdLabel (all when empty), as
- * runExperiment numbers them. Nothing to check for the whole input. */
+ * runExperiment numbers them. Nothing to check for the whole input, nor
+ * when an input cannot be read that far (missing, truncated): the run
+ * reports that as it would without a range. */
 void checkFrameRangeInInputs(const FrameRange& range,
                              const std::vector<std::string>& rawlogs,
                              const std::string& rgbdLabel);
