@@ -318,6 +318,17 @@ TEST(Cli, RedirectedLongCommandsPrintPlainProgressLinesWithTotalRateAndEta)
 	EXPECT_GE(n, 3u) << rerr;
 	EXPECT_EQ(linesWith(rerr, "bims-run: 150/150 frames (100 %)").size(), 1u)
 	    << rerr;
+	// bims-odom (and bims-calib-depth, the same replay): estimated too
+	const auto odom = bims::test::runCommand(
+	    "(" + kBin + "/bims-odom " + kConfig + " " + kSample + " -o " + d +
+	    "/odom.txt 2> " + d + "/odom.err)");
+	ASSERT_EQ(odom.code, 0) << odom.out;
+	const std::regex odomLine(
+	    R"(^bims-odom: \d+/~\d+ frames \(\d+ %\), [0-9.]+ frames/s, [0-9.]+ s, ETA [0-9.]+ s$)");
+	n = 0;
+	for (const auto& l : linesWith(slurp(d + "/odom.err"), "bims-odom: "))
+		n += std::regex_match(l, odomLine);
+	EXPECT_GE(n, 3u) << slurp(d + "/odom.err");
 	// -q: none
 	const auto quiet = bims::test::runCommand(
 	    "(" + kBin + "/bims-run " + kConfig + " " + kSample + " -o " + d +
