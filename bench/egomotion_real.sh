@@ -85,7 +85,7 @@ run_all() { # NAME RAWLOG GT BASECFG CALIB MODES
 		cfg="$DATA/${name}_$m.ini"
 		config "$base" "$m" "$calib" "$cfg"
 		out="$DATA/${name}_${m}_run"
-		"$BIN/bims-run" "$cfg" "$rl" -o "$out" -q > "$out.log" 2>&1
+		"$BIN/bims-run" "$cfg" "$rl" -o "$out" --overwrite -q > "$out.log" 2>&1
 		echo "| $name | bims-run | $m | $(traj "$gt" "$out/trajectory.txt") | $(counts_run "$out/frames.csv") | $(stage_ms "$out/metrics.json") |"
 		ms=$("$BIN/bims-odom" "$cfg" "$rl" -o "$DATA/${name}_${m}_odom.txt" --csv "$DATA/${name}_${m}_odom.csv" -q 2>&1 | odom_ms)
 		echo "| $name | bims-odom | $m | $(traj "$gt" "$DATA/${name}_${m}_odom.txt") | $(counts_odom "$DATA/${name}_${m}_odom.csv") | $ms |"

@@ -53,7 +53,7 @@ echo "| resolution, variant | read | egomotion | flow | observed flow | grids | 
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 for res in 640x480 320x240; do
   "$BIN/bims-sim" "$TMP/scene.ini" -o "$TMP/$res.rawlog" \
-    --frames "$FRAMES" --resolution "$res" --seed 1 -q > /dev/null 2>&1
+    --max-frames "$FRAMES" --resolution "$res" --seed 1 -q > /dev/null 2>&1
   for v in $VARIANTS; do
     for ((k = 0; k < REPEATS; k++)); do
       out="$TMP/out_${res}_$v"

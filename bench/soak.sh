@@ -33,7 +33,7 @@ INPUTS=()
 if [ -z "$INPUT" ]; then
 	echo "soak.sh: simulating $FRAMES frames at $RES ..." >&2
 	sed -e "/^\[sim\]/a gz_level=1" config/sim/pendulum_slow.ini > "$TMP/scene.ini"
-	"$BIN/bims-sim" "$TMP/scene.ini" -o "$TMP/in.rawlog" --frames "$FRAMES" \
+	"$BIN/bims-sim" "$TMP/scene.ini" -o "$TMP/in.rawlog" --max-frames "$FRAMES" \
 		--resolution "$RES" -q > /dev/null
 	INPUTS=("$TMP/in.rawlog")
 	WHAT="simulated pendulum_slow $RES"

@@ -34,13 +34,53 @@ function(bims_add_library)
   endif()
 endfunction()
 
-# bims_add_app(NAME bims-sim SOURCES ... DEPS ...): an executable in build/bin.
+# bims_add_app(NAME bims-sim SOURCES ... DEPS ... [SUMMARY "one line"]): an
+# executable in build/bin, and its man page (bims_add_man_page).
 function(bims_add_app)
-  cmake_parse_arguments(A "" "NAME" "SOURCES;DEPS" ${ARGN})
+  cmake_parse_arguments(A "" "NAME;SUMMARY" "SOURCES;DEPS" ${ARGN})
   add_executable(${A_NAME} ${A_SOURCES})
   target_link_libraries(${A_NAME} PRIVATE ${A_DEPS})
   bims_target_defaults(${A_NAME})
   install(TARGETS ${A_NAME} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  bims_add_man_page(${A_NAME} "${A_SUMMARY}")
+endfunction()
+
+# The programs' man pages, made at build time from their --help by Debian's
+# help2man (scripts/install-deps.sh installs it), into build/share/man/man1
+# (BIMS_MAN_DIR) and installed into MANDIR/man1. Without help2man, or in a
+# sanitizer build (the programs would run under the sanitizers at build
+# time), there are none, with a status message.
+find_program(BIMS_HELP2MAN help2man)
+if(BIMS_HELP2MAN AND NOT BIMS_SANITIZE)
+  set(BIMS_MAN_DIR "${PROJECT_BINARY_DIR}/share/man/man1")
+  file(MAKE_DIRECTORY "${BIMS_MAN_DIR}")
+else()
+  set(BIMS_MAN_DIR "")
+  message(STATUS "bims: no man pages (help2man not found, or a sanitizer build)")
+endif()
+
+# bims_add_man_page(program "summary"): PROGRAM.1 from `program --help`
+# (target PROGRAM-man, part of the default build).
+function(bims_add_man_page program summary)
+  if(NOT BIMS_MAN_DIR)
+    return()
+  endif()
+  if(NOT summary)
+    set(summary "a bims program")
+  endif()
+  set(page "${BIMS_MAN_DIR}/${program}.1")
+  # run by its name (PATH), so that the page's usage line has no build path
+  add_custom_command(OUTPUT "${page}"
+    COMMAND ${CMAKE_COMMAND} -E env
+            "PATH=$<TARGET_FILE_DIR:${program}>:$ENV{PATH}"
+            "${BIMS_HELP2MAN}" --no-info --no-discard-stderr
+            "--version-string=${PROJECT_VERSION}" "--name=${summary}"
+            "--output=${page}" ${program}
+    DEPENDS ${program}
+    COMMENT "man page ${program}.1 (help2man)"
+    VERBATIM)
+  add_custom_target(${program}-man ALL DEPENDS "${page}")
+  install(FILES "${page}" DESTINATION "${CMAKE_INSTALL_MANDIR}/man1")
 endfunction()
 
 # bims_add_gtest(NAME test_x SOURCES ... DEPS ... [LABELS ...] [TIMEOUT s])

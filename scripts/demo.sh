@@ -3,7 +3,8 @@
 #   1. what the sample holds (bims-info)
 #   2. the pipeline, each variant of docs/EVALUATION (bims-run)
 #   3. each variant's masks scored against the exact ground truth (bims-eval masks)
-# Outputs go to out/demo/<variant>/; the table is printed at the end.
+# Outputs go to out/demo/<variant>/ (an earlier demo's replaced: --overwrite); the
+# table is printed at the end.
 set -euo pipefail
 BUILD_DIR=${1:-build}
 cd "$(dirname "$0")/.."
@@ -26,8 +27,8 @@ printf '%-14s %9s %9s %9s %9s %9s %9s %12s\n' variant precision recall F1 IoU "v
 for v in bottom-only flow-only fused fused-raycast; do
   echo
   echo "== bims-run --variant $v"
-  "$BIN/bims-run" "$CONFIG" "$SAMPLE" -o "$OUT/$v" --variant "$v" -q | tee "$OUT/$v.log"
-  ev=$("$BIN/bims-eval" masks "$GT/masks" "$OUT/$v/masks" --depth-valid "$SAMPLE" -q)
+  "$BIN/bims-run" "$CONFIG" "$SAMPLE" -o "$OUT/$v" --variant "$v" --overwrite -q | tee "$OUT/$v.log"
+  ev=$("$BIN/bims-eval" masks "$GT/masks" "$OUT/$v/masks" --depth-valid "$SAMPLE" --overwrite -q)
   total=$(echo "$ev" | tail -n 1)
   vf1=$(echo "$ev" | sed -n 's/^voxel_total.* F1 \([0-9.na]*\) .*/\1/p')
   ate=$("$BIN/bims-eval" traj "$GT/groundtruth.txt" "$OUT/$v/trajectory.txt" -o "$OUT/$v/trajectory.png" 2>/dev/null |

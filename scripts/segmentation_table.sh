@@ -47,7 +47,7 @@ for p in $PRESETS; do
 	rl="$DATA/$p.rawlog"
 	gt="$DATA/${p}_gt"
 	if [ ! -f "$rl" ]; then
-		"$BIN/bims-sim" "config/sim/$p.ini" -o "$rl" -r "$RES" --frames "$FRAMES" --seed 1 -q >&2
+		"$BIN/bims-sim" "config/sim/$p.ini" -o "$rl" -r "$RES" --max-frames "$FRAMES" --seed 1 -q >&2
 	fi
 	make_config "$gt/calibration.ini" "$DATA/$p.ini" ""
 	make_config "$gt/calibration.ini" "$DATA/${p}_all.ini" all
@@ -56,7 +56,7 @@ for p in $PRESETS; do
 		"fused+raycast fused-raycast $p"; do
 		read -r name variant cfg <<< "$row"
 		out="$DATA/out_${p}_${name//[,=+]/_}"
-		"$BIN/bims-run" "$DATA/$cfg.ini" "$rl" -o "$out" --variant "$variant" -q > "$out.log" 2>&1 ||
+		"$BIN/bims-run" "$DATA/$cfg.ini" "$rl" -o "$out" --variant "$variant" --overwrite -q > "$out.log" 2>&1 ||
 			{ echo "| $p | $name | run failed: see $out.log | | | | | | |"; continue; }
 		ev=$("$BIN/bims-eval" masks "$gt/masks" "$out/masks" --depth-valid "$rl" -q --no-plots 2>/dev/null)
 		read -r _ _ pr _ re _ f1 _ iou <<< "$(echo "$ev" | tail -n 1)"

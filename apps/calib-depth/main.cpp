@@ -72,16 +72,9 @@ int main(int argc, char** argv)
 		    ec.anchor.enable = false;
 		    ec.depth_correction.enable = false;
 		    // (the same A:B rule as bims-run's)
-		    pipeline::FrameRange range;
-		    try
-		    {
-			    if (framesArg.isSet())
-				    range = pipeline::FrameRange::parse(framesArg.getValue());
-		    }
-		    catch (const std::invalid_argument& e)
-		    {
-			    throw UsageError(std::string("--frames: ") + e.what());
-		    }
+		    const pipeline::FrameRange range = pipeline::frameRangeOption(
+		        framesArg.getValue(), {inArg.getValue()},
+		        ec.sensors.rgbd_label);
 		    const size_t first = range.first, last = range.last;
 		    Trajectory known;
 		    if (posesArg.isSet())

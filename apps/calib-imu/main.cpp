@@ -40,7 +40,7 @@ int main(int argc, char** argv)
 		        "RAWLOG", "input rawlog (RGB-D + IMU)", true, "", "IN.rawlog",
 		        cmd);
 		    TCLAP::ValueArg<std::string> calibArg(
-		        "c", "calib",
+		        "", "calib",
 		        "extra .ini with [calibration] [camera] [sensors] (its R_IC, "
 		        "if any, "
 		        "is the reference the estimate is compared with)",
@@ -57,7 +57,7 @@ int main(int argc, char** argv)
 		        "inlier limit on the rotation-vector residual (0.3)", false,
 		        0.3, "DEG", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
-		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::parseCommandLine(cmd, argc, argv, {{"-c", "--calib"}});
 		    bims::checkOutputsSpareInputs(
 		        {cfgArg.getValue(), inArg.getValue(), calibArg.getValue()},
 		        bims::givenValues(outArg));

@@ -2,6 +2,7 @@
 #include <bims/common/frame_files.h>
 #include <bims/common/json.h>
 #include <bims/common/output_paths.h>
+#include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
 #include <bims/eval/depth_consistency.h>
 #include <bims/eval/mask_labels.h>
@@ -89,7 +90,7 @@ int cmdMasks(int argc, char** argv)
 	    "background); without it every pixel counts",
 	    false, "", "IN.rawlog", cmd);
 	TCLAP::ValueArg<std::string> plotDir(
-	    "o", "plot-dir",
+	    "o", "out",
 	    "folder for the per-frame overlays (default: PRED_MASK_DIR_eval)",
 	    false, "", "DIR", cmd);
 	TCLAP::SwitchArg noPlots("", "no-plots", "do not write overlays", cmd);
@@ -137,8 +138,14 @@ int cmdMasks(int argc, char** argv)
 	    "", "strip-frames",
 	    "comma-separated scan indices of the predictions for --strip", false,
 	    "", "i,j,..", cmd);
-	TCLAP::SwitchArg quiet("q", "quiet", "no per-frame lines", cmd);
-	bims::parseCommandLine(cmd, argc, argv);
+	TCLAP::SwitchArg overwrite(
+	    "", "overwrite",
+	    "replace the overlays of an earlier evaluation in the overlay folder "
+	    "(its NNNNNN.png files only)",
+	    cmd);
+	TCLAP::SwitchArg quiet("q", "quiet", "no per-frame lines, no progress",
+	                       cmd);
+	bims::parseCommandLine(cmd, argc, argv, {{"--plot-dir", "--out"}});
 	const std::vector<std::string> inputs = {
 	    gtArg.getValue(), predArg.getValue(), depth.getValue(),
 	    framesCsv.getValue()};
@@ -225,6 +232,9 @@ int cmdMasks(int argc, char** argv)
 	{
 		outDir = plotDir.isSet() ? plotDir.getValue() : p + "_eval";
 		bims::checkOutputsSpareInputs(inputs, {outDir});
+		// the overlays: one PNG per prediction, named as it is
+		bims::prepareOutputFolder(outDir, {{}, {{"", ".png"}}},
+		                          overwrite.getValue());
 		bims::makeDirs(outDir);
 	}
 	std::unique_ptr<ScanStream> scans;
@@ -234,8 +244,12 @@ int cmdMasks(int argc, char** argv)
 	size_t nPeopleFree = 0;
 	std::map<long, cv::Mat> tiles;  // for --strip
 	bims::Json jsonFrames = bims::Json::array();
+	bims::ProgressBar bar("bims-eval masks", match.pairs.size(),
+	                      !quiet.getValue());
+	size_t done = 0;
 	for (const ev::MaskPair& pair : match.pairs)
 	{
+		bar.update(done++);  // the pairs scored before this one
 		const ev::MaskFile& f = *pair.pred;
 		const std::string predPath = predDir + "/" + f.name;
 		const std::string gtPath = gtDir + "/" + pair.label->name;
@@ -314,6 +328,7 @@ int cmdMasks(int argc, char** argv)
 		     {"dt", bims::jsonNumber(pair.dt, 6)},
 		     {"metrics", m.toJson()}});
 	}
+	bar.finish();
 	if (!match.labelsWithoutPrediction.empty())
 		std::fprintf(
 		    stderr,

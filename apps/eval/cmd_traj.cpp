@@ -39,7 +39,7 @@ int cmdTraj(int argc, char** argv)
 	TCLAP::UnlabeledValueArg<std::string> estArg(
 	    "EST", "estimated trajectory (TUM format)", true, "", "EST.txt", cmd);
 	TCLAP::ValueArg<std::string> plot(
-	    "o", "plot", "PNG plot (default: EST without extension + _traj.png)",
+	    "o", "out", "PNG plot (default: EST without extension + _traj.png)",
 	    false, "", "FILE.png", cmd);
 	TCLAP::SwitchArg noPlot("", "no-plot", "do not write the plot", cmd);
 	TCLAP::ValueArg<std::string> json(
@@ -52,7 +52,7 @@ int cmdTraj(int argc, char** argv)
 	TCLAP::ValueArg<double> offset("", "offset",
 	                               "time offset added to EST stamps [s] (0)",
 	                               false, 0.0, "S", cmd);
-	bims::parseCommandLine(cmd, argc, argv);
+	bims::parseCommandLine(cmd, argc, argv, {{"--plot", "--out"}});
 	const std::vector<std::string> inputs = {gtArg.getValue(),
 	                                         estArg.getValue()};
 	bims::checkOutputsSpareInputs(inputs, bims::givenValues(plot, json));

@@ -26,7 +26,26 @@ int main(int argc, char** argv)
 		    const std::string sub = argv[1];
 		    if (sub == "-h" || sub == "--help")
 		    {
+			    // and each sub-command's options (one page: man bims-eval)
 			    std::printf("%s\n", usage.c_str());
+			    for (const auto& [name, fn] :
+			         {std::pair{"traj", &cmdTraj},
+			          std::pair{"masks", &cmdMasks},
+			          std::pair{"depth-consistency", &cmdDepthConsistency}})
+			    {
+				    std::string prog = std::string("bims-eval ") + name;
+				    char help[] = "--help";
+				    char* args[] = {prog.data(), help, nullptr};
+				    std::printf("\n");
+				    std::fflush(stdout);
+				    try
+				    {
+					    fn(2, args);
+				    }
+				    catch (const bims::ExitRequest&)
+				    {
+				    }
+			    }
 			    return 0;
 		    }
 		    if (sub == "--version")

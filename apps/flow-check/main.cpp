@@ -2,6 +2,7 @@
 //
 //   bims-flow-check CONFIG.ini IN.rawlog --gt GT.txt [--frames A:B]
 //                   [--csv FRAMES.csv] [--strip OUT.png --strip-frames i,j,..]
+//                   [-q]
 //
 // Runs the pipeline (flow-only variant) and, for every frame, labels the
 // observed flow against the expected flow of several relative poses:
@@ -125,6 +126,7 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<std::string> aVariant(
 		        "", "variant", "pipeline variant (default flow-only)", false,
 		        "flow-only", "VARIANT", cmd);
+		    TCLAP::SwitchArg aQuiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
 		    bims::checkOutputsSpareInputs(
 		        {aCfg.getValue(), aIn.getValue(), aGt.getValue()},
@@ -150,10 +152,9 @@ int main(int argc, char** argv)
 
 		    bims::pipeline::RunOptions opt;
 		    opt.rawlogs = {aIn.getValue()};
-		    opt.progress = false;
-		    if (aFrames.isSet())
-			    opt.frames =
-			        bims::pipeline::FrameRange::parse(aFrames.getValue());
+		    opt.progress = !aQuiet.getValue();
+		    opt.frames = bims::pipeline::frameRangeOption(
+		        aFrames.getValue(), opt.rawlogs, cfg.ego.sensors.rgbd_label);
 		    std::unique_ptr<bims::AppendFile> csv;  // each line checked
 		    if (aCsv.isSet())
 		    {

@@ -1,15 +1,17 @@
 // bims-grab: live RGB-D (OpenNI2) + IMU (Xsens) grabbing into a rawlog,
 // configured in rawlog-grabber style (one .ini section per sensor, driver=).
 //
-//   bims-grab CONFIG.ini -o OUT.rawlog [--frames N] [--live-segmentation
-//             [--experiment EXP.ini]] [--viewer]
+//   bims-grab GRAB.ini -o OUT.rawlog [--max-frames N] [--live-segmentation
+//             [--config CONFIG.ini]] [--viewer] [-q]
 //
 // Ctrl-C stops cleanly (the rawlog is complete); the rawlog is flushed after
 // every frame, so a kill or an unplug loses at most the last frame. No
-// device: a clear message and exit code 1. See docs/grab.md.
+// device: a clear message and exit code 1; --viewer without a display: the
+// same, before any sensor is opened. See docs/grab.md.
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/output_paths.h>
+#include <bims/common/progress.h>
 #include <bims/common/share.h>
 #include <bims/grab/grabber.h>
 #include <bims/pipeline/pipeline.h>
@@ -55,12 +57,13 @@ int main(int argc, char** argv)
 		        "bims-grab: grab RGB-D (OpenNI2) + IMU (Xsens) into a rawlog",
 		        ' ', bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> aCfg(
-		        "config", "grab .ini (config/grab/*.ini)", true, "",
-		        "CONFIG.ini", cmd);
+		        "grab-config",
+		        "grab .ini: the sensors (apps/grab/examples/*.ini)", true, "",
+		        "GRAB.ini", cmd);
 		    TCLAP::ValueArg<std::string> aOut("o", "out", "output rawlog", true,
 		                                      "", "OUT.rawlog", cmd);
 		    TCLAP::ValueArg<int> aFrames(
-		        "", "frames",
+		        "", "max-frames",
 		        "stop after N RGB-D frames (overrides [global] "
 		        "max_frames)",
 		        false, 0, "N", cmd);
@@ -69,21 +72,41 @@ int main(int argc, char** argv)
 		                          "frames as they come",
 		                          cmd);
 		    TCLAP::ValueArg<std::string> aExp(
-		        "", "experiment",
+		        "c", "config",
 		        "experiment .ini for --live-segmentation (default: "
 		        "share/bims/default.ini)",
-		        false, "", "EXP.ini", cmd);
+		        false, "", "CONFIG.ini", cmd);
 		    TCLAP::SwitchArg aViewer("", "viewer",
 		                             "show the RGB frames (with the moving "
 		                             "mask) in a window",
 		                             cmd);
-		    bims::parseCommandLine(cmd, argc, argv);
+		    TCLAP::SwitchArg aQuiet("q", "quiet", "no progress lines", cmd);
+		    bims::parseCommandLine(
+		        cmd, argc, argv,
+		        {{"--frames", "--max-frames"}, {"--experiment", "--config"}});
 		    bims::checkOutputsSpareInputs({aCfg.getValue(), aExp.getValue()},
 		                                  {aOut.getValue()});
 		    // Ctrl-C from now on: clean stop
 		    const auto& stop = bims::installStopSignals();
 		    if (aFrames.getValue() < 0)
-			    throw bims::UsageError("--frames must be >= 0");
+			    throw bims::UsageError("--max-frames must be >= 0");
+		    // the window before any sensor: no display fails here, before
+		    // the IMU is recorded
+		    mrpt::gui::CDisplayWindow::Ptr win;
+		    if (aViewer.getValue())
+		    {
+			    const char* display = std::getenv("DISPLAY");
+			    if (!display || !*display)
+				    throw std::runtime_error(
+				        "--viewer needs a display (DISPLAY is not set); "
+				        "grab without --viewer, or under X (e.g. xvfb-run)");
+			    win = mrpt::gui::CDisplayWindow::Create("bims-grab", 640, 480);
+			    if (!win->isOpen())
+				    throw std::runtime_error(
+				        std::string("--viewer: cannot open a window on "
+				                    "display '") +
+				        display + "'");
+		    }
 		    if (!mrpt::system::fileExists(aCfg.getValue()))
 			    throw std::runtime_error("cannot open '" + aCfg.getValue() +
 			                             "'");
@@ -106,28 +129,20 @@ int main(int argc, char** argv)
 			              << bims::parametersSource(expIni) << "\n";
 			    pipe = std::make_unique<bims::pipeline::Pipeline>(exp);
 		    }
-		    mrpt::gui::CDisplayWindow::Ptr win;
-		    if (aViewer.getValue())
-		    {
-			    win = mrpt::gui::CDisplayWindow::Create("bims-grab", 640, 480);
-			    if (!win->isOpen())
-			    {
-				    std::cerr << "bims-grab: warning: cannot open a window "
-				                 "(no display?); grabbing without viewer\n";
-				    win.reset();
-			    }
-		    }
-
 		    bims::RawlogWriter out(aOut.getValue(), 0);  // plain: flushable
 		    std::cerr << "bims-grab: writing " << aOut.getValue()
 		              << " (Ctrl-C to stop)\n";
 
 		    size_t n = 0;
+		    bims::ProgressBar bar("bims-grab",
+		                          static_cast<size_t>(aFrames.getValue()),
+		                          !aQuiet.getValue());
 		    auto onFrame =
 		        [&](const mrpt::obs::CObservation3DRangeScan::Ptr& scan,
 		            const std::vector<mrpt::obs::CObservationIMU::Ptr>& imu)
 		    {
 			    cv::Mat mask;
+			    std::string extra;
 			    if (pipe)
 			    {
 				    for (const auto& m : imu) pipe->addImu(*m);
@@ -135,11 +150,11 @@ int main(int argc, char** argv)
 				    {
 					    const auto& r = pipe->processFrame(*scan, n);
 					    mask = r.mask;
-					    if (n % 30 == 0)
-						    std::fprintf(stderr,
-						                 "bims-grab: frame %zu: %zu moving "
-						                 "voxels, %.0f ms\n",
-						                 n, r.movingVoxels, r.ms.total);
+					    char b[96];
+					    std::snprintf(b, sizeof(b),
+					                  "%zu moving voxels, %.0f ms",
+					                  r.movingVoxels, r.ms.total);
+					    extra = b;
 				    }
 				    catch (const std::exception& e)
 				    {
@@ -147,15 +162,14 @@ int main(int argc, char** argv)
 					              << "\n";
 				    }
 			    }
-			    else if (n % 30 == 0)
-				    std::fprintf(stderr, "bims-grab: %zu frames\n", n);
 			    if (win && win->isOpen()) win->showImage(preview(*scan, mask));
-			    ++n;
+			    bar.update(++n, extra);
 		    };
 
 		    const auto st = grabber.run(
 		        out, stop, static_cast<size_t>(aFrames.getValue()), onFrame);
 		    out.close();
+		    bar.finish();
 		    std::fprintf(stderr,
 		                 "bims-grab: %zu RGB-D frames, %zu IMU samples in "
 		                 "%.1f s (%s) -> %s\n",

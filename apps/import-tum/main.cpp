@@ -67,10 +67,10 @@ int main(int argc, char** argv)
 		    TCLAP::UnlabeledValueArg<std::string> folder(
 		        "FOLDER", "TUM RGB-D folder", true, "", "FOLDER", cmd);
 		    TCLAP::ValueArg<std::string> out(
-		        "o", "output", "output rawlog (ground truth goes to OUT_gt/)",
+		        "o", "out", "output rawlog (ground truth goes to OUT_gt/)",
 		        true, "", "OUT.rawlog", cmd);
 		    TCLAP::ValueArg<std::string> config(
-		        "", "config",
+		        "c", "config",
 		        "experiment .ini: [camera] intrinsics and depth_scale, "
 		        "[import], "
 		        "[sensors] (default: TUM 525/319.5/239.5, depth scale 5000)",
@@ -97,10 +97,10 @@ int main(int argc, char** argv)
 		        "--config)",
 		        cmd);
 		    TCLAP::ValueArg<uint64_t> seed(
-		        "", "seed", "random seed of --synth-imu (default 1)", false, 1,
+		        "s", "seed", "random seed of --synth-imu (default 1)", false, 1,
 		        "N", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
-		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::parseCommandLine(cmd, argc, argv, {{"--output", "--out"}});
 		    bims::checkOutputsSpareInputs(
 		        {folder.getValue(), config.getValue()},
 		        {out.getValue(),

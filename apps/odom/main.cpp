@@ -54,7 +54,7 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<std::string> outArg(
 		        "o", "out", "output TUM trajectory", true, "", "TRAJ.txt", cmd);
 		    TCLAP::ValueArg<std::string> calibArg(
-		        "c", "calib",
+		        "", "calib",
 		        "extra .ini whose [calibration] [camera] [sensors] override "
 		        "the "
 		        "config (e.g. bims-sim's OUT_gt/calibration.ini)",
@@ -85,7 +85,7 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<size_t> maxArg(
 		        "", "max-frames", "stop after N frames", false, 0, "N", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
-		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::parseCommandLine(cmd, argc, argv, {{"-c", "--calib"}});
 		    auto outputs = bims::givenValues(csvArg);
 		    outputs.push_back(outArg.getValue());
 		    checkOutputsSpareInputs(

@@ -1,7 +1,8 @@
 // bims-run: the whole pipeline over rawlogs, driven by one experiment .ini.
 //
 //   bims-run CONFIG.ini IN.rawlog [MORE.rawlog...] -o OUTDIR [--frames A:B]
-//            [--variant bottom-only|flow-only|fused|fused-raycast] [--quiet]
+//            [--variant bottom-only|flow-only|fused|fused-raycast]
+//            [--overwrite] [--quiet]
 //   bims-run --print-config [CONFIG.ini]
 //
 // Writes OUTDIR/trajectory.txt (TUM), masks/NNNNNN.png (255 = moving,
@@ -47,6 +48,11 @@ int main(int argc, char** argv)
 		        "bottom-only|flow-only|fused|fused-raycast (overrides "
 		        "[pipeline] variant)",
 		        false, "", "VARIANT", cmd);
+		    TCLAP::SwitchArg aOverwrite(
+		        "", "overwrite",
+		        "replace the outputs of an earlier run in OUTDIR (its files "
+		        "only; anything else there stays)",
+		        cmd);
 		    TCLAP::SwitchArg aQuiet("q", "quiet", "no progress line", cmd);
 		    TCLAP::SwitchArg aPrintConfig(
 		        "", "print-config",
@@ -80,18 +86,16 @@ int main(int argc, char** argv)
 		    opt.progress = !aQuiet.getValue();
 		    // SIGINT / SIGTERM: stop after the current frame, write it all
 		    opt.stop = &bims::installStopSignals();
-		    if (aFrames.isSet())
-		    {
-			    try
-			    {
-				    opt.frames =
-				        bims::pipeline::FrameRange::parse(aFrames.getValue());
-			    }
-			    catch (const std::invalid_argument& e)
-			    {
-				    throw bims::UsageError(e.what());
-			    }
-		    }
+		    opt.frames = bims::pipeline::frameRangeOption(
+		        aFrames.getValue(), opt.rawlogs, cfg.ego.sensors.rgbd_label);
+		    const size_t cleared = bims::prepareOutputFolder(
+		        opt.outDir, bims::pipeline::runOutputLayout(),
+		        aOverwrite.getValue());
+		    if (cleared)
+			    std::fprintf(stderr,
+			                 "bims-run: --overwrite: removed the %zu files of "
+			                 "an earlier run from %s\n",
+			                 cleared, opt.outDir.c_str());
 		    const auto sum = bims::pipeline::runExperiment(cfg, opt);
 		    std::printf("%s", bims::pipeline::formatSummary(sum).c_str());
 		    std::printf(

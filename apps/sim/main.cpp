@@ -1,5 +1,5 @@
 // bims-sim: synthetic RGB-D + IMU sequences with ground truth.
-//   bims-sim SCENE.ini -o OUT.rawlog [--seed N] [--frames N]
+//   bims-sim SCENE.ini -o OUT.rawlog [--seed N] [--max-frames N]
 //            [--resolution 320x240] [--preview K] [-q]
 //   bims-sim --imu-from-tum GT.txt -o IMU.rawlog [--seed N]
 //            [--config imu.ini]
@@ -73,7 +73,7 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<uint64_t> seed(
 		        "s", "seed", "Random seed (default 1)", false, 1, "N", cmd);
 		    TCLAP::ValueArg<int> frames(
-		        "f", "frames",
+		        "", "max-frames",
 		        "Number of RGB-D frames (overrides [sim] frames)", false, 0,
 		        "N", cmd);
 		    TCLAP::ValueArg<std::string> res(
@@ -93,7 +93,9 @@ int main(int argc, char** argv)
 		        "Also write OUT_gt/preview.png (RGB | depth | mask) of frame N",
 		        false, -1, "N", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "No progress bar", cmd);
-		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::parseCommandLine(
+		        cmd, argc, argv,
+		        {{"--frames", "--max-frames"}, {"-f", "--max-frames"}});
 		    bims::checkOutputsSpareInputs(
 		        {scene.getValue(), tum.getValue(), config.getValue()},
 		        {out.getValue(), bims::sim::groundTruthDirFor(out.getValue())});
@@ -115,7 +117,7 @@ int main(int argc, char** argv)
 		    if (frames.isSet())
 		    {
 			    if (frames.getValue() < 1)
-				    throw bims::UsageError("--frames must be >= 1");
+				    throw bims::UsageError("--max-frames must be >= 1");
 			    cfg.seq.frames = frames.getValue();
 		    }
 		    if (res.isSet())

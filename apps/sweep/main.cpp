@@ -33,6 +33,11 @@ int main(int argc, char** argv)
 		        false, "", "FILE", cmd);
 		    TCLAP::SwitchArg aDry(
 		        "", "dry-run", "check and list the runs, write nothing", cmd);
+		    TCLAP::SwitchArg aOverwrite(
+		        "", "overwrite",
+		        "replace an earlier sweep's plan and results in OUTDIR (and "
+		        "its runs' outputs, run by run)",
+		        cmd);
 		    TCLAP::SwitchArg aQuiet("q", "quiet", "no line per finished run",
 		                            cmd);
 		    TCLAP::ValueArg<std::string> aMetric(
@@ -51,6 +56,7 @@ int main(int argc, char** argv)
 		    o.jobsFile = aJobsFile.getValue();
 		    o.dryRun = aDry.getValue();
 		    o.quiet = aQuiet.getValue();
+		    o.overwrite = aOverwrite.getValue();
 		    o.plotMetric = aMetric.getValue();
 		    o.collect = aCollect.getValue();
 		    o.stop = &bims::installStopSignals();

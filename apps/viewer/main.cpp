@@ -3,10 +3,10 @@
 //
 //   bims-viewer [IN.rawlog] [--results OUTDIR] [--config CONFIG.ini]
 //               [--gt groundtruth.txt] [--no-pipeline] [--paused]
-//               [--speed S] [--frames N --screenshot FILE.png]
+//               [--speed S] [--max-frames N --screenshot FILE.png]
 //               [--keep-open] [--png-sequence DIR]
 //
-// Non-interactive use (tests, figures): --frames N steps N frames, then
+// Non-interactive use (tests, figures): --max-frames N steps N frames, then
 // --screenshot writes the 3D view as shown in the window and quits.
 #include <bims/common/app.h>
 #include <bims/common/output_paths.h>
@@ -61,7 +61,7 @@ int main(int argc, char** argv)
 		        "pipeline is then off unless --run-pipeline)",
 		        false, "", "OUTDIR", cmd);
 		    TCLAP::ValueArg<std::string> aCfg(
-		        "", "config",
+		        "c", "config",
 		        "experiment .ini for the pipeline (default: "
 		        "share/bims/default.ini)",
 		        false, "", "CONFIG.ini", cmd);
@@ -78,13 +78,13 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<double> aSpeed("", "speed",
 		                                   "replay speed (1 = real time)",
 		                                   false, 1.0, "S", cmd);
-		    TCLAP::ValueArg<int> aFrames("", "frames",
+		    TCLAP::ValueArg<int> aFrames("", "max-frames",
 		                                 "step N frames at start, then pause",
 		                                 false, -1, "N", cmd);
 		    TCLAP::ValueArg<std::string> aShot(
 		        "", "screenshot",
-		        "after --frames, write the 3D view to FILE.png and quit", false,
-		        "", "FILE.png", cmd);
+		        "after --max-frames, write the 3D view to FILE.png and quit",
+		        false, "", "FILE.png", cmd);
 		    TCLAP::SwitchArg aKeep(
 		        "", "keep-open",
 		        "stay open after --screenshot (e.g. for an X screenshot of "
@@ -97,7 +97,8 @@ int main(int argc, char** argv)
 		        false, "", "DIR", cmd);
 		    TCLAP::ValueArg<std::string> aSize("", "size", "window size WxH",
 		                                       false, "1280x800", "WxH", cmd);
-		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::parseCommandLine(cmd, argc, argv,
+		                           {{"--frames", "--max-frames"}});
 		    bims::checkOutputsSpareInputs({aIn.getValue(), aRes.getValue(),
 		                                   aCfg.getValue(), aGt.getValue()},
 		                                  bims::givenValues(aShot, aSeq));

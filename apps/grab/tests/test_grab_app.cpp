@@ -95,7 +95,7 @@ TEST(GrabApp, GrabsNFramesFromTheDummyDeviceWithTheReplayedImu)
 	const std::string out = kOut + "/dummy.rawlog", log = kOut + "/dummy.log";
 	std::remove(out.c_str());
 	ASSERT_EQ(run("'" + kGrab + "' '" + kIni + "' -o '" + out +
-	              "' --frames 20 > '" + log + "' 2>&1"),
+	              "' --max-frames 20 > '" + log + "' 2>&1"),
 	          0)
 	    << slurp(log);
 	const Content c = readBack(out);
@@ -118,12 +118,64 @@ TEST(GrabApp, GrabsNFramesFromTheDummyDeviceWithTheReplayedImu)
 	EXPECT_NEAR(c.t1, now, 60.0);
 }
 
+TEST(GrabApp, ViewerWithoutADisplayFailsBeforeAnySensorOpens)
+{
+	// it recorded 5 s of IMU and then fell back to grabbing without viewer
+	ASSERT_EQ(run("mkdir -p '" + kOut + "'"), 0);
+	const std::string out = kOut + "/noviewer.rawlog",
+	                  log = kOut + "/noviewer.log";
+	std::remove(out.c_str());
+	const auto t0 = std::chrono::steady_clock::now();
+	EXPECT_EQ(
+	    run("env -u DISPLAY -u WAYLAND_DISPLAY '" + kGrab + "' '" + kIni +
+	        "' -o '" + out + "' --max-frames 20 --viewer > '" + log + "' 2>&1"),
+	    1)
+	    << slurp(log);
+	const double s =
+	    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
+	        .count();
+	const std::string text = slurp(log);
+	EXPECT_NE(text.find("bims-grab: error: --viewer needs a display (DISPLAY "
+	                    "is not set)"),
+	          std::string::npos)
+	    << text;
+	// no sensor described, nothing written, no time spent grabbing
+	EXPECT_EQ(text.find("RGB-D: "), std::string::npos) << text;
+	EXPECT_EQ(text.find("IMU: "), std::string::npos) << text;
+	EXPECT_FALSE(std::filesystem::exists(out));
+	EXPECT_LT(s, 3.0);
+}
+
+TEST(GrabApp, OldSpellingsStillWorkWithANote)
+{
+	// --frames N and --experiment FILE: now --max-frames N and --config FILE
+	ASSERT_EQ(run("mkdir -p '" + kOut + "'"), 0);
+	const std::string out = kOut + "/old.rawlog", log = kOut + "/old.log";
+	EXPECT_EQ(
+	    run("'" + kGrab + "' '" + kIni + "' -o '" + out +
+	        "' --frames 3 --live-segmentation --experiment '" +
+	        BIMS_SOURCE_DIR + "/config/default.ini' -q > '" + log + "' 2>&1"),
+	    0)
+	    << slurp(log);
+	const std::string text = slurp(log);
+	EXPECT_NE(text.find("bims-grab: note: --frames 3 is now --max-frames 3\n"),
+	          std::string::npos)
+	    << text;
+	EXPECT_NE(text.find("bims-grab: note: --experiment"), std::string::npos)
+	    << text;
+	EXPECT_NE(text.find("parameters from " + std::string(BIMS_SOURCE_DIR) +
+	                    "/config/default.ini"),
+	          std::string::npos)
+	    << text;
+	EXPECT_EQ(readBack(out).scans, 3u);
+}
+
 TEST(GrabApp, LiveSegmentationWithoutExperimentUsesShareBimsDefaultIni)
 {
 	ASSERT_EQ(run("mkdir -p '" + kOut + "'"), 0);
 	const std::string out = kOut + "/seg.rawlog", log = kOut + "/seg.log";
 	ASSERT_EQ(run("'" + kGrab + "' '" + kIni + "' -o '" + out +
-	              "' --frames 3 --live-segmentation > '" + log + "' 2>&1"),
+	              "' --max-frames 3 --live-segmentation > '" + log + "' 2>&1"),
 	          0)
 	    << slurp(log);
 	// build/bin/bims-grab -> build/share/bims/default.ini, named
@@ -226,10 +278,10 @@ TEST(GrabApp, AFullDiskOrAnUnwritableOutputStopsWithAnErrorNamingTheFile)
 	// on a full disk): the frames before stay readable
 	const std::string out = kOut + "/full.rawlog", log = kOut + "/full.log";
 	std::remove(out.c_str());
-	EXPECT_EQ(
-	    run("bash -c \"ulimit -f 1024; trap '' XFSZ; exec '" + kGrab + "' '" +
-	        kIni + "' -o '" + out + "' --frames 200\" > '" + log + "' 2>&1"),
-	    1)
+	EXPECT_EQ(run("bash -c \"ulimit -f 1024; trap '' XFSZ; exec '" + kGrab +
+	              "' '" + kIni + "' -o '" + out + "' --max-frames 200\" > '" +
+	              log + "' 2>&1"),
+	          1)
 	    << slurp(log);
 	EXPECT_NE(
 	    slurp(log).find("error: grabbing stopped: " + out + ": write failed"),
@@ -243,7 +295,7 @@ TEST(GrabApp, AFullDiskOrAnUnwritableOutputStopsWithAnErrorNamingTheFile)
 	const std::string file = kOut + "/a_file";
 	std::ofstream(file) << "x";
 	EXPECT_EQ(run("'" + kGrab + "' '" + kIni + "' -o '" + file +
-	              "/x.rawlog' --frames 5 > '" + log + "' 2>&1"),
+	              "/x.rawlog' --max-frames 5 > '" + log + "' 2>&1"),
 	          1);
 	EXPECT_NE(slurp(log).find(file + "/x.rawlog: cannot create"),
 	          std::string::npos)

@@ -91,8 +91,13 @@ TEST(RunApp, SymlinkedOutputFilesAreReplacedNotFollowed)
 	     {"trajectory.txt", "frames.csv", "metrics.json", "segmented.rawlog",
 	      "static_map.ply", "masks/000001.png", "moving_voxels/000001.ply"})
 		fs::create_symlink(d + "/precious.txt", out + "/" + f);
+	// links at the output names look like an earlier run: refused, then
+	// replaced with --overwrite (the links, not their target)
+	const auto refused = run(q(kConfig) + " " + q(kSample) + " -o " + q(out) +
+	                         " --frames 0:2 -q");
+	EXPECT_EQ(refused.code, 2) << refused.out;
 	const auto r = run(q(kConfig) + " " + q(kSample) + " -o " + q(out) +
-	                   " --frames 0:2 -q");
+	                   " --frames 0:2 --overwrite -q");
 	ASSERT_EQ(r.code, 0) << r.out;
 	EXPECT_EQ(slurp(d + "/precious.txt"), "precious");
 	for (const char* f :
@@ -103,6 +108,65 @@ TEST(RunApp, SymlinkedOutputFilesAreReplacedNotFollowed)
 		EXPECT_GT(fs::file_size(out + "/" + f), 0u) << f;
 	}
 	EXPECT_EQ(bims::Json::parse(slurp(out + "/metrics.json"))["status"], "ok");
+}
+
+namespace
+{
+/** The files below \a dir, as paths relative to it, sorted. */
+std::vector<std::string> filesBelow(const std::string& dir)
+{
+	std::vector<std::string> v;
+	for (const auto& e : fs::recursive_directory_iterator(dir))
+		if (!e.is_directory())
+			v.push_back(fs::relative(e.path(), dir).string());
+	std::sort(v.begin(), v.end());
+	return v;
+}
+}  // namespace
+
+TEST(RunApp, AnEarlierRunIsRefusedAndOverwriteClearsItsFilesOnly)
+{
+	// masks of an earlier, longer run stayed beside the new ones, and
+	// bims-eval masks then scored two runs at once
+	const auto d = tmpDir("earlier_run");
+	const std::string out = d + "/out";
+	ASSERT_EQ(run(q(kConfig) + " " + q(kSample) + " -o " + q(out) +
+	              " --frames 0:4 -q")
+	              .code,
+	          0);
+	std::ofstream(out + "/notes.txt") << "mine";
+	std::ofstream(out + "/masks/README") << "mine";
+	fs::create_directories(out + "/masks_eval");
+	std::ofstream(out + "/masks_eval/000004.png") << "bims-eval's";
+	const auto before = filesBelow(out);
+
+	const auto again = run(q(kConfig) + " " + q(kSample) + " -o " + q(out) +
+	                       " --frames 0:1 -q");
+	EXPECT_EQ(again.code, 2) << again.out;
+	EXPECT_NE(again.out.find("bims-run: usage error: " + out +
+	                         ": holds the outputs of an earlier run ("),
+	          std::string::npos)
+	    << again.out;
+	EXPECT_NE(again.out.find("give --overwrite to replace them"),
+	          std::string::npos)
+	    << again.out;
+	EXPECT_EQ(filesBelow(out), before);  // untouched
+
+	const auto over = run(q(kConfig) + " " + q(kSample) + " -o " + q(out) +
+	                      " --frames 0:1 --overwrite -q");
+	ASSERT_EQ(over.code, 0) << over.out;
+	EXPECT_NE(over.out.find("bims-run: --overwrite: removed the "),
+	          std::string::npos)
+	    << over.out;
+	for (const char* f : {"notes.txt", "masks/README", "masks_eval/000004.png"})
+		EXPECT_TRUE(fs::exists(out + "/" + f)) << f;
+	for (const char* f : {"000000.png", "000001.png"})
+		EXPECT_TRUE(fs::exists(out + "/masks/" + f)) << f;
+	for (const char* f :
+	     {"masks/000002.png", "masks/000004.png", "moving_voxels/000004.ply"})
+		EXPECT_FALSE(fs::exists(out + "/" + f)) << f;
+	EXPECT_EQ(
+	    bims::Json::parse(slurp(out + "/metrics.json"))["frames_processed"], 2);
 }
 
 namespace
@@ -202,10 +266,11 @@ namespace
  * was killed); its output goes to DIR/log. */
 int interruptedRun(const std::string& dir, int sig)
 {
-	return bims::test::signalWhenExists({kBin + "/bims-run", kConfig, kSample,
-	                                     kSample, "-o", dir + "/out", "-q"},
-	                                    dir + "/log",
-	                                    dir + "/out/masks/000005.png", sig);
+	// --overwrite: a stale metrics.json may be there (AfterSigkill...)
+	return bims::test::signalWhenExists(
+	    {kBin + "/bims-run", kConfig, kSample, kSample, "-o", dir + "/out",
+	     "--overwrite", "-q"},
+	    dir + "/log", dir + "/out/masks/000005.png", sig);
 }
 }  // namespace
 

@@ -44,7 +44,7 @@ TEST(GuiViewer, XvfbScreenshotShowsTheThreeTierColours)
 	    std::string(BIMS_XVFB_RUN) +
 	    " -a -s '-screen 0 1280x900x24 +extension GLX' '" + kViewer + "' '" +
 	    kRawlog + "' --config '" + BIMS_SOURCE_DIR +
-	    "/config/default.ini' --frames 45 --size 1200x800 --screenshot '" +
+	    "/config/default.ini' --max-frames 45 --size 1200x800 --screenshot '" +
 	    shot + "' > '" + log + "' 2>&1";
 	// (frame 45: with the map-anchored egomotion tier 1 agrees with tier 2
 	// almost everywhere by frame 15, and its yellow hides behind the red)
@@ -78,7 +78,8 @@ TEST(GuiViewer, XScreenshotOfTheWholeWindowShowsTiersAndPanels)
 	    " -a -s '-screen 0 1200x800x24 +extension GLX' '" + BIMS_SOURCE_DIR +
 	    "/apps/viewer/tests/xshot.sh' '" + own + "' '" + xshot + "' '" +
 	    kViewer + "' '" + kRawlog + "' --config '" + BIMS_SOURCE_DIR +
-	    "/config/default.ini' --frames 15 --size 1200x800 > '" + log + "' 2>&1";
+	    "/config/default.ini' --max-frames 15 --size 1200x800 > '" + log +
+	    "' 2>&1";
 	ASSERT_EQ(run(cmd), 0) << slurp(log);
 	const cv::Mat img = cv::imread(xshot, cv::IMREAD_COLOR);
 	ASSERT_FALSE(img.empty()) << slurp(log);
@@ -99,7 +100,7 @@ TEST(GuiViewer, NoDisplayGivesAClearErrorAndNonZeroExit)
 	const std::string log = kOut + "/viewer_nodisplay.log";
 	ASSERT_EQ(run("mkdir -p '" + kOut + "'"), 0);
 	const int rc = run("env -u DISPLAY -u WAYLAND_DISPLAY '" + kViewer + "' '" +
-	                   kRawlog + "' --frames 1 --screenshot '" + kOut +
+	                   kRawlog + "' --max-frames 1 --screenshot '" + kOut +
 	                   "/never.png' > '" + log + "' 2>&1");
 	EXPECT_NE(rc, 0);
 	EXPECT_NE(rc, -1);  // exited, did not crash

@@ -104,6 +104,39 @@ void checkOptionNames(int argc, char** argv,
 	}
 }
 
+std::vector<std::string> renameOptions(int argc, char** argv,
+                                       const std::vector<OptionRename>& renamed,
+                                       const std::vector<OptionName>& known)
+{
+	std::vector<std::string> args(argv, argv + argc);
+	const std::string program =
+	    argc > 0 ? std::filesystem::path(argv[0]).filename().string() : "";
+	const auto takesValue = [&](const std::string& name)
+	{
+		for (const auto& k : known)
+			if (k.name == name) return k.takesValue;
+		return false;
+	};
+	for (size_t i = 1; i < args.size(); ++i)
+	{
+		if (args[i] == "--") break;  // the rest is positional
+		for (const auto& r : renamed)
+		{
+			if (args[i] != r.old) continue;
+			args[i] = r.now;
+			const std::string value = takesValue(r.now) && i + 1 < args.size()
+			                              ? " " + args[i + 1]
+			                              : "";
+			std::fprintf(stderr, "%s: note: %s%s is now %s%s\n",
+			             program.c_str(), r.old.c_str(), value.c_str(),
+			             r.now.c_str(), value.c_str());
+			break;
+		}
+		if (takesValue(args[i])) ++i;  // its value is no option
+	}
+	return args;
+}
+
 const char* version()
 {
 	return BIMS_VERSION;

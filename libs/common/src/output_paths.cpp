@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -187,6 +188,95 @@ void writeImageFile(const std::string& path, const cv::Mat& img)
 	}
 	if (!ok) throw std::runtime_error(path + ": cannot encode image");
 	writeFileAtomically(path, std::string(bytes.begin(), bytes.end()));
+}
+
+}  // namespace bims
+
+namespace bims
+{
+namespace
+{
+/** "000042.png", "1548339824.89375.png" with ext ".png". */
+bool isFrameFileName(const std::string& name, const std::string& ext)
+{
+	if (name.size() <= ext.size() ||
+	    name.compare(name.size() - ext.size(), ext.size(), ext) != 0)
+		return false;
+	const std::string stem = name.substr(0, name.size() - ext.size());
+	size_t dots = 0;
+	for (char c : stem)
+		if (c == '.')
+			++dots;
+		else if (c < '0' || c > '9')
+			return false;
+	return dots <= 1 && stem.front() != '.' && stem.back() != '.';
+}
+}  // namespace
+
+std::vector<std::string> earlierOutputs(const std::string& dir,
+                                        const OutputFolderLayout& layout)
+{
+	namespace fs = std::filesystem;
+	std::vector<std::string> found;
+	std::error_code ec;
+	if (!fs::is_directory(dir, ec)) return found;
+	for (const auto& f : layout.files)
+		for (const std::string& name : {f, f + ".partial"})
+		{
+			const fs::path p = fs::path(dir) / name;
+			if (fs::is_symlink(p, ec) || fs::exists(p, ec))
+				found.push_back(p.string());
+		}
+	for (const auto& [sub, ext] : layout.frameFolders)
+	{
+		const fs::path d = sub.empty() ? fs::path(dir) : fs::path(dir) / sub;
+		if (!fs::is_directory(d, ec)) continue;
+		for (const auto& e : fs::directory_iterator(d, ec))
+		{
+			const std::string name = e.path().filename().string();
+			if (isFrameFileName(name, ext) ||
+			    (name.size() > 8 &&
+			     name.compare(name.size() - 8, 8, ".partial") == 0 &&
+			     isFrameFileName(name.substr(0, name.size() - 8), ext)))
+				found.push_back(e.path().string());
+		}
+	}
+	std::sort(found.begin(), found.end());
+	return found;
+}
+
+size_t prepareOutputFolder(const std::string& dir,
+                           const OutputFolderLayout& layout, bool overwrite,
+                           const std::string& overwriteFlag)
+{
+	namespace fs = std::filesystem;
+	const auto found = earlierOutputs(dir, layout);
+	if (found.empty()) return 0;
+	if (!overwrite)
+		throw UsageError(
+		    dir + ": holds the outputs of an earlier run (" +
+		    std::to_string(found.size()) + " files, e.g. " +
+		    fs::path(found.front()).lexically_relative(dir).string() +
+		    "); give " + overwriteFlag +
+		    " to replace them, or another output folder");
+	for (const auto& f : found)
+	{
+		std::error_code ec;
+		if (fs::is_directory(fs::symlink_status(f, ec)))
+			throw std::runtime_error(f +
+			                         ": is a folder where the run writes a "
+			                         "file; not removed");
+		if (!fs::remove(f, ec) || ec)
+			throw std::runtime_error(f + ": cannot remove it for " +
+			                         overwriteFlag + ": " + ec.message());
+	}
+	for (const auto& [sub, ext] : layout.frameFolders)
+	{
+		std::error_code ec;
+		if (!sub.empty() && fs::is_empty(fs::path(dir) / sub, ec))
+			fs::remove(fs::path(dir) / sub, ec);
+	}
+	return found.size();
 }
 
 }  // namespace bims

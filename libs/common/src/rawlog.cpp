@@ -5,6 +5,7 @@
 
 #include <mrpt/img/CImage.h>
 #include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/archiveFrom_std_streams.h>
 #include <mrpt/system/filesystem.h>
@@ -198,6 +199,50 @@ RawlogReader::RawlogReader(const std::string& path) : path_(path)
 	const std::string imgDir = rawlogImagesDirectory(path);
 	if (mrpt::system::directoryExists(imgDir))
 		mrpt::img::CImage::setImagesPathBase(imgDir);
+}
+
+uint64_t RawlogReader::bytesRead() const
+{
+	return static_cast<const BufferedInArchive&>(*arch_).position();
+}
+
+size_t count3DScans(const std::vector<std::string>& rawlogs,
+                    const std::string& label, size_t atMost)
+{
+	size_t n = 0;
+	for (const auto& path : rawlogs)
+	{
+		RawlogReader r(path);
+		while (n < atMost)
+		{
+			const auto o = r.next();
+			if (!o) break;
+			if (auto s = std::dynamic_pointer_cast<
+			        mrpt::obs::CObservation3DRangeScan>(o);
+			    s && (label.empty() || s->sensorLabel == label))
+				++n;
+		}
+	}
+	return n;
+}
+
+uint64_t rawlogDataBytes(const std::string& path)
+{
+	std::ifstream f(path, std::ios::binary);
+	if (!f) return 0;
+	unsigned char head[2] = {0, 0};
+	f.read(reinterpret_cast<char*>(head), 2);
+	f.seekg(0, std::ios::end);
+	const auto size = static_cast<uint64_t>(f.tellg());
+	if (!f || head[0] != 0x1f || head[1] != 0x8b || size < 18) return size;
+	// gzip: the trailer's last 4 bytes are the data's size modulo 2^32
+	unsigned char t[4];
+	f.seekg(-4, std::ios::end);
+	f.read(reinterpret_cast<char*>(t), 4);
+	if (!f) return size;
+	uint64_t data = t[0] | (t[1] << 8) | (t[2] << 16) | (uint64_t(t[3]) << 24);
+	while (data < size) data += uint64_t(1) << 32;
+	return data;
 }
 
 mrpt::obs::CObservation::Ptr RawlogReader::next()

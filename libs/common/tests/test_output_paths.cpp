@@ -169,3 +169,68 @@ TEST(OutputPaths, AFailedAppendLeavesTheFileAtItsLastWholeRecord)
 	EXPECT_EQ(fs::file_size(path), 90u);  // 5 whole records
 	EXPECT_EQ(slurp(path).back(), '\n');
 }
+
+TEST(OutputPaths, AFolderOfAnEarlierRunIsRefusedThenClearedOfItsFilesOnly)
+{
+	const std::string d = fresh("earlier_run");
+	const bims::OutputFolderLayout layout{{"metrics.json", "trajectory.txt"},
+	                                      {{"masks", ".png"}, {"", ".png"}}};
+	// nothing of a run: a missing folder, an empty one, other files
+	EXPECT_EQ(bims::prepareOutputFolder(d + "/none", layout, false), 0u);
+	fs::create_directories(d + "/out/masks");
+	std::ofstream(d + "/out/notes.txt") << "mine";
+	std::ofstream(d + "/out/masks/readme.txt") << "mine";
+	std::ofstream(d + "/out/masks/x000001.png") << "mine";  // not a number
+	std::ofstream(d + "/out/plot.png") << "mine";
+	EXPECT_EQ(bims::prepareOutputFolder(d + "/out", layout, false), 0u);
+	// an earlier run: refused naming the folder, a file and the flag
+	std::ofstream(d + "/out/metrics.json") << "{}";
+	std::ofstream(d + "/out/trajectory.txt.partial") << "";
+	std::ofstream(d + "/out/masks/000001.png") << "";
+	std::ofstream(d + "/out/masks/000002.png.partial") << "";
+	std::ofstream(d + "/out/1548339824.89375.png") << "";
+	fs::create_directories(d + "/out/other");
+	std::ofstream(d + "/out/other/000001.png") << "mine";  // not in layout
+	EXPECT_EQ(bims::earlierOutputs(d + "/out", layout).size(), 5u);
+	try
+	{
+		bims::prepareOutputFolder(d + "/out", layout, false);
+		FAIL() << "not refused";
+	}
+	catch (const bims::UsageError& e)
+	{
+		const std::string m = e.what();
+		EXPECT_NE(m.find(d + "/out: holds the outputs of an earlier run (5 "
+		                     "files, e.g. 1548339824.89375.png); give "
+		                     "--overwrite"),
+		          std::string::npos)
+		    << m;
+	}
+	EXPECT_TRUE(fs::exists(d + "/out/metrics.json"));
+	// --overwrite: those five go, everything else stays
+	EXPECT_EQ(bims::prepareOutputFolder(d + "/out", layout, true), 5u);
+	EXPECT_TRUE(bims::earlierOutputs(d + "/out", layout).empty());
+	for (const char* f : {"notes.txt", "masks/readme.txt", "masks/x000001.png",
+	                      "plot.png", "other/000001.png"})
+		EXPECT_TRUE(fs::exists(d + "/out/" + f)) << f;
+	// a per-frame folder left empty is removed
+	fs::remove(d + "/out/masks/readme.txt");
+	fs::remove(d + "/out/masks/x000001.png");
+	std::ofstream(d + "/out/masks/000003.png") << "";
+	EXPECT_EQ(bims::prepareOutputFolder(d + "/out", layout, true), 1u);
+	EXPECT_FALSE(fs::exists(d + "/out/masks"));
+}
+
+TEST(OutputPaths, OverwriteRemovesALinkOfTheLayoutNotItsTarget)
+{
+	const std::string d = fresh("earlier_link");
+	fs::create_directories(d + "/out");
+	std::ofstream(d + "/precious.txt") << "precious";
+	fs::create_symlink(d + "/precious.txt", d + "/out/metrics.json");
+	const bims::OutputFolderLayout layout{{"metrics.json"}, {}};
+	EXPECT_THROW(bims::prepareOutputFolder(d + "/out", layout, false),
+	             bims::UsageError);
+	EXPECT_EQ(bims::prepareOutputFolder(d + "/out", layout, true), 1u);
+	EXPECT_FALSE(fs::is_symlink(fs::symlink_status(d + "/out/metrics.json")));
+	EXPECT_TRUE(fs::exists(d + "/precious.txt"));
+}

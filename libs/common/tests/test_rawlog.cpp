@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <bims_test/file_size_limit.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/system/filesystem.h>
 
@@ -150,4 +151,48 @@ TEST(Rawlog, AGzipRawlogWhoseTailFailsAtCloseIsAnError)
 	    });
 	std::filesystem::remove(p);
 	EXPECT_EQ(code, 3);
+}
+
+TEST(Rawlog, DataBytesOfPlainAndGzipFilesAreWhatTheReaderReads)
+{
+	// the progress line's share of the input read (bims-run)
+	for (int gz : {0, 6})
+	{
+		const auto p = tmpPath("bytes" + std::to_string(gz) + ".rawlog");
+		writeImus(p, 50, gz);
+		const uint64_t data = bims::rawlogDataBytes(p);
+		if (gz)
+		{
+			EXPECT_GT(data, std::filesystem::file_size(p));
+		}
+		bims::RawlogReader r(p);
+		EXPECT_EQ(r.bytesRead(), 0u);
+		uint64_t last = 0;
+		while (r.next())
+		{
+			EXPECT_GT(r.bytesRead(), last);
+			last = r.bytesRead();
+		}
+		EXPECT_EQ(last, data) << gz;
+	}
+	EXPECT_EQ(bims::rawlogDataBytes(tmpPath("no_such.rawlog")), 0u);
+}
+
+TEST(Rawlog, Count3DScansStopsAtTheLimitAndSkipsOtherLabels)
+{
+	const auto p = tmpPath("scans.rawlog");
+	{
+		bims::RawlogWriter w(p, 0);
+		for (int i = 0; i < 6; i++)
+		{
+			mrpt::obs::CObservation3DRangeScan s;
+			s.sensorLabel = i % 3 == 2 ? "OTHER" : "RGBD";
+			s.timestamp = mrpt::Clock::fromDouble(100.0 + i);
+			w.write(s);
+		}
+	}
+	EXPECT_EQ(bims::count3DScans({p}, "", 100), 6u);
+	EXPECT_EQ(bims::count3DScans({p}, "RGBD", 100), 4u);
+	EXPECT_EQ(bims::count3DScans({p, p}, "RGBD", 100), 8u);
+	EXPECT_EQ(bims::count3DScans({p, p}, "", 3), 3u);
 }

@@ -80,6 +80,9 @@ ReplayStats replayRawlog(const std::string& path, Odometry& odo,
 	};
 
 	RawlogReader reader(path);
+	// the total: max_frames, or estimated from the share of the input read
+	const uint64_t inputBytes = rawlogDataBytes(path);
+	if (opt.max_frames) bar.setTotal(opt.max_frames);
 	while (!done)
 	{
 		auto o = reader.next();
@@ -118,6 +121,11 @@ ReplayStats replayRawlog(const std::string& path, Odometry& odo,
 			}
 			depthCorrection.apply(*scan, cfg.camera);
 			pending.emplace_back(scan, nScans++);
+			if (!opt.max_frames && inputBytes > 0 && reader.bytesRead() > 0)
+				bar.setTotal(
+				    static_cast<size_t>(
+				        double(nScans) * inputBytes / reader.bytesRead() + 0.5),
+				    true);
 		}
 		newestT = std::max(newestT, t);
 		flush(false);

@@ -212,6 +212,24 @@ TEST(EvalMasks, HandComputedTotalsAndErrors)
 	                     "0.1250"),
 	          std::string::npos)
 	    << r.out;
+	// The overlays of that evaluation are not mixed with another's: refused
+	// before any work, then replaced with --overwrite (other files stay).
+	std::ofstream(d + "/pred_eval/notes.txt") << "mine";
+	r = run(kBin + "/bims-eval masks " + d + "/gt " + d + "/pred");
+	EXPECT_EQ(r.code, 2) << r.out;
+	EXPECT_NE(r.out.find(d + "/pred_eval: holds the outputs of an earlier run "
+	                         "(2 files, e.g. 000000.png); give --overwrite"),
+	          std::string::npos)
+	    << r.out;
+	fs::remove(d + "/pred/000000.png");
+	fs::remove(d + "/gt/000000.png");
+	r = run(kBin + "/bims-eval masks " + d + "/gt " + d + "/pred --overwrite");
+	EXPECT_EQ(r.code, 0) << r.out;
+	EXPECT_FALSE(fs::exists(d + "/pred_eval/000000.png"));
+	EXPECT_TRUE(fs::exists(d + "/pred_eval/000001.png"));
+	EXPECT_TRUE(fs::exists(d + "/pred_eval/notes.txt"));
+	cv::imwrite(d + "/gt/000000.png", g0);
+	cv::imwrite(d + "/pred/000000.png", p0);
 	// A mask of another size is an error naming both files.
 	cv::imwrite(d + "/pred/000001.png", cv::Mat(4, 8, CV_8UC1, cv::Scalar(0)));
 	r = run(kBin + "/bims-eval masks " + d + "/gt " + d + "/pred --no-plots");
@@ -566,8 +584,9 @@ TEST(Apps, NoProgramWritesOverItsInput)
 	}
 	if (fs::exists(kBin + "/bims-viewer"))  // built with the GUI
 	{
-		const ::Run r = run(kBin + "/bims-viewer " + in +
-		                    " --frames 3 --screenshot " + d + "/link.rawlog");
+		const ::Run r =
+		    run(kBin + "/bims-viewer " + in + " --max-frames 3 --screenshot " +
+		        d + "/link.rawlog");
 		EXPECT_EQ(r.code, 2) << r.out;
 		EXPECT_NE(r.out.find("would overwrite the input"), std::string::npos)
 		    << r.out;

@@ -7,8 +7,8 @@
 
 #include <bims/common/app.h>
 #include <bims/common/pixel_labels.h>
-#include <bims/ego/flags.h>
 #include <bims/common/trajectory.h>
+#include <bims/ego/flags.h>
 #include <bims/maps/export.h>
 #include <mrpt/obs/TPixelLabelInfo.h>
 
@@ -52,6 +52,19 @@ double msSince(Clock::time_point t0)
  * down instead of filling the memory (about 2 MB per VGA frame). */
 constexpr size_t kQueuedWrites = 16;
 }  // namespace
+
+const OutputFolderLayout& runOutputLayout()
+{
+	// every name OutputWriter writes (the test of bims-run's --overwrite
+	// checks that a run leaves nothing else)
+	static const OutputFolderLayout layout{
+	    {"trajectory.txt", "frames.csv", "metrics.json", "segmented.rawlog",
+	     "static_map.ply", "static_map.bt"},
+	    {{"masks", ".png"},
+	     {"moving_voxels", ".ply"},
+	     {"flow_labels", ".png"}}};
+	return layout;
+}
 
 OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
     : dir_(dir), p_(p), worker_(kQueuedWrites, p.writer_thread)

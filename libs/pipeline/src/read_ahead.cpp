@@ -4,6 +4,7 @@
 
 #include <pthread.h>
 
+#include <algorithm>
 #include <chrono>
 #include <exception>
 
@@ -13,6 +14,11 @@ ReadAhead::ReadAhead(std::vector<std::string> paths, size_t capacity,
                      bool threaded)
     : paths_(std::move(paths)), capacity_(capacity < 1 ? 1 : capacity)
 {
+	for (const auto& p : paths_)
+	{
+		bytesBefore_.push_back(bytesTotal_);
+		bytesTotal_ += rawlogDataBytes(p);
+	}
 	if (threaded) thread_ = std::thread([this] { loop(); });
 }
 
@@ -52,6 +58,10 @@ ReadAhead::Item ReadAhead::readOne(std::string& error)
 			}
 			it.obs = reader_->next();
 			it.file = file_;
+			if (bytesTotal_ > 0)
+				it.inputFraction = std::min(
+				    1.0, double(bytesBefore_[file_] + reader_->bytesRead()) /
+				             double(bytesTotal_));
 			if (!it.obs)
 			{
 				reader_.reset();

@@ -28,6 +28,9 @@ class ReadAhead
 		size_t file = 0;                   ///< index into the paths
 		double readMs = 0;     ///< time reading and decoding it took
 		double readCpuMs = 0;  ///< its CPU time (the reading thread's)
+		/** Share of all the files' data read with it (0..1; 0 when their
+		 * size is unknown), for the progress line. */
+		double inputFraction = 0;
 	};
 
 	ReadAhead(std::vector<std::string> paths, size_t capacity, bool threaded);
@@ -47,6 +50,9 @@ class ReadAhead
 	void loop();
 
 	std::vector<std::string> paths_;
+	/** rawlogDataBytes of the files before each file, and of all */
+	std::vector<uint64_t> bytesBefore_;
+	uint64_t bytesTotal_ = 0;
 	size_t capacity_;
 	// reading state (the reader thread's, or the caller's)
 	size_t file_ = 0;

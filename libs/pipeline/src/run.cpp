@@ -61,6 +61,56 @@ FrameRange FrameRange::parse(const std::string& s)
 	return r;
 }
 
+void checkFrameRangeInInputs(const FrameRange& range,
+                             const std::vector<std::string>& rawlogs,
+                             const std::string& rgbdLabel)
+{
+	if (range.first == 0 && !range.bounded()) return;
+	const size_t need = (range.bounded() ? range.last : range.first) + 1;
+	size_t n = 0;
+	try
+	{
+		n = count3DScans(rawlogs, rgbdLabel, need);
+	}
+	catch (const std::exception&)
+	{
+		// a missing or truncated input: the run meets it as it does without
+		// a range (the frames read whole processed, the error reported)
+		return;
+	}
+	if (n >= need) return;
+	std::string files;
+	for (const auto& f : rawlogs) files += (files.empty() ? "" : ", ") + f;
+	std::string msg =
+	    "--frames " + range.toString() + ": the input (" + files + ") has " +
+	    (n == 0 ? std::string("no 3D scan")
+	            : std::to_string(n) + " 3D scans (0 to " +
+	                  std::to_string(n - 1) + ")") +
+	    (rgbdLabel.empty() ? std::string() : " with label '" + rgbdLabel + "'");
+	if (range.first < n)
+		msg +=
+		    "; --frames " + std::to_string(range.first) + ": runs to its end";
+	throw UsageError(msg);
+}
+
+FrameRange frameRangeOption(const std::string& text,
+                            const std::vector<std::string>& rawlogs,
+                            const std::string& rgbdLabel)
+{
+	if (text.empty()) return {};
+	FrameRange r;
+	try
+	{
+		r = FrameRange::parse(text);
+	}
+	catch (const std::invalid_argument& e)
+	{
+		throw UsageError(e.what());
+	}
+	checkFrameRangeInInputs(r, rawlogs, rgbdLabel);
+	return r;
+}
+
 Percentiles Percentiles::of(std::vector<double> v)
 {
 	Percentiles p;
@@ -103,9 +153,10 @@ struct PendingScan
 	mrpt::obs::CObservation3DRangeScan::Ptr scan;
 	size_t index;
 	double t;
-	double readMs;     ///< reading the observations up to this scan
-	double readCpuMs;  ///< the same in CPU time
-	double inWaitMs;   ///< the run waiting for them
+	double readMs;         ///< reading the observations up to this scan
+	double readCpuMs;      ///< the same in CPU time
+	double inWaitMs;       ///< the run waiting for them
+	double inputFraction;  ///< share of the input read with it (0: unknown)
 	/** The IMU observations read after it (before the next scan), written
 	 * after it: the labelled rawlog keeps the input's order. */
 	std::vector<mrpt::obs::CObservation::Ptr> after;
@@ -175,7 +226,12 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	const std::string& imuLabel = cfg.ego.sensors.imu_label;
 	size_t scanIndex = 0;
 	double movingFracSum = 0, readMs = 0, readCpuMs = 0, inWaitMs = 0;
-	ProgressBar bar("bims-run", 0, opt.progress);
+	// a bounded range has a known total; otherwise it is estimated from the
+	// share of the input read
+	const bool bounded = opt.frames.bounded();
+	ProgressBar bar("bims-run",
+	                bounded ? opt.frames.last - opt.frames.first + 1 : 0,
+	                opt.progress);
 
 	auto process = [&](const PendingScan& p, const PendingScan* next)
 	{
@@ -215,6 +271,14 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		{
 			stage["wait_output"].push_back(out->writeFrame(r, p.scan, flags));
 			for (const auto& o : p.after) out->writeOther(o);
+		}
+		if (!bounded && p.inputFraction > 0)
+		{
+			const double scans = (p.index + 1) / p.inputFraction;
+			bar.setTotal(std::max(sum.framesProcessed,
+			                      static_cast<size_t>(scans + 0.5) -
+			                          std::min(opt.frames.first, p.index)),
+			             true);
 		}
 		bar.update(sum.framesProcessed, "frame " + std::to_string(p.index));
 	};
@@ -381,7 +445,14 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 						break;
 					}
 				}
-				PendingScan p{scan, idx, t, readMs, readCpuMs, inWaitMs, {}};
+				PendingScan p{scan,
+				              idx,
+				              t,
+				              readMs,
+				              readCpuMs,
+				              inWaitMs,
+				              item.inputFraction,
+				              {}};
 				readMs = readCpuMs = inWaitMs = 0;
 				if (std::isfinite(lastScanT) && t - lastScanT > kMaxScanGapS)
 				{

@@ -140,6 +140,31 @@ TEST(ReadAhead, ReadsFilesOneAfterTheOtherInOrder)
 	}
 }
 
+TEST(ReadAhead, EachItemSaysWhichShareOfAllTheInputsIsRead)
+{
+	// for the progress line's estimated total (bims-run without --frames)
+	const std::string d = tmpDir("fraction");
+	const auto a = imuRawlog(d + "/a.rawlog", 0, 30);
+	const auto b = imuRawlog(d + "/b.rawlog", 30, 30);
+	ReadAhead in({a, b}, 4, true);
+	double last = 0;
+	int n = 0;
+	for (;;)
+	{
+		const auto it = in.next();
+		if (!it.obs) break;
+		EXPECT_GT(it.inputFraction, last) << n;
+		last = it.inputFraction;
+		if (n == 29)
+		{
+			EXPECT_NEAR(it.inputFraction, 0.5, 1e-9);  // the end of a
+		}
+		n++;
+	}
+	EXPECT_EQ(n, 60);
+	EXPECT_DOUBLE_EQ(last, 1.0);
+}
+
 TEST(ReadAhead, ATruncatedFileIsAnErrorAfterEverythingReadBeforeIt)
 {
 	const std::string d = tmpDir("truncated");

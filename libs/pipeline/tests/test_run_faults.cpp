@@ -11,6 +11,7 @@
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -275,4 +276,30 @@ TEST(RunFaults, AChangedImageSizeIsAnErrorNamingFileScanAndSizes)
 	    << sum.error;
 	EXPECT_EQ(sum.framesProcessed, 5u);  // those before it, all written
 	EXPECT_TRUE(fs::exists(d + "/out/masks/000004.png"));
+}
+
+TEST(RunOutputs, TheLayoutNamesEveryFileARunWrites)
+{
+	// bims-run --overwrite clears runOutputLayout()'s files: a file a run
+	// writes that the layout missed would stay from an earlier run
+	const auto d = tmpDir("layout");
+	std::ifstream f(kSrc + "/config/default.ini");
+	std::string ini((std::istreambuf_iterator<char>(f)),
+	                std::istreambuf_iterator<char>());
+	ini = ini.substr(0, ini.find("[output]")) +
+	      "[output]\nmoving_ply=true\nstatic_map=true\nlabelled_rawlog=true\n"
+	      "flow_labels=true\n";
+	std::ofstream(d + "/all.ini") << ini;
+	const auto in = sampleWith(d, 4, [](auto&, int, int) {});
+	const auto sum = runOn({in}, d + "/out", d + "/all.ini");
+	ASSERT_EQ(sum.error, "");
+	ASSERT_EQ(sum.framesProcessed, 4u);
+	std::vector<std::string> written;
+	for (const auto& e : fs::recursive_directory_iterator(d + "/out"))
+		if (!e.is_directory()) written.push_back(e.path().string());
+	std::sort(written.begin(), written.end());
+	EXPECT_EQ(bims::earlierOutputs(d + "/out", runOutputLayout()), written);
+	// the files, the masks and flow labels of every frame (a PLY only for
+	// a frame with moving voxels)
+	EXPECT_GE(written.size(), 6u + 2 * 4u);
 }

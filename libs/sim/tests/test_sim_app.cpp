@@ -151,7 +151,7 @@ TEST(BimsSim, RawlogEditListsBothSensorsAtTheirRates)
 	if (run("command -v rawlog-edit", out) != 0)
 		GTEST_SKIP() << "rawlog-edit not installed";
 	const std::string d = tmpDir("rawlogedit");
-	const std::string f = simulate(d, kSmallScene, "--frames 31");
+	const std::string f = simulate(d, kSmallScene, "--max-frames 31");
 	ASSERT_EQ(run("rawlog-edit --info -i '" + f + "'", out), 0) << out;
 	std::map<std::string, double> rate;
 	const std::regex re(
@@ -172,7 +172,7 @@ TEST(BimsSim, NoiselessDepthUnprojectedWithGroundTruthLiesOnSurfaces)
 	const std::string d = tmpDir("geometry");
 	const std::string scene =
 	    std::string(kSmallScene) + "\n[depth]\nnoiseless=true\n";
-	const std::string f = simulate(d, scene, "--frames 3");
+	const std::string f = simulate(d, scene, "--max-frames 3");
 	const auto cfg = bims::sim::SimConfig::load(d + "/scene.ini");
 	const auto world = cfg.buildScene();
 	const auto gt = bims::loadTumTrajectory(d + "/out_gt/groundtruth.txt");
@@ -257,9 +257,9 @@ TEST(BimsSim, SameSeedGivesIdenticalBytesOtherSeedDiffers)
 {
 	const std::string a = tmpDir("seedA"), b = tmpDir("seedB"),
 	                  c = tmpDir("seedC");
-	const std::string fa = simulate(a, kSmallScene, "--seed 5 --frames 4");
-	const std::string fb = simulate(b, kSmallScene, "--seed 5 --frames 4");
-	const std::string fc = simulate(c, kSmallScene, "--seed 6 --frames 4");
+	const std::string fa = simulate(a, kSmallScene, "--seed 5 --max-frames 4");
+	const std::string fb = simulate(b, kSmallScene, "--seed 5 --max-frames 4");
+	const std::string fc = simulate(c, kSmallScene, "--seed 6 --max-frames 4");
 	EXPECT_EQ(readFile(fa), readFile(fb));
 	for (const char* g : {"groundtruth.txt", "imu.txt", "objects.txt",
 	                      "calibration.ini", "masks/000003.png"})
@@ -325,7 +325,7 @@ TEST(BimsSim, BadInputGivesClearErrorAndNonZeroExit)
 	              out),
 	          2);
 	EXPECT_EQ(run("'" + kBin + "/bims-sim' '" + d +
-	                  "/good.ini' -o x.rawlog --frames 0",
+	                  "/good.ini' -o x.rawlog --max-frames 0",
 	              out),
 	          2);
 }
@@ -335,7 +335,7 @@ TEST(BimsSim, ImuFromTumTrajectoryIsLabelledSynthetic)
 	const std::string d = tmpDir("imufromtum");
 	const std::string scene =
 	    std::string(kSmallScene) + "\n[imu]\nnoiseless=true\n";
-	simulate(d, scene, "--frames 60");
+	simulate(d, scene, "--max-frames 60");
 	std::string out;
 	ASSERT_EQ(
 	    run("'" + kBin + "/bims-sim' --imu-from-tum '" + d +
@@ -360,7 +360,7 @@ TEST(BimsSim, ImuFromTumTrajectoryIsLabelledSynthetic)
 TEST(BimsInfo, SummarisesSensorsAndRejectsBadFiles)
 {
 	const std::string d = tmpDir("info");
-	const std::string f = simulate(d, kSmallScene, "--frames 31");
+	const std::string f = simulate(d, kSmallScene, "--max-frames 31");
 	std::string out;
 	ASSERT_EQ(run("'" + kBin + "/bims-info' '" + f + "'", out), 0) << out;
 	EXPECT_NE(out.find("observations:  133"), std::string::npos) << out;
@@ -418,7 +418,7 @@ TEST(BimsSim, AFullDiskIsAnErrorAndLeavesNoRawlogUnderItsName)
 	const int rc =
 	    run("bash -c \"ulimit -f 256; trap '' XFSZ; exec '" + kBin +
 	            "/bims-sim' '" + kSrc + "/rawlogs/pendulum_slow.ini' -o '" + d +
-	            "/x.rawlog' --frames 40 -q\"",
+	            "/x.rawlog' --max-frames 40 -q\"",
 	        out);
 	EXPECT_EQ(rc, 1) << out;
 	EXPECT_NE(out.find("x.rawlog.partial: write failed"), std::string::npos)
@@ -435,7 +435,7 @@ TEST(BimsSim, SigintAndSigtermEndACompleteShorterSequence)
 		const std::string d = tmpDir(name);
 		const int rc = bims::test::signalWhenExists(
 		    {kBin + "/bims-sim", kSrc + "/rawlogs/pendulum_slow.ini", "-o",
-		     d + "/x.rawlog", "--frames", "3000", "-q"},
+		     d + "/x.rawlog", "--max-frames", "3000", "-q"},
 		    d + "/log", d + "/x_gt/masks/000005.png", sig);
 		const std::string log = readFile(d + "/log");
 		EXPECT_EQ(rc, code) << log;

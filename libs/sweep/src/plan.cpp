@@ -319,7 +319,8 @@ std::vector<std::string> runCommand(const std::string& program,
 		argv.push_back("--frames");
 		argv.push_back(plan.frames);
 	}
-	argv.insert(argv.end(), {"-o", dir + "/out", "-q"});
+	// the run's folder is the sweep's: a run done again replaces it
+	argv.insert(argv.end(), {"-o", dir + "/out", "--overwrite", "-q"});
 	return argv;
 }
 

@@ -1,5 +1,6 @@
 #include <bims/common/app.h>
 #include <bims/common/output_paths.h>
+#include <bims/common/progress.h>
 #include <bims/common/share.h>
 #include <bims/sweep/plan.h>
 #include <bims/sweep/processes.h>
@@ -17,21 +18,6 @@ namespace bims::sweep
 {
 namespace
 {
-/** "42 s", "3 min 05 s", "1 h 02 min". */
-std::string duration(double s)
-{
-	char b[48];
-	const long t = static_cast<long>(s + 0.5);
-	if (t < 60)
-		std::snprintf(b, sizeof(b), "%.1f s", s);
-	else if (t < 3600)
-		std::snprintf(b, sizeof(b), "%ld min %02ld s", t / 60, t % 60);
-	else
-		std::snprintf(b, sizeof(b), "%ld h %02ld min", t / 3600,
-		              (t % 3600) / 60);
-	return b;
-}
-
 /** Writes the results and prints the summary; the exit code. */
 int report(const ResultTable& t, const std::string& outDir,
            const std::string& plotMetric)
@@ -107,6 +93,11 @@ int runSweep(const SweepOptions& opt)
 		std::printf("bims-sweep: dry run, nothing written\n");
 		return 0;
 	}
+	// an earlier sweep's plan and results are refused, or replaced
+	prepareOutputFolder(
+	    opt.outDir,
+	    {{"sweep.json", "results.csv", "results.md", "results.png"}, {}},
+	    opt.overwrite);
 	writePlan(plan, opt.outDir);
 	if (!opt.jobsFile.empty())
 	{
@@ -151,9 +142,9 @@ int runSweep(const SweepOptions& opt)
 		const bool eta = left && !(opt.stop && *opt.stop);
 		std::fprintf(stderr, "[%zu/%zu] %s: %s%s, %s%s%s\n", done,
 		             plan.runs.size(), plan.runs[i].id.c_str(),
-		             t.rows[i].status.c_str(), fps, duration(o.seconds).c_str(),
-		             eta ? ", ETA " : "",
-		             eta ? duration(wall / done * left).c_str() : "");
+		             t.rows[i].status.c_str(), fps,
+		             formatDuration(o.seconds).c_str(), eta ? ", ETA " : "",
+		             eta ? formatDuration(wall / done * left).c_str() : "");
 	};
 	const auto outcomes = runJobs(jobs, pool);
 	for (size_t i = 0; i < outcomes.size(); i++)

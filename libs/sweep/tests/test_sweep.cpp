@@ -223,9 +223,10 @@ TEST(SweepPlan, RoundTripsThroughSweepJsonAndRunFolders)
 	}
 	const auto argv = sw::runCommand("/x/bims-run", plan, plan.runs[3], out);
 	const std::string dir = sw::runDir(out, plan.runs[3].id);
-	EXPECT_EQ(argv, (std::vector<std::string>{
-	                    "/x/bims-run", dir + "/config.ini", d + "/y.rawlog",
-	                    "--frames", "2:5", "-o", dir + "/out", "-q"}));
+	EXPECT_EQ(argv,
+	          (std::vector<std::string>{
+	              "/x/bims-run", dir + "/config.ini", d + "/y.rawlog",
+	              "--frames", "2:5", "-o", dir + "/out", "--overwrite", "-q"}));
 	EXPECT_EQ(sw::shellLine({"/a b/x", "it's", "-q", "k=v", ""}),
 	          "'/a b/x' 'it'\\''s' -q k=v ''");
 	EXPECT_NE(errorOf([&] { sw::SweepPlan::readJson(d + "/a.ini"); })

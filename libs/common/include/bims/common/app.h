@@ -49,14 +49,26 @@ struct OptionName
 void checkOptionNames(int argc, char** argv,
                       const std::vector<OptionName>& known);
 
-/** Parses the command line with MRPT's TCLAP (CmdLine in
- * mrpt/3rdparty/tclap/CmdLine.h), which prints --help, --version and parse
- * errors itself and then returns false instead of exiting: throws
- * ExitRequest{0} after --help or --version, ExitRequest{2} after a parse
- * error, so that no program goes on with empty arguments. An unknown or
- * mistyped option is a UsageError before anything else (checkOptionNames). */
+/** An option renamed by the shared command-line vocabulary (docs/cli.md):
+ * the old spelling still works, with a one-line note on stderr. */
+struct OptionRename
+{
+	std::string old;  ///< e.g. "--frames" (a count in bims-sim)
+	std::string now;  ///< e.g. "--max-frames"
+};
+
+/** \a argv (all \a argc words) with the \a renamed options written their
+ * new way; for each
+ * one met, prints "PROGRAM: note: OLD V is now NEW V" on stderr (PROGRAM:
+ * \a argv[0]'s file name). \a known: the program's options (whether NEW
+ * takes a value). Words after "--" stay as they are. */
+std::vector<std::string> renameOptions(int argc, char** argv,
+                                       const std::vector<OptionRename>& renamed,
+                                       const std::vector<OptionName>& known);
+
+/** The options a TCLAP command line declares ("-o" and "--out" of each). */
 template <class CmdLine>
-void parseCommandLine(CmdLine& cmd, int argc, char** argv)
+std::vector<OptionName> declaredOptions(CmdLine& cmd)
 {
 	std::vector<OptionName> known;
 	for (const auto* a : cmd.getArgList())
@@ -70,21 +82,32 @@ void parseCommandLine(CmdLine& cmd, int argc, char** argv)
 		if (!a->getName().empty())
 			known.push_back({"--" + a->getName(), a->isValueRequired()});
 	}
+	return known;
+}
+
+/** Parses the command line with MRPT's TCLAP (CmdLine in
+ * mrpt/3rdparty/tclap/CmdLine.h), which prints --help, --version and parse
+ * errors itself and then returns false instead of exiting: throws
+ * ExitRequest{0} after --help or --version, ExitRequest{2} after a parse
+ * error, so that no program goes on with empty arguments. An unknown or
+ * mistyped option is a UsageError before anything else (checkOptionNames).
+ * \a renamed: old spellings still taken (renameOptions). */
+template <class CmdLine>
+void parseCommandLine(CmdLine& cmd, int argc, char** argv,
+                      const std::vector<OptionRename>& renamed = {})
+{
+	const std::vector<OptionName> known = declaredOptions(cmd);
+	std::vector<std::string> args = renameOptions(argc, argv, renamed, known);
+	std::vector<char*> words;
+	for (auto& a : args) words.push_back(a.data());
+	words.push_back(nullptr);
+	const int n = static_cast<int>(args.size());
 	bool help = false;
-	for (int i = 1; i < argc; ++i)
-	{
-		const std::string a = argv[i];
+	for (const auto& a : args)
 		help |= a == "-h" || a == "--help" || a == "--version";
-	}
-	if (!help) checkOptionNames(argc, argv, known);
-	if (cmd.parse(argc, argv)) return;
-	for (int i = 1; i < argc; ++i)
-	{
-		const std::string a = argv[i];
-		if (a == "-h" || a == "--help" || a == "--version")
-			throw ExitRequest{0};
-	}
-	throw ExitRequest{2};
+	if (!help) checkOptionNames(n, words.data(), known);
+	if (cmd.parse(n, words.data())) return;
+	throw ExitRequest{help ? 0 : 2};
 }
 
 /** The values of those TCLAP value arguments that the command line gave

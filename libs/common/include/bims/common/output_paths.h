@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace cv
@@ -28,6 +29,34 @@ void checkOutputsSpareInputs(const std::vector<std::string>& inputs,
  * link. Throws naming the path if it is a folder or the link cannot be
  * removed. */
 void replaceSymlink(const std::string& path);
+
+/** What a program writes into an output folder, for refusing a folder that
+ * holds an earlier run and for clearing exactly that run with --overwrite. */
+struct OutputFolderLayout
+{
+	/** Files by name (e.g. "metrics.json"); PATH.partial files of them
+	 * count too. */
+	std::vector<std::string> files;
+	/** Sub-folders of per-frame files ("" = the folder itself) and the
+	 * files' extension: e.g. {"masks", ".png"} holds masks/000042.png. A
+	 * per-frame file is named by a number (a scan index or a time stamp:
+	 * digits and at most one '.'), then the extension. */
+	std::vector<std::pair<std::string, std::string>> frameFolders;
+};
+
+/** The files of \a layout found in \a dir (paths inside it, sorted); none
+ * when \a dir does not exist. Anything else in \a dir is not listed. */
+std::vector<std::string> earlierOutputs(const std::string& dir,
+                                        const OutputFolderLayout& layout);
+
+/** Before a program writes into the folder \a dir: when \a dir holds files
+ * of \a layout (an earlier run), throws UsageError naming the folder and
+ * one of them, and suggesting \a overwriteFlag; with \a overwrite, removes
+ * those files (and the per-frame sub-folders left empty) instead, never
+ * anything else, and returns how many it removed. */
+size_t prepareOutputFolder(const std::string& dir,
+                           const OutputFolderLayout& layout, bool overwrite,
+                           const std::string& overwriteFlag = "--overwrite");
 
 /** A whole-file output written under PATH.partial and renamed to PATH by
  * commit() (std::rename: atomic, and it replaces a symbolic link at PATH,

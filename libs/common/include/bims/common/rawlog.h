@@ -33,6 +33,13 @@ class RawlogError : public std::runtime_error
  * CRawlog::detectImagesDirectory() drops a '/'). */
 std::string rawlogImagesDirectory(const std::string& rawlogPath);
 
+/** The bytes of data a rawlog file holds, for showing how far a reading
+ * has come: its size; for a gzip file, the size of the data inside as its
+ * trailer gives it (modulo 4 GiB: taken as the smallest such size not below
+ * the compressed size, an estimate past 4 GiB). 0 when the file cannot be
+ * read. */
+uint64_t rawlogDataBytes(const std::string& path);
+
 class RawlogReader
 {
  public:
@@ -45,6 +52,8 @@ class RawlogReader
 	 * RawlogError naming the file and the entry on truncation or corruption. */
 	mrpt::obs::CObservation::Ptr next();
 
+	/** Bytes of data read so far (decompressed), of rawlogDataBytes(). */
+	uint64_t bytesRead() const;
 	/** Index of the last serialized object read (0-based), -1 before any. */
 	long entryIndex() const { return entry_; }
 	/** Number of observations returned so far. */
@@ -60,6 +69,12 @@ class RawlogReader
 	size_t nObs_ = 0;
 	bool atEnd_ = false;
 };
+
+/** The 3D scans (CObservation3DRangeScan) of \a rawlogs read one after the
+ * other, with sensor label \a label (any when empty), counted up to \a
+ * atMost (reading stops there). Throws RawlogError as RawlogReader does. */
+size_t count3DScans(const std::vector<std::string>& rawlogs,
+                    const std::string& label, size_t atMost);
 
 class RawlogWriter
 {

@@ -3,6 +3,7 @@
 // and the viewer/grabber front ends.
 #pragma once
 
+#include <bims/common/output_paths.h>
 #include <bims/pipeline/pipeline.h>
 
 #include <atomic>
@@ -20,9 +21,35 @@ struct FrameRange
 	size_t first = 0;
 	size_t last = static_cast<size_t>(-1);
 	bool contains(size_t i) const { return i >= first && i <= last; }
+	/** B given (not "A:"). */
+	bool bounded() const { return last != static_cast<size_t>(-1); }
+	/** "A:B" ("A:" when open-ended), for messages. */
+	std::string toString() const
+	{
+		return std::to_string(first) + ":" +
+		       (bounded() ? std::to_string(last) : std::string());
+	}
 	/** Parses "A:B"; throws std::invalid_argument on bad text or A > B. */
 	static FrameRange parse(const std::string& s);
 };
+
+/** For --frames A:B, before any work: throws UsageError naming the range
+ * and the inputs' 3D-scan count unless \a rawlogs hold the scans A to B
+ * (A, when open-ended). Reads them up to that scan (bims::count3DScans),
+ * counting the scans with label \a rgbdLabel (all when empty), as
+ * runExperiment numbers them. Nothing to check for the whole input, nor
+ * when an input cannot be read that far (missing, truncated): the run
+ * reports that as it would without a range. */
+void checkFrameRangeInInputs(const FrameRange& range,
+                             const std::vector<std::string>& rawlogs,
+                             const std::string& rgbdLabel);
+
+/** A program's --frames option: \a text "" (not given) is the whole input;
+ * otherwise parsed (bad text: UsageError naming it) and checked against
+ * the inputs (checkFrameRangeInInputs). */
+FrameRange frameRangeOption(const std::string& text,
+                            const std::vector<std::string>& rawlogs,
+                            const std::string& rgbdLabel);
 
 /** Median and 95th percentile of a series. */
 struct Percentiles
@@ -112,6 +139,11 @@ constexpr double kMaxScanGapS = 10.0;
  * anything bims-run writes of it is not finite: the pose, the moving
  * voxels. */
 void checkFiniteOutputs(const FrameResult& r);
+
+/** What runExperiment writes into RunOptions::outDir (bims-run's output
+ * folder), for bims::prepareOutputFolder: the files refused as an earlier
+ * run's and cleared by --overwrite. */
+const OutputFolderLayout& runOutputLayout();
 
 /** Runs \a cfg over the rawlogs, reading ahead on a thread ([pipeline]
  * read_ahead) and writing on another ([output] writer_thread); returns when

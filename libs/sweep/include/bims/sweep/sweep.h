@@ -17,6 +17,9 @@ struct SweepOptions
 	std::string jobsFile;  ///< write the jobs there instead of running them
 	bool dryRun = false;   ///< check and print the runs; write nothing
 	bool quiet = false;    ///< no line per finished run
+	/** Replace an earlier sweep's plan and results in outDir (its runs'
+	 * outputs are replaced run by run: bims-run --overwrite). */
+	bool overwrite = false;
 	std::string plotMetric = "fps";
 	/** Gather the results of OUTDIR (runs done elsewhere) instead. */
 	std::string collect;

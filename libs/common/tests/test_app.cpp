@@ -1,0 +1,82 @@
+// The shared command-line plumbing (app.h) and the progress line
+// (progress.h) of every program.
+#include <bims/common/app.h>
+#include <bims/common/progress.h>
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+namespace
+{
+std::vector<std::string> renamed(std::vector<std::string> words)
+{
+	std::vector<char*> argv;
+	for (auto& w : words) argv.push_back(w.data());
+	const std::vector<bims::OptionName> known = {{"--max-frames", true},
+	                                             {"--config", true},
+	                                             {"-o", true},
+	                                             {"-q", false}};
+	return bims::renameOptions(
+	    static_cast<int>(argv.size()), argv.data(),
+	    {{"--frames", "--max-frames"}, {"--experiment", "--config"}}, known);
+}
+}  // namespace
+
+TEST(App, OldSpellingsAreRewrittenWithANote)
+{
+	testing::internal::CaptureStderr();
+	const auto args = renamed({"/x/bims-grab", "g.ini", "--frames", "30",
+	                           "--experiment", "e.ini", "-q"});
+	const std::string err = testing::internal::GetCapturedStderr();
+	EXPECT_EQ(args,
+	          (std::vector<std::string>{"/x/bims-grab", "g.ini", "--max-frames",
+	                                    "30", "--config", "e.ini", "-q"}));
+	EXPECT_EQ(err,
+	          "bims-grab: note: --frames 30 is now --max-frames 30\n"
+	          "bims-grab: note: --experiment e.ini is now --config e.ini\n");
+}
+
+TEST(App, ValuesAndWordsAfterDoubleDashAreNotRenamed)
+{
+	testing::internal::CaptureStderr();
+	const auto args = renamed({"p", "-o", "--frames", "--", "--frames"});
+	EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+	EXPECT_EQ(args, (std::vector<std::string>{"p", "-o", "--frames", "--",
+	                                          "--frames"}));
+}
+
+TEST(Progress, APlainLineHasTotalShareRateAndEta)
+{
+	bims::ProgressBar bar("bims-run", 150, false);
+	EXPECT_EQ(
+	    bar.text(45, 3.0, false),
+	    "bims-run: 45/150 frames (30 %), 15.0 frames/s, 3.0 s, ETA 7.0 s");
+	EXPECT_EQ(bar.text(150, 10.0, false, "frame 149"),
+	          "bims-run: 150/150 frames (100 %), 15.0 frames/s, 10.0 s, "
+	          "frame 149");
+	bar.setTotal(1500, true);  // estimated
+	EXPECT_EQ(bar.text(450, 30.0, false),
+	          "bims-run: 450/~1500 frames (30 %), 15.0 frames/s, 30.0 s, ETA "
+	          "1 min 10 s");
+	bims::ProgressBar open("bims-odom", 0, false);
+	EXPECT_EQ(open.text(20, 2.0, false),
+	          "bims-odom: 20 frames, 10.0 frames/s, 2.0 s");
+}
+
+TEST(Progress, ATerminalLineHasABarAndNoLineEnd)
+{
+	bims::ProgressBar bar("bims-sim", 100, false);
+	const std::string t = bar.text(50, 5.0, true, "x");
+	EXPECT_EQ(t,
+	          "bims-sim [############            ] 50/100 frames 50 % 10.0/s "
+	          "ETA 5.0 s x");
+	EXPECT_EQ(t.find_first_of("\r\n"), std::string::npos);
+}
+
+TEST(Progress, DurationsReadAsMinutesAndHours)
+{
+	EXPECT_EQ(bims::formatDuration(8.46), "8.5 s");
+	EXPECT_EQ(bims::formatDuration(125), "2 min 05 s");
+	EXPECT_EQ(bims::formatDuration(3725), "1 h 02 min");
+}
