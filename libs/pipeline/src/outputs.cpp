@@ -55,11 +55,11 @@ constexpr size_t kQueuedWrites = 16;
 
 const OutputFolderLayout& runOutputLayout()
 {
-	// every name OutputWriter writes (the test of bims-run's --overwrite
-	// checks that a run leaves nothing else)
+	// every name a run writes (OutputWriter, effective.ini; the test of
+	// bims-run's --overwrite checks that a run leaves nothing else)
 	static const OutputFolderLayout layout{
-	    {"trajectory.txt", "frames.csv", "metrics.json", "segmented.rawlog",
-	     "static_map.ply", "static_map.bt"},
+	    {"trajectory.txt", "frames.csv", "metrics.json", "effective.ini",
+	     "segmented.rawlog", "static_map.ply", "static_map.bt"},
 	    {{"masks", ".png"},
 	     {"moving_voxels", ".ply"},
 	     {"flow_labels", ".png"}}};
