@@ -198,15 +198,18 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	size_t nextImu = 0;
 	auto writeImuUntil = [&](double tSeq)
 	{
-		// IMU samples stamped up to sequence time tSeq (inclusive).
+		// IMU samples stamped up to sequence time tSeq (inclusive); their
+		// truth lines reach the file in one write
+		std::string lines;
 		while (double(nextImu) / cfg.imu.rateHz <= tSeq + 1e-9)
 		{
 			ImuTruth tr;
 			const double stamp = t0 + double(nextImu) / cfg.imu.rateHz;
 			out.write(*imu.sample(motion, stamp, t0, &tr));
-			gtImu.append(imuTruthLine(tr));
+			lines += imuTruthLine(tr);
 			nextImu++;
 		}
+		gtImu.append(lines);
 	};
 
 	ProgressBar bar("bims-sim", size_t(cfg.seq.frames), progress);
@@ -237,15 +240,17 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 		size_t nMoving = 0;
 		for (auto m : frame.mask) nMoving += m ? 1 : 0;
 		movingSum += double(nMoving) / double(frame.mask.size());
+		std::string objectLines;  // one write per frame
 		for (size_t o = 0; o < scene.objects.size(); o++)
 		{
 			Eigen::Matrix3d R;
 			Eigen::Vector3d x;
 			scene.objects[o]->pose(tSeq, R, x);
-			gtObjects.append(std::to_string(j) + " " + std::to_string(o + 1) +
-			                 " " + scene.objects[o]->name() + " " +
-			                 tumLine(t0 + tSeq, toPose(R, x)) + "\n");
+			objectLines += std::to_string(j) + " " + std::to_string(o + 1) +
+			               " " + scene.objects[o]->name() + " " +
+			               tumLine(t0 + tSeq, toPose(R, x)) + "\n";
 		}
+		gtObjects.append(objectLines);
 		bar.update(size_t(j + 1));
 	}
 	st.interrupted = done < cfg.seq.frames;
