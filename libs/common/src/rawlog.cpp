@@ -390,7 +390,10 @@ void RawlogWriter::write(const mrpt::obs::CObservation& obs)
 
 void RawlogWriter::flush()
 {
-	// a plain rawlog reaches the OS object by object (AppendFile)
+	// a plain rawlog reaches the OS object by object (AppendFile); a gzip
+	// one gets its pending bytes out, ending a deflate block on a byte
+	if (gz_ && gzflush(gz_, Z_SYNC_FLUSH) != Z_OK)
+		throw RawlogError(path_ + ": write failed: " + gzipError(gz_));
 }
 
 void RawlogWriter::close()

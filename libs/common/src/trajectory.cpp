@@ -57,12 +57,16 @@ std::string tumLine(double t, const mrpt::poses::CPose3D& T_WC)
 	return buf;
 }
 
+std::string tumHeader(const std::string& comment)
+{
+	return (comment.empty() ? std::string() : "# " + comment + "\n") +
+	       "# timestamp tx ty tz qx qy qz qw\n";
+}
+
 void saveTumTrajectory(const std::string& path, const Trajectory& traj,
                        const std::string& headerComment)
 {
-	std::string text;
-	if (!headerComment.empty()) text += "# " + headerComment + "\n";
-	text += "# timestamp tx ty tz qx qy qz qw\n";
+	std::string text = tumHeader(headerComment);
 	for (const auto& p : traj)
 	{
 		const std::string line = tumLine(p.t, p.T_WC);

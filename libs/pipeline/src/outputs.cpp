@@ -81,8 +81,7 @@ OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
 	traj_ = std::make_unique<AppendFile>(dir_ + "/trajectory.txt");
 	csv_ = std::make_unique<AppendFile>(dir_ + "/frames.csv");
 	traj_->append(
-	    "# bims-run estimated camera trajectory T_WC (optical frame)\n# "
-	    "timestamp tx ty tz qx qy qz qw\n");
+	    tumHeader("bims-run estimated camera trajectory T_WC (optical frame)"));
 	csv_->append(
 	    "index,t,ego_flags,correspondences,inliers,residual_m,hit_voxels,"
 	    "moving_voxels,moving_px,diff_px,notdiff_px,"
@@ -140,8 +139,7 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 		    r.mask.ptr<uint8_t>(0), r.mask.rows, r.mask.cols, r.mask.step[0],
 		    "moving");  // no copy of the images
 		rawlog_->write(scan);
-		// a plain rawlog reaches the OS object by object: a killed run
-		// leaves it readable up to the last whole frame
+		// a killed run leaves it readable up to the last whole frame
 		rawlog_->flush();
 	}
 	// the trajectory and frames.csv last: a frame in frames.csv is in every

@@ -7,7 +7,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <sstream>
 #include <stdexcept>
 
 namespace bims::sim
@@ -233,32 +232,38 @@ std::vector<mrpt::obs::CObservationIMU::Ptr> synthesizeImu(
 	return out;
 }
 
+std::string imuTruthHeader()
+{
+	return "# bims-sim IMU ground truth, one line per IMU observation in the "
+	       "rawlog.\n"
+	       "# t_stamp[s] t_true[s] wx wy wz[rad/s, true angular rate in {I}] "
+	       "fx fy fz[m/s^2, true specific force in {I}] mx my mz[gauss, true "
+	       "field in {I}] "
+	       "bgx bgy bgz[rad/s gyro bias] bax bay baz[m/s^2 accel bias] "
+	       "qx qy qz qw[true R_WI] bmx bmy bmz[gauss magnetometer bias]\n";
+}
+
+std::string imuTruthLine(const ImuTruth& t)
+{
+	char buf[640];
+	std::snprintf(buf, sizeof(buf),
+	              "%.6f %.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f "
+	              "%.9e %.9e %.9e %.9e %.9e %.9e "
+	              "%.9f %.9f %.9f %.9f %.9e %.9e %.9e\n",
+	              t.tStamp, t.tTrue, t.omega_I.x(), t.omega_I.y(), t.omega_I.z(),
+	              t.f_I.x(), t.f_I.y(), t.f_I.z(), t.m_I.x(), t.m_I.y(),
+	              t.m_I.z(), t.gyroBias.x(), t.gyroBias.y(), t.gyroBias.z(),
+	              t.accBias.x(), t.accBias.y(), t.accBias.z(), t.q_WI.x(),
+	              t.q_WI.y(), t.q_WI.z(), t.q_WI.w(), t.magBias.x(),
+	              t.magBias.y(), t.magBias.z());
+	return buf;
+}
+
 void saveImuTruth(const std::string& path, const std::vector<ImuTruth>& truth)
 {
-	std::ostringstream f;
-	f << "# bims-sim IMU ground truth, one line per IMU observation in the "
-	     "rawlog.\n"
-	     "# t_stamp[s] t_true[s] wx wy wz[rad/s, true angular rate in {I}] "
-	     "fx fy fz[m/s^2, true specific force in {I}] mx my mz[gauss, true "
-	     "field in {I}] "
-	     "bgx bgy bgz[rad/s gyro bias] bax bay baz[m/s^2 accel bias] "
-	     "qx qy qz qw[true R_WI] bmx bmy bmz[gauss magnetometer bias]\n";
-	char buf[640];
-	for (const auto& t : truth)
-	{
-		std::snprintf(buf, sizeof(buf),
-		              "%.6f %.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f "
-		              "%.9e %.9e %.9e %.9e %.9e %.9e "
-		              "%.9f %.9f %.9f %.9f %.9e %.9e %.9e\n",
-		              t.tStamp, t.tTrue, t.omega_I.x(), t.omega_I.y(),
-		              t.omega_I.z(), t.f_I.x(), t.f_I.y(), t.f_I.z(), t.m_I.x(),
-		              t.m_I.y(), t.m_I.z(), t.gyroBias.x(), t.gyroBias.y(),
-		              t.gyroBias.z(), t.accBias.x(), t.accBias.y(),
-		              t.accBias.z(), t.q_WI.x(), t.q_WI.y(), t.q_WI.z(),
-		              t.q_WI.w(), t.magBias.x(), t.magBias.y(), t.magBias.z());
-		f << buf;
-	}
-	writeFileAtomically(path, f.str());
+	std::string text = imuTruthHeader();
+	for (const auto& t : truth) text += imuTruthLine(t);
+	writeFileAtomically(path, text);
 }
 
 }  // namespace bims::sim

@@ -175,29 +175,41 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	PartialFile part(outRawlog);  // renamed once complete
 	RawlogWriter out(part.path(), cfg.seq.gzLevel);
 
-	Trajectory gt;
-	std::vector<ImuTruth> imuTruth;
-	std::ostringstream objs;  // written at the end
-	objs << "# bims-sim moving-object poses T_WO (root frame of each object in "
-	        "{W}), one line\n"
-	        "# per frame and object: frame object_id name t[s] tx ty tz qx qy "
-	        "qz qw\n"
-	        "# (object_id = the value in RenderedFrame::objectId; masks are "
-	        "255 for any id > 0)\n";
+	// The ground truth grows frame by frame beside the rawlog, whose gzip
+	// stream is flushed after every frame: a killed run leaves both readable
+	// up to the last whole frame (docs/sim.md).
+	writeCalibration(cfg, st.gtDir + "/calibration.ini");
+	AppendFile gtPoses(st.gtDir + "/groundtruth.txt");
+	AppendFile gtImu(st.gtDir + "/imu.txt");
+	AppendFile gtObjects(st.gtDir + "/objects.txt");
+	gtPoses.append(tumHeader(
+	    "bims-sim ground truth: camera optical frame poses T_WC, world z up, "
+	    "x north"));
+	gtImu.append(imuTruthHeader());
+	gtObjects.append(
+	    "# bims-sim moving-object poses T_WO (root frame of each object in "
+	    "{W}), one line\n"
+	    "# per frame and object: frame object_id name t[s] tx ty tz qx qy "
+	    "qz qw\n"
+	    "# (object_id = the value in RenderedFrame::objectId; masks are "
+	    "255 for any id > 0)\n");
 
 	const double t0 = cfg.seq.startTime;
 	size_t nextImu = 0;
 	auto writeImuUntil = [&](double tSeq)
 	{
-		// IMU samples stamped up to sequence time tSeq (inclusive).
+		// IMU samples stamped up to sequence time tSeq (inclusive); their
+		// truth lines reach the file in one write
+		std::string lines;
 		while (double(nextImu) / cfg.imu.rateHz <= tSeq + 1e-9)
 		{
 			ImuTruth tr;
 			const double stamp = t0 + double(nextImu) / cfg.imu.rateHz;
 			out.write(*imu.sample(motion, stamp, t0, &tr));
-			imuTruth.push_back(tr);
+			lines += imuTruthLine(tr);
 			nextImu++;
 		}
+		gtImu.append(lines);
 	};
 
 	ProgressBar bar("bims-sim", size_t(cfg.seq.frames), progress);
@@ -216,8 +228,9 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 		    std::chrono::duration<double>(std::chrono::steady_clock::now() - r0)
 		        .count();
 		out.write(*makeScan(cfg, frame, t0 + tSeq));
+		out.flush();
 
-		gt.push_back({t0 + tSeq, toPose(k.R_WC, k.p_WC)});
+		gtPoses.append(tumLine(t0 + tSeq, toPose(k.R_WC, k.p_WC)) + "\n");
 		const std::string name = "/masks/" + frameFileName(j);
 		const cv::Mat mask(frame.height, frame.width, CV_8UC1,
 		                   frame.mask.data());
@@ -227,14 +240,17 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 		size_t nMoving = 0;
 		for (auto m : frame.mask) nMoving += m ? 1 : 0;
 		movingSum += double(nMoving) / double(frame.mask.size());
+		std::string objectLines;  // one write per frame
 		for (size_t o = 0; o < scene.objects.size(); o++)
 		{
 			Eigen::Matrix3d R;
 			Eigen::Vector3d x;
 			scene.objects[o]->pose(tSeq, R, x);
-			objs << j << " " << (o + 1) << " " << scene.objects[o]->name()
-			     << " " << tumLine(t0 + tSeq, toPose(R, x)) << "\n";
+			objectLines += std::to_string(j) + " " + std::to_string(o + 1) +
+			               " " + scene.objects[o]->name() + " " +
+			               tumLine(t0 + tSeq, toPose(R, x)) + "\n";
 		}
+		gtObjects.append(objectLines);
 		bar.update(size_t(j + 1));
 	}
 	st.interrupted = done < cfg.seq.frames;
@@ -245,15 +261,10 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	part.commit();
 	bar.finish();
 
-	saveTumTrajectory(st.gtDir + "/groundtruth.txt", gt,
-	                  "bims-sim ground truth: camera optical frame poses T_WC, "
-	                  "world z up, x north");
-	saveImuTruth(st.gtDir + "/imu.txt", imuTruth);
-	writeCalibration(cfg, st.gtDir + "/calibration.ini");
-	writeFileAtomically(st.gtDir + "/objects.txt", objs.str());
+	for (auto* f : {&gtPoses, &gtImu, &gtObjects}) f->close();
 
 	st.frames = size_t(done);
-	st.imuSamples = imuTruth.size();
+	st.imuSamples = nextImu;
 	st.movingFraction = movingSum / std::max(1, done);
 	st.cpuSeconds = double(std::clock() - cpuStart) / CLOCKS_PER_SEC;
 	st.seconds =

@@ -468,3 +468,44 @@ TEST(BimsSim, SigintAndSigtermEndACompleteShorterSequence)
 		EXPECT_FALSE(std::filesystem::exists(d + "/x.rawlog.partial"));
 	}
 }
+
+TEST(BimsSim, AKilledRunLeavesEveryFrameWrittenSoFarReadable)
+{
+	// SIGKILL cannot be caught: the rawlog stays a .partial, but its gzip
+	// stream is flushed after each frame and the ground truth grows line by
+	// line, so both read back up to the last whole frame
+	const std::string d = tmpDir("sigkill");
+	const int rc = bims::test::signalWhenExists(
+	    {kBin + "/bims-sim", kSrc + "/rawlogs/pendulum_slow.ini", "-o",
+	     d + "/x.rawlog", "--frames", "3000", "-q"},
+	    d + "/log", d + "/x_gt/masks/000005.png", SIGKILL);
+	ASSERT_EQ(rc, -SIGKILL) << readFile(d + "/log");
+	EXPECT_FALSE(std::filesystem::exists(d + "/x.rawlog"));
+	size_t scans = 0;
+	std::string torn;  // the reader's message at a torn end, if any
+	try
+	{
+		bims::RawlogReader r(d + "/x.rawlog.partial");
+		while (auto o = r.next())
+			if (IS_CLASS(*o, mrpt::obs::CObservation3DRangeScan)) scans++;
+	}
+	catch (const bims::RawlogError& e)
+	{
+		torn = e.what();
+	}
+	if (!torn.empty())
+	{
+		EXPECT_NE(torn.find("x.rawlog.partial"), std::string::npos) << torn;
+	}
+	// frame 5 was flushed before its mask was written
+	EXPECT_GE(scans, 6u) << torn;
+	EXPECT_LT(scans, 3000u);
+	// each ground-truth line follows its frame's flush
+	const auto poses = bims::loadTumTrajectory(d + "/x_gt/groundtruth.txt");
+	EXPECT_LE(poses.size(), scans);
+	EXPECT_GE(poses.size() + 1, scans);
+	const std::string imu = readFile(d + "/x_gt/imu.txt");
+	ASSERT_FALSE(imu.empty());
+	EXPECT_EQ(imu.back(), '\n');
+	EXPECT_TRUE(std::filesystem::exists(d + "/x_gt/calibration.ini"));
+}

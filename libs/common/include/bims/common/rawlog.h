@@ -80,10 +80,9 @@ class RawlogWriter
 {
  public:
 	/** Creates (truncates) \a path (a symbolic link there is replaced, its
-	 * target untouched). gzLevel 1..9 writes a gzip-compressed
-	 * rawlog (flushed only on close); 0 writes a plain rawlog whose flush()
-	 * reaches the OS, for live grabbing. Throws RawlogError if the file
-	 * cannot be created. */
+	 * target untouched). gzLevel 1..9 writes a gzip-compressed rawlog, 0 a
+	 * plain one (for live grabbing). Throws RawlogError if the file cannot
+	 * be created. */
 	explicit RawlogWriter(const std::string& path, int gzLevel = 1);
 	~RawlogWriter();
 	RawlogWriter(const RawlogWriter&) = delete;
@@ -93,8 +92,11 @@ class RawlogWriter
 	 * rawlog gets it at once or not at all (bims::AppendFile: a failed write
 	 * leaves the file at its last whole observation and throws naming it). */
 	void write(const mrpt::obs::CObservation& obs);
-	/** Nothing to do for a plain rawlog (each object reaches the OS when
-	 * written, so a kill loses at most the last object). */
+	/** Everything written so far reaches the OS: a killed program leaves
+	 * the file readable up to here. Nothing to do for a plain rawlog (each
+	 * object reaches the OS when written); a gzip rawlog's stream is
+	 * flushed to a byte boundary (zlib's Z_SYNC_FLUSH: a few bytes more per
+	 * call). Throws RawlogError naming the file if the write fails. */
 	void flush();
 	/** Closes the file; throws RawlogError naming it if the last bytes
 	 * could not be written (plain and gzip rawlogs). */

@@ -37,4 +37,8 @@ const StampedPose* poseNear(const Trajectory& traj, double t, double maxDt);
 /** One TUM line for a pose (no newline). */
 std::string tumLine(double t, const mrpt::poses::CPose3D& T_WC);
 
+/** The header of a TUM file: "# comment" (if any) and the column names,
+ * each line ended. */
+std::string tumHeader(const std::string& comment = {});
+
 }  // namespace bims

@@ -143,8 +143,12 @@ std::vector<mrpt::obs::CObservationIMU::Ptr> synthesizeImu(
     const Trajectory& trajectory, const ImuParams& params, uint64_t seed,
     std::vector<ImuTruth>* truth = nullptr);
 
-/** Writes the true IMU values as a text table (one line per sample, header
- * comment naming the columns). Throws std::runtime_error on I/O failure. */
+/** Writes the true IMU values as a text table (imuTruthHeader(), then one
+ * imuTruthLine() per sample). Throws std::runtime_error on I/O failure. */
 void saveImuTruth(const std::string& path, const std::vector<ImuTruth>& truth);
+/** The comment lines naming the columns of the IMU truth table. */
+std::string imuTruthHeader();
+/** One sample's line of the IMU truth table (newline included). */
+std::string imuTruthLine(const ImuTruth& t);
 
 }  // namespace bims::sim
