@@ -5,6 +5,14 @@
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_ARGS ?=
+# Build trees made here use Ninja and a unity build (CMake joins ~8 sources
+# of a target into one compile: the MRPT/Eigen/OpenCV headers and templates
+# are parsed and instantiated once per batch, not per file). Both cut a
+# clean build by about 40% (docs/results.md, "Build time"); UNITY=OFF gives
+# one compile per file (a change then rebuilds only its own file).
+GENERATOR ?= Ninja
+UNITY ?= ON
+TREE_ARGS = -G "$(GENERATOR)" -DCMAKE_UNITY_BUILD=$(UNITY)
 
 .PHONY: all deps configure build test test-sanitize demo bench fuzz format clean
 
@@ -15,7 +23,7 @@ deps:
 
 configure: deps
 	@if [ ! -f $(BUILD_DIR)/CMakeCache.txt ]; then \
-	  cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS); \
+	  cmake -S . -B $(BUILD_DIR) $(TREE_ARGS) -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS); \
 	fi
 
 build: configure
@@ -30,7 +38,7 @@ test: build
 SAN_BUILD_DIR ?= build-sanitize
 test-sanitize: deps
 	@if [ ! -f $(SAN_BUILD_DIR)/CMakeCache.txt ]; then \
-	  cmake -S . -B $(SAN_BUILD_DIR) -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG=-O1 -DBIMS_SANITIZE=address,undefined \
+	  cmake -S . -B $(SAN_BUILD_DIR) $(TREE_ARGS) -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG=-O1 -DBIMS_SANITIZE=address,undefined \
 	    -DBIMS_BUILD_GUI=OFF -DBIMS_BUILD_BENCH=OFF $(CMAKE_ARGS); \
 	fi
 	cmake --build $(SAN_BUILD_DIR) -j$(JOBS)

@@ -9,6 +9,7 @@
 #include <bims/eval/mask_metrics.h>
 #include <bims/eval/tum_import.h>
 #include <bims/pipeline/pipeline.h>
+#include <bims_test/data.h>
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFile.h>
 
@@ -19,8 +20,6 @@ using namespace bims::pipeline;
 
 namespace
 {
-const std::string kBonn =
-    std::string(BIMS_SHARED_DATA_DIR) + "/bonn_crowd_f150_349";
 const std::string kConfig = std::string(BIMS_SOURCE_DIR) + "/config/bonn.ini";
 
 /** The slice as config/bonn.ini imports it. */
@@ -34,7 +33,7 @@ Slice loadSlice()
 	mrpt::config::CConfigFile file(kConfig);
 	Slice s;
 	s.ip.loadFromConfigFile(file);
-	s.folder = bims::eval::readTumFolder(kBonn, s.ip);
+	s.folder = bims::eval::readTumFolder(bims::test::kBonnCrowd, s.ip);
 	return s;
 }
 /** config/bonn.ini, vision-only egomotion (the recording has no IMU). */
@@ -86,7 +85,8 @@ bims::eval::MaskMetrics scoreAgainstProxy(const ExperimentConfig& cfg,
                                           bims::eval::MaskMetrics* peopleFree)
 {
 	namespace ev = bims::eval;
-	const auto labels = ev::listMaskFiles(kBonn + "/masks_proxy");
+	const auto labels =
+	    ev::listMaskFiles(bims::test::kBonnCrowd + "/masks_proxy");
 	const auto conv = ev::LabelConvention::explicitValues(255, 0, {150, 50});
 	Pipeline pipe(cfg);
 	// the depth correction of config/bonn.ini, as bims-run applies it
@@ -110,7 +110,8 @@ bims::eval::MaskMetrics scoreAgainstProxy(const ExperimentConfig& cfg,
 	ev::MaskMetrics total;
 	for (const auto& p : match.pairs)
 	{
-		const cv::Mat l = ev::loadMask(kBonn + "/masks_proxy/" + p.label->name);
+		const cv::Mat l = ev::loadMask(bims::test::kBonnCrowd +
+		                               "/masks_proxy/" + p.label->name);
 		const auto m = ev::MaskMetrics::compute(
 		    l, masks[static_cast<size_t>(p.pred - preds.data())], cv::Mat(),
 		    conv);
@@ -126,8 +127,8 @@ TEST(BonnEndToEnd, SegmentationAgainstProxyLabels)
 	// The real-data configuration (config/bonn.ini, its variant) against
 	// the per-pixel labels of the slice, and the single-cue variants beside
 	// it. Figures of bench/segmentation_real.sh in docs/results.md.
-	if (!std::filesystem::exists(kBonn + "/masks_proxy"))
-		GTEST_SKIP() << "no Bonn labels at " << kBonn;
+	if (!std::filesystem::exists(bims::test::kBonnCrowd + "/masks_proxy"))
+		GTEST_SKIP() << "no Bonn labels at " << bims::test::kBonnCrowd;
 	const auto [ip, folder] = loadSlice();
 	const ExperimentConfig cfg = visionConfig();
 	bims::eval::MaskMetrics free;
@@ -174,8 +175,8 @@ TEST(BonnEndToEnd, SegmentationAgainstProxyLabels)
 
 TEST(BonnEndToEnd, FlowLabelsKeepTheStaticRoomStaticAndSeePeople)
 {
-	if (!std::filesystem::exists(kBonn + "/depth.txt"))
-		GTEST_SKIP() << "no Bonn sample at " << kBonn;
+	if (!std::filesystem::exists(bims::test::kBonnCrowd + "/depth.txt"))
+		GTEST_SKIP() << "no Bonn sample at " << bims::test::kBonnCrowd;
 	const auto [ip, folder] = loadSlice();
 	ASSERT_EQ(folder.frames.size(), 200u);
 

@@ -6,16 +6,9 @@
 #include <filesystem>
 #include <fstream>
 
-namespace
-{
-std::string tmpPath(const std::string& name)
-{
-	const auto dir =
-	    std::filesystem::temp_directory_path() / "bims_test_common";
-	std::filesystem::create_directories(dir);
-	return (dir / name).string();
-}
-}  // namespace
+#include "tmp_path.h"
+
+using bims::test::tmpPath;
 
 TEST(Trajectory, TumRoundTrip)
 {

@@ -3,6 +3,7 @@
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/eval/tum_import.h>
+#include <bims_test/data.h>
 #include <bims_test/run_command.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
@@ -22,8 +23,6 @@ namespace fs = std::filesystem;
 namespace
 {
 const std::string kBin = BIMS_BIN_DIR;
-const std::string kBonn =
-    std::string(BIMS_SHARED_DATA_DIR) + "/bonn_crowd_f150_349";
 
 using Run = bims::test::CommandResult;
 Run run(const std::string& args)
@@ -44,10 +43,11 @@ std::string lastLine(const std::string& s)
 
 TEST(ImportTum, BonnTwentyFramesWithConvertedGroundTruth)
 {
-	if (!fs::exists(kBonn + "/depth.txt")) GTEST_SKIP() << "no Bonn sample";
+	if (!fs::exists(bims::test::kBonnCrowd + "/depth.txt"))
+		GTEST_SKIP() << "no Bonn sample";
 	const auto d = tmpDir("import");
-	const auto r = run(kBin + "/bims-import-tum " + kBonn + " -o " + d +
-	                   "/b.rawlog --config " + BIMS_SOURCE_DIR +
+	const auto r = run(kBin + "/bims-import-tum " + bims::test::kBonnCrowd +
+	                   " -o " + d + "/b.rawlog --config " + BIMS_SOURCE_DIR +
 	                   "/config/bonn.ini --max-frames 20 -q");
 	ASSERT_EQ(r.code, 0) << r.out;
 	const auto gt = bims::loadTumTrajectory(d + "/b_gt/groundtruth.txt");
@@ -74,7 +74,8 @@ TEST(ImportTum, BonnTwentyFramesWithConvertedGroundTruth)
 	            1e-4);
 	EXPECT_NEAR(gt[0].t, 1548339824.89375, 1e-5);
 	const cv::Mat png =
-	    cv::imread(kBonn + "/depth/1548339824.89375.png", cv::IMREAD_UNCHANGED);
+	    cv::imread(bims::test::kBonnCrowd + "/depth/1548339824.89375.png",
+	               cv::IMREAD_UNCHANGED);
 	ASSERT_EQ(png.type(), CV_16UC1);
 	size_t checked = 0;
 	for (int v = 0; v < 480; v += 7)
@@ -117,7 +118,7 @@ TEST(ImportTum, BonnTwentyFramesWithConvertedGroundTruth)
 	// Masks over valid depth only: scan 5 of the rawlog is frame 5 of the
 	// folder; GT = left half moving, prediction = everything moving.
 	bims::eval::ImportParams ip;
-	const auto folder = bims::eval::readTumFolder(kBonn, ip);
+	const auto folder = bims::eval::readTumFolder(bims::test::kBonnCrowd, ip);
 	const cv::Mat d5 =
 	    cv::imread(folder.frames[5].depthPath, cv::IMREAD_UNCHANGED);
 	ASSERT_FALSE(d5.empty());
@@ -374,10 +375,11 @@ TEST(ImportTum, SynthImuFromConvertedGroundTruthSeesGravityUp)
 	// Synthetic IMU from the converted Bonn poses: the world must be z up
 	// for the accelerometer to read gravity on the IMU's up axis ({I} = MRPT
 	// scan frame by default: z up when the camera is level).
-	if (!fs::exists(kBonn + "/depth.txt")) GTEST_SKIP() << "no Bonn sample";
+	if (!fs::exists(bims::test::kBonnCrowd + "/depth.txt"))
+		GTEST_SKIP() << "no Bonn sample";
 	const auto d = tmpDir("synth");
-	const auto r = run(kBin + "/bims-import-tum " + kBonn + " -o " + d +
-	                   "/s.rawlog --config " + BIMS_SOURCE_DIR +
+	const auto r = run(kBin + "/bims-import-tum " + bims::test::kBonnCrowd +
+	                   " -o " + d + "/s.rawlog --config " + BIMS_SOURCE_DIR +
 	                   "/config/bonn.ini --max-frames 30 --synth-imu -q");
 	if (r.code == 2 && r.out.find("no simulator library") != std::string::npos)
 		GTEST_SKIP() << r.out;

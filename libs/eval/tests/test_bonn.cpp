@@ -5,6 +5,7 @@
 #include <bims/eval/depth_consistency.h>
 #include <bims/eval/pose_utils.h>
 #include <bims/eval/tum_import.h>
+#include <bims_test/data.h>
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -16,8 +17,6 @@ using mrpt::poses::CPose3D;
 
 namespace
 {
-const std::string kBonn =
-    std::string(BIMS_SHARED_DATA_DIR) + "/bonn_crowd_f150_349";
 
 ev::ImportParams bonnParams()
 {
@@ -64,10 +63,10 @@ PairResult comparePair(const ev::TumFolder& f, const ev::ImportParams& p,
 
 TEST(BonnGroundTruth, ConvertedPosesRegisterDepthFrames)
 {
-	if (!std::filesystem::exists(kBonn + "/depth.txt"))
-		GTEST_SKIP() << "no Bonn sample at " << kBonn;
+	if (!std::filesystem::exists(bims::test::kBonnCrowd + "/depth.txt"))
+		GTEST_SKIP() << "no Bonn sample at " << bims::test::kBonnCrowd;
 	const auto p = bonnParams();
-	const auto f = ev::readTumFolder(kBonn, p);
+	const auto f = ev::readTumFolder(bims::test::kBonnCrowd, p);
 	ASSERT_EQ(f.frames.size(), 200u);
 	ASSERT_TRUE(f.hasGroundTruth);
 	// The world is z up: the camera's y axis (down) points down in {W}

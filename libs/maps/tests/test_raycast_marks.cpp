@@ -7,6 +7,7 @@
 #include <bims/maps/dda.h>
 #include <bims/maps/frame_cloud.h>
 #include <bims/maps/ray_marks.h>
+#include <bims_test/data.h>
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
@@ -232,8 +233,7 @@ TEST(RayMarks, SameVoxelsAndFirstVisitsAsTraverseRay)
 // per hit voxel, 1 and 2 threads, and a memory budget that runs out.
 TEST(Raycast, BonnFramesEqualThePlainWalkVoxelForVoxel)
 {
-	const std::string dir =
-	    std::string(BIMS_SHARED_DATA_DIR) + "/bonn_crowd_f150_349/depth";
+	const std::string dir = bims::test::kBonnCrowd + "/depth";
 	if (!std::filesystem::is_directory(dir))
 		GTEST_SKIP() << "shared data missing: " << dir;
 	std::vector<std::string> pngs;

@@ -2,6 +2,7 @@
 #include <bims/common/frame_files.h>
 #include <bims/common/json.h>
 #include <bims/common/output_paths.h>
+#include "clock.h"
 
 #include "cpu_time.h"
 
@@ -23,6 +24,8 @@
 
 namespace bims::pipeline
 {
+using detail::Clock;
+using detail::msSince;
 
 void writePointsPly(const std::string& path,
                     const std::vector<mrpt::math::TPoint3D>& pts)
@@ -43,11 +46,6 @@ void writePointsPly(const std::string& path,
 
 namespace
 {
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0)
-{
-	return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 /** Queue length of the writer: a few frames, so a slow disk slows the run
  * down instead of filling the memory (about 2 MB per VGA frame). */
 constexpr size_t kQueuedWrites = 16;

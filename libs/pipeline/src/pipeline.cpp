@@ -1,6 +1,7 @@
 #include <bims/common/frames.h>
 #include <bims/flow/expected_flow.h>
 #include <bims/pipeline/pipeline.h>
+#include "clock.h"
 
 #include <chrono>
 #include <future>
@@ -10,13 +11,10 @@
 
 namespace bims::pipeline
 {
+using detail::Clock;
+using detail::msSince;
 namespace
 {
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0)
-{
-	return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 /** Waits for a job's future when leaving a scope (also by an exception). */
 template <class T>

@@ -4,6 +4,7 @@
 #include <bims/sim/imu.h>
 #include <bims/sim/rng.h>
 #include <mrpt/system/datetime.h>
+#include "ini_vector.h"
 
 #include <cmath>
 #include <cstdio>
@@ -11,17 +12,11 @@
 
 namespace bims::sim
 {
+using detail::kDeg;
+using detail::stdv;
+using detail::vec3;
 namespace
 {
-constexpr double kDeg = M_PI / 180.0;
-Eigen::Vector3d vec3(const std::vector<double>& v)
-{
-	return {v[0], v[1], v[2]};
-}
-std::vector<double> stdv(const Eigen::Vector3d& v)
-{
-	return {v.x(), v.y(), v.z()};
-}
 Eigen::Vector3d gaussVec(Rng& r)
 {
 	return {r.gauss(), r.gauss(), r.gauss()};
@@ -250,11 +245,11 @@ std::string imuTruthLine(const ImuTruth& t)
 	              "%.6f %.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f %.9f "
 	              "%.9e %.9e %.9e %.9e %.9e %.9e "
 	              "%.9f %.9f %.9f %.9f %.9e %.9e %.9e\n",
-	              t.tStamp, t.tTrue, t.omega_I.x(), t.omega_I.y(), t.omega_I.z(),
-	              t.f_I.x(), t.f_I.y(), t.f_I.z(), t.m_I.x(), t.m_I.y(),
-	              t.m_I.z(), t.gyroBias.x(), t.gyroBias.y(), t.gyroBias.z(),
-	              t.accBias.x(), t.accBias.y(), t.accBias.z(), t.q_WI.x(),
-	              t.q_WI.y(), t.q_WI.z(), t.q_WI.w(), t.magBias.x(),
+	              t.tStamp, t.tTrue, t.omega_I.x(), t.omega_I.y(),
+	              t.omega_I.z(), t.f_I.x(), t.f_I.y(), t.f_I.z(), t.m_I.x(),
+	              t.m_I.y(), t.m_I.z(), t.gyroBias.x(), t.gyroBias.y(),
+	              t.gyroBias.z(), t.accBias.x(), t.accBias.y(), t.accBias.z(),
+	              t.q_WI.x(), t.q_WI.y(), t.q_WI.z(), t.q_WI.w(), t.magBias.x(),
 	              t.magBias.y(), t.magBias.z());
 	return buf;
 }

@@ -1,6 +1,7 @@
 #include <bims/common/config.h>
 #include <bims/common/frames.h>
 #include <bims/sim/motion.h>
+#include "ini_vector.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,9 +9,11 @@
 
 namespace bims::sim
 {
+using detail::kDeg;
+using detail::stdv;
+using detail::vec3;
 namespace
 {
-constexpr double kDeg = M_PI / 180.0;
 
 /** value, 1st and 2nd derivative of A(sin(wt+a)-sin a) +
  * 0.35A(sin(1.73wt+b)-sin b). */
@@ -32,14 +35,6 @@ Eigen::Matrix3d R_SC_eigen()
 	// columns: optical x,y,z axes expressed in {S}
 	R << 0, 0, 1, -1, 0, 0, 0, -1, 0;
 	return R;
-}
-Eigen::Vector3d vec3(const std::vector<double>& v)
-{
-	return {v[0], v[1], v[2]};
-}
-std::vector<double> stdv(const Eigen::Vector3d& v)
-{
-	return {v.x(), v.y(), v.z()};
 }
 }  // namespace
 

@@ -2,19 +2,17 @@
 #include <bims/common/frames.h>
 #include <bims/sim/objects.h>
 #include <bims/sim/rng.h>
+#include "ini_vector.h"
 
 #include <cmath>
 
 namespace bims::sim
 {
+using detail::kDeg;
+using detail::vec3;
 namespace
 {
-constexpr double kDeg = M_PI / 180.0;
 
-Eigen::Vector3d vec3(const std::vector<double>& v)
-{
-	return {v[0], v[1], v[2]};
-}
 Eigen::Matrix3d rotZ(double a)
 {
 	return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix();

@@ -1,6 +1,7 @@
 #include <bims/common/config.h>
 #include <bims/sim/renderer.h>
 #include <bims/sim/rng.h>
+#include "ini_vector.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,9 +10,9 @@
 
 namespace bims::sim
 {
+using detail::kDeg;
 namespace
 {
-constexpr double kDeg = M_PI / 180.0;
 
 /** Procedural texture: a grid of cells of random colours (strong corners for
  * KLT at every cell junction), plus a small per-cell darker dot pattern. */

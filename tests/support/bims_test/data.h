@@ -1,0 +1,12 @@
+// Where the tests find the shared real recordings (never copied into the
+// repository; a test skips when its recording is not there).
+#pragma once
+
+#include <string>
+
+namespace bims::test
+{
+/** The Bonn RGB-D Dynamic "crowd" frames 150-349 (their README). */
+inline const std::string kBonnCrowd =
+    std::string(BIMS_SHARED_DATA_DIR) + "/bonn_crowd_f150_349";
+}  // namespace bims::test
