@@ -47,6 +47,7 @@ class ViewerFrame : public wxFrame
 	void refreshViews(bool resetCamera = false);
 	void updateControls();
 	void onTimer(wxTimerEvent&);
+	void placeSash();  ///< 3/5 of the width until the user drags the sash
 	void onPlayPause(wxCommandEvent&);
 	void onStep(wxCommandEvent&);
 	void onRestart(wxCommandEvent&);
@@ -75,6 +76,7 @@ class ViewerFrame : public wxFrame
 	std::string pngDir_;
 	int batchWaitTicks_ = 0;
 	bool batchCaptureRequested_ = false;
+	wxSplitterWindow* split_ = nullptr;
 	bool sashMovedByUser_ = false;  ///< the sash no longer follows resizes
 };
 

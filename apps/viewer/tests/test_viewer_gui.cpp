@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -93,6 +94,66 @@ TEST(GuiViewer, XScreenshotOfTheWholeWindowShowsTiersAndPanels)
 	cv::Mat green;
 	cv::inRange(right, cv::Scalar(0, 120, 0), cv::Scalar(60, 255, 60), green);
 	EXPECT_GT(cv::countNonZero(green), 2000);
+}
+
+namespace
+{
+/** Where the image panels are in an X screenshot: the widest run of their
+ * background grey (40,40,40) on one row of the right half, and the rows
+ * from the first to the last that hold such a run of at least \a minRun. */
+struct PanelExtent
+{
+	int widestRun = 0;
+	int rows = 0;
+};
+PanelExtent panelExtent(const cv::Mat& img, int minRun)
+{
+	PanelExtent e;
+	int first = -1, last = -1;
+	for (int y = 0; y < img.rows; ++y)
+	{
+		int run = 0, widest = 0;
+		for (int x = img.cols / 2; x < img.cols; ++x)
+		{
+			const auto& p = img.at<cv::Vec3b>(y, x);
+			run = (p[0] == 40 && p[1] == 40 && p[2] == 40) ? run + 1 : 0;
+			widest = std::max(widest, run);
+		}
+		e.widestRun = std::max(e.widestRun, widest);
+		if (widest >= minRun)
+		{
+			if (first < 0) first = y;
+			last = y;
+		}
+	}
+	e.rows = first < 0 ? 0 : last - first + 1;
+	return e;
+}
+}  // namespace
+
+TEST(GuiViewer, PanelsKeepTheirWidthWhilePlaying)
+{
+	// An X screenshot while the viewer plays (it starts playing at once; at
+	// a quarter of real time the 150 frames last 20 s). The six image panels
+	// take 2/5 of the 1200 px window, two columns of ~240 px: they collapsed
+	// to 50 px once wx moved the sash itself on a resize.
+	ASSERT_EQ(run("mkdir -p '" + kOut + "'"), 0);
+	const std::string xshot = kOut + "/viewer_playing.png";
+	const std::string log = kOut + "/viewer_playing.log";
+	std::remove(xshot.c_str());
+	const std::string cmd =
+	    std::string(BIMS_XVFB_RUN) +
+	    " -a -s '-screen 0 1200x800x24 +extension GLX' '" + BIMS_SOURCE_DIR +
+	    "/apps/viewer/tests/xshot.sh' - '" + xshot + "' '" + kViewer + "' '" +
+	    kRawlog + "' --config '" + BIMS_SOURCE_DIR +
+	    "/config/default.ini' --speed 0.25 --size 1200x800 > '" + log +
+	    "' 2>&1";
+	ASSERT_EQ(run(cmd), 0) << slurp(log);
+	const cv::Mat img = cv::imread(xshot, cv::IMREAD_COLOR);
+	ASSERT_FALSE(img.empty()) << slurp(log);
+	const auto e = panelExtent(img, 100);
+	EXPECT_GE(e.widestRun, 150) << "image panels collapsed: " << xshot;
+	EXPECT_GE(e.rows, img.rows / 2) << "image panels collapsed: " << xshot;
 }
 
 TEST(GuiViewer, NoDisplayGivesAClearErrorAndNonZeroExit)
