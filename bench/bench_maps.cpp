@@ -11,6 +11,7 @@
 //              [--voxels=0.02,0.05] [benchmark flags]
 #include <bims/common/json.h>
 #include <bims/common/rawlog.h>
+#include <bims/eval/tum_import.h>
 #include <bims/maps/dda.h>
 #include <bims/maps/motion_grids.h>
 
@@ -44,27 +45,15 @@ struct Cloud
 	mrpt::poses::CPose3D T_WS;
 };
 
-// A Bonn RGB-D depth PNG (16 bit, metres = value / 5000).
+// A Bonn RGB-D depth PNG (config/bonn.ini's camera, the PNG's values kept).
 Cloud loadBonn(const std::string& path)
 {
-	const cv::Mat d = cv::imread(path, cv::IMREAD_UNCHANGED);
-	if (d.empty() || d.type() != CV_16UC1)
-		throw std::runtime_error("cannot read 16-bit depth PNG '" + path + "'");
-	auto o = mrpt::obs::CObservation3DRangeScan::Create();
-	o->hasRangeImage = true;
-	o->range_is_depth = true;
-	o->rangeUnits = 1.0f / 5000;
-	o->rangeImage_setSize(d.rows, d.cols);
-	for (int v = 0; v < d.rows; ++v)
-		for (int u = 0; u < d.cols; ++u)
-			o->rangeImage(v, u) = d.at<uint16_t>(v, u);
-	o->cameraParams.ncols = d.cols;
-	o->cameraParams.nrows = d.rows;
-	o->cameraParams.setIntrinsicParamsFromValues(542.822841, 542.576870,
-	                                             315.593520, 237.756098);
-	o->cameraParamsIntensity = o->cameraParams;
-	o->maxRange = 10;
-	return {"bonn", o, mrpt::poses::CPose3D(0, 0, 1.5, 0, 0, 0)};
+	bims::eval::ImportParams p;
+	p.loadFromConfigFile(mrpt::config::CConfigFile(
+	    std::string(BIMS_SOURCE_DIR) + "/config/bonn.ini"));
+	p.rangeUnits = 1.0 / p.camera.depthScale;
+	return {"bonn", bims::eval::loadDepthFrame(path, 0, p),
+	        mrpt::poses::CPose3D(0, 0, 1.5, 0, 0, 0)};
 }
 
 Cloud loadSim(const std::string& path, int frame)

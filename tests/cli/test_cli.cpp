@@ -143,7 +143,7 @@ TEST(Cli, SharedOptionsAreSpelledTheSameWayInEveryProgram)
 	    "bims-run",         "bims-sim",       "bims-grab",
 	    "bims-odom",        "bims-calib-imu", "bims-calib-depth",
 	    "bims-import-tum",  "bims-eval traj", "bims-eval masks",
-	    "bims-flow-labels", "bims-sweep"};
+	    "bims-flow-labels", "bims-sweep",     "bims-maps-figure"};
 	const std::set<std::string> withQuiet = {
 	    "bims-run",        "bims-sim",        "bims-grab",
 	    "bims-odom",       "bims-calib-imu",  "bims-calib-depth",
@@ -369,4 +369,23 @@ TEST(Cli, AFrameRangeBeyondTheInputIsAUsageErrorBeforeAnyWork)
 		    << part.out;
 	}
 	EXPECT_TRUE(fs::is_empty(d));  // nothing written
+}
+
+TEST(Cli, MapsFigureTakesItsOutputAsOOrAsTheThirdWordOnce)
+{
+	if (!built("bims-maps-figure")) GTEST_SKIP() << "not built";
+	const std::string d = bims::test::freshTmpDir("bims_test_cli", "figure");
+	const std::string args = kBin + "/bims-maps-figure " + kSample + " " +
+	                         kSrc + "/rawlogs/pendulum_slow_gt";
+	for (const std::string& out :
+	     {std::string(), " " + d + "/a.png -o " + d + "/b.png"})
+	{
+		const auto r = bims::test::runCommand(args + out);
+		EXPECT_EQ(r.code, 2) << out << "\n" << r.out;
+		EXPECT_NE(r.out.find("give the output PNG once: -o OUT.png or as the "
+		                     "third word"),
+		          std::string::npos)
+		    << r.out;
+	}
+	EXPECT_FALSE(fs::exists(d + "/a.png") || fs::exists(d + "/b.png"));
 }

@@ -20,33 +20,25 @@ namespace bims::eval
 namespace fs = std::filesystem;
 using mrpt::obs::CObservation3DRangeScan;
 
-mrpt::obs::CObservation3DRangeScan::Ptr loadFrame(const TumFrame& frame,
-                                                  const ImportParams& params)
+mrpt::obs::CObservation3DRangeScan::Ptr loadDepthFrame(
+    const std::string& depthPath, double t, const ImportParams& params)
 {
 	const auto& cam = params.camera;
-	const cv::Mat raw = cv::imread(frame.depthPath, cv::IMREAD_UNCHANGED);
+	const cv::Mat raw = cv::imread(depthPath, cv::IMREAD_UNCHANGED);
 	if (raw.empty())
-		throw std::runtime_error(frame.depthPath + ": cannot read depth image");
+		throw std::runtime_error(depthPath + ": cannot read depth image");
 	if (raw.type() != CV_16UC1)
-		throw std::runtime_error(frame.depthPath +
+		throw std::runtime_error(depthPath +
 		                         ": depth must be a 16-bit single-channel PNG");
 	if (raw.cols != cam.width || raw.rows != cam.height)
 		throw std::runtime_error(
-		    frame.depthPath + ": depth image is " + std::to_string(raw.cols) +
-		    "x" + std::to_string(raw.rows) + " but [camera] says " +
-		    std::to_string(cam.width) + "x" + std::to_string(cam.height));
-	const cv::Mat rgb = cv::imread(frame.rgbPath, cv::IMREAD_COLOR);
-	if (rgb.empty())
-		throw std::runtime_error(frame.rgbPath + ": cannot read colour image");
-	if (rgb.cols != cam.width || rgb.rows != cam.height)
-		throw std::runtime_error(
-		    frame.rgbPath + ": colour image is " + std::to_string(rgb.cols) +
-		    "x" + std::to_string(rgb.rows) + " but [camera] says " +
+		    depthPath + ": depth image is " + std::to_string(raw.cols) + "x" +
+		    std::to_string(raw.rows) + " but [camera] says " +
 		    std::to_string(cam.width) + "x" + std::to_string(cam.height));
 
 	auto o = CObservation3DRangeScan::Create();
 	o->sensorLabel = params.rgbdLabel;
-	o->timestamp = mrpt::Clock::fromDouble(frame.t);
+	o->timestamp = mrpt::Clock::fromDouble(t);
 	o->sensorPose = mrpt::poses::CPose3D();
 	o->hasRangeImage = true;
 	o->range_is_depth = true;
@@ -67,6 +59,22 @@ mrpt::obs::CObservation3DRangeScan::Ptr loadFrame(const TumFrame& frame,
 	}
 	o->cameraParams = cam.asTCamera();
 	o->cameraParamsIntensity = o->cameraParams;
+	return o;
+}
+
+mrpt::obs::CObservation3DRangeScan::Ptr loadFrame(const TumFrame& frame,
+                                                  const ImportParams& params)
+{
+	const auto& cam = params.camera;
+	auto o = loadDepthFrame(frame.depthPath, frame.t, params);
+	const cv::Mat rgb = cv::imread(frame.rgbPath, cv::IMREAD_COLOR);
+	if (rgb.empty())
+		throw std::runtime_error(frame.rgbPath + ": cannot read colour image");
+	if (rgb.cols != cam.width || rgb.rows != cam.height)
+		throw std::runtime_error(
+		    frame.rgbPath + ": colour image is " + std::to_string(rgb.cols) +
+		    "x" + std::to_string(rgb.rows) + " but [camera] says " +
+		    std::to_string(cam.width) + "x" + std::to_string(cam.height));
 	o->relativePoseIntensityWRTDepth =
 	    mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
 	o->hasIntensityImage = true;

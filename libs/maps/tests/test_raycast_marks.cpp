@@ -3,12 +3,14 @@
 // (crossed voxels, the earliest visit of each block not stored) of random
 // rays split over any number of parts, and the map after whole frames of
 // the Bonn recording, voxel for voxel, with 1 and 2 threads.
+#include <bims/eval/tum_import.h>
 #include <bims/maps/COccupancyBayesGrid.h>
 #include <bims/maps/dda.h>
 #include <bims/maps/frame_cloud.h>
 #include <bims/maps/ray_marks.h>
 #include <bims_test/data.h>
 
+#include <mrpt/config/CConfigFile.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
 #include <gtest/gtest.h>
@@ -241,23 +243,13 @@ TEST(Raycast, BonnFramesEqualThePlainWalkVoxelForVoxel)
 		if (e.path().extension() == ".png") pngs.push_back(e.path().string());
 	std::sort(pngs.begin(), pngs.end());
 	ASSERT_GE(pngs.size(), 3u);
-	auto scanOf = [](const std::string& path)
-	{
-		const cv::Mat d = cv::imread(path, cv::IMREAD_UNCHANGED);
-		auto o = mrpt::obs::CObservation3DRangeScan::Create();
-		o->hasRangeImage = true;
-		o->range_is_depth = true;
-		o->rangeUnits = 1.0f / 5000;
-		o->rangeImage_setSize(d.rows, d.cols);
-		for (int v = 0; v < d.rows; ++v)
-			for (int u = 0; u < d.cols; ++u)
-				o->rangeImage(v, u) = d.at<uint16_t>(v, u);
-		o->cameraParams.ncols = d.cols;
-		o->cameraParams.nrows = d.rows;
-		o->cameraParams.setIntrinsicParamsFromValues(542.822841, 542.576870,
-		                                             315.593520, 237.756098);
-		return o;
-	};
+	// config/bonn.ini's camera; range units of the PNG's, its values kept
+	bims::eval::ImportParams bonn;
+	bonn.loadFromConfigFile(mrpt::config::CConfigFile(
+	    std::string(BIMS_SOURCE_DIR) + "/config/bonn.ini"));
+	bonn.rangeUnits = 1.0 / bonn.camera.depthScale;
+	auto scanOf = [&bonn](const std::string& path)
+	{ return bims::eval::loadDepthFrame(path, 0, bonn); };
 	const mrpt::poses::CPose3D poses[] = {{0, 0, 1.5, 0, 0, 0},
 	                                      {0.3, -0.2, 1.4, 0.2, 0.05, 0},
 	                                      {0.1, 0.4, 1.6, -0.3, 0, 0.1}};

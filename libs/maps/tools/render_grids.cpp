@@ -4,7 +4,8 @@
 // the flow labels (Diff on the mask, notDiff elsewhere): a picture of the
 // grids, not of the flow module.
 //
-//   bims-maps-figure RAWLOG GT_DIR OUT.png [--max-frames N] [--voxel M]
+//   bims-maps-figure RAWLOG GT_DIR {OUT.png | -o OUT.png} [--max-frames N]
+//                    [--voxel M]
 #include <bims/common/app.h>
 #include <bims/common/frame_files.h>
 #include <bims/common/frames.h>
@@ -44,8 +45,11 @@ int main(int argc, char** argv)
 		    TCLAP::UnlabeledValueArg<std::string> aGt(
 		        "gt", "Ground-truth folder (groundtruth.txt, masks/)", true, "",
 		        "GT_DIR", cmd);
+		    TCLAP::ValueArg<std::string> aOutOpt(
+		        "o", "out", "Output PNG (or as the third word)", false, "",
+		        "OUT.png", cmd);
 		    TCLAP::UnlabeledValueArg<std::string> aOut(
-		        "out", "Output PNG", true, "", "OUT.png", cmd);
+		        "out_png", "Output PNG (or -o)", false, "", "OUT.png", cmd);
 		    TCLAP::ValueArg<int> aFrames("", "max-frames",
 		                                 "Frames to integrate (default 60)",
 		                                 false, 60, "N", cmd);
@@ -53,12 +57,18 @@ int main(int argc, char** argv)
 		                                   "Voxel size [m] (default 0.05)",
 		                                   false, 0.05, "M", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    if (aOut.isSet() == aOutOpt.isSet())
+			    throw bims::UsageError(
+			        "give the output PNG once: -o OUT.png or as the third "
+			        "word");
+		    const std::string out =
+		        aOutOpt.isSet() ? aOutOpt.getValue() : aOut.getValue();
 		    const int frames = aFrames.getValue();
 		    const double voxel = aVoxel.getValue();
 		    if (frames < 1) throw bims::UsageError("--max-frames must be >= 1");
 		    if (!(voxel > 0)) throw bims::UsageError("--voxel must be > 0");
 		    bims::checkOutputsSpareInputs({aIn.getValue(), aGt.getValue()},
-		                                  {aOut.getValue()});
+		                                  {out});
 		    const std::string gt = aGt.getValue();
 		    const auto traj = bims::loadTumTrajectory(gt + "/groundtruth.txt");
 		    bims::maps::GridParams p;
@@ -138,11 +148,10 @@ int main(int argc, char** argv)
 		    cam.setElevationDegrees(25);
 		    mrpt::img::CImage img;
 		    fbo.render_RGB(scene, img);
-		    img.saveToFile(aOut.getValue());
+		    img.saveToFile(out);
 		    std::cout << k << " frames; " << grids.occupancy()->asString()
 		              << "\n"
-		              << grids.flow()->asString() << "\nwrote "
-		              << aOut.getValue() << "\n";
+		              << grids.flow()->asString() << "\nwrote " << out << "\n";
 		    return 0;
 	    });
 }

@@ -115,8 +115,15 @@ TumFolder readTumFolder(const std::string& folder, const ImportParams& params);
  * the camera's size. */
 cv::Mat loadDepthMeters(const std::string& path, const CameraIntrinsics& cam);
 
+/** The observation of one depth PNG alone, stamped \a t (no intensity
+ * image): the range image in params.rangeUnits, the camera of
+ * params.camera. Throws naming the file as loadDepthMeters. */
+mrpt::obs::CObservation3DRangeScan::Ptr loadDepthFrame(
+    const std::string& depthPath, double t, const ImportParams& params);
+
 /** Builds the observation of one frame (MRPT_NOTES.md section 5: registered
- * RGB-D, range_is_depth, sensorPose identity, rangeUnits from params). */
+ * RGB-D, range_is_depth, sensorPose identity, rangeUnits from params):
+ * loadDepthFrame and the colour image. */
 mrpt::obs::CObservation3DRangeScan::Ptr loadFrame(const TumFrame& frame,
                                                   const ImportParams& params);
 
