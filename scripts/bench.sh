@@ -19,7 +19,7 @@ extra=()
 if [[ -x "$BUILD/bin/bims-sim" ]]; then
   ini="$OUT/sim_vga.ini"
   sed -e 's/^frames=.*/frames=6/' "$ROOT/config/sim/static_camera.ini" > "$ini"
-  "$BUILD/bin/bims-sim" "$ini" -o "$OUT/sim_vga.rawlog" --seed 1 >/dev/null 2>&1
+  "$BUILD/bin/bims-sim" "$ini" -o "$OUT/sim_vga.rawlog" --seed 1 --overwrite >/dev/null 2>&1
   extra+=("--sim_rawlog=$OUT/sim_vga.rawlog" "--sim_frame=3")
 fi
 "$BUILD/bin/bench_maps" "${extra[@]}" "$@" | tee "$OUT/bench_maps.jsonl"

@@ -92,6 +92,11 @@ int main(int argc, char** argv)
 		        "", "preview",
 		        "Also write OUT_gt/preview.png (RGB | depth | mask) of frame N",
 		        false, -1, "N", cmd);
+		    TCLAP::SwitchArg overwrite(
+		        "", "overwrite",
+		        "replace the ground truth of an earlier run in OUT_gt/ (its "
+		        "files only; anything else there stays)",
+		        cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "No progress bar", cmd);
 		    bims::parseCommandLine(
 		        cmd, argc, argv,
@@ -100,11 +105,21 @@ int main(int argc, char** argv)
 		        {scene.getValue(), tum.getValue(), config.getValue()},
 		        {out.getValue(), bims::sim::groundTruthDirFor(out.getValue())});
 
+		    // after the checks, before any work: an earlier run's ground
+		    // truth would mix with this one's (a shorter run leaves its
+		    // extra masks)
+		    auto prepareGroundTruthDir = [&]
+		    {
+			    bims::prepareOutputFolder(
+			        bims::sim::groundTruthDirFor(out.getValue()),
+			        bims::sim::groundTruthLayout(), overwrite.getValue());
+		    };
 		    if (tum.isSet())
 		    {
 			    if (scene.isSet())
 				    throw bims::UsageError(
 				        "give either SCENE.ini or --imu-from-tum");
+			    prepareGroundTruthDir();
 			    return imuFromTum(tum.getValue(), out.getValue(),
 			                      seed.getValue(), config.getValue());
 		    }
@@ -137,6 +152,7 @@ int main(int argc, char** argv)
 			        "--preview must be a frame index in [0, " +
 			        std::to_string(cfg.seq.frames - 1) + "]");
 		    // SIGINT / SIGTERM: stop after the current frame, write it all
+		    prepareGroundTruthDir();
 		    const auto& stop = bims::installStopSignals();
 		    const auto st = bims::sim::runSimulation(
 		        cfg, out.getValue(), seed.getValue(), !quiet.getValue(),

@@ -158,6 +158,15 @@ std::string groundTruthDirFor(const std::string& rawlogPath)
 	return base + "_gt";
 }
 
+const OutputFolderLayout& groundTruthLayout()
+{
+	static const OutputFolderLayout layout{
+	    {"groundtruth.txt", "imu.txt", "objects.txt", "calibration.ini",
+	     "preview.png"},
+	    {{"masks", ".png"}}};
+	return layout;
+}
+
 SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
                        uint64_t seed, bool progress, int previewFrame,
                        const std::atomic<bool>* stop)

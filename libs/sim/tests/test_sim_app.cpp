@@ -395,7 +395,7 @@ TEST(BundledSample, RegeneratingGivesTheSameRawlogAndGroundTruth)
 	// The command of rawlogs/README.md, run from the source tree.
 	ASSERT_EQ(run("cd '" + kSrc + "' && '" + kBin +
 	                  "/bims-sim' rawlogs/pendulum_slow.ini -o '" + d +
-	                  "/pendulum_slow.rawlog' --seed 1 -q",
+	                  "/pendulum_slow.rawlog' --seed 1 --overwrite -q",
 	              out),
 	          0)
 	    << out;
@@ -514,4 +514,26 @@ TEST(BimsSim, AKilledRunLeavesEveryFrameWrittenSoFarReadable)
 	ASSERT_FALSE(imu.empty());
 	EXPECT_EQ(imu.back(), '\n');
 	EXPECT_TRUE(std::filesystem::exists(d + "/x_gt/calibration.ini"));
+}
+
+TEST(BimsSim, AnEarlierRunsGroundTruthIsRefusedUnlessOverwrite)
+{
+	// a shorter second run into the same OUT would leave the first run's
+	// extra masks beside its own
+	const std::string d = tmpDir("again");
+	simulate(d, kSmallScene, "--max-frames 4");
+	writeFile(d + "/out_gt/notes.txt", "mine");
+	std::string out;
+	const std::string again = "'" + kBin + "/bims-sim' '" + d +
+	                          "/scene.ini' -o '" + d +
+	                          "/out.rawlog' -q --max-frames 2";
+	EXPECT_NE(run(again, out), 0) << out;
+	EXPECT_NE(out.find("out_gt"), std::string::npos) << out;
+	EXPECT_NE(out.find("--overwrite"), std::string::npos) << out;
+	EXPECT_TRUE(std::filesystem::exists(d + "/out_gt/masks/000003.png"));
+	ASSERT_EQ(run(again + " --overwrite", out), 0) << out;
+	EXPECT_TRUE(std::filesystem::exists(d + "/out_gt/masks/000001.png"));
+	EXPECT_FALSE(std::filesystem::exists(d + "/out_gt/masks/000002.png"));
+	EXPECT_FALSE(std::filesystem::exists(d + "/out_gt/masks/000003.png"));
+	EXPECT_EQ(readFile(d + "/out_gt/notes.txt"), "mine");  // not its file
 }

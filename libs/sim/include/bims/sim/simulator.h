@@ -10,6 +10,7 @@
 // See docs/sim.md for every key, unit and default.
 #pragma once
 
+#include <bims/common/output_paths.h>
 #include <bims/sim/imu.h>
 #include <bims/sim/motion.h>
 #include <bims/sim/objects.h>
@@ -76,6 +77,11 @@ struct SimStats
 
 /** Folder of the ground truth of a rawlog: "<path without .rawlog>_gt". */
 std::string groundTruthDirFor(const std::string& rawlogPath);
+
+/** Every file bims-sim writes into the ground-truth folder (runSimulation,
+ * saveImuTruth): an earlier run's are refused or cleared by
+ * bims::prepareOutputFolder (bims-sim --overwrite). */
+const bims::OutputFolderLayout& groundTruthLayout();
 
 /** Runs the simulation and writes \a outRawlog and
  * groundTruthDirFor(outRawlog)/: groundtruth.txt (T_WC per frame, TUM), imu.txt
