@@ -9,6 +9,7 @@
 // camera), and the Diff/notDiff labels; writes colour pictures and prints
 // per-stage timings. Useful to tune [flow] on real sensor data.
 #include <bims/common/app.h>
+#include <bims/common/clock.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
 #include <bims/common/output_paths.h>
@@ -35,14 +36,9 @@ cv::Mat readImage(const std::string& path, int flags)
 	if (m.empty()) throw std::runtime_error(path + ": cannot decode image");
 	return m;
 }
-
-double msSince(std::chrono::steady_clock::time_point t0)
-{
-	return std::chrono::duration<double, std::milli>(
-	           std::chrono::steady_clock::now() - t0)
-	    .count();
-}
 }  // namespace
+
+using bims::msSince;
 
 int main(int argc, char** argv)
 {

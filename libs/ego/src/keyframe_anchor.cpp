@@ -1,3 +1,4 @@
+#include <bims/common/clock.h>
 #include <bims/ego/keyframe_anchor.h>
 #include <bims/ego/so3.h>
 
@@ -99,9 +100,7 @@ AnchorResult KeyframeAnchor::track(const RgbdFrame& f,
 			r.maskIgnored = true;
 		}
 	}
-	r.ms = std::chrono::duration<double, std::milli>(
-	           std::chrono::steady_clock::now() - t0)
-	           .count();
+	r.ms = msSince(t0);
 	return r;
 }
 

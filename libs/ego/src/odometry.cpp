@@ -1,3 +1,4 @@
+#include <bims/common/clock.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/moving_prediction.h>
 #include <bims/ego/odometry.h>
@@ -12,16 +13,6 @@
 
 namespace bims::ego
 {
-namespace
-{
-double msSince(std::chrono::steady_clock::time_point t0)
-{
-	return std::chrono::duration<double, std::milli>(
-	           std::chrono::steady_clock::now() - t0)
-	    .count();
-}
-}  // namespace
-
 const char* toString(RotationSource s)
 {
 	switch (s)

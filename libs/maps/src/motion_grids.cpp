@@ -1,3 +1,4 @@
+#include <bims/common/clock.h>
 #include <bims/maps/motion_grids.h>
 
 #include <chrono>
@@ -129,9 +130,7 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 	                           f, cells);
 	result_.mask1_ = &t1_->lastMovingMask();
 	result_.mask2_ = &t2_->lastMovingMask();
-	result_.updateMs = std::chrono::duration<double, std::milli>(
-	                       std::chrono::steady_clock::now() - t0)
-	                       .count();
+	result_.updateMs = msSince(t0);
 	return result_;
 }
 

@@ -1,8 +1,8 @@
 #include "outputs.h"
+#include <bims/common/clock.h>
 #include <bims/common/frame_files.h>
 #include <bims/common/json.h>
 #include <bims/common/output_paths.h>
-#include "clock.h"
 
 #include "cpu_time.h"
 
@@ -24,8 +24,7 @@
 
 namespace bims::pipeline
 {
-using detail::Clock;
-using detail::msSince;
+using Clock = std::chrono::steady_clock;
 
 void writePointsPly(const std::string& path,
                     const std::vector<mrpt::math::TPoint3D>& pts)

@@ -1,7 +1,7 @@
+#include <bims/common/clock.h>
 #include <bims/common/frames.h>
 #include <bims/flow/expected_flow.h>
 #include <bims/pipeline/pipeline.h>
-#include "clock.h"
 
 #include <chrono>
 #include <future>
@@ -11,8 +11,7 @@
 
 namespace bims::pipeline
 {
-using detail::Clock;
-using detail::msSince;
+using Clock = std::chrono::steady_clock;
 namespace
 {
 

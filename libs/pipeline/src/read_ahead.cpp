@@ -1,4 +1,5 @@
 #include "read_ahead.h"
+#include <bims/common/clock.h>
 
 #include "cpu_time.h"
 
@@ -94,9 +95,7 @@ ReadAhead::Item ReadAhead::readOne(std::string& error)
 		done_ = true;
 	}
 	it.readCpuMs = threadCpuMs() - cpu0;
-	it.readMs = std::chrono::duration<double, std::milli>(
-	                std::chrono::steady_clock::now() - t0)
-	                .count();
+	it.readMs = msSince(t0);
 	return it;
 }
 
@@ -140,10 +139,7 @@ ReadAhead::Item ReadAhead::next(double* waitMs)
 		lk.unlock();
 		cv_.notify_all();
 	}
-	if (waitMs)
-		*waitMs = std::chrono::duration<double, std::milli>(
-		              std::chrono::steady_clock::now() - t0)
-		              .count();
+	if (waitMs) *waitMs = msSince(t0);
 	if (!e.error.empty()) throw RawlogError(e.error);
 	return e.item;
 }

@@ -1,4 +1,5 @@
 #include "worker.h"
+#include <bims/common/clock.h>
 
 #include <pthread.h>
 
@@ -53,9 +54,7 @@ double SerialWorker::post(std::function<void()> job)
 	jobs_.push_back(std::move(job));
 	lk.unlock();
 	cv_.notify_all();
-	return std::chrono::duration<double, std::milli>(
-	           std::chrono::steady_clock::now() - t0)
-	    .count();
+	return msSince(t0);
 }
 
 void SerialWorker::drain()

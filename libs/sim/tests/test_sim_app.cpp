@@ -1,6 +1,7 @@
 // End-to-end tests of bims-sim and bims-info: rawlog round trip through MRPT,
 // rawlog-edit, determinism, bad input, the bundled sample.
 #include <bims/common/frames.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/sim/scene.h>
@@ -16,6 +17,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -536,4 +538,21 @@ TEST(BimsSim, AnEarlierRunsGroundTruthIsRefusedUnlessOverwrite)
 	EXPECT_FALSE(std::filesystem::exists(d + "/out_gt/masks/000002.png"));
 	EXPECT_FALSE(std::filesystem::exists(d + "/out_gt/masks/000003.png"));
 	EXPECT_EQ(readFile(d + "/out_gt/notes.txt"), "mine");  // not its file
+}
+
+TEST(BimsSim, TheGroundTruthLayoutNamesEveryFileARunWrites)
+{
+	// groundTruthLayout() is what --overwrite clears: a file the simulator
+	// writes but the layout misses would survive into the next run
+	const std::string d = tmpDir("layout");
+	simulate(d, kSmallScene, "--max-frames 3 --preview 1");
+	std::vector<std::string> written;
+	for (const auto& e :
+	     std::filesystem::recursive_directory_iterator(d + "/out_gt"))
+		if (!e.is_directory()) written.push_back(e.path().string());
+	std::sort(written.begin(), written.end());
+	EXPECT_EQ(written.size(), 8u);  // 5 files, 3 masks
+	EXPECT_EQ(
+	    bims::earlierOutputs(d + "/out_gt", bims::sim::groundTruthLayout()),
+	    written);
 }
