@@ -13,8 +13,8 @@
 #include <bims/common/trajectory.h>
 #include <bims/ego/depth_correction.h>
 #include <bims/ego/flags.h>
-#include <bims/ego/replay.h>
 #include <bims/pipeline/run.h>
+#include <bims/source/odometry_replay.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/config/CConfigFile.h>
@@ -84,10 +84,10 @@ int main(int argc, char** argv)
 		    std::vector<ego::RgbdFrame> frames;
 		    std::vector<Eigen::Matrix4d> poses;
 		    size_t index = 0, noPose = 0;
-		    ego::ReplayOptions ro;
+		    source::ReplayOptions ro;
 		    ro.progress = !quiet.getValue();
 		    if (last != static_cast<size_t>(-1)) ro.max_frames = last + 1;
-		    ego::replayRawlog(
+		    source::replayRawlog(
 		        inArg.getValue(), odo,
 		        [&](const ego::FrameEgomotion& r,
 		            const mrpt::obs::CObservation3DRangeScan& scan)

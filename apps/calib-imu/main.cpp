@@ -9,9 +9,9 @@
 #include <bims/common/experiment.h>
 #include <bims/common/output_paths.h>
 #include <bims/ego/flags.h>
-#include <bims/ego/replay.h>
 #include <bims/ego/rotation_calibration.h>
 #include <bims/ego/so3.h>
+#include <bims/source/odometry_replay.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/config/CConfigFile.h>
@@ -85,11 +85,11 @@ int main(int argc, char** argv)
 		    std::deque<ego::ImuSample> imu;
 		    std::vector<ego::RotationPair> pairs;
 		    double tPrev = NAN;
-		    ego::ReplayOptions ro;
+		    source::ReplayOptions ro;
 		    ro.progress = !quiet.getValue();
 		    ro.imu_wait_s = 0.5;
 		    const double off = ec.calibration.time_offset_s;
-		    const auto st = ego::replayRawlog(
+		    const auto st = source::replayRawlog(
 		        inArg.getValue(), odo,
 		        [&](const ego::FrameEgomotion& r, const auto&)
 		        {

@@ -14,7 +14,7 @@
 #include <bims/common/progress.h>
 #include <bims/common/share.h>
 #include <bims/grab/grabber.h>
-#include <bims/pipeline/pipeline.h>
+#include <bims/pipeline/stepper.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/gui/CDisplayWindow.h>
@@ -117,7 +117,7 @@ int main(int argc, char** argv)
 		    for (const auto& s : grabber.describe())
 			    std::cerr << "bims-grab: " << s << "\n";
 
-		    std::unique_ptr<bims::pipeline::Pipeline> pipe;
+		    std::unique_ptr<bims::pipeline::LiveSegmentation> seg;
 		    if (aSeg.getValue())
 		    {
 			    const std::string expIni = aExp.getValue().empty()
@@ -127,7 +127,8 @@ int main(int argc, char** argv)
 			    if (!expIni.empty()) exp.loadFromFile(expIni);
 			    std::cerr << "bims-grab: live segmentation: "
 			              << bims::parametersSource(expIni) << "\n";
-			    pipe = std::make_unique<bims::pipeline::Pipeline>(exp);
+			    seg = std::make_unique<bims::pipeline::LiveSegmentation>(
+			        exp, "bims-grab", "live input");
 		    }
 		    bims::RawlogWriter out(aOut.getValue(), 0);  // plain: flushable
 		    std::cerr << "bims-grab: writing " << aOut.getValue()
@@ -137,24 +138,30 @@ int main(int argc, char** argv)
 		    bims::ProgressBar bar("bims-grab",
 		                          static_cast<size_t>(aFrames.getValue()),
 		                          !aQuiet.getValue());
+		    std::string segmented;  ///< the last frame segmented, in words
+		    // a frame segmented: its mask in the window
+		    auto onSegmented = [&](const bims::source::SourceFrame& f,
+		                           const bims::pipeline::FrameResult& r)
+		    {
+			    if (win && win->isOpen())
+				    win->showImage(preview(*f.scan, r.mask));
+			    char b[96];
+			    std::snprintf(b, sizeof(b), "%zu moving voxels, %.0f ms",
+			                  r.movingVoxels, r.ms.total);
+			    segmented = b;
+		    };
 		    auto onFrame =
 		        [&](const mrpt::obs::CObservation3DRangeScan::Ptr& scan,
 		            const std::vector<mrpt::obs::CObservationIMU::Ptr>& imu)
 		    {
-			    cv::Mat mask;
 			    std::string extra;
-			    if (pipe)
+			    if (seg)
 			    {
-				    for (const auto& m : imu) pipe->addImu(*m);
 				    try
 				    {
-					    const auto& r = pipe->processFrame(*scan, n);
-					    mask = r.mask;
-					    char b[96];
-					    std::snprintf(b, sizeof(b),
-					                  "%zu moving voxels, %.0f ms",
-					                  r.movingVoxels, r.ms.total);
-					    extra = b;
+					    for (const auto& m : imu) seg->push(m, onSegmented);
+					    seg->push(scan, onSegmented);
+					    extra = segmented;
 				    }
 				    catch (const std::exception& e)
 				    {
@@ -162,12 +169,21 @@ int main(int argc, char** argv)
 					              << "\n";
 				    }
 			    }
-			    if (win && win->isOpen()) win->showImage(preview(*scan, mask));
+			    else if (win && win->isOpen())
+				    win->showImage(preview(*scan, cv::Mat()));
 			    bar.update(++n, extra);
 		    };
 
 		    const auto st = grabber.run(
 		        out, stop, static_cast<size_t>(aFrames.getValue()), onFrame);
+		    try
+		    {
+			    if (seg) seg->finish(onSegmented);  // the frames left
+		    }
+		    catch (const std::exception& e)
+		    {
+			    std::cerr << "bims-grab: segmentation: " << e.what() << "\n";
+		    }
 		    out.close();
 		    bar.finish();
 		    std::fprintf(stderr,

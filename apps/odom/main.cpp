@@ -10,8 +10,8 @@
 #include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
-#include <bims/ego/replay.h>
 #include <bims/ego/so3.h>
+#include <bims/source/odometry_replay.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/config/CConfigFile.h>
@@ -157,7 +157,7 @@ int main(int argc, char** argv)
 		    const auto gtAt = [&gt](double t) { return poseNear(gt, t, 5e-3); };
 		    ego::RgbdFrame prevFrame;
 		    double prevT = 0;
-		    ego::ReplayOptions ro;
+		    source::ReplayOptions ro;
 		    ro.max_frames = maxArg.getValue();
 		    ro.progress = !quiet.getValue();
 		    if (masksArg.isSet())
@@ -167,7 +167,7 @@ int main(int argc, char** argv)
 				                             ": mask directory not found");
 			    ro.masks_dir = masksArg.getValue();
 		    }
-		    const auto st = ego::replayRawlog(
+		    const auto st = source::replayRawlog(
 		        inArg.getValue(), odo,
 		        [&](const ego::FrameEgomotion& r,
 		            const mrpt::obs::CObservation3DRangeScan& scan)

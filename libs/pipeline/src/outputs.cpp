@@ -4,7 +4,7 @@
 #include <bims/common/json.h>
 #include <bims/common/output_paths.h>
 
-#include "cpu_time.h"
+#include <bims/common/cpu_time.h>
 
 #include <bims/common/app.h>
 #include <bims/common/pixel_labels.h>

@@ -7,6 +7,7 @@
 #include <bims/ego/flags.h>
 #include <bims/maps/export.h>
 #include <bims/pipeline/run.h>
+#include <bims/pipeline/stepper.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/obs/TPixelLabelInfo.h>
@@ -23,44 +24,11 @@
 #include <optional>
 #include <sstream>
 
-#include "cpu_time.h"
+#include <bims/common/cpu_time.h>
 #include "outputs.h"
-#include "read_ahead.h"
 
 namespace bims::pipeline
 {
-FrameRange FrameRange::parse(const std::string& s)
-{
-	const auto colon = s.find(':');
-	if (colon == std::string::npos)
-		throw std::invalid_argument(
-		    "--frames '" + s + "': expected A:B (3D-scan indices, inclusive)");
-	auto num = [&](const std::string& t, size_t def) -> size_t
-	{
-		if (t.empty()) return def;
-		size_t pos = 0;
-		long long v = -1;
-		try
-		{
-			v = std::stoll(t, &pos);
-		}
-		catch (...)
-		{
-			pos = 0;
-		}
-		if (pos != t.size() || v < 0)
-			throw std::invalid_argument("--frames '" + s + "': '" + t +
-			                            "' is not a non-negative integer");
-		return static_cast<size_t>(v);
-	};
-	FrameRange r;
-	r.first = num(s.substr(0, colon), 0);
-	r.last = num(s.substr(colon + 1), static_cast<size_t>(-1));
-	if (r.first > r.last)
-		throw std::invalid_argument("--frames '" + s + "': A > B");
-	return r;
-}
-
 void checkFrameRangeInInputs(const FrameRange& range,
                              const std::vector<std::string>& rawlogs,
                              const std::string& rgbdLabel)
@@ -148,23 +116,6 @@ void checkFiniteOutputs(const FrameResult& r)
 
 namespace
 {
-struct PendingScan
-{
-	mrpt::obs::CObservation3DRangeScan::Ptr scan;
-	size_t index;
-	double t;
-	double readMs;         ///< reading the observations up to this scan
-	double readCpuMs;      ///< the same in CPU time
-	double inWaitMs;       ///< the run waiting for them
-	double inputFraction;  ///< share of the input read with it (0: unknown)
-	/** The IMU observations read after it (before the next scan), written
-	 * after it: the labelled rawlog keeps the input's order. */
-	std::vector<mrpt::obs::CObservation::Ptr> after;
-};
-
-/** Observations read ahead: a few frames of a VGA rawlog with its IMU. */
-constexpr size_t kReadAhead = 24;
-
 /** cv::setNumThreads(n) for the lifetime of the object (n > 0), then the
  * previous setting again. */
 class OpenCvThreads
@@ -212,20 +163,10 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		writeFileAtomically(opt.outDir + "/effective.ini", cfg.effectiveIni());
 	}
 
-	std::map<std::string, std::vector<double>> stage;
-	std::deque<PendingScan> pending;
-	RejectedImuSamples rejectedImu;
-	/** A scan stamped far after the previous one, until the next scan says
-	 * whether the recording jumped or the stamp is stray. */
-	std::optional<PendingScan> held;
-	size_t obsInFile = 0, lastFile = 0;
-	double lastImuT = -std::numeric_limits<double>::infinity();
-	double newestT = lastImuT, lastScanT = lastImuT, firstT = NAN, lastT = NAN;
-	const double offset = cfg.ego.calibration.time_offset_s;
 	const std::string& rgbdLabel = cfg.ego.sensors.rgbd_label;
 	const std::string& imuLabel = cfg.ego.sensors.imu_label;
-	size_t scanIndex = 0;
-	double movingFracSum = 0, readMs = 0, readCpuMs = 0, inWaitMs = 0;
+	std::map<std::string, std::vector<double>> stage;
+	double firstT = NAN, lastT = NAN, movingFracSum = 0;
 	// a bounded range has a known total; otherwise it is estimated from the
 	// share of the input read
 	const bool bounded = opt.frames.bounded();
@@ -233,17 +174,15 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	                bounded ? opt.frames.last - opt.frames.first + 1 : 0,
 	                opt.progress);
 
-	auto process = [&](const PendingScan& p, const PendingScan* next)
+	FrameStepper stepper(pipe);
+	// after a frame ran: its statistics and outputs
+	auto process = [&](const source::SourceFrame& f)
 	{
-		const double frameCpu0 = threadCpuMs();
-		Pipeline::Next ahead;
-		if (next) ahead = {next->scan.get(), next->index};
-		const FrameResult& r = pipe.processFrame(*p.scan, p.index, ahead);
-		stage["total_cpu"].push_back(threadCpuMs() - frameCpu0);
+		const FrameResult& r = pipe.last();
+		stage["total_cpu"].push_back(stepper.lastCpuMs());
 		checkFiniteOutputs(r);
-		// IMU samples rejected up to this frame's time flag it
 		uint32_t flags = r.ego.flags;
-		if (rejectedImu.upTo(r.t)) flags |= ego::kFlagImuRejected;
+		if (f.imuRejected) flags |= ego::kFlagImuRejected;
 		sum.framesProcessed++;
 		if (r.flowAhead) sum.framesFlowAhead++;
 		const uint32_t counted =
@@ -251,9 +190,9 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		if (counted) sum.framesFlagged++;
 		for (const char* name : ego::flagNames(counted))
 			sum.framesFlaggedBy[name]++;
-		stage["read"].push_back(p.readMs);
-		stage["read_cpu"].push_back(p.readCpuMs);
-		stage["wait_input"].push_back(p.inWaitMs);
+		stage["read"].push_back(f.cost.readMs);
+		stage["read_cpu"].push_back(f.cost.readCpuMs);
+		stage["wait_input"].push_back(f.cost.waitMs);
 		stage["input"].push_back(r.ms.input);
 		stage["egomotion"].push_back(r.ms.ego);
 		stage["flow"].push_back(r.ms.flow);
@@ -266,216 +205,61 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		if (std::isnan(firstT)) firstT = r.t;
 		lastT = r.t;
 		// the callback first: the writer then owns the scan
-		if (opt.onFrame) opt.onFrame(r, *p.scan);
+		if (opt.onFrame) opt.onFrame(r, *f.scan);
 		if (out)
 		{
-			stage["wait_output"].push_back(out->writeFrame(r, p.scan, flags));
-			for (const auto& o : p.after) out->writeOther(o);
+			for (const auto& o : f.before) out->writeOther(o);
+			stage["wait_output"].push_back(out->writeFrame(r, f.scan, flags));
 		}
-		if (!bounded && p.inputFraction > 0)
+		if (!bounded && f.inputFraction > 0)
 		{
-			const double scans = (p.index + 1) / p.inputFraction;
+			const double scans = (f.index + 1) / f.inputFraction;
 			bar.setTotal(std::max(sum.framesProcessed,
 			                      static_cast<size_t>(scans + 0.5) -
-			                          std::min(opt.frames.first, p.index)),
+			                          std::min(opt.frames.first, f.index)),
 			             true);
 		}
-		bar.update(sum.framesProcessed, "frame " + std::to_string(p.index));
-	};
-	// A frame is processed once the IMU samples at its time are in (or it
-	// waited long enough for them). Looking ahead, it also waits for the next
-	// frame to be ready, which the pipeline then pairs with it (one frame of
-	// latency; the same results).
-	const bool lookahead =
-	    cfg.pipeline.flow_thread && cfg.pipeline.flow_lookahead;
-	auto ready = [&](const PendingScan& p) {
-		return p.t + offset <= lastImuT ||
-		       newestT - p.t > cfg.pipeline.imu_wait_s;
-	};
-	auto flush = [&](bool all)
-	{
-		while (!pending.empty())
-		{
-			if (!all && !ready(pending.front())) break;
-			const bool nextReady =
-			    pending.size() > 1 && (all || ready(pending[1]));
-			if (lookahead && !all && !nextReady) break;
-			process(pending.front(), nextReady ? &pending[1] : nullptr);
-			pending.pop_front();
-		}
+		bar.update(sum.framesProcessed, "frame " + std::to_string(f.index));
 	};
 
-	ego::DepthCorrection depthCorrection(cfg.ego.depth_correction);
 	std::string readError;  ///< the input's, after the frames before it
-	std::string firstSize;  ///< "WxH (3D scan #i of FILE)" of the first scan
-	auto accept = [&](PendingScan&& p)
-	{
-		lastScanT = p.t;
-		newestT = std::max(newestT, p.t);
-		// the sensor's depth distortion corrected once, for every stage and
-		// for the written scan
-		depthCorrection.apply(*p.scan, cfg.ego.camera);
-		pending.push_back(std::move(p));
-	};
-	auto dropHeld = [&](const std::string& path, const char* why)
-	{
-		sum.scansBadStamp++;
-		std::fprintf(stderr,
-		             "bims-run: warning: %s: 3D scan #%zu (t %.6f) is %.6g s "
-		             "after the previous scan and %s: a stray timestamp; "
-		             "skipped\n",
-		             path.c_str(), held->index, held->t, held->t - lastScanT,
-		             why);
-		// the IMU samples read after it stay in the labelled rawlog, in order
-		if (!out) return;
-		for (auto& o : held->after)
-			if (pending.empty())
-				out->writeOther(o);
-			else
-				pending.back().after.push_back(std::move(o));
-	};
+	source::FrameOrderParams order = source::FrameOrderParams::of(
+	    cfg.ego, cfg.pipeline.imu_wait_s, "bims-run");
+	order.frames = opt.frames;
+	order.keepInput = out != nullptr;
+	std::optional<source::RawlogFrameSource> input;
 	try
 	{
-		ReadAhead input(opt.rawlogs, kReadAhead, cfg.pipeline.read_ahead);
-		for (;;)
+		input.emplace(opt.rawlogs, order, cfg.pipeline.read_ahead);
+		for (bool end = false; !end;)
 		{
 			if (opt.stop && *opt.stop)
 			{
 				sum.interrupted = true;  // the frames done stay written
 				break;
 			}
-			double wait = 0;
-			ReadAhead::Item item;
-			try
-			{
-				item = input.next(&wait);
-			}
-			catch (const std::exception& e)
-			{
-				// a truncated or missing input ends it like its end: every
-				// frame read whole is still processed and written
-				readError = e.what();
-				break;
-			}
-			const auto& o = item.obs;
-			if (!o) break;
-			readMs += item.readMs;
-			readCpuMs += item.readCpuMs;
-			inWaitMs += wait;
-			const std::string& path = input.path(item.file);
-			if (item.file != lastFile) obsInFile = 0;
-			lastFile = item.file;
-			const size_t obsIndex = obsInFile++;
-			const double t = mrpt::Clock::toDouble(o->timestamp);
-			if (auto imu =
-			        std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(o))
-			{
-				if (!imuLabel.empty() && imu->sensorLabel != imuLabel)
-				{
-					sum.otherSkipped++;
-					continue;
-				}
-				sum.imuRead++;
-				if (rejectedImu.check(*imu, t, "bims-run", path, obsIndex)
-				        .empty())
-				{
-					pipe.addImu(*imu);
-					lastImuT = std::max(lastImuT, t);
-				}
-				sum.imuRejected = rejectedImu.count();
-				if (out)
-				{
-					if (held)
-						held->after.push_back(imu);
-					else if (pending.empty())
-						out->writeOther(imu);
-					else
-						pending.back().after.push_back(imu);
-				}
-			}
-			else if (auto scan = std::dynamic_pointer_cast<
-			             mrpt::obs::CObservation3DRangeScan>(o))
-			{
-				if (!rgbdLabel.empty() && scan->sensorLabel != rgbdLabel)
-				{
-					sum.otherSkipped++;
-					continue;
-				}
-				const size_t idx = scanIndex++;
-				sum.scansRead++;
-				if (held)
-				{
-					// this scan follows the held one: the recording jumped
-					if (t > held->t && t - held->t <= kMaxScanGapS)
-						accept(std::move(*held));
-					else
-						dropHeld(path, "the next scan is not");
-					held.reset();
-				}
-				if (idx > opt.frames.last) break;  // stops reading
-				if (!opt.frames.contains(idx)) continue;
-				if (t <= lastScanT)
-				{
-					sum.scansOutOfOrder++;
-					std::fprintf(
-					    stderr,
-					    "bims-run: warning: %s: 3D scan #%zu has a "
-					    "timestamp not after the previous one; skipped\n",
-					    path.c_str(), idx);
-					continue;
-				}
-				if (scan->hasRangeImage)
-				{
-					const std::string size =
-					    std::to_string(scan->rangeImage.cols()) + "x" +
-					    std::to_string(scan->rangeImage.rows());
-					if (firstSize.empty())
-						firstSize = size + " (3D scan #" + std::to_string(idx) +
-						            " of " + path + ")";
-					else if (firstSize.compare(0, size.size() + 1,
-					                           size + " ") != 0)
-					{
-						// an input error: the frames before it are written
-						readError = path + ": 3D scan #" + std::to_string(idx) +
-						            " has a " + size +
-						            " depth image where the run's first had " +
-						            firstSize +
-						            ": one run takes one image size (camera "
-						            "mode)";
-						break;
-					}
-				}
-				PendingScan p{scan,
-				              idx,
-				              t,
-				              readMs,
-				              readCpuMs,
-				              inWaitMs,
-				              item.inputFraction,
-				              {}};
-				readMs = readCpuMs = inWaitMs = 0;
-				if (std::isfinite(lastScanT) && t - lastScanT > kMaxScanGapS)
-				{
-					held = std::move(p);  // the next scan decides
-					continue;
-				}
-				accept(std::move(p));
-			}
-			else
-				sum.otherSkipped++;
-			newestT = std::max(newestT, t);
-			flush(false);
+			auto f = input->next();
+			end = !f;
+			if (f) stepper.add(std::move(*f));
+			while (auto done = stepper.run(end)) process(*done);
 		}
-		if (!sum.interrupted)
-		{
-			if (held) dropHeld(input.path(lastFile), "it is the last scan");
-			flush(true);
-		}
+		if (out && !sum.interrupted)
+			for (const auto& o : input->takeTrailing()) out->writeOther(o);
 	}
 	catch (const std::exception& e)
 	{
 		sum.error = e.what();
-		pending.clear();
+	}
+	if (input)
+	{
+		readError = input->error();
+		const auto& st = input->stats();
+		sum.scansRead = st.scansRead;
+		sum.scansOutOfOrder = st.scansOutOfOrder;
+		sum.scansBadStamp = st.scansBadStamp;
+		sum.imuRead = st.imuRead;
+		sum.imuRejected = st.imuRejected;
+		sum.otherSkipped = st.otherSkipped;
 	}
 	if (!readError.empty())  // first: it came first
 		sum.error =

@@ -67,12 +67,9 @@ ReplayController::ReplayController(const ViewerOptions& opt) : opt_(opt)
 		cfg_.source = "<defaults>";
 	if (opt_.cloudDecimation < 1) opt_.cloudDecimation = 1;
 
-	ReplaySourceParams sp;
-	sp.rgbdLabel = cfg_.ego.sensors.rgbd_label;
-	sp.imuLabel = cfg_.ego.sensors.imu_label;
-	sp.imuOffsetS = cfg_.ego.calibration.time_offset_s;
-	sp.imuWaitS = cfg_.pipeline.imu_wait_s;
-	src_ = std::make_unique<ReplaySource>(opt_.rawlog, sp);
+	src_ = std::make_unique<ReplaySource>(
+	    opt_.rawlog, source::FrameOrderParams::of(
+	                     cfg_.ego, cfg_.pipeline.imu_wait_s, "bims-viewer"));
 
 	if (!opt_.resultsDir.empty())
 	{
@@ -95,8 +92,14 @@ ReplayController::~ReplayController() = default;
 void ReplayController::restart()
 {
 	src_->rewind();
+	srcEnded_ = false;
+	stepper_.reset();
 	pipe_.reset();
-	if (opt_.runPipeline) pipe_ = std::make_unique<pipeline::Pipeline>(cfg_);
+	if (opt_.runPipeline)
+	{
+		pipe_ = std::make_unique<pipeline::Pipeline>(cfg_);
+		stepper_ = std::make_unique<pipeline::FrameStepper>(*pipe_);
+	}
 	est_ = pipe_ ? Trajectory() : results_;
 	frame_.reset();
 	resultsMask_.release();
@@ -112,16 +115,20 @@ double ReplayController::frameTime(size_t i) const
 
 bool ReplayController::step()
 {
-	auto f = src_->next();
+	std::optional<source::SourceFrame> f;
+	if (!stepper_)
+		f = src_->next();
+	else
+		// as bims-run runs them (pipeline::FrameStepper)
+		while (!(f = stepper_->run(srcEnded_)) && !srcEnded_)
+		{
+			auto in = src_->next();
+			srcEnded_ = !in;
+			if (in) stepper_->add(std::move(*in));
+		}
 	if (!f) return false;
-	f->scan->load();  // external images, if any
-	if (pipe_)
-	{
-		for (const auto& m : f->imu) pipe_->addImu(*m);
-		const auto& r = pipe_->processFrame(*f->scan, f->index);
-		est_.push_back({f->t, r.T_WC});
-	}
-	cur_ = static_cast<long>(f->index);
+	if (pipe_) est_.push_back({f->t, pipe_->last().T_WC});
+	++cur_;
 	frame_ = std::move(f);
 	loadResultsFrame();
 	return true;
@@ -130,8 +137,10 @@ bool ReplayController::step()
 void ReplayController::loadResultsFrame()
 {
 	resultsMask_.release();
-	if (opt_.resultsDir.empty() || cur_ < 0) return;
-	const std::string p = opt_.resultsDir + "/masks/" + frameFileName(cur_);
+	if (opt_.resultsDir.empty() || !frame_) return;
+	// bims-run names its files by the 3D-scan index
+	const std::string p =
+	    opt_.resultsDir + "/masks/" + frameFileName(frame_->index);
 	if (mrpt::system::fileExists(p))
 		resultsMask_ = cv::imread(p, cv::IMREAD_GRAYSCALE);
 }

@@ -2,14 +2,19 @@
 // clock, pipeline while replaying, panels, results folders, and an offscreen
 // render of the 3D view in which the three tier colours must appear.
 #include <bims/common/app.h>
+#include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
+#include <bims/pipeline/run.h>
 #include <bims/viewer/controller.h>
 #include <bims/viewer/panels.h>
+#include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 
 #include <mrpt/system/filesystem.h>
 
 #include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
 
 using namespace bims;
 using namespace bims::viewer;
@@ -32,9 +37,10 @@ ViewerOptions sampleOptions()
 
 TEST(ReplaySource, IndexesScansAndDeliversEveryImuSampleBeforeItsFrame)
 {
-	ReplaySourceParams p;
-	p.rgbdLabel = "RGBD";
-	p.imuLabel = "IMU";
+	source::FrameOrderParams p;
+	p.sensors.rgbd_label = "RGBD";
+	p.sensors.imu_label = "IMU";
+	p.imuWaitS = 0.1;
 	ReplaySource src(kRawlog, p);
 	ASSERT_EQ(src.frameCount(), 150u);
 	EXPECT_EQ(src.imuCount(), 499u);
@@ -65,8 +71,8 @@ TEST(ReplaySource, IndexesScansAndDeliversEveryImuSampleBeforeItsFrame)
 TEST(ReplaySource, RejectsMissingFileAndUnknownLabel)
 {
 	EXPECT_THROW(ReplaySource("/nonexistent/x.rawlog", {}), std::exception);
-	ReplaySourceParams p;
-	p.rgbdLabel = "KINECT_NOPE";
+	source::FrameOrderParams p;
+	p.sensors.rgbd_label = "KINECT_NOPE";
 	try
 	{
 		ReplaySource s(kRawlog, p);
@@ -189,8 +195,7 @@ TEST(ReplayController, ResultsFolderGivesPosesAndMasks)
 	const std::string dir =
 	    std::string(BIMS_BINARY_DIR) + "/test_viewer_results";
 	makeDirs(dir + "/masks");
-	ReplaySourceParams sp;
-	ReplaySource src(kRawlog, sp);
+	ReplaySource src(kRawlog, {});
 	Trajectory traj;
 	for (size_t i = 0; i < 3; ++i)
 		traj.push_back({src.frameTimes()[i],
@@ -242,4 +247,86 @@ TEST(ReplayController, OffscreenViewShowsTheThreeTierColours)
 	EXPECT_LT(none.blue, 0.0005);
 	EXPECT_LT(none.yellow, 0.0005);
 	EXPECT_LT(none.red, 0.0005);
+}
+
+namespace
+{
+/** The bundled sample's first 40 frames with what the ordering rule must
+ * handle: a 3D scan repeated out of order after scan #10 (skipped), and an
+ * IMU sample whose angular rate is NaN (not used, its frame flagged). */
+std::string sampleWithFaults()
+{
+	const std::string path =
+	    bims::test::freshTmpDir("bims_test_viewer", "faults") + "/in.rawlog";
+	RawlogReader in(kRawlog);
+	RawlogWriter out(path);
+	std::vector<mrpt::obs::CObservation::Ptr> scans;
+	size_t imu = 0;
+	while (auto o = in.next())
+	{
+		if (auto s =
+		        std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(
+		            o))
+		{
+			if (scans.size() == 40) break;
+			scans.push_back(s);
+			out.write(*s);
+			if (scans.size() == 11) out.write(*scans[5]);
+		}
+		else if (auto m =
+		             std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(o))
+		{
+			if (++imu == 60) m->set(mrpt::obs::IMU_WZ, NAN);
+			out.write(*m);
+		}
+	}
+	out.close();
+	return path;
+}
+}  // namespace
+
+TEST(BatchAndReplay, GiveTheSameFramesPosesAndMasks)
+{
+	const std::string input = sampleWithFaults();
+	pipeline::ExperimentConfig cfg;
+	cfg.loadFromFile(kConfig);
+	struct Seen
+	{
+		size_t index;
+		mrpt::poses::CPose3D T_WC;
+		cv::Mat mask;
+	};
+	std::vector<Seen> batch;
+	pipeline::RunOptions ro;
+	ro.rawlogs = {input};
+	ro.progress = false;
+	ro.onFrame = [&](const pipeline::FrameResult& r, const auto&) {
+		batch.push_back({r.index, r.T_WC, r.mask.clone()});
+	};
+	const auto sum = pipeline::runExperiment(cfg, ro);
+	ASSERT_TRUE(sum.error.empty()) << sum.error;
+	EXPECT_EQ(sum.scansOutOfOrder, 1u);
+	EXPECT_EQ(sum.imuRejected, 1u);
+	ASSERT_EQ(batch.size(), 40u);
+
+	ViewerOptions o;
+	o.rawlog = input;
+	o.configPath = kConfig;
+	ReplayController c(o);
+	EXPECT_EQ(c.frameCount(), batch.size());
+	size_t k = 0;
+	while (c.step())
+	{
+		ASSERT_LT(k, batch.size());
+		const auto* r = c.result();
+		ASSERT_NE(r, nullptr);
+		EXPECT_EQ(r->index, batch[k].index) << "frame " << k;
+		EXPECT_EQ(r->T_WC.asVectorVal(), batch[k].T_WC.asVectorVal())
+		    << "frame " << k;
+		ASSERT_EQ(r->mask.size(), batch[k].mask.size());
+		EXPECT_EQ(cv::countNonZero(r->mask != batch[k].mask), 0)
+		    << "frame " << k;
+		++k;
+	}
+	EXPECT_EQ(k, batch.size());
 }

@@ -5,6 +5,7 @@
 
 #include <bims/common/output_paths.h>
 #include <bims/pipeline/pipeline.h>
+#include <bims/source/frame_source.h>
 
 #include <atomic>
 #include <functional>
@@ -16,22 +17,7 @@
 namespace bims::pipeline
 {
 /** Inclusive range of 3D-scan indices ("A:B", "A:" or ":B"). */
-struct FrameRange
-{
-	size_t first = 0;
-	size_t last = static_cast<size_t>(-1);
-	bool contains(size_t i) const { return i >= first && i <= last; }
-	/** B given (not "A:"). */
-	bool bounded() const { return last != static_cast<size_t>(-1); }
-	/** "A:B" ("A:" when open-ended), for messages. */
-	std::string toString() const
-	{
-		return std::to_string(first) + ":" +
-		       (bounded() ? std::to_string(last) : std::string());
-	}
-	/** Parses "A:B"; throws std::invalid_argument on bad text or A > B. */
-	static FrameRange parse(const std::string& s);
-};
+using source::FrameRange;
 
 /** For --frames A:B, before any work: throws UsageError naming the range
  * and the inputs' 3D-scan count unless \a rawlogs hold the scans A to B
@@ -71,8 +57,8 @@ struct RunSummary
 	 * each (e.g. no IMU in the input and the mode it fell back to). */
 	std::vector<std::string> notes;
 	size_t scansOutOfOrder = 0;  ///< dropped: timestamp not increasing
-	/** dropped: timestamp more than kMaxScanGapS after the previous scan's
-	 * and the next scan's not close to it (a stray stamp) */
+	/** dropped: timestamp more than source::kMaxScanGapS after the previous
+	 * scan's and the next scan's not close to it (a stray stamp) */
 	size_t scansBadStamp = 0;
 	/** IMU samples not used: a field not finite or beyond any sensor's
 	 * range (bims::imuSampleProblem); the frames whose interval held one
@@ -128,12 +114,6 @@ struct RunOptions
 	 * metrics.json says "status": "interrupted". */
 	const std::atomic<bool>* stop = nullptr;
 };
-
-/** A 3D scan stamped more than this after the previous one [s] is held
- * back: processed when the next scan follows it within this gap (the
- * recording jumped, e.g. a second rawlog), skipped with a warning when the
- * next scan does not (a stray stamp), or when it is the last. */
-constexpr double kMaxScanGapS = 10.0;
 
 /** Throws std::runtime_error naming the frame (scan index and time) if
  * anything bims-run writes of it is not finite: the pose, the moving

@@ -7,6 +7,7 @@
 
 #include <bims/common/trajectory.h>
 #include <bims/pipeline/pipeline.h>
+#include <bims/pipeline/stepper.h>
 #include <bims/viewer/replay_source.h>
 
 #include <mrpt/img/CImage.h>
@@ -74,7 +75,8 @@ class ReplayController
 
 	// --- timeline ---------------------------------------------------------
 	size_t frameCount() const { return src_->frameCount(); }
-	/** Index of the frame shown, -1 before the first step. */
+	/** Position of the frame shown in the timeline, -1 before the first
+	 * step (its 3D-scan index differs when the input has skipped scans). */
 	long currentFrame() const { return cur_; }
 	bool atEnd() const { return cur_ + 1 >= static_cast<long>(frameCount()); }
 	/** Data time of frame \a i relative to frame 0 [s]. */
@@ -137,8 +139,10 @@ class ReplayController
 	pipeline::ExperimentConfig cfg_;
 	std::unique_ptr<ReplaySource> src_;
 	std::unique_ptr<pipeline::Pipeline> pipe_;
+	std::unique_ptr<pipeline::FrameStepper> stepper_;
+	bool srcEnded_ = false;
 	long cur_ = -1;
-	std::optional<ReplayFrame> frame_;
+	std::optional<source::SourceFrame> frame_;
 	Trajectory est_, gt_, results_;
 	cv::Mat resultsMask_;
 	LayerVisibility layers_;

@@ -1,16 +1,15 @@
-// Replays a rawlog through an Odometry in time order (used by bims-odom and
-// bims-calib-imu). IMU observations are fed as they are read; each RGB-D
-// frame waits until the IMU stream has passed its time (+ time_offset_s), or
-// until data newer than imu_wait_s has been read (IMU late or absent), so
-// the attitude can be interpolated rather than extrapolated.
+// Replays a rawlog through an Odometry (bims-odom, bims-calib-imu,
+// bims-calib-depth): the frames of RawlogFrameSource (the one ordering rule,
+// bims/source/frame_source.h) with the IMU samples before each.
 #pragma once
 
 #include <bims/ego/odometry.h>
+#include <bims/source/frame_source.h>
 
 #include <functional>
 #include <string>
 
-namespace bims::ego
+namespace bims::source
 {
 struct ReplayOptions
 {
@@ -30,7 +29,7 @@ struct ReplayStats
 	size_t frames = 0;      ///< RGB-D frames processed
 	size_t imu = 0;         ///< IMU observations fed
 	size_t flagged = 0;     ///< frames with a failure flag (!ok())
-	size_t otherLabel = 0;  ///< observations skipped for their label
+	size_t otherLabel = 0;  ///< observations skipped (label or class)
 	size_t masksUsed = 0;   ///< frames given a mask from masks_dir
 	/** IMU samples not used: a field not finite or beyond any sensor's range
 	 * (bims::imuSampleProblem; a warning each, the frame flagged
@@ -39,14 +38,14 @@ struct ReplayStats
 };
 
 using FrameCallback = std::function<void(
-    const FrameEgomotion&, const mrpt::obs::CObservation3DRangeScan&)>;
-using ImuCallback = std::function<void(const ImuSample&)>;
+    const ego::FrameEgomotion&, const mrpt::obs::CObservation3DRangeScan&)>;
+using ImuCallback = std::function<void(const ego::ImuSample&)>;
 
 /** Runs \a odo over the rawlog at \a path. Throws RawlogError on a
  * truncated or corrupt file (after the frames before it were processed). */
-ReplayStats replayRawlog(const std::string& path, Odometry& odo,
+ReplayStats replayRawlog(const std::string& path, ego::Odometry& odo,
                          const FrameCallback& onFrame,
                          const ReplayOptions& opt = {},
                          const ImuCallback& onImu = {});
 
-}  // namespace bims::ego
+}  // namespace bims::source

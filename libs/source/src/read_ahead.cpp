@@ -1,7 +1,7 @@
 #include "read_ahead.h"
-#include <bims/common/clock.h>
 
-#include "cpu_time.h"
+#include <bims/common/clock.h>
+#include <bims/common/cpu_time.h>
 
 #include <pthread.h>
 
@@ -9,7 +9,7 @@
 #include <chrono>
 #include <exception>
 
-namespace bims::pipeline
+namespace bims::source
 {
 ReadAhead::ReadAhead(std::vector<std::string> paths, size_t capacity,
                      bool threaded)
@@ -59,6 +59,7 @@ ReadAhead::Item ReadAhead::readOne(std::string& error)
 			}
 			it.obs = reader_->next();
 			it.file = file_;
+			it.entry = reader_->observationsRead() - 1;
 			if (bytesTotal_ > 0)
 				it.inputFraction = std::min(
 				    1.0, double(bytesBefore_[file_] + reader_->bytesRead()) /
@@ -144,4 +145,4 @@ ReadAhead::Item ReadAhead::next(double* waitMs)
 	return e.item;
 }
 
-}  // namespace bims::pipeline
+}  // namespace bims::source

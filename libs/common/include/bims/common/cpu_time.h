@@ -1,4 +1,4 @@
-// Internal: CPU time of the calling thread and of the process [ms], the
+// CPU time of the calling thread and of the process [ms], the
 // cross-check of wall-clock stage times on a loaded machine; the process's
 // peak resident memory.
 #pragma once
@@ -7,7 +7,7 @@
 
 #include <ctime>
 
-namespace bims::pipeline
+namespace bims
 {
 inline double cpuMs(clockid_t clock)
 {
@@ -32,4 +32,4 @@ inline double peakResidentMiB()
 	return static_cast<double>(u.ru_maxrss) / 1024.0;
 }
 
-}  // namespace bims::pipeline
+}  // namespace bims

@@ -5,7 +5,7 @@
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
-#include <bims/ego/replay.h>
+#include <bims/source/odometry_replay.h>
 #include <bims/ego/so3.h>
 #include <gtest/gtest.h>
 
@@ -17,6 +17,8 @@
 #include <filesystem>
 
 using namespace bims::ego;
+using bims::source::replayRawlog;
+using bims::source::ReplayOptions;
 
 namespace
 {

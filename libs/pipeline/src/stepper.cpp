@@ -1,0 +1,69 @@
+#include <bims/common/cpu_time.h>
+#include <bims/pipeline/stepper.h>
+
+#include <stdexcept>
+
+namespace bims::pipeline
+{
+FrameStepper::FrameStepper(Pipeline& pipe)
+    : pipe_(pipe),
+      lookahead_(pipe.config().pipeline.flow_thread &&
+                 pipe.config().pipeline.flow_lookahead)
+{
+}
+
+void FrameStepper::add(source::SourceFrame f)
+{
+	for (const auto& m : f.imu) pipe_.addImu(*m);
+	frames_.push_back(std::move(f));
+}
+
+std::optional<source::SourceFrame> FrameStepper::run(bool end)
+{
+	if (frames_.empty() || (lookahead_ && !end && frames_.size() < 2))
+		return std::nullopt;
+	source::SourceFrame f = std::move(frames_.front());
+	frames_.pop_front();
+	Pipeline::Next next;
+	if (lookahead_ && !frames_.empty())
+		next = {frames_.front().scan.get(), frames_.front().index};
+	const double cpu0 = threadCpuMs();
+	pipe_.processFrame(*f.scan, f.index, next);
+	cpuMs_ = threadCpuMs() - cpu0;
+	return f;
+}
+
+LiveSegmentation::LiveSegmentation(const ExperimentConfig& cfg,
+                                   const std::string& program,
+                                   std::string device)
+    : pipe_(cfg),
+      order_(source::FrameOrderParams::of(cfg.ego, cfg.pipeline.imu_wait_s,
+                                          program)),
+      stepper_(pipe_),
+      device_(std::move(device))
+{
+}
+
+void LiveSegmentation::runReady(bool end, const OnFrame& onFrame)
+{
+	while (auto f = order_.pop()) stepper_.add(std::move(*f));
+	while (auto done = stepper_.run(end))
+		if (onFrame) onFrame(*done, pipe_.last());
+}
+
+void LiveSegmentation::push(const mrpt::obs::CObservation::Ptr& obs,
+                            const OnFrame& onFrame)
+{
+	const bool more = order_.push(obs, {&device_, entry_++});
+	runReady(!more, onFrame);
+	if (!more && !order_.error().empty())
+		throw std::runtime_error(order_.error());
+}
+
+void LiveSegmentation::finish(const OnFrame& onFrame)
+{
+	order_.finish({&device_, entry_});
+	runReady(true, onFrame);
+}
+
+}  // namespace bims::pipeline

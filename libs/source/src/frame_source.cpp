@@ -1,0 +1,272 @@
+#include <bims/source/frame_source.h>
+
+#include "read_ahead.h"
+
+#include <mrpt/core/Clock.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+namespace bims::source
+{
+namespace
+{
+constexpr double kNever = -std::numeric_limits<double>::infinity();
+
+bool labelMatches(const std::string& want, const std::string& have)
+{
+	return want.empty() || want == have;
+}
+
+void add(InputCost& a, const InputCost& b)
+{
+	a.readMs += b.readMs;
+	a.readCpuMs += b.readCpuMs;
+	a.waitMs += b.waitMs;
+}
+}  // namespace
+
+FrameOrderParams FrameOrderParams::of(const ego::EgoConfig& ego,
+                                      double imuWaitS,
+                                      const std::string& program)
+{
+	FrameOrderParams p;
+	p.program = program;
+	p.sensors = ego.sensors;
+	p.imuOffsetS = ego.calibration.time_offset_s;
+	p.imuWaitS = imuWaitS;
+	p.camera = ego.camera;
+	p.depthCorrection = ego.depth_correction;
+	return p;
+}
+
+FrameOrder::FrameOrder(FrameOrderParams p)
+    : p_(std::move(p)),
+      depthCorrection_(p_.depthCorrection),
+      lastImuT_(kNever),
+      newestT_(kNever),
+      lastScanT_(kNever)
+{
+}
+
+bool FrameOrder::ready(const SourceFrame& f) const
+{
+	return f.t + p_.imuOffsetS <= lastImuT_ || newestT_ - f.t > p_.imuWaitS;
+}
+
+void FrameOrder::accept(SourceFrame&& f)
+{
+	lastScanT_ = f.t;
+	newestT_ = std::max(newestT_, f.t);
+	waiting_.push_back(std::move(f));
+}
+
+void FrameOrder::dropHeld(const InputPlace& at, const char* why)
+{
+	st_.scansBadStamp++;
+	std::fprintf(stderr,
+	             "%s: warning: %s: 3D scan #%zu (t %.6f) is %.6g s after the "
+	             "previous scan and %s: a stray timestamp; skipped\n",
+	             p_.program.c_str(), at.path ? at.path->c_str() : "input",
+	             held_->index, held_->t, held_->t - lastScanT_, why);
+	// the observations read before it stay, in order
+	input_.insert(input_.begin(), held_->before.begin(), held_->before.end());
+	held_.reset();
+}
+
+void FrameOrder::release(bool all)
+{
+	while (!waiting_.empty() && (all || ready(waiting_.front())))
+	{
+		SourceFrame f = std::move(waiting_.front());
+		waiting_.pop_front();
+		f.imu.swap(imu_);
+		imu_.clear();
+		f.imuRejected = rejected_.upTo(f.t + p_.imuOffsetS);
+		// the depth distortion corrected once, for every stage and for the
+		// written scan
+		depthCorrection_.apply(*f.scan, p_.camera);
+		released_.push_back(std::move(f));
+	}
+}
+
+bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
+                      const InputPlace& at, const InputCost& cost,
+                      double inputFraction)
+{
+	using mrpt::obs::CObservation3DRangeScan;
+	using mrpt::obs::CObservationIMU;
+	if (ended_ || !obs) return !ended_;
+	add(cost_, cost);
+	const std::string where = at.path ? *at.path : std::string("input");
+	const double t = mrpt::Clock::toDouble(obs->timestamp);
+	if (auto imu = std::dynamic_pointer_cast<CObservationIMU>(obs))
+	{
+		if (!labelMatches(p_.sensors.imu_label, imu->sensorLabel))
+		{
+			st_.otherSkipped++;
+			return true;
+		}
+		st_.imuRead++;
+		if (rejected_.check(*imu, t, p_.program.c_str(), where, at.entry)
+		        .empty())
+		{
+			imu_.push_back(imu);
+			lastImuT_ = std::max(lastImuT_, t);
+		}
+		st_.imuRejected = rejected_.count();
+		if (p_.keepInput) input_.push_back(imu);
+	}
+	else if (auto scan =
+	             std::dynamic_pointer_cast<CObservation3DRangeScan>(obs))
+	{
+		if (!labelMatches(p_.sensors.rgbd_label, scan->sensorLabel))
+		{
+			st_.otherSkipped++;
+			return true;
+		}
+		const size_t idx = scanIndex_++;
+		st_.scansRead++;
+		if (held_)
+		{
+			// this scan follows the held one: the recording jumped
+			if (t > held_->t && t - held_->t <= kMaxScanGapS)
+			{
+				accept(std::move(*held_));
+				held_.reset();
+			}
+			else
+				dropHeld(at, "the next scan is not");
+		}
+		if (idx > p_.frames.last)
+		{
+			ended_ = true;  // the range is read
+			return false;
+		}
+		if (!p_.frames.contains(idx)) return true;
+		if (t <= lastScanT_)
+		{
+			st_.scansOutOfOrder++;
+			std::fprintf(stderr,
+			             "%s: warning: %s: 3D scan #%zu has a timestamp not "
+			             "after the previous one; skipped\n",
+			             p_.program.c_str(), where.c_str(), idx);
+			return true;
+		}
+		if (scan->hasRangeImage)
+		{
+			const std::string size = std::to_string(scan->rangeImage.cols()) +
+			                         "x" +
+			                         std::to_string(scan->rangeImage.rows());
+			if (firstSize_.empty())
+				firstSize_ = size + " (3D scan #" + std::to_string(idx) +
+				             " of " + where + ")";
+			else if (firstSize_.compare(0, size.size() + 1, size + " ") != 0)
+			{
+				error_ = where + ": 3D scan #" + std::to_string(idx) +
+				         " has a " + size +
+				         " depth image where the run's first had " +
+				         firstSize_ +
+				         ": one run takes one image size (camera "
+				         "mode)";
+				ended_ = true;
+				return false;
+			}
+		}
+		SourceFrame f;
+		f.scan = scan;
+		f.index = idx;
+		f.t = t;
+		f.cost = cost_;
+		f.inputFraction = inputFraction;
+		f.before.swap(input_);
+		input_.clear();
+		cost_ = {};
+		if (std::isfinite(lastScanT_) && t - lastScanT_ > kMaxScanGapS)
+		{
+			held_ = std::move(f);  // the next scan decides
+			return true;
+		}
+		accept(std::move(f));
+	}
+	else
+		st_.otherSkipped++;
+	newestT_ = std::max(newestT_, t);
+	release(false);
+	return true;
+}
+
+void FrameOrder::finish(const InputPlace& at)
+{
+	if (held_) dropHeld(at, "it is the last scan");
+	ended_ = true;
+	release(true);
+}
+
+std::optional<SourceFrame> FrameOrder::pop()
+{
+	if (released_.empty()) return std::nullopt;
+	SourceFrame f = std::move(released_.front());
+	released_.pop_front();
+	return f;
+}
+
+std::vector<mrpt::obs::CObservation::Ptr> FrameOrder::takeTrailing()
+{
+	std::vector<mrpt::obs::CObservation::Ptr> v;
+	v.swap(input_);
+	return v;
+}
+
+/** Observations read ahead: a few frames of a VGA rawlog with its IMU. */
+constexpr size_t kReadAhead = 24;
+
+RawlogFrameSource::RawlogFrameSource(std::vector<std::string> paths,
+                                     FrameOrderParams p, bool readThread)
+    : paths_(std::move(paths)), order_(std::move(p))
+{
+	if (paths_.empty()) throw std::invalid_argument("no input rawlog given");
+	input_ = std::make_unique<ReadAhead>(paths_, kReadAhead, readThread);
+}
+
+RawlogFrameSource::~RawlogFrameSource() = default;
+
+std::optional<SourceFrame> RawlogFrameSource::next()
+{
+	for (;;)
+	{
+		if (auto f = order_.pop()) return f;
+		if (ended_) return std::nullopt;
+		ReadAhead::Item item;
+		InputCost cost;
+		bool more = true;
+		try
+		{
+			item = input_->next(&cost.waitMs);
+		}
+		catch (const std::exception& e)
+		{
+			// a truncated or missing input ends it like its end: every
+			// frame read whole is still released
+			error_ = e.what();
+			more = false;
+		}
+		if (more && item.obs)
+		{
+			lastFile_ = item.file;
+			cost.readMs = item.readMs;
+			cost.readCpuMs = item.readCpuMs;
+			more = order_.push(item.obs, {&paths_[item.file], item.entry}, cost,
+			                   item.inputFraction);
+			if (!more && error_.empty()) error_ = order_.error();
+			if (more) continue;
+		}
+		order_.finish({&paths_[lastFile_], 0});
+		ended_ = true;
+	}
+}
+
+}  // namespace bims::source

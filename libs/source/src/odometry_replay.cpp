@@ -1,0 +1,75 @@
+#include <bims/common/frame_files.h>
+#include <bims/common/progress.h>
+#include <bims/common/rawlog.h>
+#include <bims/ego/flags.h>
+#include <bims/source/odometry_replay.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <filesystem>
+#include <stdexcept>
+
+namespace bims::source
+{
+namespace
+{
+/** Scan k-1's mask of \a dir for frame \a k (empty when none). */
+cv::Mat feedbackMask(const std::string& dir, const SourceFrame& f)
+{
+	if (dir.empty() || f.index == 0) return {};
+	const std::string p = dir + "/" + frameFileName(f.index - 1);
+	if (!std::filesystem::exists(p)) return {};
+	cv::Mat mask = cv::imread(p, cv::IMREAD_UNCHANGED);
+	const auto& depth = f.scan->rangeImage;
+	if (mask.type() != CV_8UC1 || mask.cols != static_cast<int>(depth.cols()) ||
+	    mask.rows != static_cast<int>(depth.rows()))
+		throw std::runtime_error(
+		    p + ": not an 8-bit mask of the depth image's size (" +
+		    std::to_string(depth.cols()) + "x" + std::to_string(depth.rows()) +
+		    ")");
+	return mask;
+}
+}  // namespace
+
+ReplayStats replayRawlog(const std::string& path, ego::Odometry& odo,
+                         const FrameCallback& onFrame, const ReplayOptions& opt,
+                         const ImuCallback& onImu)
+{
+	ReplayStats st;
+	RawlogFrameSource src(
+	    {path}, FrameOrderParams::of(odo.config(), opt.imu_wait_s, "bims-odom"),
+	    false);
+	ProgressBar bar("bims-odom", opt.max_frames, opt.progress);
+	while (!opt.max_frames || st.frames < opt.max_frames)
+	{
+		auto f = src.next();
+		if (!f) break;
+		for (const auto& m : f->imu)
+		{
+			const ego::ImuSample s = ego::imuSampleFrom(*m);
+			odo.addImu(s);
+			if (onImu) onImu(s);
+			++st.imu;
+		}
+		const cv::Mat mask = feedbackMask(opt.masks_dir, *f);
+		if (!mask.empty()) ++st.masksUsed;
+		ego::FrameEgomotion r =
+		    odo.processFrame(*f->scan, mask.empty() ? nullptr : &mask);
+		if (f->imuRejected) r.flags |= ego::kFlagImuRejected;
+		++st.frames;
+		if (!r.ok() && !(r.flags & ego::kFlagFirstFrame)) ++st.flagged;
+		if (onFrame) onFrame(r, *f->scan);
+		if (!opt.max_frames && f->inputFraction > 0)
+			bar.setTotal(
+			    static_cast<size_t>((f->index + 1) / f->inputFraction + 0.5),
+			    true);
+		bar.update(st.frames);
+	}
+	bar.finish();
+	st.otherLabel = src.stats().otherSkipped;
+	st.imuRejected = src.stats().imuRejected;
+	if (!src.error().empty()) throw RawlogError(src.error());
+	return st;
+}
+
+}  // namespace bims::source

@@ -1,0 +1,249 @@
+// The one ordering rule (bims/source/frame_source.h) on hand-made streams:
+// when a frame is released, with which IMU samples, and which scans are
+// skipped and why.
+#include <bims/source/frame_source.h>
+#include <gtest/gtest.h>
+
+#include <mrpt/core/Clock.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+using namespace bims::source;
+using mrpt::obs::CObservation;
+using mrpt::obs::CObservation3DRangeScan;
+using mrpt::obs::CObservationIMU;
+
+namespace
+{
+const std::string kFile = "test.rawlog";
+
+CObservation::Ptr scan(double t, int w = 4, int h = 3,
+                       const std::string& label = "RGBD")
+{
+	auto o = CObservation3DRangeScan::Create();
+	o->timestamp = mrpt::Clock::fromDouble(t);
+	o->sensorLabel = label;
+	o->hasRangeImage = true;
+	o->rangeImage.setZero(h, w);
+	return o;
+}
+
+CObservation::Ptr imu(double t, double wz = 0.1,
+                      const std::string& label = "IMU")
+{
+	auto o = CObservationIMU::Create();
+	o->timestamp = mrpt::Clock::fromDouble(t);
+	o->sensorLabel = label;
+	o->set(mrpt::obs::IMU_WZ, wz);
+	return o;
+}
+
+FrameOrderParams params()
+{
+	FrameOrderParams p;
+	p.program = "test";
+	p.imuWaitS = 0.2;
+	return p;
+}
+
+/** Pushes \a in (entries numbered in order), then the end; the frames. */
+std::vector<SourceFrame> run(FrameOrder& order,
+                             const std::vector<CObservation::Ptr>& in)
+{
+	std::vector<SourceFrame> out;
+	size_t k = 0;
+	for (const auto& o : in)
+	{
+		if (!order.push(o, {&kFile, k++})) break;
+		while (auto f = order.pop()) out.push_back(std::move(*f));
+	}
+	order.finish({&kFile, k});
+	while (auto f = order.pop()) out.push_back(std::move(*f));
+	return out;
+}
+
+double stamp(const CObservation::Ptr& o)
+{
+	return mrpt::Clock::toDouble(o->timestamp);
+}
+}  // namespace
+
+TEST(FrameOrder, AFrameWaitsUntilTheImuHasPassedItsTime)
+{
+	FrameOrder order(params());
+	ASSERT_TRUE(order.push(imu(0.95), {&kFile, 0}));
+	ASSERT_TRUE(order.push(scan(1.0), {&kFile, 1}));
+	EXPECT_FALSE(order.pop()) << "the IMU has not reached t=1.0 yet";
+	ASSERT_TRUE(order.push(imu(0.99), {&kFile, 2}));
+	EXPECT_FALSE(order.pop());
+	ASSERT_TRUE(order.push(imu(1.01), {&kFile, 3}));
+	auto f = order.pop();
+	ASSERT_TRUE(f);
+	EXPECT_EQ(f->index, 0u);
+	EXPECT_DOUBLE_EQ(f->t, 1.0);
+	// every usable sample read so far, in input order, the one past it too
+	ASSERT_EQ(f->imu.size(), 3u);
+	EXPECT_DOUBLE_EQ(stamp(f->imu[0]), 0.95);
+	EXPECT_DOUBLE_EQ(stamp(f->imu[2]), 1.01);
+	EXPECT_FALSE(f->imuRejected);
+}
+
+TEST(FrameOrder, TheImuOffsetShiftsWhenAFrameIsReady)
+{
+	auto p = params();
+	p.imuOffsetS = 0.05;  // the IMU stamps the same instant 50 ms later
+	FrameOrder order(p);
+	order.push(scan(1.0), {&kFile, 0});
+	order.push(imu(1.03), {&kFile, 1});
+	EXPECT_FALSE(order.pop());
+	order.push(imu(1.05), {&kFile, 2});
+	EXPECT_TRUE(order.pop());
+}
+
+TEST(FrameOrder, WithoutImuAFrameIsReleasedOnceDataImuWaitNewerIsRead)
+{
+	FrameOrder order(params());
+	order.push(scan(1.0), {&kFile, 0});
+	order.push(scan(1.1), {&kFile, 1});
+	order.push(scan(1.2), {&kFile, 2});
+	EXPECT_FALSE(order.pop()) << "0.2 s newer is not more than imu_wait_s";
+	order.push(scan(1.3), {&kFile, 3});
+	auto f = order.pop();
+	ASSERT_TRUE(f);
+	EXPECT_EQ(f->index, 0u);
+	EXPECT_FALSE(order.pop());
+	order.finish({&kFile, 4});
+	for (size_t i = 1; i < 4; ++i)
+	{
+		auto g = order.pop();
+		ASSERT_TRUE(g) << "the end releases every frame";
+		EXPECT_EQ(g->index, i);
+	}
+}
+
+TEST(FrameOrder, AScanNotAfterThePreviousIsSkippedAndCounted)
+{
+	FrameOrder order(params());
+	const auto frames = run(order, {scan(1.0), scan(1.1), scan(1.05), scan(1.1),
+	                                scan(1.2), imu(1.3)});
+	ASSERT_EQ(frames.size(), 3u);
+	EXPECT_EQ(frames[0].index, 0u);
+	EXPECT_EQ(frames[1].index, 1u);
+	EXPECT_EQ(frames[2].index, 4u) << "indices count every scan read";
+	EXPECT_EQ(order.stats().scansRead, 5u);
+	EXPECT_EQ(order.stats().scansOutOfOrder, 2u);
+}
+
+TEST(FrameOrder, AStrayStampIsSkippedAndAJumpOfTheRecordingIsKept)
+{
+	{
+		FrameOrder order(params());
+		// 50 s ahead, then back on time: a stray stamp
+		const auto frames =
+		    run(order, {scan(1.0), scan(51.0), scan(1.1), scan(1.2)});
+		ASSERT_EQ(frames.size(), 3u);
+		EXPECT_EQ(frames[1].index, 2u);
+		EXPECT_EQ(order.stats().scansBadStamp, 1u);
+	}
+	{
+		FrameOrder order(params());
+		// 50 s ahead, and the recording goes on from there: a jump
+		const auto frames =
+		    run(order, {scan(1.0), scan(51.0), scan(51.1), scan(51.2)});
+		ASSERT_EQ(frames.size(), 4u);
+		EXPECT_DOUBLE_EQ(frames[1].t, 51.0);
+		EXPECT_EQ(order.stats().scansBadStamp, 0u);
+	}
+	{
+		FrameOrder order(params());
+		const auto frames = run(order, {scan(1.0), scan(1.1), scan(99.0)});
+		EXPECT_EQ(frames.size(), 2u) << "a far last scan is stray";
+		EXPECT_EQ(order.stats().scansBadStamp, 1u);
+	}
+}
+
+TEST(FrameOrder, ObservationsOfOtherLabelsAndClassesAreSkipped)
+{
+	auto p = params();
+	p.sensors.rgbd_label = "RGBD";
+	p.sensors.imu_label = "IMU";
+	FrameOrder order(p);
+	const auto frames =
+	    run(order, {imu(0.9, 0.1, "IMU2"), scan(1.0, 4, 3, "OTHER"), scan(1.1),
+	                imu(1.2), CObservationIMU::Create(), imu(1.3, 0.1, "IMU")});
+	ASSERT_EQ(frames.size(), 1u);
+	EXPECT_EQ(frames[0].index, 0u) << "scans of another label get no index";
+	EXPECT_EQ(frames[0].imu.size(), 1u) << "released at the sample at 1.2";
+	EXPECT_EQ(order.stats().otherSkipped, 3u);
+	EXPECT_EQ(order.stats().imuRead, 2u);
+}
+
+TEST(FrameOrder, ReadingStopsAfterTheLastFrameOfTheRange)
+{
+	auto p = params();
+	p.frames = FrameRange::parse("1:2");
+	FrameOrder order(p);
+	EXPECT_TRUE(order.push(scan(1.0), {&kFile, 0}));
+	EXPECT_TRUE(order.push(scan(1.1), {&kFile, 1}));
+	EXPECT_TRUE(order.push(scan(1.2), {&kFile, 2}));
+	EXPECT_FALSE(order.push(scan(1.3), {&kFile, 3})) << "past 2: stop";
+	order.finish({&kFile, 4});
+	std::vector<size_t> got;
+	while (auto f = order.pop()) got.push_back(f->index);
+	EXPECT_EQ(got, (std::vector<size_t>{1, 2}));
+	EXPECT_TRUE(order.error().empty());
+}
+
+TEST(FrameOrder, AnotherImageSizeEndsTheInputWithAnErrorAfterTheFramesBefore)
+{
+	FrameOrder order(params());
+	const auto frames =
+	    run(order, {scan(1.0), scan(1.1), scan(1.2, 8, 6), scan(1.3)});
+	EXPECT_EQ(frames.size(), 2u);
+	EXPECT_NE(order.error().find("test.rawlog: 3D scan #2 has a 8x6 depth "
+	                             "image where the run's first had 4x3"),
+	          std::string::npos)
+	    << order.error();
+}
+
+TEST(FrameOrder, ARejectedImuSampleIsNotFedAndFlagsItsFrame)
+{
+	FrameOrder order(params());
+	const auto frames = run(order, {imu(0.9), scan(1.0), imu(1.05, NAN),
+	                                scan(1.1), imu(1.2), scan(1.3), imu(1.4)});
+	ASSERT_EQ(frames.size(), 3u);
+	EXPECT_FALSE(frames[0].imuRejected);
+	EXPECT_TRUE(frames[1].imuRejected) << "the NaN sample at 1.05 <= 1.1";
+	EXPECT_FALSE(frames[2].imuRejected);
+	size_t fed = 0;
+	for (const auto& f : frames) fed += f.imu.size();
+	EXPECT_EQ(fed, 3u);
+	EXPECT_EQ(order.stats().imuRejected, 1u);
+}
+
+TEST(FrameOrder, KeptInputWrittenBeforeEachFrameIsTheInputOrder)
+{
+	auto p = params();
+	p.keepInput = true;
+	FrameOrder order(p);
+	const std::vector<CObservation::Ptr> in = {
+	    imu(0.9), scan(1.0),  imu(1.05, NAN), scan(51.0), imu(51.05), scan(1.1),
+	    imu(1.2), scan(1.05), imu(1.3),       scan(1.4),  imu(1.5)};
+	const auto frames = run(order, in);
+	// written: before-list, frame, ..., then the trailing observations
+	std::vector<CObservation::Ptr> written;
+	for (const auto& f : frames)
+	{
+		written.insert(written.end(), f.before.begin(), f.before.end());
+		written.push_back(f.scan);
+	}
+	for (const auto& o : order.takeTrailing()) written.push_back(o);
+	// the input without the stray (51.0) and out-of-order (1.05) scans, the
+	// rejected IMU sample kept
+	std::vector<CObservation::Ptr> want;
+	for (const auto& o : in)
+		if (o != in[3] && o != in[7]) want.push_back(o);
+	EXPECT_EQ(written, want);
+}
