@@ -627,6 +627,8 @@ struct OldScan
 		}
 		else if (v == 1)
 			a.str(jpeg());
+		else if (v == 100)
+			a.put(uint8_t{0});  // not stored externally: no image
 		else
 		{
 			if (v >= 6) a.put(uint8_t{0});  // not stored externally
