@@ -734,7 +734,9 @@ TEST(RawlogCorrupt, ValidScansOfEveryOldLayoutAreRead)
 	// walks them to their end flag and MRPT reads them as written
 	for (uint8_t v = 0; v <= 9; v++)
 	{
-		const auto p = tmpPath("old_scan.rawlog");
+		// one file per version: the rawlog fuzz target's old-layout seeds
+		// (tests/fuzz/corpus/rawlog/old-scan-v*) are some of them
+		const auto p = tmpPath("old_scan_v" + std::to_string(v) + ".rawlog");
 		writeBytes(p, oldScan(v).bytes());
 		bims::RawlogReader r(p);
 		mrpt::obs::CObservation::Ptr o;
