@@ -101,6 +101,35 @@ std::string tooLarge(const std::string& owner, const std::string& what,
 	       std::to_string(kMaxImagePixels) + " pixels a rawlog may hold";
 }
 
+/** The height and width a JPEG's frame header (its SOF marker) declares,
+ * or nullopt when the \a n bytes at \a p hold none before the image data. */
+std::optional<std::pair<uint32_t, uint32_t>> jpegSize(const uint8_t* p,
+                                                      size_t n)
+{
+	if (n < 2 || p[0] != 0xff || p[1] != 0xd8) return std::nullopt;  // SOI
+	size_t i = 2;
+	while (i + 4 <= n && p[i] == 0xff)
+	{
+		const uint8_t marker = p[i + 1];
+		if (marker == 0xff)  // fill byte
+		{
+			i++;
+			continue;
+		}
+		// SOF0-SOF15 but DHT (c4), JPG (c8), DAC (cc): height, width
+		if (marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 &&
+		    marker != 0xc8 && marker != 0xcc)
+		{
+			if (i + 9 > n) return std::nullopt;
+			return std::make_pair(uint32_t(p[i + 5]) << 8 | p[i + 6],
+			                      uint32_t(p[i + 7]) << 8 | p[i + 8]);
+		}
+		if (marker == 0xda || marker == 0xd9) return std::nullopt;  // SOS, EOI
+		i += 2 + (size_t(p[i + 2]) << 8 | p[i + 3]);  // the segment
+	}
+	return std::nullopt;
+}
+
 /** The class MRPT's reader takes an object header's name for: a name with
  * a namespace must match whole (MRPT's own lookup drops the namespace, so
  * that a corrupt one would pass), one without (MRPT 1.x wrote its class
@@ -324,7 +353,9 @@ class ObservationWalker
 		}
 		return block(what, n);
 	}
-	/** A JPEG-stored image: its bytes must decode (OpenCV, whose libjpeg
+	/** A JPEG-stored image: the size its frame header declares must pass
+	 * the image limits (OpenCV and MRPT allocate the whole image from it
+	 * before decoding), and its bytes must decode (OpenCV, whose libjpeg
 	 * error handler returns): MRPT decodes them with libjpeg's default
 	 * handler, which ends the whole process on bytes that are no JPEG
 	 * (found by the fuzzer). */
@@ -334,7 +365,14 @@ class ObservationWalker
 		if (!string(what)) return false;
 		const auto bytes = c_.bytes(start + sizeof(uint32_t), c_.offset());
 		if (!bytes) return false;
-		const cv::Mat raw(1, static_cast<int>(c_.offset() - start - 4), CV_8UC1,
+		const size_t n = c_.offset() - start - 4;
+		if (const auto hw = jpegSize(bytes, n);
+		    hw && !saneSize(hw->first, hw->second))
+		{
+			problem = tooLarge(what_, what, hw->first, hw->second);
+			return false;
+		}
+		const cv::Mat raw(1, static_cast<int>(n), CV_8UC1,
 		                  const_cast<uint8_t*>(bytes));
 		bool ok = false;
 		try

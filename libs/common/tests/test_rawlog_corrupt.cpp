@@ -503,6 +503,34 @@ TEST(RawlogCorrupt, AJpegImageWhoseBytesDoNotDecodeIsAnErrorNotAnExit)
 	    << readError(p);
 }
 
+TEST(RawlogCorrupt, AJpegDeclaringAHugeImageIsAnErrorNotAnAllocation)
+{
+	// OpenCV (the guard's decode check) and MRPT allocate the whole image a
+	// JPEG's frame header declares before decoding its few bytes: 30000 x
+	// 30000 (under OpenCV's own limit of 2^30 pixels) is 2.7 GB
+	const auto p = tmpPath("jpeg_size.rawlog");
+	const bool was = mrpt::img::CImage::DISABLE_JPEG_COMPRESSION();
+	mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
+	scanRawlog(p, 0, true);  // its RGB image stored as JPEG
+	mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(was);
+	auto bytes = readBytes(p);
+	const uint8_t sof0[2] = {0xff, 0xc0};
+	const auto at = std::search(bytes.begin(), bytes.end(), sof0, sof0 + 2);
+	ASSERT_NE(at, bytes.end()) << "no JPEG frame header in the scan";
+	ASSERT_EQ(*(at + 5), 0);  // height 37 (the image is 53 x 37)
+	ASSERT_EQ(*(at + 6), 37);
+	for (int k : {5, 7})  // height, width
+	{
+		*(at + k) = 30000 >> 8;
+		*(at + k + 1) = 30000 & 0xff;
+	}
+	writeBytes(p, bytes);
+	EXPECT_NE(
+	    readError(p).find("the 3D scan's intensity image is 30000 x 30000"),
+	    std::string::npos)
+	    << readError(p);
+}
+
 namespace
 {
 /** MRPT's archive layout written by hand, for objects of the serialization
