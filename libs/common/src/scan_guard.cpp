@@ -366,6 +366,16 @@ class ObservationWalker
 		const auto bytes = c_.bytes(start + sizeof(uint32_t), c_.offset());
 		if (!bytes) return false;
 		const size_t n = c_.offset() - start - 4;
+		// OpenCV decodes any format it knows (a PNG, a PPM declaring a
+		// gigapixel image), MRPT only JPEG: its start of image first
+		const bool soi = n >= 2 && bytes[0] == 0xff && bytes[1] == 0xd8;
+		if (!soi)
+		{
+			problem = "the " + what_ + "'s " + what +
+			          " is stored as JPEG but its bytes do not decode (no "
+			          "JPEG start of image)";
+			return false;
+		}
 		if (const auto hw = jpegSize(bytes, n);
 		    hw && !saneSize(hw->first, hw->second))
 		{
@@ -601,8 +611,7 @@ class ObservationWalker
 		return block(what, size);
 	}
 	/** An image of CImage version 0: width, height, channels (uint32),
-	 * origin (uint8), size in bytes (uint32), the bytes. MRPT allocates
-	 * width x height x channels bytes and reads the size into them. */
+	 * origin (uint8), size in bytes (uint32), the bytes. */
 	bool rawImage(const std::string& what)
 	{
 		const uint64_t w = c_.read<uint32_t>(), h = c_.read<uint32_t>(),
@@ -621,13 +630,16 @@ class ObservationWalker
 			          std::to_string(channels) + " channels, not 1 to 4";
 			return false;
 		}
-		if (size > w * h * channels)
+		// MRPT allocates the pixels and reads the declared bytes into them:
+		// more would be written past them, fewer leave an allocation the
+		// file does not hold
+		if (size != w * h * channels)
 		{
 			problem = "the " + what_ + "'s " + what + " declares " +
-			          std::to_string(size) + " bytes, more than its " +
+			          std::to_string(size) + " bytes, not its " +
 			          std::to_string(w) + " x " + std::to_string(h) + " x " +
-			          std::to_string(channels) +
-			          " pixels hold (MRPT would write past them)";
+			          std::to_string(channels) + " pixels' " +
+			          std::to_string(w * h * channels);
 			return false;
 		}
 		return block(what, size);

@@ -531,6 +531,35 @@ TEST(RawlogCorrupt, AJpegDeclaringAHugeImageIsAnErrorNotAnAllocation)
 	    << readError(p);
 }
 
+TEST(RawlogCorrupt, AnImageOfAnotherFormatStoredAsJpegIsAnErrorNotAnExit)
+{
+	// the guard's decode check (OpenCV) decodes any format it knows, MRPT
+	// only JPEG, with libjpeg's handler that ends the process on other
+	// bytes: a valid PGM where the JPEG was must be refused (OpenCV would
+	// also allocate whatever size a PPM or BMP header declares)
+	const auto p = tmpPath("jpeg_pgm.rawlog");
+	const bool was = mrpt::img::CImage::DISABLE_JPEG_COMPRESSION();
+	mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
+	auto bytes = scanRawlog(p, 0, true);
+	mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(was);
+	const uint8_t soi[3] = {0xff, 0xd8, 0xff};
+	const auto at = static_cast<size_t>(
+	    std::search(bytes.begin(), bytes.end(), soi, soi + 3) - bytes.begin());
+	ASSERT_LT(at, bytes.size());
+	uint32_t n;
+	std::memcpy(&n, &bytes[at - 4], 4);
+	const std::string pgm = "P5\n2 2\n255\n\x01\x02\x03\x04";
+	bytes.erase(bytes.begin() + static_cast<long>(at),
+	            bytes.begin() + static_cast<long>(at + n));
+	bytes.insert(bytes.begin() + static_cast<long>(at), pgm.begin(), pgm.end());
+	putU32(bytes, at - 4, static_cast<uint32_t>(pgm.size()));
+	writeBytes(p, bytes);
+	EXPECT_NE(readError(p).find("the 3D scan's intensity image is stored as "
+	                            "JPEG but its bytes do not decode"),
+	          std::string::npos)
+	    << readError(p);
+}
+
 namespace
 {
 /** MRPT's archive layout written by hand, for objects of the serialization
@@ -890,7 +919,13 @@ TEST(RawlogCorrupt, AnOldImageDeclaringOtherBytesThanItsPixelsIsAnError)
 	o.imageBytes = 1u << 20;
 	EXPECT_NE(readOld("old_image_bytes.rawlog", o)
 	              .find("the 3D scan's intensity image declares 1048576 "
-	                    "bytes, more than its 8 x 4 x 1 pixels hold"),
+	                    "bytes, not its 8 x 4 x 1 pixels' 32"),
+	          std::string::npos);
+	o.imageWidth = 16384;  // 64 KB allocated for the 32 bytes stored
+	o.imageBytes = 32;
+	EXPECT_NE(readOld("old_image_bytes.rawlog", o)
+	              .find("declares 32 bytes, not its 16384 x 4 x 1 pixels' "
+	                    "65536"),
 	          std::string::npos);
 	// versions 2 on: MRPT allocates the pixels, then requires the size to
 	// match them
