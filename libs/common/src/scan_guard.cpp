@@ -22,6 +22,8 @@ class Cursor
 	explicit Cursor(const PeekFn& peek) : peek_(peek) {}
 	bool ok() const { return ok_; }
 	size_t offset() const { return at_; }
+	/** The bytes the file holds from the entry's start, as far as read. */
+	size_t available() const { return size_; }
 
 	template <typename T>
 	T read()
@@ -159,6 +161,20 @@ class ObservationWalker
 	explicit ObservationWalker(const PeekFn& peek) : c_(peek) {}
 	std::string problem;
 	bool truncated = false;  ///< the problem is the end of the file
+
+	/** After run(): when a known object's walk stopped at the end of the
+	 * file with no problem found, that is the problem (truncated): MRPT
+	 * reads a size field the file cuts short as far as it goes, the rest
+	 * of the value uninitialized, and allocates that (found by the
+	 * fuzzer: 9 GB for a point count cut after 2 bytes). */
+	void endedInside()
+	{
+		if (!problem.empty() || what_.empty() || c_.ok()) return;
+		problem = "the " + what_ +
+		          "'s layout runs past the end of the file (the entry holds " +
+		          std::to_string(c_.available()) + " bytes)";
+		truncated = true;
+	}
 
 	bool run()
 	{
@@ -705,6 +721,7 @@ std::string checkSerializedSizes(const PeekFn& peek, bool* truncated)
 {
 	ObservationWalker w(peek);
 	w.run();
+	w.endedInside();
 	if (truncated) *truncated = w.truncated;
 	return w.problem;
 }

@@ -938,6 +938,35 @@ TEST(RawlogCorrupt, AnOldImageDeclaringOtherBytesThanItsPixelsIsAnError)
 	          std::string::npos);
 }
 
+TEST(RawlogCorrupt, AScanCutInsideASizeFieldIsAnErrorNotAGarbageSize)
+{
+	// Found by the rawlog fuzz target (tests/fuzz/corpus/rawlog/
+	// oom-point-count-cut): a scan of version 2 ending 2 bytes into its
+	// point count. MRPT reads the 2 bytes, keeps the other 2 uninitialized
+	// and allocated 9 GB for the count.
+	auto o = oldScan(2);
+	auto b = o.bytes();
+	const auto p = tmpPath("cut_count.rawlog");
+	const size_t at = findPair(b, 2, 0x3f800000u);  // count 2, x = 1.0f
+	b.resize(at + 2);
+	writeBytes(p, b);
+	EXPECT_NE(readError(p).find("truncated or corrupt rawlog at entry 0 (0 "
+	                            "observations read before): the 3D scan's "
+	                            "layout runs past the end of the file (the "
+	                            "entry holds " +
+	                            std::to_string(at + 2) + " bytes)"),
+	          std::string::npos)
+	    << readError(p);
+	// MRPT 2.x's layout alike: cut inside the depth image's row count
+	auto v10 = scanRawlog(p, 0);
+	v10.resize(findPair(v10, 37, 53) + 2);
+	writeBytes(p, v10);
+	EXPECT_NE(readError(p).find("the 3D scan's layout runs past the end of "
+	                            "the file"),
+	          std::string::npos)
+	    << readError(p);
+}
+
 TEST(RawlogCorrupt, AnOldImuObservationWithAHugeVectorIsAnError)
 {
 	// IMU observations of versions 0-3 (MRPT 1.x) store their flags and
