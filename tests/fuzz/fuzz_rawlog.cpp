@@ -13,30 +13,9 @@
 
 #include "fuzz_common.h"
 
-namespace
-{
-/** Whether the input holds a 3D scan of a serialization version before 9
- * (MRPT 1.x's): MRPT's readers of those trust the stored sizes, the
- * reader's guard does not know their layouts, and such an input may make
- * MRPT allocate gigabytes (docs/fuzz.md, open findings). Left out so that
- * the fuzzer explores the layouts bims writes. */
-bool holdsAnOldScan(const uint8_t* data, size_t size)
-{
-	static const std::string name = "mrpt::obs::CObservation3DRangeScan";
-	const std::string s(reinterpret_cast<const char*>(data), size);
-	for (size_t at = s.find(name); at != std::string::npos;
-	     at = s.find(name, at + 1))
-		if (at + name.size() < s.size() &&
-		    static_cast<uint8_t>(s[at + name.size()]) < 9)
-			return true;
-	return false;
-}
-}  // namespace
-
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 {
 	using namespace mrpt::obs;
-	if (holdsAnOldScan(data, size)) return 0;
 	const std::string path = bims::fuzz::writeFile("in.rawlog", data, size);
 	try
 	{

@@ -1,5 +1,6 @@
 #include "scan_guard.h"
 
+#include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/rtti/CObject.h>
 #include <opencv2/imgcodecs.hpp>
 
@@ -10,6 +11,9 @@ namespace bims
 {
 namespace
 {
+/** The measurements (and data-present flags) an IMU observation keeps. */
+constexpr uint64_t kImuFields = mrpt::obs::COUNT_IMU_DATA_FIELDS;
+
 /** Reads MRPT's archive layout from peeked bytes; every read is bounds
  * checked and sets ok = false past the available bytes. */
 class Cursor
@@ -18,6 +22,8 @@ class Cursor
 	explicit Cursor(const PeekFn& peek) : peek_(peek) {}
 	bool ok() const { return ok_; }
 	size_t offset() const { return at_; }
+	/** The bytes the file holds from the entry's start, as far as read. */
+	size_t available() const { return size_; }
 
 	template <typename T>
 	T read()
@@ -88,12 +94,62 @@ bool saneSize(uint64_t rows, uint64_t cols)
 	       rows * cols <= kMaxImagePixels;
 }
 
-std::string tooLarge(const std::string& what, uint64_t rows, uint64_t cols)
+std::string tooLarge(const std::string& owner, const std::string& what,
+                     uint64_t rows, uint64_t cols)
 {
-	return "the 3D scan's " + what + " is " + std::to_string(rows) + " x " +
-	       std::to_string(cols) + " (rows x columns), beyond the " +
+	return "the " + owner + "'s " + what + " is " + std::to_string(rows) +
+	       " x " + std::to_string(cols) + " (rows x columns), beyond the " +
 	       std::to_string(kMaxImageSide) + " per side and " +
 	       std::to_string(kMaxImagePixels) + " pixels a rawlog may hold";
+}
+
+/** The height and width a JPEG's frame header (its SOF marker) declares,
+ * or nullopt when the \a n bytes at \a p hold none before the image data. */
+std::optional<std::pair<uint32_t, uint32_t>> jpegSize(const uint8_t* p,
+                                                      size_t n)
+{
+	if (n < 2 || p[0] != 0xff || p[1] != 0xd8) return std::nullopt;  // SOI
+	size_t i = 2;
+	while (i + 4 <= n && p[i] == 0xff)
+	{
+		const uint8_t marker = p[i + 1];
+		if (marker == 0xff)  // fill byte
+		{
+			i++;
+			continue;
+		}
+		// SOF0-SOF15 but DHT (c4), JPG (c8), DAC (cc): height, width
+		if (marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 &&
+		    marker != 0xc8 && marker != 0xcc)
+		{
+			if (i + 9 > n) return std::nullopt;
+			return std::make_pair(uint32_t(p[i + 5]) << 8 | p[i + 6],
+			                      uint32_t(p[i + 7]) << 8 | p[i + 8]);
+		}
+		if (marker == 0xda || marker == 0xd9) return std::nullopt;  // SOS, EOI
+		i += 2 + (size_t(p[i + 2]) << 8 | p[i + 3]);  // the segment
+	}
+	return std::nullopt;
+}
+
+/** The class MRPT's reader takes an object header's name for: a name with
+ * a namespace must match whole (MRPT's own lookup drops the namespace, so
+ * that a corrupt one would pass), one without (MRPT 1.x wrote its class
+ * names so: "CObservation3DRangeScan", "CPose3D", "CMatrix" for today's
+ * CMatrixF) is looked up as MRPT does. nullptr: a class MRPT does not
+ * know. */
+const mrpt::rtti::TRuntimeClassId* registered(const std::string& name)
+{
+	return mrpt::rtti::findRegisteredClass(
+	    name, name.find("::") == std::string::npos);
+}
+
+/** Whether an object header's class name \a name stands for MRPT's class
+ * \a full (its full name) as MRPT's reader takes it. */
+bool isClass(const std::string& name, const char* full)
+{
+	const auto* id = registered(name);
+	return id && id == mrpt::rtti::findRegisteredClass(full, false);
 }
 
 /** Walks a serialized observation field by field. Each step returns false
@@ -106,27 +162,38 @@ class ObservationWalker
 	std::string problem;
 	bool truncated = false;  ///< the problem is the end of the file
 
+	/** After run(): when a known object's walk stopped at the end of the
+	 * file with no problem found, that is the problem (truncated): MRPT
+	 * reads a size field the file cuts short as far as it goes, the rest
+	 * of the value uninitialized, and allocates that (found by the
+	 * fuzzer: 9 GB for a point count cut after 2 bytes). */
+	void endedInside()
+	{
+		if (!problem.empty() || what_.empty() || c_.ok()) return;
+		problem = "the " + what_ +
+		          "'s layout runs past the end of the file (the entry holds " +
+		          std::to_string(c_.available()) + " bytes)";
+		truncated = true;
+	}
+
 	bool run()
 	{
 		uint8_t version = 0;
 		const std::string cls = c_.header(version);
 		// a class MRPT does not know: it would read on as a typed object
-		// and may allocate what the bytes declare (found by the fuzzer). A
-		// name with a namespace must match whole (MRPT's own lookup drops
-		// it); one without (older rawlogs) is looked up as MRPT does.
-		const bool ns = cls.find("::") != std::string::npos;
-		if (!cls.empty() && !mrpt::rtti::findRegisteredClass(cls, !ns))
+		// and may allocate what the bytes declare (found by the fuzzer)
+		if (!cls.empty() && !registered(cls))
 		{
 			problem = "an object of a class MRPT does not know ('" +
 			          printable(cls) + "')";
 			return false;
 		}
-		if (cls == "mrpt::obs::CObservation3DRangeScan")
+		if (isClass(cls, "mrpt::obs::CObservation3DRangeScan"))
 		{
 			what_ = "3D scan";
 			return scan(version);
 		}
-		if (cls == "mrpt::obs::CObservationIMU")
+		if (isClass(cls, "mrpt::obs::CObservationIMU"))
 		{
 			what_ = "IMU observation";
 			return imu(version);
@@ -135,63 +202,83 @@ class ObservationWalker
 	}
 
  private:
-	/** MRPT 2.x's layout (version 4): the sensor pose, 31 flags of the
-	 * data present, the stamp, 31 measurements, the label. */
+	/** An IMU observation. Version 4 (MRPT 2.x): the sensor pose, a flag
+	 * per measurement, the stamp, the measurements, the label. Versions 0-3
+	 * (MRPT 1.x): the pose, the flags as a vector, the stamp, the
+	 * measurements as a vector (of float in version 0, of double after),
+	 * the label; MRPT allocates a vector's declared length before finding
+	 * it longer than the kImuFields it keeps. */
 	bool imu(uint8_t version)
 	{
-		if (version != 4 || !pose()) return false;
-		for (int k = 0; k < 31; k++)
-			if (!flag("data-present flag " + std::to_string(k))) return false;
-		c_.skip(sizeof(uint64_t) + 31 * sizeof(double));
+		if (version > 4) return false;  // MRPT refuses it
+		if (!pose()) return false;
+		if (version == 4)
+		{
+			for (uint64_t k = 0; k < kImuFields; k++)
+				if (!flag("data-present flag " + std::to_string(k)))
+					return false;
+			c_.skip(sizeof(uint64_t) + kImuFields * sizeof(double));
+		}
+		else
+		{
+			// MRPT's vector<bool> reader takes any byte other than 0 as true
+			if (!imuVector("data-present flags", 1)) return false;
+			c_.skip(sizeof(uint64_t));  // timestamp
+			if (!imuVector("measurements",
+			               version == 0 ? sizeof(float) : sizeof(double)))
+				return false;
+		}
 		return string("sensor label") && end();
 	}
+	/** A vector of an old IMU observation: its length (uint32), at most
+	 * kImuFields, then the elements of \a elem bytes. */
+	bool imuVector(const std::string& what, uint64_t elem)
+	{
+		const uint64_t n = c_.read<uint32_t>();
+		if (!c_.ok()) return false;
+		if (n > kImuFields)
+		{
+			problem = "the " + what_ + "'s " + what + " declare " +
+			          std::to_string(n) + " entries, beyond the " +
+			          std::to_string(kImuFields) + " MRPT keeps";
+			return false;
+		}
+		return block(what, n * elem);
+	}
 
+	/** A 3D scan, each version (0-10) as MRPT 2.5.8 reads it: MRPT 2.1 on
+	 * writes version 10, 1.9.9 and 2.0 version 9, MRPT 1.x 8 and before.
+	 * Versions add fields (noted where read); 9 changed the depth image
+	 * from a CMatrixF object of floats to raw uint16. */
 	bool scan(uint8_t version)
 	{
-		if (version != 9 && version != 10) return false;
+		if (version > 10) return false;  // MRPT refuses it
 		scanVersion_ = version;
 		c_.skip(sizeof(float));  // maxRange
 		if (!pose()) return false;
-		const auto hasPoints = flag("has-points flag");
-		if (!hasPoints) return false;
-		if (*hasPoints)
+		bool hasPoints = true;  // version 0 always stores points
+		if (version >= 1)
 		{
-			const auto n = c_.read<uint32_t>();
-			if (!c_.ok()) return false;
-			if (n > kMaxImagePixels)
-			{
-				problem = "the 3D scan declares " + std::to_string(n) +
-				          " stored points, beyond the " +
-				          std::to_string(kMaxImagePixels) +
-				          " a rawlog may hold";
-				return false;
-			}
-			// x, y, z as float, pixel column and row as uint16
-			if (!block("stored points", uint64_t{n} * (3 * sizeof(float) +
-			                                           2 * sizeof(uint16_t))))
-				return false;
+			const auto f = flag("has-points flag");
+			if (!f) return false;
+			hasPoints = *f;
 		}
-		const auto hasRange = flag("has-range flag");
-		if (!hasRange) return false;
-		c_.skip(sizeof(float));  // rangeUnits
-		if (*hasRange && !matrix("depth image", sizeof(uint16_t))) return false;
-		const auto hasIntensity = flag("has-intensity flag");
-		if (!hasIntensity || (*hasIntensity && !image("intensity image")))
-			return false;
-		const auto hasConfidence = flag("has-confidence flag");
-		if (!hasConfidence || (*hasConfidence && !image("confidence image")))
-			return false;
-		if (!camera() || !camera() || !pose()) return false;
+		if (hasPoints && !points(version)) return false;
+		if (version >= 1 && !imagesAndCameras(version)) return false;
 		c_.skip(sizeof(float) + sizeof(uint64_t));  // stdError, timestamp
 		if (!string("sensor label")) return false;
-		for (int k = 0; k < 2; k++)  // external points / range image files
-			if (!flag("externally-stored flag") ||
-			    !string("external file name"))
-				return false;
-		if (!flag("range-is-depth flag")) return false;
-		c_.skip(1);  // intensityImageChannel
-		const auto hasLabels = flag("has-labels flag");
-		if (!hasLabels || (*hasLabels && !labels())) return false;
+		if (version >= 3)
+			for (int k = 0; k < 2; k++)  // external points / range image files
+				if (!flag("externally-stored flag") ||
+				    !string("external file name"))
+					return false;
+		if (version >= 5 && !flag("range-is-depth flag")) return false;
+		if (version >= 6) c_.skip(1);  // intensityImageChannel
+		if (version >= 7)
+		{
+			const auto hasLabels = flag("has-labels flag");
+			if (!hasLabels || (*hasLabels && !labels())) return false;
+		}
 		if (version >= 10)
 		{
 			const auto layers = c_.read<uint8_t>();
@@ -200,7 +287,52 @@ class ObservationWalker
 				    !matrix("extra depth layer", sizeof(uint16_t)))
 					return false;
 		}
-		return c_.ok();
+		return c_.ok() && end();
+	}
+
+	/** A scan's stored points: their count, then x, y, z (float) of each,
+	 * in version 0 a valid-range byte each, from version 8 their pixel
+	 * column and row (uint16). */
+	bool points(uint8_t version)
+	{
+		const auto n = c_.read<uint32_t>();
+		if (!c_.ok()) return false;
+		if (n > kMaxImagePixels)
+		{
+			problem = "the 3D scan declares " + std::to_string(n) +
+			          " stored points, beyond the " +
+			          std::to_string(kMaxImagePixels) + " a rawlog may hold";
+			return false;
+		}
+		uint64_t each = 3 * sizeof(float);
+		if (version == 0) each += 1;
+		if (version >= 8) each += 2 * sizeof(uint16_t);
+		return block("stored points", n * each);
+	}
+
+	/** A scan's images and camera models (version 1 on): the depth image
+	 * (a CMatrixF object before version 9; from 9 its units, then rows,
+	 * cols and raw uint16), the intensity and confidence images, the depth
+	 * camera's model (version 2 on), the intensity camera's model and pose
+	 * (version 4 on). */
+	bool imagesAndCameras(uint8_t version)
+	{
+		const auto hasRange = flag("has-range flag");
+		if (!hasRange) return false;
+		if (version >= 9) c_.skip(sizeof(float));  // rangeUnits
+		if (*hasRange &&
+		    !(version >= 9 ? matrix("depth image", sizeof(uint16_t))
+		                   : matrixObject("depth image", "mrpt::math::CMatrixF",
+		                                  sizeof(float))))
+			return false;
+		const auto hasIntensity = flag("has-intensity flag");
+		if (!hasIntensity || (*hasIntensity && !image("intensity image")))
+			return false;
+		const auto hasConfidence = flag("has-confidence flag");
+		if (!hasConfidence || (*hasConfidence && !image("confidence image")))
+			return false;
+		if (version >= 2 && !camera()) return false;
+		return version < 4 || (camera() && pose());
 	}
 
 	/** rows, cols (uint32), then rows * cols elements of \a elem bytes. */
@@ -210,10 +342,18 @@ class ObservationWalker
 		if (!c_.ok()) return false;
 		if (!saneSize(rows, cols))
 		{
-			problem = tooLarge(what, rows, cols);
+			problem = tooLarge(what_, what, rows, cols);
 			return false;
 		}
 		return block(what, rows * cols * elem);
+	}
+	/** A matrix stored as an object of class \a cls (CMatrixF: float
+	 * elements, CMatrixD: double; version 0, their only one): a matrix(). */
+	bool matrixObject(const std::string& what, const char* cls, uint64_t elem)
+	{
+		const auto v = object(cls);
+		if (!v || *v != 0) return false;  // another version: MRPT refuses it
+		return matrix(what, elem) && end();
 	}
 	/** A string or byte block: its length (uint32), then the bytes. */
 	bool string(const std::string& what)
@@ -229,7 +369,9 @@ class ObservationWalker
 		}
 		return block(what, n);
 	}
-	/** A JPEG-stored image: its bytes must decode (OpenCV, whose libjpeg
+	/** A JPEG-stored image: the size its frame header declares must pass
+	 * the image limits (OpenCV and MRPT allocate the whole image from it
+	 * before decoding), and its bytes must decode (OpenCV, whose libjpeg
 	 * error handler returns): MRPT decodes them with libjpeg's default
 	 * handler, which ends the whole process on bytes that are no JPEG
 	 * (found by the fuzzer). */
@@ -239,7 +381,24 @@ class ObservationWalker
 		if (!string(what)) return false;
 		const auto bytes = c_.bytes(start + sizeof(uint32_t), c_.offset());
 		if (!bytes) return false;
-		const cv::Mat raw(1, static_cast<int>(c_.offset() - start - 4), CV_8UC1,
+		const size_t n = c_.offset() - start - 4;
+		// OpenCV decodes any format it knows (a PNG, a PPM declaring a
+		// gigapixel image), MRPT only JPEG: its start of image first
+		const bool soi = n >= 2 && bytes[0] == 0xff && bytes[1] == 0xd8;
+		if (!soi)
+		{
+			problem = "the " + what_ + "'s " + what +
+			          " is stored as JPEG but its bytes do not decode (no "
+			          "JPEG start of image)";
+			return false;
+		}
+		if (const auto hw = jpegSize(bytes, n);
+		    hw && !saneSize(hw->first, hw->second))
+		{
+			problem = tooLarge(what_, what, hw->first, hw->second);
+			return false;
+		}
+		const cv::Mat raw(1, static_cast<int>(n), CV_8UC1,
 		                  const_cast<uint8_t*>(bytes));
 		bool ok = false;
 		try
@@ -301,80 +460,209 @@ class ObservationWalker
 			          " of the entry)";
 		return false;
 	}
+	/** An inner object's header, where every MRPT version writes one of
+	 * class \a cls: its version, or nullopt to stop (the bytes end, or
+	 * another class or no object is there: a mismatch). */
+	std::optional<uint8_t> object(const char* cls)
+	{
+		uint8_t v = 0;
+		const size_t at = c_.offset();
+		if (isClass(c_.header(v), cls)) return v;
+		const char* name = std::strrchr(cls, ':');
+		mismatch(std::string("a ") + (name ? name + 1 : cls), at);
+		return std::nullopt;
+	}
+	/** A CPose3D: in version 0 a 4 x 4 CMatrixF, in 1 a 4 x 4 CMatrixD
+	 * (MRPT checks the size once read), in 2 the translation and a
+	 * quaternion (7 doubles), in 3 the translation and the rotation matrix
+	 * (12). */
 	bool pose()
 	{
-		uint8_t v = 0;
-		const size_t at = c_.offset();
-		if (c_.header(v) != "mrpt::poses::CPose3D")
-			return mismatch("a CPose3D", at);
-		if (v != 3) return false;      // another MRPT's: MRPT decides
-		c_.skip(12 * sizeof(double));  // translation and rotation matrix
+		const auto v = object("mrpt::poses::CPose3D");
+		if (!v) return false;
+		switch (*v)
+		{
+			case 0:
+				if (!matrixObject("pose matrix", "mrpt::math::CMatrixF",
+				                  sizeof(float)))
+					return false;
+				break;
+			case 1:
+				if (!matrixObject("pose matrix", "mrpt::math::CMatrixD",
+				                  sizeof(double)))
+					return false;
+				break;
+			case 2:
+				c_.skip(7 * sizeof(double));
+				break;
+			case 3:
+				c_.skip(12 * sizeof(double));
+				break;
+			default:
+				return false;  // MRPT refuses it
+		}
 		return end();
 	}
+	/** A TCamera (versions 0-6): the focal length [m], 5 distortion
+	 * parameters (8 from version 3), the intrinsic matrix (a 3 x 3 CMatrixD
+	 * before version 4, then fx fy cx cy), in version 0 an unused 1 x 5
+	 * CMatrixD, the image size (version 2 on; MRPT corrects it from the
+	 * depth image), the name (5 on), the distortion model (6 on). */
 	bool camera()
 	{
-		uint8_t v = 0;
-		const size_t at = c_.offset();
-		if (c_.header(v) != "mrpt::img::TCamera")
-			return mismatch("a TCamera", at);
-		if (v != 6) return false;  // another MRPT's: MRPT decides
-		// 13 doubles (distortion, focal length [m], fx fy cx cy), the
-		// image size (MRPT corrects it from the depth image), the name, the
-		// distortion model
-		c_.skip(13 * sizeof(double) + 2 * sizeof(uint32_t));
-		if (!string("camera name")) return false;
-		c_.skip(1);
+		const auto v = object("mrpt::img::TCamera");
+		if (!v || *v > 6) return false;  // another version: MRPT refuses it
+		c_.skip((1 + (*v >= 3 ? 8 : 5)) * sizeof(double));
+		if (*v < 4)
+		{
+			if (!matrixObject("camera matrix", "mrpt::math::CMatrixD",
+			                  sizeof(double)))
+				return false;
+		}
+		else
+			c_.skip(4 * sizeof(double));
+		if (*v == 0 && !matrixObject("camera distortion vector",
+		                             "mrpt::math::CMatrixD", sizeof(double)))
+			return false;
+		if (*v >= 2) c_.skip(2 * sizeof(uint32_t));
+		if (*v >= 5 && !string("camera name")) return false;
+		if (*v >= 6) c_.skip(1);
 		return end();
 	}
+	/** A CImage, each version as MRPT 2.5.8 reads it: 0 raw pixels, 1 a
+	 * JPEG, 2-9 (from 6: an external file's name, or) grey pixels or a
+	 * colour JPEG (from 7 after its size; a negative size: raw BGR
+	 * pixels), 100 (written by an MRPT without OpenCV) an external file's
+	 * name or nothing. */
 	bool image(const std::string& what)
 	{
-		uint8_t v = 0;
 		const size_t at = c_.offset();
-		if (c_.header(v) != "mrpt::img::CImage")
-			return mismatch("a CImage", at);
-		// another MRPT's: MRPT decides; but a scan of version 10 (MRPT
-		// 2.1 on) holds MRPT 2.x's images only (an older image version
-		// made MRPT decode bytes as JPEG with libjpeg's exiting error
-		// handler: found by the fuzzer)
-		if (v != 9)
-			return scanVersion_ >= 10
-			           ? mismatch("a CImage of version 9, as MRPT 2.x writes",
-			                      at)
-			           : false;
-		if (c_.read<uint8_t>())
-			return string(what + " file name") && end();  // external file
-		if (!c_.read<uint8_t>())  // grey: w h origin size depth zip data
+		const auto v = object("mrpt::img::CImage");
+		if (!v) return false;
+		// a scan of version 10 (MRPT 2.1 on) holds MRPT 2.x's images only
+		// (an older image version made MRPT decode bytes as JPEG with
+		// libjpeg's exiting error handler: found by the fuzzer)
+		if (scanVersion_ >= 10 && *v != 9)
+			return mismatch("a CImage of version 9, as MRPT 2.x writes", at);
+		if (*v == 0) return rawImage(what) && end();
+		if (*v == 1) return jpeg(what) && end();
+		if (*v > 9 && *v != 100) return false;  // MRPT refuses it
+		if (*v >= 6)
 		{
-			const uint64_t w = c_.read<uint32_t>(), h = c_.read<uint32_t>();
-			c_.skip(sizeof(int32_t));
-			const auto size = c_.read<uint32_t>();
-			c_.skip(sizeof(int32_t));
+			const auto external = flag(what + "'s external-file flag");
+			if (!external) return false;
+			if (*external) return string(what + " file name") && end();
+			if (*v == 100) return end();
+		}
+		if (!c_.read<uint8_t>())  // colour: any byte but 0
+			return greyImage(what, *v) && end();
+		if (*v >= 7)
+		{
+			const auto w = c_.read<int32_t>(), h = c_.read<int32_t>();
 			if (!c_.ok()) return false;
-			if (!saneSize(h, w))
+			if (w < 0 && h < 0)  // raw BGR
 			{
-				problem = tooLarge(what, h, w);
-				return false;
+				const uint64_t rw = -int64_t{w}, rh = -int64_t{h};
+				if (!saneSize(rh, rw))
+				{
+					problem = tooLarge(what_, what, rh, rw);
+					return false;
+				}
+				return block(what, 3 * rw * rh) && end();
 			}
-			if (c_.read<uint8_t>()) return false;  // zip: MRPT refuses it
-			return block(what, size) && end();
+			if (w < 1 || h < 1) return end();  // empty: no pixels stored
 		}
-		const auto w = c_.read<int32_t>(), h = c_.read<int32_t>();
-		if (!c_.ok()) return false;
-		if (w >= 1 && h >= 1) return jpeg(what) && end();
-		if (w < 0 && h < 0)  // raw BGR
-		{
-			const uint64_t rw = -int64_t{w}, rh = -int64_t{h};
-			if (!saneSize(rh, rw))
-			{
-				problem = tooLarge(what, rh, rw);
-				return false;
-			}
-			if (!block(what, 3 * rw * rh)) return false;
-		}
-		return end();
+		return jpeg(what) && end();
 	}
-	/** Pixel labels: version, bytes per pixel (1, 2, 4 or 8), the label
-	 * image (rows, cols, then that many elements), then the label names as
+	/** A grey image's pixels (CImage versions 2-9): width, height, origin,
+	 * size in bytes (int32), from version 9 the pixel depth, then, unless
+	 * ZIP-compressed (which MRPT 2.x no longer reads), the bytes. MRPT
+	 * allocates width x height pixels of that depth before it checks the
+	 * size against them. */
+	bool greyImage(const std::string& what, uint8_t version)
+	{
+		const uint64_t w = c_.read<uint32_t>(), h = c_.read<uint32_t>();
+		c_.skip(sizeof(int32_t));  // origin
+		const uint64_t size = c_.read<uint32_t>();
+		const int32_t depth = version >= 9 ? c_.read<int32_t>() : 0;
+		if (!c_.ok()) return false;
+		if (!saneSize(h, w))
+		{
+			problem = tooLarge(what_, what, h, w);
+			return false;
+		}
+		// bytes per pixel of MRPT's PixelDepth: D8U D8S D16U D16S D32S
+		// D32F D64F
+		static constexpr uint64_t kDepthBytes[] = {1, 1, 2, 2, 4, 4, 8};
+		if (depth < 0 || depth > 6)
+		{
+			problem = "the " + what_ + "'s " + what + " declares pixel depth " +
+			          std::to_string(depth) + ", none of MRPT's (0 to 6)";
+			return false;
+		}
+		const uint64_t bytes = w * h * kDepthBytes[depth];
+		if (size != bytes)
+		{
+			problem = "the " + what_ + "'s " + what + " declares " +
+			          std::to_string(size) + " bytes for " + std::to_string(w) +
+			          " x " + std::to_string(h) + " pixels of " +
+			          std::to_string(kDepthBytes[depth]) + " bytes (" +
+			          std::to_string(bytes) + ")";
+			return false;
+		}
+		bool zip = version == 3 || (version == 4 && size > 16 * 1024);
+		if (version >= 5)
+		{
+			const auto z = flag(what + "'s ZIP flag");
+			if (!z) return false;
+			zip = *z;
+		}
+		if (zip)
+		{
+			problem = "the " + what_ + "'s " + what +
+			          " is stored ZIP-compressed, which MRPT 2.x no longer "
+			          "reads";
+			return false;
+		}
+		return block(what, size);
+	}
+	/** An image of CImage version 0: width, height, channels (uint32),
+	 * origin (uint8), size in bytes (uint32), the bytes. */
+	bool rawImage(const std::string& what)
+	{
+		const uint64_t w = c_.read<uint32_t>(), h = c_.read<uint32_t>(),
+		               channels = c_.read<uint32_t>();
+		c_.skip(1);
+		const uint64_t size = c_.read<uint32_t>();
+		if (!c_.ok()) return false;
+		if (!saneSize(h, w))
+		{
+			problem = tooLarge(what_, what, h, w);
+			return false;
+		}
+		if (channels < 1 || channels > 4)
+		{
+			problem = "the " + what_ + "'s " + what + " declares " +
+			          std::to_string(channels) + " channels, not 1 to 4";
+			return false;
+		}
+		// MRPT allocates the pixels and reads the declared bytes into them:
+		// more would be written past them, fewer leave an allocation the
+		// file does not hold
+		if (size != w * h * channels)
+		{
+			problem = "the " + what_ + "'s " + what + " declares " +
+			          std::to_string(size) + " bytes, not its " +
+			          std::to_string(w) + " x " + std::to_string(h) + " x " +
+			          std::to_string(channels) + " pixels' " +
+			          std::to_string(w * h * channels);
+			return false;
+		}
+		return block(what, size);
+	}
+	/** Pixel labels: version, the label bits' bytes (1 to 8: MRPT keeps
+	 * 3 in 4-byte and 5 to 7 in 8-byte elements), the label image (rows,
+	 * cols, then that many elements), then the label names as
 	 * MRPT writes a std::map<uint32_t, std::string>: "std::map", the key and
 	 * value type names, the count, then key and name per entry. MRPT's
 	 * reader allocates the label image with `new` before reading on, and
@@ -386,14 +674,14 @@ class ObservationWalker
 		const auto bytes = c_.read<uint8_t>();
 		if (!c_.ok()) return false;
 		if (version != 1) return false;  // another MRPT's: MRPT decides
-		if (bytes != 1 && bytes != 2 && bytes != 4 && bytes != 8)
+		if (bytes < 1 || bytes > 8)
 		{
 			problem = "the " + what_ + "'s pixel labels declare " +
-			          std::to_string(bytes) +
-			          " bytes per pixel, not 1, 2, 4 or 8";
+			          std::to_string(bytes) + " bytes per pixel, not 1 to 8";
 			return false;
 		}
-		if (!matrix("pixel-label image", bytes)) return false;
+		const uint64_t elem = bytes <= 2 ? bytes : bytes <= 4 ? 4 : 8;
+		if (!matrix("pixel-label image", elem)) return false;
 		for (const char* type : {"std::map", "uint32_t", "std::string"})
 		{
 			const auto at = c_.offset();
@@ -433,6 +721,7 @@ std::string checkSerializedSizes(const PeekFn& peek, bool* truncated)
 {
 	ObservationWalker w(peek);
 	w.run();
+	w.endedInside();
 	if (truncated) *truncated = w.truncated;
 	return w.problem;
 }

@@ -30,13 +30,16 @@ constexpr uint64_t kMaxStringBytes = uint64_t{1} << 26;
 using PeekFn = std::function<std::pair<const uint8_t*, size_t>(size_t n)>;
 
 /** For a top-level object of a class MRPT does not know, that problem;
- * for a top-level mrpt::obs::CObservation3DRangeScan of serialization
- * version 9 or 10 or mrpt::obs::CObservationIMU of version 4 (what MRPT 2.x
- * writes), the problem with its declared point count, the size of one of
- * its images (depth, intensity, confidence, pixel labels, extra layers) or
- * the length of one of its strings ("" when they are sane, when the object
- * is of another class or version or holds a layout the walk does not know,
- * or when the file ends first: MRPT's reader then reports the
+ * for a top-level mrpt::obs::CObservation3DRangeScan (every serialization
+ * version MRPT 2.5.8 reads, 0 to 10: MRPT 1.x's layouts too) or
+ * mrpt::obs::CObservationIMU (0 to 4), walked with the inner objects it
+ * holds (poses, images, camera models, matrices of each version MRPT
+ * reads), the problem with its declared point count, the size of one of its
+ * images (depth, intensity, confidence, pixel labels, extra layers) or
+ * matrices, the length of one of its strings or vectors, a flag that is no
+ * bool, or a layout MRPT's reader would fail on only after allocating ("" when
+ * they are sane, when the object is of another class or of a version MRPT
+ * refuses, or when the file ends first: MRPT's reader then reports the
  * truncation), or, with *truncated = true, that a block it declares (points,
  * an image, a string) runs past the end of the file. */
 std::string checkSerializedSizes(const PeekFn& peek, bool* truncated = nullptr);
