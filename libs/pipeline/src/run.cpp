@@ -253,13 +253,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	if (input)
 	{
 		readError = input->error();
-		const auto& st = input->stats();
-		sum.scansRead = st.scansRead;
-		sum.scansOutOfOrder = st.scansOutOfOrder;
-		sum.scansBadStamp = st.scansBadStamp;
-		sum.imuRead = st.imuRead;
-		sum.imuRejected = st.imuRejected;
-		sum.otherSkipped = st.otherSkipped;
+		static_cast<source::FrameOrderStats&>(sum) = input->stats();
 	}
 	if (!readError.empty())  // first: it came first
 		sum.error =

@@ -45,10 +45,11 @@ struct Percentiles
 	static Percentiles of(std::vector<double> v);
 };
 
-/** What a run measured. */
-struct RunSummary
+/** What a run measured; what the input held and what of it was skipped is
+ * the frame source's (source::FrameOrderStats). */
+struct RunSummary : source::FrameOrderStats
 {
-	size_t scansRead = 0, framesProcessed = 0, imuRead = 0, otherSkipped = 0;
+	size_t framesProcessed = 0;
 	size_t framesFlagged = 0;  ///< frames with an egomotion flag
 	/** Frames per egomotion flag by name (ego::flagNames; first_frame not
 	 * counted). */
@@ -56,14 +57,6 @@ struct RunSummary
 	/** What the user should know about how the run went, one sentence
 	 * each (e.g. no IMU in the input and the mode it fell back to). */
 	std::vector<std::string> notes;
-	size_t scansOutOfOrder = 0;  ///< dropped: timestamp not increasing
-	/** dropped: timestamp more than source::kMaxScanGapS after the previous
-	 * scan's and the next scan's not close to it (a stray stamp) */
-	size_t scansBadStamp = 0;
-	/** IMU samples not used: a field not finite or beyond any sensor's
-	 * range (bims::imuSampleProblem); the frames whose interval held one
-	 * are flagged imu_rejected */
-	size_t imuRejected = 0;
 	/** frames whose observed flow ran during the previous frame's grids
 	 * ([pipeline] flow_lookahead) */
 	size_t framesFlowAhead = 0;
