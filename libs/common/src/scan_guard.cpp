@@ -37,6 +37,18 @@ class Cursor
 	{
 		if (need(n)) at_ += n;
 	}
+	/** Whether the file holds \a n more bytes from here (none consumed). */
+	bool holds(uint64_t n)
+	{
+		if (!ok_) return false;
+		if (at_ + n > size_)
+		{
+			const auto got = peek_(at_ + n);
+			data_ = got.first;
+			size_ = got.second;
+		}
+		return at_ + n <= size_;
+	}
 	/** The bytes from offset \a from to \a to (already walked past), or
 	 * nullptr. */
 	const uint8_t* bytes(size_t from, size_t to)
@@ -198,6 +210,11 @@ class ObservationWalker
 			what_ = "IMU observation";
 			return imu(version);
 		}
+		if (isClass(cls, "mrpt::obs::CSensoryFrame") && !inFrame_)
+		{
+			what_ = "sensory frame";
+			return sensoryFrame(version);
+		}
 		return false;
 	}
 
@@ -229,6 +246,32 @@ class ObservationWalker
 				return false;
 		}
 		return string("sensor label") && end();
+	}
+	/** A sensory frame (CSensoryFrame, MRPT 1.x's CSensorialFrame): from
+	 * version 0 to 1 an ID, in version 0 a stamp, then the number of
+	 * observations and each as an object. MRPT sizes its list by that number
+	 * before reading any (the fuzzer's 1e9 made it allocate 16 GB): it may
+	 * not exceed the bytes left, one at least per object. The observations
+	 * are walked as at the top level. */
+	bool sensoryFrame(uint8_t version)
+	{
+		if (version > 2) return false;  // MRPT refuses it
+		if (version < 2) c_.skip(sizeof(uint32_t));  // ID
+		if (version == 0) c_.skip(sizeof(uint64_t));  // stamp
+		const uint64_t n = c_.read<uint32_t>();
+		if (!c_.ok()) return false;
+		if (!c_.holds(n))
+		{
+			problem = "the sensory frame declares " + std::to_string(n) +
+			          " observations, more than the bytes left in the file";
+			truncated = true;
+			return false;
+		}
+		inFrame_ = true;
+		for (uint64_t k = 0; k < n; k++)
+			if (!run()) return false;
+		what_ = "sensory frame";
+		return end();
 	}
 	/** A vector of an old IMU observation: its length (uint32), at most
 	 * kImuFields, then the elements of \a elem bytes. */
@@ -714,6 +757,7 @@ class ObservationWalker
 	Cursor c_;
 	std::string what_;     ///< "3D scan", "IMU observation"
 	int scanVersion_ = 0;  ///< of the 3D scan walked
+	bool inFrame_ = false;  ///< inside a sensory frame (they do not nest)
 };
 }  // namespace
 

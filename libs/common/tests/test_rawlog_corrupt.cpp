@@ -4,9 +4,12 @@
 #include <bims/common/rawlog.h>
 #include <gtest/gtest.h>
 
+#include <mrpt/io/CFileOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/serialization/CArchive.h>
 #include <mrpt/rtti/CObject.h>
 #include "tmp_path.h"
 
@@ -1002,6 +1005,48 @@ TEST(RawlogCorrupt, AnOldImuObservationWithAHugeVectorIsAnError)
 	writeBytes(p, imu(21, 0x20000000u));
 	EXPECT_NE(readError(p).find("the IMU observation's measurements declare "
 	                            "536870912 entries"),
+	          std::string::npos)
+	    << readError(p);
+}
+
+TEST(RawlogCorrupt, ASensoryFrameDeclaringMoreObservationsThanBytesIsAnError)
+{
+	// Found by the rawlog fuzz target (tests/fuzz/corpus/rawlog/
+	// oom-sensory-frame-count): a CSensorialFrame declaring 1 086 359 807
+	// observations; MRPT sized its list (16 GB) before reading any.
+	const auto p = tmpPath("sensory_frame.rawlog");
+	{
+		mrpt::obs::CSensoryFrame sf;
+		auto imu = mrpt::obs::CObservationIMU::Create();
+		imu->sensorLabel = "IMU";
+		imu->set(mrpt::obs::IMU_WZ, 0.5);
+		sf.insert(imu);
+		mrpt::io::CFileOutputStream f(p);
+		mrpt::serialization::archiveFrom(f) << sf;
+	}
+	{
+		// a sane frame reads back, its observation walked and kept
+		bims::RawlogReader r(p);
+		auto imu =
+		    std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(r.next());
+		ASSERT_TRUE(imu);
+		EXPECT_DOUBLE_EQ(imu->get(mrpt::obs::IMU_WZ), 0.5);
+	}
+	auto bytes = readBytes(p);
+	const std::string name = "CSensoryFrame";
+	const auto it = std::search(bytes.begin(), bytes.end(), name.begin(),
+	                            name.end());
+	ASSERT_NE(it, bytes.end());
+	const size_t count = static_cast<size_t>(it - bytes.begin()) +
+	                     name.size() + 1;  // after the version byte
+	uint32_t n = 0;
+	std::memcpy(&n, &bytes[count], 4);
+	ASSERT_EQ(n, 1u);
+	putU32(bytes, count, 0x40c088ffu);
+	writeBytes(p, bytes);
+	EXPECT_NE(readError(p).find("the sensory frame declares 1086359807 "
+	                            "observations, more than the bytes left in "
+	                            "the file"),
 	          std::string::npos)
 	    << readError(p);
 }
