@@ -73,14 +73,7 @@ class Cursor
  private:
 	bool need(uint64_t n)
 	{
-		if (!ok_) return false;
-		if (at_ + n > size_)
-		{
-			const auto got = peek_(at_ + n);
-			data_ = got.first;
-			size_ = got.second;
-			if (at_ + n > size_) ok_ = false;
-		}
+		if (!holds(n)) ok_ = false;
 		return ok_;
 	}
 
