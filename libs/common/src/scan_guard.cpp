@@ -248,8 +248,8 @@ class ObservationWalker
 	 * are walked as at the top level. */
 	bool sensoryFrame(uint8_t version)
 	{
-		if (version > 2) return false;  // MRPT refuses it
-		if (version < 2) c_.skip(sizeof(uint32_t));  // ID
+		if (version > 2) return false;                // MRPT refuses it
+		if (version < 2) c_.skip(sizeof(uint32_t));   // ID
 		if (version == 0) c_.skip(sizeof(uint64_t));  // stamp
 		const uint64_t n = c_.read<uint32_t>();
 		if (!c_.ok()) return false;
@@ -748,8 +748,8 @@ class ObservationWalker
 	}
 
 	Cursor c_;
-	std::string what_;     ///< "3D scan", "IMU observation"
-	int scanVersion_ = 0;  ///< of the 3D scan walked
+	std::string what_;      ///< "3D scan", "IMU observation"
+	int scanVersion_ = 0;   ///< of the 3D scan walked
 	bool inFrame_ = false;  ///< inside a sensory frame (they do not nest)
 };
 }  // namespace
