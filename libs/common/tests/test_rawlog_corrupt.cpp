@@ -9,8 +9,8 @@
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/obs/CSensoryFrame.h>
-#include <mrpt/serialization/CArchive.h>
 #include <mrpt/rtti/CObject.h>
+#include <mrpt/serialization/CArchive.h>
 #include "tmp_path.h"
 
 #include <algorithm>
@@ -1034,11 +1034,11 @@ TEST(RawlogCorrupt, ASensoryFrameDeclaringMoreObservationsThanBytesIsAnError)
 	}
 	auto bytes = readBytes(p);
 	const std::string name = "CSensoryFrame";
-	const auto it = std::search(bytes.begin(), bytes.end(), name.begin(),
-	                            name.end());
+	const auto it =
+	    std::search(bytes.begin(), bytes.end(), name.begin(), name.end());
 	ASSERT_NE(it, bytes.end());
-	const size_t count = static_cast<size_t>(it - bytes.begin()) +
-	                     name.size() + 1;  // after the version byte
+	const size_t count = static_cast<size_t>(it - bytes.begin()) + name.size() +
+	                     1;  // after the version byte
 	uint32_t n = 0;
 	std::memcpy(&n, &bytes[count], 4);
 	ASSERT_EQ(n, 1u);

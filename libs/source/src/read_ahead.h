@@ -1,8 +1,8 @@
 // Internal: the observations of rawlog files, one file after the other, read
-// and decoded ahead on a thread (RawlogFrameSource's input). Each observation is fully
-// loaded (external images too) before it is handed over. Reading errors
-// (bims::RawlogError naming the file and the entry) reach next() in stream
-// order, after every observation read before them. Without a thread
+// and decoded ahead on a thread (RawlogFrameSource's input). Each observation
+// is fully loaded (external images too) before it is handed over. Reading
+// errors (bims::RawlogError naming the file and the entry) reach next() in
+// stream order, after every observation read before them. Without a thread
 // (threaded = false) next() reads on the caller's thread.
 #pragma once
 
@@ -26,7 +26,7 @@ class ReadAhead
 	{
 		mrpt::obs::CObservation::Ptr obs;  ///< nullptr: end of the last file
 		size_t file = 0;                   ///< index into the paths
-		size_t entry = 0;  ///< its observation index in that file
+		size_t entry = 0;      ///< its observation index in that file
 		double readMs = 0;     ///< time reading and decoding it took
 		double readCpuMs = 0;  ///< its CPU time (the reading thread's)
 		/** Share of all the files' data read with it (0..1; 0 when their

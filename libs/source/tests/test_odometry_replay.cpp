@@ -5,8 +5,8 @@
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
-#include <bims/source/odometry_replay.h>
 #include <bims/ego/so3.h>
+#include <bims/source/odometry_replay.h>
 #include <gtest/gtest.h>
 
 #include <mrpt/config/CConfigFile.h>
@@ -17,8 +17,8 @@
 #include <filesystem>
 
 using namespace bims::ego;
-using bims::source::replayRawlog;
 using bims::source::ReplayOptions;
+using bims::source::replayRawlog;
 
 namespace
 {
