@@ -283,19 +283,20 @@ std::string sampleWithFaults()
 	out.close();
 	return path;
 }
-}  // namespace
 
-TEST(BatchAndReplay, GiveTheSameFramesPosesAndMasks)
+/** What a program saw of one frame. */
+struct Seen
 {
-	const std::string input = sampleWithFaults();
+	size_t index;
+	mrpt::poses::CPose3D T_WC;
+	cv::Mat mask;
+};
+
+/** bims-run's frames of \a input (config/default.ini). */
+std::vector<Seen> batchFrames(const std::string& input)
+{
 	pipeline::ExperimentConfig cfg;
 	cfg.loadFromFile(kConfig);
-	struct Seen
-	{
-		size_t index;
-		mrpt::poses::CPose3D T_WC;
-		cv::Mat mask;
-	};
 	std::vector<Seen> batch;
 	pipeline::RunOptions ro;
 	ro.rawlogs = {input};
@@ -304,9 +305,25 @@ TEST(BatchAndReplay, GiveTheSameFramesPosesAndMasks)
 		batch.push_back({r.index, r.T_WC, r.mask.clone()});
 	};
 	const auto sum = pipeline::runExperiment(cfg, ro);
-	ASSERT_TRUE(sum.error.empty()) << sum.error;
+	EXPECT_TRUE(sum.error.empty()) << sum.error;
 	EXPECT_EQ(sum.scansOutOfOrder, 1u);
 	EXPECT_EQ(sum.imuRejected, 1u);
+	return batch;
+}
+
+void expectSame(const pipeline::FrameResult& r, const Seen& want, size_t k)
+{
+	EXPECT_EQ(r.index, want.index) << "frame " << k;
+	EXPECT_EQ(r.T_WC.asVectorVal(), want.T_WC.asVectorVal()) << "frame " << k;
+	ASSERT_EQ(r.mask.size(), want.mask.size()) << "frame " << k;
+	EXPECT_EQ(cv::countNonZero(r.mask != want.mask), 0) << "frame " << k;
+}
+}  // namespace
+
+TEST(BatchAndReplay, GiveTheSameFramesPosesAndMasks)
+{
+	const std::string input = sampleWithFaults();
+	const auto batch = batchFrames(input);
 	ASSERT_EQ(batch.size(), 40u);
 
 	ViewerOptions o;
@@ -320,13 +337,31 @@ TEST(BatchAndReplay, GiveTheSameFramesPosesAndMasks)
 		ASSERT_LT(k, batch.size());
 		const auto* r = c.result();
 		ASSERT_NE(r, nullptr);
-		EXPECT_EQ(r->index, batch[k].index) << "frame " << k;
-		EXPECT_EQ(r->T_WC.asVectorVal(), batch[k].T_WC.asVectorVal())
-		    << "frame " << k;
-		ASSERT_EQ(r->mask.size(), batch[k].mask.size());
-		EXPECT_EQ(cv::countNonZero(r->mask != batch[k].mask), 0)
-		    << "frame " << k;
+		expectSame(*r, batch[k], k);
 		++k;
 	}
 	EXPECT_EQ(k, batch.size());
+}
+
+TEST(BatchAndLive, GiveTheSameFramesPosesAndMasks)
+{
+	// the observations handed over one by one as a live sensor would
+	const std::string input = sampleWithFaults();
+	const auto batch = batchFrames(input);
+	pipeline::ExperimentConfig cfg;
+	cfg.loadFromFile(kConfig);
+	pipeline::LiveSegmentation live(cfg, "test", "live input");
+	size_t k = 0;
+	const auto onFrame =
+	    [&](const source::SourceFrame&, const pipeline::FrameResult& r)
+	{
+		ASSERT_LT(k, batch.size());
+		expectSame(r, batch[k], k);
+		++k;
+	};
+	RawlogReader in(input);
+	while (auto o = in.next()) live.push(o, onFrame);
+	live.finish(onFrame);
+	EXPECT_EQ(k, batch.size());
+	EXPECT_EQ(live.stats().scansOutOfOrder, 1u);
 }
