@@ -13,6 +13,10 @@ namespace
 {
 /** The measurements (and data-present flags) an IMU observation keeps. */
 constexpr uint64_t kImuFields = mrpt::obs::COUNT_IMU_DATA_FIELDS;
+/** More observations than any sensory frame holds (a handful in practice):
+ * beyond it the count is refused before the file is peeked that far (the
+ * peek buffers what it is asked for). */
+constexpr uint64_t kMaxFrameObservations = 1 << 20;
 
 /** Reads MRPT's archive layout from peeked bytes; every read is bounds
  * checked and sets ok = false past the available bytes. */
@@ -253,6 +257,14 @@ class ObservationWalker
 		if (version == 0) c_.skip(sizeof(uint64_t));  // stamp
 		const uint64_t n = c_.read<uint32_t>();
 		if (!c_.ok()) return false;
+		if (n > kMaxFrameObservations)
+		{
+			problem = "the sensory frame declares " + std::to_string(n) +
+			          " observations, more than the " +
+			          std::to_string(kMaxFrameObservations) +
+			          " a rawlog may hold";
+			return false;
+		}
 		if (!c_.holds(n))
 		{
 			problem = "the sensory frame declares " + std::to_string(n) +

@@ -1045,6 +1045,16 @@ TEST(RawlogCorrupt, ASensoryFrameDeclaringMoreObservationsThanBytesIsAnError)
 	putU32(bytes, count, 0x40c088ffu);
 	writeBytes(p, bytes);
 	EXPECT_NE(readError(p).find("the sensory frame declares 1086359807 "
+	                            "observations, more than the 1048576 a "
+	                            "rawlog may hold"),
+	          std::string::npos)
+	    << readError(p);
+	// fewer, but more than the file's bytes (oom-sensory-frame-count-2 held
+	// 2 153 775 104: the guard's own peek of that many bytes ran out of
+	// memory)
+	putU32(bytes, count, 4096);
+	writeBytes(p, bytes);
+	EXPECT_NE(readError(p).find("the sensory frame declares 4096 "
 	                            "observations, more than the bytes left in "
 	                            "the file"),
 	          std::string::npos)
