@@ -254,10 +254,11 @@ namespace
 /** The bundled sample's first 40 frames with what the ordering rule must
  * handle: a 3D scan repeated out of order after scan #10 (skipped), and an
  * IMU sample whose angular rate is NaN (not used, its frame flagged). */
-std::string sampleWithFaults()
+std::string sampleWithFaults(const std::string& test)
 {
+	// a folder per test: CTest runs them in parallel
 	const std::string path =
-	    bims::test::freshTmpDir("bims_test_viewer", "faults") + "/in.rawlog";
+	    bims::test::freshTmpDir("bims_test_viewer", test) + "/in.rawlog";
 	RawlogReader in(kRawlog);
 	RawlogWriter out(path);
 	std::vector<mrpt::obs::CObservation::Ptr> scans;
@@ -322,7 +323,7 @@ void expectSame(const pipeline::FrameResult& r, const Seen& want, size_t k)
 
 TEST(BatchAndReplay, GiveTheSameFramesPosesAndMasks)
 {
-	const std::string input = sampleWithFaults();
+	const std::string input = sampleWithFaults("batch_and_replay");
 	const auto batch = batchFrames(input);
 	ASSERT_EQ(batch.size(), 40u);
 
@@ -346,7 +347,7 @@ TEST(BatchAndReplay, GiveTheSameFramesPosesAndMasks)
 TEST(BatchAndLive, GiveTheSameFramesPosesAndMasks)
 {
 	// the observations handed over one by one as a live sensor would
-	const std::string input = sampleWithFaults();
+	const std::string input = sampleWithFaults("batch_and_live");
 	const auto batch = batchFrames(input);
 	pipeline::ExperimentConfig cfg;
 	cfg.loadFromFile(kConfig);
