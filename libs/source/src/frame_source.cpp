@@ -101,7 +101,8 @@ bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
 	using mrpt::obs::CObservationIMU;
 	if (ended_ || !obs) return !ended_;
 	add(cost_, cost);
-	const std::string where = at.path ? *at.path : std::string("input");
+	static const std::string kInput = "input";
+	const std::string& where = at.path ? *at.path : kInput;  // no copy
 	const double t = mrpt::Clock::toDouble(obs->timestamp);
 	if (auto imu = std::dynamic_pointer_cast<CObservationIMU>(obs))
 	{
