@@ -294,7 +294,7 @@ mrpt::obs::CObservation::Ptr RawlogReader::next()
 			for (const auto& so : *sf) pending_.push_back(so);
 		else if (std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(obj))
 			continue;  // odometry actions are not used by bims
-		else
+		else  // (the guard refuses such objects before MRPT reads them)
 			throw RawlogError(
 			    path_ + ": entry " + std::to_string(entry_) + " is a " +
 			    obj->GetRuntimeClass()->className +

@@ -1,6 +1,8 @@
 #include "scan_guard.h"
 
+#include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CObservationIMU.h>
+#include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/rtti/CObject.h>
 #include <opencv2/imgcodecs.hpp>
 
@@ -161,6 +163,16 @@ bool isClass(const std::string& name, const char* full)
 	return id && id == mrpt::rtti::findRegisteredClass(full, false);
 }
 
+/** Whether an object of class \a id may stand where the walk is: the
+ * observations, sensory frames and action collections of a rawlog at the
+ * top level, observations alone inside a sensory frame. */
+bool isEntryOf(const mrpt::rtti::TRuntimeClassId& id, bool inFrame)
+{
+	if (id.derivedFrom(CLASS_ID(mrpt::obs::CObservation))) return true;
+	return !inFrame && (id.derivedFrom(CLASS_ID(mrpt::obs::CSensoryFrame)) ||
+	                    id.derivedFrom(CLASS_ID(mrpt::obs::CActionCollection)));
+}
+
 /** Walks a serialized observation field by field. Each step returns false
  * to stop: with `problem` set when a declared size is insane, empty when the
  * bytes end or hold a layout this walker does not know (MRPT then decides). */
@@ -195,6 +207,19 @@ class ObservationWalker
 		{
 			problem = "an object of a class MRPT does not know ('" +
 			          printable(cls) + "')";
+			return false;
+		}
+		// Nor one of another class than a rawlog entry's: MRPT would read
+		// it whole before the reader could refuse it, and reads the sizes
+		// of a matrix, image or pose as they are (found by the fuzzer: a
+		// top-level CPose3D whose CMatrixD declared 22 GB).
+		if (!cls.empty() && !isEntryOf(*registered(cls), inFrame_))
+		{
+			problem = "an object of class '" + printable(cls) + "', not " +
+			          (inFrame_ ? "an observation (a sensory frame holds "
+			                      "observations only)"
+			                    : "an observation, sensory frame or action "
+			                      "collection");
 			return false;
 		}
 		if (isClass(cls, "mrpt::obs::CObservation3DRangeScan"))

@@ -6,9 +6,11 @@
 
 #include <mrpt/io/CFileOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
+#include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPose3D.h>
 #include <mrpt/rtti/CObject.h>
 #include <mrpt/serialization/CArchive.h>
 #include "tmp_path.h"
@@ -1059,4 +1061,37 @@ TEST(RawlogCorrupt, ASensoryFrameDeclaringMoreObservationsThanBytesIsAnError)
 	                            "the file"),
 	          std::string::npos)
 	    << readError(p);
+}
+
+TEST(RawlogCorrupt, AnObjectThatIsNoRawlogEntryIsAnErrorBeforeMrptReadsIt)
+{
+	// Found by the rawlog fuzz target (tests/fuzz/corpus/rawlog/
+	// oom-top-level-pose-matrix): a top-level CPose3D of version 1 whose
+	// CMatrixD declared 22 GB; MRPT allocated them before the reader could
+	// see the entry is no observation. A valid pose is refused as well, by
+	// the guard, naming its class.
+	const auto p = tmpPath("pose_entry.rawlog");
+	{
+		auto f = mrpt::io::CFileOutputStream(p);
+		auto a = mrpt::serialization::archiveFrom(f);
+		a << mrpt::poses::CPose3D(1, 2, 3, 0, 0, 0);
+	}
+	EXPECT_NE(readError(p).find("corrupt rawlog at entry 0 (0 observations "
+	                            "read before): an object of class "
+	                            "'mrpt::poses::CPose3D', not an observation, "
+	                            "sensory frame or action collection"),
+	          std::string::npos)
+	    << readError(p);
+	// an action collection stays a valid entry (skipped), before an IMU
+	// observation that is read
+	{
+		auto f = mrpt::io::CFileOutputStream(p);
+		auto a = mrpt::serialization::archiveFrom(f);
+		a << mrpt::obs::CActionCollection() << mrpt::obs::CObservationIMU();
+	}
+	bims::RawlogReader r(p);
+	const auto o = r.next();
+	ASSERT_TRUE(o);
+	EXPECT_TRUE(std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(o));
+	EXPECT_FALSE(r.next());
 }
