@@ -4,6 +4,7 @@
 #include <bims/common/json.h>
 #include <bims/common/rawlog.h>
 #include <bims/eval/mask_metrics.h>
+#include <bims/pipeline/pipeline.h>
 #include <bims/pipeline/run.h>
 #include <gtest/gtest.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -543,4 +544,52 @@ TEST(EndToEnd, ARunFromItsEffectiveIniWritesTheSameOutputs)
 	const std::string c = runFrom(paper, "from_paper");
 	EXPECT_FALSE(readAll(a + "/trajectory.txt") ==
 	             readAll(c + "/trajectory.txt"));
+}
+
+// The grids unproject a frame's depth with the camera model its egomotion and
+// flow use ([camera] when the experiment gives one), at the pose the
+// pipeline estimated: not with the rawlog's own cameraParams.
+TEST(EndToEnd, TheGridsUseTheCameraModelAndPoseOfTheEgomotion)
+{
+	bims::RawlogReader reader(kSample);
+	mrpt::obs::CObservation3DRangeScan::Ptr scan;
+	while (!scan)
+		if (auto o = reader.next())
+			scan =
+			    std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(
+			        o);
+		else
+			FAIL() << "no 3D scan in " << kSample;
+	ExperimentConfig cfg;
+	cfg.loadFromFile(kConfig);
+	auto& cam = cfg.ego.camera;
+	cam.given = true;
+	cam.width = int(scan->rangeImage.cols());
+	cam.height = int(scan->rangeImage.rows());
+	// another camera than the rawlog's
+	cam.fx = 1.25 * scan->cameraParams.fx();
+	cam.fy = 1.2 * scan->cameraParams.fy();
+	cam.cx = scan->cameraParams.cx() + 3;
+	cam.cy = scan->cameraParams.cy() - 2;
+	Pipeline pipe(cfg);
+	const FrameResult& r = pipe.processFrame(*scan, 0);
+	const auto& f = pipe.grids().lastFrame();
+	EXPECT_EQ(f.K, (bims::maps::Intrinsics{cam.width, cam.height, cam.fx,
+	                                       cam.fy, cam.cx, cam.cy}));
+	EXPECT_EQ(f.T_WC, r.T_WC);
+	ASSERT_GT(f.numPoints(), 100u);
+	// every reading is its pixel's depth along [camera]'s ray, at T_WC
+	for (size_t i = 0; i < f.numPoints(); i += 97)
+	{
+		const int u = int(f.pixel[i] % uint32_t(cam.width));
+		const int v = int(f.pixel[i] / uint32_t(cam.width));
+		const double d = f.depth[f.pixel[i]];
+		ASSERT_GT(d, 0);
+		const mrpt::math::TPoint3D p_C((u - cam.cx) / cam.fx * d,
+		                               (v - cam.cy) / cam.fy * d, d);
+		const auto p_W = r.T_WC.composePoint(p_C);
+		EXPECT_NEAR(f.points_W[i].x, p_W.x, 1e-5) << "reading " << i;
+		EXPECT_NEAR(f.points_W[i].y, p_W.y, 1e-5) << "reading " << i;
+		EXPECT_NEAR(f.points_W[i].z, p_W.z, 1e-5) << "reading " << i;
+	}
 }

@@ -281,6 +281,17 @@ struct FrameCloudBuilder::Keyer
 void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
                               const mrpt::poses::CPose3D& T_WS, FrameCloud& out)
 {
+	const auto& cam = scan.cameraParams;
+	build(scan,
+	      {int(cam.ncols), int(cam.nrows), cam.fx(), cam.fy(), cam.cx(),
+	       cam.cy()},
+	      T_WS + bims::T_SC(), out);
+}
+
+void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
+                              const Intrinsics& cam,
+                              const mrpt::poses::CPose3D& T_WC, FrameCloud& out)
+{
 	resetFrame(out, true);
 	out.voxel_size = p_.voxel_size;
 	out.timestamp = scan.timestamp;
@@ -293,21 +304,20 @@ void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
 	};
 	if (!scan.hasRangeImage) fail(" has no range image");
 	const int W = int(scan.rangeImage.cols()), H = int(scan.rangeImage.rows());
-	const auto& cam = scan.cameraParams;
-	if (int(cam.ncols) != W || int(cam.nrows) != H)
-		fail(": cameraParams size " + std::to_string(cam.ncols) + "x" +
-		     std::to_string(cam.nrows) + " differs from the range image " +
+	if (cam.width != W || cam.height != H)
+		fail(": camera size " + std::to_string(cam.width) + "x" +
+		     std::to_string(cam.height) + " differs from the range image " +
 		     std::to_string(W) + "x" + std::to_string(H));
-	if (!(cam.fx() > 0 && cam.fy() > 0)) fail(": focal lengths must be > 0");
-	out.K = {W, H, cam.fx(), cam.fy(), cam.cx(), cam.cy()};
-	if (!finitePose(T_WS))
+	if (!(cam.fx > 0 && cam.fy > 0)) fail(": focal lengths must be > 0");
+	out.K = cam;
+	if (!finitePose(T_WC))
 	{
 		resetFrame(out);
 		out.stats.badPose = true;
 		out.K = {};
 		return;
 	}
-	out.T_WC = T_WS + bims::T_SC();
+	out.T_WC = T_WC;
 	const auto& R = out.T_WC.getRotationMatrix();
 	const mrpt::math::TPoint3D t = out.T_WC.translation();
 	out.origin_W = t;
@@ -326,8 +336,8 @@ void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
 
 	const double units = scan.rangeUnits;
 	const double maxR = p_.max_range;
-	const double ifx = 1 / cam.fx(), ify = 1 / cam.fy();
-	const double cx = cam.cx(), cy = cam.cy();
+	const double ifx = 1 / cam.fx, ify = 1 / cam.fy;
+	const double cx = cam.cx, cy = cam.cy;
 	const bool isDepth = scan.range_is_depth;
 	// Per column: 1 + xn^2 and xn * R.col0 (the terms of the unprojection
 	// that depend on u only, computed as per pixel before), one array each.

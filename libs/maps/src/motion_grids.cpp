@@ -34,15 +34,28 @@ void MotionGrids::clear()
 	t2_->clear();
 }
 
+template <class Build>
+const FrameCloud& MotionGrids::buildInto(const Build& build)
+{
+	if (!spare_ || spare_.use_count() != 1)
+		spare_ = std::make_shared<FrameCloud>();
+	build(*spare_);
+	std::swap(frame_, spare_);
+	return *frame_;
+}
+
 const FrameCloud& MotionGrids::buildFrame(
     const mrpt::obs::CObservation3DRangeScan& scan,
     const mrpt::poses::CPose3D& T_WS)
 {
-	if (!spare_ || spare_.use_count() != 1)
-		spare_ = std::make_shared<FrameCloud>();
-	builder_.build(scan, T_WS, *spare_);
-	std::swap(frame_, spare_);
-	return *frame_;
+	return buildInto([&](FrameCloud& f) { builder_.build(scan, T_WS, f); });
+}
+
+const FrameCloud& MotionGrids::buildFrame(
+    const mrpt::obs::CObservation3DRangeScan& scan, const Intrinsics& K,
+    const mrpt::poses::CPose3D& T_WC)
+{
+	return buildInto([&](FrameCloud& f) { builder_.build(scan, K, T_WC, f); });
 }
 
 const MotionFrameResult& MotionGrids::processFrame(

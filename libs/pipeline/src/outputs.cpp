@@ -202,10 +202,17 @@ size_t OutputWriter::close(const Pipeline& pipe)
 	size_t nStatic = 0;
 	const auto& g = pipe.grids();
 	const maps::CMotionGridBase* motion = nullptr;
-	if (pipe.config().pipeline.variant == Variant::BottomOnly)
-		motion = g.background().get();
-	else if (pipe.config().pipeline.variant != Variant::FlowOnly)
-		motion = g.flow().get();
+	switch (maskTier(pipe.config().pipeline.variant))
+	{
+		case 1:
+			motion = g.background().get();
+			break;
+		case 2:
+			motion = g.flow().get();
+			break;
+		default:
+			break;  // the flow labels alone: no grid says moving
+	}
 	if (p_.static_map && pipe.framesProcessed() > 0)
 	{
 		PartialFile ply(dir_ + "/static_map.ply"), bt(dir_ + "/static_map.bt");

@@ -1,9 +1,9 @@
 #include <bims/common/clock.h>
-#include <bims/common/frames.h>
 #include <bims/flow/expected_flow.h>
 #include <bims/pipeline/pipeline.h>
 
 #include <chrono>
+#include <functional>
 #include <future>
 #include <stdexcept>
 
@@ -67,8 +67,9 @@ maps::PixelLabels toPixelLabels(const cv::Mat& labels)
 Pipeline::Pipeline(const ExperimentConfig& cfg)
     : cfg_(cfg), odom_(cfg.ego), observed_(cfg.flow), grids_(cfg.grids)
 {
-	// exclude_moving: the variant's own tier decides what is moving.
-	grids_.setDecisionTier(cfg.pipeline.variant == Variant::BottomOnly ? 1 : 2);
+	// exclude_moving: the variant's own tier decides what is moving (tier
+	// 2 for the flow labels alone, whose voxels tier 2 accumulates).
+	grids_.setDecisionTier(maskTier(cfg.pipeline.variant) == 1 ? 1 : 2);
 	if (cfg.pipeline.flow_thread)
 		flowThread_ = std::make_unique<SerialWorker>(1, true, "bims-flow");
 	if (cfg.pipeline.cloud_thread)
@@ -131,68 +132,115 @@ void Pipeline::startLookahead(const Next& next)
 	nextAfter_ = nFrames_;
 }
 
+/** A frame's jobs on the two threads, or in sequence: the observed flow
+ * (started by the previous frame's look-ahead, posted to the flow thread,
+ * or run here when asked for) and the FrameCloud (posted to the cloud
+ * thread, or built here). The jobs use the pipeline's members and the
+ * frame's result: leaving (also by an exception) waits for them. */
+struct Pipeline::FrameJobs
+{
+	std::future<Observed> observing;
+	std::function<Observed()> observeHere;
+	std::future<void> building;
+	std::function<void()> buildHere;
+
+	~FrameJobs()
+	{
+		if (observing.valid()) observing.wait();
+		if (building.valid()) building.wait();
+	}
+	/** The observed flow (get() rethrows what the flow job threw). */
+	Observed observed()
+	{
+		return observing.valid() ? observing.get() : observeHere();
+	}
+	/** The FrameCloud built (get() rethrows what the build threw). */
+	void built()
+	{
+		if (building.valid())
+			building.get();
+		else
+			buildHere();
+	}
+};
+
 const FrameResult& Pipeline::processFrame(
     const mrpt::obs::CObservation3DRangeScan& scan, size_t index, Next next)
 {
 	const auto t0 = Clock::now();
 	FrameResult r;
 	r.index = index;
+	FrameJobs jobs;
+	takeInput(scan, r, jobs);
+	const bool haveFlow = havePrev_ && prev_.grey.size() == cur_.grey.size();
+	if (haveFlow && !jobs.observing.valid()) startObservedFlow(jobs);
+	egomotion(r);
+	// A refinement may still correct the egomotion (and so the next
+	// prediction and the pose the cloud is registered with): then the look
+	// ahead and the cloud start after it.
+	const bool mayCorrect = cfg_.flow.refine_pose != flow::RefinePose::None &&
+	                        cfg_.flow.refine_to_ego;
+	if (!mayCorrect) startNextJobs(scan, next, r, jobs);
+	maps::PixelLabels labels;
+	flowLabels(haveFlow ? &jobs : nullptr, r, labels);
+	if (mayCorrect) startNextJobs(scan, next, r, jobs);
+	runGrids(haveFlow ? &labels : nullptr, r, jobs);
+	finishFrame(r);
+	r.ms.total = msSince(t0);
+	res_ = std::move(r);
+	return res_;
+}
 
-	// The observed flow of this frame: started by the previous call (look
-	// ahead), on the flow thread now, or in sequence below.
-	std::future<Observed> observing;
-	// The FrameCloud, built on the cloud thread during the labels.
-	std::future<void> building;
-	// the jobs use members and locals: never leave before they end
-	const WaitFor<Observed> waitForObserving{observing};
-	const WaitFor<void> waitForBuilding{building};
-
-	// Input: grey image + metric depth + intrinsics, once for all stages.
-	auto t = Clock::now();
-	// (only if the frame that queued it completed: prev_ is its frame)
-	if (havePrev_ && nextIndex_ == index && nextAfter_ + 1 == nFrames_ &&
+void Pipeline::takeInput(const mrpt::obs::CObservation3DRangeScan& scan,
+                         FrameResult& r, FrameJobs& jobs)
+{
+	// The frame decoded by the previous call's look ahead, with its observed
+	// flow on the way (only if the frame that queued it completed: prev_ is
+	// its frame), or decoded here: grey image, metric depth and camera
+	// model, once for all stages.
+	if (havePrev_ && nextIndex_ == r.index && nextAfter_ + 1 == nFrames_ &&
 	    nextObserved_.valid())
 	{
 		std::swap(cur_, next_);
-		observing = std::move(nextObserved_);
+		jobs.observing = std::move(nextObserved_);
 		nextIndex_ = kNoNext;
 		r.flowAhead = true;
 		r.ms.input = nextInputMs_;
 	}
 	else
 	{
+		const auto t = Clock::now();
 		dropLookahead();
 		const std::string why = ego::rgbdFrameFrom(scan, cfg_.ego.camera, cur_);
 		if (!why.empty())
-			throw std::runtime_error("3D scan #" + std::to_string(index) +
+			throw std::runtime_error("3D scan #" + std::to_string(r.index) +
 			                         " ('" + scan.sensorLabel + "'): " + why);
 		r.ms.input = msSince(t);
 	}
 	r.t = cur_.t;
-	const auto cam = cameraOf(cur_);
+}
 
+void Pipeline::startObservedFlow(FrameJobs& jobs)
+{
 	// The observed flow needs only the two images and the rotation it is
 	// derotated with, predicted first (gyro) so that it does not depend on
 	// the tracker: with flow_thread it runs on the flow thread while the
 	// egomotion runs here. Nothing writes the images meanwhile; the result
 	// is the same as in sequence.
-	const cv::Size size = cur_.grey.size();
-	const bool haveFlow = havePrev_ && prev_.grey.size() == size;
-	std::function<Observed()> observeHere;
-	if (haveFlow && !observing.valid())
-	{
-		const Eigen::Matrix3d R_derot = odom_.predictRotation(cur_.t);
-		auto job =
-		    [this, prevGrey = prev_.grey, curGrey = cur_.grey, cam, R_derot]
-		{ return observe(prevGrey, curGrey, cam, R_derot); };
-		if (flowThread_)
-			observing = postTask(*flowThread_, job);
-		else
-			observeHere = job;
-	}
+	const Eigen::Matrix3d R_derot = odom_.predictRotation(cur_.t);
+	auto job = [this, prevGrey = prev_.grey, curGrey = cur_.grey,
+	            cam = cameraOf(cur_), R_derot]
+	{ return observe(prevGrey, curGrey, cam, R_derot); };
+	if (flowThread_)
+		jobs.observing = postTask(*flowThread_, job);
+	else
+		jobs.observeHere = job;
+}
 
-	// Egomotion, with the previous moving mask keeping features off movers.
-	t = Clock::now();
+void Pipeline::egomotion(FrameResult& r)
+{
+	// with the previous moving mask keeping features off movers
+	const auto t = Clock::now();
 	const cv::Mat* fb = (cfg_.pipeline.feedback_mask && !feedback_.empty())
 	                        ? &feedback_
 	                        : nullptr;
@@ -200,41 +248,37 @@ const FrameResult& Pipeline::processFrame(
 	r.T_WC = r.ego.T_WC;
 	r.T_CprevC = r.ego.T_CprevC;
 	r.ms.ego = msSince(t);
-	// A refinement may still correct the egomotion (and so the next
-	// prediction): then the look-ahead starts after it.
-	const bool mayCorrect = cfg_.flow.refine_pose != flow::RefinePose::None &&
-	                        cfg_.flow.refine_to_ego;
-	// The grids take MRPT's scan frame {S} in {W}; the cloud needs nothing
-	// else (its build touches nothing the labels use).
-	mrpt::poses::CPose3D T_WS;
-	auto buildCloud = [this, &scan, &T_WS, &r]
+}
+
+void Pipeline::startNextJobs(const mrpt::obs::CObservation3DRangeScan& scan,
+                             const Next& next, FrameResult& r, FrameJobs& jobs)
+{
+	startLookahead(next);
+	// The cloud: this frame's depth with its camera model at its final pose
+	// (its build touches nothing the labels use).
+	const maps::Intrinsics K{cur_.grey.cols, cur_.grey.rows, cur_.K(0, 0),
+	                         cur_.K(1, 1),   cur_.K(0, 2),   cur_.K(1, 2)};
+	jobs.buildHere = [this, &scan, K, T_WC = r.T_WC, &ms = r.ms.cloud]
 	{
 		const auto t = Clock::now();
-		grids_.buildFrame(scan, T_WS);
-		r.ms.cloud = msSince(t);
+		grids_.buildFrame(scan, K, T_WC);
+		ms = msSince(t);
 	};
-	auto startCloud = [&]
-	{
-		T_WS = r.T_WC + (mrpt::poses::CPose3D() - T_SC());
-		if (!cloudThread_) return;
-		building = postTask(*cloudThread_, buildCloud);
-	};
-	if (!mayCorrect)
-	{
-		startLookahead(next);
-		startCloud();
-	}
+	if (cloudThread_) jobs.building = postTask(*cloudThread_, jobs.buildHere);
+}
 
-	// Flow labels on the current frame's pixels.
-	t = Clock::now();
-	r.maskFlow = cv::Mat::zeros(size, CV_8UC1);
-	maps::PixelLabels pixLabels;
-	if (haveFlow)
+void Pipeline::flowLabels(FrameJobs* jobs, FrameResult& r,
+                          maps::PixelLabels& labels)
+{
+	// Flow labels on the current frame's pixels (none on the first frame).
+	const auto t = Clock::now();
+	r.maskFlow = cv::Mat::zeros(cur_.grey.size(), CV_8UC1);
+	if (jobs)
 	{
-		// (get() rethrows what the flow job threw)
-		const Observed o = observing.valid() ? observing.get() : observeHere();
+		const Observed o = jobs->observed();
 		r.ms.observed = o.ms;
 		const cv::Mat& obs = o.flow;
+		const auto cam = cameraOf(cur_);
 		if (cfg_.flow.refine_pose != flow::RefinePose::None)
 		{
 			r.flowPose = flow::refinePoseWithFlow(
@@ -254,62 +298,55 @@ const FrameResult& Pipeline::processFrame(
 		r.maskFlow.setTo(255, r.labels == static_cast<int8_t>(flow::kDiff));
 		r.flowObserved = obs;
 		r.flowExpected = exp;
-		pixLabels = toPixelLabels(r.labels);
+		labels = toPixelLabels(r.labels);
 	}
 	r.ms.flow = msSince(t);
-	if (mayCorrect)
-	{
-		startLookahead(next);
-		startCloud();
-	}
+}
 
-	// The three tiers.
-	t = Clock::now();
-	if (building.valid())
-		building.get();  // (rethrows what the build threw)
-	else
-		buildCloud();
-	const auto& g = grids_.processFrame(grids_.lastFrame(),
-	                                    haveFlow ? &pixLabels : nullptr);
+void Pipeline::runGrids(const maps::PixelLabels* labels, FrameResult& r,
+                        FrameJobs& jobs)
+{
+	// The three tiers, then the variant's mask.
+	const auto t = Clock::now();
+	jobs.built();
+	const auto& g = grids_.processFrame(grids_.lastFrame(), labels);
+	const cv::Size size = cur_.grey.size();
 	r.maskTier1 = toMat(g.maskTier1(), size);
 	r.maskTier2 = toMat(g.maskTier2(), size);
 	r.hitVoxels = g.hitVoxels;
 	r.cloudStats = g.stats;
 	r.ms.grids = msSince(t);
-
-	switch (cfg_.pipeline.variant)
+	switch (maskTier(cfg_.pipeline.variant))
 	{
-		case Variant::BottomOnly:
+		case 1:
 			r.mask = r.maskTier1;
 			r.movingVoxels = g.movingTier1;
 			r.movingVoxelCentres = grids_.background()->movingCells();
 			break;
-		case Variant::FlowOnly:
-			r.mask = r.maskFlow;
-			r.movingVoxels = 0;
-			break;
-		case Variant::Fused:
-		case Variant::FusedRaycast:
+		case 2:
 			r.mask = r.maskTier2;
 			r.movingVoxels = g.movingTier2;
 			r.movingVoxelCentres = grids_.flow()->movingCells();
 			break;
+		default:
+			r.mask = r.maskFlow;
+			r.movingVoxels = 0;
 	}
+}
+
+void Pipeline::finishFrame(FrameResult& r)
+{
 	r.warmup = nFrames_ < static_cast<size_t>(cfg_.pipeline.warmup_frames);
 	if (r.warmup)
 	{
-		r.mask = cv::Mat::zeros(size, CV_8UC1);
+		r.mask = cv::Mat::zeros(cur_.grey.size(), CV_8UC1);
 		r.movingVoxelCentres.clear();
 		r.movingVoxels = 0;
 	}
 	feedback_ = r.mask;
-
 	std::swap(prev_, cur_);
 	havePrev_ = true;
 	++nFrames_;
-	r.ms.total = msSince(t0);
-	res_ = std::move(r);
-	return res_;
 }
 
 }  // namespace bims::pipeline

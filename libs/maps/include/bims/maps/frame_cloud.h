@@ -81,6 +81,11 @@ struct Intrinsics
 {
 	int width = 0, height = 0;
 	double fx = 0, fy = 0, cx = 0, cy = 0;
+	bool operator==(const Intrinsics& o) const
+	{
+		return width == o.width && height == o.height && fx == o.fx &&
+		       fy == o.fy && cx == o.cx && cy == o.cy;
+	}
 };
 
 /** See the file comment. */
@@ -128,11 +133,22 @@ class FrameCloudBuilder
 	explicit FrameCloudBuilder(const GridParams& p = {});
 	void setParams(const GridParams& p);
 
-	/** From a depth/range image. \param T_WS pose of MRPT's scan frame {S}
-	 * in {W} (the observation's sensorPose is NOT added: pass
-	 * robotPose + sensorPose yourself). A non-finite pose yields an empty
-	 * frame with stats.badPose = true. Throws std::invalid_argument if the
-	 * scan has no range image or its camera size differs from the image. */
+	/** From the scan's depth/range image (rangeImage x rangeUnits;
+	 * Euclidean ranges when range_is_depth is false), unprojected with the
+	 * camera model \a K (its size must be the range image's) at the pose
+	 * \a T_WC of the optical frame {C} in {W}: the caller's camera model
+	 * and pose, the ones its egomotion and flow use (the scan's own
+	 * cameraParams and sensorPose are not read). A non-finite pose yields
+	 * an empty frame with stats.badPose = true. Throws
+	 * std::invalid_argument if the scan has no range image, \a K's size
+	 * differs from the image or its focal lengths are not > 0. */
+	void build(const mrpt::obs::CObservation3DRangeScan& scan,
+	           const Intrinsics& K, const mrpt::poses::CPose3D& T_WC,
+	           FrameCloud& out);
+	/** The same in MRPT's convention (CMetricMap::insertObservation): the
+	 * scan's own cameraParams, and \param T_WS the pose of MRPT's scan
+	 * frame {S} in {W} (the observation's sensorPose is NOT added: pass
+	 * robotPose + sensorPose yourself). */
 	void build(const mrpt::obs::CObservation3DRangeScan& scan,
 	           const mrpt::poses::CPose3D& T_WS, FrameCloud& out);
 

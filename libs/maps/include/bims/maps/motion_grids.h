@@ -54,6 +54,12 @@ class MotionGrids
 	 * the caller prepares the labels. */
 	const FrameCloud& buildFrame(const mrpt::obs::CObservation3DRangeScan& scan,
 	                             const mrpt::poses::CPose3D& T_WS);
+	/** Same with the caller's camera model \a K and optical-frame pose
+	 * \a T_WC (FrameCloudBuilder::build: the scan's cameraParams are not
+	 * read). */
+	const FrameCloud& buildFrame(const mrpt::obs::CObservation3DRangeScan& scan,
+	                             const Intrinsics& K,
+	                             const mrpt::poses::CPose3D& T_WC);
 	/** The FrameCloud of the last processFrame(scan, ...) / buildFrame.
 	 * processFrame(lastFrame(), ...) hands its cells to tiers 1 and 2
 	 * without a copy; the next buildFrame() builds into another buffer. */
@@ -79,6 +85,10 @@ class MotionGrids
 	std::shared_ptr<COccupancyBayesGrid> t0_;
 	std::shared_ptr<CBackgroundSubtractionGrid> t1_;
 	std::shared_ptr<CFlowConsistencyGrid> t2_;
+	/** Builds the next frame into the spare buffer (\a build(frame)) and
+	 * makes it lastFrame(). */
+	template <class Build>
+	const FrameCloud& buildInto(const Build& build);
 	FrameCloudBuilder builder_;
 	// lastFrame() and the buffer the next frame is built into (tiers 1 and
 	// 2 may still hold the cells of either: a held buffer is replaced).

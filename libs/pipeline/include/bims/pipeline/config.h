@@ -37,6 +37,13 @@ inline Choices<Variant> choices(Variant)
 	    {Variant::FusedRaycast, "fused-raycast"}};
 	return t;
 }
+/** The grid tier whose MAP is the variant's mask: 1 or 2, or 0 for the
+ * flow labels alone (the one place that says it: the pipeline's mask and
+ * exclude_moving tier, the outputs' static map). */
+constexpr int maskTier(Variant v)
+{
+	return v == Variant::BottomOnly ? 1 : v == Variant::FlowOnly ? 0 : 2;
+}
 
 /** [pipeline] */
 struct PipelineParams

@@ -136,6 +136,21 @@ class Pipeline
 	Observed observe(const cv::Mat& prevGrey, const cv::Mat& curGrey,
 	                 const mrpt::img::TCamera& cam,
 	                 const Eigen::Matrix3d& R_derot);
+	// The steps of processFrame(), in their order (pipeline.cpp).
+	struct FrameJobs;
+	void takeInput(const mrpt::obs::CObservation3DRangeScan& scan,
+	               FrameResult& r, FrameJobs& jobs);
+	void startObservedFlow(FrameJobs& jobs);
+	void egomotion(FrameResult& r);
+	/** The next frame's look ahead, and this frame's FrameCloud. */
+	void startNextJobs(const mrpt::obs::CObservation3DRangeScan& scan,
+	                   const Next& next, FrameResult& r, FrameJobs& jobs);
+	/** \a jobs null: no previous frame to take the flow from. */
+	void flowLabels(FrameJobs* jobs, FrameResult& r, maps::PixelLabels& labels);
+	void runGrids(const maps::PixelLabels* labels, FrameResult& r,
+	              FrameJobs& jobs);
+	void finishFrame(FrameResult& r);
+
 	/** Decodes \a next into next_ and queues its observed flow. */
 	void startLookahead(const Next& next);
 	/** Waits for a queued look-ahead flow and forgets it. */
