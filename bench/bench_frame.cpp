@@ -58,7 +58,7 @@ Pair g_pair;
 // of it): the ground truth's with --gt, otherwise a pan of a few degrees and
 // a step of a few centimetres.
 bims::flow::FlowParams g_flow;
-mrpt::poses::CPose3D g_T_prev_cur(0.02, -0.01, 0.03, 0.035, -0.02, 0.01);
+mrpt::poses::CPose3D g_T_CprevC(0.02, -0.01, 0.03, 0.035, -0.02, 0.01);
 
 /** T_{C(t-1) C(t)} of the pair from a TUM trajectory with one line per 3D
  * scan (bims-sim's groundtruth.txt). */
@@ -200,7 +200,7 @@ void benchObserved(bm::State& st, bims::flow::FlowParams p)
 
 cv::Matx33d derotation()
 {
-	return bims::flow::rotationHomography(g_pair.cam, g_T_prev_cur);
+	return bims::flow::rotationHomography(g_pair.cam, g_T_CprevC);
 }
 
 cv::Mat warpedPrev()
@@ -276,7 +276,7 @@ void benchExpected(bm::State& st)
 	ProcCpu cpu(st);
 	for (auto _ : st)
 		bm::DoNotOptimize(bims::flow::expectedFlowExact(
-		    g_pair.cur.depth, g_pair.cam, g_T_prev_cur));
+		    g_pair.cur.depth, g_pair.cam, g_T_CprevC));
 }
 
 // The labels as the pipeline makes them: the derotated observed flow, the
@@ -286,15 +286,15 @@ void benchLabels(bm::State& st)
 	bims::flow::ObservedFlow of(g_flow);
 	const cv::Mat obs =
 	    of.computeDerotated(g_pair.prev.grey, g_pair.cur.grey, derotation());
-	const cv::Mat exp = bims::flow::expectedFlowExact(g_pair.cur.depth,
-	                                                  g_pair.cam, g_T_prev_cur);
+	const cv::Mat exp =
+	    bims::flow::expectedFlowExact(g_pair.cur.depth, g_pair.cam, g_T_CprevC);
 	const cv::Mat* tensor = of.tensor().empty() ? nullptr : &of.tensor();
 	bims::flow::LabelStats stats;
 	ProcCpu cpu(st);
 	for (auto _ : st)
 		bm::DoNotOptimize(
 		    bims::flow::labelConsistency(obs, exp, g_pair.cur.depth, g_pair.cam,
-		                                 g_T_prev_cur, g_flow, &stats, tensor));
+		                                 g_T_CprevC, g_flow, &stats, tensor));
 	st.counters["diff"] = static_cast<double>(stats.diff);
 	st.counters["notdiff"] = static_cast<double>(stats.notDiff);
 }
@@ -367,14 +367,14 @@ int main(int argc, char** argv)
 		}
 		if (frame < 1) throw std::runtime_error("--frame must be >= 1");
 		loadPair(rawlog, frame);
-		if (!gt.empty()) g_T_prev_cur = relativePoseFromGt(gt, frame);
+		if (!gt.empty()) g_T_CprevC = relativePoseFromGt(gt, frame);
 		if (!std::ifstream(config))
 			throw std::runtime_error("cannot open " + config);
 		g_flow.loadFromConfigFile(mrpt::config::CConfigFile(config), "flow");
 		std::cerr << "frames " << frame - 1 << ", " << frame << " of " << rawlog
 		          << ": " << g_pair.cur.grey.cols << "x" << g_pair.cur.grey.rows
 		          << ", OpenCV threads " << cv::getNumThreads()
-		          << ", [flow] of " << config << ", T_prev_cur " << g_T_prev_cur
+		          << ", [flow] of " << config << ", T_CprevC " << g_T_CprevC
 		          << "\n";
 		registerAll();
 		int n = int(rest.size());

@@ -1,8 +1,8 @@
 // bims-calib-imu CONFIG.ini IN.rawlog [--calib CALIB.ini] [-o OUT.ini]
 // Estimates R_IC (camera {C} in IMU {I}, p_I = R_IC p_C) from a sequence:
-// vision-only odometry gives each inter-frame rotation R_CprevCcur, the raw
-// gyro integrated over the same interval gives R_IprevIcur, and R_IC solves
-// Log(R_IprevIcur) = R_IC Log(R_CprevCcur) robustly (docs/ego.md). When the
+// vision-only odometry gives each inter-frame rotation R_CprevC, the raw
+// gyro integrated over the same interval gives R_IprevI, and R_IC solves
+// Log(R_IprevI) = R_IC Log(R_CprevC) robustly (docs/ego.md). When the
 // config already holds an R_IC, the angle between the two is reported.
 #include <bims/common/app.h>
 #include <bims/common/config.h>

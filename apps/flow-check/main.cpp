@@ -200,7 +200,7 @@ int main(int argc, char** argv)
 			        bims::flow::structureTensor(f.grey, fp.texture_window_px);
 			    const auto ref = bims::flow::refinePoseWithFlow(
 			        r.flowObserved, f.depth, cam, E, refineP, nullptr, &S);
-			    const CPose3D V = ref.T_prev_cur;
+			    const CPose3D V = ref.T_CprevC;
 			    cv::Mat labU;
 			    const auto sE =
 			        score(r.flowObserved, f.depth, cam, E, fp, validPx, S);

@@ -121,7 +121,7 @@ int main(int argc, char** argv)
 			    if (!(ps >> x))
 				    throw bims::UsageError(
 				        "--pose needs 6 numbers 'x y z yaw pitch roll'");
-		    const mrpt::poses::CPose3D T_prev_cur(
+		    const mrpt::poses::CPose3D T_CprevC(
 		        pv[0], pv[1], pv[2], mrpt::DEG2RAD(pv[3]), mrpt::DEG2RAD(pv[4]),
 		        mrpt::DEG2RAD(pv[5]));
 
@@ -135,13 +135,13 @@ int main(int argc, char** argv)
 		    const cv::Mat obs = of.compute(g0, g1);
 		    const double tObs = msSince(t0);
 		    t0 = std::chrono::steady_clock::now();
-		    const cv::Mat exp = bims::flow::expectedFlow(params.expected, depth,
-		                                                 cam, T_prev_cur);
+		    const cv::Mat exp =
+		        bims::flow::expectedFlow(params.expected, depth, cam, T_CprevC);
 		    const double tExp = msSince(t0);
 		    t0 = std::chrono::steady_clock::now();
 		    bims::flow::LabelStats st;
 		    const cv::Mat lab = bims::flow::labelConsistency(
-		        obs, exp, depth, cam, T_prev_cur, params, &st);
+		        obs, exp, depth, cam, T_CprevC, params, &st);
 		    const double tLab = msSince(t0);
 
 		    const std::string out = aOut.getValue();

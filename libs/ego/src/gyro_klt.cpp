@@ -44,9 +44,9 @@ void GyroAidedKLT::reset()
 }
 
 Eigen::Matrix3d GyroAidedKLT::infiniteHomography(
-    const Eigen::Matrix3d& K, const Eigen::Matrix3d& R_CprevCcur)
+    const Eigen::Matrix3d& K, const Eigen::Matrix3d& R_CprevC)
 {
-	return K * R_CprevCcur.transpose() * K.inverse();
+	return K * R_CprevC.transpose() * K.inverse();
 }
 
 cv::Point2f GyroAidedKLT::warp(const Eigen::Matrix3d& H, const cv::Point2f& x)
@@ -56,9 +56,10 @@ cv::Point2f GyroAidedKLT::warp(const Eigen::Matrix3d& H, const cv::Point2f& x)
 	        static_cast<float>(y.y() / y.z())};
 }
 
-const std::vector<Track>& GyroAidedKLT::track(
-    const cv::Mat& grey, const Eigen::Matrix3d& K,
-    const Eigen::Matrix3d* R_CprevCcur, const cv::Mat* movingMaskPrev)
+const std::vector<Track>& GyroAidedKLT::track(const cv::Mat& grey,
+                                              const Eigen::Matrix3d& K,
+                                              const Eigen::Matrix3d* R_CprevC,
+                                              const cv::Mat* movingMaskPrev)
 {
 	if (grey.empty() || grey.type() != CV_8UC1)
 		throw std::invalid_argument(
@@ -104,14 +105,14 @@ const std::vector<Track>& GyroAidedKLT::track(
 		tried_ = p0;
 		std::vector<cv::Point2f> p1(p0.size());
 		int flags = 0;
-		if (R_CprevCcur)
+		if (R_CprevC)
 		{
-			const Eigen::Matrix3d H = infiniteHomography(K, *R_CprevCcur);
+			const Eigen::Matrix3d H = infiniteHomography(K, *R_CprevC);
 			for (size_t i = 0; i < p0.size(); i++) p1[i] = warp(H, p0[i]);
 			flags = cv::OPTFLOW_USE_INITIAL_FLOW;
 		}
 		const std::vector<cv::Point2f> guess =
-		    R_CprevCcur ? p1 : p0;  // what LK started from
+		    R_CprevC ? p1 : p0;  // what LK started from
 		std::vector<uint8_t> st, stBack;
 		std::vector<float> err;
 		const cv::TermCriteria term(

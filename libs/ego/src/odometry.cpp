@@ -291,8 +291,8 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	Eigen::Vector3d t_rel;
 	if (!(r.flags & (kFlagTooFewTracks | kFlagTooFewInliers)))
 	{
-		R_rel = m.R_CprevCcur;
-		t_rel = m.t_CprevCcur;
+		R_rel = m.R_CprevC;
+		t_rel = m.t_CprevC;
 		r.inliers = m.inliers;
 		r.residual_rms_m = m.residual_rms_m;
 		for (size_t k = 0; k < corrTrack.size(); k++)

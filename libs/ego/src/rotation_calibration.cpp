@@ -41,8 +41,8 @@ RotationCalibResult estimateRotationIC(const std::vector<RotationPair>& pairs,
 	std::vector<Eigen::Vector3d> a, b;
 	for (const auto& p : pairs)
 	{
-		const Eigen::Vector3d wi = logSO3(p.R_IprevIcur);
-		const Eigen::Vector3d wc = logSO3(p.R_CprevCcur);
+		const Eigen::Vector3d wi = logSO3(p.R_IprevI);
+		const Eigen::Vector3d wc = logSO3(p.R_CprevC);
 		if (!wi.allFinite() || !wc.allFinite()) continue;
 		if (wi.norm() < minA || wc.norm() < minA) continue;
 		a.push_back(wi);

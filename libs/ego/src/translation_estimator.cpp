@@ -82,7 +82,7 @@ void TranslationEstimator::scoreInliers(const std::vector<Correspondence>& c,
 	for (size_t i = 0; i < c.size(); i++)
 	{
 		const double e =
-		    (c[i].p_prev - m.R_CprevCcur * c[i].p_cur - m.t_CprevCcur).norm();
+		    (c[i].p_prev - m.R_CprevC * c[i].p_cur - m.t_CprevC).norm();
 		if (e < threshold(c[i].p_prev.z()))
 		{
 			m.inlier[i] = 1;
@@ -95,11 +95,10 @@ void TranslationEstimator::scoreInliers(const std::vector<Correspondence>& c,
 }
 
 MotionEstimate TranslationEstimator::estimateTranslation(
-    const std::vector<Correspondence>& c,
-    const Eigen::Matrix3d& R_CprevCcur) const
+    const std::vector<Correspondence>& c, const Eigen::Matrix3d& R_CprevC) const
 {
 	MotionEstimate m;
-	m.R_CprevCcur = R_CprevCcur;
+	m.R_CprevC = R_CprevC;
 	const size_t n = c.size();
 	if (n == 0)
 	{
@@ -111,7 +110,7 @@ MotionEstimate TranslationEstimator::estimateTranslation(
 	std::vector<double> thr(n);
 	for (size_t i = 0; i < n; i++)
 	{
-		d[i] = c[i].p_prev - R_CprevCcur * c[i].p_cur;
+		d[i] = c[i].p_prev - R_CprevC * c[i].p_cur;
 		thr[i] = threshold(c[i].p_prev.z());
 	}
 	// Hypotheses: every point when few, else a seeded random subset.
@@ -147,19 +146,19 @@ MotionEstimate TranslationEstimator::estimateTranslation(
 		}
 	}
 	// Least squares over the inliers (weights 1/threshold^2), twice.
-	m.t_CprevCcur = best;
+	m.t_CprevC = best;
 	for (int it = 0; it < 3; it++)
 	{
 		Eigen::Vector3d s = Eigen::Vector3d::Zero();
 		double sw = 0;
 		for (size_t i = 0; i < n; i++)
-			if ((d[i] - m.t_CprevCcur).norm() < thr[i])
+			if ((d[i] - m.t_CprevC).norm() < thr[i])
 			{
 				const double w = 1 / (thr[i] * thr[i]);
 				s += w * d[i];
 				sw += w;
 			}
-		if (sw > 0) m.t_CprevCcur = s / sw;
+		if (sw > 0) m.t_CprevC = s / sw;
 	}
 	scoreInliers(c, m);
 	return m;
@@ -219,8 +218,8 @@ MotionEstimate TranslationEstimator::estimateSE3(
 		m.inlier.assign(n, 0);
 		return m;
 	}
-	m.R_CprevCcur = bestR;
-	m.t_CprevCcur = bestT;
+	m.R_CprevC = bestR;
+	m.t_CprevC = bestT;
 	for (int it = 0; it < 3; it++)
 	{
 		scoreInliers(c, m);
@@ -235,8 +234,8 @@ MotionEstimate TranslationEstimator::estimateSE3(
 		Eigen::Matrix3d R;
 		Eigen::Vector3d t;
 		if (!kabsch(c, idx, w, R, t)) break;
-		m.R_CprevCcur = R;
-		m.t_CprevCcur = t;
+		m.R_CprevC = R;
+		m.t_CprevC = t;
 	}
 	scoreInliers(c, m);
 	return m;
@@ -248,8 +247,8 @@ MotionEstimate TranslationEstimator::refineSE3(
 {
 	MotionEstimate m = init;
 	if (init.inlier.size() != c.size() || init.inliers < 3) return m;
-	Eigen::Matrix3d R = init.R_CprevCcur;
-	Eigen::Vector3d t = init.t_CprevCcur;
+	Eigen::Matrix3d R = init.R_CprevC;
+	Eigen::Vector3d t = init.t_CprevC;
 	const double wp = 1 / (sigmaPrior_rad * sigmaPrior_rad);
 	for (int it = 0; it < 6; it++)
 	{
@@ -280,8 +279,8 @@ MotionEstimate TranslationEstimator::refineSE3(
 		t += dx.tail<3>();
 		if (dx.norm() < 1e-10) break;
 	}
-	m.R_CprevCcur = R;
-	m.t_CprevCcur = t;
+	m.R_CprevC = R;
+	m.t_CprevC = t;
 	scoreInliers(c, m);
 	return m;
 }
@@ -326,8 +325,8 @@ MotionEstimate TranslationEstimator::refineReprojection(
 {
 	MotionEstimate m = init;
 	if (init.inlier.size() != c.size() || init.inliers < 3) return m;
-	Eigen::Matrix3d R = init.R_CprevCcur;
-	Eigen::Vector3d t = init.t_CprevCcur;
+	Eigen::Matrix3d R = init.R_CprevC;
+	Eigen::Vector3d t = init.t_CprevC;
 	const double sig = p_.reprojection_sigma_px, k = 1.345;
 	for (int it = 0; it < 5; it++)
 	{
@@ -361,8 +360,8 @@ MotionEstimate TranslationEstimator::refineReprojection(
 		t += dx.tail<3>();
 		if (dx.norm() < 1e-9) break;
 	}
-	m.R_CprevCcur = R;
-	m.t_CprevCcur = t;
+	m.R_CprevC = R;
+	m.t_CprevC = t;
 	// Inliers: consistent in 3D (as before) and in both images.
 	m.inliers = 0;
 	double ss = 0;

@@ -57,7 +57,7 @@ TEST(TranslationEstimator, RecoversTranslationWith40PercentOutliers)
 		const MotionEstimate m =
 		    TranslationEstimator(p).estimateTranslation(d.c, kR);
 		ASSERT_TRUE(m.ok) << method;
-		EXPECT_LT((m.t_CprevCcur - kT).norm(), 0.004) << method;
+		EXPECT_LT((m.t_CprevC - kT).norm(), 0.004) << method;
 		int wrong = 0;
 		for (size_t i = 0; i < d.c.size(); i++)
 			wrong += (m.inlier[i] && d.outlier[i]);
@@ -76,8 +76,8 @@ TEST(TranslationEstimator, VisionOnlySE3With40PercentOutliers)
 	const Data d = makeData(kR, kT, 200, 0.4, 5);
 	const MotionEstimate m = TranslationEstimator().estimateSE3(d.c);
 	ASSERT_TRUE(m.ok);
-	EXPECT_LT(angleSO3(m.R_CprevCcur.transpose() * kR) * 180 / M_PI, 0.3);
-	EXPECT_LT((m.t_CprevCcur - kT).norm(), 0.01);
+	EXPECT_LT(angleSO3(m.R_CprevC.transpose() * kR) * 180 / M_PI, 0.3);
+	EXPECT_LT((m.t_CprevC - kT).norm(), 0.01);
 	int wrong = 0;
 	for (size_t i = 0; i < d.c.size(); i++)
 		wrong += (m.inlier[i] && d.outlier[i]);
@@ -140,9 +140,9 @@ TEST(TranslationEstimator, RefinementFusesImuPrior)
 	const MotionEstimate loose = est.refineSE3(d.c, m0, Rimu, 1.0);
 	const auto deg = [](const Eigen::Matrix3d& A, const Eigen::Matrix3d& B)
 	{ return angleSO3(A.transpose() * B) * 180 / M_PI; };
-	EXPECT_LT(deg(tight.R_CprevCcur, Rimu), 0.01);
-	EXPECT_LT(deg(loose.R_CprevCcur, kR), 0.15);
-	EXPECT_LT((loose.t_CprevCcur - kT).norm(), 0.006);
+	EXPECT_LT(deg(tight.R_CprevC, Rimu), 0.01);
+	EXPECT_LT(deg(loose.R_CprevC, kR), 0.15);
+	EXPECT_LT((loose.t_CprevC - kT).norm(), 0.006);
 }
 
 TEST(TranslationEstimator, FailsCleanlyOnTooFewPoints)
@@ -157,7 +157,7 @@ TEST(TranslationEstimator, FailsCleanlyOnTooFewPoints)
 	for (int i = 0; i < 20; i++)
 		line.push_back({{0.1 * i, 0, 2}, {0.1 * i, 0, 2}});
 	const MotionEstimate m = est.estimateSE3(line);
-	EXPECT_TRUE(m.R_CprevCcur.allFinite());
+	EXPECT_TRUE(m.R_CprevC.allFinite());
 	EXPECT_FALSE(m.ok);
 }
 
@@ -226,8 +226,8 @@ TEST(TranslationEstimator, ReprojectionRefinementBeatsNoisyDepth)
 		const MotionEstimate m3 = est.estimateTranslation(cs, R);
 		const MotionEstimate mr = est.refineReprojection(cs, m3, K, false);
 		ASSERT_TRUE(mr.ok);
-		err3d += (m3.t_CprevCcur - t).norm() / 20;
-		errRep += (mr.t_CprevCcur - t).norm() / 20;
+		err3d += (m3.t_CprevC - t).norm() / 20;
+		errRep += (mr.t_CprevC - t).norm() / 20;
 	}
 	EXPECT_LT(errRep, 0.5 * err3d)
 	    << "3D " << err3d << " reprojection " << errRep;

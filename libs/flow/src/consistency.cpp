@@ -10,7 +10,7 @@ namespace bims::flow
 {
 cv::Mat labelConsistency(const cv::Mat& observed, const cv::Mat& expected,
                          const cv::Mat& depth, const mrpt::img::TCamera& cam,
-                         const mrpt::poses::CPose3D& T_prev_cur,
+                         const mrpt::poses::CPose3D& T_CprevC,
                          const FlowParams& p, LabelStats* stats,
                          const cv::Mat* tensor)
 {
@@ -27,7 +27,7 @@ cv::Mat labelConsistency(const cv::Mat& observed, const cv::Mat& expected,
 		    "labelConsistency: visible_change_grey needs the current image's "
 		    "structure tensor (CV_32FC3 of the depth's size)");
 	const double minChange2 = p.visible_change_grey * p.visible_change_grey;
-	const double tx = T_prev_cur.x(), ty = T_prev_cur.y();
+	const double tx = T_CprevC.x(), ty = T_CprevC.y();
 	const double f = 0.5 * (cam.fx() + cam.fy());
 	const double noiseGain = p.depth_noise_sigmas * f *
 	                         std::sqrt(tx * tx + ty * ty) * p.depth_noise_a;

@@ -62,10 +62,10 @@ void projectionJacobian(const mrpt::img::TCamera& cam,
 }
 
 cv::Mat expectedFlowExact(const cv::Mat& depth, const mrpt::img::TCamera& cam,
-                          const mrpt::poses::CPose3D& T_prev_cur)
+                          const mrpt::poses::CPose3D& T_CprevC)
 {
 	checkDepth(depth, cam);
-	const Rt T = rotTrans(T_prev_cur);
+	const Rt T = rotTrans(T_CprevC);
 	const double fx = cam.fx(), fy = cam.fy(), cx = cam.cx(), cy = cam.cy();
 	// p = z (xn, yn, 1), so R p + t = z a(u, v) + t with a = R (xn, yn, 1)
 	// independent of the depth: per column its xn part (double, once), per
@@ -141,26 +141,26 @@ cv::Mat expectedFlowExact(const cv::Mat& depth, const mrpt::img::TCamera& cam,
 
 cv::Mat expectedFlow(ExpectedFlowModel model, const cv::Mat& depth,
                      const mrpt::img::TCamera& cam,
-                     const mrpt::poses::CPose3D& T_prev_cur)
+                     const mrpt::poses::CPose3D& T_CprevC)
 {
 	return model == ExpectedFlowModel::Linear
-	           ? expectedFlowLinear(depth, cam, T_prev_cur)
-	           : expectedFlowExact(depth, cam, T_prev_cur);
+	           ? expectedFlowLinear(depth, cam, T_CprevC)
+	           : expectedFlowExact(depth, cam, T_CprevC);
 }
 
 cv::Mat expectedFlowLinear(const cv::Mat& depth, const mrpt::img::TCamera& cam,
-                           const mrpt::poses::CPose3D& T_prev_cur)
+                           const mrpt::poses::CPose3D& T_CprevC)
 {
 	checkDepth(depth, cam);
-	// Small-angle rotation vector of R_prev_cur.
+	// Small-angle rotation vector of R_CprevC.
 	cv::Mat Rm(3, 3, CV_64F), rvec;
-	const auto& R = T_prev_cur.getRotationMatrix();
+	const auto& R = T_CprevC.getRotationMatrix();
 	for (int r = 0; r < 3; r++)
 		for (int c = 0; c < 3; c++) Rm.at<double>(r, c) = R(r, c);
 	cv::Rodrigues(Rm, rvec);
 	const double w[3] = {rvec.at<double>(0), rvec.at<double>(1),
 	                     rvec.at<double>(2)};
-	const double t[3] = {T_prev_cur.x(), T_prev_cur.y(), T_prev_cur.z()};
+	const double t[3] = {T_CprevC.x(), T_CprevC.y(), T_CprevC.z()};
 	const double fx = cam.fx(), fy = cam.fy(), cx = cam.cx(), cy = cam.cy();
 	cv::Mat flow(depth.size(), CV_32FC2);
 	for (int v = 0; v < depth.rows; v++)
@@ -192,9 +192,9 @@ cv::Mat expectedFlowLinear(const cv::Mat& depth, const mrpt::img::TCamera& cam,
 }
 
 cv::Mat homographyFlow(const mrpt::img::TCamera& cam,
-                       const mrpt::poses::CPose3D& R_prev_cur)
+                       const mrpt::poses::CPose3D& R_CprevC)
 {
-	const Rt T = rotTrans(R_prev_cur);
+	const Rt T = rotTrans(R_CprevC);
 	const double fx = cam.fx(), fy = cam.fy(), cx = cam.cx(), cy = cam.cy();
 	cv::Mat flow(static_cast<int>(cam.nrows), static_cast<int>(cam.ncols),
 	             CV_32FC2);
@@ -221,9 +221,9 @@ cv::Mat homographyFlow(const mrpt::img::TCamera& cam,
 }
 
 cv::Matx33d rotationHomography(const mrpt::img::TCamera& cam,
-                               const mrpt::poses::CPose3D& T_prev_cur)
+                               const mrpt::poses::CPose3D& T_CprevC)
 {
-	const Rt T = rotTrans(T_prev_cur);
+	const Rt T = rotTrans(T_CprevC);
 	const cv::Matx33d K(cam.fx(), 0, cam.cx(), 0, cam.fy(), cam.cy(), 0, 0, 1);
 	const cv::Matx33d R(T.R);
 	return K * R * K.inv();

@@ -114,7 +114,7 @@ FlowPoseResult refinePoseWithFlow(const cv::Mat& observed, const cv::Mat& depth,
 		    "refinePoseWithFlow: step_px and iterations must be >= 1");
 
 	FlowPoseResult res;
-	res.T_prev_cur = init;
+	res.T_CprevC = init;
 	const double fx = cam.fx(), fy = cam.fy(), cx = cam.cx(), cy = cam.cy();
 	const bool useEx = exclude && !exclude->empty();
 
@@ -256,7 +256,7 @@ FlowPoseResult refinePoseWithFlow(const cv::Mat& observed, const cv::Mat& depth,
 		to[i] = t[i];
 		for (int j = 0; j < 3; j++) Ro(i, j) = R(i, j);
 	}
-	res.T_prev_cur = mrpt::poses::CPose3D::FromRotationAndTranslation(Ro, to);
+	res.T_CprevC = mrpt::poses::CPose3D::FromRotationAndTranslation(Ro, to);
 	res.ok = true;
 	return res;
 }

@@ -18,8 +18,8 @@ TEST(Consistency, MovingPatchIsDiffAndStaticBackgroundIsNot)
 	const int W = 320, H = 240;
 	const auto cam = test::vgaCamera(W, H);
 	const double z = 2.0, tx = 0.02;  // camera moves +x by 2 cm
-	// Camera {C(t)} at +tx in {C(t-1)}: T_prev_cur translation (tx, 0, 0).
-	const mrpt::poses::CPose3D T_prev_cur(tx, 0, 0, 0, 0, 0);
+	// Camera {C(t)} at +tx in {C(t-1)}: T_CprevC translation (tx, 0, 0).
+	const mrpt::poses::CPose3D T_CprevC(tx, 0, 0, 0, 0, 0);
 	const double s =
 	    cam.fx() * tx / z;  // wall content moves by -s in the image
 	const cv::Mat wall = test::texture(W, H, 11), obj = test::texture(W, H, 12);
@@ -36,10 +36,10 @@ TEST(Consistency, MovingPatchIsDiffAndStaticBackgroundIsNot)
 	auto p = bims::test::paperPreset<FlowParams>("flow");
 	ObservedFlow of(p);
 	const cv::Mat obs = of.compute(prev, cur);
-	const cv::Mat exp = expectedFlowExact(depth, cam, T_prev_cur);
+	const cv::Mat exp = expectedFlowExact(depth, cam, T_CprevC);
 	LabelStats st;
 	const cv::Mat lab =
-	    labelConsistency(obs, exp, depth, cam, T_prev_cur, p, &st);
+	    labelConsistency(obs, exp, depth, cam, T_CprevC, p, &st);
 
 	size_t objDiff = 0, objN = 0, bgDiff = 0, bgN = 0;
 	const cv::Rect inner(r1.x + 8, r1.y + 8, r1.width - 16, r1.height - 16);

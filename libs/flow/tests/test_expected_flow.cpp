@@ -53,8 +53,8 @@ TEST(ExpectedFlow, ExactFlowMatchesIndependentProjection)
 {
 	const auto cam = test::vgaCamera();
 	const cv::Mat z = randomDepth(640, 480, 2);
-	const CPose3D T_prev_cur(0.03, -0.02, 0.05, 0.02, -0.01, 0.03);
-	const cv::Mat e = expectedFlowExact(z, cam, T_prev_cur);
+	const CPose3D T_CprevC(0.03, -0.02, 0.05, 0.02, -0.01, 0.03);
+	const cv::Mat e = expectedFlowExact(z, cam, T_CprevC);
 	std::mt19937 rng(3);
 	for (int k = 0; k < 200; k++)
 	{
@@ -63,7 +63,7 @@ TEST(ExpectedFlow, ExactFlowMatchesIndependentProjection)
 		// independent path: MRPT pose composition and the pinhole formula
 		const mrpt::math::TPoint3D p((u - cam.cx()) * d / cam.fx(),
 		                             (v - cam.cy()) * d / cam.fy(), d);
-		const auto q = T_prev_cur.composePoint(p);
+		const auto q = T_CprevC.composePoint(p);
 		const double up = cam.fx() * q.x / q.z + cam.cx();
 		const double vp = cam.fy() * q.y / q.z + cam.cy();
 		EXPECT_NEAR(e.at<cv::Vec2f>(v, u)[0], up - u, 1e-3);

@@ -55,8 +55,8 @@ TEST(FlowPose, Se3RecoversTheTruePoseFromExactFlow)
 	const auto r = refinePoseWithFlow(obs, depth, cam, kInit, p);
 	ASSERT_TRUE(r.ok);
 	EXPECT_GT(r.samples, 1000);
-	EXPECT_LT(rotDeg(r.T_prev_cur, kTrue), 1e-3);
-	EXPECT_LT(transDist(r.T_prev_cur, kTrue), 1e-4);
+	EXPECT_LT(rotDeg(r.T_CprevC, kTrue), 1e-3);
+	EXPECT_LT(transDist(r.T_CprevC, kTrue), 1e-4);
 	EXPECT_GT(r.median_px_before, 1.0);
 	EXPECT_LT(r.median_px_after, 1e-3);
 }
@@ -75,8 +75,8 @@ TEST(FlowPose, TranslationModeKeepsTheRotation)
 	init.z(-0.01);
 	const auto r = refinePoseWithFlow(obs, depth, cam, init, p);
 	ASSERT_TRUE(r.ok);
-	EXPECT_LT(rotDeg(r.T_prev_cur, init), 1e-9);
-	EXPECT_LT(transDist(r.T_prev_cur, kTrue), 1e-4);
+	EXPECT_LT(rotDeg(r.T_CprevC, init), 1e-9);
+	EXPECT_LT(transDist(r.T_CprevC, kTrue), 1e-4);
 }
 
 TEST(FlowPose, IgnoresAMovingMinority)
@@ -90,8 +90,8 @@ TEST(FlowPose, IgnoresAMovingMinority)
 	obs(mover) += cv::Scalar(6.0f, -3.0f);
 	const auto r = refinePoseWithFlow(obs, depth, cam, kInit, FlowPoseParams{});
 	ASSERT_TRUE(r.ok);
-	EXPECT_LT(rotDeg(r.T_prev_cur, kTrue), 0.01);
-	EXPECT_LT(transDist(r.T_prev_cur, kTrue), 1e-3);
+	EXPECT_LT(rotDeg(r.T_CprevC, kTrue), 0.01);
+	EXPECT_LT(transDist(r.T_CprevC, kTrue), 1e-3);
 	EXPECT_NEAR(r.inlier_fraction, 0.7, 0.05);
 }
 
@@ -111,12 +111,12 @@ TEST(FlowPose, TexturelessSamplesAreNotUsed)
 	ASSERT_TRUE(r.ok);
 	// (pixels within half a window of the blank half still pass the texture
 	// test; Tukey drops most of them)
-	EXPECT_LT(rotDeg(r.T_prev_cur, kTrue), 0.01);
-	EXPECT_LT(transDist(r.T_prev_cur, kTrue), 5e-4);
+	EXPECT_LT(rotDeg(r.T_CprevC, kTrue), 0.01);
+	EXPECT_LT(transDist(r.T_CprevC, kTrue), 5e-4);
 	// without the tensor the blank half's zero flow drags the fit away
 	const auto r0 =
 	    refinePoseWithFlow(obs, depth, cam, kInit, FlowPoseParams{});
-	EXPECT_GT(rotDeg(r0.T_prev_cur, kTrue), 10 * rotDeg(r.T_prev_cur, kTrue));
+	EXPECT_GT(rotDeg(r0.T_CprevC, kTrue), 10 * rotDeg(r.T_CprevC, kTrue));
 }
 
 TEST(FlowPose, TooFewSamplesKeepTheInitialPose)
@@ -127,7 +127,7 @@ TEST(FlowPose, TooFewSamplesKeepTheInitialPose)
 	const auto r = refinePoseWithFlow(obs, depth, cam, kInit, FlowPoseParams{});
 	EXPECT_FALSE(r.ok);
 	EXPECT_EQ(r.samples, 0);
-	EXPECT_LT(transDist(r.T_prev_cur, kInit), 1e-12);
+	EXPECT_LT(transDist(r.T_CprevC, kInit), 1e-12);
 }
 
 TEST(FlowPose, BadInputThrows)

@@ -286,7 +286,7 @@ void Pipeline::flowLabels(FrameJobs* jobs, FrameResult& r,
 			    flow::flowPoseParamsFrom(cfg_.flow), nullptr, &o.tensor);
 			if (r.flowPose.ok)
 			{
-				r.T_CprevC = r.flowPose.T_prev_cur;
+				r.T_CprevC = r.flowPose.T_CprevC;
 				if (cfg_.flow.refine_to_ego)
 					r.T_WC = odom_.correctLastMotion(r.T_CprevC);
 			}

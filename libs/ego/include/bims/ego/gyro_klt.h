@@ -53,7 +53,7 @@ class GyroAidedKLT
 	 * replenishes features on \a grey for the next call.
 	 * \param grey CV_8UC1 image; all frames must have the same size.
 	 * \param K camera intrinsics [px] of this image.
-	 * \param R_CprevCcur the current camera {C_cur} expressed in the
+	 * \param R_CprevC the current camera {C_cur} expressed in the
 	 *        previous one {C_prev} (from the gyro), or nullptr for unaided
 	 *        LK (initial guess = previous position).
 	 * \param movingMaskPrev CV_8UC1, same size, non-zero = labelled moving
@@ -62,12 +62,12 @@ class GyroAidedKLT
 	 * \throws std::invalid_argument on a wrong image type/size. */
 	const std::vector<Track>& track(const cv::Mat& grey,
 	                                const Eigen::Matrix3d& K,
-	                                const Eigen::Matrix3d* R_CprevCcur,
+	                                const Eigen::Matrix3d* R_CprevC,
 	                                const cv::Mat* movingMaskPrev);
 
 	/** The infinite homography H = K R_CcurCprev K^-1, x_cur ~ H x_prev. */
-	static Eigen::Matrix3d infiniteHomography(
-	    const Eigen::Matrix3d& K, const Eigen::Matrix3d& R_CprevCcur);
+	static Eigen::Matrix3d infiniteHomography(const Eigen::Matrix3d& K,
+	                                          const Eigen::Matrix3d& R_CprevC);
 	/** Applies a homography to a pixel. */
 	static cv::Point2f warp(const Eigen::Matrix3d& H, const cv::Point2f& x);
 

@@ -1,8 +1,8 @@
 // Estimation of the IMU-camera rotation R_IC ({C} in {I}, p_I = R_IC p_C)
 // from a sequence: the rotation the gyro measures between two frames,
-// R_IprevIcur, and the one vision measures, R_CprevCcur, are conjugate,
-// R_IprevIcur = R_IC R_CprevCcur R_IC^T, so their rotation vectors satisfy
-// Log(R_IprevIcur) = R_IC Log(R_CprevCcur) (the hand-eye rotation problem).
+// R_IprevI, and the one vision measures, R_CprevC, are conjugate,
+// R_IprevI = R_IC R_CprevC R_IC^T, so their rotation vectors satisfy
+// Log(R_IprevI) = R_IC Log(R_CprevC) (the hand-eye rotation problem).
 // R_IC is the orthogonal Procrustes (Wahba) solution over all pairs, made
 // robust by 2-pair RANSAC (pairs with tracking failures are outliers).
 #pragma once
@@ -20,8 +20,8 @@ namespace bims::ego
 /** Relative rotations of one frame interval. */
 struct RotationPair
 {
-	Eigen::Matrix3d R_IprevIcur;  ///< integrated gyro
-	Eigen::Matrix3d R_CprevCcur;  ///< visual odometry
+	Eigen::Matrix3d R_IprevI;  ///< integrated gyro
+	Eigen::Matrix3d R_CprevC;  ///< visual odometry
 };
 
 struct RotationCalibResult

@@ -1,7 +1,7 @@
 // TranslationEstimator: camera motion between two frames from tracked
 // features with depth, robust to features on independently moving objects.
 //
-// Motion model: T_CprevCcur = (R, t), the current camera in the previous one,
+// Motion model: T_CprevC = (R, t), the current camera in the previous one,
 // so a static point satisfies p_prev = R p_cur + t. With R known from the IMU
 // this is the paper's eq. (2) in the rotation-compensated frame {R}:
 // Q_prev - Q_cur = R_WCprev t, with Q = R_WC p (points rotated to the world
@@ -37,9 +37,9 @@ struct Correspondence
 struct MotionEstimate
 {
 	bool ok = false;  ///< enough inliers (>= min_inliers)
-	Eigen::Matrix3d R_CprevCcur = Eigen::Matrix3d::Identity();
-	Eigen::Vector3d t_CprevCcur = Eigen::Vector3d::Zero();  ///< [m]
-	std::vector<uint8_t> inlier;  ///< per correspondence
+	Eigen::Matrix3d R_CprevC = Eigen::Matrix3d::Identity();
+	Eigen::Vector3d t_CprevC = Eigen::Vector3d::Zero();  ///< [m]
+	std::vector<uint8_t> inlier;                         ///< per correspondence
 	int inliers = 0;
 	double residual_rms_m = 0;  ///< RMS 3D residual of the inliers [m]
 };
@@ -49,10 +49,9 @@ class TranslationEstimator
  public:
 	explicit TranslationEstimator(const TranslationParams& p = {});
 
-	/** Translation with a known rotation R_CprevCcur (IMU mode). */
-	MotionEstimate estimateTranslation(
-	    const std::vector<Correspondence>& c,
-	    const Eigen::Matrix3d& R_CprevCcur) const;
+	/** Translation with a known rotation R_CprevC (IMU mode). */
+	MotionEstimate estimateTranslation(const std::vector<Correspondence>& c,
+	                                   const Eigen::Matrix3d& R_CprevC) const;
 
 	/** Full SE(3) from the correspondences alone (vision-only mode). */
 	MotionEstimate estimateSE3(const std::vector<Correspondence>& c) const;

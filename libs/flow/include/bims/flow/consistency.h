@@ -28,7 +28,7 @@ struct LabelStats
  * (0, max_depth_m], a finite expected flow, and both flows landing inside
  * the image. Threshold: diff_threshold_px, plus depth_noise_sigmas times the
  * expected-flow standard deviation caused by depth noise
- * (f * |t_xy| * sigma_z / z^2, sigma_z = a z^2) when enabled; \a T_prev_cur
+ * (f * |t_xy| * sigma_z / z^2, sigma_z = a z^2) when enabled; \a T_CprevC
  * gives t. Pixels on depth edges get no label when depth_edge_rel > 0.
  * With visible_change_grey > 0, \a tensor (structureTensor() of the current
  * image, CV_32FC3) is required: a pixel whose flow difference d changes the
@@ -36,7 +36,7 @@ struct LabelStats
  * Label values; throws std::invalid_argument on mismatched inputs. */
 cv::Mat labelConsistency(const cv::Mat& observed, const cv::Mat& expected,
                          const cv::Mat& depth, const mrpt::img::TCamera& cam,
-                         const mrpt::poses::CPose3D& T_prev_cur,
+                         const mrpt::poses::CPose3D& T_CprevC,
                          const FlowParams& p, LabelStats* stats = nullptr,
                          const cv::Mat* tensor = nullptr);
 

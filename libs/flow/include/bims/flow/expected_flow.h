@@ -35,34 +35,34 @@ void projectionJacobian(const mrpt::img::TCamera& cam,
 
 /** Exact expected backward flow: each current pixel with depth z > 0 is
  * back-projected, moved to the previous camera frame with
- * T_prev_cur = T_{C(t-1) C(t)} and projected. \a depth is CV_32FC1 metres
+ * T_CprevC = T_{C(t-1) C(t)} and projected. \a depth is CV_32FC1 metres
  * (0 or non-finite = no reading). Output CV_32FC2; NaN where there is no
  * depth or the point falls behind the previous camera. */
 cv::Mat expectedFlowExact(const cv::Mat& depth, const mrpt::img::TCamera& cam,
-                          const mrpt::poses::CPose3D& T_prev_cur);
+                          const mrpt::poses::CPose3D& T_CprevC);
 
 /** First-order expected flow (paper eq. 8): du = J(p) * dp with
- * dp = [theta]x p + t (small-angle rotation vector theta of T_prev_cur).
+ * dp = [theta]x p + t (small-angle rotation vector theta of T_CprevC).
  * Same conventions as expectedFlowExact(). */
 cv::Mat expectedFlowLinear(const cv::Mat& depth, const mrpt::img::TCamera& cam,
-                           const mrpt::poses::CPose3D& T_prev_cur);
+                           const mrpt::poses::CPose3D& T_CprevC);
 
 /** The expected flow of [flow] expected: expectedFlowExact() or
  * expectedFlowLinear(). */
 cv::Mat expectedFlow(ExpectedFlowModel model, const cv::Mat& depth,
                      const mrpt::img::TCamera& cam,
-                     const mrpt::poses::CPose3D& T_prev_cur);
+                     const mrpt::poses::CPose3D& T_CprevC);
 
-/** Flow of a pure rotation R_prev_cur, independent of depth: the infinite
+/** Flow of a pure rotation R_CprevC, independent of depth: the infinite
  * homography H = K R K^-1 applied to every pixel (CV_32FC2, width x height of
  * \a cam). */
 cv::Mat homographyFlow(const mrpt::img::TCamera& cam,
-                       const mrpt::poses::CPose3D& R_prev_cur);
+                       const mrpt::poses::CPose3D& R_CprevC);
 
-/** The infinite homography H = K R K^-1 of the rotation of \a T_prev_cur
+/** The infinite homography H = K R K^-1 of the rotation of \a T_CprevC
  * (its translation is ignored): maps a current pixel (u, v, 1) to where a
  * point at infinity seen there was seen in the previous frame. */
 cv::Matx33d rotationHomography(const mrpt::img::TCamera& cam,
-                               const mrpt::poses::CPose3D& T_prev_cur);
+                               const mrpt::poses::CPose3D& T_CprevC);
 
 }  // namespace bims::flow

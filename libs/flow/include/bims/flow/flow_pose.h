@@ -1,9 +1,9 @@
 // Relative camera pose from the dense observed flow over the static majority.
 //
-// The expected flow is only as good as T_prev_cur. On real data the feature
+// The expected flow is only as good as T_CprevC. On real data the feature
 // egomotion (and above all a poor or synthetic IMU rotation) leaves errors of
 // a few pixels of flow, far above diff_threshold_px. refinePoseWithFlow()
-// fits T_prev_cur to the observed flow of a grid of pixels with depth
+// fits T_CprevC to the observed flow of a grid of pixels with depth
 // (robust Gauss-Newton: Huber, then Tukey with a MAD scale), so that the
 // pixels of independently moving objects, a minority, are ignored.
 #pragma once
@@ -48,15 +48,15 @@ struct FlowPoseParams
 
 struct FlowPoseResult
 {
-	mrpt::poses::CPose3D T_prev_cur;  ///< refined (or initial, when !ok)
-	bool ok = false;                  ///< false: the initial pose is kept
-	int samples = 0;                  ///< pixels used
-	double inlier_fraction = 0;       ///< of the final Tukey weights > 0
-	double median_px_before = 0;      ///< median |obs - exp| of the samples
-	double median_px_after = 0;       ///< ... with the refined pose
+	mrpt::poses::CPose3D T_CprevC;  ///< refined (or initial, when !ok)
+	bool ok = false;                ///< false: the initial pose is kept
+	int samples = 0;                ///< pixels used
+	double inlier_fraction = 0;     ///< of the final Tukey weights > 0
+	double median_px_before = 0;    ///< median |obs - exp| of the samples
+	double median_px_after = 0;     ///< ... with the refined pose
 };
 
-/** Fits T_prev_cur = T_{C(t-1) C(t)} to the backward observed flow
+/** Fits T_CprevC = T_{C(t-1) C(t)} to the backward observed flow
  * (CV_32FC2, u_{t-1} - u_t, NaN = none) on the current frame's pixels with
  * the current \a depth (CV_32FC1 metres), starting from \a init. Pixels with
  * non-zero \a exclude (CV_8UC1, optional: e.g. the previous moving mask) are
