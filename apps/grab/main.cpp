@@ -35,22 +35,20 @@ int main(int argc, char** argv)
 		                                      "", "OUT.rawlog", cmd);
 		    TCLAP::ValueArg<int> aFrames(
 		        "", "max-frames",
-		        "stop after N RGB-D frames (overrides [global] "
-		        "max_frames)",
+		        "stop after N RGB-D frames (overrides [global] max_frames)",
 		        false, 0, "N", cmd);
-		    TCLAP::SwitchArg aSeg("", "live-segmentation",
-		                          "run the segmentation pipeline on the "
-		                          "frames as they come",
-		                          cmd);
+		    TCLAP::SwitchArg aSeg(
+		        "", "live-segmentation",
+		        "run the segmentation pipeline on the frames as they come",
+		        cmd);
 		    TCLAP::ValueArg<std::string> aExp(
 		        "c", "config",
 		        "experiment .ini for --live-segmentation (default: "
 		        "share/bims/default.ini)",
 		        false, "", "CONFIG.ini", cmd);
-		    TCLAP::SwitchArg aViewer("", "viewer",
-		                             "show the RGB frames (with the moving "
-		                             "mask) in a window",
-		                             cmd);
+		    TCLAP::SwitchArg aViewer(
+		        "", "viewer",
+		        "show the RGB frames (with the moving mask) in a window", cmd);
 		    TCLAP::SwitchArg aQuiet("q", "quiet", "no progress lines", cmd);
 		    bims::parseCommandLine(
 		        cmd, argc, argv,
