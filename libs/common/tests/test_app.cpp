@@ -3,6 +3,7 @@
 #include <bims/common/app.h>
 #include <bims/common/progress.h>
 #include <gtest/gtest.h>
+#include <mrpt/3rdparty/tclap/CmdLine.h>
 
 #include <string>
 #include <vector>
@@ -44,6 +45,21 @@ TEST(App, ValuesAndWordsAfterDoubleDashAreNotRenamed)
 	EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
 	EXPECT_EQ(args, (std::vector<std::string>{"p", "-o", "--frames", "--",
 	                                          "--frames"}));
+}
+
+TEST(App, GivenValueTellsAnOptionGivenEmptyFromOneNotGiven)
+{
+	TCLAP::CmdLine cmd("test", ' ', "0");
+	TCLAP::ValueArg<std::string> a("", "csv", "a file", false, "d", "F", cmd);
+	TCLAP::ValueArg<std::string> b("", "gt", "a file", false, "d", "F", cmd);
+	TCLAP::ValueArg<size_t> n("", "max", "a count", false, 3, "N", cmd);
+	std::vector<std::string> words = {"p", "--csv", "", "--max", "7"};
+	std::vector<char*> argv;
+	for (auto& w : words) argv.push_back(w.data());
+	bims::parseCommandLine(cmd, static_cast<int>(argv.size()), argv.data());
+	EXPECT_EQ(bims::givenValue(a), std::optional<std::string>(""));
+	EXPECT_EQ(bims::givenValue(b), std::nullopt);
+	EXPECT_EQ(bims::givenValue(n), std::optional<size_t>(7));
 }
 
 TEST(Progress, APlainLineHasTotalShareRateAndEta)

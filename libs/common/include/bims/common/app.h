@@ -3,6 +3,7 @@
 
 #include <atomic>
 #include <functional>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -118,6 +119,16 @@ std::vector<std::string> givenValues(Arg&... args)
 	std::vector<std::string> v;
 	(..., (args.isSet() ? v.push_back(args.getValue()) : void()));
 	return v;
+}
+
+/** The value of a TCLAP value argument if the command line gave it (an
+ * option's "given or not" for a library's options struct). */
+template <class Arg>
+auto givenValue(Arg& arg)
+    -> std::optional<std::decay_t<decltype(arg.getValue())>>
+{
+	if (!arg.isSet()) return std::nullopt;
+	return arg.getValue();
 }
 
 /** From now on SIGINT and SIGTERM ask the program to stop cleanly: the

@@ -1,0 +1,81 @@
+// bims-odom's run: egomotion alone over a rawlog (replayRawlog), the
+// trajectory T_WC in the TUM format, an optional per-frame CSV and the
+// per-stage timing summary on stderr. The program's main only reads its
+// command line into OdometryRunOptions and calls runOdometry.
+#pragma once
+
+#include <bims/common/trajectory.h>
+#include <bims/ego/odometry.h>
+#include <bims/ego/rgbd_input.h>
+#include <bims/source/odometry_replay.h>
+
+#include <mrpt/poses/CPose3D.h>
+
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace bims::source
+{
+/** What bims-odom's command line gives (nullopt: option not given). */
+struct OdometryRunOptions
+{
+	std::string config;  ///< experiment .ini
+	std::string rawlog;  ///< input rawlog
+	std::string out;     ///< output TUM trajectory
+	/** extra .ini whose [calibration] [camera] [sensors] override the
+	 * config ("": none) */
+	std::string calib;
+	std::optional<std::string> mode;      ///< [odometry] mode: imu | vision
+	std::optional<std::string> gyro_aid;  ///< [odometry] gyro_aid
+	std::optional<std::string> csv;       ///< per-frame details
+	std::optional<std::string> masks;     ///< folder of moving masks NNNNNN.png
+	/** ground truth: adds the tracker's accuracy to the CSV */
+	std::optional<std::string> gt;
+	size_t max_frames = 0;  ///< stop after N frames (0: all)
+	bool progress = true;   ///< progress line on stderr
+};
+
+/** The configuration bims-odom runs: \a o.config, then \a o.calib's sensor
+ * sections, --mode and --gyro-aid. Throws UsageError for a missing --calib
+ * file or a bad --mode / --gyro-aid value, ConfigError when mode imu has
+ * no [calibration] R_IC. */
+ego::EgoConfig odometryConfig(const OdometryRunOptions& o);
+
+/** The sample at quantile \a q (0..1) of \a v: the element of rank
+ * round(q (n-1)) once sorted; 0 for an empty series. */
+double percentile(std::vector<double> v, double q);
+
+/** How well the tracker followed the truth over one frame pair. */
+struct TrackerTruth
+{
+	double rate_deg_s = NAN;       ///< true angular rate [deg/s]
+	int attempted_with_depth = 0;  ///< features attempted with a true match
+	int tracked_within_2px = 0;    ///< tracks within 2 px of the truth
+};
+
+/** Tracker accuracy of \a r against the true relative pose \a T_CprevC
+ * (T_{C(t-1) C(t)}) over \a dt seconds: the previous image's features
+ * (depth of \a prevDepth) moved by the truth into the current image
+ * (intrinsics \a K). */
+TrackerTruth trackerAgainstTruth(const ego::FrameEgomotion& r,
+                                 const cv::Mat& prevDepth,
+                                 const Eigen::Matrix3d& K,
+                                 const mrpt::poses::CPose3D& T_CprevC,
+                                 double dt);
+
+/** The header of bims-odom's --csv (with its newline). */
+const char* odometryCsvHeader();
+
+/** One line of bims-odom's --csv for frame \a r (with its newline). */
+std::string odometryCsvLine(const ego::FrameEgomotion& r,
+                            const TrackerTruth& truth);
+
+/** bims-odom: checks that no output is an input (checkOutputsSpareInputs),
+ * runs the odometry of \a o over its rawlog, writes the trajectory (and
+ * the CSV) and prints the summary on stderr. Returns the program's exit
+ * code (0); errors are thrown. */
+int runOdometry(const OdometryRunOptions& o);
+
+}  // namespace bims::source

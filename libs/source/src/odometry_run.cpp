@@ -1,0 +1,223 @@
+#include <bims/common/app.h>
+#include <bims/common/config.h>
+#include <bims/common/experiment.h>
+#include <bims/common/output_paths.h>
+#include <bims/ego/flags.h>
+#include <bims/ego/so3.h>
+#include <bims/source/odometry_run.h>
+
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/system/filesystem.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+namespace bims::source
+{
+ego::EgoConfig odometryConfig(const OdometryRunOptions& o)
+{
+	ego::EgoConfig ec;
+	ec.loadFromFile(o.config);
+	if (!o.calib.empty())
+	{
+		if (!mrpt::system::fileExists(o.calib))
+			throw UsageError(o.calib + ": no such calibration file");
+		checkIniFile(o.calib);
+		mrpt::config::CConfigFile cal(o.calib);
+		checkExperimentSections(cal);
+		ec.overrideSensorSections(cal);
+	}
+	if (o.mode)
+	{
+		try
+		{
+			ec.odometry.mode = parseChoice<ego::OdometryMode>(*o.mode);
+		}
+		catch (const std::invalid_argument& e)
+		{
+			throw UsageError(std::string("--mode: ") + e.what());
+		}
+	}
+	if (o.gyro_aid)
+	{
+		if (*o.gyro_aid != "true" && *o.gyro_aid != "false")
+			throw UsageError("--gyro-aid must be true or false");
+		ec.odometry.gyro_aid = (*o.gyro_aid == "true");
+	}
+	if (ec.odometry.mode == ego::OdometryMode::Imu && !ec.calibration.has_R_IC)
+		throw ConfigError(
+		    o.config +
+		    ": [calibration] R_IC missing (needed by [odometry] mode = "
+		    "imu; give it in the config or with --calib)");
+	return ec;
+}
+
+double percentile(std::vector<double> v, double q)
+{
+	if (v.empty()) return 0;
+	std::sort(v.begin(), v.end());
+	return v[std::min(v.size() - 1,
+	                  static_cast<size_t>(q * (v.size() - 1) + 0.5))];
+}
+
+TrackerTruth trackerAgainstTruth(const ego::FrameEgomotion& r,
+                                 const cv::Mat& prevDepth,
+                                 const Eigen::Matrix3d& K,
+                                 const mrpt::poses::CPose3D& T_CprevC,
+                                 double dt)
+{
+	TrackerTruth out;
+	Eigen::Matrix3d R;
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < 3; j++)
+			R(i, j) = T_CprevC.getRotationMatrix()(i, j);
+	const Eigen::Vector3d t(T_CprevC.x(), T_CprevC.y(), T_CprevC.z());
+	out.rate_deg_s = ego::angleSO3(R) * 180 / M_PI / dt;
+	// True position of a previous-image feature.
+	const auto truth = [&](const cv::Point2f& x, Eigen::Vector2d& y)
+	{
+		const float z = ego::depthAt(prevDepth, x);
+		if (z <= 0) return false;
+		const Eigen::Vector3d q =
+		    K * (R.transpose() * (ego::backProject(K, x, z) - t));
+		y = q.head<2>() / q.z();
+		return q.z() > 0;
+	};
+	Eigen::Vector2d y;
+	for (const auto& x : r.attempted) out.attempted_with_depth += truth(x, y);
+	for (const auto& tr : r.tracks)
+		if (truth(tr.prev, y) &&
+		    std::hypot(y.x() - tr.cur.x, y.y() - tr.cur.y) < 2.0)
+			++out.tracked_within_2px;
+	return out;
+}
+
+const char* odometryCsvHeader()
+{
+	return "t,flags,rotation,correspondences,inliers,residual_m,tracks,"
+	       "ms_input,ms_track,ms_motion,true_rate_deg_s,"
+	       "attempted_with_depth,tracked_within_2px,"
+	       "anchor_keyframe,anchor_inliers,anchor_inlier_fraction,"
+	       "anchor_overlap,anchor_coverage,anchor_guess,anchor_correction_m,"
+	       "anchor_correction_deg,anchor_excluded,anchor_seen_through,"
+	       "ms_anchor,anchor_note\n";
+}
+
+std::string odometryCsvLine(const ego::FrameEgomotion& r,
+                            const TrackerTruth& truth)
+{
+	char buf[512];
+	const auto& a = r.anchor;
+	std::snprintf(
+	    buf, sizeof(buf),
+	    "%.6f,%s,%s,%d,%d,%.5f,%zu,%.3f,%.3f,%.3f,%.3f,%d,%d,"
+	    "%d,%d,%.3f,%.3f,%.3f,%d,%.4f,%.3f,%.3f,%d,%.3f,%s\n",
+	    r.t, ego::flagsToString(r.flags).c_str(), ego::toString(r.R_source),
+	    r.correspondences, r.inliers, r.residual_rms_m, r.tracks.size(),
+	    r.ms_input, r.ms_track, r.ms_motion, truth.rate_deg_s,
+	    truth.attempted_with_depth, truth.tracked_within_2px, a.keyframe,
+	    a.inliers, a.inlier_fraction, a.overlap, a.coverage, a.guess,
+	    a.correction_m, a.correction_deg, a.excluded_fraction, a.seen_through,
+	    r.ms_anchor, a.why.empty() ? "-" : a.why.c_str());
+	return buf;
+}
+
+int runOdometry(const OdometryRunOptions& o)
+{
+	std::vector<std::string> outputs = {o.out};
+	if (o.csv) outputs.insert(outputs.begin(), *o.csv);
+	checkOutputsSpareInputs(
+	    {o.config, o.rawlog, o.calib, o.masks.value_or(""), o.gt.value_or("")},
+	    outputs);
+	const ego::EgoConfig ec = odometryConfig(o);
+	ego::Odometry odo(ec);
+	Trajectory traj;
+	std::vector<double> msIn, msTrack, msMotion, msEgo;
+	std::unique_ptr<AppendFile> csv;  // each line checked
+	if (o.csv)
+	{
+		csv = std::make_unique<AppendFile>(*o.csv);
+		csv->append(odometryCsvHeader());
+	}
+	Trajectory gt;
+	if (o.gt) gt = loadTumTrajectory(*o.gt);
+	// Ground-truth pose nearest to t (within 5 ms), or nullptr.
+	const auto gtAt = [&gt](double t) { return poseNear(gt, t, 5e-3); };
+	cv::Mat prevDepth;
+	double prevT = 0;
+	ReplayOptions ro;
+	ro.max_frames = o.max_frames;
+	ro.progress = o.progress;
+	if (o.masks)
+	{
+		if (!mrpt::system::directoryExists(*o.masks))
+			throw std::runtime_error(*o.masks + ": mask directory not found");
+		ro.masks_dir = *o.masks;
+	}
+	const auto st = replayRawlog(
+	    o.rawlog, odo,
+	    [&](const ego::FrameEgomotion& r,
+	        const mrpt::obs::CObservation3DRangeScan& scan)
+	    {
+		    if (r.flags & ego::kFlagOutOfOrder || r.flags & ego::kFlagBadImage)
+			    return;  // no pose for this frame
+		    traj.push_back({r.t, r.T_WC});
+		    msIn.push_back(r.ms_input);
+		    msTrack.push_back(r.ms_track);
+		    msMotion.push_back(r.ms_motion);
+		    msEgo.push_back(r.ms_track + r.ms_motion);
+		    // Tracker accuracy against the ground truth.
+		    TrackerTruth truth;
+		    ego::RgbdFrame cur;
+		    if (!gt.empty() && ego::rgbdFrameFrom(scan, ec.camera, cur).empty())
+		    {
+			    const StampedPose* g1 = gtAt(r.t);
+			    const StampedPose* g0 = gtAt(prevT);
+			    if (g0 && g1 && !prevDepth.empty())
+				    truth = trackerAgainstTruth(
+				        r, prevDepth, cur.K, g1->T_WC - g0->T_WC, r.t - prevT);
+			    prevDepth = cur.depth;
+		    }
+		    prevT = r.t;
+		    if (csv) csv->append(odometryCsvLine(r, truth));
+	    },
+	    ro);
+	if (traj.empty())
+		throw std::runtime_error(
+		    o.rawlog + ": no usable RGB-D frame (check [sensors] rgbd_label)");
+	if (csv) csv->close();
+	const char* mode = choiceName(ec.odometry.mode);
+	const char* aid = ec.odometry.gyro_aid ? "true" : "false";
+	saveTumTrajectory(
+	    o.out, traj,
+	    std::string("bims-odom mode=") + mode + " gyro_aid=" + aid);
+	std::fprintf(
+	    stderr,
+	    "bims-odom: %zu frames (%zu flagged), %zu IMU samples; mode=%s "
+	    "gyro_aid=%s\n"
+	    "bims-odom: ms/frame median (p95): input %.2f (%.2f), tracking "
+	    "%.2f (%.2f), motion %.2f (%.2f), egomotion %.2f (%.2f)\n",
+	    st.frames, st.flagged, st.imu, mode, aid, percentile(msIn, 0.5),
+	    percentile(msIn, 0.95), percentile(msTrack, 0.5),
+	    percentile(msTrack, 0.95), percentile(msMotion, 0.5),
+	    percentile(msMotion, 0.95), percentile(msEgo, 0.5),
+	    percentile(msEgo, 0.95));
+	if (o.masks)
+		std::fprintf(stderr, "bims-odom: masks of %s for %zu of %zu frames\n",
+		             ro.masks_dir.c_str(), st.masksUsed, st.frames);
+	else
+		std::fprintf(stderr,
+		             "bims-odom: no --masks: moving content is left to "
+		             "the robust alignment (no mask)\n");
+	if (st.imuRejected)
+		std::fprintf(stderr,
+		             "bims-odom: %zu IMU samples not used (a value not "
+		             "finite or beyond any sensor's range); their frames "
+		             "are flagged imu_rejected\n",
+		             st.imuRejected);
+	return 0;
+}
+
+}  // namespace bims::source

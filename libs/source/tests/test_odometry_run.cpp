@@ -1,0 +1,192 @@
+// bims-odom's run (odometry_run.h): its configuration from the options, the
+// tracker's accuracy against the truth, the CSV and the whole run on the
+// bundled sample.
+#include <bims/common/app.h>
+#include <bims/common/config.h>
+#include <bims/common/trajectory.h>
+#include <bims/source/odometry_run.h>
+#include <bims_test/tmp_dir.h>
+#include <gtest/gtest.h>
+
+#include <mrpt/poses/CPose3D.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+using namespace bims::source;
+
+namespace
+{
+const std::string kSrc = BIMS_SOURCE_DIR;
+const std::string kSample = kSrc + "/rawlogs/pendulum_slow.rawlog";
+const std::string kGt = kSrc + "/rawlogs/pendulum_slow_gt/";
+const std::string kConfig = kSrc + "/config/default.ini";
+
+std::vector<std::string> lines(const std::string& path)
+{
+	std::ifstream f(path);
+	std::vector<std::string> v;
+	for (std::string l; std::getline(f, l);) v.push_back(l);
+	return v;
+}
+
+size_t fields(const std::string& line)
+{
+	return static_cast<size_t>(std::count(line.begin(), line.end(), ',')) + 1;
+}
+}  // namespace
+
+TEST(OdometryRun, PercentileIsTheSampleOfRoundedRank)
+{
+	EXPECT_EQ(percentile({}, 0.5), 0);
+	EXPECT_EQ(percentile({5, 1, 3, 2, 4}, 0.5), 3);
+	EXPECT_EQ(percentile({5, 1, 3, 2, 4}, 0.95), 5);  // rank round(3.8) = 4
+	std::vector<double> v;
+	for (int i = 1; i <= 12; i++) v.push_back(i);
+	// rank round(0.95 * 11) = 10: the 11th value (not ceil(0.95 n) = 12th)
+	EXPECT_EQ(percentile(v, 0.95), 11);
+	EXPECT_EQ(percentile(v, 0), 1);
+	EXPECT_EQ(percentile(v, 1), 12);
+}
+
+TEST(OdometryRun, OptionsOverrideTheConfigAndBadValuesAreUsageErrors)
+{
+	OdometryRunOptions o;
+	o.config = kConfig;
+	const auto base = odometryConfig(o);
+	EXPECT_EQ(base.odometry.mode, bims::ego::OdometryMode::Imu);
+	EXPECT_TRUE(base.odometry.gyro_aid);
+	o.mode = "vision";
+	o.gyro_aid = "false";
+	const auto ec = odometryConfig(o);
+	EXPECT_EQ(ec.odometry.mode, bims::ego::OdometryMode::Vision);
+	EXPECT_FALSE(ec.odometry.gyro_aid);
+
+	auto bad = o;
+	bad.gyro_aid = "maybe";
+	EXPECT_THROW(odometryConfig(bad), bims::UsageError);
+	bad = o;
+	bad.mode = "";  // given, empty: not a mode
+	EXPECT_THROW(odometryConfig(bad), bims::UsageError);
+	bad = o;
+	bad.calib = kGt + "no_such_calibration.ini";
+	try
+	{
+		odometryConfig(bad);
+		ADD_FAILURE() << "no error for a missing --calib";
+	}
+	catch (const bims::UsageError& e)
+	{
+		EXPECT_EQ(std::string(e.what()),
+		          bad.calib + ": no such calibration file");
+	}
+}
+
+TEST(OdometryRun, ImuModeWithoutRicIsAConfigErrorNamingTheFile)
+{
+	const std::string d = bims::test::freshTmpDir("bims_test_source", "odom");
+	const std::string ini = d + "/no_ric.ini";
+	std::ofstream(ini) << "[odometry]\nmode = imu\n";
+	OdometryRunOptions o;
+	o.config = ini;
+	try
+	{
+		odometryConfig(o);
+		ADD_FAILURE() << "no error without R_IC";
+	}
+	catch (const bims::ConfigError& e)
+	{
+		EXPECT_EQ(std::string(e.what()).rfind(ini + ": [calibration] R_IC", 0),
+		          0u)
+		    << e.what();
+	}
+	o.mode = "vision";  // vision needs no R_IC
+	EXPECT_NO_THROW(odometryConfig(o));
+}
+
+TEST(OdometryRun, TrackerAgainstTruthCountsTracksWithinTwoPixels)
+{
+	// A wall 2 m ahead, the camera moves 0.1 m to the right: a feature
+	// moves 50 * 0.1 / 2 = 2.5 px to the left.
+	const cv::Mat depth(48, 64, CV_32FC1, cv::Scalar(2.0f));
+	Eigen::Matrix3d K;
+	K << 50, 0, 32, 0, 50, 24, 0, 0, 1;
+	bims::ego::FrameEgomotion r;
+	r.attempted = {{20, 20}, {30, 20}, {-10, -10}};  // the last: no depth
+	bims::ego::Track good, off;
+	good.prev = {20, 20};
+	good.cur = {17.6f, 20.3f};
+	off.prev = {30, 20};
+	off.cur = {29.0f, 20.0f};  // 1.5 px from the truth (27.5, 20): good too
+	bims::ego::Track far = off;
+	far.cur = {30.0f, 20.0f};  // 2.5 px from the truth
+	r.tracks = {good, off, far};
+	const mrpt::poses::CPose3D T(0.1, 0, 0, 0, 0, 0);
+	const auto t = trackerAgainstTruth(r, depth, K, T, 0.5);
+	EXPECT_EQ(t.attempted_with_depth, 2);
+	EXPECT_EQ(t.tracked_within_2px, 2);
+	EXPECT_NEAR(t.rate_deg_s, 0, 1e-9);
+	// 10 degrees of yaw in 0.5 s
+	const mrpt::poses::CPose3D R(0, 0, 0, 0, 10 * M_PI / 180, 0);
+	EXPECT_NEAR(trackerAgainstTruth(r, depth, K, R, 0.5).rate_deg_s, 20, 1e-9);
+}
+
+TEST(OdometryRun, CsvLineHasOneFieldPerHeaderColumn)
+{
+	bims::ego::FrameEgomotion r;
+	r.t = 12.5;
+	const std::string line = odometryCsvLine(r, {});
+	EXPECT_EQ(fields(line), fields(odometryCsvHeader()));
+	EXPECT_EQ(line.rfind("12.500000,", 0), 0u) << line;
+	EXPECT_NE(line.find(",nan,0,0,"), std::string::npos) << line;
+	EXPECT_EQ(line.substr(line.size() - 3), ",-\n");
+	r.anchor.why = "no keyframe";
+	EXPECT_EQ(odometryCsvLine(r, {1.5, 7, 3}).find(",1.500,7,3,") !=
+	              std::string::npos,
+	          true);
+}
+
+TEST(OdometryRun, RunsTheSampleIntoATrajectoryCsvAndSummary)
+{
+	const std::string d = bims::test::freshTmpDir("bims_test_source", "run");
+	OdometryRunOptions o;
+	o.config = kConfig;
+	o.rawlog = kSample;
+	o.out = d + "/traj.txt";
+	o.csv = d + "/frames.csv";
+	o.gt = kGt + "groundtruth.txt";
+	o.masks = kGt + "masks";
+	o.max_frames = 12;
+	o.progress = false;
+	testing::internal::CaptureStderr();
+	EXPECT_EQ(runOdometry(o), 0);
+	const std::string err = testing::internal::GetCapturedStderr();
+	EXPECT_EQ(err.rfind("bims-odom: 12 frames (0 flagged), ", 0), 0u) << err;
+	EXPECT_NE(err.find("bims-odom: masks of " + *o.masks +
+	                   " for 11 of 12 "
+	                   "frames\n"),
+	          std::string::npos)
+	    << err;
+	EXPECT_EQ(bims::loadTumTrajectory(o.out).size(), 12u);
+	const auto csv = lines(*o.csv);
+	ASSERT_EQ(csv.size(), 13u);
+	EXPECT_EQ(csv[0] + "\n", odometryCsvHeader());
+	int within2px = 0;
+	for (size_t i = 2; i < csv.size(); i++)
+	{
+		std::istringstream s(csv[i]);
+		std::string f;
+		for (int k = 0; k <= 12; k++) std::getline(s, f, ',');
+		within2px += std::stoi(f);
+	}
+	EXPECT_GT(within2px, 100);  // the tracker follows the truth
+
+	auto same = o;  // an output that is an input: refused before any work
+	same.csv = kSample;
+	EXPECT_THROW(runOdometry(same), bims::UsageError);
+	auto noMasks = o;
+	noMasks.masks = d + "/none";
+	EXPECT_THROW(runOdometry(noMasks), std::runtime_error);
+}
