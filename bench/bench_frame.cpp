@@ -135,11 +135,7 @@ void loadPair(const std::string& path, int frame)
 		if (!why.empty()) throw std::runtime_error(path + ": " + why);
 		f->grey = f->grey.clone();
 	}
-	auto& c = g_pair.cam;
-	c.ncols = g_pair.cur.grey.cols;
-	c.nrows = g_pair.cur.grey.rows;
-	const auto& K = g_pair.cur.K;
-	c.setIntrinsicParamsFromValues(K(0, 0), K(1, 1), K(0, 2), K(1, 2));
+	g_pair.cam = g_pair.cur.camera();
 }
 
 void benchDecode(bm::State& st)

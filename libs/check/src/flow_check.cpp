@@ -146,11 +146,7 @@ int runFlowCheck(const FlowCheckOptions& o)
 		ego::RgbdFrame f;
 		const std::string why = ego::rgbdFrameFrom(scan, cfg.ego.camera, f);
 		if (!why.empty()) throw std::runtime_error(why);
-		mrpt::img::TCamera cam;
-		cam.ncols = static_cast<uint32_t>(f.depth.cols);
-		cam.nrows = static_cast<uint32_t>(f.depth.rows);
-		cam.setIntrinsicParamsFromValues(f.K(0, 0), f.K(1, 1), f.K(0, 2),
-		                                 f.K(1, 2));
+		const mrpt::img::TCamera cam = f.camera();
 		const CPose3D G = *gtCur - *gtP;  // T_{C(t-1) C(t)}
 		const auto c =
 		    flow::checkPoseSources(r.flowObserved, f.depth, f.grey, cam,

@@ -62,6 +62,15 @@ std::string rgbdFrameFrom(const mrpt::obs::CObservation3DRangeScan& obs,
 	return {};
 }
 
+mrpt::img::TCamera RgbdFrame::camera() const
+{
+	mrpt::img::TCamera c;
+	c.ncols = static_cast<uint32_t>(grey.cols);
+	c.nrows = static_cast<uint32_t>(grey.rows);
+	c.setIntrinsicParamsFromValues(K(0, 0), K(1, 1), K(0, 2), K(1, 2));
+	return c;
+}
+
 std::string intrinsicsOf(const mrpt::obs::CObservation3DRangeScan& obs,
                          const CameraParams& cam, Eigen::Matrix3d& K)
 {

@@ -15,17 +15,6 @@ using Clock = std::chrono::steady_clock;
 namespace
 {
 
-/** Waits for a job's future when leaving a scope (also by an exception). */
-template <class T>
-struct WaitFor
-{
-	std::future<T>& f;
-	~WaitFor()
-	{
-		if (f.valid()) f.wait();
-	}
-};
-
 /** Queues \a job on \a worker; its result (or exception) in the future. */
 template <class F>
 auto postTask(SerialWorker& worker, F job)
@@ -37,14 +26,6 @@ auto postTask(SerialWorker& worker, F job)
 	return result;
 }
 
-mrpt::img::TCamera cameraOf(const ego::RgbdFrame& f)
-{
-	mrpt::img::TCamera c;
-	c.ncols = static_cast<uint32_t>(f.grey.cols);
-	c.nrows = static_cast<uint32_t>(f.grey.rows);
-	c.setIntrinsicParamsFromValues(f.K(0, 0), f.K(1, 1), f.K(0, 2), f.K(1, 2));
-	return c;
-}
 }  // namespace
 
 cv::Mat toMat(const maps::PixelMask& m, cv::Size size)
@@ -126,7 +107,7 @@ void Pipeline::startLookahead(const Next& next)
 	const Eigen::Matrix3d R = odom_.predictRotation(next_.t);
 	nextObserved_ =
 	    postTask(*flowThread_, [this, prevGrey = cur_.grey,
-	                            curGrey = next_.grey, cam = cameraOf(next_), R]
+	                            curGrey = next_.grey, cam = next_.camera(), R]
 	             { return observe(prevGrey, curGrey, cam, R); });
 	nextIndex_ = next.index;
 	nextAfter_ = nFrames_;
@@ -229,7 +210,7 @@ void Pipeline::startObservedFlow(FrameJobs& jobs)
 	// is the same as in sequence.
 	const Eigen::Matrix3d R_derot = odom_.predictRotation(cur_.t);
 	auto job = [this, prevGrey = prev_.grey, curGrey = cur_.grey,
-	            cam = cameraOf(cur_), R_derot]
+	            cam = cur_.camera(), R_derot]
 	{ return observe(prevGrey, curGrey, cam, R_derot); };
 	if (flowThread_)
 		jobs.observing = postTask(*flowThread_, job);
@@ -278,7 +259,7 @@ void Pipeline::flowLabels(FrameJobs* jobs, FrameResult& r,
 		const Observed o = jobs->observed();
 		r.ms.observed = o.ms;
 		const cv::Mat& obs = o.flow;
-		const auto cam = cameraOf(cur_);
+		const auto cam = cur_.camera();
 		if (cfg_.flow.refine_pose != flow::RefinePose::None)
 		{
 			r.flowPose = flow::refinePoseWithFlow(

@@ -22,6 +22,10 @@ struct RgbdFrame
 	cv::Mat grey;   ///< CV_8UC1
 	cv::Mat depth;  ///< CV_32FC1 optical-axis depth [m], 0 = no reading
 	Eigen::Matrix3d K = Eigen::Matrix3d::Identity();  ///< intrinsics [px]
+
+	/** K and the image size as MRPT's camera model (what the flow stage
+	 * takes). */
+	mrpt::img::TCamera camera() const;
 };
 
 /** Fills \a out from \a obs (intensity -> grey, rangeImage * rangeUnits ->
