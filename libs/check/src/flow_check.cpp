@@ -5,6 +5,7 @@
 #include <bims/ego/rgbd_input.h>
 #include <bims/eval/plots.h>
 #include <bims/eval/pose_utils.h>
+#include <bims/pipeline/mask_overlay.h>
 #include <bims/pipeline/run.h>
 
 #include <algorithm>
@@ -90,10 +91,7 @@ cv::Mat stripTile(const mrpt::obs::CObservation3DRangeScan& scan,
 		const cv::Mat c = scan.intensityImage.asCvMatRef();
 		if (c.channels() == 3 && c.size() == rgb.size()) rgb = c.clone();
 	}
-	cv::Mat red(rgb.size(), CV_8UC3, cv::Scalar(0, 0, 255));
-	cv::Mat blend;
-	cv::addWeighted(rgb, 0.45, red, 0.55, 0, blend);
-	blend.copyTo(rgb, mask > 0);
+	rgb = pipeline::overlayMoving(rgb, mask);
 	cv::putText(rgb, "frame " + std::to_string(index), {10, 30},
 	            cv::FONT_HERSHEY_SIMPLEX, 0.9, cv::Scalar(255, 255, 255), 2);
 	return rgb;

@@ -2,6 +2,7 @@
 #include <bims/common/config.h>
 #include <bims/common/share.h>
 #include <bims/grab/grab_app.h>
+#include <bims/pipeline/mask_overlay.h>
 
 #include <mrpt/gui/CDisplayWindow.h>
 #include <mrpt/system/filesystem.h>
@@ -17,14 +18,8 @@ mrpt::img::CImage preview(const mrpt::obs::CObservation3DRangeScan& scan,
                           const cv::Mat& mask)
 {
 	if (!scan.hasIntensityImage) return {};
-	cv::Mat bgr = scan.intensityImage.asCvMatRef().clone();
-	if (bgr.channels() == 1) cv::cvtColor(bgr, bgr, cv::COLOR_GRAY2BGR);
-	if (!mask.empty() && mask.size() == bgr.size())
-	{
-		cv::Mat red(bgr.size(), CV_8UC3, cv::Scalar(0, 0, 255)), mix;
-		cv::addWeighted(bgr, 0.5, red, 0.5, 0, mix);
-		mix.copyTo(bgr, mask);
-	}
+	const cv::Mat bgr =
+	    pipeline::overlayMoving(scan.intensityImage.asCvMatRef(), mask);
 	return mrpt::img::CImage(bgr, mrpt::img::DEEP_COPY);
 }
 

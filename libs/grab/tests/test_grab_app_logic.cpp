@@ -64,10 +64,10 @@ TEST(GrabPreview, TheMaskIsHalfRedOverTheImage)
 	ASSERT_EQ(p.type(), CV_8UC3);
 	EXPECT_EQ(p.at<cv::Vec3b>(0, 0), cv::Vec3b(100, 100, 100));
 	EXPECT_EQ(p.at<cv::Vec3b>(12, 12), cv::Vec3b(50, 50, 178));  // 50+127.5
-	// a mask of another size is not drawn
+	// a mask of another size is scaled to the image
 	const cv::Mat q =
 	    preview(scan, cv::Mat(20, 30, CV_8UC1, cv::Scalar(255))).asCvMatRef();
-	EXPECT_EQ(q.at<cv::Vec3b>(12, 12), cv::Vec3b(100, 100, 100));
+	EXPECT_EQ(q.at<cv::Vec3b>(0, 0), cv::Vec3b(50, 50, 178));
 }
 
 TEST(GrabbedFrames, CountsFramesWithoutSegmentation)

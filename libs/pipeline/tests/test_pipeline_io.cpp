@@ -1,5 +1,6 @@
 // bims-run's writing thread (internal class): order, a failed job stops the
 // rest and is reported.
+#include <bims/pipeline/mask_overlay.h>
 #include <gtest/gtest.h>
 
 #include <stdexcept>
@@ -56,4 +57,23 @@ TEST(SerialWorker, AFailedJobStopsTheRestAndIsReportedByPostAndDrain)
 		EXPECT_THROW(post(60), std::runtime_error);
 		EXPECT_EQ(seen.size(), 5u);
 	}
+}
+
+TEST(MaskOverlay, MovingPixelsHalfRedTheRestUnchanged)
+{
+	const cv::Mat grey(6, 8, CV_8UC1, cv::Scalar(100));
+	cv::Mat mask(6, 8, CV_8UC1, cv::Scalar(0));
+	mask.at<uint8_t>(2, 3) = 255;
+	const cv::Mat o = bims::pipeline::overlayMoving(grey, mask);
+	ASSERT_EQ(o.type(), CV_8UC3);
+	EXPECT_EQ(o.at<cv::Vec3b>(2, 3), cv::Vec3b(50, 50, 178));
+	EXPECT_EQ(o.at<cv::Vec3b>(0, 0), cv::Vec3b(100, 100, 100));
+	EXPECT_EQ(cv::countNonZero(o.reshape(1) != 100), 3);
+	// a mask of half the size covers the image, nearest
+	const cv::Mat half(3, 4, CV_8UC1, cv::Scalar(255));
+	const cv::Mat h = bims::pipeline::overlayMoving(grey, half);
+	EXPECT_EQ(cv::countNonZero(h.reshape(1) == 178), 6 * 8);
+	// no mask: the image as colour
+	const cv::Mat n = bims::pipeline::overlayMoving(grey, cv::Mat());
+	EXPECT_EQ(cv::countNonZero(n.reshape(1) != 100), 0);
 }

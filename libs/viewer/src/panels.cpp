@@ -1,3 +1,4 @@
+#include <bims/pipeline/mask_overlay.h>
 #include <bims/viewer/panels.h>
 
 #include <mrpt/img/CImage.h>
@@ -35,15 +36,11 @@ cv::Mat intensityBgr(const mrpt::obs::CObservation3DRangeScan& scan)
 
 cv::Mat overlayMask(const cv::Mat& bgr, const cv::Mat& maskIn)
 {
-	cv::Mat out = bgr.clone();
+	cv::Mat out = pipeline::overlayMoving(bgr, maskIn);
 	if (maskIn.empty() || bgr.empty()) return out;
 	cv::Mat mask = maskIn;
 	if (mask.size() != bgr.size())
 		cv::resize(maskIn, mask, bgr.size(), 0, 0, cv::INTER_NEAREST);
-	cv::Mat red(bgr.size(), CV_8UC3, cv::Scalar(0, 0, 255));
-	cv::Mat blended;
-	cv::addWeighted(bgr, 0.5, red, 0.5, 0, blended);
-	blended.copyTo(out, mask);
 	std::vector<std::vector<cv::Point>> contours;
 	cv::findContours(mask.clone(), contours, cv::RETR_EXTERNAL,
 	                 cv::CHAIN_APPROX_SIMPLE);
