@@ -15,13 +15,6 @@
 
 namespace bims::maps
 {
-size_t PixelMask::count() const
-{
-	size_t n = 0;
-	for (auto v : data) n += v != 0;
-	return n;
-}
-
 FrameStats& FrameStats::operator+=(const FrameStats& o)
 {
 	valid += o.valid;
