@@ -83,10 +83,12 @@ std::string RejectedImuSamples::check(const mrpt::obs::CObservationIMU& imu,
 	if (bad.empty()) return bad;
 	++n_;
 	stamps_.push_back(t);
-	std::fprintf(stderr,
-	             "%s: warning: %s: observation #%zu (IMU, t %.6f): %s; sample "
-	             "not used (%zu so far)\n",
-	             prog, path.c_str(), obsIndex, t, bad.c_str(), n_);
+	if (prog)
+		std::fprintf(
+		    stderr,
+		    "%s: warning: %s: observation #%zu (IMU, t %.6f): %s; sample "
+		    "not used (%zu so far)\n",
+		    prog, path.c_str(), obsIndex, t, bad.c_str(), n_);
 	return bad;
 }
 

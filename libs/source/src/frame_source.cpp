@@ -67,11 +67,13 @@ void FrameOrder::accept(SourceFrame&& f)
 void FrameOrder::dropHeld(const InputPlace& at, const char* why)
 {
 	st_.scansBadStamp++;
-	std::fprintf(stderr,
-	             "%s: warning: %s: 3D scan #%zu (t %.6f) is %.6g s after the "
-	             "previous scan and %s: a stray timestamp; skipped\n",
-	             p_.program.c_str(), at.path ? at.path->c_str() : "input",
-	             held_->index, held_->t, held_->t - lastScanT_, why);
+	if (p_.warnings)
+		std::fprintf(
+		    stderr,
+		    "%s: warning: %s: 3D scan #%zu (t %.6f) is %.6g s after the "
+		    "previous scan and %s: a stray timestamp; skipped\n",
+		    p_.program.c_str(), at.path ? at.path->c_str() : "input",
+		    held_->index, held_->t, held_->t - lastScanT_, why);
 	// the observations read before it stay, in order
 	input_.insert(input_.begin(), held_->before.begin(), held_->before.end());
 	held_.reset();
@@ -112,7 +114,9 @@ bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
 			return true;
 		}
 		st_.imuRead++;
-		if (rejected_.check(*imu, t, p_.program.c_str(), where, at.entry)
+		if (rejected_
+		        .check(*imu, t, p_.warnings ? p_.program.c_str() : nullptr,
+		               where, at.entry)
 		        .empty())
 		{
 			imu_.push_back(imu);
@@ -151,10 +155,12 @@ bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
 		if (t <= lastScanT_)
 		{
 			st_.scansOutOfOrder++;
-			std::fprintf(stderr,
-			             "%s: warning: %s: 3D scan #%zu has a timestamp not "
-			             "after the previous one; skipped\n",
-			             p_.program.c_str(), where.c_str(), idx);
+			if (p_.warnings)
+				std::fprintf(
+				    stderr,
+				    "%s: warning: %s: 3D scan #%zu has a timestamp not "
+				    "after the previous one; skipped\n",
+				    p_.program.c_str(), where.c_str(), idx);
 			return true;
 		}
 		if (scan->hasRangeImage)

@@ -247,3 +247,36 @@ TEST(FrameOrder, KeptInputWrittenBeforeEachFrameIsTheInputOrder)
 		if (o != in[3] && o != in[7]) want.push_back(o);
 	EXPECT_EQ(written, want);
 }
+
+TEST(FrameOrder, WithoutWarningsTheSameFramesAndCountsAndNothingOnStderr)
+{
+	// an out-of-order scan, a stray stamp and a NaN IMU sample: warned of
+	// by default, counted in silence for a pass that only indexes the input
+	const std::vector<CObservation::Ptr> in = {
+	    imu(0.9),   scan(1.0), imu(1.05, NAN), scan(1.1),
+	    scan(1.05), scan(40.), scan(1.2),      imu(1.3)};
+	auto once = [&](bool warnings, std::string& err)
+	{
+		FrameOrderParams p = params();
+		p.warnings = warnings;
+		FrameOrder order(p);
+		testing::internal::CaptureStderr();
+		const auto frames = run(order, in);
+		err = testing::internal::GetCapturedStderr();
+		std::vector<size_t> idx;
+		for (const auto& f : frames) idx.push_back(f.index);
+		const auto& s = order.stats();
+		idx.push_back(1000 + s.scansOutOfOrder);
+		idx.push_back(2000 + s.scansBadStamp);
+		idx.push_back(3000 + s.imuRejected);
+		return idx;
+	};
+	std::string loud, quiet;
+	const auto a = once(true, loud), b = once(false, quiet);
+	EXPECT_EQ(a, b);
+	EXPECT_EQ(a, (std::vector<size_t>{0, 1, 4, 1001, 2001, 3001}));
+	EXPECT_NE(loud.find("not after the previous one"), std::string::npos);
+	EXPECT_NE(loud.find("a stray timestamp"), std::string::npos);
+	EXPECT_NE(loud.find("sample not used"), std::string::npos);
+	EXPECT_EQ(quiet, "");
+}

@@ -11,6 +11,7 @@ ReplaySource::ReplaySource(const std::string& path, source::FrameOrderParams p)
 	source::FrameOrderParams index = p_;
 	index.depthCorrection.enable = false;  // the stamps are enough
 	index.program = "bims-viewer";
+	index.warnings = false;  // the replay warns, once per replay
 	source::RawlogFrameSource all({path_}, index, false);
 	while (auto f = all.next()) times_.push_back(f->t);
 	if (!all.error().empty()) throw RawlogError(all.error());

@@ -26,8 +26,8 @@ class RejectedImuSamples
 {
  public:
 	/** imuSampleProblem(imu); when not empty, a warning on stderr ("PROG:
-	 * warning: PATH: observation #N (IMU, t T): PROBLEM; sample not used")
-	 * and \a t [s] remembered. */
+	 * warning: PATH: observation #N (IMU, t T): PROBLEM; sample not used";
+	 * none when \a prog is null) and \a t [s] remembered. */
 	std::string check(const mrpt::obs::CObservationIMU& imu, double t,
 	                  const char* prog, const std::string& path,
 	                  size_t obsIndex);

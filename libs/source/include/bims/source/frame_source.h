@@ -74,6 +74,9 @@ struct FrameOrderParams
 {
 	/** The program named in the warnings ("bims-run: warning: ..."). */
 	std::string program = "bims";
+	/** Warn on stderr of what is skipped (counted in FrameOrderStats
+	 * either way): off for a pass that only indexes the input. */
+	bool warnings = true;
 	ego::SensorsParams sensors;
 	/** IMU stamp = camera stamp + offset for the same instant [s]. */
 	double imuOffsetS = 0;
