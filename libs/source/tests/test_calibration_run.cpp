@@ -5,6 +5,7 @@
 #include <bims/ego/flags.h>
 #include <bims/ego/so3.h>
 #include <bims/source/calibration_run.h>
+#include <bims_test/text.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 
@@ -41,14 +42,6 @@ bims::ego::FrameEgomotion frame(double t, uint32_t flags,
 Eigen::Matrix3d aboutZ(double rad)
 {
 	return Eigen::AngleAxisd(rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-}
-
-std::string slurp(const std::string& p)
-{
-	std::ifstream f(p);
-	std::stringstream s;
-	s << f.rdbuf();
-	return s.str();
 }
 }  // namespace
 
@@ -158,7 +151,8 @@ TEST(DepthCalibration, FitsAtTheTruePosesAndRefusesTheOdometrysOnTheSample)
 	o.out = d + "/depth.ini";
 	o.progress = false;
 	ASSERT_EQ(runDepthCalibration(o), 0);
-	EXPECT_NE(slurp(o.out).find("[depth_correction]"), std::string::npos);
+	EXPECT_NE(bims::test::fileText(o.out).find("[depth_correction]"),
+	          std::string::npos);
 	// the vision odometry of the 320 x 240 sample is too poor: refused
 	o.poses.clear();
 	o.out = d + "/refused.ini";
