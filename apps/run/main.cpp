@@ -10,14 +10,11 @@
 // segmented.rawlog (masks as pixel labels), frames.csv, metrics.json,
 // effective.ini (every parameter used), and prints a summary table.
 // --print-config prints that effective.ini (of CONFIG.ini, or of the built-in
-// defaults) and exits. See docs/pipeline.md and docs/config.md.
+// defaults) and exits. See docs/pipeline.md and docs/config.md. The run:
+// bims::pipeline::runFromCommandLine (run.h).
 #include <bims/common/app.h>
-#include <bims/common/output_paths.h>
 #include <bims/pipeline/run.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
-
-#include <csignal>
-#include <cstdio>
 
 int main(int argc, char** argv)
 {
@@ -61,60 +58,12 @@ int main(int argc, char** argv)
 		        "[CONFIG.ini]",
 		        cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
-		    auto inputs = aIn.getValue();
-		    inputs.push_back(aCfg.getValue());
-		    bims::checkOutputsSpareInputs(inputs, {aOut.getValue()});
-
-		    bims::pipeline::ExperimentConfig cfg;
-		    cfg.loadFromFile(aCfg.getValue());
-		    if (aVariant.isSet())
-		    {
-			    try
-			    {
-				    cfg.setVariant(bims::parseChoice<bims::pipeline::Variant>(
-				        aVariant.getValue()));
-			    }
-			    catch (const std::invalid_argument& e)
-			    {
-				    throw bims::UsageError(std::string("--variant: ") +
-				                           e.what());
-			    }
-		    }
-		    bims::pipeline::RunOptions opt;
-		    opt.rawlogs = aIn.getValue();
-		    opt.outDir = aOut.getValue();
-		    opt.progress = !aQuiet.getValue();
-		    // SIGINT / SIGTERM: stop after the current frame, write it all
-		    opt.stop = &bims::installStopSignals();
-		    opt.frames = bims::pipeline::frameRangeOption(
-		        aFrames.getValue(), opt.rawlogs, cfg.ego.sensors.rgbd_label);
-		    const size_t cleared = bims::prepareOutputFolder(
-		        opt.outDir, bims::pipeline::runOutputLayout(),
-		        aOverwrite.getValue());
-		    if (cleared)
-			    std::fprintf(stderr,
-			                 "bims-run: --overwrite: removed the %zu files of "
-			                 "an earlier run from %s\n",
-			                 cleared, opt.outDir.c_str());
-		    const auto sum = bims::pipeline::runExperiment(cfg, opt);
-		    std::printf("%s", bims::pipeline::formatSummary(sum).c_str());
-		    std::printf(
-		        "outputs in %s/ (trajectory.txt, masks/, metrics.json, ...)\n",
-		        opt.outDir.c_str());
-		    if (!sum.error.empty())
-			    std::fprintf(stderr, "bims-run: error: %s\n",
-			                 sum.error.c_str());
-		    if (sum.interrupted)
-		    {
-			    const int sig = bims::stopSignal();
-			    std::fprintf(stderr,
-			                 "bims-run: interrupted by %s after %zu frames: "
-			                 "their outputs are complete, metrics.json says "
-			                 "\"status\": \"interrupted\"\n",
-			                 sig == SIGTERM ? "SIGTERM" : "SIGINT",
-			                 sum.framesProcessed);
-			    return 128 + (sig ? sig : SIGINT);
-		    }
-		    return sum.error.empty() ? 0 : 1;
+		    return bims::pipeline::runFromCommandLine(
+		        {aCfg.getValue(), aIn.getValue(), aOut.getValue(),
+		         aFrames.getValue(), bims::givenValue(aVariant),
+		         aOverwrite.getValue(), !aQuiet.getValue(),
+		         // SIGINT / SIGTERM: stop after the current frame, write it
+		         // all
+		         bims::installStopSignals});
 	    });
 }

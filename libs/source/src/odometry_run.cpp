@@ -16,19 +16,23 @@
 
 namespace bims::source
 {
+void overrideSensorSectionsFrom(ego::EgoConfig& ec, const std::string& calib,
+                                const std::string& noSuch)
+{
+	if (!mrpt::system::fileExists(calib))
+		throw UsageError(calib + ": no such " + noSuch);
+	checkIniFile(calib);
+	mrpt::config::CConfigFile cal(calib);
+	checkExperimentSections(cal);
+	ec.overrideSensorSections(cal);
+}
+
 ego::EgoConfig odometryConfig(const OdometryRunOptions& o)
 {
 	ego::EgoConfig ec;
 	ec.loadFromFile(o.config);
 	if (!o.calib.empty())
-	{
-		if (!mrpt::system::fileExists(o.calib))
-			throw UsageError(o.calib + ": no such calibration file");
-		checkIniFile(o.calib);
-		mrpt::config::CConfigFile cal(o.calib);
-		checkExperimentSections(cal);
-		ec.overrideSensorSections(cal);
-	}
+		overrideSensorSectionsFrom(ec, o.calib, "calibration file");
 	if (o.mode)
 	{
 		try

@@ -1,6 +1,8 @@
 // Reading what a program printed, for tests.
 #pragma once
 
+#include <fstream>
+#include <sstream>
 #include <string>
 
 namespace bims::test
@@ -14,5 +16,14 @@ inline std::string restOfLineAfter(const std::string& text,
 	if (at == std::string::npos) return {};
 	const auto from = at + head.size();
 	return text.substr(from, text.find('\n', from) - from);
+}
+
+/** The whole text of the file at \a path ("" when it cannot be read). */
+inline std::string fileText(const std::string& path)
+{
+	std::ifstream f(path);
+	std::stringstream s;
+	s << f.rdbuf();
+	return s.str();
 }
 }  // namespace bims::test

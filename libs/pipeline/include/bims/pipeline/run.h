@@ -11,6 +11,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,23 +20,10 @@ namespace bims::pipeline
 /** Inclusive range of 3D-scan indices ("A:B", "A:" or ":B"). */
 using source::FrameRange;
 
-/** For --frames A:B, before any work: throws UsageError naming the range
- * and the inputs' 3D-scan count unless \a rawlogs hold the scans A to B
- * (A, when open-ended). Reads them up to that scan (bims::count3DScans),
- * counting the scans with label \a rgbdLabel (all when empty), as
- * runExperiment numbers them. Nothing to check for the whole input, nor
- * when an input cannot be read that far (missing, truncated): the run
- * reports that as it would without a range. */
-void checkFrameRangeInInputs(const FrameRange& range,
-                             const std::vector<std::string>& rawlogs,
-                             const std::string& rgbdLabel);
-
-/** A program's --frames option: \a text "" (not given) is the whole input;
- * otherwise parsed (bad text: UsageError naming it) and checked against
- * the inputs (checkFrameRangeInInputs). */
-FrameRange frameRangeOption(const std::string& text,
-                            const std::vector<std::string>& rawlogs,
-                            const std::string& rgbdLabel);
+/** A program's --frames option and its check against the inputs (one home:
+ * bims/source/frame_source.h). */
+using source::checkFrameRangeInInputs;
+using source::frameRangeOption;
 
 /** Median and 95th percentile of a series. */
 struct Percentiles
@@ -129,5 +117,40 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt);
 
 /** The summary as an aligned text table. */
 std::string formatSummary(const RunSummary& s);
+
+/** What bims-run's command line gives (bims-run CONFIG.ini IN.rawlog...
+ * -o OUTDIR). */
+struct RunCommand
+{
+	std::string config;                ///< experiment .ini
+	std::vector<std::string> rawlogs;  ///< read one after the other
+	std::string outDir;                ///< output folder
+	std::string frames;                ///< --frames A:B ("": all)
+	/** --variant NAME, overriding [pipeline] variant */
+	std::optional<std::string> variant;
+	bool overwrite = false;  ///< clear an earlier run's outputs in outDir
+	bool progress = true;    ///< progress line on stderr
+	/** Called once the config is read, before the frame range is checked:
+	 * the flag that stops the run after the current frame when it turns
+	 * true (main(): bims::installStopSignals; a signal before it still ends
+	 * the program at once). Empty: never stopped. */
+	std::function<const std::atomic<bool>&()> installStop;
+};
+
+/** --variant \a name: cfg.setVariant of the parsed name; a bad name is a
+ * UsageError "--variant: ..." naming the choices. */
+void applyVariantOption(ExperimentConfig& cfg, const std::string& name);
+
+/** bims-run's exit code for a finished run: 128 + \a signal when it was
+ * interrupted (SIGINT's when \a signal is 0), 1 when an error stopped it,
+ * else 0. */
+int runExitCode(const RunSummary& s, int signal);
+
+/** bims-run: checks that no output is an input, reads the config (and
+ * --variant), checks the frame range, prepares the output folder (the
+ * --overwrite note on stderr), runs the experiment, prints the summary and
+ * where the outputs are, and the error or the interruption on stderr
+ * (stopSignal() names the signal). Returns the exit code (runExitCode). */
+int runFromCommandLine(const RunCommand& c);
 
 }  // namespace bims::pipeline

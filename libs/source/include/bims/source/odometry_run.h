@@ -37,6 +37,13 @@ struct OdometryRunOptions
 	bool progress = true;   ///< progress line on stderr
 };
 
+/** Overrides \a ec's [calibration] [camera] [sensors] with those of the
+ * .ini \a calib (checked as strictly as the config: checkIniFile,
+ * checkExperimentSections); throws UsageError "CALIB: no such NOUN" (\a
+ * noSuch: the NOUN) when it does not exist. bims-odom, bims-calib-imu. */
+void overrideSensorSectionsFrom(ego::EgoConfig& ec, const std::string& calib,
+                                const std::string& noSuch);
+
 /** The configuration bims-odom runs: \a o.config, then \a o.calib's sensor
  * sections, --mode and --gyro-aid. Throws UsageError for a missing --calib
  * file or a bad --mode / --gyro-aid value, ConfigError when mode imu has

@@ -1,0 +1,72 @@
+// bims-run's command: the options of its command line into a run
+// (runExperiment) and its report.
+#include <bims/common/app.h>
+#include <bims/common/choice.h>
+#include <bims/common/output_paths.h>
+#include <bims/pipeline/run.h>
+
+#include <csignal>
+#include <cstdio>
+#include <stdexcept>
+
+namespace bims::pipeline
+{
+void applyVariantOption(ExperimentConfig& cfg, const std::string& name)
+{
+	try
+	{
+		cfg.setVariant(parseChoice<Variant>(name));
+	}
+	catch (const std::invalid_argument& e)
+	{
+		throw UsageError(std::string("--variant: ") + e.what());
+	}
+}
+
+int runExitCode(const RunSummary& s, int signal)
+{
+	if (s.interrupted) return 128 + (signal ? signal : SIGINT);
+	return s.error.empty() ? 0 : 1;
+}
+
+int runFromCommandLine(const RunCommand& c)
+{
+	auto inputs = c.rawlogs;
+	inputs.push_back(c.config);
+	checkOutputsSpareInputs(inputs, {c.outDir});
+
+	ExperimentConfig cfg;
+	cfg.loadFromFile(c.config);
+	if (c.variant) applyVariantOption(cfg, *c.variant);
+	RunOptions opt;
+	opt.rawlogs = c.rawlogs;
+	opt.outDir = c.outDir;
+	opt.progress = c.progress;
+	if (c.installStop) opt.stop = &c.installStop();
+	opt.frames =
+	    frameRangeOption(c.frames, opt.rawlogs, cfg.ego.sensors.rgbd_label);
+	const size_t cleared =
+	    prepareOutputFolder(opt.outDir, runOutputLayout(), c.overwrite);
+	if (cleared)
+		std::fprintf(stderr,
+		             "bims-run: --overwrite: removed the %zu files of an "
+		             "earlier run from %s\n",
+		             cleared, opt.outDir.c_str());
+	const auto sum = runExperiment(cfg, opt);
+	std::printf("%s", formatSummary(sum).c_str());
+	std::printf("outputs in %s/ (trajectory.txt, masks/, metrics.json, ...)\n",
+	            opt.outDir.c_str());
+	if (!sum.error.empty())
+		std::fprintf(stderr, "bims-run: error: %s\n", sum.error.c_str());
+	const int sig = stopSignal();
+	if (sum.interrupted)
+		std::fprintf(stderr,
+		             "bims-run: interrupted by %s after %zu frames: their "
+		             "outputs are complete, metrics.json says \"status\": "
+		             "\"interrupted\"\n",
+		             sig == SIGTERM ? "SIGTERM" : "SIGINT",
+		             sum.framesProcessed);
+	return runExitCode(sum, sig);
+}
+
+}  // namespace bims::pipeline

@@ -1,0 +1,211 @@
+#include <bims/common/app.h>
+#include <bims/common/output_paths.h>
+#include <bims/common/trajectory.h>
+#include <bims/ego/flags.h>
+#include <bims/ego/so3.h>
+#include <bims/source/calibration_run.h>
+#include <bims/source/frame_source.h>
+#include <bims/source/odometry_run.h>
+
+#include <mrpt/system/filesystem.h>
+
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+
+namespace bims::source
+{
+void RotationPairCollector::addFrame(const ego::FrameEgomotion& r)
+{
+	if (r.ok() && !(r.flags & ego::kFlagFirstFrame) && std::isfinite(tPrev_))
+	{
+		const auto R_I = ego::integrateGyro(imu_, tPrev_ + off_, r.t + off_);
+		if (R_I)
+		{
+			Eigen::Matrix3d R_C;
+			for (int i = 0; i < 3; i++)
+				for (int j = 0; j < 3; j++)
+					R_C(i, j) = r.T_CprevC.getRotationMatrix()(i, j);
+			pairs_.push_back({*R_I, R_C});
+		}
+	}
+	if (!(r.flags & ego::kFlagOutOfOrder)) tPrev_ = r.t;
+	while (imu_.size() > 2 && imu_[1].t < tPrev_ + off_ - 0.5) imu_.pop_front();
+}
+
+std::string imuCalibrationIni(const Eigen::Matrix3d& R_IC, double time_offset_s,
+                              const std::string& rawlog)
+{
+	std::ostringstream f;
+	f << "# bims-calib-imu estimate from " << rawlog << "\n"
+	  << "[calibration]\n; p_I = R_IC p_C, row major\nR_IC =";
+	char buf[32];
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < 3; j++)
+		{
+			std::snprintf(buf, sizeof(buf), " %.9f", R_IC(i, j));
+			f << buf;
+		}
+	f << "\ntime_offset_s = " << time_offset_s << "\n";
+	return f.str();
+}
+
+int runImuCalibration(const ImuCalibrationOptions& o)
+{
+	checkOutputsSpareInputs(
+	    {o.config, o.rawlog, o.calib},
+	    o.out ? std::vector<std::string>{*o.out} : std::vector<std::string>{});
+	ego::EgoConfig ec;
+	ec.loadFromFile(o.config);
+	if (!o.calib.empty()) overrideSensorSectionsFrom(ec, o.calib, "file");
+	const bool haveRef = ec.calibration.has_R_IC;
+	const Eigen::Matrix3d R_ref = ec.calibration.R_IC;
+	// Vision only, and R_IC unknown to the odometry (no gyro aid from it).
+	ec.odometry.mode = ego::OdometryMode::Vision;
+	ec.calibration.has_R_IC = false;
+	ego::Odometry odo(ec);
+
+	const double off = ec.calibration.time_offset_s;
+	RotationPairCollector pairs(off);
+	ReplayOptions ro;
+	ro.progress = o.progress;
+	ro.imu_wait_s = 0.5;
+	const auto st = replayRawlog(
+	    o.rawlog, odo,
+	    [&](const ego::FrameEgomotion& r, const auto&) { pairs.addFrame(r); },
+	    ro, [&](const ego::ImuSample& s) { pairs.addImu(s); });
+	if (st.imu == 0)
+		throw std::runtime_error(
+		    o.rawlog + ": no IMU observation (check [sensors] imu_label)");
+
+	const auto res =
+	    ego::estimateRotationIC(pairs.pairs(), o.min_angle_deg, o.inlier_deg);
+	std::printf(
+	    "bims-calib-imu: %zu frames, %zu IMU samples, %zu frame pairs, %d "
+	    "rotating > %.2f deg, %d inliers, residual RMS %.3f deg, "
+	    "conditioning %.3f\n",
+	    st.frames, st.imu, pairs.pairs().size(), res.informative,
+	    o.min_angle_deg, res.inliers, res.rms_deg, res.conditioning);
+	if (!res.ok)
+		throw std::runtime_error(
+		    "R_IC not observable from this sequence (too few informative "
+		    "pairs, or rotation about a single axis): rotate the rig about "
+		    "at least two axes");
+	std::printf("R_IC =");
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < 3; j++) std::printf(" %.6f", res.R_IC(i, j));
+	std::printf("\n");
+	if (haveRef)
+		std::printf("bims-calib-imu: angle to the configured R_IC: %.3f deg\n",
+		            ego::angleSO3(R_ref.transpose() * res.R_IC) * 180 / M_PI);
+	if (o.out)
+		writeFileAtomically(*o.out, imuCalibrationIni(res.R_IC, off, o.rawlog));
+	return 0;
+}
+
+double largestDepthCorrection(const ego::DepthCorrectionParams& p,
+                              const Eigen::Matrix3d& K, cv::Size size)
+{
+	ego::DepthCorrection dc(p);
+	double worst = 0;
+	cv::Mat fac = dc.factors(K, size);
+	cv::minMaxLoc(cv::abs(fac - 1), nullptr, &worst);
+	return worst;
+}
+
+int runDepthCalibration(const DepthCalibrationOptions& o)
+{
+	checkOutputsSpareInputs({o.config, o.rawlog, o.poses}, {o.out});
+	ego::EgoConfig ec;
+	ec.loadFromFile(o.config);
+	// raw depth, frame-to-frame vision odometry
+	ec.odometry.mode = ego::OdometryMode::Vision;
+	ec.anchor.enable = false;
+	ec.depth_correction.enable = false;
+	// (the same A:B rule as bims-run's)
+	const FrameRange range =
+	    frameRangeOption(o.frames, {o.rawlog}, ec.sensors.rgbd_label);
+	const size_t first = range.first, last = range.last;
+	Trajectory known;
+	if (!o.poses.empty()) known = loadTumTrajectory(o.poses);
+
+	ego::Odometry odo(ec);
+	std::vector<ego::RgbdFrame> frames;
+	std::vector<Eigen::Matrix4d> poses;
+	size_t index = 0, noPose = 0;
+	ReplayOptions ro;
+	ro.progress = o.progress;
+	if (last != static_cast<size_t>(-1)) ro.max_frames = last + 1;
+	replayRawlog(
+	    o.rawlog, odo,
+	    [&](const ego::FrameEgomotion& r,
+	        const mrpt::obs::CObservation3DRangeScan& scan)
+	    {
+		    const size_t i = index++;
+		    if (i < first || i > last) return;
+		    if (r.flags & (ego::kFlagOutOfOrder | ego::kFlagBadImage)) return;
+		    mrpt::poses::CPose3D T = r.T_WC;
+		    if (!known.empty())
+		    {
+			    const StampedPose* p = poseNear(known, r.t, 5e-3);
+			    if (!p)
+			    {
+				    ++noPose;
+				    return;
+			    }
+			    T = p->T_WC;
+		    }
+		    ego::RgbdFrame f;
+		    if (!ego::rgbdFrameFrom(scan, ec.camera, f).empty()) return;
+		    frames.push_back(std::move(f));
+		    poses.push_back(
+		        T.getHomogeneousMatrixVal<mrpt::math::CMatrixDouble44>()
+		            .asEigen());
+	    },
+	    ro);
+	if (frames.empty())
+		throw std::runtime_error(
+		    o.rawlog +
+		    ": no usable RGB-D frame in the range (check --frames, "
+		    "[sensors] rgbd_label" +
+		    std::string(known.empty() ? ")" : ", --poses stamps)"));
+	const ego::DepthFitResult res = ego::estimateDepthCorrection(frames, poses);
+	std::printf(
+	    "bims-calib-depth: %zu frames (%zu without a pose), %d pairs, "
+	    "%zu residuals; robust RMS point-to-plane %.4f -> %.4f m\n"
+	    "bims-calib-depth: correction (1 + delta): left %+.2f %%, right "
+	    "%+.2f %%, top %+.2f %%, bottom %+.2f %%, top-left corner %+.2f %%\n",
+	    frames.size(), noPose, res.pairs, res.residuals, res.rms_before_m,
+	    res.rms_after_m, 100 * res.left, 100 * res.right, 100 * res.top,
+	    100 * res.bottom, 100 * res.corner);
+	// A sensor's distortion is a few percent: a larger fit absorbed pose
+	// errors (a poor odometry, or moving objects in the stretch).
+	const ego::RgbdFrame& f0 = frames.front();
+	const double worst =
+	    largestDepthCorrection(res.params, f0.K, f0.depth.size());
+	if (worst > o.max_correction)
+	{
+		char msg[400];
+		std::snprintf(
+		    msg, sizeof(msg),
+		    "the fitted correction reaches %.1f %% (limit --max-correction "
+		    "%.1f %%): the %s do not fit a static scene well enough; give "
+		    "--poses (e.g. ground truth) or a slower, longer static stretch "
+		    "(nothing written)",
+		    100 * worst, 100 * o.max_correction,
+		    known.empty() ? "odometry's poses" : "given poses");
+		throw std::runtime_error(msg);
+	}
+	char note[512];
+	std::snprintf(note, sizeof(note),
+	              "# bims-calib-depth: %zu frames of %s (%s poses), robust "
+	              "RMS %.4f -> %.4f m\n",
+	              frames.size(),
+	              mrpt::system::extractFileName(o.rawlog).c_str(),
+	              known.empty() ? "vision odometry" : "given", res.rms_before_m,
+	              res.rms_after_m);
+	writeFileAtomically(o.out, res.params.toIni(note));
+	return 0;
+}
+
+}  // namespace bims::source
