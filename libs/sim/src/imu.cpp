@@ -4,6 +4,8 @@
 #include <bims/sim/imu.h>
 #include <bims/sim/rng.h>
 #include <mrpt/system/datetime.h>
+
+#include <Eigen/SVD>
 #include "ini_vector.h"
 
 #include <cmath>
@@ -252,6 +254,43 @@ std::string imuTruthLine(const ImuTruth& t)
 	              t.q_WI.x(), t.q_WI.y(), t.q_WI.z(), t.q_WI.w(), t.magBias.x(),
 	              t.magBias.y(), t.magBias.z());
 	return buf;
+}
+
+void loadSynthCalibration(const mrpt::config::CConfigFileBase& cfg,
+                          ImuParams& imu)
+{
+	if (!cfg.sectionExists("calibration")) return;
+	ConfigSection s(cfg, "calibration");
+	if (s.has("R_IC"))
+	{
+		const auto v = s.getDoubles("R_IC", {}, 9, -1.0001, 1.0001);
+		Eigen::Matrix3d M;
+		M << v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8];
+		Eigen::JacobiSVD<Eigen::Matrix3d> svd(
+		    M, Eigen::ComputeFullU | Eigen::ComputeFullV);
+		const Eigen::Matrix3d R = svd.matrixU() * svd.matrixV().transpose();
+		if ((R - M).norm() > 1e-3 || R.determinant() < 0)
+			s.fail("R_IC", "not a rotation matrix");
+		imu.R_IC = R;
+	}
+	else if (s.has("R_IC_ypr_deg"))
+	{
+		const auto y = s.getDoubles("R_IC_ypr_deg", {}, 3, -360, 360);
+		imu.setR_IC_ypr(y[0], y[1], y[2]);
+	}
+	imu.timeOffsetS = s.getDouble("time_offset_s", 0.0, -10.0, 10.0);
+}
+
+std::vector<mrpt::obs::CObservation::Ptr> synthesizeImportImu(
+    const Trajectory& gt, const std::string& label,
+    const mrpt::config::CConfigFileBase* calibration, uint64_t seed)
+{
+	ImuParams imu;
+	imu.label = label;
+	if (calibration) loadSynthCalibration(*calibration, imu);
+	std::vector<mrpt::obs::CObservation::Ptr> obs;
+	for (auto& o : synthesizeImu(gt, imu, seed)) obs.push_back(o);
+	return obs;
 }
 
 void saveImuTruth(const std::string& path, const std::vector<ImuTruth>& truth)

@@ -143,6 +143,22 @@ std::vector<mrpt::obs::CObservationIMU::Ptr> synthesizeImu(
     const Trajectory& trajectory, const ImuParams& params, uint64_t seed,
     std::vector<ImuTruth>* truth = nullptr);
 
+/** R_IC and time_offset_s of a synthetic IMU from [calibration] of \a cfg
+ * (no section: \a imu unchanged): either the egomotion module's key R_IC
+ * (9 reals, row major, p_I = R_IC p_C; ConfigError if not a rotation) or
+ * the simulator's R_IC_ypr_deg. Not strict about other keys: the section
+ * belongs to those modules, whose readers are. */
+void loadSynthCalibration(const mrpt::config::CConfigFileBase& cfg,
+                          ImuParams& imu);
+
+/** IMU readings synthesised from the ground truth \a gt (T_WC) of an
+ * imported recording (bims-import-tum --synth-imu): the default IMU labelled
+ * \a label (+ "_SYNTH"), R_IC and time_offset_s from \a calibration
+ * (loadSynthCalibration; nullptr: the defaults), \a seed. */
+std::vector<mrpt::obs::CObservation::Ptr> synthesizeImportImu(
+    const Trajectory& gt, const std::string& label,
+    const mrpt::config::CConfigFileBase* calibration, uint64_t seed);
+
 /** Writes the true IMU values as a text table (imuTruthHeader(), then one
  * imuTruthLine() per sample). Throws std::runtime_error on I/O failure. */
 void saveImuTruth(const std::string& path, const std::vector<ImuTruth>& truth);

@@ -1,0 +1,81 @@
+#include <bims/common/app.h>
+#include <bims/common/output_paths.h>
+#include <bims/eval/pose_utils.h>
+#include <bims/eval/tum_import_run.h>
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/core/format.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <stdexcept>
+
+namespace bims::eval
+{
+std::string importReport(const std::string& out, const ImportSummary& sum,
+                         bool synthetic, bool bonnConverted)
+{
+	std::string r = mrpt::format(
+	    "%s: %zu RGB-D frames, %zu IMU observations%s\n", out.c_str(),
+	    sum.frames, sum.imu, synthetic ? " (synthetic)" : "");
+	if (sum.gtPoses || sum.framesWithoutGt)
+		r += mrpt::format(
+		    "%s/groundtruth.txt: %zu poses (T_WC at the frames' stamps%s), "
+		    "%zu frames outside the ground truth\n",
+		    sum.gtDir.c_str(), sum.gtPoses,
+		    bonnConverted ? ", Bonn-converted" : "", sum.framesWithoutGt);
+	else
+		r += mrpt::format("%s: no groundtruth.txt in the folder\n",
+		                  sum.gtDir.c_str());
+	return r;
+}
+
+int runImport(const ImportRunOptions& o)
+{
+	checkOutputsSpareInputs({o.folder, o.config.value_or("")},
+	                        {o.out, groundTruthDirFor(o.out)});
+	if (o.gz < 0 || o.gz > 9) throw UsageError("--gz must be in 0..9");
+	ImportParams params;
+	std::unique_ptr<mrpt::config::CConfigFile> cfg;
+	if (o.config)
+	{
+		if (!std::filesystem::exists(*o.config))
+			throw std::runtime_error(*o.config + ": config file not found");
+		cfg = std::make_unique<mrpt::config::CConfigFile>(*o.config);
+		params.loadFromConfigFile(*cfg);
+	}
+	else
+		std::fprintf(stderr,
+		             "bims-import-tum: no --config: using the TUM default "
+		             "camera (fx=fy=525, cx=319.5, cy=239.5, 640x480, depth "
+		             "scale 5000)\n");
+
+	ImportOptions opt;
+	opt.maxFrames = o.max_frames;
+	opt.bonnGt = o.bonn_gt;
+	opt.gzLevel = o.gz;
+	opt.progress = o.progress;
+	const bool bonnConverted = opt.bonnGt || params.bonnGt;
+	if (o.synth_imu)
+	{
+		if (!o.synthesize)
+			throw UsageError(
+			    "--synth-imu: this build has no simulator library (libs/sim)");
+		const auto tum = readTumFolder(o.folder, params);
+		if (!tum.hasGroundTruth)
+			throw std::runtime_error(
+			    o.folder +
+			    ": --synth-imu needs groundtruth.txt to synthesise from");
+		Trajectory gt = tum.groundTruth;
+		if (bonnConverted)
+			for (auto& p : gt) p.T_WC = bonnMarkerToCamera(p.T_WC);
+		opt.extra = o.synthesize(gt, params.imuLabel, cfg.get(), o.seed);
+	}
+
+	const auto sum = importTum(o.folder, o.out, params, opt);
+	std::fputs(importReport(o.out, sum, o.synth_imu, bonnConverted).c_str(),
+	           stdout);
+	return 0;
+}
+
+}  // namespace bims::eval

@@ -1,0 +1,147 @@
+// bims-import-tum's run (tum_import_run.h) called directly: the report,
+// the option checks and the synthetic IMU asked of the program's hook.
+#include <bims/common/app.h>
+#include <bims/common/rawlog.h>
+#include <bims/common/trajectory.h>
+#include <bims/eval/pose_utils.h>
+#include <bims/eval/tum_import_run.h>
+#include <bims_test/tmp_dir.h>
+#include <gtest/gtest.h>
+#include <mrpt/obs/CObservationIMU.h>
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+
+namespace
+{
+namespace fs = std::filesystem;
+
+/** A TUM folder of two 640x480 frames at t = 1.0 and 1.1, with a
+ * groundtruth.txt of 6 poses over [0.9, 1.4] when \a withGt. */
+std::string tumFolder(const std::string& name, bool withGt)
+{
+	const auto d = bims::test::freshTmpDir("bims_test_import_run", name);
+	fs::create_directories(d + "/rgb");
+	fs::create_directories(d + "/depth");
+	for (const char* f : {"a", "b"})
+	{
+		cv::imwrite(d + "/rgb/" + f + ".png",
+		            cv::Mat(480, 640, CV_8UC3, cv::Scalar(9, 9, 9)));
+		cv::imwrite(d + "/depth/" + f + ".png",
+		            cv::Mat(480, 640, CV_16UC1, cv::Scalar(5000)));
+	}
+	std::ofstream(d + "/rgb.txt") << "1.0 rgb/a.png\n1.1 rgb/b.png\n";
+	std::ofstream(d + "/depth.txt") << "1.0 depth/a.png\n1.1 depth/b.png\n";
+	if (withGt)
+	{
+		std::ofstream gt(d + "/groundtruth.txt");
+		for (int i = 0; i < 6; i++)
+			gt << 0.9 + 0.1 * i << " " << 0.01 * i << " 0 0 0 0 0 1\n";
+	}
+	return d;
+}
+
+/** The message of the exception of type E that runImport(o) throws. */
+template <class E>
+std::string errorOf(const bims::eval::ImportRunOptions& o)
+{
+	try
+	{
+		bims::eval::runImport(o);
+	}
+	catch (const E& e)
+	{
+		return e.what();
+	}
+	return "";
+}
+}  // namespace
+
+TEST(ImportRun, TheReportNamesFramesImuAndGroundTruth)
+{
+	bims::eval::ImportSummary s;
+	s.frames = 3;
+	s.imu = 7;
+	s.gtDir = "x_gt";
+	EXPECT_EQ(bims::eval::importReport("x.rawlog", s, false, false),
+	          "x.rawlog: 3 RGB-D frames, 7 IMU observations\n"
+	          "x_gt: no groundtruth.txt in the folder\n");
+	s.gtPoses = 2;
+	s.framesWithoutGt = 1;
+	EXPECT_EQ(bims::eval::importReport("x.rawlog", s, true, true),
+	          "x.rawlog: 3 RGB-D frames, 7 IMU observations (synthetic)\n"
+	          "x_gt/groundtruth.txt: 2 poses (T_WC at the frames' stamps, "
+	          "Bonn-converted), 1 frames outside the ground truth\n");
+}
+
+TEST(ImportRun, BadOptionsAreErrorsBeforeAnyOutput)
+{
+	const auto d = tumFolder("bad", false);
+	bims::eval::ImportRunOptions o;
+	o.folder = d;
+	o.out = d + "/x.rawlog";
+	o.progress = false;
+	o.gz = 10;
+	EXPECT_EQ(errorOf<bims::UsageError>(o), "--gz must be in 0..9");
+	o.gz = 0;
+	o.config = d + "/none.ini";
+	EXPECT_EQ(errorOf<std::runtime_error>(o),
+	          d + "/none.ini: config file not found");
+	o.config.reset();
+	o.synth_imu = true;
+	EXPECT_EQ(errorOf<bims::UsageError>(o),
+	          "--synth-imu: this build has no simulator library (libs/sim)");
+	o.synthesize = [](auto&&...)
+	{ return std::vector<mrpt::obs::CObservation::Ptr>{}; };
+	EXPECT_EQ(errorOf<std::runtime_error>(o),
+	          d + ": --synth-imu needs groundtruth.txt to synthesise from");
+	EXPECT_FALSE(fs::exists(o.out));
+}
+
+TEST(ImportRun, SynthImuTakesTheConvertedTruthLabelCalibrationAndSeed)
+{
+	const auto d = tumFolder("synth", true);
+	std::ofstream(d + "/c.ini") << "[sensors]\nimu_label = XS\n";
+	bims::eval::ImportRunOptions o;
+	o.folder = d;
+	o.out = d + "/x.rawlog";
+	o.config = d + "/c.ini";
+	o.bonn_gt = true;
+	o.synth_imu = true;
+	o.seed = 42;
+	o.progress = false;
+	bims::Trajectory given;
+	std::string label;
+	bool withCalibration = false;
+	uint64_t seed = 0;
+	o.synthesize = [&](const bims::Trajectory& gt, const std::string& l,
+	                   const mrpt::config::CConfigFileBase* c, uint64_t s)
+	{
+		given = gt;
+		label = l;
+		withCalibration = c != nullptr;
+		seed = s;
+		auto imu = mrpt::obs::CObservationIMU::Create();
+		imu->sensorLabel = l + "_SYNTH";
+		imu->timestamp = mrpt::Clock::fromDouble(1.05);
+		return std::vector<mrpt::obs::CObservation::Ptr>{imu};
+	};
+	EXPECT_EQ(bims::eval::runImport(o), 0);
+	ASSERT_EQ(given.size(), 6u);
+	const auto raw = bims::loadTumTrajectory(d + "/groundtruth.txt");
+	EXPECT_TRUE(given[2].T_WC.asTPose() ==
+	            bims::eval::bonnMarkerToCamera(raw[2].T_WC).asTPose());
+	EXPECT_EQ(label, "XS");
+	EXPECT_TRUE(withCalibration);
+	EXPECT_EQ(seed, 42u);
+	size_t imu = 0, n = 0;
+	bims::RawlogReader r(o.out);
+	while (auto obs = r.next())
+	{
+		n++;
+		imu += obs->sensorLabel == "XS_SYNTH";
+	}
+	EXPECT_EQ(n, 3u);
+	EXPECT_EQ(imu, 1u);
+}
