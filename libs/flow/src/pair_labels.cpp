@@ -75,8 +75,12 @@ PairLabels labelPair(const cv::Mat& rgb0, const cv::Mat& rgb1,
 	r.expected = expectedFlow(params.expected, depth, cam, T_CprevC);
 	r.msExpected = msSince(t0);
 	t0 = std::chrono::steady_clock::now();
-	r.labels = labelConsistency(r.observed, r.expected, depth, cam, T_CprevC,
-	                            params, &r.stats);
+	// the current image's structure tensor, computed with the flow when
+	// [flow] asks for it (visible_change_grey > 0: the default)
+	const cv::Mat& tensor = of.tensor();
+	r.labels =
+	    labelConsistency(r.observed, r.expected, depth, cam, T_CprevC, params,
+	                     &r.stats, tensor.empty() ? nullptr : &tensor);
 	r.msLabels = msSince(t0);
 	return r;
 }

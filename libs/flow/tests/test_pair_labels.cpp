@@ -89,6 +89,26 @@ TEST(PairLabels, AStillPairIsConsistentAMovedImageIsNot)
 	EXPECT_GT(moved.stats.diff, 10000u);
 }
 
+TEST(PairLabels, TheDefaultFlowParametersRunWithTheImagesStructureTensor)
+{
+	// [flow]'s defaults gate a Diff by the visible change of the grey image
+	// (visible_change_grey > 0), which needs the current image's structure
+	// tensor: the pair is labelled with it (it was an error before)
+	const bims::flow::FlowParams params;
+	ASSERT_GT(params.visible_change_grey, 0);
+	const auto cam = bims::flow::pairCamera(160, 120, 0, 0, -1, -1);
+	const cv::Mat depth(120, 160, CV_16UC1, cv::Scalar(10000));
+	const auto still =
+	    bims::flow::labelPair(texture(160, 120, 0), texture(160, 120, 0), depth,
+	                          5000, cam, {}, params);
+	EXPECT_GT(still.stats.notDiff, 10000u);
+	EXPECT_EQ(still.stats.diff, 0u);
+	const auto moved =
+	    bims::flow::labelPair(texture(160, 120, 0), texture(160, 120, 4), depth,
+	                          5000, cam, {}, params);
+	EXPECT_GT(moved.stats.diff, 5000u);
+}
+
 TEST(PairLabels, TheOverlayTurnsDiffPixelsHalfRed)
 {
 	const cv::Mat rgb(2, 2, CV_8UC3, cv::Scalar(100, 60, 20));
