@@ -84,33 +84,39 @@ Pipeline::Observed Pipeline::observe(const cv::Mat& prevGrey,
 	return o;
 }
 
-void Pipeline::dropLookahead()
+bool Pipeline::Lookahead::holds(size_t i, size_t frames) const
 {
-	if (nextObserved_.valid()) nextObserved_.wait();
-	nextObserved_ = {};
-	nextIndex_ = kNoNext;
+	return index == i && after + 1 == frames && observed.valid();
+}
+
+void Pipeline::Lookahead::drop()
+{
+	if (observed.valid()) observed.wait();
+	observed = {};
+	index = kNone;
 }
 
 void Pipeline::startLookahead(const Next& next)
 {
-	dropLookahead();
+	ahead_.drop();
 	if (!next.scan || !flowThread_ || !cfg_.pipeline.flow_lookahead) return;
 	const auto t = Clock::now();
 	// A frame that cannot be decoded, or that the next call would not pair
 	// with this one, is left to that call (which reports it).
-	if (!ego::rgbdFrameFrom(*next.scan, cfg_.ego.camera, next_).empty() ||
-	    next_.grey.size() != cur_.grey.size() || !(next_.t > cur_.t))
+	ego::RgbdFrame& f = ahead_.frame;
+	if (!ego::rgbdFrameFrom(*next.scan, cfg_.ego.camera, f).empty() ||
+	    f.grey.size() != cur_.grey.size() || !(f.t > cur_.t))
 		return;
-	nextInputMs_ = msSince(t);
+	ahead_.inputMs = msSince(t);
 	// What the next call would predict at its start: the egomotion of this
 	// frame is final, and the caller has added the IMU samples already.
-	const Eigen::Matrix3d R = odom_.predictRotation(next_.t);
-	nextObserved_ =
-	    postTask(*flowThread_, [this, prevGrey = cur_.grey,
-	                            curGrey = next_.grey, cam = next_.camera(), R]
-	             { return observe(prevGrey, curGrey, cam, R); });
-	nextIndex_ = next.index;
-	nextAfter_ = nFrames_;
+	const Eigen::Matrix3d R = odom_.predictRotation(f.t);
+	ahead_.observed = postTask(
+	    *flowThread_,
+	    [this, prevGrey = cur_.grey, curGrey = f.grey, cam = f.camera(), R]
+	    { return observe(prevGrey, curGrey, cam, R); });
+	ahead_.index = next.index;
+	ahead_.after = nFrames_;
 }
 
 /** A frame's jobs on the two threads, or in sequence: the observed flow
@@ -179,19 +185,18 @@ void Pipeline::takeInput(const mrpt::obs::CObservation3DRangeScan& scan,
 	// flow on the way (only if the frame that queued it completed: prev_ is
 	// its frame), or decoded here: grey image, metric depth and camera
 	// model, once for all stages.
-	if (havePrev_ && nextIndex_ == r.index && nextAfter_ + 1 == nFrames_ &&
-	    nextObserved_.valid())
+	if (havePrev_ && ahead_.holds(r.index, nFrames_))
 	{
-		std::swap(cur_, next_);
-		jobs.observing = std::move(nextObserved_);
-		nextIndex_ = kNoNext;
+		std::swap(cur_, ahead_.frame);
+		jobs.observing = std::move(ahead_.observed);
+		ahead_.index = Lookahead::kNone;
 		r.flowAhead = true;
-		r.ms.input = nextInputMs_;
+		r.ms.input = ahead_.inputMs;
 	}
 	else
 	{
 		const auto t = Clock::now();
-		dropLookahead();
+		ahead_.drop();
 		const std::string why = ego::rgbdFrameFrom(scan, cfg_.ego.camera, cur_);
 		if (!why.empty())
 			throw std::runtime_error("3D scan #" + std::to_string(r.index) +

@@ -151,17 +151,26 @@ class Pipeline
 	              FrameJobs& jobs);
 	void finishFrame(FrameResult& r);
 
-	/** Decodes \a next into next_ and queues its observed flow. */
+	/** Decodes \a next into ahead_ and queues its observed flow. */
 	void startLookahead(const Next& next);
-	/** Waits for a queued look-ahead flow and forgets it. */
-	void dropLookahead();
 
-	ego::RgbdFrame next_;  ///< the frame of the queued look-ahead flow
-	static constexpr size_t kNoNext = static_cast<size_t>(-1);
-	size_t nextIndex_ = kNoNext;
-	size_t nextAfter_ = 0;  ///< nFrames_ when it was queued
-	double nextInputMs_ = 0;
-	std::future<Observed> nextObserved_;
+	/** The next frame, decoded ahead, with its observed flow queued on the
+	 * flow thread (flow_lookahead). */
+	struct Lookahead
+	{
+		static constexpr size_t kNone = static_cast<size_t>(-1);
+		ego::RgbdFrame frame;
+		size_t index = kNone;  ///< its 3D-scan index; kNone: nothing queued
+		size_t after = 0;      ///< framesProcessed() when it was queued
+		double inputMs = 0;    ///< its decoding
+		std::future<Observed> observed;
+		/** Whether it holds frame \a index, queued by the frame before
+		 * (\a frames processed since). */
+		bool holds(size_t index, size_t frames) const;
+		/** Waits for the queued flow and forgets it. */
+		void drop();
+	};
+	Lookahead ahead_;
 	std::unique_ptr<SerialWorker> flowThread_;   ///< null: flow in sequence
 	std::unique_ptr<SerialWorker> cloudThread_;  ///< null: cloud in sequence
 };
