@@ -5,6 +5,7 @@
 #include <bims/ego/flags.h>
 #include <bims/ego/so3.h>
 #include <bims/source/calibration_run.h>
+#include <bims_test/sample.h>
 #include <bims_test/text.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
@@ -21,10 +22,10 @@ using namespace bims::source;
 
 namespace
 {
-const std::string kSrc = BIMS_SOURCE_DIR;
-const std::string kSample = kSrc + "/rawlogs/pendulum_slow.rawlog";
-const std::string kConfig = kSrc + "/config/default.ini";
-const std::string kGt = kSrc + "/rawlogs/pendulum_slow_gt/";
+using bims::test::kDefaultConfig;
+using bims::test::kSample;
+using bims::test::kSampleGt;
+using bims::test::kSourceDir;
 
 bims::ego::FrameEgomotion frame(double t, uint32_t flags,
                                 const Eigen::Matrix3d& R_CprevC)
@@ -116,9 +117,9 @@ TEST(ImuCalibration, EstimatesRICOnTheSampleAndWritesIt)
 {
 	const std::string d = bims::test::freshTmpDir("bims_test_source", "imu");
 	ImuCalibrationOptions o;
-	o.config = kConfig;
+	o.config = kDefaultConfig;
 	o.rawlog = kSample;
-	o.calib = kGt + "calibration.ini";
+	o.calib = kSampleGt + "calibration.ini";
 	o.out = d + "/imu.ini";
 	o.min_angle_deg = 0.1;
 	o.inlier_deg = 0.05;
@@ -144,10 +145,10 @@ TEST(DepthCalibration, FitsAtTheTruePosesAndRefusesTheOdometrysOnTheSample)
 {
 	const std::string d = bims::test::freshTmpDir("bims_test_source", "depth");
 	DepthCalibrationOptions o;
-	o.config = kConfig;
+	o.config = kDefaultConfig;
 	o.rawlog = kSample;
 	o.frames = "0:40";
-	o.poses = kGt + "groundtruth.txt";
+	o.poses = kSampleGt + "groundtruth.txt";
 	o.out = d + "/depth.ini";
 	o.progress = false;
 	ASSERT_EQ(runDepthCalibration(o), 0);

@@ -5,6 +5,7 @@
 #include <bims/common/config.h>
 #include <bims/common/trajectory.h>
 #include <bims/source/odometry_run.h>
+#include <bims_test/sample.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 
@@ -19,10 +20,10 @@ using namespace bims::source;
 
 namespace
 {
-const std::string kSrc = BIMS_SOURCE_DIR;
-const std::string kSample = kSrc + "/rawlogs/pendulum_slow.rawlog";
-const std::string kGt = kSrc + "/rawlogs/pendulum_slow_gt/";
-const std::string kConfig = kSrc + "/config/default.ini";
+using bims::test::kDefaultConfig;
+using bims::test::kSample;
+using bims::test::kSampleGt;
+using bims::test::kSourceDir;
 
 std::vector<std::string> lines(const std::string& path)
 {
@@ -54,7 +55,7 @@ TEST(OdometryRun, PercentileIsTheSampleOfRoundedRank)
 TEST(OdometryRun, OptionsOverrideTheConfigAndBadValuesAreUsageErrors)
 {
 	OdometryRunOptions o;
-	o.config = kConfig;
+	o.config = kDefaultConfig;
 	const auto base = odometryConfig(o);
 	EXPECT_EQ(base.odometry.mode, bims::ego::OdometryMode::Imu);
 	EXPECT_TRUE(base.odometry.gyro_aid);
@@ -71,7 +72,7 @@ TEST(OdometryRun, OptionsOverrideTheConfigAndBadValuesAreUsageErrors)
 	bad.mode = "";  // given, empty: not a mode
 	EXPECT_THROW(odometryConfig(bad), bims::UsageError);
 	bad = o;
-	bad.calib = kGt + "no_such_calibration.ini";
+	bad.calib = kSampleGt + "no_such_calibration.ini";
 	try
 	{
 		odometryConfig(bad);
@@ -152,12 +153,12 @@ TEST(OdometryRun, RunsTheSampleIntoATrajectoryCsvAndSummary)
 {
 	const std::string d = bims::test::freshTmpDir("bims_test_source", "run");
 	OdometryRunOptions o;
-	o.config = kConfig;
+	o.config = kDefaultConfig;
 	o.rawlog = kSample;
 	o.out = d + "/traj.txt";
 	o.csv = d + "/frames.csv";
-	o.gt = kGt + "groundtruth.txt";
-	o.masks = kGt + "masks";
+	o.gt = kSampleGt + "groundtruth.txt";
+	o.masks = kSampleGt + "masks";
 	o.max_frames = 12;
 	o.progress = false;
 	testing::internal::CaptureStderr();
