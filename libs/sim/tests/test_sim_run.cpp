@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 const std::string kScene =
     std::string(BIMS_SOURCE_DIR) + "/config/sim/pendulum_slow.ini";
 
-std::string tmpDir(const std::string& name)
+std::string runDir(const std::string& name)
 {
 	return bims::test::freshTmpDir("bims_test_sim_run", name);
 }
@@ -56,7 +56,7 @@ TEST(SimRun, TheOptionsOverrideTheScene)
 
 TEST(SimRun, BadOptionsAreUsageErrorsBeforeAnyOutput)
 {
-	const auto d = tmpDir("usage");
+	const auto d = runDir("usage");
 	bims::sim::SimOptions o;
 	o.out = d + "/x.rawlog";
 	EXPECT_EQ(usageError(o), "missing SCENE.ini (or --imu-from-tum)");
@@ -85,7 +85,7 @@ TEST(SimRun, BadOptionsAreUsageErrorsBeforeAnyOutput)
 
 TEST(SimRun, ImuFromTumWritesTheRawlogAndTheTruth)
 {
-	const auto d = tmpDir("imu");
+	const auto d = runDir("imu");
 	bims::Trajectory traj;
 	for (int i = 0; i < 10; i++)
 		traj.push_back({1.0 + 0.1 * i,
