@@ -286,16 +286,6 @@ TEST(FrameRange, ParsesInclusiveRanges)
 	EXPECT_THROW(FrameRange::parse("-1:3"), std::invalid_argument);
 }
 
-TEST(Percentiles, MedianAndP95)
-{
-	std::vector<double> v;
-	for (int i = 1; i <= 100; i++) v.push_back(i);
-	const auto p = Percentiles::of(v);
-	EXPECT_DOUBLE_EQ(p.median, 51);
-	EXPECT_DOUBLE_EQ(p.p95, 95);
-	EXPECT_DOUBLE_EQ(p.mean, 50.5);
-}
-
 TEST(RunCommand, VariantOptionSetsTheVariantOrIsAUsageError)
 {
 	bims::pipeline::ExperimentConfig cfg;

@@ -2,6 +2,7 @@
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
 #include <bims/common/output_paths.h>
+#include <bims/common/stats.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/so3.h>
 #include <bims/source/odometry_run.h>
@@ -56,14 +57,6 @@ ego::EgoConfig odometryConfig(const OdometryRunOptions& o)
 		    ": [calibration] R_IC missing (needed by [odometry] mode = "
 		    "imu; give it in the config or with --calib)");
 	return ec;
-}
-
-double percentile(std::vector<double> v, double q)
-{
-	if (v.empty()) return 0;
-	std::sort(v.begin(), v.end());
-	return v[std::min(v.size() - 1,
-	                  static_cast<size_t>(q * (v.size() - 1) + 0.5))];
 }
 
 TrackerTruth trackerAgainstTruth(const ego::FrameEgomotion& r,
@@ -197,17 +190,18 @@ int runOdometry(const OdometryRunOptions& o)
 	saveTumTrajectory(
 	    o.out, traj,
 	    std::string("bims-odom mode=") + mode + " gyro_aid=" + aid);
+	const auto pIn = Percentiles::of(msIn), pTrack = Percentiles::of(msTrack),
+	           pMotion = Percentiles::of(msMotion),
+	           pEgo = Percentiles::of(msEgo);
 	std::fprintf(
 	    stderr,
 	    "bims-odom: %zu frames (%zu flagged), %zu IMU samples; mode=%s "
 	    "gyro_aid=%s\n"
 	    "bims-odom: ms/frame median (p95): input %.2f (%.2f), tracking "
 	    "%.2f (%.2f), motion %.2f (%.2f), egomotion %.2f (%.2f)\n",
-	    st.frames, st.flagged, st.imu, mode, aid, percentile(msIn, 0.5),
-	    percentile(msIn, 0.95), percentile(msTrack, 0.5),
-	    percentile(msTrack, 0.95), percentile(msMotion, 0.5),
-	    percentile(msMotion, 0.95), percentile(msEgo, 0.5),
-	    percentile(msEgo, 0.95));
+	    st.frames, st.flagged, st.imu, mode, aid, pIn.median, pIn.p95,
+	    pTrack.median, pTrack.p95, pMotion.median, pMotion.p95, pEgo.median,
+	    pEgo.p95);
 	if (o.masks)
 		std::fprintf(stderr, "bims-odom: masks of %s for %zu of %zu frames\n",
 		             ro.masks_dir.c_str(), st.masksUsed, st.frames);

@@ -39,19 +39,6 @@ size_t fields(const std::string& line)
 }
 }  // namespace
 
-TEST(OdometryRun, PercentileIsTheSampleOfRoundedRank)
-{
-	EXPECT_EQ(percentile({}, 0.5), 0);
-	EXPECT_EQ(percentile({5, 1, 3, 2, 4}, 0.5), 3);
-	EXPECT_EQ(percentile({5, 1, 3, 2, 4}, 0.95), 5);  // rank round(3.8) = 4
-	std::vector<double> v;
-	for (int i = 1; i <= 12; i++) v.push_back(i);
-	// rank round(0.95 * 11) = 10: the 11th value (not ceil(0.95 n) = 12th)
-	EXPECT_EQ(percentile(v, 0.95), 11);
-	EXPECT_EQ(percentile(v, 0), 1);
-	EXPECT_EQ(percentile(v, 1), 12);
-}
-
 TEST(OdometryRun, OptionsOverrideTheConfigAndBadValuesAreUsageErrors)
 {
 	OdometryRunOptions o;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <bims/common/output_paths.h>
+#include <bims/common/stats.h>
 #include <bims/pipeline/pipeline.h>
 #include <bims/source/frame_source.h>
 
@@ -25,13 +26,8 @@ using source::FrameRange;
 using source::checkFrameRangeInInputs;
 using source::frameRangeOption;
 
-/** Median and 95th percentile of a series. */
-struct Percentiles
-{
-	double median = 0, p95 = 0, mean = 0;
-	size_t n = 0;
-	static Percentiles of(std::vector<double> v);
-};
+/** Median and 95th percentile of a series (bims/common/stats.h). */
+using bims::Percentiles;
 
 /** What a run measured; what the input held and what of it was skipped is
  * the frame source's (source::FrameOrderStats). */

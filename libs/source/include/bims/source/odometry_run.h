@@ -50,10 +50,6 @@ void overrideSensorSectionsFrom(ego::EgoConfig& ec, const std::string& calib,
  * no [calibration] R_IC. */
 ego::EgoConfig odometryConfig(const OdometryRunOptions& o);
 
-/** The sample at quantile \a q (0..1) of \a v: the element of rank
- * round(q (n-1)) once sorted; 0 for an empty series. */
-double percentile(std::vector<double> v, double q);
-
 /** How well the tracker followed the truth over one frame pair. */
 struct TrackerTruth
 {
