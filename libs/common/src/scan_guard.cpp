@@ -201,9 +201,10 @@ class ObservationWalker
 	{
 		uint8_t version = 0;
 		const std::string cls = c_.header(version);
+		const auto* id = cls.empty() ? nullptr : registered(cls);
 		// a class MRPT does not know: it would read on as a typed object
 		// and may allocate what the bytes declare (found by the fuzzer)
-		if (!cls.empty() && !registered(cls))
+		if (!cls.empty() && !id)
 		{
 			problem = "an object of a class MRPT does not know ('" +
 			          printable(cls) + "')";
@@ -213,7 +214,7 @@ class ObservationWalker
 		// it whole before the reader could refuse it, and reads the sizes
 		// of a matrix, image or pose as they are (found by the fuzzer: a
 		// top-level CPose3D whose CMatrixD declared 22 GB).
-		if (!cls.empty() && !isEntryOf(*registered(cls), inFrame_))
+		if (id && !isEntryOf(*id, inFrame_))
 		{
 			problem = "an object of class '" + printable(cls) + "', not " +
 			          (inFrame_ ? "an observation (a sensory frame holds "

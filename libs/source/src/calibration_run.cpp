@@ -22,11 +22,7 @@ void RotationPairCollector::addFrame(const ego::FrameEgomotion& r)
 		const auto R_I = ego::integrateGyro(imu_, tPrev_ + off_, r.t + off_);
 		if (R_I)
 		{
-			Eigen::Matrix3d R_C;
-			for (int i = 0; i < 3; i++)
-				for (int j = 0; j < 3; j++)
-					R_C(i, j) = r.T_CprevC.getRotationMatrix()(i, j);
-			pairs_.push_back({*R_I, R_C});
+			pairs_.push_back({*R_I, r.T_CprevC.getRotationMatrix().asEigen()});
 		}
 	}
 	if (!(r.flags & ego::kFlagOutOfOrder)) tPrev_ = r.t;

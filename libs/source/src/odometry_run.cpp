@@ -66,10 +66,7 @@ TrackerTruth trackerAgainstTruth(const ego::FrameEgomotion& r,
                                  double dt)
 {
 	TrackerTruth out;
-	Eigen::Matrix3d R;
-	for (int i = 0; i < 3; i++)
-		for (int j = 0; j < 3; j++)
-			R(i, j) = T_CprevC.getRotationMatrix()(i, j);
+	const Eigen::Matrix3d R = T_CprevC.getRotationMatrix().asEigen();
 	const Eigen::Vector3d t(T_CprevC.x(), T_CprevC.y(), T_CprevC.z());
 	out.rate_deg_s = ego::angleSO3(R) * 180 / M_PI / dt;
 	// True position of a previous-image feature.
