@@ -71,21 +71,31 @@ TEST(PairLabels, ThePoseIsSixNumbersMetresAndDegrees)
 	}
 }
 
-TEST(PairLabels, AStillPairIsConsistentAMovedImageIsNot)
+namespace
+{
+/** The labels of a still pair and of a pair whose image moved 4 px while
+ * the camera (identity pose) did not, a wall 2 m away. */
+std::pair<bims::flow::PairLabels, bims::flow::PairLabels> stillAndMoved(
+    const bims::flow::FlowParams& params)
 {
 	const auto cam = bims::flow::pairCamera(160, 120, 0, 0, -1, -1);
 	const cv::Mat depth(120, 160, CV_16UC1, cv::Scalar(10000));  // 2 m
-	const auto params = noVisibleChange();
-	const auto still =
-	    bims::flow::labelPair(texture(160, 120, 0), texture(160, 120, 0), depth,
-	                          5000, cam, {}, params);
+	auto pair = [&](int shift)
+	{
+		return bims::flow::labelPair(texture(160, 120, 0),
+		                             texture(160, 120, shift), depth, 5000, cam,
+		                             {}, params);
+	};
+	return {pair(0), pair(4)};
+}
+}  // namespace
+
+TEST(PairLabels, AStillPairIsConsistentAMovedImageIsNot)
+{
+	const auto [still, moved] = stillAndMoved(noVisibleChange());
 	EXPECT_EQ(still.labels.size(), cv::Size(160, 120));
 	EXPECT_GT(still.stats.notDiff, 10000u);
 	EXPECT_EQ(still.stats.diff, 0u);
-	// the image moved 4 px, the camera (identity pose) did not
-	const auto moved =
-	    bims::flow::labelPair(texture(160, 120, 0), texture(160, 120, 4), depth,
-	                          5000, cam, {}, params);
 	EXPECT_GT(moved.stats.diff, 10000u);
 }
 
@@ -96,16 +106,9 @@ TEST(PairLabels, TheDefaultFlowParametersRunWithTheImagesStructureTensor)
 	// tensor: the pair is labelled with it (it was an error before)
 	const bims::flow::FlowParams params;
 	ASSERT_GT(params.visible_change_grey, 0);
-	const auto cam = bims::flow::pairCamera(160, 120, 0, 0, -1, -1);
-	const cv::Mat depth(120, 160, CV_16UC1, cv::Scalar(10000));
-	const auto still =
-	    bims::flow::labelPair(texture(160, 120, 0), texture(160, 120, 0), depth,
-	                          5000, cam, {}, params);
+	const auto [still, moved] = stillAndMoved(params);
 	EXPECT_GT(still.stats.notDiff, 10000u);
 	EXPECT_EQ(still.stats.diff, 0u);
-	const auto moved =
-	    bims::flow::labelPair(texture(160, 120, 0), texture(160, 120, 4), depth,
-	                          5000, cam, {}, params);
 	EXPECT_GT(moved.stats.diff, 5000u);
 }
 
