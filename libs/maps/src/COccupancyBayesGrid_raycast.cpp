@@ -32,10 +32,11 @@ namespace
 // Rays are cast tile by tile of the image (kTile x kTile pixels): the rays
 // of a tile cross nearly the same voxels, which then stay in cache.
 constexpr int kTile = 8;
-// Largest bounding box of the rays for the bitsets (voxels, one bit each in
-// two bitsets per thread: 32 MiB); beyond it (huge extents at fine voxels)
+// Largest bounding box of the rays for the bitsets (voxels of the box
+// padded to powers of two blocks per axis, one bit each per thread: 32 MiB,
+// of which a frame touches only the blocks its rays enter); beyond it (huge extents at fine voxels)
 // the rays are walked voxel by voxel (castPlain).
-constexpr size_t kMaxMarkedVoxels = size_t(1) << 27;
+constexpr size_t kMaxMarkedVoxels = size_t(1) << 28;
 // Rays per work item of a thread (32 tiles).
 constexpr size_t kChunk = 2048;
 }  // namespace
@@ -192,81 +193,67 @@ size_t COccupancyBayesGrid::castMarked(const double a[3], const RayBox& box,
 
 	// 2. The cells of each block entered; the missing blocks created in
 	// the order of their first visit, as a plain walk creates them.
-	auto& tab = blockTable_;
-	tab.assign(box.blocks(), nullptr);
+	auto& cells = blockCells_;
+	cells.assign(m.touched.size(), nullptr);
 	std::vector<std::pair<uint64_t, size_t>> missing;
-	auto blockKeyOf = [&](size_t b)
+	auto keyOf = [&](size_t b)
 	{
-		const size_t bx = b % box.n[0], by = (b / box.n[0]) % box.n[1],
-		             bz = b / box.n[0] / box.n[1];
-		return packKey(box.lo[0] + int32_t(bx), box.lo[1] + int32_t(by),
-		               box.lo[2] + int32_t(bz));
+		int32_t c[3];
+		box.blockCoords(b, c);
+		return packKey(c[0], c[1], c[2]);
 	};
-	for (size_t b = 0; b < box.blocks(); ++b)
+	for (size_t i = 0; i < m.touched.size(); ++i)
 	{
-		if (m.state[b] == RayMarks::kStored)
-			tab[b] = grid_.findBlock(blockKeyOf(b))->cells;
-		else if (m.state[b] == RayMarks::kMissing)
-			missing.emplace_back(m.firstVisit[b], b);
+		const size_t b = m.touched[i];
+		if (m.stored(b))
+			cells[i] = grid_.findBlock(keyOf(b))->cells;
+		else
+			missing.emplace_back(m.firstVisit[b], i);
 	}
 	std::sort(missing.begin(), missing.end());
 	bool budgetHit = false;
-	for (const auto& [visit, b] : missing)
+	for (const auto& [visit, i] : missing)
 	{
-		const uint32_t id = grid_.findOrCreateBlock(blockKeyOf(b));
+		const uint32_t id = grid_.findOrCreateBlock(keyOf(m.touched[i]));
 		if (id == FlatHashMap::kNotFound)
+		{
 			budgetHit = true;
+			m.state[m.touched[i]] = RayMarks::kUnknown;  // not created
+		}
 		else
-			tab[b] = grid_.block(id).cells;
+			cells[i] = grid_.block(id).cells;
 	}
 
 	// 3. One miss per crossed cell.
-	applyRayMarks(box, m, tab.data(), F);
+	applyRayMarks(m, cells.data(), F);
 
 	// Over the budget: the steps into blocks that could not be created, as
 	// a plain walk counts them (every step).
 	size_t over = 0;
 	if (budgetHit)
 		for (const auto& e : ends)
-			traverseRay(
-			    a, e.p,
-			    [&](int32_t x, int32_t y, int32_t z)
-			    {
-				    over += !tab[box.blockIndex(size_t((x >> 3) - box.lo[0]),
-				                                size_t((y >> 3) - box.lo[1]),
-				                                size_t((z >> 3) - box.lo[2]))];
-			    });
+			traverseRay(a, e.p,
+			            [&](int32_t x, int32_t y, int32_t z)
+			            {
+				            over += m.state[box.blockOf(x >> 3, y >> 3, z >> 3)] ==
+				                    RayMarks::kUnknown;
+			            });
 	return over;
 }
 
-void COccupancyBayesGrid::applyRayMarks(const RayBox& box, const RayMarks& m,
-                                        Cell* const* tab, uint32_t F)
+void COccupancyBayesGrid::applyRayMarks(const RayMarks& m,
+                                        Cell* const* cells, uint32_t F)
 {
-	const size_t ny = box.n[1] * 8, nz = box.n[2] * 8;
-	const uint64_t* bits = m.bits.data();
-	for (size_t z = 0; z < nz; ++z)
-		for (size_t y = 0; y < ny; ++y)
-		{
-			const size_t row = z * ny + y;
-			const size_t blockRow = box.blockIndex(0, y >> 3, z >> 3);
-			const size_t cellRow = ((z & 7) << 6) | ((y & 7) << 3);
-			for (size_t w = 0; w < box.rowWords; ++w)
-			{
-				uint64_t v = bits[2 * (row * box.rowWords + w)];
-				while (v)
-				{
-					// The crossed voxels of one block in this word.
-					const unsigned j = unsigned(__builtin_ctzll(v)) >> 3;
-					uint32_t byte = uint32_t(v >> (8 * j)) & 0xff;
-					v &= ~(uint64_t(0xff) << (8 * j));
-					Cell* blk = tab[blockRow + w * 8 + j];
-					if (!blk) continue;  // over the memory budget
-					Cell* cells = blk + cellRow;
-					for (; byte; byte &= byte - 1)
-						applyMiss(cells[__builtin_ctz(byte)], F);
-				}
-			}
-		}
+	// Word z of a block's bits is its row z of cells (cell z * 64 + bit).
+	for (size_t i = 0; i < m.touched.size(); ++i)
+	{
+		Cell* blk = cells[i];
+		if (!blk) continue;  // over the memory budget
+		const uint64_t* w = &m.bits[8 * size_t(m.touched[i])];
+		for (size_t z = 0; z < 8; ++z, blk += 64)
+			for (uint64_t v = w[z]; v; v &= v - 1)
+				applyMiss(blk[__builtin_ctzll(v)], F);
+	}
 }
 
 }  // namespace bims::maps

@@ -4,45 +4,87 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 
-// The two-lane walk needs SSE2 and 64-bit integer moves (x86-64).
-#if defined(__SSE2__) && defined(__x86_64__)
-#define BIMS_RAYMARKS_SSE2 1
-#include <emmintrin.h>
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
 #endif
 
 namespace bims::maps
 {
+namespace
+{
+/** The bits of \a v placed, lowest first, at the set bits of \a m. */
+uint64_t deposit(uint64_t v, uint64_t m)
+{
+	uint64_t r = 0;
+	for (unsigned b = 0; m; m &= m - 1, ++b)
+		if ((v >> b) & 1) r |= m & (~m + 1);
+	return r;
+}
+/** The bits of \a g at the set bits of \a m, packed lowest first. */
+uint64_t extract(uint64_t g, uint64_t m)
+{
+	uint64_t r = 0;
+	for (unsigned b = 0; m; m &= m - 1, ++b)
+		if (g & m & (~m + 1)) r |= uint64_t(1) << b;
+	return r;
+}
+unsigned ceilLog2(size_t n)
+{
+	unsigned k = 0;
+	while ((size_t(1) << k) < n) ++k;
+	return k;
+}
+}  // namespace
+
 RayBox::RayBox(const int32_t l[3], const int32_t h[3])
 {
+	unsigned most = 0;
 	for (int k = 0; k < 3; ++k)
 	{
 		lo[k] = l[k];
-		n[k] = size_t(h[k] - l[k] + 1);
+		logN[k] = ceilLog2(size_t(h[k] - l[k] + 1));
+		most = std::max(most, logN[k]);
+		mask[k] = uint64_t(7) << (3 * k);  // the cell in the block
 	}
-	rowWords = (n[0] * 8 + 63) / 64;
+	unsigned pos = 9;  // then the block's bits, interleaved x, y, z
+	for (unsigned b = 0; b < most; ++b)
+		for (int k = 0; k < 3; ++k)
+			if (b < logN[k]) mask[k] |= uint64_t(1) << pos++;
+}
+
+uint64_t RayBox::bitOf(int32_t x, int32_t y, int32_t z) const
+{
+	return deposit(uint64_t(x - lo[0] * 8), mask[0]) |
+	       deposit(uint64_t(y - lo[1] * 8), mask[1]) |
+	       deposit(uint64_t(z - lo[2] * 8), mask[2]);
+}
+
+void RayBox::blockCoords(size_t b, int32_t out[3]) const
+{
+	for (int k = 0; k < 3; ++k)
+		out[k] = lo[k] + int32_t(extract(uint64_t(b) << 9, mask[k]) >> 3);
 }
 
 void RayMarks::reset(const RayBox& box)
 {
-	bits.resize(2 * box.words());
-	for (size_t w = 0; w < bits.size(); w += 2)
-	{
-		bits[w] = 0;
-		bits[w + 1] = ~uint64_t(0);
-	}
+	// Invariant between frames: only the touched blocks have bits set.
+	for (const uint32_t b : touched)
+		std::memset(&bits[8 * size_t(b)], 0, 8 * sizeof(uint64_t));
+	touched.clear();
+	if (bits.size() < box.words()) bits.resize(box.words(), 0);
 	state.assign(box.blocks(), kUnknown);
-	firstVisit.assign(box.blocks(), kNoVisit);
+	if (firstVisit.size() < box.blocks()) firstVisit.resize(box.blocks());
 }
 
 namespace
 {
-/** The slow part of a visit: the first visit of a voxel whose block this
- * thread has not looked up, or a visit of a block that is not stored. A
- * block no longer needs slow visits once it is stored, or once it is
- * missing and visited by the oldest ray in flight: every later visit by
- * this thread is then of that ray's later steps or of younger rays, with
- * later (ray, step). */
+/** The slow part of a visit: a block this thread has not looked up, or a
+ * block that is not stored. A block no longer needs slow visits once it is
+ * stored, or once it is missing and visited by the oldest ray in flight:
+ * every later visit by this thread is then of that ray's later steps or of
+ * younger rays, with later (ray, step). */
 struct Resolver
 {
 	const RayBox& box;
@@ -52,187 +94,253 @@ struct Resolver
 
 	void visit(uint64_t g, uint32_t ray, uint32_t step, uint32_t oldest)
 	{
-		const uint64_t row = g / box.rowBits(), ny = box.n[1] * 8;
-		const size_t x = size_t(g % box.rowBits()), y = size_t(row % ny),
-		             z = size_t(row / ny);
-		const size_t bx = x >> 3, by = y >> 3, bz = z >> 3;
-		const size_t bi = box.blockIndex(bx, by, bz);
-		uint8_t& st = m.state[bi];
+		const size_t b = size_t(g >> 9);
+		uint8_t& st = m.state[b];
 		if (st == RayMarks::kUnknown)
 		{
-			st = stored(ctx, box.lo[0] + int32_t(bx), box.lo[1] + int32_t(by),
-			            box.lo[2] + int32_t(bz))
-			         ? RayMarks::kStored
-			         : RayMarks::kMissing;
-			if (st == RayMarks::kStored) clearUnresolved(bx, by, bz);
-		}
-		if (st == RayMarks::kMissing)
-		{
-			m.firstVisit[bi] =
-			    std::min(m.firstVisit[bi], (uint64_t(ray) << 32) | step);
-			if (ray == oldest) clearUnresolved(bx, by, bz);
-		}
-	}
-	/** The block's voxels need no more slow visits. */
-	void clearUnresolved(size_t bx, size_t by, size_t bz)
-	{
-		const uint64_t byteMask = ~(uint64_t(0xff) << ((bx & 7) * 8));
-		const size_t ny = box.n[1] * 8;
-		for (size_t z = bz * 8; z < bz * 8 + 8; ++z)
-			for (size_t y = by * 8; y < by * 8 + 8; ++y)
+			int32_t c[3];
+			box.blockCoords(b, c);
+			m.touched.push_back(uint32_t(b));
+			if (stored(ctx, c[0], c[1], c[2]))
+				st = RayMarks::kStored | RayMarks::kResolved;
+			else
 			{
-				const size_t w = (z * ny + y) * box.rowWords + (bx >> 3);
-				m.bits[2 * w + 1] &= byteMask;
+				st = RayMarks::kMissing;
+				m.firstVisit[b] = RayMarks::kNoVisit;
 			}
+		}
+		if (st & RayMarks::kMissing)
+		{
+			m.firstVisit[b] =
+			    std::min(m.firstVisit[b], (uint64_t(ray) << 32) | step);
+			if (ray == oldest) st |= RayMarks::kResolved;
+		}
 	}
 };
 
-/** Marks voxel bit \a g, visited by \a ray at its \a step (\a oldest: the
- * oldest ray this thread walks at the time). */
-inline void mark(uint64_t g, uint32_t ray, uint32_t step, uint32_t oldest,
-                 uint64_t* bits, Resolver& res)
+/** What a walker needs: the rays, the box, the marks. */
+struct Walk
 {
-	const uint64_t bit = uint64_t(1) << (g & 63);
-	uint64_t* q = bits + 2 * (g >> 6);
-	if (q[1] & bit) res.visit(g, ray, step, oldest);
-	q[0] |= bit;
-}
-
-#if defined(BIMS_RAYMARKS_SSE2)
-/** One ray of the two-lane walk: the state of traverseRay() with the voxel
- * as its bit index. */
-struct Lane
-{
-	uint64_t g = 0;
-	int64_t inc[3] = {};          // bit increment of a step per axis
-	double t[3] = {}, d[3] = {};  // tMax and tDelta per axis
-	uint32_t n = 0;               // voxels left, the current one included
-	uint32_t step = 0;            // voxels visited so far
-	uint32_t ray = 0;
+	const double* a;
+	const RayEnd* ends;
+	size_t r0, r1;
+	const RayBox& box;
+	Resolver& res;
 };
 
-/** The rays two at a time in the lanes of SSE2 registers: the setup of
- * traverseRay() (ddaAxisSetup), then its comparisons and additions of tMax
- * in both lanes, so the same voxels. A lone last ray runs in both lanes. */
-void markRaysSse2(const double a[3], const RayEnd* ends, size_t r0, size_t r1,
-                  const RayBox& box, Resolver& res)
+#if defined(__x86_64__) && defined(__GNUC__)
+#define BIMS_RAY_LANES_X86 1
+// The vector operations of the walker (ray_walk_lanes.inc) per instruction
+// set: N lanes of doubles (D) and 64-bit integers (I), lane masks (M).
+struct Sse2Ops
 {
-	const int32_t x0 = int32_t(std::floor(a[0])),
-	              y0 = int32_t(std::floor(a[1])),
-	              z0 = int32_t(std::floor(a[2]));
-	const uint64_t g0 = box.bitOf(x0, y0, z0);
-	const int64_t rowBits = int64_t(box.rowBits()),
-	              planeBits = int64_t(box.planeBits());
-	uint64_t* bits = res.m.bits.data();
-	size_t r = r0;
-	auto load = [&](Lane& s)
+	static constexpr int N = 2;
+	using D = __m128d;
+	using I = __m128i;
+	using M = __m128i;
+	static D loadD(const double* p) { return _mm_load_pd(p); }
+	static I loadI(const int64_t* p)
 	{
-		while (r < r1)
-		{
-			const size_t ri = r++;
-			const double* b = ends[ri].p;
-			const int32_t ex = int32_t(std::floor(b[0])),
-			              ey = int32_t(std::floor(b[1])),
-			              ez = int32_t(std::floor(b[2]));
-			s.n = uint32_t(std::abs(ex - x0) + std::abs(ey - y0) +
-			               std::abs(ez - z0));
-			if (s.n == 0) continue;
-			int32_t sx, sy, sz;
-			ddaAxisSetup(a[0], b[0], x0, sx, s.t[0], s.d[0]);
-			ddaAxisSetup(a[1], b[1], y0, sy, s.t[1], s.d[1]);
-			ddaAxisSetup(a[2], b[2], z0, sz, s.t[2], s.d[2]);
-			s.inc[0] = sx;
-			s.inc[1] = sy * rowBits;
-			s.inc[2] = sz * planeBits;
-			s.g = g0;
-			s.step = 0;
-			s.ray = uint32_t(ri);
-			return true;
-		}
-		return false;
-	};
-	Lane A, B;
-	if (!load(A)) return;
-	if (!load(B)) B = A;
-	const __m128d ones = _mm_castsi128_pd(_mm_set1_epi32(-1));
-	for (;;)
-	{
-		__m128d T0 = _mm_set_pd(B.t[0], A.t[0]),
-		        T1 = _mm_set_pd(B.t[1], A.t[1]),
-		        T2 = _mm_set_pd(B.t[2], A.t[2]);
-		const __m128d D0 = _mm_set_pd(B.d[0], A.d[0]),
-		              D1 = _mm_set_pd(B.d[1], A.d[1]),
-		              D2 = _mm_set_pd(B.d[2], A.d[2]);
-		const __m128i S0 = _mm_set_epi64x(B.inc[0], A.inc[0]),
-		              S1 = _mm_set_epi64x(B.inc[1], A.inc[1]),
-		              S2 = _mm_set_epi64x(B.inc[2], A.inc[2]);
-		__m128i G = _mm_set_epi64x(int64_t(B.g), int64_t(A.g));
-		const uint32_t k = std::min(A.n, B.n), oldest = std::min(A.ray, B.ray);
-		for (uint32_t i = 0; i < k; ++i)
-		{
-			mark(uint64_t(_mm_cvtsi128_si64(G)), A.ray, A.step + i, oldest,
-			     bits, res);
-			mark(uint64_t(_mm_cvtsi128_si64(_mm_unpackhi_epi64(G, G))), B.ray,
-			     B.step + i, oldest, bits, res);
-			// The step of traverseRay() in both lanes.
-			const __m128d lxy = _mm_cmplt_pd(T0, T1),
-			              lxz = _mm_cmplt_pd(T0, T2),
-			              lyz = _mm_cmplt_pd(T1, T2);
-			const __m128d mx = _mm_and_pd(lxy, lxz);
-			const __m128d my = _mm_andnot_pd(mx, lyz);
-			const __m128d mz = _mm_andnot_pd(_mm_or_pd(mx, my), ones);
-			T0 = _mm_add_pd(T0, _mm_and_pd(mx, D0));
-			T1 = _mm_add_pd(T1, _mm_and_pd(my, D1));
-			T2 = _mm_add_pd(T2, _mm_and_pd(mz, D2));
-			const __m128i inc = _mm_or_si128(
-			    _mm_or_si128(_mm_and_si128(_mm_castpd_si128(mx), S0),
-			                 _mm_and_si128(_mm_castpd_si128(my), S1)),
-			    _mm_and_si128(_mm_castpd_si128(mz), S2));
-			G = _mm_add_epi64(G, inc);
-		}
-		// Back to the scalar states.
-		auto lo = [](__m128d v) { return _mm_cvtsd_f64(v); };
-		auto hi = [](__m128d v)
-		{ return _mm_cvtsd_f64(_mm_unpackhi_pd(v, v)); };
-		A.t[0] = lo(T0), A.t[1] = lo(T1), A.t[2] = lo(T2);
-		B.t[0] = hi(T0), B.t[1] = hi(T1), B.t[2] = hi(T2);
-		A.g = uint64_t(_mm_cvtsi128_si64(G));
-		B.g = uint64_t(_mm_cvtsi128_si64(_mm_unpackhi_epi64(G, G)));
-		A.n -= k, B.n -= k;
-		A.step += k, B.step += k;
-		const bool same = A.ray == B.ray;
-		if (A.n == 0 && !load(A))
-		{
-			if (B.n == 0 || same) return;
-			A = B;
-		}
-		if (B.n == 0 && !load(B))
-		{
-			if (A.n == 0) return;
-			B = A;
-		}
+		return _mm_load_si128(reinterpret_cast<const __m128i*>(p));
 	}
-}
+	static void storeD(double* p, D v) { _mm_store_pd(p, v); }
+	static void storeI(int64_t* p, I v)
+	{
+		_mm_store_si128(reinterpret_cast<__m128i*>(p), v);
+	}
+	static I set1(int64_t v) { return _mm_set1_epi64x(v); }
+	static void lanes(I v, uint64_t* out)
+	{
+		out[0] = uint64_t(_mm_cvtsi128_si64(v));
+		out[1] = uint64_t(_mm_cvtsi128_si64(_mm_unpackhi_epi64(v, v)));
+	}
+	static M lt(D a, D b) { return _mm_castpd_si128(_mm_cmplt_pd(a, b)); }
+	static M both(M a, M b) { return _mm_and_si128(a, b); }
+	static M notFirst(M a, M b) { return _mm_andnot_si128(a, b); }
+	static M neither(M a, M b)
+	{
+		return _mm_xor_si128(_mm_or_si128(a, b), _mm_set1_epi32(-1));
+	}
+	static D addIf(D t, M m, D d)
+	{
+		return _mm_add_pd(t, _mm_and_pd(_mm_castsi128_pd(m), d));
+	}
+	static I pick(M mx, M my, I a, I b, I c)
+	{
+		return _mm_or_si128(
+		    _mm_or_si128(_mm_and_si128(mx, a), _mm_and_si128(my, b)),
+		    _mm_andnot_si128(_mm_or_si128(mx, my), c));
+	}
+	static I stepBits(I g, I m, I c)
+	{
+		return _mm_or_si128(
+		    _mm_and_si128(_mm_add_epi64(_mm_and_si128(g, m), c), m),
+		    _mm_andnot_si128(m, g));
+	}
+};
+#define BIMS_AVX2 __attribute__((target("avx2")))
+struct Avx2Ops
+{
+	static constexpr int N = 4;
+	using D = __m256d;
+	using I = __m256i;
+	using M = __m256i;
+	BIMS_AVX2 static D loadD(const double* p) { return _mm256_load_pd(p); }
+	BIMS_AVX2 static I loadI(const int64_t* p)
+	{
+		return _mm256_load_si256(reinterpret_cast<const __m256i*>(p));
+	}
+	BIMS_AVX2 static void storeD(double* p, D v) { _mm256_store_pd(p, v); }
+	BIMS_AVX2 static void storeI(int64_t* p, I v)
+	{
+		_mm256_store_si256(reinterpret_cast<__m256i*>(p), v);
+	}
+	BIMS_AVX2 static I set1(int64_t v) { return _mm256_set1_epi64x(v); }
+	BIMS_AVX2 static void lanes(I v, uint64_t* out)
+	{
+		const __m128i lo = _mm256_castsi256_si128(v),
+		              hi = _mm256_extracti128_si256(v, 1);
+		out[0] = uint64_t(_mm_cvtsi128_si64(lo));
+		out[1] = uint64_t(_mm_extract_epi64(lo, 1));
+		out[2] = uint64_t(_mm_cvtsi128_si64(hi));
+		out[3] = uint64_t(_mm_extract_epi64(hi, 1));
+	}
+	BIMS_AVX2 static M lt(D a, D b)
+	{
+		return _mm256_castpd_si256(_mm256_cmp_pd(a, b, _CMP_LT_OQ));
+	}
+	BIMS_AVX2 static M both(M a, M b) { return _mm256_and_si256(a, b); }
+	BIMS_AVX2 static M notFirst(M a, M b) { return _mm256_andnot_si256(a, b); }
+	BIMS_AVX2 static M neither(M a, M b)
+	{
+		return _mm256_xor_si256(_mm256_or_si256(a, b), _mm256_set1_epi32(-1));
+	}
+	BIMS_AVX2 static D addIf(D t, M m, D d)
+	{
+		return _mm256_add_pd(t, _mm256_and_pd(_mm256_castsi256_pd(m), d));
+	}
+	BIMS_AVX2 static I pick(M mx, M my, I a, I b, I c)
+	{
+		return _mm256_or_si256(
+		    _mm256_or_si256(_mm256_and_si256(mx, a), _mm256_and_si256(my, b)),
+		    _mm256_andnot_si256(_mm256_or_si256(mx, my), c));
+	}
+	BIMS_AVX2 static I stepBits(I g, I m, I c)
+	{
+		return _mm256_or_si256(
+		    _mm256_and_si256(_mm256_add_epi64(_mm256_and_si256(g, m), c), m),
+		    _mm256_andnot_si256(m, g));
+	}
+};
+#define BIMS_AVX512 __attribute__((target("avx512f,avx512dq")))
+struct Avx512Ops
+{
+	static constexpr int N = 8;
+	using D = __m512d;
+	using I = __m512i;
+	using M = __mmask8;
+	BIMS_AVX512 static D loadD(const double* p) { return _mm512_load_pd(p); }
+	BIMS_AVX512 static I loadI(const int64_t* p)
+	{
+		return _mm512_load_si512(p);
+	}
+	BIMS_AVX512 static void storeD(double* p, D v) { _mm512_store_pd(p, v); }
+	BIMS_AVX512 static void storeI(int64_t* p, I v)
+	{
+		_mm512_store_si512(p, v);
+	}
+	BIMS_AVX512 static I set1(int64_t v) { return _mm512_set1_epi64(v); }
+	// (__m512i is a vector of GCC's extensions: its operators and element
+	// reads avoid intrinsics that GCC 12 flags as maybe uninitialized.)
+	BIMS_AVX512 static void lanes(I v, uint64_t* out)
+	{
+		for (int i = 0; i < 8; ++i) out[i] = uint64_t(v[i]);
+	}
+	BIMS_AVX512 static M lt(D a, D b)
+	{
+		return _mm512_cmp_pd_mask(a, b, _CMP_LT_OQ);
+	}
+	BIMS_AVX512 static M both(M a, M b) { return M(a & b); }
+	BIMS_AVX512 static M notFirst(M a, M b) { return M(~a & b); }
+	BIMS_AVX512 static M neither(M a, M b) { return M(~(a | b)); }
+	BIMS_AVX512 static D addIf(D t, M m, D d)
+	{
+		return _mm512_mask_add_pd(t, m, t, d);
+	}
+	BIMS_AVX512 static I pick(M mx, M my, I a, I b, I c)
+	{
+		return _mm512_mask_mov_epi64(_mm512_mask_mov_epi64(c, my, b), mx, a);
+	}
+	BIMS_AVX512 static I stepBits(I g, I m, I c)
+	{
+		return (((g & m) + c) & m) | (g & ~m);
+	}
+};
+
+// The walker once per instruction set, with that set as the function's
+// target, so that no code outside it uses the set.
+#define BIMS_WALK_NAME walk2
+#define BIMS_WALK_OPS Sse2Ops
+#define BIMS_WALK_TARGET
+#include "ray_walk_lanes.inc"
+#define BIMS_WALK_NAME walk4
+#define BIMS_WALK_OPS Avx2Ops
+#define BIMS_WALK_TARGET BIMS_AVX2
+#include "ray_walk_lanes.inc"
+#define BIMS_WALK_NAME walk8
+#define BIMS_WALK_OPS Avx512Ops
+#define BIMS_WALK_TARGET BIMS_AVX512
+#include "ray_walk_lanes.inc"
 #endif
 
 }  // namespace
 
+bool rayLanesSupported(RayLanes lanes)
+{
+	switch (lanes)
+	{
+		case RayLanes::Best:
+		case RayLanes::Two:
+			return true;
+#if defined(BIMS_RAY_LANES_X86)
+		case RayLanes::Four:
+			return __builtin_cpu_supports("avx2");
+		case RayLanes::Eight:
+			return __builtin_cpu_supports("avx512f") &&
+			       __builtin_cpu_supports("avx512dq");
+#endif
+		default:
+			return false;
+	}
+}
+
 void markRays(const double a[3], const RayEnd* ends, size_t r0, size_t r1,
               const RayBox& box, BlockStored stored, const void* ctx,
-              RayMarks& m)
+              RayMarks& m, RayLanes lanes)
 {
 	Resolver res{box, stored, ctx, m};
-#if defined(BIMS_RAYMARKS_SSE2)
-	markRaysSse2(a, ends, r0, r1, box, res);
+	const Walk w{a, ends, r0, r1, box, res};
+#if defined(BIMS_RAY_LANES_X86)
+	static const RayLanes best = rayLanesSupported(RayLanes::Eight)
+	                                 ? RayLanes::Eight
+	                             : rayLanesSupported(RayLanes::Four)
+	                                 ? RayLanes::Four
+	                                 : RayLanes::Two;
+	if (lanes == RayLanes::Best || !rayLanesSupported(lanes)) lanes = best;
+	if (lanes == RayLanes::Eight) return walk8(w);
+	if (lanes == RayLanes::Four) return walk4(w);
+	walk2(w);
 #else
+	(void)lanes;
 	for (size_t r = r0; r < r1; ++r)
 	{
 		uint32_t step = 0;
 		traverseRay(a, ends[r].p,
 		            [&](int32_t x, int32_t y, int32_t z)
 		            {
-			            mark(box.bitOf(x, y, z), uint32_t(r), step++,
-			                 uint32_t(r), m.bits.data(), res);
+			            const uint64_t g = box.bitOf(x, y, z);
+			            res.visit(g, uint32_t(r), step++, uint32_t(r));
+			            m.bits[g >> 6] |= uint64_t(1) << (g & 63);
 		            });
 	}
 #endif
@@ -240,11 +348,18 @@ void markRays(const double a[3], const RayEnd* ends, size_t r0, size_t r1,
 
 void mergeRayMarks(RayMarks& m, const RayMarks& o)
 {
-	for (size_t w = 0; w < m.bits.size(); w += 2) m.bits[w] |= o.bits[w];
-	for (size_t b = 0; b < m.state.size(); ++b)
+	for (const uint32_t b : o.touched)
 	{
-		if (m.state[b] == RayMarks::kUnknown) m.state[b] = o.state[b];
-		m.firstVisit[b] = std::min(m.firstVisit[b], o.firstVisit[b]);
+		for (size_t i = 8 * size_t(b); i < 8 * size_t(b) + 8; ++i)
+			m.bits[i] |= o.bits[i];
+		if (m.state[b] == RayMarks::kUnknown)
+		{
+			m.touched.push_back(b);
+			m.state[b] = o.state[b];
+			m.firstVisit[b] = o.firstVisit[b];
+		}
+		else if (m.missing(b))
+			m.firstVisit[b] = std::min(m.firstVisit[b], o.firstVisit[b]);
 	}
 }
 

@@ -31,6 +31,9 @@ namespace
 using Key = std::tuple<int32_t, int32_t, int32_t>;
 
 /** Blocks stored for the walk: those in a std::set. */
+// Every walker this CPU runs (the others are skipped).
+constexpr RayLanes kLanes[] = {RayLanes::Two, RayLanes::Four, RayLanes::Eight};
+
 bool inSet(const void* ctx, int32_t bx, int32_t by, int32_t bz)
 {
 	return static_cast<const std::set<Key>*>(ctx)->count({bx, by, bz}) > 0;
@@ -146,6 +149,9 @@ TEST(RayMarks, SameVoxelsAndFirstVisitsAsTraverseRay)
 {
 	std::mt19937 rng(5);
 	std::uniform_real_distribution<double> U(-1, 1);
+	// Reused over the trials and lanes, as the grid reuses them over frames
+	// (reset() clears only what the last walk marked).
+	std::vector<RayMarks> marks(3);
 	for (int trial = 0; trial < 12; ++trial)
 	{
 		const double a[3] = {U(rng) * 20, U(rng) * 20 - 30, U(rng) * 20};
@@ -188,43 +194,50 @@ TEST(RayMarks, SameVoxelsAndFirstVisitsAsTraverseRay)
 		size_t i = 0;
 		for (const auto& [b, v] : first)
 			if (i++ % 3 == 0) stored.insert(b);
-		for (size_t parts : {size_t(1), size_t(3)})
-		{
-			std::vector<RayMarks> marks(parts);
-			for (size_t p = 0; p < parts; ++p)
+		for (const RayLanes lanes : kLanes)
+			for (size_t parts : {size_t(1), size_t(3)})
 			{
-				marks[p].reset(box);
-				// Part p takes every parts-th run of 50 rays.
-				for (size_t r0 = 50 * p; r0 < ends.size(); r0 += 50 * parts)
-					markRays(a, ends.data(), r0, std::min(ends.size(), r0 + 50),
-					         box, inSet, &stored, marks[p]);
-			}
-			for (size_t p = 1; p < parts; ++p)
-				mergeRayMarks(marks[0], marks[p]);
-			const RayMarks& m = marks[0];
-			size_t crossed = 0;
-			for (size_t w = 0; w < m.bits.size(); w += 2)
-				crossed += size_t(__builtin_popcountll(m.bits[w]));
-			ASSERT_EQ(crossed, voxels.size()) << "trial " << trial;
-			for (const auto& [x, y, z] : voxels)
-			{
-				const uint64_t g = box.bitOf(x, y, z);
-				ASSERT_TRUE((m.bits[2 * (g >> 6)] >> (g & 63)) & 1);
-			}
-			for (const auto& [b, v] : first)
-			{
-				const auto& [bx, by, bz] = b;
-				const size_t bi = box.blockIndex(
-				    size_t(bx - lo[0]), size_t(by - lo[1]), size_t(bz - lo[2]));
-				const bool isStored = stored.count(b) > 0;
-				ASSERT_EQ(m.state[bi],
-				          isStored ? RayMarks::kStored : RayMarks::kMissing);
-				if (!isStored)
+				if (!rayLanesSupported(lanes)) continue;
+				for (size_t p = 0; p < parts; ++p)
 				{
-					ASSERT_EQ(m.firstVisit[bi], v) << "trial " << trial;
+					marks[p].reset(box);
+					// Part p takes every parts-th run of 50 rays.
+					for (size_t r0 = 50 * p; r0 < ends.size(); r0 += 50 * parts)
+						markRays(a, ends.data(), r0,
+						         std::min(ends.size(), r0 + 50), box, inSet,
+						         &stored, marks[p], lanes);
+				}
+				for (size_t p = 1; p < parts; ++p)
+					mergeRayMarks(marks[0], marks[p]);
+				const RayMarks& m = marks[0];
+				const std::string at = "trial " + std::to_string(trial) +
+				                       " lanes " + std::to_string(int(lanes));
+				size_t crossed = 0;
+				for (const uint64_t w : m.bits)
+					crossed += size_t(__builtin_popcountll(w));
+				ASSERT_EQ(crossed, voxels.size()) << at;
+				for (const auto& [x, y, z] : voxels)
+				{
+					const uint64_t g = box.bitOf(x, y, z);
+					ASSERT_TRUE((m.bits[g >> 6] >> (g & 63)) & 1) << at;
+				}
+				ASSERT_EQ(m.touched.size(), first.size()) << at;
+				for (const auto& [b, v] : first)
+				{
+					const auto& [bx, by, bz] = b;
+					const size_t bi = box.blockOf(bx, by, bz);
+					int32_t c[3];
+					box.blockCoords(bi, c);
+					ASSERT_TRUE(c[0] == bx && c[1] == by && c[2] == bz) << at;
+					const bool isStored = stored.count(b) > 0;
+					ASSERT_EQ(m.stored(bi), isStored) << at;
+					ASSERT_EQ(m.missing(bi), !isStored) << at;
+					if (!isStored)
+					{
+						ASSERT_EQ(m.firstVisit[bi], v) << at;
+					}
 				}
 			}
-		}
 	}
 }
 

@@ -135,9 +135,8 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 	 * too large for the bitsets). Returns the steps over the budget. */
 	size_t castPlain(const double a[3], uint32_t F);
 	/** The missed cells of castMarked(), from the crossed bits of \a m;
-	 * \a tab: the cells of each block of \a box, nullptr if not stored. */
-	void applyRayMarks(const RayBox& box, const RayMarks& m, Cell* const* tab,
-	                   uint32_t F);
+	 * \a cells: those of each block of m.touched, nullptr if not stored. */
+	void applyRayMarks(const RayMarks& m, Cell* const* cells, uint32_t F);
 	/** One miss in frame F, unless the cell was hit or missed in it. */
 	void applyMiss(Cell& c, uint32_t F) const
 	{
@@ -163,7 +162,7 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 	// Scratch of decayRaycast(), reused across frames.
 	std::vector<RayEnd> rayEnds_;
 	std::vector<uint32_t> tileStart_;
-	std::vector<Cell*> blockTable_;
+	std::vector<Cell*> blockCells_;
 	std::vector<RayMarks> rayMarks_;  // one per thread
 	// Scratch of decayFrustum(): per-tile depth bounds.
 	std::vector<float> tileMax_, tileMinPos_;

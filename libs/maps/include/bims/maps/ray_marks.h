@@ -12,56 +12,67 @@
 namespace bims::maps
 {
 /** The rays' bounding box in blocks of 8^3 voxels, and the layout of its
- * voxel bitsets: one bit per voxel, x fastest, a row of voxels along x
- * padded to whole 64-bit words, so that a step of the DDA along x, y or z
- * adds a constant to the bit index (1, rowBits(), planeBits()). */
+ * voxel bitset: the bit index of a voxel holds its cell index in its block
+ * (bits 0-8: x, y, z three bits each, the cells' order in a block) and
+ * above them the block's place in the box in Morton order (the box padded
+ * to powers of two blocks per axis). So a block's 512 bits are one 64-byte
+ * cache line, a word is one row z of a block, neighbouring blocks are near
+ * in memory, and a step of the DDA along an axis is an addition on that
+ * axis's bits only (step()). */
 struct RayBox
 {
-	int32_t lo[3] = {};  // first block per axis
-	size_t n[3] = {};    // blocks per axis
-	size_t rowWords = 0;
+	int32_t lo[3] = {};     // first block per axis
+	unsigned logN[3] = {};  // log2 of the padded blocks per axis
+	uint64_t mask[3] = {};  // the bits of the bit index holding each axis
 
 	/** The box of blocks [lo, hi] (inclusive). */
 	RayBox(const int32_t lo[3], const int32_t hi[3]);
 
-	size_t blocks() const { return n[0] * n[1] * n[2]; }
-	size_t rows() const { return n[1] * 8 * n[2] * 8; }
-	size_t words() const { return rowWords * rows(); }
-	uint64_t rowBits() const { return uint64_t(rowWords) * 64; }
-	uint64_t planeBits() const { return rowBits() * n[1] * 8; }
+	/** Blocks of the padded box (bit index >> 9 is below this). */
+	size_t blocks() const { return size_t(1) << (logN[0] + logN[1] + logN[2]); }
+	size_t words() const { return blocks() * 8; }
 	/** Bit of the voxel (x, y, z) (absolute voxel indices, in the box). */
-	uint64_t bitOf(int32_t x, int32_t y, int32_t z) const
+	uint64_t bitOf(int32_t x, int32_t y, int32_t z) const;
+	/** Block (bx, by, bz) (absolute block indices, in the box). */
+	size_t blockOf(int32_t bx, int32_t by, int32_t bz) const
 	{
-		return uint64_t(x - lo[0] * 8) + rowBits() * uint64_t(y - lo[1] * 8) +
-		       planeBits() * uint64_t(z - lo[2] * 8);
+		return size_t(bitOf(bx * 8, by * 8, bz * 8) >> 9);
 	}
-	/** Index of the block (bx, by, bz) relative to lo, x fastest. */
-	size_t blockIndex(size_t bx, size_t by, size_t bz) const
+	/** The absolute block indices of block \a b. */
+	void blockCoords(size_t b, int32_t out[3]) const;
+	/** The bit index one voxel along the axis of \a m from \a g, in the
+	 * direction of \a c (c = -m: +1, c = -1: -1; m = c = 0: no move). */
+	static uint64_t step(uint64_t g, uint64_t m, uint64_t c)
 	{
-		return bx + n[0] * (by + n[1] * bz);
+		return (((g & m) + c) & m) | (g & ~m);
 	}
 };
 
-/** The marks of the rays one thread walked: per voxel a "crossed" bit and
- * an "unresolved" bit (its block not looked up yet, or looked up and not
- * stored), interleaved word by word so that one cache line holds both; per
- * block whether it is stored and, if it is not, the earliest visit
- * (ray << 32 | step) by the rays of this thread. */
+/** The marks of the rays one thread walked: a "crossed" bit per voxel; per
+ * block whether it was looked up and is stored, whether visits of it still
+ * need the slow path and, if it is missing, the earliest visit
+ * (ray << 32 | step) by the rays of this thread. Only the blocks in
+ * touched (looked up, in the order of looking up) have crossed bits or
+ * state; reset() clears just them, so a frame costs what its rays touch. */
 struct RayMarks
 {
 	static constexpr uint64_t kNoVisit = ~uint64_t(0);
 	enum : uint8_t
 	{
-		kUnknown = 0,
-		kStored = 1,
-		kMissing = 2
+		kUnknown = 0,   // not looked up (visits take the slow path)
+		kResolved = 1,  // no more slow visits
+		kMissing = 2,   // looked up, not stored
+		kStored = 4,    // looked up, stored
 	};
-	std::vector<uint64_t> bits;        // [2w]: crossed, [2w + 1]: unresolved
+	std::vector<uint64_t> bits;        // 8 words per block
 	std::vector<uint8_t> state;        // per block
-	std::vector<uint64_t> firstVisit;  // per block, for kMissing blocks
+	std::vector<uint64_t> firstVisit;  // per block, valid if kMissing
+	std::vector<uint32_t> touched;     // blocks looked up
 
-	/** Nothing crossed, every voxel unresolved, no block looked up. */
+	/** Nothing crossed, no block looked up. */
 	void reset(const RayBox& box);
+	bool missing(size_t b) const { return state[b] & kMissing; }
+	bool stored(size_t b) const { return state[b] & kStored; }
 };
 
 /** The end of a ray, in voxel units. */
@@ -74,20 +85,31 @@ struct RayEnd
 using BlockStored = bool (*)(const void* ctx, int32_t bx, int32_t by,
                              int32_t bz);
 
+/** How many rays a walker steps at once, in the lanes of which registers. */
+enum class RayLanes
+{
+	Best,    // the widest this CPU runs
+	Two,     // SSE2 (or the compiler's generic vectors off x86)
+	Four,    // AVX2
+	Eight,   // AVX-512
+};
+/** Can this CPU run \a lanes? */
+bool rayLanesSupported(RayLanes lanes);
+
 /** Walks rays [r0, r1) of \a ends from \a a (voxel units), with the DDA of
  * traverseRay() (the same voxels, step by step), and marks every voxel
  * they cross in \a m (reset for \a box before the first call; rays may be
  * split over calls and threads in any way: the marks of the parts, merged
- * with mergeRayMarks(), are the same). The first visit of a voxel of a
- * block looks the block up with \a stored; visits of blocks not stored
- * keep their earliest (ray, step). Single-threaded per RayMarks. */
+ * with mergeRayMarks(), are the same, and so for every \a lanes). The
+ * first visit of a block looks it up with \a stored; visits of blocks not
+ * stored keep their earliest (ray, step). Single-threaded per RayMarks. */
 void markRays(const double a[3], const RayEnd* ends, size_t r0, size_t r1,
               const RayBox& box, BlockStored stored, const void* ctx,
-              RayMarks& m);
+              RayMarks& m, RayLanes lanes = RayLanes::Best);
 
 /** Merges \a other into \a m: crossed bits or-ed, blocks looked up by
- * either, earliest visits. (The unresolved bits of \a m are left stale:
- * call before applying, not before walking more rays into \a m.) */
+ * either, earliest visits. (Call before applying, not before walking more
+ * rays into \a m.) */
 void mergeRayMarks(RayMarks& m, const RayMarks& other);
 
 }  // namespace bims::maps
