@@ -34,8 +34,8 @@ namespace
 constexpr int kTile = 8;
 // Largest bounding box of the rays for the bitsets (voxels of the box
 // padded to powers of two blocks per axis, one bit each per thread: 32 MiB,
-// of which a frame touches only the blocks its rays enter); beyond it (huge extents at fine voxels)
-// the rays are walked voxel by voxel (castPlain).
+// of which a frame touches only the blocks its rays enter); beyond it (huge
+// extents at fine voxels) the rays are walked voxel by voxel (castPlain).
 constexpr size_t kMaxMarkedVoxels = size_t(1) << 28;
 // Rays per work item of a thread (32 tiles).
 constexpr size_t kChunk = 2048;
@@ -235,14 +235,15 @@ size_t COccupancyBayesGrid::castMarked(const double a[3], const RayBox& box,
 			traverseRay(a, e.p,
 			            [&](int32_t x, int32_t y, int32_t z)
 			            {
-				            over += m.state[box.blockOf(x >> 3, y >> 3, z >> 3)] ==
-				                    RayMarks::kUnknown;
+				            over +=
+				                m.state[box.blockOf(x >> 3, y >> 3, z >> 3)] ==
+				                RayMarks::kUnknown;
 			            });
 	return over;
 }
 
-void COccupancyBayesGrid::applyRayMarks(const RayMarks& m,
-                                        Cell* const* cells, uint32_t F)
+void COccupancyBayesGrid::applyRayMarks(const RayMarks& m, Cell* const* cells,
+                                        uint32_t F)
 {
 	// Word z of a block's bits is its row z of cells (cell z * 64 + bit).
 	for (size_t i = 0; i < m.touched.size(); ++i)

@@ -80,42 +80,18 @@ void RayMarks::reset(const RayBox& box)
 
 namespace
 {
-/** The slow part of a visit: a block this thread has not looked up, or a
- * block that is not stored. A block no longer needs slow visits once it is
- * stored, or once it is missing and visited by the oldest ray in flight:
- * every later visit by this thread is then of that ray's later steps or of
- * younger rays, with later (ray, step). */
-struct Resolver
+/** Runs of a ray's visits inside one word of the bitset (one row z of cells
+ * of one block), collected by a walker and applied in batches: the word,
+ * its bits, and the run's first visit (ray << 32 | step). A block's
+ * earliest visit is the start of one of its runs. */
+struct Runs
 {
-	const RayBox& box;
-	BlockStored stored;
-	const void* ctx;
-	RayMarks& m;
-
-	void visit(uint64_t g, uint32_t ray, uint32_t step, uint32_t oldest)
-	{
-		const size_t b = size_t(g >> 9);
-		uint8_t& st = m.state[b];
-		if (st == RayMarks::kUnknown)
-		{
-			int32_t c[3];
-			box.blockCoords(b, c);
-			m.touched.push_back(uint32_t(b));
-			if (stored(ctx, c[0], c[1], c[2]))
-				st = RayMarks::kStored | RayMarks::kResolved;
-			else
-			{
-				st = RayMarks::kMissing;
-				m.firstVisit[b] = RayMarks::kNoVisit;
-			}
-		}
-		if (st & RayMarks::kMissing)
-		{
-			m.firstVisit[b] =
-			    std::min(m.firstVisit[b], (uint64_t(ray) << 32) | step);
-			if (ray == oldest) st |= RayMarks::kResolved;
-		}
-	}
+	static constexpr size_t kCap = 1024;
+	static constexpr size_t kSlack = 16;  // a walker may write 16 past n
+	alignas(64) int64_t word[kCap + kSlack];
+	alignas(64) int64_t bits[kCap + kSlack];
+	alignas(64) int64_t first[kCap + kSlack];
+	size_t n = 0;
 };
 
 /** What a walker needs: the rays, the box, the marks. */
@@ -125,59 +101,97 @@ struct Walk
 	const RayEnd* ends;
 	size_t r0, r1;
 	const RayBox& box;
-	Resolver& res;
+	BlockStored stored;
+	const void* ctx;
+	RayMarks& m;
+	Runs& runs;
+
+	/** Applies the runs collected: each word's bits set; each block entered
+	 * for the first time looked up; the earliest first visit kept for the
+	 * blocks not stored. */
+	void apply()
+	{
+		uint64_t* out = m.bits.data();
+		uint8_t* state = m.state.data();
+		for (size_t i = 0; i < runs.n; ++i)
+		{
+			const uint64_t w = uint64_t(runs.word[i]);
+			const uint64_t v = uint64_t(runs.first[i]);
+			const size_t b = size_t(w >> 3);
+			if (state[b] == RayMarks::kUnknown)
+			{
+				int32_t c[3];
+				box.blockCoords(b, c);
+				m.touched.push_back(uint32_t(b));
+				state[b] = stored(ctx, c[0], c[1], c[2]) ? RayMarks::kStored
+				                                         : RayMarks::kMissing;
+				m.firstVisit[b] = v;
+			}
+			else if (state[b] == RayMarks::kMissing)
+				m.firstVisit[b] = std::min(m.firstVisit[b], v);
+			out[w] |= uint64_t(runs.bits[i]);
+		}
+		runs.n = 0;
+	}
+	/** One run; applies the batch when it is full. */
+	void push(uint64_t word, uint64_t bits, uint64_t first)
+	{
+		runs.word[runs.n] = int64_t(word);
+		runs.bits[runs.n] = int64_t(bits);
+		runs.first[runs.n] = int64_t(first);
+		if (++runs.n == Runs::kCap) apply();
+	}
 };
+
+/** The walker's operations on one lane in scalars (CPUs without AVX2,
+ * other architectures); the vector sets below have the same members. */
+struct ScalarOps
+{
+	static constexpr int N = 1;
+	using D = double;
+	using I = int64_t;
+	using M = bool;
+	static D loadD(const double* p) { return *p; }
+	static I loadI(const int64_t* p) { return *p; }
+	static void storeD(double* p, D v) { *p = v; }
+	static void storeI(int64_t* p, I v) { *p = v; }
+	static I set1(int64_t v) { return v; }
+	static I add(I a, I b) { return int64_t(uint64_t(a) + uint64_t(b)); }
+	/** The word of a bit index, and its bit in the word. */
+	static I word(I g) { return int64_t(uint64_t(g) >> 6); }
+	static I bit(I g) { return int64_t(uint64_t(1) << (g & 63)); }
+	static M differ(I a, I b) { return a != b; }
+	/** m ? a : b */
+	static I select(M m, I a, I b) { return m ? a : b; }
+	static I orI(I a, I b) { return a | b; }
+	/** The lanes of \a v in \a m, packed at \a out (N written); how many. */
+	static size_t compress(M m, I v, int64_t* out)
+	{
+		*out = v;
+		return m;
+	}
+	static M lt(D a, D b) { return a < b; }
+	static M le(D a, D b) { return a <= b; }
+	static M both(M a, M b) { return a && b; }
+	/** m ? t + d : t */
+	static D addIf(D t, M m, D d) { return m ? t + d : t; }
+	/** mx ? a : my ? b : c */
+	static I pick(M mx, M my, I a, I b, I c) { return mx ? a : my ? b : c; }
+	/** RayBox::step() */
+	static I stepBits(I g, I m, I c)
+	{
+		return int64_t(RayBox::step(uint64_t(g), uint64_t(m), uint64_t(c)));
+	}
+};
+#define BIMS_WALK_NAME walk1
+#define BIMS_WALK_OPS ScalarOps
+#define BIMS_WALK_TARGET
+#include "ray_walk_lanes.inc"
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #define BIMS_RAY_LANES_X86 1
 // The vector operations of the walker (ray_walk_lanes.inc) per instruction
 // set: N lanes of doubles (D) and 64-bit integers (I), lane masks (M).
-struct Sse2Ops
-{
-	static constexpr int N = 2;
-	using D = __m128d;
-	using I = __m128i;
-	using M = __m128i;
-	static D loadD(const double* p) { return _mm_load_pd(p); }
-	static I loadI(const int64_t* p)
-	{
-		return _mm_load_si128(reinterpret_cast<const __m128i*>(p));
-	}
-	static void storeD(double* p, D v) { _mm_store_pd(p, v); }
-	static void storeI(int64_t* p, I v)
-	{
-		_mm_store_si128(reinterpret_cast<__m128i*>(p), v);
-	}
-	static I set1(int64_t v) { return _mm_set1_epi64x(v); }
-	static void lanes(I v, uint64_t* out)
-	{
-		out[0] = uint64_t(_mm_cvtsi128_si64(v));
-		out[1] = uint64_t(_mm_cvtsi128_si64(_mm_unpackhi_epi64(v, v)));
-	}
-	static M lt(D a, D b) { return _mm_castpd_si128(_mm_cmplt_pd(a, b)); }
-	static M both(M a, M b) { return _mm_and_si128(a, b); }
-	static M notFirst(M a, M b) { return _mm_andnot_si128(a, b); }
-	static M neither(M a, M b)
-	{
-		return _mm_xor_si128(_mm_or_si128(a, b), _mm_set1_epi32(-1));
-	}
-	static D addIf(D t, M m, D d)
-	{
-		return _mm_add_pd(t, _mm_and_pd(_mm_castsi128_pd(m), d));
-	}
-	static I pick(M mx, M my, I a, I b, I c)
-	{
-		return _mm_or_si128(
-		    _mm_or_si128(_mm_and_si128(mx, a), _mm_and_si128(my, b)),
-		    _mm_andnot_si128(_mm_or_si128(mx, my), c));
-	}
-	static I stepBits(I g, I m, I c)
-	{
-		return _mm_or_si128(
-		    _mm_and_si128(_mm_add_epi64(_mm_and_si128(g, m), c), m),
-		    _mm_andnot_si128(m, g));
-	}
-};
 #define BIMS_AVX2 __attribute__((target("avx2")))
 struct Avx2Ops
 {
@@ -196,35 +210,63 @@ struct Avx2Ops
 		_mm256_store_si256(reinterpret_cast<__m256i*>(p), v);
 	}
 	BIMS_AVX2 static I set1(int64_t v) { return _mm256_set1_epi64x(v); }
-	BIMS_AVX2 static void lanes(I v, uint64_t* out)
+	BIMS_AVX2 static I add(I a, I b) { return _mm256_add_epi64(a, b); }
+	BIMS_AVX2 static I word(I g) { return _mm256_srli_epi64(g, 6); }
+	BIMS_AVX2 static I bit(I g)
 	{
-		const __m128i lo = _mm256_castsi256_si128(v),
-		              hi = _mm256_extracti128_si256(v, 1);
-		out[0] = uint64_t(_mm_cvtsi128_si64(lo));
-		out[1] = uint64_t(_mm_extract_epi64(lo, 1));
-		out[2] = uint64_t(_mm_cvtsi128_si64(hi));
-		out[3] = uint64_t(_mm_extract_epi64(hi, 1));
+		return _mm256_sllv_epi64(_mm256_set1_epi64x(1),
+		                         _mm256_and_si256(g, _mm256_set1_epi64x(63)));
+	}
+	BIMS_AVX2 static M differ(I a, I b)
+	{
+		return _mm256_xor_si256(_mm256_cmpeq_epi64(a, b),
+		                        _mm256_set1_epi32(-1));
+	}
+	/** m ? a : b */
+	BIMS_AVX2 static I select(M m, I a, I b)
+	{
+		return _mm256_blendv_epi8(b, a, m);
+	}
+	BIMS_AVX2 static I orI(I a, I b) { return _mm256_or_si256(a, b); }
+	/** The lanes of \a v in \a m, packed at \a out (N written); how many. */
+	BIMS_AVX2 static size_t compress(M m, I v, int64_t* out)
+	{
+		// Per 4-bit lane mask, the 32-bit elements to gather, in order.
+		alignas(32) static const int32_t kPerm[16][8] = {
+		    {0, 1, 2, 3, 4, 5, 6, 7}, {0, 1, 2, 3, 4, 5, 6, 7},
+		    {2, 3, 0, 1, 4, 5, 6, 7}, {0, 1, 2, 3, 4, 5, 6, 7},
+		    {4, 5, 0, 1, 2, 3, 6, 7}, {0, 1, 4, 5, 2, 3, 6, 7},
+		    {2, 3, 4, 5, 0, 1, 6, 7}, {0, 1, 2, 3, 4, 5, 6, 7},
+		    {6, 7, 0, 1, 2, 3, 4, 5}, {0, 1, 6, 7, 2, 3, 4, 5},
+		    {2, 3, 6, 7, 0, 1, 4, 5}, {0, 1, 2, 3, 6, 7, 4, 5},
+		    {4, 5, 6, 7, 0, 1, 2, 3}, {0, 1, 4, 5, 6, 7, 2, 3},
+		    {2, 3, 4, 5, 6, 7, 0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}};
+		const int k = _mm256_movemask_pd(_mm256_castsi256_pd(m));
+		const __m256i p =
+		    _mm256_load_si256(reinterpret_cast<const __m256i*>(kPerm[k]));
+		_mm256_storeu_si256(reinterpret_cast<__m256i*>(out),
+		                    _mm256_permutevar8x32_epi32(v, p));
+		return size_t(__builtin_popcount(unsigned(k)));
 	}
 	BIMS_AVX2 static M lt(D a, D b)
 	{
 		return _mm256_castpd_si256(_mm256_cmp_pd(a, b, _CMP_LT_OQ));
 	}
-	BIMS_AVX2 static M both(M a, M b) { return _mm256_and_si256(a, b); }
-	BIMS_AVX2 static M notFirst(M a, M b) { return _mm256_andnot_si256(a, b); }
-	BIMS_AVX2 static M neither(M a, M b)
+	BIMS_AVX2 static M le(D a, D b)
 	{
-		return _mm256_xor_si256(_mm256_or_si256(a, b), _mm256_set1_epi32(-1));
+		return _mm256_castpd_si256(_mm256_cmp_pd(a, b, _CMP_LE_OQ));
 	}
+	BIMS_AVX2 static M both(M a, M b) { return _mm256_and_si256(a, b); }
 	BIMS_AVX2 static D addIf(D t, M m, D d)
 	{
 		return _mm256_add_pd(t, _mm256_and_pd(_mm256_castsi256_pd(m), d));
 	}
+	/** mx ? a : my ? b : c */
 	BIMS_AVX2 static I pick(M mx, M my, I a, I b, I c)
 	{
-		return _mm256_or_si256(
-		    _mm256_or_si256(_mm256_and_si256(mx, a), _mm256_and_si256(my, b)),
-		    _mm256_andnot_si256(_mm256_or_si256(mx, my), c));
+		return _mm256_blendv_epi8(_mm256_blendv_epi8(c, b, my), a, mx);
 	}
+	/** RayBox::step() */
 	BIMS_AVX2 static I stepBits(I g, I m, I c)
 	{
 		return _mm256_or_si256(
@@ -233,6 +275,8 @@ struct Avx2Ops
 	}
 };
 #define BIMS_AVX512 __attribute__((target("avx512f,avx512dq")))
+// (__m512i is a vector of GCC's extensions: its operators avoid intrinsics
+// that GCC 12 flags as maybe uninitialized.)
 struct Avx512Ops
 {
 	static constexpr int N = 8;
@@ -250,19 +294,33 @@ struct Avx512Ops
 		_mm512_store_si512(p, v);
 	}
 	BIMS_AVX512 static I set1(int64_t v) { return _mm512_set1_epi64(v); }
-	// (__m512i is a vector of GCC's extensions: its operators and element
-	// reads avoid intrinsics that GCC 12 flags as maybe uninitialized.)
-	BIMS_AVX512 static void lanes(I v, uint64_t* out)
+	BIMS_AVX512 static I add(I a, I b) { return a + b; }
+	// (Bit indices are below 2^63: the signed shift is the unsigned one.)
+	BIMS_AVX512 static I word(I g) { return g >> 6; }
+	BIMS_AVX512 static I bit(I g) { return _mm512_set1_epi64(1) << (g & 63); }
+	BIMS_AVX512 static M differ(I a, I b)
 	{
-		for (int i = 0; i < 8; ++i) out[i] = uint64_t(v[i]);
+		return _mm512_cmpneq_epi64_mask(a, b);
+	}
+	BIMS_AVX512 static I select(M m, I a, I b)
+	{
+		return _mm512_mask_blend_epi64(m, b, a);
+	}
+	BIMS_AVX512 static I orI(I a, I b) { return a | b; }
+	BIMS_AVX512 static size_t compress(M m, I v, int64_t* out)
+	{
+		_mm512_storeu_si512(out, _mm512_maskz_compress_epi64(m, v));
+		return size_t(__builtin_popcount(unsigned(m)));
 	}
 	BIMS_AVX512 static M lt(D a, D b)
 	{
 		return _mm512_cmp_pd_mask(a, b, _CMP_LT_OQ);
 	}
+	BIMS_AVX512 static M le(D a, D b)
+	{
+		return _mm512_cmp_pd_mask(a, b, _CMP_LE_OQ);
+	}
 	BIMS_AVX512 static M both(M a, M b) { return M(a & b); }
-	BIMS_AVX512 static M notFirst(M a, M b) { return M(~a & b); }
-	BIMS_AVX512 static M neither(M a, M b) { return M(~(a | b)); }
 	BIMS_AVX512 static D addIf(D t, M m, D d)
 	{
 		return _mm512_mask_add_pd(t, m, t, d);
@@ -279,10 +337,6 @@ struct Avx512Ops
 
 // The walker once per instruction set, with that set as the function's
 // target, so that no code outside it uses the set.
-#define BIMS_WALK_NAME walk2
-#define BIMS_WALK_OPS Sse2Ops
-#define BIMS_WALK_TARGET
-#include "ray_walk_lanes.inc"
 #define BIMS_WALK_NAME walk4
 #define BIMS_WALK_OPS Avx2Ops
 #define BIMS_WALK_TARGET BIMS_AVX2
@@ -300,7 +354,7 @@ bool rayLanesSupported(RayLanes lanes)
 	switch (lanes)
 	{
 		case RayLanes::Best:
-		case RayLanes::Two:
+		case RayLanes::One:
 			return true;
 #if defined(BIMS_RAY_LANES_X86)
 		case RayLanes::Four:
@@ -318,32 +372,20 @@ void markRays(const double a[3], const RayEnd* ends, size_t r0, size_t r1,
               const RayBox& box, BlockStored stored, const void* ctx,
               RayMarks& m, RayLanes lanes)
 {
-	Resolver res{box, stored, ctx, m};
-	const Walk w{a, ends, r0, r1, box, res};
+	Runs runs;
+	Walk w{a, ends, r0, r1, box, stored, ctx, m, runs};
 #if defined(BIMS_RAY_LANES_X86)
-	static const RayLanes best = rayLanesSupported(RayLanes::Eight)
-	                                 ? RayLanes::Eight
-	                             : rayLanesSupported(RayLanes::Four)
-	                                 ? RayLanes::Four
-	                                 : RayLanes::Two;
+	static const RayLanes best =
+	    rayLanesSupported(RayLanes::Eight)  ? RayLanes::Eight
+	    : rayLanesSupported(RayLanes::Four) ? RayLanes::Four
+	                                        : RayLanes::One;
 	if (lanes == RayLanes::Best || !rayLanesSupported(lanes)) lanes = best;
 	if (lanes == RayLanes::Eight) return walk8(w);
 	if (lanes == RayLanes::Four) return walk4(w);
-	walk2(w);
 #else
 	(void)lanes;
-	for (size_t r = r0; r < r1; ++r)
-	{
-		uint32_t step = 0;
-		traverseRay(a, ends[r].p,
-		            [&](int32_t x, int32_t y, int32_t z)
-		            {
-			            const uint64_t g = box.bitOf(x, y, z);
-			            res.visit(g, uint32_t(r), step++, uint32_t(r));
-			            m.bits[g >> 6] |= uint64_t(1) << (g & 63);
-		            });
-	}
 #endif
+	walk1(w);
 }
 
 void mergeRayMarks(RayMarks& m, const RayMarks& o)

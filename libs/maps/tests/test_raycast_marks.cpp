@@ -32,7 +32,7 @@ using Key = std::tuple<int32_t, int32_t, int32_t>;
 
 /** Blocks stored for the walk: those in a std::set. */
 // Every walker this CPU runs (the others are skipped).
-constexpr RayLanes kLanes[] = {RayLanes::Two, RayLanes::Four, RayLanes::Eight};
+constexpr RayLanes kLanes[] = {RayLanes::One, RayLanes::Four, RayLanes::Eight};
 
 bool inSet(const void* ctx, int32_t bx, int32_t by, int32_t bz)
 {

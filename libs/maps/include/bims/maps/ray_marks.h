@@ -49,20 +49,18 @@ struct RayBox
 };
 
 /** The marks of the rays one thread walked: a "crossed" bit per voxel; per
- * block whether it was looked up and is stored, whether visits of it still
- * need the slow path and, if it is missing, the earliest visit
- * (ray << 32 | step) by the rays of this thread. Only the blocks in
- * touched (looked up, in the order of looking up) have crossed bits or
+ * block whether it was looked up and is stored and, if it is missing, the
+ * earliest visit (ray << 32 | step) by the rays of this thread. Only the blocks
+ * in touched (looked up, in the order of looking up) have crossed bits or
  * state; reset() clears just them, so a frame costs what its rays touch. */
 struct RayMarks
 {
 	static constexpr uint64_t kNoVisit = ~uint64_t(0);
 	enum : uint8_t
 	{
-		kUnknown = 0,   // not looked up (visits take the slow path)
-		kResolved = 1,  // no more slow visits
-		kMissing = 2,   // looked up, not stored
-		kStored = 4,    // looked up, stored
+		kUnknown = 0,  // not looked up
+		kMissing = 1,  // looked up, not stored
+		kStored = 2,   // looked up, stored
 	};
 	std::vector<uint64_t> bits;        // 8 words per block
 	std::vector<uint8_t> state;        // per block
@@ -71,8 +69,8 @@ struct RayMarks
 
 	/** Nothing crossed, no block looked up. */
 	void reset(const RayBox& box);
-	bool missing(size_t b) const { return state[b] & kMissing; }
-	bool stored(size_t b) const { return state[b] & kStored; }
+	bool missing(size_t b) const { return state[b] == kMissing; }
+	bool stored(size_t b) const { return state[b] == kStored; }
 };
 
 /** The end of a ray, in voxel units. */
@@ -88,10 +86,10 @@ using BlockStored = bool (*)(const void* ctx, int32_t bx, int32_t by,
 /** How many rays a walker steps at once, in the lanes of which registers. */
 enum class RayLanes
 {
-	Best,    // the widest this CPU runs
-	Two,     // SSE2 (or the compiler's generic vectors off x86)
-	Four,    // AVX2
-	Eight,   // AVX-512
+	Best,   // the widest this CPU runs
+	One,    // one ray at a time (traverseRay() itself)
+	Four,   // AVX2
+	Eight,  // AVX-512
 };
 /** Can this CPU run \a lanes? */
 bool rayLanesSupported(RayLanes lanes);
@@ -100,9 +98,10 @@ bool rayLanesSupported(RayLanes lanes);
  * traverseRay() (the same voxels, step by step), and marks every voxel
  * they cross in \a m (reset for \a box before the first call; rays may be
  * split over calls and threads in any way: the marks of the parts, merged
- * with mergeRayMarks(), are the same, and so for every \a lanes). The
- * first visit of a block looks it up with \a stored; visits of blocks not
- * stored keep their earliest (ray, step). Single-threaded per RayMarks. */
+ * with mergeRayMarks(), are the same, and so for every \a lanes; lanes
+ * this CPU cannot run fall back to Best). Each block the rays enter
+ * is looked up once with \a stored; the blocks not stored keep their earliest
+ * visit (ray, step). Single-threaded per RayMarks. */
 void markRays(const double a[3], const RayEnd* ends, size_t r0, size_t r1,
               const RayBox& box, BlockStored stored, const void* ctx,
               RayMarks& m, RayLanes lanes = RayLanes::Best);
