@@ -111,12 +111,15 @@ struct Walk
 	 * blocks not stored. */
 	void apply()
 	{
+		// Locals: the stores to the bits could alias the members.
 		uint64_t* out = m.bits.data();
 		uint8_t* state = m.state.data();
-		for (size_t i = 0; i < runs.n; ++i)
+		uint64_t* firstVisit = m.firstVisit.data();
+		const int64_t *word = runs.word, *bits = runs.bits, *first = runs.first;
+		const size_t n = runs.n;
+		for (size_t i = 0; i < n; ++i)
 		{
-			const uint64_t w = uint64_t(runs.word[i]);
-			const uint64_t v = uint64_t(runs.first[i]);
+			const uint64_t w = uint64_t(word[i]), v = uint64_t(first[i]);
 			const size_t b = size_t(w >> 3);
 			if (state[b] == RayMarks::kUnknown)
 			{
@@ -125,11 +128,11 @@ struct Walk
 				m.touched.push_back(uint32_t(b));
 				state[b] = stored(ctx, c[0], c[1], c[2]) ? RayMarks::kStored
 				                                         : RayMarks::kMissing;
-				m.firstVisit[b] = v;
+				firstVisit[b] = v;
 			}
 			else if (state[b] == RayMarks::kMissing)
-				m.firstVisit[b] = std::min(m.firstVisit[b], v);
-			out[w] |= uint64_t(runs.bits[i]);
+				firstVisit[b] = std::min(firstVisit[b], v);
+			out[w] |= uint64_t(bits[i]);
 		}
 		runs.n = 0;
 	}
