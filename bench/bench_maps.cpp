@@ -3,7 +3,8 @@
 // per million occupied cells, the storage choice (hashed voxels vs hashed
 // blocks), and the growth of the update with the readings (scale_points:
 // the frame thinned) and with the map (scale_extent: the frame among copies
-// of itself elsewhere; scale_explore: into unseen space, memory per frame).
+// of itself elsewhere; scale_explore: into unseen space, memory per frame),
+// and the ray cast's walk alone per instruction set (walk/.../lanesN).
 // One JSON object per measurement on stdout (see
 // json_reporter.h); run through scripts/bench.sh.
 //
@@ -14,6 +15,7 @@
 #include <bims/eval/tum_import.h>
 #include <bims/maps/dda.h>
 #include <bims/maps/motion_grids.h>
+#include <bims/maps/ray_marks.h>
 
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/maps/COccupancyGridMap3D.h>
@@ -118,6 +120,50 @@ void benchBuild(bm::State& st, const Cloud& c, double voxel)
 	FrameCloud f;
 	for (auto _ : st) b.build(*c.scan, c.T_WS, f);
 	setCounters(st, c, voxel, f);
+}
+
+// The ray cast's walk alone (markRays), one ray per reading in the image's
+// row order, with the walker of \a lanes, every block stored (a map in its
+// steady state): how the instruction sets compare on this CPU.
+void benchWalk(bm::State& st, const Cloud& c, double voxel, RayLanes lanes)
+{
+	if (!rayLanesSupported(lanes))
+	{
+		st.SkipWithError("this CPU does not run these lanes");
+		return;
+	}
+	FrameCloudBuilder b(paramsFor(voxel, "raycast"));
+	FrameCloud f;
+	b.build(*c.scan, c.T_WS, f);
+	const double inv = 1 / voxel;
+	const double a[3] = {f.origin_W.x * inv, f.origin_W.y * inv,
+	                     f.origin_W.z * inv};
+	std::vector<RayEnd> ends;
+	int32_t lo[3], hi[3];
+	for (int k = 0; k < 3; ++k) lo[k] = hi[k] = int32_t(std::floor(a[k]));
+	for (const auto& p : f.points_W)
+	{
+		ends.push_back({{p.x * inv, p.y * inv, p.z * inv}});
+		for (int k = 0; k < 3; ++k)
+		{
+			const int32_t v = int32_t(std::floor(ends.back().p[k]));
+			lo[k] = std::min(lo[k], v), hi[k] = std::max(hi[k], v);
+		}
+	}
+	for (int k = 0; k < 3; ++k)
+		lo[k] = (lo[k] >> 3) - 1, hi[k] = (hi[k] >> 3) + 1;
+	const RayBox box(lo, hi);
+	const BlockStored all = [](const void*, int32_t, int32_t, int32_t)
+	{ return true; };
+	RayMarks m;
+	for (auto _ : st)
+	{
+		m.reset(box);
+		markRays(a, ends.data(), 0, ends.size(), box, all, nullptr, m, lanes);
+	}
+	setCounters(st, c, voxel, f);
+	st.counters["rays"] = double(ends.size());
+	st.counters["blocks_touched"] = double(m.touched.size());
 }
 
 enum class Stage
@@ -504,6 +550,13 @@ void registerAll()
 					if (d == "raycast_mt2") b->MeasureProcessCPUTime();
 				}
 			}
+			for (const auto& [ln, l] :
+			     {std::pair{"1", RayLanes::One}, std::pair{"4", RayLanes::Four},
+			      std::pair{"8", RayLanes::Eight}})
+				timed(bm::RegisterBenchmark(
+				          ("walk" + sfx + "/lanes" + ln).c_str(), benchWalk, c,
+				          v, l),
+				      5, 5);
 			for (int stride : {4, 2, 1})
 				timed(bm::RegisterBenchmark(("scale_points" + sfx + "/stride" +
 				                             std::to_string(stride))
