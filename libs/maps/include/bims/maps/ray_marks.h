@@ -87,7 +87,7 @@ using BlockStored = bool (*)(const void* ctx, int32_t bx, int32_t by,
 enum class RayLanes
 {
 	Best,   // the widest this CPU runs
-	One,    // one ray at a time (traverseRay() itself)
+	One,    // one at a time, in scalars (any CPU)
 	Four,   // AVX2
 	Eight,  // AVX-512
 };
