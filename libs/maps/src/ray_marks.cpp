@@ -113,7 +113,7 @@ struct Walk
 	{
 		// Locals: the stores to the bits could alias the members.
 		uint64_t* out = m.bits.data();
-		uint8_t* state = m.state.data();
+		const uint8_t* state = m.state.data();
 		uint64_t* firstVisit = m.firstVisit.data();
 		const int64_t *word = runs.word, *bits = runs.bits, *first = runs.first;
 		const size_t n = runs.n;
@@ -121,20 +121,26 @@ struct Walk
 		{
 			const uint64_t w = uint64_t(word[i]), v = uint64_t(first[i]);
 			const size_t b = size_t(w >> 3);
-			if (state[b] == RayMarks::kUnknown)
+			if (state[b] != RayMarks::kStored)
 			{
-				int32_t c[3];
-				box.blockCoords(b, c);
-				m.touched.push_back(uint32_t(b));
-				state[b] = stored(ctx, c[0], c[1], c[2]) ? RayMarks::kStored
-				                                         : RayMarks::kMissing;
-				firstVisit[b] = v;
+				if (state[b] == RayMarks::kUnknown)
+					lookUp(b, v);
+				else
+					firstVisit[b] = std::min(firstVisit[b], v);
 			}
-			else if (state[b] == RayMarks::kMissing)
-				firstVisit[b] = std::min(firstVisit[b], v);
 			out[w] |= uint64_t(bits[i]);
 		}
 		runs.n = 0;
+	}
+	/** Block \a b, entered for the first time by this thread at \a v. */
+	[[gnu::noinline]] void lookUp(size_t b, uint64_t v)
+	{
+		int32_t c[3];
+		box.blockCoords(b, c);
+		m.touched.push_back(uint32_t(b));
+		m.state[b] = stored(ctx, c[0], c[1], c[2]) ? RayMarks::kStored
+		                                           : RayMarks::kMissing;
+		m.firstVisit[b] = v;
 	}
 	/** One run; applies the batch when it is full. */
 	void push(uint64_t word, uint64_t bits, uint64_t first)
