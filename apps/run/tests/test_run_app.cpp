@@ -336,8 +336,15 @@ TEST(RunApp, AfterSigkillEveryFileIsWholeAndNoMetricsSaysDone)
 		frames++;
 	}
 	EXPECT_GE(frames, 5u);  // masks/000005.png was being written
+	// Every PLY present is whole. The kill lands as masks/000005.png appears,
+	// which is when the writer creates moving_voxels/000005.ply.partial: a
+	// leftover to ignore (docs/pipeline.md), possibly still empty.
 	for (const auto& e : fs::directory_iterator(d + "/out/moving_voxels"))
-		EXPECT_GT(fs::file_size(e.path()), 0u) << e.path();
+		if (e.path().extension() != ".partial")
+		{
+			EXPECT_EQ(e.path().extension(), ".ply") << e.path();
+			EXPECT_GT(fs::file_size(e.path()), 0u) << e.path();
+		}
 }
 
 TEST(RunApp, PrintConfigIsTheEffectiveIniOfARun)
