@@ -139,20 +139,9 @@ void benchWalk(bm::State& st, const Cloud& c, double voxel, RayLanes lanes)
 	const double a[3] = {f.origin_W.x * inv, f.origin_W.y * inv,
 	                     f.origin_W.z * inv};
 	std::vector<RayEnd> ends;
-	int32_t lo[3], hi[3];
-	for (int k = 0; k < 3; ++k) lo[k] = hi[k] = int32_t(std::floor(a[k]));
 	for (const auto& p : f.points_W)
-	{
 		ends.push_back({{p.x * inv, p.y * inv, p.z * inv}});
-		for (int k = 0; k < 3; ++k)
-		{
-			const int32_t v = int32_t(std::floor(ends.back().p[k]));
-			lo[k] = std::min(lo[k], v), hi[k] = std::max(hi[k], v);
-		}
-	}
-	for (int k = 0; k < 3; ++k)
-		lo[k] = (lo[k] >> 3) - 1, hi[k] = (hi[k] >> 3) + 1;
-	const RayBox box(lo, hi);
+	const RayBox box = RayBox::around(a, ends.data(), ends.size());
 	const BlockStored all = [](const void*, int32_t, int32_t, int32_t)
 	{ return true; };
 	RayMarks m;

@@ -106,23 +106,7 @@ void COccupancyBayesGrid::decayRaycast(const FrameCloud& f, uint32_t F)
 	collectRayEnds(f, inv);
 	if (rayEnds_.empty()) return;
 
-	// Bounding box of the rays in blocks (one block of margin: a DDA may
-	// round one voxel past its end on an axis).
-	int32_t lo[3], hi[3];
-	for (int k = 0; k < 3; ++k) lo[k] = hi[k] = int32_t(std::floor(a[k]));
-	for (const auto& e : rayEnds_)
-		for (int k = 0; k < 3; ++k)
-		{
-			const int32_t v = int32_t(std::floor(e.p[k]));
-			lo[k] = std::min(lo[k], v);
-			hi[k] = std::max(hi[k], v);
-		}
-	for (int k = 0; k < 3; ++k)
-	{
-		lo[k] = (lo[k] >> 3) - 1;
-		hi[k] = (hi[k] >> 3) + 1;
-	}
-	const RayBox box(lo, hi);
+	const RayBox box = RayBox::around(a, rayEnds_.data(), rayEnds_.size());
 	const size_t over = box.words() * 64 <= kMaxMarkedVoxels
 	                        ? castMarked(a, box, F)
 	                        : castPlain(a, F);

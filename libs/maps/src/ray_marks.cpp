@@ -54,6 +54,25 @@ RayBox::RayBox(const int32_t l[3], const int32_t h[3])
 			if (b < logN[k]) mask[k] |= uint64_t(1) << pos++;
 }
 
+RayBox RayBox::around(const double a[3], const RayEnd* ends, size_t n)
+{
+	int32_t lo[3], hi[3];
+	for (int k = 0; k < 3; ++k) lo[k] = hi[k] = int32_t(std::floor(a[k]));
+	for (size_t i = 0; i < n; ++i)
+		for (int k = 0; k < 3; ++k)
+		{
+			const int32_t v = int32_t(std::floor(ends[i].p[k]));
+			lo[k] = std::min(lo[k], v);
+			hi[k] = std::max(hi[k], v);
+		}
+	for (int k = 0; k < 3; ++k)
+	{
+		lo[k] = (lo[k] >> 3) - 1;
+		hi[k] = (hi[k] >> 3) + 1;
+	}
+	return RayBox(lo, hi);
+}
+
 uint64_t RayBox::bitOf(int32_t x, int32_t y, int32_t z) const
 {
 	return deposit(uint64_t(x - lo[0] * 8), mask[0]) |

@@ -11,6 +11,12 @@
 
 namespace bims::maps
 {
+/** The end of a ray, in voxel units. */
+struct RayEnd
+{
+	double p[3];
+};
+
 /** The rays' bounding box in blocks of 8^3 voxels, and the layout of its
  * voxel bitset: the bit index of a voxel holds its cell index in its block
  * (bits 0-8: x, y, z three bits each, the cells' order in a block) and
@@ -27,6 +33,9 @@ struct RayBox
 
 	/** The box of blocks [lo, hi] (inclusive). */
 	RayBox(const int32_t lo[3], const int32_t hi[3]);
+	/** The box of the rays from \a a (voxel units) to \a ends, with one
+	 * block of margin (a DDA may round one voxel past its end on an axis). */
+	static RayBox around(const double a[3], const RayEnd* ends, size_t n);
 
 	/** Blocks of the padded box (bit index >> 9 is below this). */
 	size_t blocks() const { return size_t(1) << (logN[0] + logN[1] + logN[2]); }
@@ -55,7 +64,6 @@ struct RayBox
  * state; reset() clears just them, so a frame costs what its rays touch. */
 struct RayMarks
 {
-	static constexpr uint64_t kNoVisit = ~uint64_t(0);
 	enum : uint8_t
 	{
 		kUnknown = 0,  // not looked up
@@ -71,12 +79,6 @@ struct RayMarks
 	void reset(const RayBox& box);
 	bool missing(size_t b) const { return state[b] == kMissing; }
 	bool stored(size_t b) const { return state[b] == kStored; }
-};
-
-/** The end of a ray, in voxel units. */
-struct RayEnd
-{
-	double p[3];
 };
 
 /** Is the block (bx, by, bz) (absolute block indices) stored? */
