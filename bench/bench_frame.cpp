@@ -16,9 +16,13 @@
 // (default config/default.ini). --gt: the relative pose of the pair from a
 // TUM trajectory with one pose per 3D scan (bims-sim's NAME_gt/
 // groundtruth.txt); without it a made-up pose of a few degrees and
-// centimetres (the labels are then mostly Diff).
+// centimetres (the labels are then mostly Diff). The map-anchored tracking's
+// dense alignment (ego/dense_*) uses the experiment's [anchor] section, the
+// earlier frame as the keyframe, and two initial guesses (no motion, and the
+// pair's pose), as KeyframeAnchor::track gives it.
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
+#include <bims/ego/dense_align.h>
 #include <bims/ego/gyro_klt.h>
 #include <bims/ego/rgbd_input.h>
 #include <bims/flow/consistency.h>
@@ -58,6 +62,7 @@ Pair g_pair;
 // of it): the ground truth's with --gt, otherwise a pan of a few degrees and
 // a step of a few centimetres.
 bims::flow::FlowParams g_flow;
+bims::ego::AnchorParams g_anchor;  ///< the experiment's [anchor]
 mrpt::poses::CPose3D g_T_CprevC(0.02, -0.01, 0.03, 0.035, -0.02, 0.01);
 
 /** T_{C(t-1) C(t)} of the pair from a TUM trajectory with one line per 3D
@@ -295,6 +300,43 @@ void benchLabels(bm::State& st)
 	st.counters["notdiff"] = static_cast<double>(stats.notDiff);
 }
 
+// The keyframe's pyramid with its normals and gradients, and the frame's.
+void benchDenseBuild(bm::State& st)
+{
+	bims::ego::DenseFrame ref, cur;
+	ProcCpu cpu(st);
+	for (auto _ : st)
+	{
+		ref.build(g_pair.prev.grey, g_pair.prev.depth, g_pair.prev.K, g_anchor);
+		ref.prepareReference(g_anchor);
+		cur.build(g_pair.cur.grey, g_pair.cur.depth, g_pair.cur.K, g_anchor);
+	}
+}
+
+// The alignment of the frame to the keyframe (Levenberg-Marquardt over the
+// levels, both guesses, the IMU's rotation as prior; the final outlier
+// image).
+void benchDenseAlign(bm::State& st)
+{
+	bims::ego::DenseFrame ref, cur;
+	ref.build(g_pair.prev.grey, g_pair.prev.depth, g_pair.prev.K, g_anchor);
+	ref.prepareReference(g_anchor);
+	cur.build(g_pair.cur.grey, g_pair.cur.depth, g_pair.cur.K, g_anchor);
+	const Eigen::Matrix3d R = g_T_CprevC.getRotationMatrix().asEigen();
+	const Eigen::Vector3d t(g_T_CprevC.x(), g_T_CprevC.y(), g_T_CprevC.z());
+	const std::vector<bims::ego::InitialGuess> inits = {
+	    {Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()}, {R, t}};
+	bims::ego::DenseAlignResult r;
+	ProcCpu cpu(st);
+	for (auto _ : st)
+		r = bims::ego::alignDense(
+		    ref, cur, inits, g_anchor, &R,
+		    g_anchor.rotation_prior_sigma_deg * M_PI / 180);
+	st.counters["iterations"] = r.iterations;
+	st.counters["inliers"] = r.inliers;
+	st.counters["ok"] = r.ok;
+}
+
 template <class F>
 void reg(const std::string& name, F f)
 {
@@ -330,6 +372,8 @@ void registerAll()
 	reg("observed/compose", benchCompose);
 	reg("expected_exact", benchExpected);
 	reg("labels", benchLabels);
+	reg("ego/dense_build", benchDenseBuild);
+	reg("ego/dense_align", benchDenseAlign);
 }
 }  // namespace
 
@@ -366,12 +410,14 @@ int main(int argc, char** argv)
 		if (!gt.empty()) g_T_CprevC = relativePoseFromGt(gt, frame);
 		if (!std::ifstream(config))
 			throw std::runtime_error("cannot open " + config);
-		g_flow.loadFromConfigFile(mrpt::config::CConfigFile(config), "flow");
+		const mrpt::config::CConfigFile cfg(config);
+		g_flow.loadFromConfigFile(cfg, "flow");
+		g_anchor.loadFromConfigFile(cfg, "anchor");
 		std::cerr << "frames " << frame - 1 << ", " << frame << " of " << rawlog
 		          << ": " << g_pair.cur.grey.cols << "x" << g_pair.cur.grey.rows
 		          << ", OpenCV threads " << cv::getNumThreads()
-		          << ", [flow] of " << config << ", T_CprevC " << g_T_CprevC
-		          << "\n";
+		          << ", [flow] and [anchor] of " << config << ", T_CprevC "
+		          << g_T_CprevC << "\n";
 		registerAll();
 		int n = int(rest.size());
 		return bims::bench::runWithJsonLines(n, rest.data());

@@ -1,4 +1,5 @@
 #include <bims/ego/dense_align.h>
+#include <bims/ego/normal_equations.h>
 #include <bims/ego/so3.h>
 
 #include <opencv2/imgproc.hpp>
@@ -182,31 +183,15 @@ struct Pass
 	}
 };
 
-/** Tukey's biweight loss rho(e) (c^2 / 6 beyond c). */
-inline double tukeyLoss(double e, double c)
-{
-	const double a = e / c;
-	if (a * a >= 1) return c * c / 6;
-	const double s = 1 - a * a;
-	return c * c / 6 * (1 - s * s * s);
-}
-
-inline double tukeyWeight(double e, double c)
-{
-	const double a = e / c;
-	if (a * a >= 1) return 0;
-	const double s = 1 - a * a;
-	return s * s;
-}
-
-/** One pass over the samples at pose (R, t): the normal equations (when
- * \a H wanted) and the counts; \a outliers (optional) gets 255 at the
- * samples that are associated but not inliers. */
+/** One pass over the samples at pose (R, t): the normal equations (with
+ * \a rows, their scratch) and the counts; \a outliers (optional) gets 255 at
+ * the samples that are associated but not inliers. */
 Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
           const Eigen::Matrix3d& R, const Eigen::Vector3d& t, float offset,
-          double photoSigma, const AnchorParams& p, bool normalEquations,
+          double photoSigma, const AnchorParams& p, NormalEquations6* rows,
           cv::Mat* outliers, std::vector<int>* seenThrough = nullptr)
 {
+	const bool normalEquations = rows != nullptr;
 	Pass out;
 	const int W = ref.depth.cols, H = ref.depth.rows;
 	const float r00 = float(R(0, 0)), r01 = float(R(0, 1)),
@@ -223,18 +208,11 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 	const double sp = photoSigma;
 	const double photoScale = p.photo_weight / (sp * sp);
 	const double rhoMax = c * c / 6;
-	// upper triangle accumulators
-	double h[21] = {0}, bb[6] = {0};
-	auto accumulate = [&h, &bb](const float* J, double w, double r)
-	{
-		int k = 0;
-		for (int i = 0; i < 6; i++)
-		{
-			const double wi = w * J[i];
-			bb[i] += wi * r;
-			for (int j = i; j < 6; j++) h[k++] += wi * J[j];
-		}
-	};
+	if (rows) rows->clear();
+	const double invC = 1 / c;
+	// the photometric residual's a = r / (sp c), and the square root of
+	// its weight's scale, photo_weight / sp^2
+	const double photoA = 1 / (sp * c), photoRootScale = std::sqrt(photoScale);
 	for (const Sample& s : cur)
 	{
 		// excluded samples (predicted moving) only get classified, in the
@@ -295,18 +273,20 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 			out.cost += rhoMax;
 			continue;
 		}
-		double wg = 1, rg = 0, sg = 1;
+		// (no normal: weight 1, no cost)
+		Tukey tg{1, 0};
+		double rg = 0, invSg = 1;
 		if (hasNormal)
 		{
 			rg = q.nx * X + q.ny * Y + q.nz * Z - q.d;
-			sg = p.geo_sigma_m + p.geo_sigma_z2 * zr * zr;
-			wg = tukeyWeight(rg / sg, c);
+			invSg = 1 / (p.geo_sigma_m + p.geo_sigma_z2 * zr * zr);
+			tg = Tukey::at(rg * invSg * invC, c);
 		}
-		if (wg <= 0 && outliers) outliers->data[s.pix] = 255;
+		if (tg.s <= 0 && outliers) outliers->data[s.pix] = 255;
 		if (!counts) continue;
 		++out.associated;
-		if (hasNormal) out.cost += tukeyLoss(rg / sg, c);
-		if (wg <= 0) continue;
+		out.cost += tg.loss;
+		if (tg.s <= 0) continue;
 		++out.inliers;
 		out.sumGeo2 += rg * rg;
 		if (hasNormal && normalEquations)
@@ -318,7 +298,8 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 			                     Y * q.nz - Z * q.ny,
 			                     Z * q.nx - X * q.nz,
 			                     X * q.ny - Y * q.nx};
-			accumulate(Jg, wg / (sg * sg), rg);
+			// weight s^2 / sg^2
+			rows->add(Jg, tg.s * invSg, rg);
 		}
 		if (!photo) continue;
 		if (!(u >= 0 && v >= 0 && u < W - 1 && v < H - 1))
@@ -341,8 +322,9 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 		++out.photoN;
 		++out.photoHist[std::min(Pass::kBins - 1,
 		                         static_cast<int>(std::abs(rp) * 0.5))];
-		const double wp = tukeyWeight(rp / sp, c);
-		out.cost += p.photo_weight * tukeyLoss(rp / sp, c);
+		const Tukey tp = Tukey::at(rp * photoA, c);
+		const double wp = tp.s * tp.s;
+		out.cost += p.photo_weight * tp.loss;
 		out.photoSum += wp * (Ir - s.grey);
 		out.photoW += wp;
 		if (wp <= 0 || !normalEquations) continue;
@@ -351,18 +333,9 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 		            g2 = -(gx * fx * X + gy * fy * Y) * iz * iz;
 		const float Jp[6] = {
 		    g0, g1, g2, Y * g2 - Z * g1, Z * g0 - X * g2, X * g1 - Y * g0};
-		accumulate(Jp, wp * photoScale, rp);
+		rows->add(Jp, tp.s * photoRootScale, rp);
 	}
-	int k = 0;
-	for (int i = 0; i < 6; i++)
-	{
-		out.b[i] = bb[i];
-		for (int j = i; j < 6; j++)
-		{
-			out.H(i, j) = out.H(j, i) = h[k];
-			++k;
-		}
-	}
+	if (rows) rows->get(out.H, out.b);
 	return out;
 }
 
@@ -474,12 +447,15 @@ namespace
 /** Levenberg-Marquardt at one level from (R, t): a step is taken only if
  * it lowers the robust cost (the photometric scale and brightness offset
  * stay fixed within the level, so that costs compare; they are estimated
- * afresh for the next level at the end). Returns the steps taken. */
+ * afresh for the next level at the end). \a first: the pass at (R, t)
+ * with this offset and scale, when already made (unused when the rotation
+ * is held at the prior). Returns the steps taken. */
 int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
                  Eigen::Matrix3d& R, Eigen::Vector3d& t, float& offset,
                  double& photoSigma, const AnchorParams& p,
                  const Eigen::Matrix3d* R_prior, double sigmaPrior_rad,
-                 int* inliers)
+                 NormalEquations6& rows, int* inliers,
+                 const Pass* first = nullptr)
 {
 	const bool fixRotation = R_prior && !(sigmaPrior_rad > 0);
 	if (fixRotation) R = *R_prior;
@@ -491,7 +467,9 @@ int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
 		                        logSO3(R_prior->transpose() * Rx).squaredNorm()
 		                  : 0.0;
 	};
-	Pass cur = pass(Lr, samples, R, t, offset, photoSigma, p, true, nullptr);
+	Pass cur = first && !fixRotation ? *first
+	                                 : pass(Lr, samples, R, t, offset,
+	                                        photoSigma, p, &rows, nullptr);
 	double curCost = cur.cost + priorCost(R);
 	double lambda = 1e-4;
 	int steps = 0;
@@ -523,7 +501,7 @@ int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
 		const Eigen::Matrix3d Rn = dR * R;
 		const Eigen::Vector3d tn = dR * t + d.head<3>();
 		Pass nxt =
-		    pass(Lr, samples, Rn, tn, offset, photoSigma, p, true, nullptr);
+		    pass(Lr, samples, Rn, tn, offset, photoSigma, p, &rows, nullptr);
 		const double nxtCost = nxt.cost + priorCost(Rn);
 		++steps;
 		if (nxtCost < curCost)
@@ -627,6 +605,8 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 	// a wide first scale; each pass then estimates it from its residuals
 	const double sigma0 = std::max(p.photo_sigma_grey, 40.0);
 	double photoSigma = sigma0;
+	NormalEquations6 rows;
+	Pass counted;  // a guess's first pass at the coarsest level
 	int best = -1;
 	int firstInliers = -1;  // the first guess's, before iterating
 	for (size_t k = 0; k < inits.size(); k++)
@@ -642,9 +622,10 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 		// guess needs no count.
 		if (inits.size() > 1)
 		{
-			const int start = pass(ref.levels[static_cast<size_t>(top)], coarse,
-			                       Rk, tk, 0, sigma0, p, false, nullptr)
-			                      .inliers;
+			// (with its normal equations: the level's first pass if taken)
+			counted = pass(ref.levels[static_cast<size_t>(top)], coarse, Rk, tk,
+			               0, sigma0, p, &rows, nullptr);
+			const int start = counted.inliers;
 			if (k == 0)
 				firstInliers = start;
 			else if (start <= firstInliers)
@@ -652,7 +633,8 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 		}
 		r.iterations +=
 		    iterateLevel(ref.levels[static_cast<size_t>(top)], coarse, Rk, tk,
-		                 ok, sk, p, R_prior, sigmaPrior_rad, &inl);
+		                 ok, sk, p, R_prior, sigmaPrior_rad, rows, &inl,
+		                 inits.size() > 1 ? &counted : nullptr);
 		if (inl > best)
 		{
 			best = inl;
@@ -669,14 +651,14 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 		samples = samplesOf(cur.levels[static_cast<size_t>(l)], strideAt(l));
 		r.iterations += iterateLevel(ref.levels[static_cast<size_t>(l)],
 		                             samples, R, t, offset, photoSigma, p,
-		                             R_prior, sigmaPrior_rad, nullptr);
+		                             R_prior, sigmaPrior_rad, rows, nullptr);
 	}
 	// Final counts and the outlier image at the finest level.
 	const DenseLevel& Lf = cur.levels[static_cast<size_t>(fine)];
 	r.outliers = cv::Mat::zeros(Lf.depth.size(), CV_8UC1);
 	const Pass fin =
 	    pass(ref.levels[static_cast<size_t>(fine)], samples, R, t, offset,
-	         photoSigma, p, false, &r.outliers, &r.seenThrough);
+	         photoSigma, p, nullptr, &r.outliers, &r.seenThrough);
 	if (p.stride_px > 1)
 	{
 		// a sample stands for its stride x stride block

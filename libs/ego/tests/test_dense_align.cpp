@@ -2,9 +2,12 @@
 #include <bims/ego/dense_align.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/keyframe_anchor.h>
+#include <bims/ego/normal_equations.h>
 #include <bims/ego/odometry.h>
 
 #include <gtest/gtest.h>
+
+#include <random>
 
 #include "synth_scene.h"
 
@@ -340,4 +343,56 @@ TEST(KeyframeAnchor, AMaskThatLeavesNothingToAlignIsRetriedWithout)
 	EXPECT_TRUE(a.accepted) << a.why;
 	EXPECT_TRUE(a.maskIgnored);
 	EXPECT_LT((a.t_WC - s.p(0.05)).norm(), 0.01);
+}
+
+TEST(NormalEquations6, EqualTheSumsOfTheirResidualsAndClearEmptiesThem)
+{
+	// H = sum w J^T J, b = sum w J^T r, as a plain loop sums them
+	std::mt19937 rng(7);
+	std::uniform_real_distribution<double> u(-2, 2), uw(0, 1);
+	NormalEquations6 ne;
+	NormalEquations6::Mat6 H, Hn = NormalEquations6::Mat6::Zero();
+	NormalEquations6::Vec6 b, bn = NormalEquations6::Vec6::Zero();
+	ne.get(H, b);
+	EXPECT_EQ(H.norm() + b.norm(), 0);
+	for (int round = 0; round < 2; round++)
+	{
+		ne.clear();
+		Hn.setZero();
+		bn.setZero();
+		for (int k = 0; k < 1000 + 37 * round; k++)
+		{
+			float J[6];
+			for (float& j : J) j = float(u(rng));
+			const double w = uw(rng), r = u(rng);
+			ne.add(J, std::sqrt(w), r);
+			for (int i = 0; i < 6; i++)
+			{
+				bn[i] += w * J[i] * r;
+				for (int j = 0; j < 6; j++) Hn(i, j) += w * J[i] * J[j];
+			}
+		}
+		EXPECT_EQ(ne.size(), size_t(1000 + 37 * round));
+		ne.get(H, b);
+		EXPECT_LT((H - Hn).norm(), 1e-10 * Hn.norm()) << H << "\n\n" << Hn;
+		EXPECT_LT((b - bn).norm(), 1e-10 * bn.norm()) << b.transpose();
+	}
+}
+
+TEST(Tukey, WeightIsTheSquareOfSAndTheLossIsFlatBeyondC)
+{
+	const double c = 4.685;
+	for (double e : {0.0, 0.5, -1.0, 2.0, -4.0, 4.6})
+	{
+		const Tukey t = Tukey::at(e / c, c);
+		const double q = 1 - (e / c) * (e / c);
+		EXPECT_NEAR(t.s * t.s, q * q, 1e-15) << e;
+		EXPECT_NEAR(t.loss, c * c / 6 * (1 - q * q * q), 1e-12) << e;
+	}
+	EXPECT_EQ(Tukey::at(0, c).loss, 0);
+	for (double e : {4.685, -5.0, 100.0})
+	{
+		EXPECT_EQ(Tukey::at(e / c, c).s, 0) << e;
+		EXPECT_EQ(Tukey::at(e / c, c).loss, c * c / 6) << e;
+	}
 }
