@@ -1,5 +1,6 @@
 // Tier 0: the miss update for decay = frustum (decay = raycast:
 // COccupancyBayesGrid_raycast.cpp).
+#include <bims/common/rounding.h>
 #include <bims/maps/COccupancyBayesGrid.h>
 
 #include <algorithm>
@@ -125,7 +126,9 @@ void COccupancyBayesGrid::decayFrustum(const FrameCloud& f, uint32_t F)
 			if (z <= 1e-6) return;
 			const double u = K.fx * cam(i, j, k, 0) / z + K.cx;
 			const double v = K.fy * cam(i, j, k, 1) / z + K.cy;
-			const long ui = std::lround(u), vi = std::lround(v);
+			// (far off the image, or not finite: no pixel)
+			if (!(std::abs(u) < 1e15 && std::abs(v) < 1e15)) return;
+			const long ui = bims::roundHalfAway(u), vi = bims::roundHalfAway(v);
 			if (ui < 0 || vi < 0 || ui >= W || vi >= H) return;
 			const float d = f.depth[size_t(vi) * W + size_t(ui)];
 			// Decay only cells wholly in front of the measured depth.
