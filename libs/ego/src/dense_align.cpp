@@ -606,7 +606,6 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 	const double sigma0 = std::max(p.photo_sigma_grey, 40.0);
 	double photoSigma = sigma0;
 	NormalEquations6 rows;
-	Pass counted;  // a guess's first pass at the coarsest level
 	int best = -1;
 	int firstInliers = -1;  // the first guess's, before iterating
 	for (size_t k = 0; k < inits.size(); k++)
@@ -620,21 +619,24 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 		// than the first one did (the frame-to-frame guess is usually the
 		// better one: 4 Gauss-Newton passes saved; docs/ego.md). A single
 		// guess needs no count.
+		// The first guess's count is also its level's first pass (with the
+		// normal equations); a later one's only counts (it is usually not
+		// iterated).
+		const bool reuse = inits.size() > 1 && k == 0;
+		Pass counted;
 		if (inits.size() > 1)
 		{
-			// (with its normal equations: the level's first pass if taken)
 			counted = pass(ref.levels[static_cast<size_t>(top)], coarse, Rk, tk,
-			               0, sigma0, p, &rows, nullptr);
+			               0, sigma0, p, reuse ? &rows : nullptr, nullptr);
 			const int start = counted.inliers;
 			if (k == 0)
 				firstInliers = start;
 			else if (start <= firstInliers)
 				continue;
 		}
-		r.iterations +=
-		    iterateLevel(ref.levels[static_cast<size_t>(top)], coarse, Rk, tk,
-		                 ok, sk, p, R_prior, sigmaPrior_rad, rows, &inl,
-		                 inits.size() > 1 ? &counted : nullptr);
+		r.iterations += iterateLevel(
+		    ref.levels[static_cast<size_t>(top)], coarse, Rk, tk, ok, sk, p,
+		    R_prior, sigmaPrior_rad, rows, &inl, reuse ? &counted : nullptr);
 		if (inl > best)
 		{
 			best = inl;
