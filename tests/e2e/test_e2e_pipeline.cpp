@@ -344,14 +344,19 @@ TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 {
 	// Reading ahead, the observed flow on its own thread (and of the next
 	// frame during this frame's grids), the cloud built beside the labels,
-	// writing on threads and OpenCV's pool
+	// writing on threads and OpenCV's pool, tier 0's decay of a frame on the
+	// cloud thread during the next frame (frustum by default; ray casting
+	// checked below)
 	// must not change a single byte of the outputs (nor the order of the
 	// labelled rawlog, which is the input's).
 	ExperimentConfig cfg;
 	cfg.loadFromFile(kConfig);
-	auto runWith = [&](bool threads, bool lookahead, const std::string& name)
+	ASSERT_EQ(cfg.grids.decay, bims::maps::DecayMode::Frustum);
+	auto runWith = [&](bool threads, bool lookahead, const std::string& name,
+	                   Variant variant = Variant::Fused)
 	{
 		ExperimentConfig c = cfg;
+		c.setVariant(variant);
 		c.pipeline.read_ahead = threads;
 		c.pipeline.flow_thread = threads;
 		c.pipeline.flow_lookahead = lookahead;
@@ -394,6 +399,23 @@ TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 			EXPECT_TRUE(readAll(a + f) == readAll(b + f))
 			    << f << " differs (" << name << ")";
 		}
+	}
+	{
+		// the ray cast on the cloud thread: same static map and masks
+		const std::string ra =
+		    runWith(false, false, "sequential_raycast", Variant::FusedRaycast);
+		const std::string rb =
+		    runWith(true, true, "lookahead_raycast", Variant::FusedRaycast);
+		EXPECT_FALSE(readAll(ra + "/static_map.ply") ==
+		             readAll(a + "/static_map.ply"))
+		    << "the ray cast must change the static map";
+		for (const char* f : {"static_map.ply", "masks/000015.png",
+		                      "masks/000019.png", "trajectory.txt"})
+			EXPECT_TRUE(readAll(ra + "/" + f) == readAll(rb + "/" + f))
+			    << f << " differs (ray cast)";
+		EXPECT_TRUE(csvWithoutTimes(ra + "/frames.csv") ==
+		            csvWithoutTimes(rb + "/frames.csv"))
+		    << "frames.csv differs (ray cast)";
 	}
 	// the labelled rawlog: the input's observations up to the last frame and
 	// the IMU samples after it, in the input's order

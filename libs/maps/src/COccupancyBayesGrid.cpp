@@ -120,6 +120,24 @@ void COccupancyBayesGrid::checkFrame(const FrameCloud& f,
 		    " m, grid has " + std::to_string(params_.voxel_size) + " m");
 }
 
+void COccupancyBayesGrid::throwIfDecayPending(const char* what) const
+{
+	if (decayOf_)
+		throw std::logic_error(std::string("COccupancyBayesGrid::") + what +
+		                       ": the decay of frame " +
+		                       std::to_string(decayFrame_) +
+		                       " is still pending (applyPendingDecay() first)");
+}
+
+void COccupancyBayesGrid::applyPendingDecay()
+{
+	if (!decayOf_) return;
+	const FrameCloud& f = *decayOf_;
+	decayOf_ = nullptr;
+	if (params_.decay == DecayMode::Raycast) decayRaycast(f, decayFrame_);
+	if (params_.decay == DecayMode::Frustum) decayFrustum(f, decayFrame_);
+}
+
 void COccupancyBayesGrid::integrate(const FrameCloud& f,
                                     std::vector<float>* priorOut,
                                     const std::vector<uint8_t>* hold)
@@ -128,6 +146,7 @@ void COccupancyBayesGrid::integrate(const FrameCloud& f,
 		throw std::invalid_argument(
 		    "COccupancyBayesGrid::integrate: one hold flag per cell expected");
 	checkFrame(f, "integrate");
+	throwIfDecayPending("integrate");
 	pending_ = nullptr;
 	// The cells are found while the update runs (no array of pointers).
 	cellPtr_.clear();
@@ -146,6 +165,7 @@ void COccupancyBayesGrid::beginFrame(const FrameCloud& f,
                                      std::vector<float>& out)
 {
 	checkFrame(f, "beginFrame");
+	throwIfDecayPending("beginFrame");
 	grid_.resolve(f.cells, cellPtr_);
 	pending_ = &f;
 	pendingFrame_ = frameCount_;
@@ -164,6 +184,7 @@ void COccupancyBayesGrid::beginFrame(const FrameCloud& f,
 void COccupancyBayesGrid::integratePending(const FrameCloud& f,
                                            const std::vector<uint8_t>* hold)
 {
+	throwIfDecayPending("integratePending");
 	if (pending_ != &f || pendingFrame_ != frameCount_ ||
 	    cellPtr_.size() != f.cells.size())
 		throw std::logic_error(
@@ -267,8 +288,13 @@ void COccupancyBayesGrid::applyFrame(const FrameCloud& f,
 				update(i - kPrefetchAhead, ring[(i - kPrefetchAhead) % kRing]);
 		}
 	}
-	if (params_.decay == DecayMode::Raycast) decayRaycast(f, F);
-	if (params_.decay == DecayMode::Frustum) decayFrustum(f, F);
+	// The decay last (hits win), now or by applyPendingDecay().
+	if (params_.decay != DecayMode::All)
+	{
+		decayOf_ = &f;
+		decayFrame_ = F;
+		if (!deferDecay_) applyPendingDecay();
+	}
 	frameCount_ = F;
 	lastTimestamp_ = f.timestamp;
 	if (st.overBudget) accountFrame(st);
@@ -397,6 +423,7 @@ bool COccupancyBayesGrid::internal_insertObservation(
 
 void COccupancyBayesGrid::internal_clear()
 {
+	decayOf_ = nullptr;  // a pending decay has no map left to act on
 	grid_.clear();
 	clearBase();
 }

@@ -29,9 +29,16 @@ void MotionGrids::setDecisionTier(int tier)
 
 void MotionGrids::clear()
 {
+	decaying_.reset();
 	t0_->clear();
 	t1_->clear();
 	t2_->clear();
+}
+
+void MotionGrids::applyPendingDecay()
+{
+	t0_->applyPendingDecay();
+	decaying_.reset();
 }
 
 template <class Build>
@@ -71,6 +78,8 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 	if (f.voxel_size != p_.voxel_size)
 		throw std::invalid_argument(
 		    "MotionGrids::processFrame: frame keyed for another voxel size");
+	applyPendingDecay();  // the last frame's, if the caller has not
+	t0_->setDeferDecay(deferDecay_ && &f == frame_.get());
 	result_ = MotionFrameResult();
 	result_.stats = f.stats;
 	t0_->accountFrame(f.stats);
@@ -144,6 +153,7 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 	result_.mask1_ = &t1_->lastMovingMask();
 	result_.mask2_ = &t2_->lastMovingMask();
 	result_.updateMs = msSince(t0);
+	if (t0_->decayPending()) decaying_ = frame_;
 	return result_;
 }
 

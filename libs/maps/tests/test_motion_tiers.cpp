@@ -400,3 +400,85 @@ TEST(OccupancyGrid, IntegrateEqualsBeginFrameThenPending)
 		EXPECT_EQ(over, mb < 2) << "the small budget must leave cells out";
 	}
 }
+
+// setDeferDecay(): tier 0's decay of a frame applied later (as the pipeline
+// does on its cloud thread, after the next frame's cloud is built) or by
+// the next processFrame() gives the same maps, masks and posteriors as
+// the decay in processFrame(); meanwhile tier 0 lacks exactly the decay.
+TEST(MotionGrids, DeferredDecayGivesTheSameMapsAndMasks)
+{
+	using namespace bims::maps::test;
+	for (const DecayMode mode :
+	     {DecayMode::Raycast, DecayMode::Frustum, DecayMode::All})
+		for (const bool exclude : {false, true})
+		{
+			GridParams p = test::paperGrids();
+			p.voxel_size = 0.05;
+			p.decay = mode;
+			p.exclude_moving = exclude;
+			MotionGrids a(p), b(p);
+			b.setDeferDecay(true);
+			auto scene = room();
+			const int n = 6;
+			bool lacked = false;  // tier 0 of b without the decay differed
+			for (int f = 0; f < n; ++f)
+			{
+				SCOPED_TRACE(::testing::Message()
+				             << "decay " << int(mode) << ", exclude " << exclude
+				             << ", frame " << f);
+				scene.push_back(
+				    {{2.0, -1.0 + 0.2 * f, 0}, {2.3, -0.7 + 0.2 * f, 1.5}});
+				const mrpt::poses::CPose3D T(0.1 * f, 0.05 * f, 1, 0.1 * f, 0,
+				                             0);
+				auto scan = renderScan(scene, T, 80, 60, 60, f);
+				const auto& ra = a.processFrame(*scan, T, nullptr);
+				// the next frame's cloud first, then the decay (even
+				// frames); odd frames leave it to the next processFrame()
+				b.buildFrame(*scan, T);
+				if (f % 2 == 0 && b.decayPending())
+				{
+					lacked |=
+					    bytesOf(*a.occupancy()) != bytesOf(*b.occupancy());
+					b.applyPendingDecay();
+				}
+				const auto& rb = b.processFrame(b.lastFrame(), nullptr);
+				EXPECT_EQ(b.decayPending(), mode != DecayMode::All);
+				EXPECT_EQ(ra.maskTier1().data, rb.maskTier1().data);
+				EXPECT_EQ(ra.maskTier2().data, rb.maskTier2().data);
+				EXPECT_EQ(a.background()->lastPosterior(),
+				          b.background()->lastPosterior());
+				EXPECT_EQ(a.flow()->lastPosterior(), b.flow()->lastPosterior());
+				EXPECT_EQ(ra.movingTier1, rb.movingTier1);
+			}
+			b.applyPendingDecay();
+			EXPECT_FALSE(b.decayPending());
+			EXPECT_TRUE(bytesOf(*a.occupancy()) == bytesOf(*b.occupancy()))
+			    << "decay " << int(mode) << ", exclude " << exclude;
+			EXPECT_EQ(lacked, mode != DecayMode::All)
+			    << "decay " << int(mode) << ": the deferred decay must change "
+			    << "tier 0 (else this test proves nothing)";
+		}
+}
+
+// While a decay is pending, tier 0 refuses the next frame (the caller must
+// apply it first); clear() drops it.
+TEST(OccupancyGrid, PendingDecayRefusesTheNextFrame)
+{
+	GridParams p = test::paperGrids();
+	p.voxel_size = 0.05;
+	p.decay = DecayMode::Raycast;
+	const auto frames = framesOver(p, 2);
+	COccupancyBayesGrid g(p);
+	g.setDeferDecay(true);
+	g.integrate(frames[0]);
+	ASSERT_TRUE(g.decayPending());
+	EXPECT_THROW(g.integrate(frames[1]), std::logic_error);
+	std::vector<float> prior;
+	EXPECT_THROW(g.beginFrame(frames[1], prior), std::logic_error);
+	g.applyPendingDecay();
+	EXPECT_FALSE(g.decayPending());
+	EXPECT_NO_THROW(g.integrate(frames[1]));
+	g.clear();
+	EXPECT_FALSE(g.decayPending());
+	EXPECT_NO_THROW(g.integrate(frames[0]));
+}

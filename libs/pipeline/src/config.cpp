@@ -30,7 +30,8 @@ void PipelineParams::describe(OptionVisitor& v)
 	v.flag("flow_lookahead", flow_lookahead,
 	       "and the next frame's observed flow during this frame's grids");
 	v.flag("cloud_thread", cloud_thread,
-	       "the voxel cloud built on a thread beside the labels");
+	       "the voxel cloud built on a thread beside the labels, and tier "
+	       "0's decay of a frame there during the next frame");
 	v.integer("opencv_threads", opencv_threads, 0, 64,
 	          "OpenCV's thread pool (0 = its default, 1 = none)");
 }

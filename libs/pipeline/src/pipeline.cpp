@@ -55,9 +55,23 @@ Pipeline::Pipeline(const ExperimentConfig& cfg)
 		flowThread_ = std::make_unique<SerialWorker>(1, true, "bims-flow");
 	if (cfg.pipeline.cloud_thread)
 		cloudThread_ = std::make_unique<SerialWorker>(1, true, "bims-cloud");
+	// Tier 0's decay of a frame (the misses) on the cloud thread, during
+	// the next frame's egomotion and labels; the next frame's cloud is
+	// built after it there, and its tiers wait for that build.
+	grids_.setDeferDecay(cloudThread_ != nullptr);
 }
 
-Pipeline::~Pipeline() = default;
+Pipeline::~Pipeline()
+{
+	if (decaying_.valid()) decaying_.wait();
+}
+
+double Pipeline::settleDecay() const
+{
+	if (!decaying_.valid()) return 0;
+	lastDecayMs_ = decaying_.get();
+	return lastDecayMs_;
+}
 
 void Pipeline::addImu(const mrpt::obs::CObservationIMU& imu)
 {
@@ -294,6 +308,7 @@ void Pipeline::runGrids(const maps::PixelLabels* labels, FrameResult& r,
 {
 	// The three tiers, then the variant's mask.
 	const auto t = Clock::now();
+	r.ms.decayPrev = settleDecay();
 	jobs.built();
 	const auto& g = grids_.processFrame(grids_.lastFrame(), labels);
 	const cv::Size size = cur_.grey.size();
@@ -318,6 +333,15 @@ void Pipeline::runGrids(const maps::PixelLabels* labels, FrameResult& r,
 			r.mask = r.maskFlow;
 			r.movingVoxels = 0;
 	}
+	// The decay last: nothing above reads tier 0 (setDeferDecay).
+	if (grids_.decayPending())
+		decaying_ = postTask(*cloudThread_,
+		                     [this]
+		                     {
+			                     const auto t = Clock::now();
+			                     grids_.applyPendingDecay();
+			                     return msSince(t);
+		                     });
 }
 
 void Pipeline::finishFrame(FrameResult& r)

@@ -134,6 +134,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		if (r.ms.observed > 0) stage["flow_observed"].push_back(r.ms.observed);
 		stage["grids"].push_back(r.ms.grids);
 		stage["grids_cloud"].push_back(r.ms.cloud);
+		if (r.ms.decayPrev > 0) stage["grids_decay"].push_back(r.ms.decayPrev);
 		stage["total"].push_back(r.ms.total);
 		const double validPx = static_cast<double>(r.cloudStats.valid);
 		if (validPx > 0) movingFracSum += cv::countNonZero(r.mask) / validPx;
@@ -272,8 +273,8 @@ std::string formatSummary(const RunSummary& s)
 	o << "stage        median ms   p95 ms   mean ms\n";
 	for (const char* k :
 	     {"read", "read_cpu", "wait_input", "input", "egomotion", "flow",
-	      "flow_observed", "grids", "grids_cloud", "total", "total_cpu",
-	      "outputs", "outputs_cpu", "wait_output"})
+	      "flow_observed", "grids", "grids_cloud", "grids_decay", "total",
+	      "total_cpu", "outputs", "outputs_cpu", "wait_output"})
 	{
 		const auto it = s.stageMs.find(k);
 		if (it == s.stageMs.end()) continue;

@@ -63,6 +63,22 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 	void integratePending(const FrameCloud& frame,
 	                      const std::vector<uint8_t>* hold);
 
+	/** Leaves the decay of each frame (decay = frustum or raycast: the
+	 * misses of the cells the frame did not hit) for applyPendingDecay():
+	 * integrate() and integratePending() then apply the hits only. The
+	 * decay reads the frame, which must stay alive and unchanged until
+	 * applyPendingDecay(); until then the map lacks the frame's misses, and
+	 * integrate(), beginFrame() and integratePending() throw
+	 * std::logic_error. With decay = all (lazy) nothing is left. */
+	void setDeferDecay(bool on) { deferDecay_ = on; }
+	bool deferDecay() const { return deferDecay_; }
+	/** A frame's decay is waiting for applyPendingDecay(). */
+	bool decayPending() const { return decayOf_ != nullptr; }
+	/** Applies the decay left by the last integrate()/integratePending()
+	 * (nothing if none): the map is then as if integrate() had not
+	 * deferred it. It touches this map and reads the frame only. */
+	void applyPendingDecay();
+
 	/** O- for each of frame.cells, without modifying the map. Order
 	 * independent: if this frame (same non-zero timestamp) was already
 	 * integrated, returns the values from before it.*/
@@ -157,6 +173,11 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 	std::vector<Cell*> cellPtr_;
 	const FrameCloud* pending_ = nullptr;
 	uint32_t pendingFrame_ = 0;
+	// setDeferDecay(): the frame whose decay waits, and its frame number.
+	bool deferDecay_ = false;
+	const FrameCloud* decayOf_ = nullptr;
+	uint32_t decayFrame_ = 0;
+	void throwIfDecayPending(const char* what) const;
 
 	Storage grid_;
 	// Scratch of decayRaycast(), reused across frames.

@@ -75,6 +75,20 @@ class MotionGrids
 	const GridParams& params() const { return p_; }
 	void clear();
 
+	/** With \a on, processFrame(lastFrame(), ...) leaves tier 0's decay of
+	 * the frame (decay = frustum or raycast: the misses of the cells it did
+	 * not hit) for applyPendingDecay(). The result, the masks and tiers 1
+	 * and 2 are final without it: only the next frame's O- needs it. The
+	 * next processFrame() applies a decay still pending first, so results
+	 * do not change. applyPendingDecay() touches tier 0 and reads the frame
+	 * it decays (held until then, so buildFrame() builds into another
+	 * buffer): it may run on another thread while the caller uses nothing
+	 * of these grids but buildFrame(), e.g. during the next frame's
+	 * egomotion. A frame not built by buildFrame() is decayed at once. */
+	void setDeferDecay(bool on) { deferDecay_ = on; }
+	bool decayPending() const { return t0_->decayPending(); }
+	void applyPendingDecay();
+
 	/** Which tier's MAP decides "moving" for exclude_moving (1 or 2;
 	 * default 2). */
 	void setDecisionTier(int tier);
@@ -101,6 +115,9 @@ class MotionGrids
 	// both): two buffers, the one the maps no longer hold is refilled.
 	std::shared_ptr<std::vector<VoxelKey>> cellsBuf_[2];
 	int decisionTier_ = 2;
+	bool deferDecay_ = false;
+	// The frame whose decay is pending (kept alive for it).
+	std::shared_ptr<const FrameCloud> decaying_;
 };
 
 }  // namespace bims::maps

@@ -40,6 +40,10 @@ struct StageTimes
 	double observed = 0;  ///< the observed flow alone, on whichever thread
 	double grids = 0;     ///< cloud building (or waiting for it) + the tiers
 	double cloud = 0;     ///< building the FrameCloud, on whichever thread
+	/** tier 0's decay (frustum, raycast) of the previous frame on the cloud
+	 * thread (with cloud_thread; else it is part of grids), which this
+	 * frame waited for before its grids; 0 if none */
+	double decayPrev = 0;
 	double total = 0;
 };
 
@@ -112,7 +116,13 @@ class Pipeline
 
 	const FrameResult& last() const { return res_; }
 	const ExperimentConfig& config() const { return cfg_; }
-	const maps::MotionGrids& grids() const { return grids_; }
+	/** The grids after the last frame (waits for its decay on the cloud
+	 * thread; throws what that decay threw). */
+	const maps::MotionGrids& grids() const
+	{
+		settleDecay();
+		return grids_;
+	}
 	const ego::Odometry& odometry() const { return odom_; }
 	size_t framesProcessed() const { return nFrames_; }
 
@@ -173,6 +183,11 @@ class Pipeline
 	Lookahead ahead_;
 	std::unique_ptr<SerialWorker> flowThread_;   ///< null: flow in sequence
 	std::unique_ptr<SerialWorker> cloudThread_;  ///< null: cloud in sequence
+	/** The last frame's decay on the cloud thread (its ms), and waiting for
+	 * it: the ms of the last one waited for. */
+	mutable std::future<double> decaying_;
+	mutable double lastDecayMs_ = 0;
+	double settleDecay() const;
 };
 
 /** maps::PixelMask -> CV_8UC1 (a copy; 0x0 mask -> \a size of zeros). */
