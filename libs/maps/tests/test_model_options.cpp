@@ -16,6 +16,7 @@
 
 #include <cmath>
 
+#include "scene_raycaster.h"
 #include "test_util.h"
 
 using namespace bims::maps;
@@ -282,5 +283,86 @@ TEST(ModelOptions, ExcludeByEitherHoldsWhatTier1CallsMovingAgainstTheFlow)
 		else  // either, and auto without ray casting
 			EXPECT_EQ(mg.occupancy()->logOddsFixed(obj), before)
 			    << bims::choiceName(by);
+	}
+}
+
+// neighbourhoodMaxPrior() against its plain definition, for every
+// neighbourhood, on frames of a room with thousands of voxels over many
+// blocks (and neighbours in blocks that do not exist): the largest prior
+// of the neighbours tier 0 has observed, and the cell's own prior.
+TEST(ModelOptions, NeighbourhoodMaxPriorEqualsThePlainDefinition)
+{
+	using namespace bims::maps::test;
+	for (const DecayMode mode : {DecayMode::Raycast, DecayMode::All})
+	{
+		GridParams p = paperGrids();
+		p.voxel_size = 0.02;
+		p.decay = mode;
+		COccupancyBayesGrid g(p);
+		FrameCloudBuilder b(p);
+		auto scene = room();
+		FrameCloud f;
+		size_t explained = 0;
+		for (int k = 0; k < 5; ++k)
+		{
+			scene.push_back(
+			    {{2.0, -1.0 + 0.1 * k, 0}, {2.3, -0.7 + 0.1 * k, 1.5}});
+			const mrpt::poses::CPose3D T(0.05 * k, 0.02 * k, 1, 0.05 * k, 0, 0);
+			b.build(*renderScan(scene, T, 160, 120, 60, k), T, f);
+			std::vector<float> prior, out;
+			g.priorLogOdds(f, prior);
+			for (const BgNeighbourhood nb :
+			     {BgNeighbourhood::Ray, BgNeighbourhood::Faces,
+			      BgNeighbourhood::Block})
+			{
+				g.neighbourhoodMaxPrior(f, prior, nb, out);
+				ASSERT_EQ(out.size(), f.cells.size());
+				const double s = p.voxel_size;
+				const auto& o = f.origin_W;
+				for (size_t i = 0; i < f.cells.size(); ++i)
+				{
+					const VoxelKey& c = f.cells[i];
+					std::vector<VoxelKey> nbs;
+					if (nb == BgNeighbourhood::Ray)
+					{
+						const auto ctr = g.centerOf(c);
+						double dx = ctr.x - o.x, dy = ctr.y - o.y,
+						       dz = ctr.z - o.z;
+						const double n = std::sqrt(dx * dx + dy * dy + dz * dz);
+						dx *= s / n, dy *= s / n, dz *= s / n;
+						for (int sg : {-1, 1})
+							nbs.push_back(
+							    g.keyOf({ctr.x + sg * dx, ctr.y + sg * dy,
+							             ctr.z + sg * dz}));
+					}
+					else
+						for (int z = -1; z <= 1; ++z)
+							for (int y = -1; y <= 1; ++y)
+								for (int x = -1; x <= 1; ++x)
+								{
+									const int m =
+									    std::abs(x) + std::abs(y) + std::abs(z);
+									if (m > 0 && (m == 1 ||
+									              nb == BgNeighbourhood::Block))
+										nbs.push_back(
+										    {c.x + x, c.y + y, c.z + z});
+								}
+					float want = prior[i];
+					for (const auto& n : nbs)
+					{
+						const auto* cell = g.storage().find(n);
+						if (n == c || !cell || cell->stamp == 0) continue;
+						want =
+						    std::max(want, float(fromFixed(g.logOddsFixed(n))));
+					}
+					explained += want != prior[i];
+					ASSERT_EQ(out[i], want)
+					    << "frame " << k << ", " << bims::choiceName(nb)
+					    << ", cell " << i;
+				}
+			}
+			g.integrate(f);
+		}
+		EXPECT_GT(explained, 1000u) << "the neighbours must matter";
 	}
 }
