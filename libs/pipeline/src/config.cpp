@@ -31,7 +31,7 @@ void PipelineParams::describe(OptionVisitor& v)
 	       "and the next frame's observed flow during this frame's grids");
 	v.flag("cloud_thread", cloud_thread,
 	       "the voxel cloud built on a thread beside the labels, and tier "
-	       "0's decay of a frame there during the next frame");
+	       "0's decay of a frame on another during the next frame");
 	v.integer("opencv_threads", opencv_threads, 0, 64,
 	          "OpenCV's thread pool (0 = its default, 1 = none)");
 }

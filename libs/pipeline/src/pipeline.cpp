@@ -54,11 +54,15 @@ Pipeline::Pipeline(const ExperimentConfig& cfg)
 	if (cfg.pipeline.flow_thread)
 		flowThread_ = std::make_unique<SerialWorker>(1, true, "bims-flow");
 	if (cfg.pipeline.cloud_thread)
+	{
 		cloudThread_ = std::make_unique<SerialWorker>(1, true, "bims-cloud");
-	// Tier 0's decay of a frame (the misses) on the cloud thread, during
-	// the next frame's egomotion and labels; the next frame's cloud is
-	// built after it there, and its tiers wait for that build.
-	grids_.setDeferDecay(cloudThread_ != nullptr);
+		// Tier 0's decay of a frame (the misses) on a thread of its own,
+		// during the next frame's egomotion, labels and cloud build (which
+		// builds into another buffer and touches no map); the next frame's
+		// tiers wait for it.
+		decayThread_ = std::make_unique<SerialWorker>(1, true, "bims-decay");
+		grids_.setDeferDecay(true);
+	}
 }
 
 Pipeline::~Pipeline()
@@ -335,7 +339,7 @@ void Pipeline::runGrids(const maps::PixelLabels* labels, FrameResult& r,
 	}
 	// The decay last: nothing above reads tier 0 (setDeferDecay).
 	if (grids_.decayPending())
-		decaying_ = postTask(*cloudThread_,
+		decaying_ = postTask(*decayThread_,
 		                     [this]
 		                     {
 			                     const auto t = Clock::now();

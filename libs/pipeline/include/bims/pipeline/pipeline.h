@@ -40,7 +40,7 @@ struct StageTimes
 	double observed = 0;  ///< the observed flow alone, on whichever thread
 	double grids = 0;     ///< cloud building (or waiting for it) + the tiers
 	double cloud = 0;     ///< building the FrameCloud, on whichever thread
-	/** tier 0's decay (frustum, raycast) of the previous frame on the cloud
+	/** tier 0's decay (frustum, raycast) of the previous frame on the decay
 	 * thread (with cloud_thread; else it is part of grids), which this
 	 * frame waited for before its grids; 0 if none */
 	double decayPrev = 0;
@@ -116,7 +116,7 @@ class Pipeline
 
 	const FrameResult& last() const { return res_; }
 	const ExperimentConfig& config() const { return cfg_; }
-	/** The grids after the last frame (waits for its decay on the cloud
+	/** The grids after the last frame (waits for its decay on the decay
 	 * thread; throws what that decay threw). */
 	const maps::MotionGrids& grids() const
 	{
@@ -183,7 +183,10 @@ class Pipeline
 	Lookahead ahead_;
 	std::unique_ptr<SerialWorker> flowThread_;   ///< null: flow in sequence
 	std::unique_ptr<SerialWorker> cloudThread_;  ///< null: cloud in sequence
-	/** The last frame's decay on the cloud thread (its ms), and waiting for
+	/** With cloud_thread: tier 0's decay of a frame, during the next frame
+	 * (beside that frame's cloud build). */
+	std::unique_ptr<SerialWorker> decayThread_;
+	/** The last frame's decay on the decay thread (its ms), and waiting for
 	 * it: the ms of the last one waited for. */
 	mutable std::future<double> decaying_;
 	mutable double lastDecayMs_ = 0;
