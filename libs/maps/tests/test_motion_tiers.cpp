@@ -402,8 +402,8 @@ TEST(OccupancyGrid, IntegrateEqualsBeginFrameThenPending)
 }
 
 // setDeferDecay(): tier 0's decay of a frame applied later (as the pipeline
-// does on its cloud thread, after the next frame's cloud is built) or by
-// the next processFrame() gives the same maps, masks and posteriors as
+// does on a thread of its own; here after the next frame's cloud is built)
+// or by the next processFrame() gives the same maps, masks and posteriors as
 // the decay in processFrame(); meanwhile tier 0 lacks exactly the decay.
 TEST(MotionGrids, DeferredDecayGivesTheSameMapsAndMasks)
 {
