@@ -35,7 +35,7 @@ void MotionGrids::clear()
 	t2_->clear();
 }
 
-void MotionGrids::applyPendingDecay()
+void MotionGrids::applyPendingDecay() const
 {
 	t0_->applyPendingDecay();
 	decaying_.reset();

@@ -418,9 +418,12 @@ TEST(MotionGrids, DeferredDecayGivesTheSameMapsAndMasks)
 			p.exclude_moving = exclude;
 			MotionGrids a(p), b(p);
 			b.setDeferDecay(true);
+			// tier 0 of b as it is (occupancy() would apply a pending decay)
+			const auto t0b = b.occupancy();
 			auto scene = room();
 			const int n = 6;
 			bool lacked = false;  // tier 0 of b without the decay differed
+			std::vector<uint8_t> aBefore;  // a's tier 0 after the last frame
 			for (int f = 0; f < n; ++f)
 			{
 				SCOPED_TRACE(::testing::Message()
@@ -432,14 +435,20 @@ TEST(MotionGrids, DeferredDecayGivesTheSameMapsAndMasks)
 				                             0);
 				auto scan = renderScan(scene, T, 80, 60, 60, f);
 				const auto& ra = a.processFrame(*scan, T, nullptr);
-				// the next frame's cloud first, then the decay (even
-				// frames); odd frames leave it to the next processFrame()
+				// the next frame's cloud first, then the last frame's decay
+				// (even frames); frame 3 reads tier 0 through occupancy(),
+				// which applies it; the others leave it to processFrame()
 				b.buildFrame(*scan, T);
 				if (f % 2 == 0 && b.decayPending())
 				{
-					lacked |=
-					    bytesOf(*a.occupancy()) != bytesOf(*b.occupancy());
+					lacked |= bytesOf(*t0b) != aBefore;
 					b.applyPendingDecay();
+					EXPECT_TRUE(bytesOf(*t0b) == aBefore);
+				}
+				else if (f == 3 && b.decayPending())
+				{
+					EXPECT_TRUE(bytesOf(*b.occupancy()) == aBefore);
+					EXPECT_FALSE(b.decayPending());
 				}
 				const auto& rb = b.processFrame(b.lastFrame(), nullptr);
 				EXPECT_EQ(b.decayPending(), mode != DecayMode::All);
@@ -449,6 +458,7 @@ TEST(MotionGrids, DeferredDecayGivesTheSameMapsAndMasks)
 				          b.background()->lastPosterior());
 				EXPECT_EQ(a.flow()->lastPosterior(), b.flow()->lastPosterior());
 				EXPECT_EQ(ra.movingTier1, rb.movingTier1);
+				aBefore = bytesOf(*a.occupancy());
 			}
 			b.applyPendingDecay();
 			EXPECT_FALSE(b.decayPending());

@@ -66,7 +66,13 @@ class MotionGrids
 	const FrameCloud& lastFrame() const { return *frame_; }
 	const MotionFrameResult& lastResult() const { return result_; }
 
-	std::shared_ptr<COccupancyBayesGrid> occupancy() const { return t0_; }
+	/** Tier 0, with a decay left by setDeferDecay() applied first (so not
+	 * while applyPendingDecay() may run on another thread). */
+	std::shared_ptr<COccupancyBayesGrid> occupancy() const
+	{
+		applyPendingDecay();
+		return t0_;
+	}
 	std::shared_ptr<CBackgroundSubtractionGrid> background() const
 	{
 		return t1_;
@@ -87,7 +93,7 @@ class MotionGrids
 	 * egomotion. A frame not built by buildFrame() is decayed at once. */
 	void setDeferDecay(bool on) { deferDecay_ = on; }
 	bool decayPending() const { return t0_->decayPending(); }
-	void applyPendingDecay();
+	void applyPendingDecay() const;
 
 	/** Which tier's MAP decides "moving" for exclude_moving (1 or 2;
 	 * default 2). */
@@ -117,7 +123,7 @@ class MotionGrids
 	int decisionTier_ = 2;
 	bool deferDecay_ = false;
 	// The frame whose decay is pending (kept alive for it).
-	std::shared_ptr<const FrameCloud> decaying_;
+	mutable std::shared_ptr<const FrameCloud> decaying_;
 };
 
 }  // namespace bims::maps
