@@ -72,9 +72,7 @@ Pipeline::~Pipeline()
 
 double Pipeline::settleDecay() const
 {
-	if (!decaying_.valid()) return 0;
-	lastDecayMs_ = decaying_.get();
-	return lastDecayMs_;
+	return decaying_.valid() ? decaying_.get() : 0;
 }
 
 void Pipeline::addImu(const mrpt::obs::CObservationIMU& imu)

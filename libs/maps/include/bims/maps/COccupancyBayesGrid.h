@@ -71,7 +71,6 @@ class COccupancyBayesGrid : public CBayesVoxelGridBase
 	 * integrate(), beginFrame() and integratePending() throw
 	 * std::logic_error. With decay = all (lazy) nothing is left. */
 	void setDeferDecay(bool on) { deferDecay_ = on; }
-	bool deferDecay() const { return deferDecay_; }
 	/** A frame's decay is waiting for applyPendingDecay(). */
 	bool decayPending() const { return decayOf_ != nullptr; }
 	/** Applies the decay left by the last integrate()/integratePending()

@@ -187,9 +187,8 @@ class Pipeline
 	 * (beside that frame's cloud build). */
 	std::unique_ptr<SerialWorker> decayThread_;
 	/** The last frame's decay on the decay thread (its ms), and waiting for
-	 * it: the ms of the last one waited for. */
+	 * it (its ms; 0 if none was in flight). */
 	mutable std::future<double> decaying_;
-	mutable double lastDecayMs_ = 0;
 	double settleDecay() const;
 };
 
