@@ -345,7 +345,7 @@ TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 	// Reading ahead, the observed flow on its own thread (and of the next
 	// frame during this frame's grids), the cloud built beside the labels,
 	// writing on threads and OpenCV's pool, tier 0's decay of a frame on the
-	// cloud thread during the next frame (frustum by default; ray casting
+	// decay thread during the next frame (frustum by default; ray casting
 	// checked below)
 	// must not change a single byte of the outputs (nor the order of the
 	// labelled rawlog, which is the input's).
@@ -401,7 +401,7 @@ TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 		}
 	}
 	{
-		// the ray cast on the cloud thread: same static map and masks
+		// the ray cast's decay on the decay thread: same static map and masks
 		const std::string ra =
 		    runWith(false, false, "sequential_raycast", Variant::FusedRaycast);
 		const std::string rb =

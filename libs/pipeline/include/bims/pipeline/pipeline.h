@@ -186,8 +186,9 @@ class Pipeline
 	/** With cloud_thread: tier 0's decay of a frame, during the next frame
 	 * (beside that frame's cloud build). */
 	std::unique_ptr<SerialWorker> decayThread_;
-	/** The last frame's decay on the decay thread (its ms), and waiting for
-	 * it (its ms; 0 if none was in flight). */
+	/** The last frame's decay on the decay thread (its result: the decay's
+	 * ms); settleDecay() waits for it and returns those ms (0 if none was
+	 * in flight). */
 	mutable std::future<double> decaying_;
 	double settleDecay() const;
 };
