@@ -4,3 +4,4 @@
 int cmdTraj(int argc, char** argv);
 int cmdMasks(int argc, char** argv);
 int cmdDepthConsistency(int argc, char** argv);
+int cmdAttitude(int argc, char** argv);

@@ -1,6 +1,7 @@
 // bims-eval traj GT.txt EST.txt [options]
 // bims-eval masks GT_MASK_DIR PRED_MASK_DIR [--depth-valid IN.rawlog] [options]
 // bims-eval depth-consistency IN.rawlog GT.txt [options]
+// bims-eval attitude REF.txt EST.txt [--ref-up AXIS] [options]
 // See docs/eval.md for the definitions.
 #include <bims/common/app.h>
 
@@ -20,7 +21,9 @@ int main(int argc, char** argv)
 		        "       bims-eval masks GT_MASK_DIR PRED_MASK_DIR "
 		        "[--depth-valid "
 		        "IN.rawlog] [--help]\n"
-		        "       bims-eval depth-consistency IN.rawlog GT.txt [--help]";
+		        "       bims-eval depth-consistency IN.rawlog GT.txt [--help]\n"
+		        "       bims-eval attitude REF.txt EST.txt [--ref-up AXIS] "
+		        "[--help]";
 		    if (argc < 2)
 			    throw bims::UsageError("missing sub-command\n" + usage);
 		    const std::string sub = argv[1];
@@ -31,7 +34,8 @@ int main(int argc, char** argv)
 			    for (const auto& [name, fn] :
 			         {std::pair{"traj", &cmdTraj},
 			          std::pair{"masks", &cmdMasks},
-			          std::pair{"depth-consistency", &cmdDepthConsistency}})
+			          std::pair{"depth-consistency", &cmdDepthConsistency},
+			          std::pair{"attitude", &cmdAttitude}})
 			    {
 				    std::string prog = std::string("bims-eval ") + name;
 				    char help[] = "--help";
@@ -60,6 +64,7 @@ int main(int argc, char** argv)
 		    if (sub == "masks") return cmdMasks(argc - 1, argv + 1);
 		    if (sub == "depth-consistency")
 			    return cmdDepthConsistency(argc - 1, argv + 1);
+		    if (sub == "attitude") return cmdAttitude(argc - 1, argv + 1);
 		    throw bims::UsageError("unknown sub-command '" + sub + "'\n" +
 		                           usage);
 	    });

@@ -1,6 +1,6 @@
 // bims-odom CONFIG.ini IN.rawlog -o TRAJ.txt [--calib CALIB.ini]
 //           [--mode imu|vision] [--gyro-aid true|false] [--csv FRAMES.csv]
-//           [--masks DIR]
+//           [--masks DIR] [--attitude ATT.txt]
 // Egomotion alone: writes the camera trajectory T_WC in the TUM format and a
 // per-stage timing summary. Works with or without IMU data in the rawlog
 // (mode = vision for data without IMU).
@@ -55,6 +55,12 @@ int main(int argc, char** argv)
 		        "rate and the number of features tracked within 2 px of the "
 		        "truth",
 		        false, "", "GT.txt", cmd);
+		    TCLAP::ValueArg<std::string> attArg(
+		        "", "attitude",
+		        "also write the IMU attitude filter's rotation R_WC = R_WI "
+		        "R_IC at each frame (TUM, translation 0; compare with "
+		        "bims-eval attitude)",
+		        false, "", "ATT.txt", cmd);
 		    TCLAP::ValueArg<size_t> maxArg(
 		        "", "max-frames", "stop after N frames", false, 0, "N", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
@@ -64,6 +70,6 @@ int main(int argc, char** argv)
 		        {cfgArg.getValue(), inArg.getValue(), outArg.getValue(),
 		         calibArg.getValue(), givenValue(modeArg), givenValue(aidArg),
 		         givenValue(csvArg), givenValue(masksArg), givenValue(gtArg),
-		         maxArg.getValue(), !quiet.getValue()});
+		         maxArg.getValue(), !quiet.getValue(), givenValue(attArg)});
 	    });
 }

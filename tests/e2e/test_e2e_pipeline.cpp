@@ -3,7 +3,9 @@
 // input (truncated rawlog, no IMU, wrong sensor label).
 #include <bims/common/json.h>
 #include <bims/common/rawlog.h>
+#include <bims/ego/flags.h>
 #include <bims/eval/mask_metrics.h>
+#include <bims/eval/trajectory_metrics.h>
 #include <bims/pipeline/pipeline.h>
 #include <bims/pipeline/run.h>
 #include <gtest/gtest.h>
@@ -15,6 +17,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
@@ -50,17 +53,20 @@ cv::Mat validDepth(const mrpt::obs::CObservation3DRangeScan& s)
 
 /** Runs a variant over frames [0, last] and scores the non-warm-up frames. */
 bims::eval::MaskMetrics score(ExperimentConfig cfg, Variant v, size_t last,
-                              RunSummary* sumOut = nullptr)
+                              RunSummary* sumOut = nullptr,
+                              const std::string& rawlog = kSample,
+                              std::function<void(const FrameResult&)> more = {})
 {
 	cfg.setVariant(v);
 	RunOptions opt;
-	opt.rawlogs = {kSample};
+	opt.rawlogs = {rawlog};
 	opt.frames = FrameRange{0, last};
 	opt.progress = false;
 	bims::eval::MaskMetrics m;
 	opt.onFrame = [&](const FrameResult& r,
 	                  const mrpt::obs::CObservation3DRangeScan& scan)
 	{
+		if (more) more(r);
 		if (r.warmup) return;
 		char name[32];
 		std::snprintf(name, sizeof(name), "/%06zu.png", r.index);
@@ -113,6 +119,64 @@ TEST(EndToEnd, FusionBeatsEachIsolatedVariantOnTheWholeSample)
 	EXPECT_GT(bottom, 0.90);
 	EXPECT_GT(raycast, flow + 0.1);
 	EXPECT_GT(raycast, 0.88);
+}
+
+// Depth + IMU without colour (a phone's LiDAR, a time-of-flight camera):
+// the bundled sample with its images dropped. Every frame runs tiers 0 and
+// 1 without the flow tier (tier 2 = tier 1, said in the outputs), the
+// egomotion from the IMU's rotation and the keyframe alignment's geometric
+// term; the people are still found.
+TEST(EndToEnd, DepthOnlyRunsTiers0And1WithoutTheFlowTier)
+{
+	const std::string dir = tmpDir("depth_only");
+	const std::string depthOnly = dir + "/depth_only.rawlog";
+	{
+		bims::RawlogReader in(kSample);
+		bims::RawlogWriter w(depthOnly, 1);
+		while (auto o = in.next())
+		{
+			if (auto s = std::dynamic_pointer_cast<
+			        mrpt::obs::CObservation3DRangeScan>(o))
+			{
+				s->hasIntensityImage = false;
+				s->intensityImage = mrpt::img::CImage();
+			}
+			w.write(*o);
+		}
+	}
+	ExperimentConfig cfg;
+	cfg.loadFromFile(kConfig);
+	bims::Trajectory est;
+	size_t flowOff = 0, measured = 0, frames = 0;
+	RunSummary sum;
+	const auto m =
+	    score(cfg, Variant::Fused, 149, &sum, depthOnly,
+	          [&](const FrameResult& r)
+	          {
+		          ++frames;
+		          flowOff += r.flowOff;
+		          EXPECT_TRUE(r.ego.flags & bims::ego::kFlagNoImage);
+		          EXPECT_TRUE(r.labels.empty());
+		          EXPECT_EQ(cv::countNonZero(r.maskFlow), 0);
+		          EXPECT_EQ(cv::countNonZero(r.maskTier2 != r.maskTier1), 0);
+		          if (r.index > 0) measured += r.ego.ok();
+		          est.push_back({r.t, r.T_WC});
+	          });
+	EXPECT_EQ(flowOff, frames);
+	EXPECT_EQ(sum.framesWithoutFlow, frames);
+	EXPECT_EQ(sum.framesFlaggedBy.at("no_image"), frames);
+	ASSERT_FALSE(sum.notes.empty());
+	EXPECT_NE(sum.notes.back().find("depth only"), std::string::npos);
+	// measured by the alignment (anchored) on almost every frame
+	EXPECT_GE(measured, frames - 1 - 3);
+	const auto gt =
+	    bims::loadTumTrajectory(std::string(BIMS_SOURCE_DIR) +
+	                            "/rawlogs/pendulum_slow_gt/groundtruth.txt");
+	const double ate = bims::eval::computeAte(gt, est).stats.rmse;
+	std::printf("depth only: ATE %.4f m, %zu of %zu frames measured\n", ate,
+	            measured, frames - 1);
+	EXPECT_LT(ate, 0.02);
+	EXPECT_GT(m.f1(), 0.85);
 }
 
 TEST(EndToEnd, WritesTheContractOutputs)

@@ -358,7 +358,8 @@ std::vector<const char*> flagNames(uint32_t flags)
 	    {kFlagAnchorLost, "anchor_lost"},
 	    {kFlagMaskIgnored, "mask_ignored"},
 	    {kFlagAnchorRelocalised, "anchor_relocalised"},
-	    {kFlagImuRejected, "imu_rejected"}};
+	    {kFlagImuRejected, "imu_rejected"},
+	    {kFlagNoImage, "no_image"}};
 	std::vector<const char*> out;
 	for (const auto& [bit, name] : names)
 		if (flags & bit) out.push_back(name);

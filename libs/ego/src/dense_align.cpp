@@ -345,11 +345,23 @@ void DenseFrame::build(const cv::Mat& grey, const cv::Mat& depth,
                        const Eigen::Matrix3d& K, const AnchorParams& p,
                        const cv::Mat& exclude)
 {
-	CV_Assert(grey.type() == CV_8UC1 && depth.type() == CV_32FC1 &&
-	          grey.size() == depth.size());
+	CV_Assert(depth.type() == CV_32FC1);
+	CV_Assert(grey.empty() ||
+	          (grey.type() == CV_8UC1 && grey.size() == depth.size()));
 	CV_Assert(exclude.empty() ||
 	          (exclude.type() == CV_8UC1 && exclude.size() == depth.size()));
 	reference_ = false;
+	image_ = !grey.empty();
+	if (!image_)
+	{
+		// depth only: the levels' grey stays flat (no gradient, no
+		// photometric term: alignDense() drops it)
+		if (noImage_.size() != depth.size())
+			noImage_ = cv::Mat::zeros(depth.size(), CV_8UC1);
+		build(noImage_, depth, K, p, exclude);
+		image_ = false;
+		return;
+	}
 	levels.assign(static_cast<size_t>(p.coarsest_level) + 1, DenseLevel());
 	const float zmin = float(p.min_depth_m), zmax = float(p.max_depth_m);
 	auto reading = [zmin, zmax](float z)
@@ -574,10 +586,19 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 
 DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
                             const std::vector<InitialGuess>& inits,
-                            const AnchorParams& p,
+                            const AnchorParams& params,
                             const Eigen::Matrix3d* R_prior,
                             double sigmaPrior_rad)
 {
+	// the photometric term needs an image in both frames (else depth only)
+	AnchorParams depthOnly;
+	if (!ref.hasImage() || !cur.hasImage())
+	{
+		depthOnly = params;
+		depthOnly.photo_weight = 0;
+	}
+	const AnchorParams& p =
+	    ref.hasImage() && cur.hasImage() ? params : depthOnly;
 	DenseAlignResult r;
 	if (!inits.empty())
 	{

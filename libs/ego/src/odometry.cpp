@@ -31,6 +31,8 @@ const char* toString(RotationSource s)
 bool FrameEgomotion::ok() const
 {
 	if (flags & (kFlagOutOfOrder | kFlagBadImage)) return false;
+	// without an image only the keyframe alignment measures the motion
+	if (flags & kFlagNoImage) return (flags & kFlagAnchored) != 0;
 	// the keyframe alignment measures the motion even without tracks
 	return (flags & kFlagAnchored) ||
 	       !(flags & (kFlagTooFewTracks | kFlagTooFewInliers));
@@ -171,7 +173,10 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		}
 		T_WC_ = toPose(R_WC_, t_WC_);
 		const auto t1 = std::chrono::steady_clock::now();
-		klt_.track(f.grey, f.K, nullptr, mask);
+		if (f.hasImage())
+			klt_.track(f.grey, f.K, nullptr, mask);
+		else
+			klt_.reset();
 		r.ms_track = msSince(t1);
 		if (anchoring)
 		{
@@ -180,7 +185,8 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 			r.ms_anchor = r.anchor.ms;
 		}
 		r.T_WC = T_WC_;
-		r.flags = kFlagFirstFrame | (imuMode ? imuFlags : 0);
+		r.flags = kFlagFirstFrame | (imuMode ? imuFlags : 0) |
+		          (f.hasImage() ? 0u : uint32_t(kFlagNoImage));
 		havePrev_ = true;
 		tPrev_ = f.t;
 		depthPrev_ = f.depth.clone();
@@ -202,9 +208,22 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		}
 	}
 	const auto t1 = std::chrono::steady_clock::now();
-	r.tracks = klt_.track(f.grey, f.K, R_pred ? &*R_pred : nullptr, mask);
-	r.tracker = klt_.stats();
-	r.attempted = klt_.attemptedPoints();
+	// A depth-only frame has no features: its motion is the IMU's rotation
+	// (else constant velocity) and the last translation, then measured by
+	// the keyframe alignment alone (geometric term). The tracker starts
+	// afresh at the next frame with an image.
+	const bool image = f.hasImage();
+	if (image)
+	{
+		r.tracks = klt_.track(f.grey, f.K, R_pred ? &*R_pred : nullptr, mask);
+		r.tracker = klt_.stats();
+		r.attempted = klt_.attemptedPoints();
+	}
+	else
+	{
+		klt_.reset();
+		r.flags |= kFlagNoImage;
+	}
 	r.ms_track = msSince(t1);
 
 	const auto t2 = std::chrono::steady_clock::now();
@@ -262,8 +281,8 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		}
 		const Eigen::Matrix3d R_rel = R_WC_.transpose() * R_new;
 		R_imuRel = R_rel;
-		m = est_.estimateTranslation(corr, R_rel);
 		r.R_source = RotationSource::Imu;
+		if (image) m = est_.estimateTranslation(corr, R_rel);
 		if (m.ok && cfg_.translation.reprojection &&
 		    cfg_.translation.refine != TranslationRefine::SE3)
 			m = est_.refineReprojection(corr, m, f.K, false);
@@ -275,21 +294,23 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 			r.R_source = RotationSource::ImuRefined;
 		}
 	}
-	else
+	else if (image)
 	{
 		m = est_.estimateSE3(corr);
 		if (m.ok && cfg_.translation.reprojection)
 			m = est_.refineReprojection(corr, m, f.K, true);
 		r.R_source = RotationSource::Vision;
 	}
-	if (r.correspondences < cfg_.odometry.min_tracks)
+	if (!image)
+		;  // no features to count: the flag says why (kFlagNoImage)
+	else if (r.correspondences < cfg_.odometry.min_tracks)
 		r.flags |= kFlagTooFewTracks;
 	else if (!m.ok)
 		r.flags |= kFlagTooFewInliers;
 
 	Eigen::Matrix3d R_rel;
 	Eigen::Vector3d t_rel;
-	if (!(r.flags & (kFlagTooFewTracks | kFlagTooFewInliers)))
+	if (image && !(r.flags & (kFlagTooFewTracks | kFlagTooFewInliers)))
 	{
 		R_rel = m.R_CprevC;
 		t_rel = m.t_CprevC;

@@ -14,27 +14,32 @@ std::string rgbdFrameFrom(const mrpt::obs::CObservation3DRangeScan& obs,
                           const CameraParams& cam, RgbdFrame& out)
 {
 	out.t = mrpt::Clock::toDouble(obs.timestamp);
-	if (!obs.hasIntensityImage || obs.intensityImage.isEmpty())
-		return "no intensity image";
 	if (!obs.hasRangeImage || obs.rangeImage.rows() == 0)
 		return "no range image";
 	const_cast<mrpt::obs::CObservation3DRangeScan&>(obs).load();
-	cv::Mat img = obs.intensityImage.asCvMat<cv::Mat>(mrpt::img::SHALLOW_COPY);
-	if (img.channels() == 3)
-		cv::cvtColor(img, out.grey, cv::COLOR_BGR2GRAY);
-	else if (img.channels() == 1)
-		out.grey = img;
-	else
-		return "intensity image has an unsupported channel count";
-	if (out.grey.depth() != CV_8U) return "intensity image is not 8-bit";
 	const int H = static_cast<int>(obs.rangeImage.rows());
 	const int W = static_cast<int>(obs.rangeImage.cols());
-	if (H != out.grey.rows || W != out.grey.cols)
+	if (!obs.hasIntensityImage || obs.intensityImage.isEmpty())
+		out.grey.release();  // depth only
+	else
 	{
-		std::ostringstream os;
-		os << "depth " << W << "x" << H << " and intensity " << out.grey.cols
-		   << "x" << out.grey.rows << " differ (registered RGB-D expected)";
-		return os.str();
+		cv::Mat img =
+		    obs.intensityImage.asCvMat<cv::Mat>(mrpt::img::SHALLOW_COPY);
+		if (img.channels() == 3)
+			cv::cvtColor(img, out.grey, cv::COLOR_BGR2GRAY);
+		else if (img.channels() == 1)
+			out.grey = img;
+		else
+			return "intensity image has an unsupported channel count";
+		if (out.grey.depth() != CV_8U) return "intensity image is not 8-bit";
+		if (H != out.grey.rows || W != out.grey.cols)
+		{
+			std::ostringstream os;
+			os << "depth " << W << "x" << H << " and intensity "
+			   << out.grey.cols << "x" << out.grey.rows
+			   << " differ (registered RGB-D expected)";
+			return os.str();
+		}
 	}
 	if (std::string why = intrinsicsOf(obs, cam, out.K); !why.empty())
 		return why;
@@ -65,8 +70,8 @@ std::string rgbdFrameFrom(const mrpt::obs::CObservation3DRangeScan& obs,
 mrpt::img::TCamera RgbdFrame::camera() const
 {
 	mrpt::img::TCamera c;
-	c.ncols = static_cast<uint32_t>(grey.cols);
-	c.nrows = static_cast<uint32_t>(grey.rows);
+	c.ncols = static_cast<uint32_t>(depth.cols);
+	c.nrows = static_cast<uint32_t>(depth.rows);
 	c.setIntrinsicParamsFromValues(K(0, 0), K(1, 1), K(0, 2), K(1, 2));
 	return c;
 }

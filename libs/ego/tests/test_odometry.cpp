@@ -32,7 +32,10 @@ struct RunResult
 
 // 1.5 s at 20 Hz with IMU at 200 Hz; errors of T_C0C (relative to the first
 // frame, so independent of the world anchoring).
-RunResult run(EgoConfig cfg, bool withImu, int frames = 30)
+// depthOnly: the frames' images dropped (a LiDAR or time-of-flight camera
+// without colour).
+RunResult run(EgoConfig cfg, bool withImu, int frames = 30,
+              bool depthOnly = false)
 {
 	cfg.calibration.R_IC = kR_IC;
 	cfg.calibration.has_R_IC = true;
@@ -48,8 +51,16 @@ RunResult run(EgoConfig cfg, bool withImu, int frames = 30)
 		if (withImu)
 			for (; tImu <= t + 0.03; tImu += dtImu)
 				odo.addImu(test::imuAt(m, kR_IC, tImu));
-		const RgbdFrame f = test::render(m.R(t), m.p(t), K320(), 320, 240, t);
+		RgbdFrame f = test::render(m.R(t), m.p(t), K320(), 320, 240, t);
+		if (depthOnly) f.grey.release();
 		const FrameEgomotion e = odo.processFrame(f);
+		if (depthOnly)
+		{
+			EXPECT_TRUE(e.flags & kFlagNoImage) << k;
+			EXPECT_TRUE(e.tracks.empty());
+			// no feature count flags a frame that has no image to track in
+			EXPECT_FALSE(e.flags & (kFlagTooFewTracks | kFlagTooFewInliers));
+		}
 		if (k == 0)
 		{
 			T0 = e.T_WC;
@@ -98,6 +109,56 @@ TEST(Odometry, RefinedImuRotation)
 	EXPECT_EQ(r.failed, 0);
 	EXPECT_LT(r.maxRotErr_deg, 0.3);
 	EXPECT_LT(r.maxTransErr, 0.03);
+}
+
+TEST(Odometry, DepthOnlyFramesAreMeasuredByTheKeyframeAlignment)
+{
+	// IMU rotation, the motion measured by the geometric term alone. This
+	// box room's few planes leave translation along them unobservable to
+	// geometry alone: the translation's accuracy is tested on the
+	// simulator's furnished room (EndToEnd.DepthOnlyRunsTiers0And1...).
+	EgoConfig cfg;
+	cfg.odometry.mode = OdometryMode::Imu;
+	const RunResult r = run(cfg, true, 30, true);
+	EXPECT_EQ(r.failed, 0);
+	EXPECT_LT(r.maxRotErr_deg, 0.3);
+	// without an IMU: the alignment estimates the rotation too
+	cfg.odometry.mode = OdometryMode::Vision;
+	const RunResult v = run(cfg, false, 30, true);
+	EXPECT_EQ(v.failed, 0);
+	EXPECT_LT(v.maxRotErr_deg, 1.0);
+}
+
+TEST(Odometry, DepthOnlyWithoutTheAlignmentIsNotMeasured)
+{
+	// nothing measures a depth-only frame without the keyframe alignment:
+	// its pose is the prediction, and it says so
+	EgoConfig cfg;
+	cfg.odometry.mode = OdometryMode::Vision;
+	cfg.anchor.enable = false;
+	Odometry odo(cfg);
+	test::Motion m;
+	for (int k = 0; k < 3; k++)
+	{
+		RgbdFrame f = test::render(m.R(k * 0.05), m.p(k * 0.05), K320(), 320,
+		                           240, k * 0.05);
+		f.grey.release();
+		const FrameEgomotion e = odo.processFrame(f);
+		EXPECT_TRUE(e.flags & kFlagNoImage);
+		if (k > 0)
+		{
+			EXPECT_FALSE(e.ok()) << flagsToString(e.flags);
+			EXPECT_TRUE(std::isfinite(e.T_WC.x()));
+		}
+	}
+	// a frame with an image afterwards: the tracker starts afresh (no
+	// previous image), the next one is measured again
+	odo.processFrame(
+	    test::render(m.R(0.15), m.p(0.15), K320(), 320, 240, 0.15));
+	const FrameEgomotion e = odo.processFrame(
+	    test::render(m.R(0.2), m.p(0.2), K320(), 320, 240, 0.2));
+	EXPECT_TRUE(e.ok()) << flagsToString(e.flags);
+	EXPECT_FALSE(e.flags & kFlagNoImage);
 }
 
 TEST(Odometry, ImuModeWithoutImuDataFallsBackToVisionAndFlags)

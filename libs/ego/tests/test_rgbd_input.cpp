@@ -77,3 +77,22 @@ TEST(RgbdInput, DepthAndIntensityOfDifferentSizesAreRefused)
 	              "depth 32x24 and intensity 33x24 differ"),
 	          std::string::npos);
 }
+
+TEST(RgbdInput, AScanWithoutAnImageIsADepthOnlyFrame)
+{
+	auto s = scan(32, 24);
+	s.hasIntensityImage = false;
+	bims::ego::RgbdFrame f;
+	// a frame decoded before keeps no stale image
+	ASSERT_EQ(bims::ego::rgbdFrameFrom(scan(32, 24), {}, f), "");
+	ASSERT_TRUE(f.hasImage());
+	ASSERT_EQ(bims::ego::rgbdFrameFrom(s, {}, f), "");
+	EXPECT_FALSE(f.hasImage());
+	EXPECT_EQ(f.size(), cv::Size(32, 24));
+	EXPECT_FLOAT_EQ(f.depth.at<float>(10, 10), 1.5f);
+	EXPECT_EQ(f.camera().ncols, 32u);
+	EXPECT_EQ(f.camera().nrows, 24u);
+	// no depth is still refused
+	s.hasRangeImage = false;
+	EXPECT_EQ(bims::ego::rgbdFrameFrom(s, {}, f), "no range image");
+}

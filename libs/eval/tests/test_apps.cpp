@@ -597,3 +597,56 @@ TEST(Apps, NoProgramWritesOverItsInput)
 	EXPECT_EQ(fs::file_size(cfg), fs::file_size(std::string(BIMS_SOURCE_DIR) +
 	                                            "/config/default.ini"));
 }
+
+// The IMU attitude of the bundled sample (bims-odom --attitude) against its
+// ground truth (bims-eval attitude): the simulator's IMU, magnetometer
+// included, gives a tilt well under a degree and no heading drift to speak
+// of; bad axes and missing files are clear errors.
+TEST(EvalAttitude, TheSampleImuAttitudeAgainstItsGroundTruth)
+{
+	const auto d = tmpDir("attitude");
+	const std::string sample =
+	    std::string(BIMS_SOURCE_DIR) + "/rawlogs/pendulum_slow.rawlog";
+	const std::string gt = std::string(BIMS_SOURCE_DIR) +
+	                       "/rawlogs/pendulum_slow_gt/groundtruth.txt";
+	const auto o =
+	    run(kBin + "/bims-odom " + BIMS_SOURCE_DIR + "/config/default.ini " +
+	        sample + " -o " + d + "/traj.txt --attitude " + d + "/att.txt -q");
+	ASSERT_EQ(o.code, 0) << o.out;
+	const auto att = bims::loadTumTrajectory(d + "/att.txt");
+	const auto traj = bims::loadTumTrajectory(d + "/traj.txt");
+	ASSERT_GT(att.size(), traj.size() - 3);
+	for (const auto& p : att) EXPECT_EQ(p.T_WC.translation().norm(), 0);
+	const auto r = run(kBin + "/bims-eval attitude " + gt + " " + d +
+	                   "/att.txt --skip-s 1 --json " + d + "/att.json");
+	ASSERT_EQ(r.code, 0) << r.out;
+	double tilt = -1, drift = 1e9, headingMax = -1;
+	std::sscanf(r.out.substr(r.out.find("tilt_rmse")).c_str(), "tilt_rmse %lf",
+	            &tilt);
+	std::sscanf(r.out.substr(r.out.find("heading_drift")).c_str(),
+	            "heading_drift %lf deg/min (max |heading error| %lf", &drift,
+	            &headingMax);
+	EXPECT_GE(tilt, 0);
+	EXPECT_LT(tilt, 1.0) << r.out;
+	// (4 s: the slope of a heading that wanders by tenths of a degree)
+	EXPECT_LT(std::abs(drift), 60) << r.out;
+	EXPECT_GE(headingMax, 0);
+	EXPECT_LT(headingMax, 2.0) << r.out;
+	EXPECT_TRUE(fs::exists(d + "/att.json"));
+	// the wrong up axis for the reference shows as a large tilt
+	const auto w = run(kBin + "/bims-eval attitude " + gt + " " + d +
+	                   "/att.txt --ref-up y");
+	ASSERT_EQ(w.code, 0) << w.out;
+	std::sscanf(w.out.substr(w.out.find("tilt_rmse")).c_str(), "tilt_rmse %lf",
+	            &tilt);
+	EXPECT_GT(tilt, 30) << w.out;
+	const auto bad = run(kBin + "/bims-eval attitude " + gt + " " + d +
+	                     "/att.txt --ref-up w");
+	EXPECT_EQ(bad.code, 2) << bad.out;
+	EXPECT_NE(bad.out.find("'w' is not an axis"), std::string::npos) << bad.out;
+	const auto none =
+	    run(kBin + "/bims-eval attitude " + d + "/none.txt " + d + "/att.txt");
+	EXPECT_NE(none.code, 0);
+	EXPECT_NE(none.out.find("none.txt: file not found"), std::string::npos)
+	    << none.out;
+}

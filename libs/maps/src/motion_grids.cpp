@@ -75,6 +75,13 @@ const MotionFrameResult& MotionGrids::processFrame(
 const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
                                                    const PixelLabels* labels)
 {
+	return processFrame(f, labels, false);
+}
+
+const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
+                                                   const PixelLabels* labels,
+                                                   bool flowOff)
+{
 	if (f.voxel_size != p_.voxel_size)
 		throw std::invalid_argument(
 		    "MotionGrids::processFrame: frame keyed for another voxel size");
@@ -86,8 +93,10 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 	if (f.stats.badPose) return result_;
 	const auto t0 = std::chrono::steady_clock::now();
 	static const PixelLabels none;
-	// Without flow labels (first frame) there is no decision to exclude by.
-	const bool exclude = p_.exclude_moving && labels;
+	// Without flow labels (first frame) there is no decision to exclude by;
+	// without a flow tier (flowOff) tier 1's is the decision (tier 2
+	// equals it without labels).
+	const bool exclude = p_.exclude_moving && (labels || flowOff);
 	const bool neighbours = p_.bg_neighbourhood != BgNeighbourhood::None;
 	if (!exclude && !neighbours)
 	{
@@ -114,7 +123,7 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 		t2_->posterior(f, labels ? *labels : none, post1_, post2_);
 		if (exclude)
 		{
-			const auto& dec = decisionTier_ == 1 ? post1_ : post2_;
+			const auto& dec = decisionTier_ == 1 || flowOff ? post1_ : post2_;
 			const bool either = p_.exclude_by == ExcludeBy::Either ||
 			                    (p_.exclude_by == ExcludeBy::Auto &&
 			                     p_.decay != DecayMode::Raycast);

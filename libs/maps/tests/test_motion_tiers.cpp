@@ -492,3 +492,42 @@ TEST(OccupancyGrid, PendingDecayRefusesTheNextFrame)
 	EXPECT_FALSE(g.decayPending());
 	EXPECT_NO_THROW(g.integrate(frames[0]));
 }
+
+// A frame without a flow tier (depth only: flowOff) excludes what tier 1
+// calls moving from tier 0 (exclude_moving); the same frame without labels
+// and without flowOff (a first frame) excludes nothing. Tiers 1 and 2 are
+// the same either way (tier 2 without labels equals tier 1).
+TEST(MotionGrids, WithoutAFlowTierTier1DecidesWhatTier0LeavesOut)
+{
+	GridParams p;  // the tuned model (config/default.ini)
+	p.voxel_size = 0.1;
+	p.exclude_moving = true;
+	p.decay = DecayMode::Raycast;
+	// c is seen through b for 15 frames (b free), then b is hit
+	const VoxelKey a{3, 4, 0}, b{2, 0, 0}, c{6, 0, 0};
+	double lb[2] = {0, 0}, la[2] = {0, 0};
+	std::vector<float> post[2];
+	for (int off = 0; off < 2; ++off)
+	{
+		MotionGrids mg(p);
+		for (int f = 1; f <= 15; ++f)
+			mg.processFrame(frameAt(p, {a, c}, {4, 4}, {0.05, 0.05, 0.05}, f),
+			                nullptr, off == 1);
+		const auto cb = mg.occupancy()->centerOf(b);
+		const auto ca = mg.occupancy()->centerOf(a);
+		const double before = mg.occupancy()->logOddsAt(cb);
+		ASSERT_LT(before, 0) << "b is known free";
+		const auto& r =
+		    mg.processFrame(frameAt(p, {a, b}, {4, 4}, {0.05, 0.05, 0.05}, 16),
+		                    nullptr, off == 1);
+		ASSERT_EQ(r.movingTier1, 1u) << "b appeared in free space";
+		EXPECT_EQ(r.movingTier2, r.movingTier1);
+		lb[off] = mg.occupancy()->logOddsAt(cb) - before;
+		la[off] = mg.occupancy()->logOddsAt(ca);
+		post[off] = mg.background()->lastPosterior();
+	}
+	EXPECT_GT(lb[0], 0) << "without flowOff tier 0 folds the mover in";
+	EXPECT_EQ(lb[1], 0) << "with flowOff tier 0 leaves the mover out";
+	EXPECT_EQ(la[0], la[1]) << "the static voxel is folded in either way";
+	EXPECT_EQ(post[0], post[1]);
+}

@@ -250,6 +250,7 @@ void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
 	    jsonNumber(sum.meanMovingPixelFraction, 6);
 	j["static_map_voxels"] = staticVoxels_;
 	j["frames_flow_ahead"] = sum.framesFlowAhead;
+	j["frames_without_flow"] = sum.framesWithoutFlow;
 	j["imu_rejected"] = sum.imuRejected;
 	j["scans_bad_stamp"] = sum.scansBadStamp;
 	Json& stages = j["stage_ms"] = Json::object();

@@ -121,7 +121,8 @@ void Pipeline::startLookahead(const Next& next)
 	// with this one, is left to that call (which reports it).
 	ego::RgbdFrame& f = ahead_.frame;
 	if (!ego::rgbdFrameFrom(*next.scan, cfg_.ego.camera, f).empty() ||
-	    f.grey.size() != cur_.grey.size() || !(f.t > cur_.t))
+	    !f.hasImage() || !cur_.hasImage() || f.size() != cur_.size() ||
+	    !(f.t > cur_.t))
 		return;
 	ahead_.inputMs = msSince(t);
 	// What the next call would predict at its start: the egomotion of this
@@ -175,7 +176,11 @@ const FrameResult& Pipeline::processFrame(
 	r.index = index;
 	FrameJobs jobs;
 	takeInput(scan, r, jobs);
-	const bool haveFlow = havePrev_ && prev_.grey.size() == cur_.grey.size();
+	// The flow tier needs an image in both frames: without (depth only) it
+	// is off for the frame, and tier 1 decides (tier 2 = tier 1).
+	const bool haveFlow = havePrev_ && prev_.hasImage() && cur_.hasImage() &&
+	                      prev_.size() == cur_.size();
+	r.flowOff = !cur_.hasImage() || (havePrev_ && !prev_.hasImage());
 	if (haveFlow && !jobs.observing.valid()) startObservedFlow(jobs);
 	egomotion(r);
 	// A refinement may still correct the egomotion (and so the next
@@ -258,8 +263,9 @@ void Pipeline::startNextJobs(const mrpt::obs::CObservation3DRangeScan& scan,
 	startLookahead(next);
 	// The cloud: this frame's depth with its camera model at its final pose
 	// (its build touches nothing the labels use).
-	const maps::Intrinsics K{cur_.grey.cols, cur_.grey.rows, cur_.K(0, 0),
-	                         cur_.K(1, 1),   cur_.K(0, 2),   cur_.K(1, 2)};
+	const maps::Intrinsics K{cur_.size().width, cur_.size().height,
+	                         cur_.K(0, 0),      cur_.K(1, 1),
+	                         cur_.K(0, 2),      cur_.K(1, 2)};
 	jobs.buildHere = [this, &scan, K, T_WC = r.T_WC, &ms = r.ms.cloud]
 	{
 		const auto t = Clock::now();
@@ -274,7 +280,7 @@ void Pipeline::flowLabels(FrameJobs* jobs, FrameResult& r,
 {
 	// Flow labels on the current frame's pixels (none on the first frame).
 	const auto t = Clock::now();
-	r.maskFlow = cv::Mat::zeros(cur_.grey.size(), CV_8UC1);
+	r.maskFlow = cv::Mat::zeros(cur_.size(), CV_8UC1);
 	if (jobs)
 	{
 		const Observed o = jobs->observed();
@@ -312,8 +318,8 @@ void Pipeline::runGrids(const maps::PixelLabels* labels, FrameResult& r,
 	const auto t = Clock::now();
 	r.ms.decayPrev = settleDecay();
 	jobs.built();
-	const auto& g = grids_.processFrame(grids_.lastFrame(), labels);
-	const cv::Size size = cur_.grey.size();
+	const auto& g = grids_.processFrame(grids_.lastFrame(), labels, r.flowOff);
+	const cv::Size size = cur_.size();
 	r.maskTier1 = toMat(g.maskTier1(), size);
 	r.maskTier2 = toMat(g.maskTier2(), size);
 	r.hitVoxels = g.hitVoxels;
@@ -351,7 +357,7 @@ void Pipeline::finishFrame(FrameResult& r)
 	r.warmup = nFrames_ < static_cast<size_t>(cfg_.pipeline.warmup_frames);
 	if (r.warmup)
 	{
-		r.mask = cv::Mat::zeros(cur_.grey.size(), CV_8UC1);
+		r.mask = cv::Mat::zeros(cur_.size(), CV_8UC1);
 		r.movingVoxelCentres.clear();
 		r.movingVoxels = 0;
 	}

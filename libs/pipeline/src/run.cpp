@@ -120,6 +120,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		if (f.imuRejected) flags |= ego::kFlagImuRejected;
 		sum.framesProcessed++;
 		if (r.flowAhead) sum.framesFlowAhead++;
+		if (r.flowOff) sum.framesWithoutFlow++;
 		const uint32_t counted =
 		    flags & ~static_cast<uint32_t>(ego::kFlagFirstFrame);
 		if (counted) sum.framesFlagged++;
@@ -230,6 +231,14 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		    "(rotation and translation from the tracked 3D features, the "
 		    "tracker seeded at constant velocity), each flagged "
 		    "imu_missing");
+	if (sum.framesWithoutFlow > 0)
+		sum.notes.push_back(
+		    std::to_string(sum.framesWithoutFlow) + " of " +
+		    std::to_string(sum.framesProcessed) +
+		    " frames had no image in them or in the frame before (depth "
+		    "only): the flow tier was off for them (tier 1 decided, tier 2 "
+		    "equals it) and their egomotion came from the keyframe "
+		    "alignment's geometric term alone (flagged no_image)");
 	for (auto& [name, v] : stage) sum.stageMs[name] = Percentiles::of(v);
 	sum.dataSeconds = std::isnan(firstT) ? 0 : lastT - firstT;
 	sum.meanMovingPixelFraction =

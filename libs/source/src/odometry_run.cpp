@@ -122,12 +122,13 @@ int runOdometry(const OdometryRunOptions& o)
 {
 	std::vector<std::string> outputs = {o.out};
 	if (o.csv) outputs.insert(outputs.begin(), *o.csv);
+	if (o.attitude) outputs.insert(outputs.begin(), *o.attitude);
 	checkOutputsSpareInputs(
 	    {o.config, o.rawlog, o.calib, o.masks.value_or(""), o.gt.value_or("")},
 	    outputs);
 	const ego::EgoConfig ec = odometryConfig(o);
 	ego::Odometry odo(ec);
-	Trajectory traj;
+	Trajectory traj, attitude;
 	std::vector<double> msIn, msTrack, msMotion, msEgo;
 	std::unique_ptr<AppendFile> csv;  // each line checked
 	if (o.csv)
@@ -158,6 +159,9 @@ int runOdometry(const OdometryRunOptions& o)
 		    if (r.flags & ego::kFlagOutOfOrder || r.flags & ego::kFlagBadImage)
 			    return;  // no pose for this frame
 		    traj.push_back({r.t, r.T_WC});
+		    if (const auto R = odo.imuRotation(r.t))
+			    attitude.push_back(
+			        {r.t, ego::toPose(*R, Eigen::Vector3d::Zero())});
 		    msIn.push_back(r.ms_input);
 		    msTrack.push_back(r.ms_track);
 		    msMotion.push_back(r.ms_motion);
@@ -187,6 +191,17 @@ int runOdometry(const OdometryRunOptions& o)
 	saveTumTrajectory(
 	    o.out, traj,
 	    std::string("bims-odom mode=") + mode + " gyro_aid=" + aid);
+	if (o.attitude)
+	{
+		if (attitude.empty())
+			throw std::runtime_error(
+			    o.rawlog +
+			    ": --attitude: no frame has an IMU attitude (no IMU samples "
+			    "with [sensors] imu_label, or no [calibration] R_IC)");
+		saveTumTrajectory(*o.attitude, attitude,
+		                  "bims-odom: the IMU attitude filter's R_WC = R_WI "
+		                  "R_IC at each frame (translation not estimated: 0)");
+	}
 	const auto pIn = Percentiles::of(msIn), pTrack = Percentiles::of(msTrack),
 	           pMotion = Percentiles::of(msMotion),
 	           pEgo = Percentiles::of(msEgo);

@@ -48,7 +48,8 @@ struct DenseLevel
 class DenseFrame
 {
  public:
-	/** Builds levels 0..p.coarsest_level from \a grey (CV_8UC1) and
+	/** Builds levels 0..p.coarsest_level from \a grey (CV_8UC1, or empty:
+	 * a depth-only frame, aligned without the photometric term) and
 	 * \a depth (CV_32FC1 [m]). Depth outside [min, max]_depth_m is dropped;
 	 * pixels where \a exclude (CV_8UC1, may be empty) is non-zero are not
 	 * sampled when this frame is aligned (DenseLevel::exclude). A
@@ -61,6 +62,8 @@ class DenseFrame
 	 * can then be the reference of alignDense(). */
 	void prepareReference(const AnchorParams& p);
 	bool isReference() const { return reference_; }
+	/** Whether it was built with an image (else depth only). */
+	bool hasImage() const { return image_; }
 	/** Drops the readings where \a mask (CV_8UC1 of the finest level's
 	 * size) is non-zero, from the finest and every coarser level: content
 	 * known to move (marked so: a point landing there counts as covered
@@ -72,6 +75,8 @@ class DenseFrame
 
  private:
 	bool reference_ = false;
+	bool image_ = true;
+	cv::Mat noImage_;  // the flat image of a depth-only frame
 };
 
 /** Result of one alignment. */
@@ -124,7 +129,8 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
                             const Eigen::Matrix3d* R_prior = nullptr,
                             double sigmaPrior_rad = 0);
 
-/** Same, from several initial guesses: each is iterated at the coarsest
+/** Same, from several initial guesses (the photometric term only when both
+ * frames have an image): each is iterated at the coarsest
  * level (a later one only if it starts with more inliers than the first),
  * the one with most inliers there goes on to the finer levels (e.g. the
  * frame-to-frame estimate, which people in view can corrupt, and the

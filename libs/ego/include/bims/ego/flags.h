@@ -50,6 +50,11 @@ enum EgoFlag : uint32_t
 	 * finite or beyond any sensor's range; bims::imuSampleProblem) and
 	 * not used. Set by bims-run. */
 	kFlagImuRejected = 1u << 17,
+	/** The frame has no image (depth only): no features were tracked; its
+	 * rotation is the IMU's (else constant velocity) and its motion is
+	 * measured only by the keyframe alignment's geometric term (a frame
+	 * without kFlagAnchored is not measured). */
+	kFlagNoImage = 1u << 18,
 };
 
 /** The names of the set bits, in bit order ("imu_gap", "too_few_tracks");

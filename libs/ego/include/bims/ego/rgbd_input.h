@@ -15,13 +15,21 @@ namespace bims::ego
 {
 /** One RGB-D frame ready for tracking. Registered RGB-D is assumed: depth
  * pixel (u, v) belongs to intensity pixel (u, v) (as in the simulator and in
- * TUM/Bonn imports). */
+ * TUM/Bonn imports). A depth-only frame (a scan without an intensity image:
+ * a phone's LiDAR without its video, a time-of-flight camera) has an empty
+ * grey image: what needs one (the tracker, the optical flow, the
+ * photometric term) is skipped for it. */
 struct RgbdFrame
 {
 	double t = 0;   ///< camera timestamp [s]
-	cv::Mat grey;   ///< CV_8UC1
+	cv::Mat grey;   ///< CV_8UC1 of the depth's size, or empty (depth only)
 	cv::Mat depth;  ///< CV_32FC1 optical-axis depth [m], 0 = no reading
 	Eigen::Matrix3d K = Eigen::Matrix3d::Identity();  ///< intrinsics [px]
+
+	/** Whether the frame has an image (else depth only). */
+	bool hasImage() const { return !grey.empty(); }
+	/** The image size: the depth's. */
+	cv::Size size() const { return depth.size(); }
 
 	/** K and the image size as MRPT's camera model (what the flow stage
 	 * takes). */
@@ -30,9 +38,10 @@ struct RgbdFrame
 
 /** Fills \a out from \a obs (intensity -> grey, rangeImage * rangeUnits ->
  * depth, Euclidean ranges converted to depth when range_is_depth = false;
- * K from \a cam when given, else from obs.cameraParams).
- * \return empty string on success, else what is wrong (no image, sizes
- * differ, camera size disagrees with [camera]). */
+ * K from \a cam when given, else from obs.cameraParams). A scan without an
+ * intensity image gives a depth-only frame (grey empty).
+ * \return empty string on success, else what is wrong (no range image,
+ * sizes differ, camera size disagrees with [camera]). */
 std::string rgbdFrameFrom(const mrpt::obs::CObservation3DRangeScan& obs,
                           const CameraParams& cam, RgbdFrame& out);
 

@@ -47,6 +47,13 @@ class MotionGrids
 	 * size (throws std::invalid_argument otherwise). */
 	const MotionFrameResult& processFrame(const FrameCloud& frame,
 	                                      const PixelLabels* labels);
+	/** Same; \a flowOff: the frame has no flow tier at all (depth only, no
+	 * labels): tier 1 decides what exclude_moving leaves out (tier 2,
+	 * without labels, equals it). Without \a flowOff a frame without labels
+	 * (the first one) excludes nothing. */
+	const MotionFrameResult& processFrame(const FrameCloud& frame,
+	                                      const PixelLabels* labels,
+	                                      bool flowOff);
 
 	/** Builds the FrameCloud of a scan (as processFrame(scan, ...) does)
 	 * into lastFrame(), for processFrame(lastFrame(), labels) later: the

@@ -60,6 +60,9 @@ struct FrameResult
 	ego::FrameEgomotion ego;        ///< egomotion details (flags, inliers, ...)
 	flow::FlowPoseResult flowPose;  ///< the dense-flow refinement, if any
 	bool warmup = false;            ///< mask forced empty (warm-up frame)
+	/** The flow tier is off for this frame: it or the previous one has no
+	 * image (depth only). Tier 1 decides; tier 2 equals it; no labels. */
+	bool flowOff = false;
 	/** its observed flow ran during the previous frame (flow_lookahead) */
 	bool flowAhead = false;
 	/** The variant's moving-pixel mask (CV_8UC1, 255 = moving). */
@@ -102,7 +105,9 @@ class Pipeline
 
 	/** Runs one RGB-D frame; \a index is its 3D-scan index. Throws
 	 * std::runtime_error naming the frame when the observation has no
-	 * usable intensity or depth image.
+	 * usable depth image (or an unusable intensity image). A scan without
+	 * an intensity image is a depth-only frame: no flow tier
+	 * (FrameResult::flowOff), the egomotion without features.
 	 *
 	 * \a next (optional): the frame the next call will run, given only when
 	 * every IMU sample that call would see has been added already (results

@@ -44,6 +44,9 @@ struct RunSummary : source::FrameOrderStats
 	/** frames whose observed flow ran during the previous frame's grids
 	 * ([pipeline] flow_lookahead) */
 	size_t framesFlowAhead = 0;
+	/** frames without a flow tier (no image in them or in the frame
+	 * before: depth only; FrameResult::flowOff) */
+	size_t framesWithoutFlow = 0;
 	/** Wall time of the whole run: reading, every frame, every output
 	 * (static map included; metrics.json excepted). */
 	double seconds = 0;

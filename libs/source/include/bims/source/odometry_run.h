@@ -35,6 +35,9 @@ struct OdometryRunOptions
 	std::optional<std::string> gt;
 	size_t max_frames = 0;  ///< stop after N frames (0: all)
 	bool progress = true;   ///< progress line on stderr
+	/** the IMU attitude filter's R_WC = R_WI R_IC at each frame's stamp
+	 * (zero translation; frames without an attitude left out), TUM */
+	std::optional<std::string> attitude;
 };
 
 /** Overrides \a ec's [calibration] [camera] [sensors] with those of the
