@@ -1,9 +1,11 @@
 #include <bims/ego/rotation_calibration.h>
 #include <bims/ego/so3.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 namespace bims::ego
@@ -84,6 +86,21 @@ RotationCalibResult estimateRotationIC(const std::vector<RotationPair>& pairs,
 	res.R_IC = R;
 	res.inliers = static_cast<int>(best.size());
 	res.rms_deg = std::sqrt(ss / best.size()) * 180 / M_PI;
+	// the uncertainty of a small rotation delta of R_IC (R <- Exp(delta) R):
+	// a_i - Exp(delta) R b_i ~ r_i + [R b_i]_x delta
+	Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
+	for (int i : best)
+	{
+		const Eigen::Matrix3d J = skew(R * b[i]);
+		info += J.transpose() * J;
+	}
+	const double dof = std::max(1.0, 3.0 * best.size() - 3);
+	const double sigma2 = ss / dof;
+	Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(info);
+	const double lmin = eig.eigenvalues()(0);  // ascending
+	res.uncertainty_deg = lmin > 0 ? std::sqrt(sigma2 / lmin) * 180 / M_PI
+	                               : std::numeric_limits<double>::infinity();
+	res.weakAxis_I = eig.eigenvectors().col(0);
 	res.ok = res.inliers >= 3 && res.conditioning > 0.05;
 	return res;
 }

@@ -91,6 +91,19 @@ int runImuCalibration(const ImuCalibrationOptions& o)
 	for (int i = 0; i < 3; i++)
 		for (int j = 0; j < 3; j++) std::printf(" %.6f", res.R_IC(i, j));
 	std::printf("\n");
+	std::printf(
+	    "bims-calib-imu: 1-sigma uncertainty %.2f deg about (%.3f %.3f %.3f) "
+	    "in {I}, its worst-determined axis\n",
+	    res.uncertainty_deg, res.weakAxis_I.x(), res.weakAxis_I.y(),
+	    res.weakAxis_I.z());
+	if (res.uncertainty_deg > o.max_uncertainty_deg)
+		std::fprintf(
+		    stderr,
+		    "bims-calib-imu: warning: R_IC is poorly observed (1-sigma %.2f "
+		    "deg > %.2f): the sequence rotated mostly about one axis; "
+		    "record one that rotates about at least two, or keep a nominal "
+		    "R_IC\n",
+		    res.uncertainty_deg, o.max_uncertainty_deg);
 	if (haveRef)
 		std::printf("bims-calib-imu: angle to the configured R_IC: %.3f deg\n",
 		            ego::angleSO3(R_ref.transpose() * res.R_IC) * 180 / M_PI);

@@ -34,6 +34,14 @@ struct RotationCalibResult
 	/** Ratio of the 2nd to 1st singular value of the data: near 0 means the
 	 * motion rotated about one axis only and R_IC is not observable. */
 	double conditioning = 0;
+	/** 1-sigma uncertainty of R_IC about its worst-determined axis [deg]:
+	 * the covariance sigma^2 (sum_i J_i^T J_i)^-1 of a small rotation of
+	 * R_IC, J_i = [R_IC Log_C,i]_x, sigma^2 the residuals' variance per
+	 * component. Rotations about one axis only leave the rotation of R_IC
+	 * about that axis unobserved: this grows without bound. */
+	double uncertainty_deg = 0;
+	/** That axis, a unit vector in {I}. */
+	Eigen::Vector3d weakAxis_I = Eigen::Vector3d::UnitX();
 };
 
 /** \param minAngle_deg pairs rotating less (either sensor) are skipped.

@@ -29,6 +29,8 @@ struct ImuCalibrationOptions
 	double min_angle_deg = 0.3;      ///< frame pairs rotating less: skipped
 	double inlier_deg = 0.3;         ///< inlier limit on the residual
 	bool progress = true;            ///< progress line on stderr
+	/** a 1-sigma uncertainty beyond this is warned about [deg] */
+	double max_uncertainty_deg = 1.0;
 };
 
 /** The pairs (gyro rotation, visual rotation) of consecutive frames, fed as
