@@ -188,3 +188,45 @@ TEST(AttitudeFilter, ConvertsMrptObservation)
 	EXPECT_FALSE(s.q_WI.has_value());
 	EXPECT_DOUBLE_EQ(s.gyro.z(), 0.3);
 }
+
+// A phone's IMU (no magnetometer): tilt from gravity, heading from the gyro.
+// No sample is flagged (nothing missing that was never there), the tilt
+// holds, and the heading drifts no faster than the gyro's bias allows.
+TEST(AttitudeFilter, WithoutAMagnetometerTiltHoldsAndNothingIsFlagged)
+{
+	Stream st;
+	st.m.w_C = {0.05, 0.2, -0.1};
+	AttitudeParams p;
+	p.use_magnetometer = false;
+	AttitudeFilter f(p);
+	double worstTilt = 0;
+	Eigen::Matrix3d D0 = Eigen::Matrix3d::Zero();
+	for (int i = 0; i <= 6000; i++)
+	{
+		ImuSample s = st.at(i * 0.01);
+		s.hasMag = false;
+		s.mag.setZero();
+		const uint32_t flags = f.add(s);
+		ASSERT_EQ(flags, 0u) << "sample " << i << ": " << flagsToString(flags);
+		if (i * 0.01 < p.init_time_s) continue;
+		if (D0.isZero())  // the start's heading is arbitrary without north
+			D0 = f.q_WI().toRotationMatrix() * st.R_WI(i * 0.01).transpose();
+		const Eigen::Vector3d upEst =
+		    f.q_WI().toRotationMatrix().transpose() * Eigen::Vector3d::UnitZ();
+		const Eigen::Vector3d upTrue =
+		    st.R_WI(i * 0.01).transpose() * Eigen::Vector3d::UnitZ();
+		worstTilt =
+		    std::max(worstTilt,
+		             std::acos(std::min(1.0, upEst.dot(upTrue))) * 180 / M_PI);
+	}
+	ASSERT_TRUE(f.initialized());
+	EXPECT_LT(worstTilt, 1.0);
+	EXPECT_EQ(f.stats().magGated, 0u);
+	// the heading error since the start: bounded by the whole bias
+	// integrated (its vertical part is unobserved without a magnetometer)
+	const Eigen::Matrix3d D =
+	    f.q_WI().toRotationMatrix() * st.R_WI(60).transpose();
+	const double err = angleSO3(D * D0.transpose()) * 180 / M_PI;
+	std::printf("heading error after 59 s: %.2f deg\n", err);
+	EXPECT_LT(err, st.bias.norm() * 59 * 180 / M_PI);
+}
