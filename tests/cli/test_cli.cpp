@@ -27,22 +27,13 @@ const std::string kSample = kSrc + "/rawlogs/pendulum_slow.rawlog";
 const std::string kConfig = kSrc + "/config/default.ini";
 
 /** Every program, bims-eval by sub-command. */
-const std::vector<std::string> kPrograms = {"bims-run",
-                                            "bims-viewer",
-                                            "bims-grab",
-                                            "bims-sim",
-                                            "bims-odom",
-                                            "bims-calib-imu",
-                                            "bims-calib-depth",
-                                            "bims-import-tum",
-                                            "bims-eval traj",
-                                            "bims-eval masks",
-                                            "bims-eval depth-consistency",
-                                            "bims-info",
-                                            "bims-flow-labels",
-                                            "bims-flow-check",
-                                            "bims-sweep",
-                                            "bims-maps-figure"};
+const std::vector<std::string> kPrograms = {
+    "bims-run",         "bims-viewer",      "bims-grab",
+    "bims-sim",         "bims-odom",        "bims-calib-imu",
+    "bims-calib-depth", "bims-import-tum",  "bims-import-stray",
+    "bims-eval traj",   "bims-eval masks",  "bims-eval depth-consistency",
+    "bims-info",        "bims-flow-labels", "bims-flow-check",
+    "bims-sweep",       "bims-maps-figure"};
 
 bool built(const std::string& program)
 {
@@ -143,12 +134,13 @@ TEST(Cli, SharedOptionsAreSpelledTheSameWayInEveryProgram)
 	    "bims-run",         "bims-sim",       "bims-grab",
 	    "bims-odom",        "bims-calib-imu", "bims-calib-depth",
 	    "bims-import-tum",  "bims-eval traj", "bims-eval masks",
-	    "bims-flow-labels", "bims-sweep",     "bims-maps-figure"};
+	    "bims-flow-labels", "bims-sweep",     "bims-maps-figure",
+	    "bims-import-stray"};
 	const std::set<std::string> withQuiet = {
-	    "bims-run",        "bims-sim",        "bims-grab",
-	    "bims-odom",       "bims-calib-imu",  "bims-calib-depth",
-	    "bims-import-tum", "bims-eval masks", "bims-flow-check",
-	    "bims-sweep"};
+	    "bims-run",        "bims-sim",         "bims-grab",
+	    "bims-odom",       "bims-calib-imu",   "bims-calib-depth",
+	    "bims-import-tum", "bims-eval masks",  "bims-flow-check",
+	    "bims-sweep",      "bims-import-stray"};
 	size_t checked = 0;
 	for (const auto& p : kPrograms)
 	{

@@ -1,4 +1,5 @@
 #include <bims/eval/association.h>
+#include <bims/eval/rgbd_frame.h>
 #include <bims/eval/tum_import.h>
 
 #include <cmath>
@@ -130,12 +131,7 @@ TumFolder readTumFolder(const std::string& folder, const ImportParams& params)
 
 cv::Mat loadDepthMeters(const std::string& path, const CameraIntrinsics& cam)
 {
-	const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
-	if (raw.empty())
-		throw std::runtime_error(path + ": cannot read depth image");
-	if (raw.type() != CV_16UC1)
-		throw std::runtime_error(path +
-		                         ": depth must be a 16-bit single-channel PNG");
+	const cv::Mat raw = readDepthPng(path);
 	if (raw.cols != cam.width || raw.rows != cam.height)
 		throw std::runtime_error(
 		    path + ": depth image is " + std::to_string(raw.cols) + "x" +

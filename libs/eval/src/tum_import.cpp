@@ -3,6 +3,7 @@
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
 #include <bims/eval/pose_utils.h>
+#include <bims/eval/rgbd_frame.h>
 #include <bims/eval/tum_import.h>
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/system/datetime.h>
@@ -24,42 +25,14 @@ mrpt::obs::CObservation3DRangeScan::Ptr loadDepthFrame(
     const std::string& depthPath, double t, const ImportParams& params)
 {
 	const auto& cam = params.camera;
-	const cv::Mat raw = cv::imread(depthPath, cv::IMREAD_UNCHANGED);
-	if (raw.empty())
-		throw std::runtime_error(depthPath + ": cannot read depth image");
-	if (raw.type() != CV_16UC1)
-		throw std::runtime_error(depthPath +
-		                         ": depth must be a 16-bit single-channel PNG");
+	const cv::Mat raw = readDepthPng(depthPath);
 	if (raw.cols != cam.width || raw.rows != cam.height)
 		throw std::runtime_error(
 		    depthPath + ": depth image is " + std::to_string(raw.cols) + "x" +
 		    std::to_string(raw.rows) + " but [camera] says " +
 		    std::to_string(cam.width) + "x" + std::to_string(cam.height));
-
-	auto o = CObservation3DRangeScan::Create();
-	o->sensorLabel = params.rgbdLabel;
-	o->timestamp = mrpt::Clock::fromDouble(t);
-	o->sensorPose = mrpt::poses::CPose3D();
-	o->hasRangeImage = true;
-	o->range_is_depth = true;
-	o->rangeUnits = static_cast<float>(params.rangeUnits);
-	o->maxRange = static_cast<float>(65535 * params.rangeUnits);
-	o->stdError = 0.01f;
-	o->rangeImage_setSize(cam.height, cam.width);
-	const double k = 1.0 / (cam.depthScale * params.rangeUnits);
-	for (int v = 0; v < cam.height; v++)
-	{
-		const uint16_t* r = raw.ptr<uint16_t>(v);
-		for (int u = 0; u < cam.width; u++)
-		{
-			const double units = std::round(r[u] * k);
-			o->rangeImage(v, u) =
-			    units > 65535 ? 0 : static_cast<uint16_t>(units);
-		}
-	}
-	o->cameraParams = cam.asTCamera();
-	o->cameraParamsIntensity = o->cameraParams;
-	return o;
+	return depthObservation(raw, 1.0 / cam.depthScale, cam.asTCamera(),
+	                        params.rgbdLabel, t, params.rangeUnits);
 }
 
 mrpt::obs::CObservation3DRangeScan::Ptr loadFrame(const TumFrame& frame,
@@ -75,11 +48,7 @@ mrpt::obs::CObservation3DRangeScan::Ptr loadFrame(const TumFrame& frame,
 		    frame.rgbPath + ": colour image is " + std::to_string(rgb.cols) +
 		    "x" + std::to_string(rgb.rows) + " but [camera] says " +
 		    std::to_string(cam.width) + "x" + std::to_string(cam.height));
-	o->relativePoseIntensityWRTDepth =
-	    mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
-	o->hasIntensityImage = true;
-	o->intensityImageChannel = CObservation3DRangeScan::CH_VISIBLE;
-	o->intensityImage = mrpt::img::CImage(rgb, mrpt::img::DEEP_COPY);
+	attachColour(*o, rgb);
 	return o;
 }
 

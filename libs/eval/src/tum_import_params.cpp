@@ -1,5 +1,6 @@
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
+#include <bims/eval/rgbd_frame.h>
 #include <bims/eval/tum_import.h>
 
 namespace bims::eval
@@ -48,17 +49,7 @@ void ImportParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg)
 	rangeUnits = im.getDouble("range_units", rangeUnits, 1e-6, 0.1);
 	im.finish();
 
-	ConfigSection se(cfg, "sensors");
-	// Empty means "any label" to the readers of a rawlog; the importer
-	// then writes the default label.
-	const std::string r = se.getString("rgbd_label", rgbdLabel);
-	const std::string i = se.getString("imu_label", imuLabel);
-	// Informative keys of bims-sim's OUT_gt/calibration.ini.
-	se.allow("rgbd_rate_hz");
-	se.allow("imu_rate_hz");
-	if (!r.empty()) rgbdLabel = r;
-	if (!i.empty()) imuLabel = i;
-	se.finish();
+	loadImportLabels(cfg, rgbdLabel, imuLabel);
 }
 
 }  // namespace bims::eval

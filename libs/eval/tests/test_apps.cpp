@@ -455,9 +455,9 @@ TEST(Apps, HelpExitsCleanlyAndBadOptionsAreUsageErrors)
 	// exiting: no program may go on with empty arguments after them.
 	for (const std::string app :
 	     {"bims-run", "bims-odom", "bims-sim", "bims-import-tum",
-	      "bims-flow-check", "bims-flow-labels", "bims-calib-imu",
-	      "bims-calib-depth", "bims-info", "bims-maps-figure", "bims-grab",
-	      "bims-sweep", "bims-eval masks", "bims-eval traj",
+	      "bims-import-stray", "bims-flow-check", "bims-flow-labels",
+	      "bims-calib-imu", "bims-calib-depth", "bims-info", "bims-maps-figure",
+	      "bims-grab", "bims-sweep", "bims-eval masks", "bims-eval traj",
 	      "bims-eval depth-consistency"})
 	{
 		if (!fs::exists(kBin + "/" + app.substr(0, app.find(' '))))
@@ -573,7 +573,11 @@ TEST(Apps, NoProgramWritesOverItsInput)
 	      "bims-eval traj " + d + "/gt.txt " + d + "/gt.txt --json " + d +
 	          "/gt.txt",
 	      "bims-sim " + cfg + " -o " + cfg,
-	      "bims-import-tum " + d + " -o " + d + "/../aliases"})
+	      "bims-import-tum " + d + " -o " + d + "/../aliases",
+	      "bims-import-stray " + d + " -o " + d + "/../aliases",
+	      "bims-import-stray " + d + " -o " + cfg + " -c " + cfg,
+	      "bims-import-stray " + d + " -o " + d + "/x.rawlog -c " + d +
+	          "/x_arkit_reference.txt"})
 	{
 		const ::Run r = run(kBin + "/" + args);
 		EXPECT_EQ(r.code, 2) << args << "\n" << r.out;

@@ -128,8 +128,9 @@ std::string configReference()
 	    "`config/paper.ini`\nis the paper's literal model. An absent key "
 	    "keeps its default, an unknown key\nor a value out of range is an "
 	    "error naming the file, the section and the key.\n"
-	    "`[import]` (read by `bims-import-tum` only) and MRPT map "
-	    "definitions (`[map...]`)\nare not listed.\n";
+	    "`[import]` and `[import_stray]` (read by `bims-import-tum` and "
+	    "`bims-import-stray` only,\n`docs/eval.md`) and MRPT map "
+	    "definitions (`[map...]`) are not listed.\n";
 	const ExperimentConfig defaults;
 	forEachSection(defaults,
 	               [&](const char* section, const char* title, const auto& opts)
@@ -171,8 +172,9 @@ void ExperimentConfig::loadFromConfigFile(
 	grids.loadFromConfigFile(cfg, "grids");
 	pipeline.loadFromConfigFile(cfg, "pipeline");
 	output.loadFromConfigFile(cfg, "output");
-	// import settings live in the same file (config/bonn.ini) but are
-	// read by bims-import-tum only.
+	// import settings live in the same file (config/bonn.ini,
+	// config/stray.ini) but are read by bims-import-tum and
+	// bims-import-stray only.
 	if (pipeline.variant == Variant::FusedRaycast) setVariant(pipeline.variant);
 }
 

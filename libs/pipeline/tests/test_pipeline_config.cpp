@@ -92,6 +92,7 @@ TEST(PipelineConfig, EffectiveIniReadBackIsTheSameConfiguration)
 	    {"default.ini", loaded("default.ini")},
 	    {"paper.ini", loaded("paper.ini")},
 	    {"bonn.ini", loaded("bonn.ini")},
+	    {"stray.ini", loaded("stray.ini")},
 	    {"default.ini --variant fused-raycast", raycast}};
 	for (const auto& [name, c] : cases)
 	{
@@ -118,15 +119,32 @@ TEST(PipelineConfig, EffectiveIniReadBackIsTheSameConfiguration)
 	          tilted.ego.calibration.R_IC);
 }
 
+TEST(PipelineConfig, TheStrayPresetGivesTheIphoneImuMounting)
+{
+	// config/stray.ini (bims-import-stray's [import_stray] aside, which
+	// bims-run accepts unread): R_IC = R_CI^T of the data's README, the
+	// clock offset, no magnetometer, the importer's labels
+	const ExperimentConfig s = loaded("stray.ini");
+	Eigen::Matrix3d R;
+	R << 0, -1, 0, -1, 0, 0, 0, 0, -1;
+	EXPECT_EQ(s.ego.calibration.R_IC, R);
+	EXPECT_TRUE(s.ego.calibration.has_R_IC);
+	EXPECT_EQ(s.ego.calibration.time_offset_s, -0.005);
+	EXPECT_FALSE(s.ego.attitude.use_magnetometer);
+	EXPECT_EQ(s.ego.sensors.rgbd_label, "RGBD");
+	EXPECT_EQ(s.ego.sensors.imu_label, "IMU");
+	EXPECT_FALSE(s.ego.camera.given);  // each scan's own intrinsics
+}
+
 TEST(PipelineConfig, EffectiveIniHasEverySectionAndAMeaningPerKey)
 {
 	const std::string text = ExperimentConfig().effectiveIni();
 	mrpt::config::CConfigFileMemory m(text);
 	std::vector<std::string> sections;
 	m.getAllSections(sections);
-	// all but [camera] (only when a file gives intrinsics) and [import]
-	// (bims-import-tum's)
-	EXPECT_EQ(sections.size(), bims::experimentSections().size() - 2);
+	// all but [camera] (only when a file gives intrinsics), [import]
+	// (bims-import-tum's) and [import_stray] (bims-import-stray's)
+	EXPECT_EQ(sections.size(), bims::experimentSections().size() - 3);
 	for (const char* s : {"sensors", "calibration", "depth_correction",
 	                      "attitude", "tracker", "translation", "odometry",
 	                      "anchor", "flow", "grids", "pipeline", "output"})

@@ -1,0 +1,38 @@
+// bims-import-stray's run (docs/eval.md): the options checked, the
+// experiment .ini read, the import (importStray) and its report on stdout.
+// The program's main only reads its command line into
+// StrayImportRunOptions and calls runStrayImport.
+#pragma once
+
+#include <bims/eval/stray_import.h>
+
+#include <optional>
+#include <string>
+
+namespace bims::eval
+{
+/** What bims-import-stray's command line gives (nullopt: not given). */
+struct StrayImportRunOptions
+{
+	std::string folder;                 ///< the Stray Scanner capture
+	std::string out;                    ///< output rawlog
+	std::optional<std::string> config;  ///< experiment .ini
+	size_t max_frames = 0;              ///< only the first N frames (0: all)
+	int gz = 1;                         ///< gzip level of the rawlog (0: plain)
+	bool progress = true;               ///< progress line on stderr
+};
+
+/** The lines bims-import-stray prints on stdout after importing into
+ * \a out: frames (size, colour or not), IMU samples, the confidence
+ * threshold and the share of depth readings it dropped, the reference
+ * trajectory's poses and the frames left out of it. */
+std::string strayImportReport(const std::string& out,
+                              const StrayImportSummary& sum);
+
+/** bims-import-stray: checks the options (UsageError; no output may be an
+ * input), reads the config (a note on stderr without one), imports and
+ * prints strayImportReport. Returns the program's exit code (0); errors
+ * are thrown. */
+int runStrayImport(const StrayImportRunOptions& o);
+
+}  // namespace bims::eval

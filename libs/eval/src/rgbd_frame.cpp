@@ -1,0 +1,95 @@
+#include <bims/common/config.h>
+#include <bims/eval/rgbd_frame.h>
+#include <mrpt/core/Clock.h>
+
+#include <cmath>
+#include <opencv2/imgcodecs.hpp>
+#include <stdexcept>
+
+namespace bims::eval
+{
+using mrpt::obs::CObservation3DRangeScan;
+
+cv::Mat readDepthPng(const std::string& path)
+{
+	cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
+	if (raw.empty())
+		throw std::runtime_error(path + ": cannot read depth image");
+	if (raw.type() != CV_16UC1)
+		throw std::runtime_error(path +
+		                         ": depth must be a 16-bit single-channel PNG");
+	return raw;
+}
+
+CObservation3DRangeScan::Ptr depthObservation(const cv::Mat& depth,
+                                              double metresPerUnit,
+                                              const mrpt::img::TCamera& camera,
+                                              const std::string& label,
+                                              double t, double rangeUnits)
+{
+	const int W = static_cast<int>(camera.ncols),
+	          H = static_cast<int>(camera.nrows);
+	if (depth.type() != CV_16UC1 || depth.cols != W || depth.rows != H)
+		throw std::invalid_argument(
+		    "depthObservation: a CV_16UC1 image of the camera's size " +
+		    std::to_string(W) + "x" + std::to_string(H) + " expected");
+	auto o = CObservation3DRangeScan::Create();
+	o->sensorLabel = label;
+	o->timestamp = mrpt::Clock::fromDouble(t);
+	o->sensorPose = mrpt::poses::CPose3D();
+	o->hasRangeImage = true;
+	o->range_is_depth = true;
+	o->rangeUnits = static_cast<float>(rangeUnits);
+	o->maxRange = static_cast<float>(65535 * rangeUnits);
+	o->stdError = 0.01f;
+	o->rangeImage_setSize(H, W);
+	const double k = metresPerUnit / rangeUnits;
+	for (int v = 0; v < H; v++)
+	{
+		const uint16_t* r = depth.ptr<uint16_t>(v);
+		for (int u = 0; u < W; u++)
+		{
+			const double units = std::round(r[u] * k);
+			o->rangeImage(v, u) =
+			    units > 65535 ? 0 : static_cast<uint16_t>(units);
+		}
+	}
+	o->cameraParams = camera;
+	o->cameraParamsIntensity = camera;
+	return o;
+}
+
+void attachColour(CObservation3DRangeScan& obs, const cv::Mat& bgr)
+{
+	if (bgr.type() != CV_8UC3 ||
+	    bgr.cols != static_cast<int>(obs.rangeImage.cols()) ||
+	    bgr.rows != static_cast<int>(obs.rangeImage.rows()))
+		throw std::invalid_argument(
+		    "attachColour: an 8-bit BGR image of the depth image's size "
+		    "expected");
+	// the intensity camera is the depth camera (registered RGB-D): the pose
+	// only turns MRPT's 3D-scan axes into the optical axes
+	obs.relativePoseIntensityWRTDepth =
+	    mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+	obs.hasIntensityImage = true;
+	obs.intensityImageChannel = CObservation3DRangeScan::CH_VISIBLE;
+	obs.intensityImage = mrpt::img::CImage(bgr, mrpt::img::DEEP_COPY);
+}
+
+void loadImportLabels(const mrpt::config::CConfigFileBase& cfg,
+                      std::string& rgbdLabel, std::string& imuLabel)
+{
+	ConfigSection se(cfg, "sensors");
+	// Empty means "any label" to the readers of a rawlog; the importer
+	// then writes the label given.
+	const std::string r = se.getString("rgbd_label", rgbdLabel);
+	const std::string i = se.getString("imu_label", imuLabel);
+	// Informative keys of bims-sim's OUT_gt/calibration.ini.
+	se.allow("rgbd_rate_hz");
+	se.allow("imu_rate_hz");
+	if (!r.empty()) rgbdLabel = r;
+	if (!i.empty()) imuLabel = i;
+	se.finish();
+}
+
+}  // namespace bims::eval

@@ -1,0 +1,332 @@
+// Reading a Stray Scanner capture's files: odometry.csv, imu.csv,
+// camera_matrix.csv and the depth/ listing (stray_import.h).
+#include <bims/eval/stray_import.h>
+#include <mrpt/poses/CPose3DQuat.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+namespace bims::eval
+{
+namespace fs = std::filesystem;
+
+namespace
+{
+std::string trim(const std::string& s)
+{
+	const auto a = s.find_first_not_of(" \t\r\n");
+	if (a == std::string::npos) return {};
+	const auto b = s.find_last_not_of(" \t\r\n");
+	return s.substr(a, b - a + 1);
+}
+
+/** The comma-separated fields of \a line, each trimmed. */
+std::vector<std::string> fields(const std::string& line)
+{
+	std::vector<std::string> out;
+	std::string cell;
+	std::istringstream ss(line);
+	while (std::getline(ss, cell, ',')) out.push_back(trim(cell));
+	if (!line.empty() && line.back() == ',') out.push_back("");
+	return out;
+}
+
+std::string joined(const std::vector<std::string>& names)
+{
+	std::string s;
+	for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+	return s;
+}
+
+std::runtime_error rowError(const std::string& path, size_t line,
+                            const std::string& what)
+{
+	return std::runtime_error(path + ":" + std::to_string(line) + ": " + what);
+}
+
+/** A CSV of a header line \a names and rows of as many finite numbers, time
+ * (the first column) strictly increasing: each row and its line. */
+struct CsvRow
+{
+	size_t line;
+	std::vector<double> v;
+	std::vector<std::string> text;
+};
+
+std::vector<CsvRow> readNumericCsv(const std::string& path,
+                                   const std::vector<std::string>& names)
+{
+	std::ifstream f(path);
+	if (!f) throw std::runtime_error(path + ": cannot open");
+	std::string line;
+	size_t n = 0;
+	// the header: the columns' names in this order (the meaning and the
+	// sign of every column below depend on it)
+	while (std::getline(f, line))
+	{
+		n++;
+		if (!trim(line).empty()) break;
+	}
+	if (fields(line) != names)
+		throw rowError(path, n,
+		               "expected the header '" + joined(names) + "', got '" +
+		                   trim(line) + "'");
+	std::vector<CsvRow> rows;
+	while (std::getline(f, line))
+	{
+		n++;
+		if (trim(line).empty()) continue;
+		CsvRow r{n, {}, fields(line)};
+		if (r.text.size() != names.size())
+			throw rowError(path, n,
+			               "expected " + std::to_string(names.size()) +
+			                   " comma-separated values (" + joined(names) +
+			                   "), got " + std::to_string(r.text.size()) +
+			                   " (a truncated row?)");
+		for (size_t i = 0; i < names.size(); i++)
+		{
+			const std::string& s = r.text[i];
+			char* end = nullptr;
+			errno = 0;
+			const double x = std::strtod(s.c_str(), &end);
+			if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE ||
+			    !std::isfinite(x))
+				throw rowError(
+				    path, n, names[i] + " '" + s + "' is not a finite number");
+			r.v.push_back(x);
+		}
+		if (!rows.empty() && !(r.v[0] > rows.back().v[0]))
+		{
+			char b[160];
+			std::snprintf(b, sizeof(b),
+			              "timestamp %.9f is not after the previous row's "
+			              "%.9f (time must increase)",
+			              r.v[0], rows.back().v[0]);
+			throw rowError(path, n, b);
+		}
+		rows.push_back(std::move(r));
+	}
+	if (rows.empty()) throw std::runtime_error(path + ": no rows");
+	return rows;
+}
+
+/** "000123" -> 123; -1 when not all digits. */
+long frameNumber(const std::string& s)
+{
+	if (s.empty() || s.size() > 9) return -1;
+	for (char c : s)
+		if (c < '0' || c > '9') return -1;
+	return std::stol(s);
+}
+}  // namespace
+
+mrpt::poses::CPose3D StrayFrame::pose() const
+{
+	const double n =
+	    std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+	const mrpt::math::CQuaternionDouble qq(q[3] / n, q[0] / n, q[1] / n,
+	                                       q[2] / n);
+	return mrpt::poses::CPose3D(mrpt::poses::CPose3DQuat(p[0], p[1], p[2], qq));
+}
+
+std::vector<StrayFrame> readStrayOdometry(const std::string& path)
+{
+	const auto rows = readNumericCsv(
+	    path, {"timestamp", "frame", "x", "y", "z", "qx", "qy", "qz", "qw"});
+	std::vector<StrayFrame> out;
+	std::map<long, size_t> lineOf;
+	for (const auto& r : rows)
+	{
+		StrayFrame f;
+		f.t = r.v[0];
+		f.line = r.line;
+		f.index = frameNumber(r.text[1]);
+		if (f.index < 0)
+			throw rowError(
+			    path, r.line,
+			    "frame '" + r.text[1] + "' is not a frame number (digits)");
+		if (const auto it = lineOf.find(f.index); it != lineOf.end())
+			throw rowError(path, r.line,
+			               "frame " + r.text[1] + " is given twice (line " +
+			                   std::to_string(it->second) + ")");
+		lineOf[f.index] = r.line;
+		for (int i = 0; i < 3; i++) f.p[i] = r.v[2 + i];
+		for (int i = 0; i < 4; i++) f.q[i] = r.v[5 + i];
+		const double qn = std::sqrt(f.q[0] * f.q[0] + f.q[1] * f.q[1] +
+		                            f.q[2] * f.q[2] + f.q[3] * f.q[3]);
+		if (std::abs(qn - 1.0) > 1e-3)
+			throw rowError(path, r.line,
+			               "quaternion qx qy qz qw is not unit (norm " +
+			                   std::to_string(qn) + ")");
+		out.push_back(f);
+	}
+	return out;
+}
+
+std::vector<StrayImuSample> readStrayImu(const std::string& path)
+{
+	const auto rows = readNumericCsv(path, {"timestamp", "a_x", "a_y", "a_z",
+	                                        "alpha_x", "alpha_y", "alpha_z"});
+	std::vector<StrayImuSample> out;
+	out.reserve(rows.size());
+	for (const auto& r : rows)
+	{
+		StrayImuSample s;
+		s.t = r.v[0];
+		for (int i = 0; i < 3; i++)
+		{
+			s.a[i] = r.v[1 + i];
+			s.alpha[i] = r.v[4 + i];
+		}
+		out.push_back(s);
+	}
+	return out;
+}
+
+void readStrayCameraMatrix(const std::string& path, double K[3][3])
+{
+	std::ifstream f(path);
+	if (!f) throw std::runtime_error(path + ": cannot open");
+	std::string line;
+	size_t n = 0, row = 0;
+	while (std::getline(f, line))
+	{
+		n++;
+		if (trim(line).empty()) continue;
+		if (row == 3)
+			throw rowError(path, n, "a 4th row: expected a 3x3 matrix");
+		const auto cells = fields(line);
+		if (cells.size() != 3)
+			throw rowError(path, n,
+			               "expected 3 comma-separated numbers, got " +
+			                   std::to_string(cells.size()));
+		for (int i = 0; i < 3; i++)
+		{
+			char* end = nullptr;
+			const double x = std::strtod(cells[i].c_str(), &end);
+			if (cells[i].empty() || end != cells[i].c_str() + cells[i].size() ||
+			    !std::isfinite(x))
+				throw rowError(path, n,
+				               "'" + cells[i] + "' is not a finite number");
+			K[row][i] = x;
+		}
+		const bool ok = row == 0 ? K[0][0] > 0 && K[0][1] == 0
+		                : row == 1
+		                    ? K[1][0] == 0 && K[1][1] > 0
+		                    : K[2][0] == 0 && K[2][1] == 0 && K[2][2] == 1;
+		if (!ok)
+			throw rowError(path, n,
+			               row == 0
+			                   ? "expected 'fx, 0, cx' with fx > 0 (no skew)"
+			               : row == 1 ? "expected '0, fy, cy' with fy > 0"
+			                          : "expected '0, 0, 1'");
+		row++;
+	}
+	if (row != 3)
+		throw std::runtime_error(path + ": " + std::to_string(row) +
+		                         " rows, expected 3 (a 3x3 camera matrix)");
+}
+
+StrayCapture readStrayCapture(const std::string& folder)
+{
+	const fs::path dir(folder);
+	if (!fs::is_directory(dir))
+		throw std::runtime_error(folder + ": not a directory");
+	StrayCapture c;
+	c.path = folder;
+	const std::string odometry = (dir / "odometry.csv").string();
+	if (!fs::exists(odometry))
+		throw std::runtime_error(odometry +
+		                         ": not found (the frames' poses and clock; "
+		                         "is this a Stray Scanner capture?)");
+	c.frames = readStrayOdometry(odometry);
+
+	// depth/NNNNNN.png: exactly the frames of odometry.csv
+	const fs::path depthDir = dir / "depth";
+	if (!fs::is_directory(depthDir))
+		throw std::runtime_error(depthDir.string() +
+		                         ": not a directory (the depth images)");
+	std::map<long, std::string> depthOf;
+	for (const auto& e : fs::directory_iterator(depthDir))
+	{
+		if (e.path().extension() != ".png") continue;
+		const long k = frameNumber(e.path().stem().string());
+		if (k < 0)
+			throw std::runtime_error(
+			    e.path().string() +
+			    ": not named as a frame (NNNNNN.png, the frame column of "
+			    "odometry.csv)");
+		depthOf[k] = e.path().string();
+	}
+	c.hasConfidence = fs::is_directory(dir / "confidence");
+	for (auto& f : c.frames)
+	{
+		const auto it = depthOf.find(f.index);
+		if (it == depthOf.end())
+		{
+			char name[32];
+			std::snprintf(name, sizeof(name), "%06ld.png", f.index);
+			throw std::runtime_error(odometry + ":" + std::to_string(f.line) +
+			                         ": frame " + std::to_string(f.index) +
+			                         " has no depth image (" +
+			                         (depthDir / name).string() + ")");
+		}
+		f.depthPath = it->second;
+		if (c.hasConfidence)
+			f.confidencePath =
+			    (dir / "confidence" / fs::path(it->second).filename()).string();
+		depthOf.erase(it);
+	}
+	if (!depthOf.empty())
+		throw std::runtime_error(depthOf.begin()->second + ": frame " +
+		                         std::to_string(depthOf.begin()->first) +
+		                         " has no row in " + odometry);
+
+	readStrayCameraMatrix((dir / "camera_matrix.csv").string(), c.K);
+
+	const std::string imu = (dir / "imu.csv").string();
+	c.hasImu = fs::exists(imu);
+	if (c.hasImu)
+		c.imu = readStrayImu(imu);
+	else
+		std::fprintf(stderr,
+		             "bims-import-stray: warning: %s: not found: depth only, "
+		             "no IMU observations\n",
+		             imu.c_str());
+	if (!c.hasConfidence)
+		std::fprintf(stderr,
+		             "bims-import-stray: warning: %s: not found: every depth "
+		             "reading kept (no ARKit confidence to filter by)\n",
+		             (dir / "confidence").string().c_str());
+	if (fs::exists(dir / "rgb.mp4"))
+		c.videoPath = (dir / "rgb.mp4").string();
+	else
+		std::fprintf(stderr,
+		             "bims-import-stray: note: %s: not found: depth and IMU "
+		             "only, the scans have no colour image\n",
+		             (dir / "rgb.mp4").string().c_str());
+	return c;
+}
+
+mrpt::img::TCamera strayDepthCamera(const double K[3][3], int colourWidth,
+                                    int colourHeight, int width, int height)
+{
+	const double sx = static_cast<double>(width) / colourWidth,
+	             sy = static_cast<double>(height) / colourHeight;
+	mrpt::img::TCamera c;
+	c.ncols = static_cast<uint32_t>(width);
+	c.nrows = static_cast<uint32_t>(height);
+	c.setIntrinsicParamsFromValues(K[0][0] * sx, K[1][1] * sy, K[0][2] * sx,
+	                               K[1][2] * sy);
+	c.distortion = mrpt::img::DistortionModel::none;
+	return c;
+}
+
+}  // namespace bims::eval

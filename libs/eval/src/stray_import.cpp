@@ -1,0 +1,267 @@
+#include <bims/common/output_paths.h>
+#include <bims/common/progress.h>
+#include <bims/common/rawlog.h>
+#include <bims/eval/rgbd_frame.h>
+#include <bims/eval/stray_import.h>
+#include <bims/eval/tum_import.h>
+#include <mrpt/core/Clock.h>
+#include <mrpt/obs/CObservationIMU.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <stdexcept>
+
+namespace bims::eval
+{
+namespace
+{
+std::string sizeText(int w, int h)
+{
+	return std::to_string(w) + "x" + std::to_string(h);
+}
+
+/** The number of frames of an opened video: the container's count, or
+ * the frames decoded when it gives none (the video is reopened). */
+size_t videoFrameCount(cv::VideoCapture& video, const std::string& path)
+{
+	const double n = video.get(cv::CAP_PROP_FRAME_COUNT);
+	if (n > 0) return static_cast<size_t>(std::llround(n));
+	size_t count = 0;
+	while (video.grab()) count++;
+	video.release();
+	if (!video.open(path))
+		throw std::runtime_error(path + ": cannot open the video again");
+	return count;
+}
+
+/** The IMU sample as the rawlog's observation: specific force -a (Apple's
+ * accelerometer points down at rest; a specific force points up), the
+ * gyro as is; no magnetometer, no orientation. */
+mrpt::obs::CObservationIMU::Ptr imuObservation(const StrayImuSample& s,
+                                               const std::string& label)
+{
+	auto m = mrpt::obs::CObservationIMU::Create();
+	m->sensorLabel = label;
+	m->timestamp = mrpt::Clock::fromDouble(s.t);
+	m->set(mrpt::obs::IMU_X_ACC, -s.a[0]);
+	m->set(mrpt::obs::IMU_Y_ACC, -s.a[1]);
+	m->set(mrpt::obs::IMU_Z_ACC, -s.a[2]);
+	m->set(mrpt::obs::IMU_WX, s.alpha[0]);
+	m->set(mrpt::obs::IMU_WY, s.alpha[1]);
+	m->set(mrpt::obs::IMU_WZ, s.alpha[2]);
+	return m;
+}
+}  // namespace
+
+std::string strayReferencePathFor(const std::string& rawlogPath)
+{
+	// groundTruthDirFor's "OUT_gt" without its suffix: OUT
+	std::string base = groundTruthDirFor(rawlogPath);
+	base.resize(base.size() - 3);
+	return base + "_arkit_reference.txt";
+}
+
+StrayImportSummary importStray(const std::string& folder,
+                               const std::string& outRawlog,
+                               const StrayImportParams& params,
+                               const StrayImportOptions& options)
+{
+	const StrayCapture cap = readStrayCapture(folder);
+	std::vector<StrayFrame> frames = cap.frames;
+	if (options.maxFrames > 0 && frames.size() > options.maxFrames)
+		frames.resize(options.maxFrames);
+
+	StrayImportSummary sum;
+	sum.confidence = cap.hasConfidence;
+	sum.minConfidence = params.min_confidence;
+	// the depth grid: the first image's size, every image's
+	const std::string firstDepth = frames.front().depthPath;
+	{
+		const cv::Mat d = readDepthPng(firstDepth);
+		sum.width = d.cols;
+		sum.height = d.rows;
+	}
+
+	// rgb.mp4: frame k of the video is the k-th depth frame (all of them:
+	// the count is checked before --max-frames)
+	cv::VideoCapture video;
+	int colourW = params.colour_width, colourH = params.colour_height;
+	if (!cap.videoPath.empty())
+	{
+		const std::string& vp = cap.videoPath;
+		if (!video.open(vp))
+			throw std::runtime_error(
+			    vp + ": cannot open the video (OpenCV's video I/O)");
+		sum.colour = true;
+		sum.videoWidth = static_cast<int>(video.get(cv::CAP_PROP_FRAME_WIDTH));
+		sum.videoHeight =
+		    static_cast<int>(video.get(cv::CAP_PROP_FRAME_HEIGHT));
+		const size_t n = videoFrameCount(video, vp);
+		if (n != cap.frames.size())
+			throw std::runtime_error(
+			    vp + ": " + std::to_string(n) +
+			    " video frames, but the capture has " +
+			    std::to_string(cap.frames.size()) +
+			    " depth frames (odometry.csv); video frame k must be depth "
+			    "frame k");
+		for (size_t k = 0; k < cap.frames.size(); k++)
+			if (cap.frames[k].index != static_cast<long>(k))
+				throw std::runtime_error(
+				    folder +
+				    "/odometry.csv:" + std::to_string(cap.frames[k].line) +
+				    ": frame " + std::to_string(cap.frames[k].index) +
+				    " is row " + std::to_string(k + 1) +
+				    ": with rgb.mp4 the frames must be 0, 1, 2, ... (video "
+				    "frame k is depth frame k)");
+		// the same field of view: the aspect ratios agree (to 1 %)
+		const double a = double(sum.videoWidth) * sum.height,
+		             b = double(sum.videoHeight) * sum.width;
+		if (!(sum.videoWidth > 0 && sum.videoHeight > 0) ||
+		    std::abs(a - b) > 0.01 * std::max(a, b))
+			throw std::runtime_error(
+			    vp + ": video frames are " +
+			    sizeText(sum.videoWidth, sum.videoHeight) +
+			    ", not of the depth images' aspect ratio (" +
+			    sizeText(sum.width, sum.height) + ", " + firstDepth + ")");
+		colourW = sum.videoWidth;
+		colourH = sum.videoHeight;
+	}
+	sum.camera =
+	    strayDepthCamera(cap.K, colourW, colourH, sum.width, sum.height);
+
+	// Frames and IMU by time: (t, kind, index); kind 0 = IMU first at equal
+	// stamps. IMU from the start of the file (the attitude filter wants
+	// those before the first frame) up to the last frame written.
+	struct Item
+	{
+		double t;
+		int kind;  // 0 IMU, 1 frame
+		size_t i;
+	};
+	const double t0 = frames.front().t, t1 = frames.back().t;
+	std::vector<Item> items;
+	for (size_t i = 0; i < cap.imu.size() && cap.imu[i].t <= t1; i++)
+	{
+		items.push_back({cap.imu[i].t, 0, i});
+		sum.imuBeforeFirst += cap.imu[i].t < t0;
+	}
+	for (size_t i = 0; i < frames.size(); i++)
+		items.push_back({frames[i].t, 1, i});
+	std::stable_sort(items.begin(), items.end(),
+	                 [](const Item& a, const Item& b)
+	                 { return a.t < b.t || (a.t == b.t && a.kind < b.kind); });
+
+	// OUT.rawlog.partial until complete
+	PartialFile part(outRawlog);
+	RawlogWriter w(part.path(), options.gzLevel);
+	ProgressBar bar("bims-import-stray", frames.size(), options.progress);
+	cv::Mat bgr, small;
+	for (const auto& it : items)
+	{
+		if (it.kind == 0)
+		{
+			w.write(*imuObservation(cap.imu[it.i], params.imu_label));
+			sum.imu++;
+			continue;
+		}
+		const StrayFrame& f = frames[it.i];
+		cv::Mat depth = readDepthPng(f.depthPath);
+		if (depth.cols != sum.width || depth.rows != sum.height)
+			throw std::runtime_error(f.depthPath + ": depth image is " +
+			                         sizeText(depth.cols, depth.rows) +
+			                         " but the first (" + firstDepth + ") is " +
+			                         sizeText(sum.width, sum.height));
+		cv::Mat conf;
+		if (cap.hasConfidence)
+		{
+			conf = cv::imread(f.confidencePath, cv::IMREAD_UNCHANGED);
+			if (conf.empty())
+				throw std::runtime_error(f.confidencePath +
+				                         ": cannot read confidence image");
+			if (conf.type() != CV_8UC1)
+				throw std::runtime_error(
+				    f.confidencePath +
+				    ": confidence must be an 8-bit single-channel PNG");
+			if (conf.cols != sum.width || conf.rows != sum.height)
+				throw std::runtime_error(
+				    f.confidencePath + ": confidence image is " +
+				    sizeText(conf.cols, conf.rows) + " but its depth image (" +
+				    f.depthPath + ") is " + sizeText(sum.width, sum.height));
+		}
+		for (int v = 0; v < depth.rows; v++)
+		{
+			uint16_t* d = depth.ptr<uint16_t>(v);
+			const uint8_t* c = conf.empty() ? nullptr : conf.ptr<uint8_t>(v);
+			for (int u = 0; u < depth.cols; u++)
+			{
+				if (d[u] == 0) continue;
+				sum.readings++;
+				if (c && c[u] < params.min_confidence)
+				{
+					d[u] = 0;
+					sum.dropped++;
+				}
+			}
+		}
+		auto o = depthObservation(depth, kStrayRangeUnits, sum.camera,
+		                          params.rgbd_label, f.t, kStrayRangeUnits);
+		if (sum.colour)
+		{
+			if (!video.read(bgr) || bgr.empty())
+				throw std::runtime_error(
+				    cap.videoPath + ": ends after " + std::to_string(it.i) +
+				    " frames, but the capture has " +
+				    std::to_string(cap.frames.size()) + " depth frames");
+			if (bgr.cols != sum.videoWidth || bgr.rows != sum.videoHeight ||
+			    bgr.type() != CV_8UC3)
+				throw std::runtime_error(
+				    cap.videoPath + ": frame " + std::to_string(it.i) + " is " +
+				    sizeText(bgr.cols, bgr.rows) + ", the first " +
+				    sizeText(sum.videoWidth, sum.videoHeight));
+			// the colour down to the depth grid: ARKit registers the depth
+			// to this camera, so the grid stays registered RGB-D at the
+			// LiDAR's own resolution
+			cv::resize(bgr, small, cv::Size(sum.width, sum.height), 0, 0,
+			           cv::INTER_AREA);
+			attachColour(*o, small);
+		}
+		w.write(*o);
+		bar.update(++sum.frames);
+	}
+	// all of the video read: nothing may be left (a container that
+	// counted its frames wrong)
+	if (sum.colour && frames.size() == cap.frames.size() && video.grab())
+		throw std::runtime_error(
+		    cap.videoPath + ": more than " + std::to_string(cap.frames.size()) +
+		    " video frames, but the capture has " +
+		    std::to_string(cap.frames.size()) + " depth frames");
+	w.close();
+	part.commit();
+	bar.finish();
+
+	// ARKit's poses at the written frames, from the first with a position
+	sum.referencePath = strayReferencePathFor(outRawlog);
+	size_t k = 0;
+	while (k < frames.size() && frames[k].p[0] == 0 && frames[k].p[1] == 0 &&
+	       frames[k].p[2] == 0)
+		k++;
+	sum.referenceLeftOut = k;
+	for (; k < frames.size(); k++)
+		sum.reference.push_back({frames[k].t, frames[k].pose()});
+	sum.referencePoses = sum.reference.size();
+	saveTumTrajectory(
+	    sum.referencePath, sum.reference,
+	    "ARKit's visual-inertial estimate, NOT ground truth: a reference. "
+	    "T_WC of the camera optical frame (x right, y down, z forward) in "
+	    "ARKit's world (y up) at each 3D scan's stamp, from " +
+	        folder + "/odometry.csv; the first " +
+	        std::to_string(sum.referenceLeftOut) +
+	        " frames (translation exactly 0: ARKit initialising) left out");
+	return sum;
+}
+
+}  // namespace bims::eval

@@ -1,0 +1,81 @@
+#include <bims/common/app.h>
+#include <bims/common/config.h>
+#include <bims/common/output_paths.h>
+#include <bims/eval/stray_import_run.h>
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/core/format.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <stdexcept>
+
+namespace bims::eval
+{
+std::string strayImportReport(const std::string& out,
+                              const StrayImportSummary& sum)
+{
+	std::string r = mrpt::format(
+	    "%s: %zu RGB-D frames of %dx%d (%s), %zu IMU observations (%zu before "
+	    "the first frame)\n",
+	    out.c_str(), sum.frames, sum.width, sum.height,
+	    sum.colour ? mrpt::format("colour from rgb.mp4, %dx%d resized",
+	                              sum.videoWidth, sum.videoHeight)
+	                     .c_str()
+	               : "no colour: no rgb.mp4",
+	    sum.imu, sum.imuBeforeFirst);
+	r += mrpt::format(
+	    "intrinsics of the depth grid: fx %.4f fy %.4f cx %.4f "
+	    "cy %.4f\n",
+	    sum.camera.fx(), sum.camera.fy(), sum.camera.cx(), sum.camera.cy());
+	if (sum.confidence)
+		r += mrpt::format(
+		    "confidence >= %d kept: %llu of %llu depth readings dropped "
+		    "(%.1f %%)\n",
+		    sum.minConfidence, static_cast<unsigned long long>(sum.dropped),
+		    static_cast<unsigned long long>(sum.readings),
+		    sum.readings ? 100.0 * double(sum.dropped) / double(sum.readings)
+		                 : 0.0);
+	else
+		r += mrpt::format(
+		    "no confidence/ folder: all %llu depth readings kept\n",
+		    static_cast<unsigned long long>(sum.readings));
+	r += mrpt::format(
+	    "%s: %zu ARKit poses (a reference, not ground truth), the first %zu "
+	    "frames left out (no position yet)\n",
+	    sum.referencePath.c_str(), sum.referencePoses, sum.referenceLeftOut);
+	return r;
+}
+
+int runStrayImport(const StrayImportRunOptions& o)
+{
+	checkOutputsSpareInputs({o.folder, o.config.value_or("")},
+	                        {o.out, strayReferencePathFor(o.out)});
+	if (o.gz < 0 || o.gz > 9) throw UsageError("--gz must be in 0..9");
+	StrayImportParams params;
+	if (o.config)
+	{
+		if (!std::filesystem::exists(*o.config))
+			throw std::runtime_error(*o.config + ": config file not found");
+		checkIniFile(*o.config);
+		mrpt::config::CConfigFile cfg(*o.config);
+		params.loadFromConfigFile(cfg);
+	}
+	else
+		std::fprintf(stderr,
+		             "bims-import-stray: no --config: [import_stray] "
+		             "min_confidence %d, colour %dx%d without rgb.mp4, labels "
+		             "%s and %s\n",
+		             params.min_confidence, params.colour_width,
+		             params.colour_height, params.rgbd_label.c_str(),
+		             params.imu_label.c_str());
+	StrayImportOptions opt;
+	opt.maxFrames = o.max_frames;
+	opt.gzLevel = o.gz;
+	opt.progress = o.progress;
+	const auto sum = importStray(o.folder, o.out, params, opt);
+	std::fputs(strayImportReport(o.out, sum).c_str(), stdout);
+	return 0;
+}
+
+}  // namespace bims::eval
