@@ -8,6 +8,9 @@
 #
 #   bench/egomotion_real.sh [BUILD_DIR] [DATA_DIR] [PRESET...]
 #
+# BIMS_VARIANTS="fused bottom-only" runs bims-run once per variant (default:
+# the config's own). BIMS_SET="section.key=value ..." overrides keys of every
+# experiment file (e.g. BIMS_SET="anchor.mask_veto_consistent=0").
 # Defaults: build, a temporary folder, every preset of config/sim/. The Bonn
 # slice is read from ../shared/data/bonn_crowd_f150_349 (BIMS_BONN=DIR for
 # another TUM/Bonn folder). Prints one markdown row per sequence and
@@ -75,6 +78,16 @@ config() { # BASE MODE CALIB OUT
 		{print}
 		/^\[odometry\]/ {print "mode=" mode; seen=1}
 		END {if (!seen) printf "\n[odometry]\nmode=%s\n", mode}' "$1" > "$4"
+	local kv sec key val
+	for kv in ${BIMS_SET:-}; do
+		sec=${kv%%.*}; key=${kv#*.}; val=${key#*=}; key=${key%%=*}
+		awk -v sec="[$sec]" -v key="$key" -v val="$val" '
+			/^\[/ {s=$0}
+			s==sec && $0 ~ "^" key " *=" {next}
+			{print}
+			$0==sec {print key "=" val; done=1}
+			END {if (!done) printf "\n%s\n%s=%s\n", sec, key, val}' "$4" > "$4.tmp" && mv "$4.tmp" "$4"
+	done
 }
 
 echo "| sequence | program | mode | ATE RMSE [m] | RPE [m/s] | RPE [deg/s] | anchored / failed / lost / relocalised | egomotion ms (median) |"
@@ -84,9 +97,12 @@ run_all() { # NAME RAWLOG GT BASECFG CALIB MODES
 	for m in $modes; do
 		cfg="$DATA/${name}_$m.ini"
 		config "$base" "$m" "$calib" "$cfg"
-		out="$DATA/${name}_${m}_run"
-		"$BIN/bims-run" "$cfg" "$rl" -o "$out" --overwrite -q > "$out.log" 2>&1
-		echo "| $name | bims-run | $m | $(traj "$gt" "$out/trajectory.txt") | $(counts_run "$out/frames.csv") | $(stage_ms "$out/metrics.json") |"
+		for v in ${BIMS_VARIANTS:-default}; do
+			out="$DATA/${name}_${m}_${v}_run"
+			"$BIN/bims-run" "$cfg" "$rl" -o "$out" --overwrite -q \
+				$([ "$v" = default ] || echo "--variant $v") > "$out.log" 2>&1
+			echo "| $name | bims-run$([ "$v" = default ] || echo " --variant $v") | $m | $(traj "$gt" "$out/trajectory.txt") | $(counts_run "$out/frames.csv") | $(stage_ms "$out/metrics.json") |"
+		done
 		ms=$("$BIN/bims-odom" "$cfg" "$rl" -o "$DATA/${name}_${m}_odom.txt" --csv "$DATA/${name}_${m}_odom.csv" -q 2>&1 | odom_ms)
 		echo "| $name | bims-odom | $m | $(traj "$gt" "$DATA/${name}_${m}_odom.txt") | $(counts_odom "$DATA/${name}_${m}_odom.csv") | $ms |"
 	done

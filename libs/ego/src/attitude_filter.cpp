@@ -359,7 +359,8 @@ std::vector<const char*> flagNames(uint32_t flags)
 	    {kFlagMaskIgnored, "mask_ignored"},
 	    {kFlagAnchorRelocalised, "anchor_relocalised"},
 	    {kFlagImuRejected, "imu_rejected"},
-	    {kFlagNoImage, "no_image"}};
+	    {kFlagNoImage, "no_image"},
+	    {kFlagMaskVetoed, "mask_vetoed"}};
 	std::vector<const char*> out;
 	for (const auto& [bit, name] : names)
 		if (flags & bit) out.push_back(name);

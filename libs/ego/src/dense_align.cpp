@@ -189,7 +189,8 @@ struct Pass
 Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
           const Eigen::Matrix3d& R, const Eigen::Vector3d& t, float offset,
           double photoSigma, const AnchorParams& p, NormalEquations6* rows,
-          cv::Mat* outliers, std::vector<int>* seenThrough = nullptr)
+          cv::Mat* outliers, std::vector<int>* seenThrough = nullptr,
+          cv::Mat* consistent = nullptr)
 {
 	const bool normalEquations = rows != nullptr;
 	Pass out;
@@ -283,6 +284,7 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 			tg = Tukey::at(rg * invSg * invC, c);
 		}
 		if (tg.s <= 0 && outliers) outliers->data[s.pix] = 255;
+		if (tg.s > 0 && consistent) consistent->data[s.pix] = 255;
 		if (!counts) continue;
 		++out.associated;
 		out.cost += tg.loss;
@@ -679,14 +681,16 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 	// Final counts and the outlier image at the finest level.
 	const DenseLevel& Lf = cur.levels[static_cast<size_t>(fine)];
 	r.outliers = cv::Mat::zeros(Lf.depth.size(), CV_8UC1);
-	const Pass fin =
-	    pass(ref.levels[static_cast<size_t>(fine)], samples, R, t, offset,
-	         photoSigma, p, nullptr, &r.outliers, &r.seenThrough);
+	r.consistent = cv::Mat::zeros(Lf.depth.size(), CV_8UC1);
+	const Pass fin = pass(ref.levels[static_cast<size_t>(fine)], samples, R, t,
+	                      offset, photoSigma, p, nullptr, &r.outliers,
+	                      &r.seenThrough, &r.consistent);
 	if (p.stride_px > 1)
 	{
 		// a sample stands for its stride x stride block
 		const cv::Mat k(p.stride_px, p.stride_px, CV_8UC1, cv::Scalar(1));
 		cv::dilate(r.outliers, r.outliers, k, cv::Point(0, 0));
+		cv::dilate(r.consistent, r.consistent, k, cv::Point(0, 0));
 	}
 	r.R_RC = orthonormalize(R);
 	r.t_RC = t;

@@ -60,6 +60,7 @@ AnchorResult KeyframeAnchor::track(const RgbdFrame& f,
 	r.R_WC = R_pred;
 	r.t_WC = t_pred;
 	lastOutliers_.release();
+	lastConsistent_.release();
 	pending_ = false;
 	// (also the frame that may become a keyframe: no copy of the images)
 	cur_.build(f.grey, f.depth, f.K, p_, moving);
@@ -131,6 +132,7 @@ void KeyframeAnchor::alignTo(Keyframe& k, const Eigen::Matrix3d& R_pred,
 	r.guess = a.guess;
 	r.outliers = a.outliers;
 	lastOutliers_ = a.outliers;
+	lastConsistent_ = a.consistent;
 	const Eigen::Matrix3d R_WC = k.R_WK * a.R_RC;
 	const Eigen::Vector3d t_WC = k.R_WK * a.t_RC + k.t_WK;
 	// The correction against the nearest guess: a result next to the
@@ -201,7 +203,11 @@ bool KeyframeAnchor::wantKeyframe(const AnchorResult& r,
 	}
 	pending_ = want && haveLast_;
 	// outliers of an alignment that was not accepted say nothing
-	if (!r.accepted) lastOutliers_.release();
+	if (!r.accepted)
+	{
+		lastOutliers_.release();
+		lastConsistent_.release();
+	}
 	R_pending_ = R_WC;
 	t_pending_ = t_WC;
 	return pending_;
@@ -240,6 +246,71 @@ bool KeyframeAnchor::addPending(const cv::Mat& moving)
 	kf_.push_back(std::move(k));
 	while (static_cast<int>(kf_.size()) > p_.max_keyframes) kf_.pop_front();
 	return true;
+}
+
+cv::Mat KeyframeAnchor::vetoMask(const cv::Mat& moving, double* vetoed) const
+{
+	if (vetoed) *vetoed = 0;
+	const int level = p_.finest_level;
+	// (the alignment's images are of the last tracked frame's finest
+	// level: the mask must be of that frame's size)
+	if (!(p_.mask_veto_consistent > 0) || moving.empty() ||
+	    lastConsistent_.empty() || lastOutliers_.empty() ||
+	    (moving.cols >> level) != lastConsistent_.cols ||
+	    (moving.rows >> level) != lastConsistent_.rows)
+		return moving;
+	// per connected region of the mask: its pixels on the static surface
+	// (consistent) and off it (outliers), at the alignment's level
+	cv::Mat labels;
+	const int n = cv::connectedComponents(moving, labels, 8, CV_32S);
+	if (n <= 1) return moving;
+	std::vector<int> on(n, 0), off(n, 0);
+	const int W = lastConsistent_.cols, H = lastConsistent_.rows;
+	for (int v = 0; v < labels.rows; v++)
+	{
+		const int* l = labels.ptr<int>(v);
+		const int lv = v >> level;
+		if (lv >= H) break;
+		const uint8_t* c = lastConsistent_.ptr<uint8_t>(lv);
+		const uint8_t* o = lastOutliers_.ptr<uint8_t>(lv);
+		for (int u = 0; u < labels.cols; u++)
+		{
+			const int lu = u >> level;
+			if (l[u] == 0 || lu >= W) continue;
+			if (c[lu])
+				++on[l[u]];
+			else if (o[lu])
+				++off[l[u]];
+		}
+	}
+	std::vector<uint8_t> drop(n, 0);
+	bool any = false;
+	for (int k = 1; k < n; k++)
+	{
+		const int seen = on[k] + off[k];
+		drop[k] = seen > 0 && on[k] >= p_.mask_veto_consistent * seen;
+		any = any || drop[k];
+	}
+	if (!any) return moving;
+	cv::Mat kept = moving.clone();
+	size_t total = 0, left = 0;
+	for (int v = 0; v < labels.rows; v++)
+	{
+		const int* l = labels.ptr<int>(v);
+		uint8_t* m = kept.ptr<uint8_t>(v);
+		for (int u = 0; u < labels.cols; u++)
+		{
+			if (l[u] == 0) continue;
+			++total;
+			if (drop[l[u]])
+			{
+				m[u] = 0;
+				++left;
+			}
+		}
+	}
+	if (vetoed) *vetoed = total ? double(left) / total : 0;
+	return kept;
 }
 
 }  // namespace bims::ego

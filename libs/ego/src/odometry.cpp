@@ -151,6 +151,16 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 			moving.release();
 		}
 	}
+	// The geometry's veto: the regions of the mask that the previous
+	// frame's alignment found on the static keyframe are not left out (a
+	// tier's false alarm must not cost the tracker the static scene).
+	if (anchoring && !moving.empty())
+	{
+		double vetoed = 0;
+		moving = anchor_.vetoMask(moving, &vetoed);
+		if (vetoed > 0) r.flags |= kFlagMaskVetoed;
+		r.mask_vetoed = vetoed;
+	}
 	mask = moving.empty() ? nullptr : &moving;
 	// The previous frame becomes a keyframe now that its moving mask is
 	// known (the same mask, after the same guard).

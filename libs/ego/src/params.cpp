@@ -236,6 +236,9 @@ void AnchorParams::describe(OptionVisitor& v)
 	       "predict the previous moving mask into the frame");
 	v.integer("mask_margin_px", mask_margin_px, 0, 100,
 	          "growth of the predicted mask [px]");
+	v.real("mask_veto_consistent", mask_veto_consistent, 0, 1,
+	       "a region of the fed-back mask whose aligned samples lay on the "
+	       "static surface at least this often is not used (0: off)");
 	v.real("min_depth_m", min_depth_m, 0, 100,
 	       "depth below this is unused [m]");
 	v.real("max_depth_m", max_depth_m, 0.01, 1000,

@@ -257,6 +257,9 @@ TEST(KeyframeAnchor, AMaskOverMostOfTheImageIsCountedAndNotUsed)
 	EgoConfig cfg;
 	cfg.odometry.mode = OdometryMode::Vision;
 	cfg.anchor = params320();
+	// (the size guard alone: the geometry's veto would take the static
+	// region out of the mask; OdometryUsesTheVetoedMask)
+	cfg.anchor.mask_veto_consistent = 0;
 	Odometry odo(cfg);
 	test::Motion m;
 	cv::Mat most = cv::Mat::zeros(240, 320, CV_8UC1), some = most.clone();
@@ -394,5 +397,95 @@ TEST(Tukey, WeightIsTheSquareOfSAndTheLossIsFlatBeyondC)
 	{
 		EXPECT_EQ(Tukey::at(e / c, c).s, 0) << e;
 		EXPECT_EQ(Tukey::at(e / c, c).loss, c * c / 6) << e;
+	}
+}
+
+// The geometry's veto of a fed-back mask: of two regions called moving in a
+// frame, the one its alignment found on the static keyframe's surface (a
+// false alarm) is left out of the mask; the one on an object in front of
+// the keyframe's surface (a mover) stays. Off, the mask is kept whole.
+TEST(KeyframeAnchor, TheAlignmentVetoesMaskRegionsItFoundOnTheStaticScene)
+{
+	AnchorOnMotion s;
+	RgbdFrame f = s.frame(0.05);
+	// an object 40 cm in front of the room in this frame only
+	const cv::Rect object(200, 80, 60, 60), falseAlarm(40, 60, 60, 60);
+	f.depth(object) -= 0.4f;
+	const AnchorResult a = s.track(f, 0.05);
+	ASSERT_TRUE(a.accepted) << a.why;
+	cv::Mat mask = cv::Mat::zeros(240, 320, CV_8UC1);
+	mask(object).setTo(255);
+	mask(falseAlarm).setTo(255);
+	double vetoed = -1;
+	const cv::Mat kept = s.anchor.vetoMask(mask, &vetoed);
+	EXPECT_EQ(cv::countNonZero(kept(falseAlarm)), 0);
+	EXPECT_EQ(cv::countNonZero(kept(object)), object.area());
+	EXPECT_DOUBLE_EQ(vetoed, 0.5);
+	EXPECT_EQ(cv::countNonZero(mask), 2 * object.area());  // input untouched
+	// a mask of another size, or the veto off: the mask as it is
+	EXPECT_EQ(
+	    cv::countNonZero(s.anchor.vetoMask(cv::Mat::ones(24, 32, CV_8UC1))),
+	    24 * 32);
+	AnchorParams off = params320();
+	off.mask_veto_consistent = 0;
+	KeyframeAnchor b(off);
+	const AnchorResult a0 =
+	    b.track(s.frame(0), s.R(0), s.p(0), {}, nullptr, cv::Mat());
+	b.wantKeyframe(a0, s.R(0), s.p(0), true);
+	ASSERT_TRUE(b.addPending(cv::Mat()));
+	ASSERT_TRUE(
+	    b.track(f, s.R(0.05), s.p(0.05), {}, nullptr, cv::Mat()).accepted);
+	EXPECT_EQ(cv::countNonZero(b.vetoMask(mask)), 2 * object.area());
+}
+
+// Odometry feeds the vetoed mask on: a false alarm over the static room
+// (the bottom tier's, without the flow tier's veto) from the second frame on
+// (the first frame's mask is empty: a warm-up frame) is neither excluded
+// from the alignment nor dropped from the keyframe; the frame says so.
+// Without the veto it is excluded on every frame.
+TEST(KeyframeAnchor, OdometryUsesTheVetoedMask)
+{
+	EgoConfig cfg;
+	cfg.odometry.mode = OdometryMode::Vision;
+	cfg.anchor = params320();
+	Odometry odo(cfg);
+	test::Motion m;
+	cv::Mat falseAlarm = cv::Mat::zeros(240, 320, CV_8UC1);
+	falseAlarm(cv::Rect(20, 20, 150, 150)).setTo(255);  // 29 % of the view
+	FrameEgomotion e;
+	for (int k = 0; k < 4; k++)
+	{
+		e = odo.processFrame(test::render(m.R(k * 0.05), m.p(k * 0.05), K320(),
+		                                  320, 240, k * 0.05),
+		                     k > 1 ? &falseAlarm : nullptr);
+		if (k < 2) continue;  // frame 1's mask is the first
+		EXPECT_TRUE(e.flags & kFlagMaskVetoed) << k << flagsToString(e.flags);
+		EXPECT_GT(e.mask_vetoed, 0.99) << k;
+		EXPECT_LT(e.anchor.excluded_fraction, 0.01) << k;
+		EXPECT_TRUE(e.flags & kFlagAnchored);
+	}
+}
+
+TEST(KeyframeAnchor, OdometryWithoutTheVetoExcludesTheFalseAlarm)
+{
+	EgoConfig cfg;
+	cfg.odometry.mode = OdometryMode::Vision;
+	cfg.anchor = params320();
+	cfg.anchor.mask_veto_consistent = 0;
+	Odometry odo(cfg);
+	test::Motion m;
+	cv::Mat falseAlarm = cv::Mat::zeros(240, 320, CV_8UC1);
+	falseAlarm(cv::Rect(20, 20, 150, 150)).setTo(255);
+	for (int k = 0; k < 4; k++)
+	{
+		const FrameEgomotion e =
+		    odo.processFrame(test::render(m.R(k * 0.05), m.p(k * 0.05), K320(),
+		                                  320, 240, k * 0.05),
+		                     k > 1 ? &falseAlarm : nullptr);
+		EXPECT_FALSE(e.flags & kFlagMaskVetoed);
+		if (k >= 2)
+		{
+			EXPECT_GT(e.anchor.excluded_fraction, 0.25) << k;
+		}
 	}
 }

@@ -177,6 +177,7 @@ TEST(MovingPrediction, TheOdometryExcludesThePredictedMaskWhenAskedTo)
 		cfg.odometry.mode = OdometryMode::Vision;
 		cfg.anchor.predict_mask = predict;
 		cfg.anchor.mask_margin_px = 0;
+		cfg.anchor.mask_veto_consistent = 0;  // (a static region)
 		Odometry odo(cfg);
 		const RgbdFrame f0 = frame(0), f1 = frame(1), f2 = frame(2);
 		odo.processFrame(f0);

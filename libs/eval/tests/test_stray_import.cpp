@@ -240,7 +240,9 @@ TEST(ImportStray, SyntheticCaptureEveryConvention)
 	const auto d = makeCapture("all");
 	const std::string out = d + "_out/all.rawlog";
 	fs::create_directories(d + "_out");
-	const auto sum = ev::importStray(d, out, {}, quiet());
+	ev::StrayImportParams high;  // high confidence only (1 below)
+	high.min_confidence = 2;
+	const auto sum = ev::importStray(d, out, high, quiet());
 	EXPECT_FALSE(fs::exists(out + ".partial"));
 	const auto obs = readAll(out);
 	const auto imu = imuRows();
@@ -714,7 +716,7 @@ TEST(ImportStray, BadInputIsAClearErrorNamingTheFile)
 	ev::StrayImportParams p;
 	p.min_confidence = 0;
 	p.loadFromConfigFile(preset);
-	EXPECT_EQ(p.min_confidence, 2);
+	EXPECT_EQ(p.min_confidence, 1);
 	EXPECT_EQ(p.colour_width, 1920);
 	EXPECT_EQ(p.colour_height, 1440);
 	EXPECT_EQ(p.rgbd_label, "RGBD");

@@ -129,11 +129,14 @@ TEST(PipelineConfig, TheStrayPresetGivesTheIphoneImuMounting)
 	R << 0, -1, 0, -1, 0, 0, 0, 0, -1;
 	EXPECT_EQ(s.ego.calibration.R_IC, R);
 	EXPECT_TRUE(s.ego.calibration.has_R_IC);
-	EXPECT_EQ(s.ego.calibration.time_offset_s, -0.005);
+	EXPECT_EQ(s.ego.calibration.time_offset_s, 0);
 	EXPECT_FALSE(s.ego.attitude.use_magnetometer);
 	EXPECT_EQ(s.ego.sensors.rgbd_label, "RGBD");
 	EXPECT_EQ(s.ego.sensors.imu_label, "IMU");
 	EXPECT_FALSE(s.ego.camera.given);  // each scan's own intrinsics
+	// the LiDAR's grids: ray-cast free space, nothing beyond 3.5 m
+	EXPECT_EQ(s.grids.decay, bims::maps::DecayMode::Raycast);
+	EXPECT_EQ(s.grids.max_range, 3.5);
 }
 
 TEST(PipelineConfig, EffectiveIniHasEverySectionAndAMeaningPerKey)

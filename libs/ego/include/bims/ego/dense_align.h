@@ -105,6 +105,10 @@ struct DenseAlignResult
 	 * outlier (in front of the reference's surface or off it: candidate
 	 * moving), 0 elsewhere. */
 	cv::Mat outliers;
+	/** Finest-level image (CV_8UC1): 255 where a current point (excluded
+	 * ones too) lies on the reference's surface within the gate and Tukey's
+	 * limit: it agrees with the static scene. */
+	cv::Mat consistent;
 	/** Reference pixels (finest level, v * width + u) that a current point
 	 * lies behind by more than the gate: the reference's surface there has
 	 * moved away (a static surface is never seen through). */

@@ -55,6 +55,10 @@ enum EgoFlag : uint32_t
 	 * measured only by the keyframe alignment's geometric term (a frame
 	 * without kFlagAnchored is not measured). */
 	kFlagNoImage = 1u << 18,
+	/** Part of the fed-back moving mask was not used: the previous frame's
+	 * alignment found those regions on the static keyframe's surface
+	 * ([anchor] mask_veto_consistent). */
+	kFlagMaskVetoed = 1u << 19,
 };
 
 /** The names of the set bits, in bit order ("imu_gap", "too_few_tracks");

@@ -80,6 +80,16 @@ class KeyframeAnchor
 	 * outliers are excluded. Returns false when nothing was pending. */
 	bool addPending(const cv::Mat& moving);
 
+	/** The geometry's veto of a fed-back moving mask (AnchorParams::
+	 * mask_veto_consistent): \a moving (CV_8UC1, non-zero = moving) of the
+	 * frame of the last track() without its connected regions whose samples
+	 * that alignment found on the static keyframe's surface at least that
+	 * often (among those it found on it or off it). \a moving itself when
+	 * the veto is off, the last alignment was not accepted, or \a moving is
+	 * not of its size. \param vetoed gets the share of \a moving's pixels
+	 * left out. */
+	cv::Mat vetoMask(const cv::Mat& moving, double* vetoed = nullptr) const;
+
 	size_t keyframes() const { return kf_.size(); }
 	void clear();
 
@@ -107,6 +117,7 @@ class KeyframeAnchor
 	// keyframe
 	bool haveLast_ = false;
 	cv::Mat lastOutliers_;
+	cv::Mat lastConsistent_;  // of the last accepted alignment
 	bool pending_ = false;
 	Eigen::Matrix3d R_pending_ = Eigen::Matrix3d::Identity();
 	Eigen::Vector3d t_pending_ = Eigen::Vector3d::Zero();

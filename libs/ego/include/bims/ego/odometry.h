@@ -59,6 +59,9 @@ struct FrameEgomotion
 	std::vector<int8_t> trackInlier;
 	/** What the map anchoring did ([anchor]; tried = false when off). */
 	AnchorResult anchor;
+	/** Share of the fed-back moving mask's pixels the geometry vetoed
+	 * (KeyframeAnchor::vetoMask; kFlagMaskVetoed). */
+	double mask_vetoed = 0;
 	double ms_input = 0, ms_track = 0, ms_motion = 0;  ///< stage times [ms]
 	double ms_anchor = 0;  ///< of ms_motion: the keyframe alignment [ms]
 	TrackerStats tracker;  ///< KLT counters of this frame

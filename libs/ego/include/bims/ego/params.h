@@ -294,6 +294,14 @@ struct AnchorParams
 	/** The predicted mask grows by this many pixels a side (the movers' own
 	 * motion between two frames, the prediction's error) [px]. */
 	int mask_margin_px = 4;
+	/** The geometry's veto of the fed-back moving mask: a connected region
+	 * of the previous frame's mask is not used (not excluded from the
+	 * alignment, not dropped from the keyframe) when at least this share
+	 * of its aligned samples lay on the static keyframe's surface in that
+	 * frame's accepted alignment: what the alignment found static is not
+	 * left out because a tier called it moving (flagged mask_vetoed).
+	 * 0: off. docs/ego.md, "The fed-back mask". */
+	double mask_veto_consistent = 0.5;
 	double min_depth_m = 0.3;  ///< depth outside [min,max] unused [m]
 	double max_depth_m = 6.0;
 

@@ -24,7 +24,7 @@ struct StrayImportParams
 {
 	/** [import_stray] min_confidence: depth readings whose ARKit confidence
 	 * (0 low, 1 medium, 2 high) is below this are written as 0 (none). */
-	int min_confidence = 2;
+	int min_confidence = 1;
 	/** [import_stray] colour_width, colour_height: the size of the colour
 	 * stream camera_matrix.csv describes, when there is no rgb.mp4 to take
 	 * it from [px]. */
