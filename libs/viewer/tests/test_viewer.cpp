@@ -254,7 +254,7 @@ namespace
 /** The bundled sample's first 40 frames with what the ordering rule must
  * handle: a 3D scan repeated out of order after scan #10 (skipped), and an
  * IMU sample whose angular rate is NaN (not used, its frame flagged). */
-std::string sampleWithFaults(const std::string& test)
+std::string sampleWithFaults(const std::string& test, bool depthOnly = false)
 {
 	// a folder per test: CTest runs them in parallel
 	const std::string path =
@@ -270,6 +270,12 @@ std::string sampleWithFaults(const std::string& test)
 		            o))
 		{
 			if (scans.size() == 40) break;
+			if (depthOnly)
+			{
+				// a LiDAR or time-of-flight camera without colour
+				s->hasIntensityImage = false;
+				s->intensityImage = mrpt::img::CImage();
+			}
 			scans.push_back(s);
 			out.write(*s);
 			if (scans.size() == 11) out.write(*scans[5]);
@@ -341,6 +347,44 @@ TEST(BatchAndReplay, GiveTheSameFramesPosesAndMasks)
 		expectSame(*r, batch[k], k);
 		++k;
 	}
+	EXPECT_EQ(k, batch.size());
+}
+
+// The same for a recording without colour: depth-only frames run the same
+// way in the three programs.
+TEST(BatchReplayAndLive, DepthOnlyFramesAreTheSameInAllThree)
+{
+	const std::string input = sampleWithFaults("depth_only", true);
+	const auto batch = batchFrames(input);
+	ASSERT_EQ(batch.size(), 40u);
+	ViewerOptions o;
+	o.rawlog = input;
+	o.configPath = kConfig;
+	ReplayController c(o);
+	size_t k = 0;
+	while (c.step())
+	{
+		ASSERT_LT(k, batch.size());
+		ASSERT_NE(c.result(), nullptr);
+		EXPECT_TRUE(c.result()->flowOff);
+		expectSame(*c.result(), batch[k], k);
+		++k;
+	}
+	EXPECT_EQ(k, batch.size());
+	pipeline::ExperimentConfig cfg;
+	cfg.loadFromFile(kConfig);
+	pipeline::LiveSegmentation live(cfg, "test", "live input");
+	k = 0;
+	const auto onFrame =
+	    [&](const source::SourceFrame&, const pipeline::FrameResult& r)
+	{
+		ASSERT_LT(k, batch.size());
+		expectSame(r, batch[k], k);
+		++k;
+	};
+	RawlogReader in(input);
+	while (auto ob = in.next()) live.push(ob, onFrame);
+	live.finish(onFrame);
 	EXPECT_EQ(k, batch.size());
 }
 
