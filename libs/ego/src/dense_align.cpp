@@ -343,27 +343,22 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 
 }  // namespace
 
-void DenseFrame::build(const cv::Mat& grey, const cv::Mat& depth,
+void DenseFrame::build(const cv::Mat& image, const cv::Mat& depth,
                        const Eigen::Matrix3d& K, const AnchorParams& p,
                        const cv::Mat& exclude)
 {
 	CV_Assert(depth.type() == CV_32FC1);
-	CV_Assert(grey.empty() ||
-	          (grey.type() == CV_8UC1 && grey.size() == depth.size()));
+	CV_Assert(image.empty() ||
+	          (image.type() == CV_8UC1 && image.size() == depth.size()));
 	CV_Assert(exclude.empty() ||
 	          (exclude.type() == CV_8UC1 && exclude.size() == depth.size()));
 	reference_ = false;
-	image_ = !grey.empty();
-	if (!image_)
-	{
-		// depth only: the levels' grey stays flat (no gradient, no
-		// photometric term: alignDense() drops it)
-		if (noImage_.size() != depth.size())
-			noImage_ = cv::Mat::zeros(depth.size(), CV_8UC1);
-		build(noImage_, depth, K, p, exclude);
-		image_ = false;
-		return;
-	}
+	image_ = !image.empty();
+	// depth only: the levels' grey stays flat (no gradient, no photometric
+	// term: alignDense() drops it)
+	if (!image_ && noImage_.size() != depth.size())
+		noImage_ = cv::Mat::zeros(depth.size(), CV_8UC1);
+	const cv::Mat& grey = image_ ? image : noImage_;
 	levels.assign(static_cast<size_t>(p.coarsest_level) + 1, DenseLevel());
 	const float zmin = float(p.min_depth_m), zmax = float(p.max_depth_m);
 	auto reading = [zmin, zmax](float z)
@@ -593,14 +588,8 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
                             double sigmaPrior_rad)
 {
 	// the photometric term needs an image in both frames (else depth only)
-	AnchorParams depthOnly;
-	if (!ref.hasImage() || !cur.hasImage())
-	{
-		depthOnly = params;
-		depthOnly.photo_weight = 0;
-	}
-	const AnchorParams& p =
-	    ref.hasImage() && cur.hasImage() ? params : depthOnly;
+	AnchorParams p = params;
+	if (!ref.hasImage() || !cur.hasImage()) p.photo_weight = 0;
 	DenseAlignResult r;
 	if (!inits.empty())
 	{

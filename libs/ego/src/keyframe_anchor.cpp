@@ -261,55 +261,47 @@ cv::Mat KeyframeAnchor::vetoMask(const cv::Mat& moving, double* vetoed) const
 		return moving;
 	// per connected region of the mask: its pixels on the static surface
 	// (consistent) and off it (outliers), at the alignment's level
-	cv::Mat labels;
-	const int n = cv::connectedComponents(moving, labels, 8, CV_32S);
+	cv::Mat labels, stats, centroids;
+	const int n = cv::connectedComponentsWithStats(moving, labels, stats,
+	                                               centroids, 8, CV_32S);
 	if (n <= 1) return moving;
 	std::vector<int> on(n, 0), off(n, 0);
 	const int W = lastConsistent_.cols, H = lastConsistent_.rows;
-	for (int v = 0; v < labels.rows; v++)
+	for (int v = 0; v < labels.rows && (v >> level) < H; v++)
 	{
 		const int* l = labels.ptr<int>(v);
-		const int lv = v >> level;
-		if (lv >= H) break;
-		const uint8_t* c = lastConsistent_.ptr<uint8_t>(lv);
-		const uint8_t* o = lastOutliers_.ptr<uint8_t>(lv);
-		for (int u = 0; u < labels.cols; u++)
+		const uint8_t* c = lastConsistent_.ptr<uint8_t>(v >> level);
+		const uint8_t* o = lastOutliers_.ptr<uint8_t>(v >> level);
+		for (int u = 0; u < labels.cols && (u >> level) < W; u++)
 		{
-			const int lu = u >> level;
-			if (l[u] == 0 || lu >= W) continue;
-			if (c[lu])
+			if (l[u] == 0) continue;
+			if (c[u >> level])
 				++on[l[u]];
-			else if (o[lu])
+			else if (o[u >> level])
 				++off[l[u]];
 		}
 	}
+	// the regions dropped, and the share of the mask's pixels they hold
 	std::vector<uint8_t> drop(n, 0);
-	bool any = false;
+	long total = 0, dropped = 0;
 	for (int k = 1; k < n; k++)
 	{
 		const int seen = on[k] + off[k];
 		drop[k] = seen > 0 && on[k] >= p_.mask_veto_consistent * seen;
-		any = any || drop[k];
+		const int area = stats.at<int>(k, cv::CC_STAT_AREA);
+		total += area;
+		dropped += drop[k] ? area : 0;
 	}
-	if (!any) return moving;
+	if (dropped == 0) return moving;
 	cv::Mat kept = moving.clone();
-	size_t total = 0, left = 0;
 	for (int v = 0; v < labels.rows; v++)
 	{
 		const int* l = labels.ptr<int>(v);
 		uint8_t* m = kept.ptr<uint8_t>(v);
 		for (int u = 0; u < labels.cols; u++)
-		{
-			if (l[u] == 0) continue;
-			++total;
-			if (drop[l[u]])
-			{
-				m[u] = 0;
-				++left;
-			}
-		}
+			if (drop[l[u]]) m[u] = 0;
 	}
-	if (vetoed) *vetoed = total ? double(left) / total : 0;
+	if (vetoed) *vetoed = double(dropped) / total;
 	return kept;
 }
 

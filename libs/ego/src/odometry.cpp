@@ -311,11 +311,11 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 			m = est_.refineReprojection(corr, m, f.K, true);
 		r.R_source = RotationSource::Vision;
 	}
-	if (!image)
-		;  // no features to count: the flag says why (kFlagNoImage)
-	else if (r.correspondences < cfg_.odometry.min_tracks)
+	// (a frame without an image has no features to count: kFlagNoImage
+	// says why)
+	if (image && r.correspondences < cfg_.odometry.min_tracks)
 		r.flags |= kFlagTooFewTracks;
-	else if (!m.ok)
+	else if (image && !m.ok)
 		r.flags |= kFlagTooFewInliers;
 
 	Eigen::Matrix3d R_rel;

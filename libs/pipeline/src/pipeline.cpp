@@ -178,9 +178,9 @@ const FrameResult& Pipeline::processFrame(
 	takeInput(scan, r, jobs);
 	// The flow tier needs an image in both frames: without (depth only) it
 	// is off for the frame, and tier 1 decides (tier 2 = tier 1).
-	const bool haveFlow = havePrev_ && prev_.hasImage() && cur_.hasImage() &&
-	                      prev_.size() == cur_.size();
 	r.flowOff = !cur_.hasImage() || (havePrev_ && !prev_.hasImage());
+	const bool haveFlow =
+	    havePrev_ && !r.flowOff && prev_.size() == cur_.size();
 	if (haveFlow && !jobs.observing.valid()) startObservedFlow(jobs);
 	egomotion(r);
 	// A refinement may still correct the egomotion (and so the next

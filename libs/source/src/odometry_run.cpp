@@ -159,7 +159,7 @@ int runOdometry(const OdometryRunOptions& o)
 		    if (r.flags & ego::kFlagOutOfOrder || r.flags & ego::kFlagBadImage)
 			    return;  // no pose for this frame
 		    traj.push_back({r.t, r.T_WC});
-		    if (const auto R = odo.imuRotation(r.t))
+		    if (const auto R = o.attitude ? odo.imuRotation(r.t) : std::nullopt)
 			    attitude.push_back(
 			        {r.t, ego::toPose(*R, Eigen::Vector3d::Zero())});
 		    msIn.push_back(r.ms_input);

@@ -10,6 +10,8 @@
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 
+#include <functional>
+
 #include <mrpt/system/filesystem.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -327,12 +329,14 @@ void expectSame(const pipeline::FrameResult& r, const Seen& want, size_t k)
 }
 }  // namespace
 
-TEST(BatchAndReplay, GiveTheSameFramesPosesAndMasks)
+namespace
 {
-	const std::string input = sampleWithFaults("batch_and_replay");
-	const auto batch = batchFrames(input);
-	ASSERT_EQ(batch.size(), 40u);
-
+/** The viewer's replay of \a input gives \a batch's frames; \a check (if
+ * any) looks at each result too. */
+void expectReplaySame(
+    const std::string& input, const std::vector<Seen>& batch,
+    const std::function<void(const pipeline::FrameResult&)>& check = {})
+{
 	ViewerOptions o;
 	o.rawlog = input;
 	o.configPath = kConfig;
@@ -344,55 +348,18 @@ TEST(BatchAndReplay, GiveTheSameFramesPosesAndMasks)
 		ASSERT_LT(k, batch.size());
 		const auto* r = c.result();
 		ASSERT_NE(r, nullptr);
+		if (check) check(*r);
 		expectSame(*r, batch[k], k);
 		++k;
 	}
 	EXPECT_EQ(k, batch.size());
 }
 
-// The same for a recording without colour: depth-only frames run the same
-// way in the three programs.
-TEST(BatchReplayAndLive, DepthOnlyFramesAreTheSameInAllThree)
+/** Live segmentation of \a input's observations, handed over one by one as a
+ * live sensor would, gives \a batch's frames; returns its order statistics. */
+source::FrameOrderStats expectLiveSame(const std::string& input,
+                                       const std::vector<Seen>& batch)
 {
-	const std::string input = sampleWithFaults("depth_only", true);
-	const auto batch = batchFrames(input);
-	ASSERT_EQ(batch.size(), 40u);
-	ViewerOptions o;
-	o.rawlog = input;
-	o.configPath = kConfig;
-	ReplayController c(o);
-	size_t k = 0;
-	while (c.step())
-	{
-		ASSERT_LT(k, batch.size());
-		ASSERT_NE(c.result(), nullptr);
-		EXPECT_TRUE(c.result()->flowOff);
-		expectSame(*c.result(), batch[k], k);
-		++k;
-	}
-	EXPECT_EQ(k, batch.size());
-	pipeline::ExperimentConfig cfg;
-	cfg.loadFromFile(kConfig);
-	pipeline::LiveSegmentation live(cfg, "test", "live input");
-	k = 0;
-	const auto onFrame =
-	    [&](const source::SourceFrame&, const pipeline::FrameResult& r)
-	{
-		ASSERT_LT(k, batch.size());
-		expectSame(r, batch[k], k);
-		++k;
-	};
-	RawlogReader in(input);
-	while (auto ob = in.next()) live.push(ob, onFrame);
-	live.finish(onFrame);
-	EXPECT_EQ(k, batch.size());
-}
-
-TEST(BatchAndLive, GiveTheSameFramesPosesAndMasks)
-{
-	// the observations handed over one by one as a live sensor would
-	const std::string input = sampleWithFaults("batch_and_live");
-	const auto batch = batchFrames(input);
 	pipeline::ExperimentConfig cfg;
 	cfg.loadFromFile(kConfig);
 	pipeline::LiveSegmentation live(cfg, "test", "live input");
@@ -408,5 +375,34 @@ TEST(BatchAndLive, GiveTheSameFramesPosesAndMasks)
 	while (auto o = in.next()) live.push(o, onFrame);
 	live.finish(onFrame);
 	EXPECT_EQ(k, batch.size());
-	EXPECT_EQ(live.stats().scansOutOfOrder, 1u);
+	return live.stats();
+}
+}  // namespace
+
+TEST(BatchAndReplay, GiveTheSameFramesPosesAndMasks)
+{
+	const std::string input = sampleWithFaults("batch_and_replay");
+	const auto batch = batchFrames(input);
+	ASSERT_EQ(batch.size(), 40u);
+	expectReplaySame(input, batch);
+}
+
+// The same for a recording without colour: depth-only frames run the same
+// way in the three programs.
+TEST(BatchReplayAndLive, DepthOnlyFramesAreTheSameInAllThree)
+{
+	const std::string input = sampleWithFaults("depth_only", true);
+	const auto batch = batchFrames(input);
+	ASSERT_EQ(batch.size(), 40u);
+	expectReplaySame(input, batch,
+	                 [](const pipeline::FrameResult& r)
+	                 { EXPECT_TRUE(r.flowOff); });
+	expectLiveSame(input, batch);
+}
+
+TEST(BatchAndLive, GiveTheSameFramesPosesAndMasks)
+{
+	const std::string input = sampleWithFaults("batch_and_live");
+	const auto batch = batchFrames(input);
+	EXPECT_EQ(expectLiveSame(input, batch).scansOutOfOrder, 1u);
 }

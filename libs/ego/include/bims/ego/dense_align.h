@@ -48,14 +48,14 @@ struct DenseLevel
 class DenseFrame
 {
  public:
-	/** Builds levels 0..p.coarsest_level from \a grey (CV_8UC1, or empty:
+	/** Builds levels 0..p.coarsest_level from \a image (CV_8UC1 grey, or empty:
 	 * a depth-only frame, aligned without the photometric term) and
 	 * \a depth (CV_32FC1 [m]). Depth outside [min, max]_depth_m is dropped;
 	 * pixels where \a exclude (CV_8UC1, may be empty) is non-zero are not
 	 * sampled when this frame is aligned (DenseLevel::exclude). A
 	 * 2x2 block's depth is the mean of its readings when they agree (within
 	 * 3 % + 1 cm), else none (no averaging across depth edges). */
-	void build(const cv::Mat& grey, const cv::Mat& depth,
+	void build(const cv::Mat& image, const cv::Mat& depth,
 	           const Eigen::Matrix3d& K, const AnchorParams& p,
 	           const cv::Mat& exclude = cv::Mat());
 	/** Adds gradients and normals at levels finest..coarsest: the frame
