@@ -93,7 +93,8 @@ bool CBayesVoxelGridBase::internal_canComputeObservationLikelihood(
 	return false;
 }
 
-void CBayesVoxelGridBase::writeBase(mrpt::serialization::CArchive& out) const
+void CBayesVoxelGridBase::writeBase(mrpt::serialization::CArchive& out,
+                                    uint8_t version) const
 {
 	const auto& p = params_;
 	out << p.voxel_size << uint8_t(p.decay) << p.p_miss << p.reading_lambda
@@ -101,10 +102,10 @@ void CBayesVoxelGridBase::writeBase(mrpt::serialization::CArchive& out) const
 	    << p.flow_lambda << uint8_t(p.flow_evidence) << p.max_range << p.extent
 	    << p.max_memory_mb << int32_t(p.raycast_decimation)
 	    << uint8_t(p.raycast_target);
-	// version 1
-	out << p.p_unknown << uint8_t(p.bg_neighbourhood) << p.exclude_moving;
-	// version 2
-	out << uint8_t(p.exclude_by);
+	if (version >= 1)
+		out << p.p_unknown << uint8_t(p.bg_neighbourhood) << p.exclude_moving;
+	if (version >= 2) out << uint8_t(p.exclude_by);
+	if (version >= 3) out << p.raycast_margin;
 	out << frameCount_ << int64_t(lastTimestamp_.time_since_epoch().count());
 }
 
@@ -115,6 +116,7 @@ void CBayesVoxelGridBase::readBase(mrpt::serialization::CArchive& in,
 	// built with the paper's model there (config/paper.ini), whatever the
 	// defaults are now.
 	GridParams p;
+	p.raycast_margin = 0;
 	p.p_unknown = 0;
 	p.bg_neighbourhood = BgNeighbourhood::None;
 	p.exclude_moving = false;
@@ -150,6 +152,7 @@ void CBayesVoxelGridBase::readBase(mrpt::serialization::CArchive& in,
 			    "bims::maps: corrupt serialised grid (bad enum value)");
 		p.exclude_by = ExcludeBy(xb);
 	}
+	if (version >= 3) in >> p.raycast_margin;
 	setParamsBase(p);  // validates
 	int64_t ts;
 	in >> frameCount_ >> ts;

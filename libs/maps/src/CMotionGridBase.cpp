@@ -8,6 +8,7 @@
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <algorithm>
 #include <sstream>
 #include <stdexcept>
 
@@ -286,7 +287,8 @@ void CMotionGridBase::readMotion(mrpt::serialization::CArchive& in,
                                  uint8_t version)
 {
 	grid_.clear();
-	readBase(in, version);
+	// Version 3 changed the cells, 4 added a parameter (raycast_margin).
+	readBase(in, version >= 4 ? 3 : std::min<uint8_t>(version, 2));
 	grid_.setMaxBytes(size_t(params_.max_memory_mb * 1048576.0));
 	uint64_t nb;
 	in >> nb;

@@ -104,6 +104,23 @@ void COccupancyBayesGrid::decayRaycast(const FrameCloud& f, uint32_t F)
 	}
 	const double a[3] = {o.x * inv, o.y * inv, o.z * inv};
 	collectRayEnds(f, inv);
+	// The readings' noise band (raycast_margin): each ray ends that far
+	// before its reading (in voxel units); a ray no longer than it is not
+	// cast.
+	if (const double margin = params_.raycast_margin * inv; margin > 0)
+	{
+		size_t w = 0;
+		for (const RayEnd& e : rayEnds_)
+		{
+			const double d[3] = {e.p[0] - a[0], e.p[1] - a[1], e.p[2] - a[2]};
+			const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+			if (n <= margin) continue;
+			const double k = (n - margin) / n;
+			rayEnds_[w++] = {
+			    {a[0] + k * d[0], a[1] + k * d[1], a[2] + k * d[2]}};
+		}
+		rayEnds_.resize(w);
+	}
 	if (rayEnds_.empty()) return;
 
 	const RayBox box = RayBox::around(a, rayEnds_.data(), rayEnds_.size());

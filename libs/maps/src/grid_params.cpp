@@ -42,6 +42,8 @@ void GridParams::validate() const
 	check(max_memory_mb >= 1, "max_memory_mb", "must be >= 1");
 	check(raycast_decimation >= 1 && raycast_decimation <= 64,
 	      "raycast_decimation", "must be in [1, 64]");
+	check(raycast_margin >= 0 && std::isfinite(raycast_margin),
+	      "raycast_margin", "must be >= 0");
 	check(raycast_threads >= 1 && raycast_threads <= 64, "raycast_threads",
 	      "must be in [1, 64]");
 }
@@ -87,6 +89,9 @@ void GridParams::describe(OptionVisitor& v)
 	          "decay = raycast: every k-th pixel in u and v casts a ray");
 	v.choice("raycast_target", raycast_target,
 	         "decay = raycast: rays to each reading or to each hit voxel");
+	v.real("raycast_margin", raycast_margin, 0, 1e3,
+	       "decay = raycast: rays end this far before their reading, no miss "
+	       "in its noise band [m]");
 	v.flag("exclude_moving", exclude_moving,
 	       "tier 0 integrates only the voxels called static (false: the "
 	       "paper)");

@@ -109,6 +109,7 @@ TEST(OccupancyGrid, RaycastFreesBeforeTheHitAndNothingBehindIt)
 {
 	GridParams p = test::paperGrids();
 	p.decay = DecayMode::Raycast;
+	p.raycast_margin = 0;  // the free space reaches the hit voxel
 	COccupancyBayesGrid g(p);
 	// Sensor in voxel (0,0,0), readings at voxels 20 and 30 along x.
 	const mrpt::math::TPoint3D o(0.025, 0.025, 0.025);
@@ -127,10 +128,42 @@ TEST(OccupancyGrid, RaycastFreesBeforeTheHitAndNothingBehindIt)
 	EXPECT_EQ(g.logOddsFixed({30, 0, 0}), hit);
 }
 
+// raycast_margin: the inverse sensor model's free region ends the margin
+// before the reading (r < z - alpha/2): the voxels in that band keep their
+// belief; a ray not longer than the margin frees nothing.
+TEST(OccupancyGrid, RaycastMarginLeavesTheReadingsNoiseBandUnmissed)
+{
+	GridParams p = test::paperGrids();
+	p.decay = DecayMode::Raycast;
+	p.voxel_size = 0.05;
+	p.raycast_margin = 0.1;  // two voxels
+	COccupancyBayesGrid g(p);
+	const mrpt::math::TPoint3D o(0.025, 0.025, 0.025);
+	// Readings at the centres of voxels 20 (along x) and 1 (along y): the
+	// first ray ends at x = 1.025 - 0.1 = 0.925 m, in voxel 18.
+	g.integrate(frameAt(p, {{20, 0, 0}, {0, 1, 0}}, {1, 1}, o));
+	const LogOddsFx hit = g.hitFixed(1), miss = -g.missFixed();
+	for (int x = 1; x <= 17; ++x)
+		EXPECT_EQ(g.logOddsFixed({x, 0, 0}), miss) << x;
+	EXPECT_EQ(g.logOddsFixed({18, 0, 0}), 0);
+	EXPECT_EQ(g.logOddsFixed({19, 0, 0}), 0);
+	EXPECT_EQ(g.logOddsFixed({20, 0, 0}), hit);
+	// The sensor's own voxel is crossed by the long ray only.
+	EXPECT_EQ(g.logOddsFixed({0, 0, 0}), miss);
+	EXPECT_EQ(g.logOddsFixed({0, 1, 0}), hit);
+	// Without the margin the band is missed as well.
+	p.raycast_margin = 0;
+	COccupancyBayesGrid h(p);
+	h.integrate(frameAt(p, {{20, 0, 0}}, {1}, o));
+	EXPECT_EQ(h.logOddsFixed({18, 0, 0}), miss);
+	EXPECT_EQ(h.logOddsFixed({19, 0, 0}), miss);
+}
+
 TEST(OccupancyGrid, RaycastDiagonalRayIsSixConnected)
 {
 	GridParams p = test::paperGrids();
 	p.decay = DecayMode::Raycast;
+	p.raycast_margin = 0;  // the free space reaches the hit voxel
 	COccupancyBayesGrid g(p);
 	const mrpt::math::TPoint3D o(0.01, 0.02, 0.03);
 	const VoxelKey end{17, -9, 6};

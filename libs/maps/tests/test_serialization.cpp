@@ -49,6 +49,7 @@ TEST(Serialization, OccupancyRoundTripIsExactAndKeepsWorking)
 		GridParams p = test::paperGrids();
 		p.decay = mode;
 		p.voxel_size = 0.1;
+		p.raycast_margin = 0.15;  // not the default: read back, not assumed
 		MotionGrids mg(p);
 		feed(mg, 3);
 		const auto& a = *mg.occupancy();
@@ -125,7 +126,7 @@ class Tier1WrittenAsVersion2 : public CBackgroundSubtractionGrid
 	uint8_t serializeGetVersion() const override { return 2; }
 	void serializeTo(mrpt::serialization::CArchive& out) const override
 	{
-		writeBase(out);
+		writeBase(out, 2);
 		const uint64_t nb = grid_.numBlocks();
 		out << nb;
 		constexpr size_t N = Storage::kCellsPerBlock;
@@ -174,6 +175,8 @@ TEST(Serialization, Tier1OfVersion2IsRead)
 	}
 	auto b = roundTrip(static_cast<const CBackgroundSubtractionGrid&>(old));
 	ASSERT_TRUE(b);
+	// A map of version 2 was built without a ray margin.
+	EXPECT_EQ(b->params().raycast_margin, 0);
 	EXPECT_EQ(b->frameCount(), old.frameCount());
 	EXPECT_EQ(b->lastCells(), old.lastCells());
 	EXPECT_EQ(b->lastPosterior(), old.lastPosterior());

@@ -62,10 +62,13 @@ class CBayesVoxelGridBase : public mrpt::maps::CMetricMap
 	/** Resets counters (called by derived internal_clear()). */
 	void clearBase();
 	void setParamsBase(const GridParams& p);
-	/** Serialises params and counters. */
-	void writeBase(mrpt::serialization::CArchive& out) const;
-	/** \a version: of the derived class's serialisation (0: without
-	 * p_unknown, bg_neighbourhood, exclude_moving). */
+	/** Serialises params and counters, the parameters in the layout of
+	 * \a version (readBase(); older ones only to test the readers). */
+	void writeBase(mrpt::serialization::CArchive& out,
+	               uint8_t version = 3) const;
+	/** \a version: of the parameters' serialisation (0: without
+	 * p_unknown, bg_neighbourhood, exclude_moving; 1: without exclude_by;
+	 * 2: without raycast_margin; 3: all). */
 	void readBase(mrpt::serialization::CArchive& in, uint8_t version);
 
 	/** Appends cubes of side voxel_size at \a centers with \a color to the

@@ -157,6 +157,11 @@ struct GridParams
 	int raycast_decimation = 1;
 	/** decay = raycast: rays to each reading or to each hit voxel. */
 	RayTarget raycast_target = RayTarget::Voxels;
+	/** decay = raycast: a ray ends this far before its reading [m], so the
+	 * voxels in the reading's noise band get no miss (the free region of
+	 * the inverse sensor model, r < z - alpha/2; docs/model.md). 0: up to
+	 * the hit voxel. */
+	double raycast_margin = 0.1;
 	/** MotionGrids: tier 0 (the background of tier 1) integrates only the
 	 * voxels that the motion decision of this frame calls static; a voxel
 	 * labelled moving keeps its belief (no hit, no miss). false = the
