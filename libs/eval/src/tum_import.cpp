@@ -158,19 +158,19 @@ ImportSummary importTum(const std::string& folder, const std::string& outRawlog,
 		else if (it.kind == 1)
 		{
 			w.write(*options.extra[it.i]);
-			sum.imu++;
+			if (sum.imu++ == 0) sum.imuLabel = options.extra[it.i]->sensorLabel;
 		}
 		else
 		{
 			const auto& a = tum.accel[it.i];
 			auto m = mrpt::obs::CObservationIMU::Create();
-			m->sensorLabel = params.imuLabel;
+			m->sensorLabel = params.accelLabel;
 			m->timestamp = mrpt::Clock::fromDouble(a.t);
 			m->set(mrpt::obs::IMU_X_ACC, a.a[0]);
 			m->set(mrpt::obs::IMU_Y_ACC, a.a[1]);
 			m->set(mrpt::obs::IMU_Z_ACC, a.a[2]);
 			w.write(*m);
-			sum.imu++;
+			sum.accel++;
 		}
 	}
 	w.close();

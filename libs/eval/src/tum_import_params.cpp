@@ -47,6 +47,13 @@ void ImportParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg)
 	timestampFrom = im.getChoice("timestamp", timestampFrom);
 	gtMaxGap = im.getDouble("gt_max_gap_s", gtMaxGap, 0.0, 60.0);
 	rangeUnits = im.getDouble("range_units", rangeUnits, 1e-6, 0.1);
+	accelLabel = im.getString("accel_label", accelLabel);
+	if (accelLabel.empty()) im.fail("accel_label", "must not be empty");
+	if (accelLabel.find("SYNTH") != std::string::npos)
+		im.fail("accel_label",
+		        "'" + accelLabel +
+		            "': accelerometer.txt is a real sensor; a label with "
+		            "SYNTH is the synthetic IMU's (--synth-imu)");
 	im.finish();
 
 	loadImportLabels(cfg, rgbdLabel, imuLabel);

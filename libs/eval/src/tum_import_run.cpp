@@ -13,11 +13,23 @@
 namespace bims::eval
 {
 std::string importReport(const std::string& out, const ImportSummary& sum,
-                         bool synthetic, bool bonnConverted)
+                         bool synthetic, bool bonnConverted,
+                         const ImportParams& params)
 {
 	std::string r = mrpt::format(
-	    "%s: %zu RGB-D frames, %zu IMU observations%s\n", out.c_str(),
-	    sum.frames, sum.imu, synthetic ? " (synthetic)" : "");
+	    "%s: %zu RGB-D frames, %zu IMU observations%s", out.c_str(), sum.frames,
+	    sum.imu,
+	    sum.imu
+	        ? (std::string(synthetic ? " (synthetic, label '" : " (label '") +
+	           sum.imuLabel + "')")
+	              .c_str()
+	        : "");
+	if (sum.accel)
+		r += mrpt::format(
+		    ", %zu accelerometer samples of accelerometer.txt (label '%s', "
+		    "accelerometer only)",
+		    sum.accel, params.accelLabel.c_str());
+	r += "\n";
 	if (sum.gtPoses || sum.framesWithoutGt)
 		r += mrpt::format(
 		    "%s/groundtruth.txt: %zu poses (T_WC at the frames' stamps%s), "
@@ -73,8 +85,9 @@ int runImport(const ImportRunOptions& o)
 	}
 
 	const auto sum = importTum(o.folder, o.out, params, opt);
-	std::fputs(importReport(o.out, sum, o.synth_imu, bonnConverted).c_str(),
-	           stdout);
+	std::fputs(
+	    importReport(o.out, sum, o.synth_imu, bonnConverted, params).c_str(),
+	    stdout);
 	return 0;
 }
 

@@ -1,6 +1,7 @@
 // bims-import-tum's run (tum_import_run.h) called directly: the report,
 // the option checks and the synthetic IMU asked of the program's hook.
 #include <bims/common/app.h>
+#include <bims/common/config.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/eval/pose_utils.h>
@@ -61,16 +62,21 @@ std::string errorOf(const bims::eval::ImportRunOptions& o)
 TEST(ImportRun, TheReportNamesFramesImuAndGroundTruth)
 {
 	bims::eval::ImportSummary s;
+	bims::eval::ImportParams p;
 	s.frames = 3;
-	s.imu = 7;
 	s.gtDir = "x_gt";
-	EXPECT_EQ(bims::eval::importReport("x.rawlog", s, false, false),
-	          "x.rawlog: 3 RGB-D frames, 7 IMU observations\n"
+	EXPECT_EQ(bims::eval::importReport("x.rawlog", s, false, false, p),
+	          "x.rawlog: 3 RGB-D frames, 0 IMU observations\n"
 	          "x_gt: no groundtruth.txt in the folder\n");
+	s.imu = 7;
+	s.imuLabel = "IMU_SYNTH";
+	s.accel = 5;
 	s.gtPoses = 2;
 	s.framesWithoutGt = 1;
-	EXPECT_EQ(bims::eval::importReport("x.rawlog", s, true, true),
-	          "x.rawlog: 3 RGB-D frames, 7 IMU observations (synthetic)\n"
+	EXPECT_EQ(bims::eval::importReport("x.rawlog", s, true, true, p),
+	          "x.rawlog: 3 RGB-D frames, 7 IMU observations (synthetic, label "
+	          "'IMU_SYNTH'), 5 accelerometer samples of accelerometer.txt "
+	          "(label 'ACCEL', accelerometer only)\n"
 	          "x_gt/groundtruth.txt: 2 poses (T_WC at the frames' stamps, "
 	          "Bonn-converted), 1 frames outside the ground truth\n");
 }
@@ -144,4 +150,48 @@ TEST(ImportRun, SynthImuTakesTheConvertedTruthLabelCalibrationAndSeed)
 	}
 	EXPECT_EQ(n, 3u);
 	EXPECT_EQ(imu, 1u);
+}
+
+// accelerometer.txt is a real sensor of its own: its samples get [import]
+// accel_label (accelerometer only), never the synthetic IMU's label, even
+// when the config's imu_label names the synthetic one (config/bonn.ini).
+TEST(ImportRun, AccelerometerTxtIsARealSensorWithItsOwnLabel)
+{
+	const auto d = tumFolder("accel", false);
+	std::ofstream(d + "/accelerometer.txt")
+	    << "# accelerometer data\n1.02 0.1 -9.8 0.2\n1.05 0.0 -9.7 0.1\n";
+	std::ofstream(d + "/c.ini") << "[sensors]\nimu_label = IMU_SYNTH\n";
+	bims::eval::ImportRunOptions o;
+	o.folder = d;
+	o.out = d + "/x.rawlog";
+	o.config = d + "/c.ini";
+	o.progress = false;
+	ASSERT_EQ(bims::eval::runImport(o), 0);
+	std::vector<std::string> labels;
+	std::vector<double> ay;
+	bims::RawlogReader r(o.out);
+	while (auto obs = r.next())
+		if (auto imu =
+		        std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(obs))
+		{
+			labels.push_back(imu->sensorLabel);
+			ay.push_back(imu->get(mrpt::obs::IMU_Y_ACC));
+			EXPECT_FALSE(imu->has(mrpt::obs::IMU_WX)) << "no gyro invented";
+		}
+	EXPECT_EQ(labels, (std::vector<std::string>{"ACCEL", "ACCEL"}));
+	EXPECT_EQ(ay, (std::vector<double>{-9.8, -9.7}));
+	// Another label by [import] accel_label; a synthetic-looking one refused.
+	std::ofstream(d + "/c.ini") << "[import]\naccel_label = PHONE_ACC\n";
+	o.out = d + "/y.rawlog";
+	ASSERT_EQ(bims::eval::runImport(o), 0);
+	bims::RawlogReader r2(o.out);
+	size_t phone = 0;
+	while (auto obs = r2.next()) phone += obs->sensorLabel == "PHONE_ACC";
+	EXPECT_EQ(phone, 2u);
+	std::ofstream(d + "/c.ini") << "[import]\naccel_label = ACC_SYNTH\n";
+	o.out = d + "/z.rawlog";
+	const std::string e = errorOf<bims::ConfigError>(o);
+	EXPECT_NE(e.find("accel_label"), std::string::npos) << e;
+	EXPECT_NE(e.find("SYNTH"), std::string::npos) << e;
+	EXPECT_FALSE(fs::exists(o.out));
 }

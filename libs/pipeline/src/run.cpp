@@ -221,6 +221,8 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		stage["outputs"] = out->frameMs();
 		stage["outputs_cpu"] = out->frameCpuMs();
 	}
+	for (auto& n : source::imuNotes(sum, imuLabel))
+		sum.notes.push_back(std::move(n));
 	if (sum.framesProcessed > 0 && sum.imuRead == 0 &&
 	    cfg.ego.odometry.mode == ego::OdometryMode::Imu)
 		sum.notes.push_back(

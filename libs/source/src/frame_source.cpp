@@ -21,6 +21,11 @@ bool labelMatches(const std::string& want, const std::string& have)
 	return want.empty() || want == have;
 }
 
+std::string quoted(const std::string& label)
+{
+	return "'" + label + "'";
+}
+
 void add(InputCost& a, const InputCost& b)
 {
 	a.readMs += b.readMs;
@@ -108,12 +113,32 @@ bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
 	const double t = mrpt::Clock::toDouble(obs->timestamp);
 	if (auto imu = std::dynamic_pointer_cast<CObservationIMU>(obs))
 	{
+		const uint8_t channels = imuChannels(*imu);
 		if (!labelMatches(p_.sensors.imu_label, imu->sensorLabel))
 		{
 			st_.otherSkipped++;
+			auto& o = st_.imuOtherLabels[imu->sensorLabel];
+			o.channels |= channels;
+			if (o.samples++ == 0 && p_.warnings)
+				std::fprintf(
+				    stderr,
+				    "%s: warning: %s: IMU samples labelled %s (%s) are "
+				    "not used: [sensors] imu_label is %s\n",
+				    p_.program.c_str(), where.c_str(),
+				    quoted(imu->sensorLabel).c_str(),
+				    imuChannelNames(channels).c_str(),
+				    quoted(p_.sensors.imu_label).c_str());
 			return true;
 		}
-		st_.imuRead++;
+		if (st_.imuRead++ == 0 && !(channels & kImuGyro) && p_.warnings)
+			std::fprintf(stderr,
+			             "%s: warning: %s: the IMU labelled %s measures %s: "
+			             "without a gyro the egomotion cannot use it (frames "
+			             "run as vision, flagged imu_missing)\n",
+			             p_.program.c_str(), where.c_str(),
+			             quoted(imu->sensorLabel).c_str(),
+			             imuChannelNames(channels).c_str());
+		st_.imuChannels |= channels;
 		if (rejected_
 		        .check(*imu, t, p_.warnings ? p_.program.c_str() : nullptr,
 		               where, at.entry)
@@ -204,6 +229,51 @@ bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
 	newestT_ = std::max(newestT_, t);
 	release(false);
 	return true;
+}
+
+uint8_t imuChannels(const mrpt::obs::CObservationIMU& imu)
+{
+	using namespace mrpt::obs;  // TIMUDataIndex values
+	auto all = [&](TIMUDataIndex a, TIMUDataIndex b, TIMUDataIndex c)
+	{ return imu.has(a) && imu.has(b) && imu.has(c); };
+	return uint8_t((all(IMU_WX, IMU_WY, IMU_WZ) ? kImuGyro : 0) |
+	               (all(IMU_X_ACC, IMU_Y_ACC, IMU_Z_ACC) ? kImuAccel : 0) |
+	               (all(IMU_MAG_X, IMU_MAG_Y, IMU_MAG_Z) ? kImuMag : 0));
+}
+
+std::string imuChannelNames(uint8_t c)
+{
+	std::string s;
+	for (const auto& [bit, name] :
+	     {std::pair{kImuGyro, "gyro"}, {kImuAccel, "accel"}, {kImuMag, "mag"}})
+		if (c & bit) s += (s.empty() ? "" : " + ") + std::string(name);
+	return s.empty() ? "no gyro, accel or mag" : s;
+}
+
+std::vector<std::string> imuNotes(const FrameOrderStats& s,
+                                  const std::string& label)
+{
+	std::vector<std::string> notes;
+	const std::string which =
+	    label.empty() ? "of any label" : "labelled " + quoted(label);
+	if (s.imuRead > 0)
+	{
+		std::string n = "IMU " + which + ": " + std::to_string(s.imuRead) +
+		                " samples (" + imuChannelNames(s.imuChannels) + ")";
+		if (!(s.imuChannels & kImuGyro))
+			n += "; without a gyro the egomotion cannot use them (it takes "
+			     "the rotation between frames from the gyro): its frames ran "
+			     "as vision, flagged imu_missing";
+		notes.push_back(n);
+	}
+	for (const auto& [other, st] : s.imuOtherLabels)
+		notes.push_back(
+		    std::to_string(st.samples) + " IMU samples labelled " +
+		    quoted(other) + " (" + imuChannelNames(st.channels) +
+		    ") were not used: [sensors] imu_label is " + quoted(label) +
+		    (s.imuRead == 0 ? " (set it to " + quoted(other) + " to use them)"
+		                    : ""));
+	return notes;
 }
 
 void FrameOrder::finish(const InputPlace& at)

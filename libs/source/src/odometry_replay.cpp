@@ -68,6 +68,7 @@ ReplayStats replayRawlog(const std::string& path, ego::Odometry& odo,
 	bar.finish();
 	st.otherLabel = src.stats().otherSkipped;
 	st.imuRejected = src.stats().imuRejected;
+	st.imuNotes = imuNotes(src.stats(), odo.config().sensors.imu_label);
 	if (!src.error().empty()) throw RawlogError(src.error());
 	return st;
 }

@@ -221,6 +221,8 @@ int runOdometry(const OdometryRunOptions& o)
 		std::fprintf(stderr,
 		             "bims-odom: no --masks: moving content is left to "
 		             "the robust alignment (no mask)\n");
+	for (const auto& n : st.imuNotes)
+		std::fprintf(stderr, "bims-odom: %s\n", n.c_str());
 	if (st.imuRejected)
 		std::fprintf(stderr,
 		             "bims-odom: %zu IMU samples not used (a value not "

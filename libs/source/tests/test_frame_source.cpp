@@ -180,6 +180,84 @@ TEST(FrameOrder, ObservationsOfOtherLabelsAndClassesAreSkipped)
 	EXPECT_EQ(order.stats().imuRead, 2u);
 }
 
+// No IMU is left unused silently: the samples of other labels are counted
+// by label with what they measure, and the notes of a run say which IMU was
+// used, what it measures, and what was not used and how to use it.
+TEST(FrameOrder, ImuSamplesOfOtherLabelsAreCountedAndNamed)
+{
+	auto accel = [](double t, const std::string& label)
+	{
+		auto o = CObservationIMU::Create();
+		o->timestamp = mrpt::Clock::fromDouble(t);
+		o->sensorLabel = label;
+		o->set(mrpt::obs::IMU_X_ACC, 0.1);
+		o->set(mrpt::obs::IMU_Y_ACC, -9.8);
+		o->set(mrpt::obs::IMU_Z_ACC, 0.2);
+		return o;
+	};
+	auto full = [](double t)
+	{
+		auto o = CObservationIMU::Create();
+		o->timestamp = mrpt::Clock::fromDouble(t);
+		o->sensorLabel = "IMU_SYNTH";
+		for (auto i :
+		     {mrpt::obs::IMU_WX, mrpt::obs::IMU_WY, mrpt::obs::IMU_WZ,
+		      mrpt::obs::IMU_X_ACC, mrpt::obs::IMU_Y_ACC, mrpt::obs::IMU_Z_ACC,
+		      mrpt::obs::IMU_MAG_X, mrpt::obs::IMU_MAG_Y, mrpt::obs::IMU_MAG_Z})
+			o->set(i, 0.5);
+		return o;
+	};
+	auto p = params();
+	p.warnings = false;
+	p.sensors.imu_label = "IMU_SYNTH";
+	{
+		FrameOrder order(p);
+		run(order, {accel(0.9, "ACCEL"), full(0.95), accel(1.0, "ACCEL"),
+		            scan(1.0), imu(1.05, 0.1, "GYRO"), full(1.2)});
+		const auto& s = order.stats();
+		EXPECT_EQ(s.imuRead, 2u);
+		EXPECT_EQ(s.imuChannels, kImuGyro | kImuAccel | kImuMag);
+		ASSERT_EQ(s.imuOtherLabels.size(), 2u);
+		EXPECT_EQ(s.imuOtherLabels.at("ACCEL").samples, 2u);
+		EXPECT_EQ(s.imuOtherLabels.at("ACCEL").channels, kImuAccel);
+		EXPECT_EQ(s.imuOtherLabels.at("GYRO").channels, 0)
+		    << "one gyro axis is not a gyro";
+		EXPECT_EQ(
+		    imuNotes(s, "IMU_SYNTH"),
+		    (std::vector<std::string>{
+		        "IMU labelled 'IMU_SYNTH': 2 samples (gyro + accel + mag)",
+		        "2 IMU samples labelled 'ACCEL' (accel) were not used: "
+		        "[sensors] imu_label is 'IMU_SYNTH'",
+		        "1 IMU samples labelled 'GYRO' (no gyro, accel or mag) were "
+		        "not "
+		        "used: [sensors] imu_label is 'IMU_SYNTH'"}));
+	}
+	{
+		// The configured label matches none: the note says how to use them.
+		FrameOrder order(p);
+		run(order, {accel(0.9, "ACCEL"), scan(1.0), accel(1.2, "ACCEL")});
+		EXPECT_EQ(imuNotes(order.stats(), "IMU_SYNTH"),
+		          (std::vector<std::string>{
+		              "2 IMU samples labelled 'ACCEL' (accel) were not used: "
+		              "[sensors] imu_label is 'IMU_SYNTH' (set it to 'ACCEL' "
+		              "to use them)"}));
+	}
+	{
+		// An accelerometer alone: used, and said to give the egomotion
+		// nothing.
+		p.sensors.imu_label = "ACCEL";
+		FrameOrder order(p);
+		run(order, {accel(0.9, "ACCEL"), scan(1.0), accel(1.2, "ACCEL")});
+		const auto n = imuNotes(order.stats(), "ACCEL");
+		ASSERT_EQ(n.size(), 1u);
+		EXPECT_EQ(n[0].rfind("IMU labelled 'ACCEL': 2 samples (accel); without "
+		                     "a gyro the egomotion cannot use them",
+		                     0),
+		          0u)
+		    << n[0];
+	}
+}
+
 TEST(FrameOrder, ReadingStopsAfterTheLastFrameOfTheRange)
 {
 	auto p = params();

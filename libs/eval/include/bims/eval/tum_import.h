@@ -72,6 +72,10 @@ struct ImportParams
 	/** [sensors] rgbd_label, imu_label: sensor labels in the rawlog (an
 	 * empty value, "any" for rawlog readers, keeps the default). */
 	std::string rgbdLabel = "RGBD", imuLabel = "IMU";
+	/** [import] accel_label: the sensor label of accelerometer.txt's
+	 * samples, a real sensor of its own (accelerometer only): never a
+	 * synthetic IMU's label (one with "SYNTH" is refused). */
+	std::string accelLabel = "ACCEL";
 
 	/** Checks the file's sections (bims::checkExperimentSections) and reads
 	 * [camera], [import], [sensors] strictly. */
@@ -140,9 +144,11 @@ struct ImportOptions
 
 struct ImportSummary
 {
-	size_t frames = 0;           ///< 3D scans written
-	size_t imu = 0;              ///< IMU observations written (file + extra)
-	size_t gtPoses = 0;          ///< poses in OUT_gt/groundtruth.txt
+	size_t frames = 0;     ///< 3D scans written
+	size_t accel = 0;      ///< accelerometer.txt samples written (accelLabel)
+	size_t imu = 0;        ///< other IMU observations written (options.extra)
+	std::string imuLabel;  ///< their sensor label (of the first)
+	size_t gtPoses = 0;    ///< poses in OUT_gt/groundtruth.txt
 	size_t framesWithoutGt = 0;  ///< frames the ground truth did not cover
 	std::string gtDir;           ///< OUT_gt folder
 	Trajectory groundTruth;  ///< what groundtruth.txt holds (T_WC at frames)

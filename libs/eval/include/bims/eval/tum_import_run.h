@@ -42,10 +42,12 @@ struct ImportRunOptions
 };
 
 /** The lines bims-import-tum prints on stdout after importing into
- * \a out: frames and IMU observations (\a synthetic: marked so), then the
- * ground truth's poses (\a bonnConverted: marked so) or its absence. */
+ * \a out: frames, IMU observations (\a synthetic: marked so) and
+ * accelerometer samples with their labels (\a params), then the ground
+ * truth's poses (\a bonnConverted: marked so) or its absence. */
 std::string importReport(const std::string& out, const ImportSummary& sum,
-                         bool synthetic, bool bonnConverted);
+                         bool synthetic, bool bonnConverted,
+                         const ImportParams& params);
 
 /** bims-import-tum: checks the options (UsageError; no output may be an
  * input), reads the config (a note on stderr without one), synthesises the

@@ -8,7 +8,9 @@
 //
 // The rule, per observation:
 //  - an observation whose sensorLabel is not [sensors] rgbd_label (3D scans)
-//    or imu_label (IMU) is skipped (counted; an empty label takes all);
+//    or imu_label (IMU) is skipped (counted; an empty label takes all); IMU
+//    samples of another label are counted by label, and the first of each
+//    label is warned about (no IMU is left unused silently);
 //  - an IMU sample is checked (bims::RejectedImuSamples: a field not finite
 //    or beyond any sensor's range is warned about and not used);
 //  - 3D scans are numbered from 0 in input order (the index bims-run names
@@ -37,7 +39,9 @@
 #include <mrpt/obs/CObservationIMU.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <deque>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -142,6 +146,25 @@ struct SourceFrame
 	double inputFraction = 0;
 };
 
+/** What an IMU's samples measure: bits of ImuChannel. */
+enum ImuChannel : uint8_t
+{
+	kImuGyro = 1,
+	kImuAccel = 2,
+	kImuMag = 4
+};
+/** The channels of one sample (all three axes present). */
+uint8_t imuChannels(const mrpt::obs::CObservationIMU& imu);
+/** "gyro + accel + mag", "accel", ..., "no gyro, accel or mag". */
+std::string imuChannelNames(uint8_t channels);
+
+/** The IMU samples of one sensor label. */
+struct ImuLabelStats
+{
+	size_t samples = 0;
+	uint8_t channels = 0;  ///< ImuChannel bits seen in any of them
+};
+
 /** What the rule did with the observations it was given. */
 struct FrameOrderStats
 {
@@ -149,9 +172,20 @@ struct FrameOrderStats
 	size_t scansOutOfOrder = 0;  ///< skipped: stamp not after the previous
 	size_t scansBadStamp = 0;    ///< skipped: a stray stamp
 	size_t imuRead = 0;          ///< IMU samples with the label
+	uint8_t imuChannels = 0;     ///< what they measure (ImuChannel bits)
 	size_t imuRejected = 0;      ///< of them not used (warned about)
 	size_t otherSkipped = 0;     ///< another label, or another class
+	/** IMU samples of another label than [sensors] imu_label (among
+	 * otherSkipped), by label. */
+	std::map<std::string, ImuLabelStats> imuOtherLabels;
 };
+
+/** What a run should say about its IMU (bims-run's and bims-odom's
+ * summaries): the label used, its samples and channels, a gyro-less IMU
+ * the egomotion cannot use, and the IMU samples left unused under other
+ * labels. \a label: [sensors] imu_label. */
+std::vector<std::string> imuNotes(const FrameOrderStats& s,
+                                  const std::string& label);
 
 /** Where an observation comes from, for the warnings. */
 struct InputPlace

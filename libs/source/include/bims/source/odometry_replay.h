@@ -8,6 +8,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace bims::source
 {
@@ -35,6 +36,8 @@ struct ReplayStats
 	 * (bims::imuSampleProblem; a warning each, the frame flagged
 	 * imu_rejected). */
 	size_t imuRejected = 0;
+	/** What to say about the IMU (imuNotes()). */
+	std::vector<std::string> imuNotes;
 };
 
 using FrameCallback = std::function<void(
