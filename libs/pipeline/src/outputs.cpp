@@ -252,6 +252,8 @@ void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
 	j["frames_flow_ahead"] = sum.framesFlowAhead;
 	j["frames_without_flow"] = sum.framesWithoutFlow;
 	j["imu_rejected"] = sum.imuRejected;
+	j["imu_out_of_order"] = sum.imuOutOfOrder;
+	j["imu_bad_stamp"] = sum.imuBadStamp;
 	j["scans_bad_stamp"] = sum.scansBadStamp;
 	Json& stages = j["stage_ms"] = Json::object();
 	for (const auto& [name, p] : sum.stageMs)

@@ -307,13 +307,16 @@ std::string formatSummary(const RunSummary& s)
 		o << " (docs/ego.md)\n";
 	}
 	for (const auto& note : s.notes) o << "note: " << note << "\n";
-	if (s.imuRejected || s.scansBadStamp || s.scansOutOfOrder)
+	if (s.imuRejected || s.imuOutOfOrder || s.imuBadStamp || s.scansBadStamp ||
+	    s.scansOutOfOrder)
 	{
 		std::snprintf(buf, sizeof(buf),
 		              "not used: %zu IMU samples (a field not finite or "
-		              "beyond range), %zu 3D scans with a stray timestamp, %zu "
-		              "out of order (warnings above)\n",
-		              s.imuRejected, s.scansBadStamp, s.scansOutOfOrder);
+		              "beyond range), %zu IMU samples out of order or "
+		              "repeated, %zu with a stray timestamp, %zu 3D scans with "
+		              "a stray timestamp, %zu out of order (warnings above)\n",
+		              s.imuRejected, s.imuOutOfOrder, s.imuBadStamp,
+		              s.scansBadStamp, s.scansOutOfOrder);
 		o << buf;
 	}
 	if (!s.error.empty()) o << "stopped early: " << s.error << "\n";

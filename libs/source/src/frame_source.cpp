@@ -84,6 +84,48 @@ void FrameOrder::dropHeld(const InputPlace& at, const char* why)
 	held_.reset();
 }
 
+bool FrameOrder::imuStampUsable(const mrpt::obs::CObservationIMU::Ptr& imu,
+                                double t, const std::string& where)
+{
+	if (!(t <= imuStampT_)) return true;
+	if (st_.imuOutOfOrder++ == 0 && p_.warnings)
+		std::fprintf(stderr,
+		             "%s: warning: %s: IMU sample '%s' at t %.6f is not after "
+		             "the previous one (t %.6f): skipped (the next ones too, "
+		             "counted in the summary, not warned about)\n",
+		             p_.program.c_str(), where.c_str(),
+		             imu->sensorLabel.c_str(), t, imuStampT_);
+	return false;
+}
+
+void FrameOrder::useImu(const mrpt::obs::CObservationIMU::Ptr& imu, double t,
+                        const std::string& where, size_t entry)
+{
+	imuStampT_ = t;
+	if (rejected_
+	        .check(*imu, t, p_.warnings ? p_.program.c_str() : nullptr, where,
+	               entry)
+	        .empty())
+	{
+		imu_.push_back(imu);
+		lastImuT_ = std::max(lastImuT_, t);
+	}
+	st_.imuRejected = rejected_.count();
+}
+
+void FrameOrder::dropHeldImu(const std::string& where, const char* why)
+{
+	if (st_.imuBadStamp++ == 0 && p_.warnings)
+		std::fprintf(stderr,
+		             "%s: warning: %s: IMU sample '%s' at t %.6f is %.6g s "
+		             "after the previous one and %s: a stray timestamp; "
+		             "skipped (the next ones too, counted in the summary, not "
+		             "warned about)\n",
+		             p_.program.c_str(), where.c_str(),
+		             heldImu_->sensorLabel.c_str(), heldImuT_,
+		             heldImuT_ - imuStampT_, why);
+}
+
 void FrameOrder::release(bool all)
 {
 	while (!waiting_.empty() && (all || ready(waiting_.front())))
@@ -139,16 +181,28 @@ bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
 			             quoted(imu->sensorLabel).c_str(),
 			             imuChannelNames(channels).c_str());
 		st_.imuChannels |= channels;
-		if (rejected_
-		        .check(*imu, t, p_.warnings ? p_.program.c_str() : nullptr,
-		               where, at.entry)
-		        .empty())
-		{
-			imu_.push_back(imu);
-			lastImuT_ = std::max(lastImuT_, t);
-		}
-		st_.imuRejected = rejected_.count();
 		if (p_.keepInput) input_.push_back(imu);
+		if (heldImu_)
+		{
+			// the sample after a far one: it follows within the gap (the
+			// recording jumped, both are used) or the far stamp was stray
+			if (t > heldImuT_ && t - heldImuT_ <= kMaxScanGapS)
+				useImu(heldImu_, heldImuT_, where, heldImuEntry_);
+			else
+				dropHeldImu(where, "the next sample is not");
+			heldImu_.reset();
+		}
+		if (imuStampUsable(imu, t, where))
+		{
+			if (std::isfinite(imuStampT_) && t - imuStampT_ > kMaxScanGapS)
+			{
+				heldImu_ = imu;  // the next sample decides
+				heldImuT_ = t;
+				heldImuEntry_ = at.entry;
+			}
+			else
+				useImu(imu, t, where, at.entry);
+		}
 	}
 	else if (auto scan =
 	             std::dynamic_pointer_cast<CObservation3DRangeScan>(obs))
@@ -254,6 +308,18 @@ std::vector<std::string> imuNotes(const FrameOrderStats& s,
                                   const std::string& label)
 {
 	std::vector<std::string> notes;
+	// Samples whose stamp or values could not be used: most of them, and
+	// the IMU was in effect absent.
+	const size_t unusable = s.imuRejected + s.imuOutOfOrder + s.imuBadStamp;
+	if (s.imuRead > 0 && 2 * unusable > s.imuRead)
+		notes.push_back(
+		    "the IMU was mostly unusable: " + std::to_string(unusable) +
+		    " of its " + std::to_string(s.imuRead) + " samples skipped (" +
+		    std::to_string(s.imuOutOfOrder) + " out of order or repeated, " +
+		    std::to_string(s.imuBadStamp) + " with a stray stamp, " +
+		    std::to_string(s.imuRejected) +
+		    " with a value not finite or beyond range): frames without IMU "
+		    "data ran as vision (imu_missing, imu_gap)");
 	const std::string which =
 	    label.empty() ? "of any label" : "labelled " + quoted(label);
 	if (s.imuRead > 0)
@@ -279,6 +345,12 @@ std::vector<std::string> imuNotes(const FrameOrderStats& s,
 void FrameOrder::finish(const InputPlace& at)
 {
 	if (held_) dropHeld(at, "it is the last scan");
+	if (heldImu_)
+	{
+		dropHeldImu(at.path ? *at.path : std::string("input"),
+		            "it is the last sample");
+		heldImu_.reset();
+	}
 	ended_ = true;
 	release(true);
 }

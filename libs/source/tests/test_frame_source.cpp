@@ -258,6 +258,75 @@ TEST(FrameOrder, ImuSamplesOfOtherLabelsAreCountedAndNamed)
 	}
 }
 
+// IMU stamps as scan stamps: one stamp shifted far ahead is stray (skipped,
+// counted; it must not release every frame at once nor push the others out
+// of order), a recording that jumps keeps its samples, stamps that go back
+// or repeat are skipped and counted.
+TEST(FrameOrder, ImuSamplesWithStrayOrOutOfOrderStampsAreSkippedAndCounted)
+{
+	auto p = params();
+	p.warnings = false;
+	auto stamps = [](const std::vector<SourceFrame>& frames)
+	{
+		std::vector<double> t;
+		for (const auto& f : frames)
+			for (const auto& m : f.imu)
+				t.push_back(mrpt::Clock::toDouble(m->timestamp));
+		return t;
+	};
+	{
+		FrameOrder order(p);
+		const auto frames = run(
+		    order, {imu(0.95), scan(1.0), imu(1.05), imu(1.07 + 1e5), imu(1.1),
+		            scan(1.1), imu(1.15), imu(1.2), scan(1.2), imu(1.25)});
+		ASSERT_EQ(frames.size(), 3u);
+		EXPECT_EQ(stamps(frames),
+		          (std::vector<double>{0.95, 1.05, 1.1, 1.15, 1.2}));
+		EXPECT_EQ(order.stats().imuBadStamp, 1u);
+		EXPECT_EQ(order.stats().imuOutOfOrder, 0u);
+		EXPECT_EQ(order.stats().imuRead, 7u);
+	}
+	{
+		// a far stamp followed by one within the gap: the recording jumped
+		FrameOrder order(p);
+		const auto frames =
+		    run(order, {imu(0.95), scan(1.0), imu(31.0), imu(31.05),
+		                scan(31.05), imu(31.1), scan(31.1), imu(31.15)});
+		ASSERT_EQ(frames.size(), 3u);
+		EXPECT_EQ(stamps(frames),
+		          (std::vector<double>{0.95, 31.0, 31.05, 31.1}));
+		EXPECT_EQ(order.stats().imuBadStamp, 0u);
+	}
+	{
+		// stamps that go back or repeat, and a far one as the last sample
+		FrameOrder order(p);
+		const auto frames =
+		    run(order, {imu(0.95), scan(1.0), imu(1.05), imu(1.05), imu(1.02),
+		                imu(1.1), scan(1.1), imu(1.2), imu(500.0)});
+		ASSERT_EQ(frames.size(), 2u);
+		EXPECT_EQ(stamps(frames), (std::vector<double>{0.95, 1.05, 1.1}));
+		EXPECT_EQ(order.stats().imuOutOfOrder, 2u);
+		EXPECT_EQ(order.stats().imuBadStamp, 1u);
+		const auto n = imuNotes(order.stats(), "IMU");
+		ASSERT_FALSE(n.empty());
+		EXPECT_EQ(n[0].rfind("IMU labelled 'IMU': 7 samples", 0), 0u) << n[0];
+	}
+	{
+		// all in reverse order: most of the IMU unusable, and said so
+		FrameOrder order(p);
+		run(order, {imu(1.3), imu(1.2), imu(1.1), scan(1.0), imu(1.0),
+		            scan(1.1), imu(0.9)});
+		EXPECT_EQ(order.stats().imuOutOfOrder, 4u);
+		const auto n = imuNotes(order.stats(), "IMU");
+		ASSERT_FALSE(n.empty());
+		EXPECT_EQ(n[0].rfind("the IMU was mostly unusable: 4 of its 5 samples "
+		                     "skipped (4 out of order or repeated",
+		                     0),
+		          0u)
+		    << n[0];
+	}
+}
+
 TEST(FrameOrder, ReadingStopsAfterTheLastFrameOfTheRange)
 {
 	auto p = params();

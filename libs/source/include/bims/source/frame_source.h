@@ -13,6 +13,10 @@
 //    label is warned about (no IMU is left unused silently);
 //  - an IMU sample is checked (bims::RejectedImuSamples: a field not finite
 //    or beyond any sensor's range is warned about and not used);
+//  - an IMU sample stamped not after the previous one used is skipped; one
+//    stamped more than kMaxScanGapS after it is held until the next sample
+//    says whether the recording jumped (kept) or the stamp is stray
+//    (skipped); the first of each kind is warned about, all are counted;
 //  - 3D scans are numbered from 0 in input order (the index bims-run names
 //    its files by); a scan outside the frame range is skipped, and reading
 //    stops after the range's last;
@@ -41,6 +45,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -174,6 +179,8 @@ struct FrameOrderStats
 	size_t imuRead = 0;          ///< IMU samples with the label
 	uint8_t imuChannels = 0;     ///< what they measure (ImuChannel bits)
 	size_t imuRejected = 0;      ///< of them not used (warned about)
+	size_t imuOutOfOrder = 0;    ///< skipped: stamp not after the previous
+	size_t imuBadStamp = 0;      ///< skipped: a stray stamp (far ahead)
 	size_t otherSkipped = 0;     ///< another label, or another class
 	/** IMU samples of another label than [sensors] imu_label (among
 	 * otherSkipped), by label. */
@@ -226,6 +233,12 @@ class FrameOrder
 	void accept(SourceFrame&& f);
 	void dropHeld(const InputPlace& at, const char* why);
 	void release(bool all);
+	/** The stamp rule of IMU samples: false if \a imu is skipped or held. */
+	bool imuStampUsable(const mrpt::obs::CObservationIMU::Ptr& imu, double t,
+	                    const std::string& where);
+	void useImu(const mrpt::obs::CObservationIMU::Ptr& imu, double t,
+	            const std::string& where, size_t entry);
+	void dropHeldImu(const std::string& where, const char* why);
 
 	FrameOrderParams p_;
 	FrameOrderStats st_;
@@ -234,6 +247,13 @@ class FrameOrder
 	std::deque<SourceFrame> waiting_;  ///< accepted, waiting for the IMU
 	std::deque<SourceFrame> released_;
 	std::optional<SourceFrame> held_;  ///< a far stamp, the next scan decides
+	/** An IMU sample of a far stamp, the next sample decides (with the
+	 * place it was read at). */
+	mrpt::obs::CObservationIMU::Ptr heldImu_;
+	double heldImuT_ = 0;
+	size_t heldImuEntry_ = 0;
+	/** Stamp of the last IMU sample whose stamp was used. */
+	double imuStampT_ = -std::numeric_limits<double>::infinity();
 	std::vector<mrpt::obs::CObservationIMU::Ptr> imu_;  ///< not handed out
 	std::vector<mrpt::obs::CObservation::Ptr> input_;   ///< keepInput
 	InputCost cost_;  ///< since the last frame made
