@@ -24,7 +24,7 @@ echo "== the bundled sample"
 mkdir -p "$OUT"
 table="$OUT/summary.txt"
 printf '%-14s %9s %9s %9s %9s %9s %9s %12s\n' variant precision recall F1 IoU "voxel F1" frames/s "ATE RMSE m" > "$table"
-for v in bottom-only flow-only fused fused-raycast; do
+for v in bottom-only flow-only fused; do
   echo
   echo "== bims-run --variant $v"
   "$BIN/bims-run" "$CONFIG" "$SAMPLE" -o "$OUT/$v" --variant "$v" --overwrite -q | tee "$OUT/$v.log"

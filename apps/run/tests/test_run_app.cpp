@@ -359,7 +359,7 @@ TEST(RunApp, PrintConfigIsTheEffectiveIniOfARun)
 	EXPECT_NE(file.out.find("[grids]\nvoxel_size = 0.05 // "),
 	          std::string::npos)
 	    << file.out;
-	EXPECT_NE(file.out.find("\ndecay = frustum // "), std::string::npos);
+	EXPECT_NE(file.out.find("\ndecay = raycast // "), std::string::npos);
 	const auto p = run(q(paper) + " --print-config");
 	ASSERT_EQ(p.code, 0) << p.out;
 	EXPECT_NE(p.out.find("\ndecay = all // "), std::string::npos);

@@ -44,7 +44,7 @@ TEST(PipelineConfig, TheBuiltInDefaultsAreConfigDefaultIni)
 	EXPECT_EQ(file.ego.calibration.R_IC, builtIn.ego.calibration.R_IC);
 	EXPECT_EQ(file.ego.camera.given, builtIn.ego.camera.given);
 	// and a few of the tuned keys by name
-	EXPECT_EQ(builtIn.grids.decay, bims::maps::DecayMode::Frustum);
+	EXPECT_EQ(builtIn.grids.decay, bims::maps::DecayMode::Raycast);
 	EXPECT_EQ(builtIn.grids.p_unknown, 0.97);
 	EXPECT_TRUE(builtIn.grids.exclude_moving);
 	EXPECT_TRUE(builtIn.flow.derotate);
@@ -152,7 +152,7 @@ TEST(PipelineConfig, EffectiveIniHasEverySectionAndAMeaningPerKey)
 	                      "attitude", "tracker", "translation", "odometry",
 	                      "anchor", "flow", "grids", "pipeline", "output"})
 		EXPECT_TRUE(m.sectionExists(s)) << s;
-	EXPECT_NE(text.find("\ndecay = frustum // "), std::string::npos);
+	EXPECT_NE(text.find("\ndecay = raycast // "), std::string::npos);
 	EXPECT_NE(text.find("\nvariant = fused // "), std::string::npos);
 	EXPECT_NE(fromText("[camera]\nfx=500\nfy=500\ncx=320\ncy=240\n"
 	                   "width=640\nheight=480\n"
@@ -218,7 +218,7 @@ TEST(PipelineConfig, FusedRaycastSetsRaycastDecay)
 {
 	ExperimentConfig c;
 	c.ego.odometry.mode = bims::ego::OdometryMode::Vision;
-	EXPECT_EQ(c.grids.decay, bims::maps::DecayMode::Frustum);
+	c.grids.decay = bims::maps::DecayMode::Frustum;
 	c.setVariant(Variant::FusedRaycast);
 	EXPECT_EQ(c.grids.decay, bims::maps::DecayMode::Raycast);
 }

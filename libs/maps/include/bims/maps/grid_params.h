@@ -116,7 +116,7 @@ struct GridParams
 	/** Edge of a cubic voxel [m]. */
 	double voxel_size = 0.05;
 	/** Which unobserved cells decay (tier 0). */
-	DecayMode decay = DecayMode::Frustum;
+	DecayMode decay = DecayMode::Raycast;
 	/** P(D = 0): probability that the sensor misses an occupied cell. Also
 	 * sets the decay per frame, log(2 - p_miss). */
 	double p_miss = 0.1;
