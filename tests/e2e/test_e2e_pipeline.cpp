@@ -42,6 +42,17 @@ std::string tmpDir(const std::string& name)
 	return d.string();
 }
 
+/** The bundled sample copied to \a out, each observation passed through
+ * \a edit first (which may change it, or return false to leave it out). */
+void rewriteSample(const std::string& out,
+                   const std::function<bool(mrpt::obs::CObservation&)>& edit)
+{
+	bims::RawlogReader in(kSample);
+	bims::RawlogWriter w(out, 1);
+	while (auto o = in.next())
+		if (edit(*o)) w.write(*o);
+}
+
 cv::Mat validDepth(const mrpt::obs::CObservation3DRangeScan& s)
 {
 	cv::Mat v(s.rangeImage.rows(), s.rangeImage.cols(), CV_8UC1);
@@ -141,20 +152,17 @@ TEST(EndToEnd, DepthOnlyRunsTiers0And1WithoutTheFlowTier)
 {
 	const std::string dir = tmpDir("depth_only");
 	const std::string depthOnly = dir + "/depth_only.rawlog";
-	{
-		bims::RawlogReader in(kSample);
-		bims::RawlogWriter w(depthOnly, 1);
-		while (auto o = in.next())
-		{
-			if (auto s = std::dynamic_pointer_cast<
-			        mrpt::obs::CObservation3DRangeScan>(o))
-			{
-				s->hasIntensityImage = false;
-				s->intensityImage = mrpt::img::CImage();
-			}
-			w.write(*o);
-		}
-	}
+	rewriteSample(
+	    depthOnly,
+	    [](mrpt::obs::CObservation& o)
+	    {
+		    if (auto* s = dynamic_cast<mrpt::obs::CObservation3DRangeScan*>(&o))
+		    {
+			    s->hasIntensityImage = false;
+			    s->intensityImage = mrpt::img::CImage();
+		    }
+		    return true;
+	    });
 	ExperimentConfig cfg;
 	cfg.loadFromFile(kConfig);
 	bims::Trajectory est;
@@ -198,19 +206,16 @@ TEST(EndToEnd, OneStrayImuStampIsSkippedAndTheRunHolds)
 {
 	const std::string dir = tmpDir("stray_imu");
 	const std::string shifted = dir + "/shifted.rawlog";
-	{
-		bims::RawlogReader in(kSample);
-		bims::RawlogWriter w(shifted, 1);
-		size_t imu = 0;
-		while (auto o = in.next())
-		{
-			if (std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(o) &&
-			    imu++ == 200)
-				o->timestamp = mrpt::Clock::fromDouble(
-				    mrpt::Clock::toDouble(o->timestamp) + 1e5);
-			w.write(*o);
-		}
-	}
+	size_t imu = 0;
+	rewriteSample(
+	    shifted,
+	    [&](mrpt::obs::CObservation& o)
+	    {
+		    if (dynamic_cast<mrpt::obs::CObservationIMU*>(&o) && imu++ == 200)
+			    o.timestamp = mrpt::Clock::fromDouble(
+			        mrpt::Clock::toDouble(o.timestamp) + 1e5);
+		    return true;
+	    });
 	ExperimentConfig cfg;
 	cfg.loadFromFile(kConfig);
 	const auto gt =
@@ -324,16 +329,15 @@ TEST(EndToEnd, RawlogWithoutImuRunsVisionOnly)
 {
 	const std::string dir = tmpDir("noimu");
 	const std::string noImu = dir + "/noimu.rawlog";
-	{
-		bims::RawlogReader in(kSample);
-		bims::RawlogWriter w(noImu, 1);
-		size_t scans = 0;
-		while (auto o = in.next())
-			if (std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(
-			        o) &&
-			    scans++ < 20)
-				w.write(*o);
-	}
+	size_t scans = 0;
+	rewriteSample(
+	    noImu,
+	    [&](const mrpt::obs::CObservation& o)
+	    {
+		    return dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(
+		               &o) &&
+		           scans++ < 20;
+	    });
 	ExperimentConfig cfg;
 	cfg.loadFromFile(kConfig);
 	cfg.ego.odometry.mode = bims::ego::OdometryMode::Vision;

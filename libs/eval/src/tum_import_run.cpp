@@ -16,14 +16,11 @@ std::string importReport(const std::string& out, const ImportSummary& sum,
                          bool synthetic, bool bonnConverted,
                          const ImportParams& params)
 {
-	std::string r = mrpt::format(
-	    "%s: %zu RGB-D frames, %zu IMU observations%s", out.c_str(), sum.frames,
-	    sum.imu,
-	    sum.imu
-	        ? (std::string(synthetic ? " (synthetic, label '" : " (label '") +
-	           sum.imuLabel + "')")
-	              .c_str()
-	        : "");
+	std::string r = mrpt::format("%s: %zu RGB-D frames, %zu IMU observations",
+	                             out.c_str(), sum.frames, sum.imu);
+	if (sum.imu)
+		r += std::string(synthetic ? " (synthetic, " : " (") + "label '" +
+		     sum.imuLabel + "')";
 	if (sum.accel)
 		r += mrpt::format(
 		    ", %zu accelerometer samples of accelerometer.txt (label '%s', "

@@ -1,5 +1,7 @@
 #include <bims/source/frame_source.h>
 
+#include <bims/ego/attitude_filter.h>
+
 #include "read_ahead.h"
 
 #include <mrpt/core/Clock.h>
@@ -24,6 +26,19 @@ bool labelMatches(const std::string& want, const std::string& have)
 std::string quoted(const std::string& label)
 {
 	return "'" + label + "'";
+}
+
+// A stamp more than kMaxScanGapS after the last one used is held until the
+// next one decides (3D scans and IMU samples alike).
+bool farAhead(double t, double last)
+{
+	return std::isfinite(last) && t - last > kMaxScanGapS;
+}
+// The one after a held far stamp follows it within the gap: the recording
+// jumped (the held one is used), else its stamp was stray.
+bool followsHeld(double t, double held)
+{
+	return t > held && t - held <= kMaxScanGapS;
 }
 
 void add(InputCost& a, const InputCost& b)
@@ -124,6 +139,7 @@ void FrameOrder::dropHeldImu(const std::string& where, const char* why)
 		             p_.program.c_str(), where.c_str(),
 		             heldImu_->sensorLabel.c_str(), heldImuT_,
 		             heldImuT_ - imuStampT_, why);
+	heldImu_.reset();
 }
 
 void FrameOrder::release(bool all)
@@ -186,15 +202,17 @@ bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
 		{
 			// the sample after a far one: it follows within the gap (the
 			// recording jumped, both are used) or the far stamp was stray
-			if (t > heldImuT_ && t - heldImuT_ <= kMaxScanGapS)
+			if (followsHeld(t, heldImuT_))
+			{
 				useImu(heldImu_, heldImuT_, where, heldImuEntry_);
+				heldImu_.reset();
+			}
 			else
 				dropHeldImu(where, "the next sample is not");
-			heldImu_.reset();
 		}
 		if (imuStampUsable(imu, t, where))
 		{
-			if (std::isfinite(imuStampT_) && t - imuStampT_ > kMaxScanGapS)
+			if (farAhead(t, imuStampT_))
 			{
 				heldImu_ = imu;  // the next sample decides
 				heldImuT_ = t;
@@ -217,7 +235,7 @@ bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
 		if (held_)
 		{
 			// this scan follows the held one: the recording jumped
-			if (t > held_->t && t - held_->t <= kMaxScanGapS)
+			if (followsHeld(t, held_->t))
 			{
 				accept(std::move(*held_));
 				held_.reset();
@@ -271,7 +289,7 @@ bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
 		f.before.swap(input_);
 		input_.clear();
 		cost_ = {};
-		if (std::isfinite(lastScanT_) && t - lastScanT_ > kMaxScanGapS)
+		if (farAhead(t, lastScanT_))
 		{
 			held_ = std::move(f);  // the next scan decides
 			return true;
@@ -287,12 +305,10 @@ bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
 
 uint8_t imuChannels(const mrpt::obs::CObservationIMU& imu)
 {
-	using namespace mrpt::obs;  // TIMUDataIndex values
-	auto all = [&](TIMUDataIndex a, TIMUDataIndex b, TIMUDataIndex c)
-	{ return imu.has(a) && imu.has(b) && imu.has(c); };
-	return uint8_t((all(IMU_WX, IMU_WY, IMU_WZ) ? kImuGyro : 0) |
-	               (all(IMU_X_ACC, IMU_Y_ACC, IMU_Z_ACC) ? kImuAccel : 0) |
-	               (all(IMU_MAG_X, IMU_MAG_Y, IMU_MAG_Z) ? kImuMag : 0));
+	// what the egomotion reads from it (one home: ego::imuSampleFrom)
+	const ego::ImuSample s = ego::imuSampleFrom(imu);
+	return uint8_t((s.hasGyro ? kImuGyro : 0) | (s.hasAcc ? kImuAccel : 0) |
+	               (s.hasMag ? kImuMag : 0));
 }
 
 std::string imuChannelNames(uint8_t c)
@@ -346,11 +362,8 @@ void FrameOrder::finish(const InputPlace& at)
 {
 	if (held_) dropHeld(at, "it is the last scan");
 	if (heldImu_)
-	{
 		dropHeldImu(at.path ? *at.path : std::string("input"),
 		            "it is the last sample");
-		heldImu_.reset();
-	}
 	ended_ = true;
 	release(true);
 }

@@ -158,7 +158,8 @@ enum ImuChannel : uint8_t
 	kImuAccel = 2,
 	kImuMag = 4
 };
-/** The channels of one sample (all three axes present). */
+/** The channels of one sample, as the egomotion reads them
+ * (ego::imuSampleFrom: all three axes present and finite). */
 uint8_t imuChannels(const mrpt::obs::CObservationIMU& imu);
 /** "gyro + accel + mag", "accel", ..., "no gyro, accel or mag". */
 std::string imuChannelNames(uint8_t channels);
@@ -238,6 +239,7 @@ class FrameOrder
 	                    const std::string& where);
 	void useImu(const mrpt::obs::CObservationIMU::Ptr& imu, double t,
 	            const std::string& where, size_t entry);
+	/** Skips the held IMU sample (a stray stamp): counted, warned once. */
 	void dropHeldImu(const std::string& where, const char* why);
 
 	FrameOrderParams p_;
