@@ -3,8 +3,9 @@
 //
 //   bims-viewer [IN.rawlog] [--results OUTDIR] [--config CONFIG.ini]
 //               [--gt groundtruth.txt] [--no-pipeline] [--paused]
-//               [--speed S] [--max-frames N --screenshot FILE.png]
-//               [--keep-open] [--png-sequence DIR]
+//               [--speed S] [--mode realtime|every-frame] [--layers LIST]
+//               [--max-frames N --screenshot FILE.png] [--keep-open]
+//               [--png-sequence DIR] [--state-file FILE.json]
 //
 // Non-interactive use (tests, figures): --max-frames N steps N frames, then
 // --screenshot writes the 3D view as shown in the window and quits.
@@ -13,7 +14,9 @@
 #include <bims/common/share.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 
@@ -78,6 +81,25 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<double> aSpeed("", "speed",
 		                                   "replay speed (1 = real time)",
 		                                   false, 1.0, "S", cmd);
+		    TCLAP::ValueArg<std::string> aMode(
+		        "", "mode",
+		        "playing mode: realtime (the pipeline keeps the data's pace; "
+		        "frames finished while the window is still drawing are not "
+		        "drawn, all are processed) or every-frame (each frame is "
+		        "drawn; playback slows to the drawing)",
+		        false, "realtime", "MODE", cmd);
+		    TCLAP::ValueArg<std::string> aLayers(
+		        "", "layers",
+		        "3D layers shown at start, comma-separated: cloud, tier0, "
+		        "tier1, tier2, trajectory, gt (or all, none); also in the "
+		        "View menu",
+		        false, "cloud,tier1,tier2,trajectory,gt", "LIST", cmd);
+		    TCLAP::ValueArg<std::string> aState(
+		        "", "state-file",
+		        "after each frame drawn, write the window's state (frame, "
+		        "slider, counter, status bar, widget rectangles) to "
+		        "FILE.json (scripts, tests)",
+		        false, "", "FILE.json", cmd);
 		    TCLAP::ValueArg<int> aFrames("", "max-frames",
 		                                 "step N frames at start, then pause",
 		                                 false, -1, "N", cmd);
@@ -99,9 +121,10 @@ int main(int argc, char** argv)
 		                                       false, "1280x800", "WxH", cmd);
 		    bims::parseCommandLine(cmd, argc, argv,
 		                           {{"--frames", "--max-frames"}});
-		    bims::checkOutputsSpareInputs({aIn.getValue(), aRes.getValue(),
-		                                   aCfg.getValue(), aGt.getValue()},
-		                                  bims::givenValues(aShot, aSeq));
+		    bims::checkOutputsSpareInputs(
+		        {aIn.getValue(), aRes.getValue(), aCfg.getValue(),
+		         aGt.getValue()},
+		        bims::givenValues(aShot, aSeq, aState));
 
 		    auto& o = gOptions;
 		    // Default parameters: share/bims/default.ini of the build tree or
@@ -121,6 +144,30 @@ int main(int argc, char** argv)
 		    o.screenshot = aShot.getValue();
 		    o.keepOpen = aKeep.getValue();
 		    o.pngDir = aSeq.getValue();
+		    o.stateFile = aState.getValue();
+		    const auto parsed = [](const std::string& flag, auto parse)
+		    {
+			    try
+			    {
+				    return parse();
+			    }
+			    catch (const std::invalid_argument& e)
+			    {
+				    throw bims::UsageError(flag + ": " + e.what());
+			    }
+		    };
+		    o.mode = parsed(
+		        "--mode", [&]
+		        { return bims::viewer::playModeFromString(aMode.getValue()); });
+		    o.layers = parsed("--layers",
+		                      [&] {
+			                      return bims::viewer::LayerVisibility::parse(
+			                          aLayers.getValue());
+		                      });
+		    // a PNG sequence holds every frame: each must be drawn
+		    if (!o.pngDir.empty()) o.mode = bims::viewer::PlayMode::EveryFrame;
+		    if (o.speed <= 0 || !std::isfinite(o.speed))
+			    throw bims::UsageError("--speed: a positive number expected");
 		    if (std::sscanf(aSize.getValue().c_str(), "%dx%d", &o.width,
 		                    &o.height) != 2 ||
 		        o.width < 200 || o.height < 150)
@@ -135,11 +182,29 @@ int main(int argc, char** argv)
 				                             o.viewer.rawlog + "'");
 		    }
 
-		    std::cerr << "bims-viewer: "
-		              << bims::parametersSource(o.viewer.configPath) << "\n";
+		    // the parameters are named only when they are used
+		    if (o.viewer.runPipeline)
+			    std::cerr << "bims-viewer: "
+			              << bims::parametersSource(o.viewer.configPath)
+			              << "\n";
+		    const char* display = std::getenv("DISPLAY");
+		    const char* wayland = std::getenv("WAYLAND_DISPLAY");
+		    if ((!display || !*display) && (!wayland || !*wayland))
+			    throw std::runtime_error(
+			        "no display (DISPLAY is not set). Without a desktop, run "
+			        "the viewer under Xvfb, e.g. xvfb-run -a -s '-screen 0 "
+			        "1280x900x24 +extension GLX' bims-viewer IN.rawlog "
+			        "--max-frames N --screenshot FILE.png");
 		    int wxArgc = 1;
 		    char* wxArgv[] = {argv[0], nullptr};
 		    const int rc = wxEntry(wxArgc, wxArgv);
+		    if (!bims::viewer_app::ViewerFrame::created)
+			    throw std::runtime_error(
+			        std::string("could not open the display '") +
+			        (display ? display : wayland) +
+			        "' (GTK failed to start; see above). Check DISPLAY, or "
+			        "run the viewer under Xvfb: xvfb-run -a bims-viewer ... "
+			        "--screenshot FILE.png");
 		    if (rc != 0) return rc;
 		    return bims::viewer_app::ViewerFrame::exitCode;
 	    });

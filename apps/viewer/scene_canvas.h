@@ -19,6 +19,7 @@ class SceneCanvas : public mrpt::gui::CWxGLCanvasBase
 	/** True once the last requested capture was written; the error text
 	 * (empty when fine) in \a error. */
 	bool captureDone(std::string* error = nullptr) const;
+	const std::string& capturePath() const { return capturePath_; }
 
  protected:
 	void postRender() override;

@@ -1,7 +1,8 @@
 #include "viewer_frame.h"
-#include <bims/common/frame_files.h>
 
 #include <bims/common/app.h>
+#include <bims/common/frame_files.h>
+#include <bims/common/json.h>
 
 #include <wx/aboutdlg.h>
 #include <wx/dirdlg.h>
@@ -9,7 +10,6 @@
 #include <wx/slider.h>
 #include <wx/splitter.h>
 
-#include <cstdio>
 #include <iostream>
 
 #include "image_panel.h"
@@ -18,6 +18,7 @@
 namespace bims::viewer_app
 {
 int ViewerFrame::exitCode = 0;
+bool ViewerFrame::created = false;
 
 namespace
 {
@@ -26,39 +27,41 @@ enum
 	ID_OPEN_RESULTS = wxID_HIGHEST + 1,
 	ID_SCREENSHOT,
 	ID_PNG_SEQ,
-	ID_LAYER_CLOUD,
-	ID_LAYER_T0,
-	ID_LAYER_T1,
-	ID_LAYER_T2,
-	ID_LAYER_EST,
-	ID_LAYER_GT,
+	ID_LAYER_FIRST,  // one per viewer::Layer
+	ID_LAYER_LAST = ID_LAYER_FIRST + int(viewer::kLayerCount) - 1,
+	ID_FOLLOW,
 	ID_PLAY,
 	ID_STEP,
 	ID_RESTART,
+	ID_MODE_REALTIME,
+	ID_MODE_EVERY,
 	ID_SLIDER,
 	ID_SPEED
 };
 const double kSpeeds[] = {0.1, 0.25, 0.5, 1, 2, 4, 8};
-constexpr viewer::Panel kPanels[] = {
-    viewer::Panel::RgbMask, viewer::Panel::Depth, viewer::Panel::FlowObserved,
-    viewer::Panel::FlowExpected, viewer::Panel::Labels};
+
+/** A widget's rectangle on the screen as [x, y, w, h]. */
+Json screenRect(const wxWindow* w)
+{
+	const wxRect r = w->GetScreenRect();
+	return Json::array({r.x, r.y, r.width, r.height});
+}
 }  // namespace
 
 ViewerFrame::ViewerFrame(const AppOptions& opt)
     : wxFrame(nullptr, wxID_ANY, "bims-viewer", wxDefaultPosition,
               wxSize(opt.width, opt.height)),
       opt_(opt),
-      timer_(this),
-      batchTimer_(this)
+      timer_(this)
 {
+	created = true;
 	buildMenus();
 	buildLayout();
-	CreateStatusBar();
+	CreateStatusBar(2);
+	const int widths[] = {-3, -2};
+	SetStatusWidths(2, widths);
 	SetStatusText("File > Open rawlog... to start");
 	Bind(wxEVT_TIMER, &ViewerFrame::onTimer, this, timer_.GetId());
-	Bind(
-	    wxEVT_TIMER, [this](wxTimerEvent&) { startBatchScreenshot(); },
-	    batchTimer_.GetId());
 	pngDir_ = opt_.pngDir;
 	if (!pngDir_.empty()) makeDirs(pngDir_);
 	if (!opt_.viewer.rawlog.empty())
@@ -79,24 +82,26 @@ ViewerFrame::ViewerFrame(const AppOptions& opt)
 			showError(e.what());
 		}
 	}
-	if (ctl_ && opt_.frames > 0)
+	if (worker_)
 	{
-		ctl_->seek(static_cast<size_t>(opt_.frames - 1));
-		refreshViews(true);
-	}
-	if (!opt_.screenshot.empty())
-		batchTimer_.Start(100);  // capture once the window is drawn
-	else if (ctl_)
-	{
-		ctl_->setSpeed(opt_.speed);
+		worker_->setSpeed(opt_.speed);
 		// the speed box shows --speed when it is one of its entries
 		for (size_t i = 0; i < std::size(kSpeeds); ++i)
 			if (kSpeeds[i] == opt_.speed) speedChoice_->SetSelection(int(i));
-		ctl_->setPlaying(!opt_.paused && opt_.frames <= 0);
-		updateControls();
+		// --max-frames N: frame N-1; --paused: the first frame; else play
+		batchTarget_ = std::max(0, opt_.frames - 1);
+		if (!opt_.screenshot.empty() || opt_.paused || opt_.frames > 0)
+			worker_->seek(static_cast<size_t>(batchTarget_));
+		else
+			worker_->play(true);
 	}
-	lastTick_ = std::chrono::steady_clock::now();
-	timer_.Start(15);
+	timer_.Start(20);
+}
+
+ViewerFrame::~ViewerFrame()
+{
+	timer_.Stop();
+	worker_.reset();  // stops the replay thread before the widgets go
 }
 
 void ViewerFrame::buildMenus()
@@ -110,21 +115,27 @@ void ViewerFrame::buildMenus()
 	file->AppendSeparator();
 	file->Append(wxID_EXIT, "&Quit\tCtrl+Q");
 	auto* view = new wxMenu;
-	view->AppendCheckItem(ID_LAYER_CLOUD, "Registered &cloud")->Check(true);
-	view->AppendCheckItem(ID_LAYER_T0, "Tier &0 occupied voxels (blue)")
-	    ->Check(true);
-	view->AppendCheckItem(ID_LAYER_T1, "Tier &1 moving voxels (yellow)")
-	    ->Check(true);
-	view->AppendCheckItem(ID_LAYER_T2, "Tier &2 moving voxels (red)")
-	    ->Check(true);
-	view->AppendCheckItem(ID_LAYER_EST, "&Estimated trajectory (cyan)")
-	    ->Check(true);
-	view->AppendCheckItem(ID_LAYER_GT, "&Ground truth (green)")->Check(true);
+	for (size_t i = 0; i < viewer::kLayerCount; ++i)
+		view->AppendCheckItem(ID_LAYER_FIRST + int(i),
+		                      viewer::layerTitle(viewer::Layer(i)))
+		    ->Check(opt_.layers.on[i]);
+	view->AppendSeparator();
+	view->AppendCheckItem(ID_FOLLOW, "Camera &follows the sensor")
+	    ->Check(follow_);
 	auto* play = new wxMenu;
 	// Plain keys (GTK accelerators need modifiers): see the char hook.
 	play->Append(ID_PLAY, "&Play / Pause (Space)");
 	play->Append(ID_STEP, "&Step one frame (Right)");
 	play->Append(ID_RESTART, "&Restart (Home)");
+	play->AppendSeparator();
+	play->AppendRadioItem(ID_MODE_REALTIME,
+	                      "Real &time (frames finished while drawing are "
+	                      "not drawn)");
+	play->AppendRadioItem(ID_MODE_EVERY,
+	                      "&Every frame (playback slows to the drawing)");
+	play->Check(opt_.mode == viewer::PlayMode::RealTime ? ID_MODE_REALTIME
+	                                                    : ID_MODE_EVERY,
+	            true);
 	auto* help = new wxMenu;
 	help->Append(wxID_ABOUT, "&About");
 	auto* bar = new wxMenuBar;
@@ -163,7 +174,27 @@ void ViewerFrame::buildMenus()
 	Bind(wxEVT_MENU, &ViewerFrame::onPlayPause, this, ID_PLAY);
 	Bind(wxEVT_MENU, &ViewerFrame::onStep, this, ID_STEP);
 	Bind(wxEVT_MENU, &ViewerFrame::onRestart, this, ID_RESTART);
-	Bind(wxEVT_MENU, &ViewerFrame::onLayer, this, ID_LAYER_CLOUD, ID_LAYER_GT);
+	Bind(wxEVT_MENU, &ViewerFrame::onLayer, this, ID_LAYER_FIRST,
+	     ID_LAYER_LAST);
+	Bind(
+	    wxEVT_MENU,
+	    [this](wxCommandEvent& e)
+	    {
+		    follow_ = e.IsChecked();
+		    if (follow_ && shown_) draw(shown_);
+	    },
+	    ID_FOLLOW);
+	Bind(
+	    wxEVT_MENU,
+	    [this](wxCommandEvent& e)
+	    {
+		    opt_.mode = e.GetId() == ID_MODE_REALTIME
+		                    ? viewer::PlayMode::RealTime
+		                    : viewer::PlayMode::EveryFrame;
+		    if (worker_) worker_->setMode(opt_.mode);
+		    updateControls();
+	    },
+	    ID_MODE_REALTIME, ID_MODE_EVERY);
 }
 
 void ViewerFrame::buildLayout()
@@ -172,21 +203,24 @@ void ViewerFrame::buildLayout()
 	                                   wxDefaultSize, wxSP_LIVE_UPDATE);
 	canvas_ = new SceneCanvas(split);
 	auto* right = new wxPanel(split);
+	// Two columns of panels, each keeping its image's aspect ratio inside:
+	// at any image size (256x192 to 1280x720) they share the space evenly.
 	auto* grid = new wxGridSizer(3, 2, 2, 2);
 	for (size_t i = 0; i < panels_.size(); ++i)
 	{
-		panels_[i] = new ImagePanel(right, viewer::toString(kPanels[i]));
+		panels_[i] = new ImagePanel(
+		    right, viewer::toString(static_cast<viewer::Panel>(i)));
 		grid->Add(panels_[i], 1, wxEXPAND);
 	}
 	right->SetSizer(grid);
-	split->SplitVertically(canvas_, right, opt_.width * 3 / 5);
-	split->SetSashGravity(0.6);
+	split->SplitVertically(canvas_, right, opt_.width / 2);
+	split->SetSashGravity(0.5);
 	split->SetMinimumPaneSize(100);
-	// The frame gets its real size only once shown, and under load the
-	// window manager may resize it after the first events: the sash stays
-	// at 3/5 of the width (placeSash) until the user drags it (a drag is
-	// told by SASH_POS_CHANGING, sent only while the mouse moves the sash;
-	// wx sends SASH_POS_CHANGED also when it moves the sash itself).
+	// The frame gets its real size only once shown, and the window manager
+	// may resize it after the first events: the sash stays at half the
+	// width (placeSash) until the user drags it (a drag is told by
+	// SASH_POS_CHANGING, sent only while the mouse moves the sash; wx sends
+	// SASH_POS_CHANGED also when it moves the sash itself).
 	split_ = split;
 	CallAfter([this] { placeSash(); });
 	split->Bind(wxEVT_SPLITTER_SASH_POS_CHANGING,
@@ -202,7 +236,7 @@ void ViewerFrame::buildLayout()
 		     CallAfter([this] { placeSash(); });
 	     });
 
-	// Timeline: play/pause, step, restart, speed, slider.
+	// Timeline: play/pause, step, restart, speed, slider, frame counter.
 	auto* bar = new wxPanel(this);
 	auto* hs = new wxBoxSizer(wxHORIZONTAL);
 	playBtn_ =
@@ -232,18 +266,18 @@ void ViewerFrame::buildLayout()
 	Bind(wxEVT_BUTTON, &ViewerFrame::onStep, this, ID_STEP);
 	Bind(wxEVT_BUTTON, &ViewerFrame::onRestart, this, ID_RESTART);
 	Bind(wxEVT_CHOICE, &ViewerFrame::onSpeed, this, ID_SPEED);
-	// On release only: going back re-runs the pipeline from frame 0.
+	// The slider follows playback except while the user holds the thumb;
+	// it seeks on release (going back re-runs the pipeline from frame 0,
+	// on the replay thread: the window stays live meanwhile).
+	slider_->Bind(wxEVT_SCROLL_THUMBTRACK,
+	              [this](wxScrollEvent&) { sliderHeld_ = true; });
 	slider_->Bind(wxEVT_SCROLL_CHANGED,
-	              [this](wxScrollEvent&)
-	              {
-		              wxCommandEvent e;
-		              onSlider(e);
-	              });
+	              [this](wxScrollEvent&) { onSliderReleased(); });
 }
 
 void ViewerFrame::placeSash()
 {
-	const int want = GetClientSize().x * 3 / 5;
+	const int want = GetClientSize().x / 2;
 	if (!sashMovedByUser_ && split_->GetSashPosition() != want)
 		split_->SetSashPosition(want);
 }
@@ -251,135 +285,160 @@ void ViewerFrame::placeSash()
 void ViewerFrame::open(const viewer::ViewerOptions& vo)
 {
 	wxBusyCursor busy;
-	auto ctl = std::make_unique<viewer::ReplayController>(vo);
-	ctl_ = std::move(ctl);
+	worker_.reset();  // the old replay thread stops first
+	shown_.reset();
+	ackPending_ = 0;
+	cameraSet_ = false;
+	worker_ = std::make_unique<viewer::ReplayWorker>(vo, opt_.layers);
+	worker_->setMode(opt_.mode);
 	opt_.viewer = vo;
 	SetTitle("bims-viewer - " + vo.rawlog);
-	slider_->SetRange(0, std::max<int>(1, int(ctl_->frameCount()) - 1));
-	auto* m = GetMenuBar();
-	ctl_->layers().cloud = m->IsChecked(ID_LAYER_CLOUD);
-	ctl_->layers().tier0 = m->IsChecked(ID_LAYER_T0);
-	ctl_->layers().tier1 = m->IsChecked(ID_LAYER_T1);
-	ctl_->layers().tier2 = m->IsChecked(ID_LAYER_T2);
-	ctl_->layers().estimated = m->IsChecked(ID_LAYER_EST);
-	ctl_->layers().groundTruth = m->IsChecked(ID_LAYER_GT);
-	refreshViews(true);
+	slider_->SetRange(0, std::max<int>(1, int(worker_->frameCount()) - 1));
+	slider_->SetValue(0);
+	updateControls();
 }
 
-void ViewerFrame::refreshViews(bool resetCamera)
+void ViewerFrame::showLayers()
 {
-	if (!ctl_) return;
-	auto& scene = canvas_->getOpenGLSceneRef();
-	ctl_->fillScene(*scene);
-	if (resetCamera || ctl_->currentFrame() == 0)
+	if (!shown_) return;
+	viewer::showView(*canvas_->getOpenGLSceneRef(), *shown_, opt_.layers);
+}
+
+void ViewerFrame::draw(const std::shared_ptr<const viewer::FrameView>& v)
+{
+	shown_ = v;
+	showLayers();
+	const auto& c = v->follow;
+	if (!cameraSet_)
 	{
-		const auto c = ctl_->suggestedCamera();
 		canvas_->setCameraPointing(c.pointX, c.pointY, c.pointZ);
 		canvas_->setZoomDistance(c.zoom);
 		canvas_->setAzimuthDegrees(c.azimuthDeg);
 		canvas_->setElevationDegrees(c.elevationDeg);
+		cameraSet_ = v->frame >= 0;
 	}
-	if (!pngDir_.empty() && ctl_->currentFrame() >= 0)
-	{
-		canvas_->requestCapture(pngDir_ + "/" +
-		                        bims::frameFileName(ctl_->currentFrame()));
-	}
-	canvas_->Refresh(false);
+	else if (follow_)  // the look-at point moves with the sensor; the
+	                   // user's orbit and zoom stay
+		canvas_->setCameraPointing(c.pointX, c.pointY, c.pointZ);
+	if (!pngDir_.empty() && v->frame >= 0)
+		canvas_->requestCapture(pngDir_ + "/" + bims::frameFileName(v->frame));
 	for (size_t i = 0; i < panels_.size(); ++i)
-		panels_[i]->setImage(ctl_->panel(kPanels[i]));
+		panels_[i]->setImage(v->panels[i]);
+	canvas_->Refresh(false);
+	canvas_->Update();  // paint now: the view shown is the view acked
+	if (!sliderHeld_) slider_->SetValue(std::max(0L, v->frame));
+	frameLabel_->SetLabel("  " + v->counter + "  ");
+	ackPending_ = v->seq;
 	updateControls();
+	writeState();
 }
 
 void ViewerFrame::updateControls()
 {
-	if (!ctl_) return;
-	const long cur = ctl_->currentFrame();
-	slider_->SetValue(std::max(0L, cur));
-	frameLabel_->SetLabel(
-	    wxString::Format("  %ld / %zu  ", cur, ctl_->frameCount() - 1));
-	const wxString play = ctl_->playing() ? "Pause" : "Play";
+	if (!worker_) return;
+	const auto st = worker_->state();
+	const wxString play = st.playing ? "Pause" : "Play";
 	if (playBtn_->GetLabel() != play) playBtn_->SetLabel(play);
-	SetStatusText(ctl_->statusText());
+	if (shown_) SetStatusText(shown_->status, 0);
+	std::string right;
+	if (!st.busy.empty())
+		right = st.busy;
+	else
+	{
+		right = std::string(st.playing ? "playing " : "paused ") +
+		        viewer::toString(st.mode) + ": " +
+		        std::to_string(st.processed) + " processed";
+		if (st.notDrawn > 0)
+			right += ", " + std::to_string(st.notDrawn) + " not drawn";
+		if (!worker_->pipelineRunning()) right += " (no pipeline)";
+	}
+	if (GetStatusBar()->GetStatusText(1) != right) SetStatusText(right, 1);
+}
+
+void ViewerFrame::writeState()
+{
+	if (opt_.stateFile.empty() || !shown_) return;
+	const auto st = worker_->state();
+	Json j;
+	j["frame"] = shown_->frame;
+	j["frame_count"] = shown_->frameCount;
+	j["counter"] = frameLabel_->GetLabel().Trim().Trim(false).ToStdString();
+	j["slider"] = slider_->GetValue();
+	j["status"] = GetStatusBar()->GetStatusText(0).ToStdString();
+	j["status_replay"] = GetStatusBar()->GetStatusText(1).ToStdString();
+	j["playing"] = st.playing;
+	j["mode"] = viewer::toString(st.mode);
+	j["processed"] = st.processed;
+	j["not_drawn"] = st.notDrawn;
+	j["window"] = screenRect(this);
+	j["view3d"] = screenRect(canvas_);
+	j["slider_rect"] = screenRect(slider_);
+	Json panels = Json::array();
+	for (const auto* p : panels_) panels.push_back(screenRect(p));
+	j["panels"] = panels;
+	try
+	{
+		writeJsonFile(opt_.stateFile, j);
+	}
+	catch (const std::exception& e)
+	{
+		std::cerr << "bims-viewer: warning: " << e.what() << "\n";
+		opt_.stateFile.clear();  // said once
+	}
 }
 
 void ViewerFrame::onTimer(wxTimerEvent&)
 {
-	// While playing, the event loop may never go idle (the pipeline and the
-	// software-rendered 3D view take longer than the timer's period), so
-	// nothing queued with CallAfter runs: the sash is placed here too (it
-	// was left 1095 px out of 1200, the image panels 50 px wide;
-	// test_viewer_gui's PanelsKeepTheirWidthWhilePlaying).
 	placeSash();
-	const auto now = std::chrono::steady_clock::now();
-	const double dt = std::chrono::duration<double>(now - lastTick_).count();
-	lastTick_ = now;
-	if (!ctl_ || !ctl_->playing()) return;
-	// Exporting a PNG sequence: every frame must be drawn (and written)
-	// before the next one; playback slows down to the drawing speed.
-	if (!pngDir_.empty() && !canvas_->captureDone()) return;
-	try
+	if (!worker_) return;
+	// Tell the worker what was drawn (with a PNG sequence: once written).
+	if (ackPending_ && (pngDir_.empty() || canvas_->captureDone()))
 	{
-		if (ctl_->advance(dt) > 0) refreshViews();
-		if (!ctl_->playing()) updateControls();
+		worker_->drawn(ackPending_);
+		ackPending_ = 0;
 	}
-	catch (const std::exception& e)
+	const std::string err = worker_->takeError();
+	if (!err.empty())
 	{
-		ctl_->setPlaying(false);
-		showError(e.what());
+		if (!opt_.screenshot.empty())
+		{
+			std::cerr << "bims-viewer: error: " << err << "\n";
+			exitCode = 1;
+			Close(true);
+			return;
+		}
+		showError(err);
 	}
+	const auto v = worker_->latest();
+	if (v && v != shown_ && !ackPending_) draw(v);
+	updateControls();
+	if (!opt_.screenshot.empty()) batchScreenshot();
 }
 
 void ViewerFrame::onPlayPause(wxCommandEvent&)
 {
-	if (!ctl_) return;
-	ctl_->setPlaying(!ctl_->playing());
-	lastTick_ = std::chrono::steady_clock::now();
-	updateControls();
+	if (worker_) worker_->togglePlay();
 }
 
 void ViewerFrame::onStep(wxCommandEvent&)
 {
-	if (!ctl_) return;
-	ctl_->setPlaying(false);
-	try
-	{
-		if (ctl_->step()) refreshViews();
-	}
-	catch (const std::exception& e)
-	{
-		showError(e.what());
-	}
-	updateControls();
+	if (worker_) worker_->step();
 }
 
 void ViewerFrame::onRestart(wxCommandEvent&)
 {
-	if (!ctl_) return;
-	ctl_->setPlaying(false);
-	ctl_->seek(0);
-	refreshViews(true);
+	if (worker_) worker_->restart();
 }
 
-void ViewerFrame::onSlider(wxCommandEvent&)
+void ViewerFrame::onSliderReleased()
 {
-	if (!ctl_) return;
-	wxBusyCursor busy;  // going back re-runs the pipeline from frame 0
-	ctl_->setPlaying(false);
-	try
-	{
-		ctl_->seek(static_cast<size_t>(slider_->GetValue()));
-	}
-	catch (const std::exception& e)
-	{
-		showError(e.what());
-	}
-	refreshViews();
+	sliderHeld_ = false;
+	if (worker_) worker_->seek(static_cast<size_t>(slider_->GetValue()));
 }
 
 void ViewerFrame::onSpeed(wxCommandEvent&)
 {
-	if (ctl_) ctl_->setSpeed(kSpeeds[speedChoice_->GetSelection()]);
-	updateControls();
+	if (worker_) worker_->setSpeed(kSpeeds[speedChoice_->GetSelection()]);
 }
 
 void ViewerFrame::onOpen(wxCommandEvent&)
@@ -396,8 +455,7 @@ void ViewerFrame::onOpen(wxCommandEvent&)
 	try
 	{
 		open(vo);
-		ctl_->setPlaying(true);
-		updateControls();
+		worker_->play(true);
 	}
 	catch (const std::exception& e)
 	{
@@ -407,7 +465,7 @@ void ViewerFrame::onOpen(wxCommandEvent&)
 
 void ViewerFrame::onOpenResults(wxCommandEvent&)
 {
-	if (!ctl_)
+	if (!worker_)
 	{
 		showError("open a rawlog first");
 		return;
@@ -420,6 +478,7 @@ void ViewerFrame::onOpenResults(wxCommandEvent&)
 	try
 	{
 		open(vo);
+		worker_->seek(0);
 	}
 	catch (const std::exception& e)
 	{
@@ -452,35 +511,18 @@ void ViewerFrame::onPngSequence(wxCommandEvent& ev)
 		return;
 	}
 	pngDir_ = dlg.GetPath().ToStdString();
+	// every frame must be drawn to be written
+	GetMenuBar()->Check(ID_MODE_EVERY, true);
+	opt_.mode = viewer::PlayMode::EveryFrame;
+	if (worker_) worker_->setMode(opt_.mode);
 }
 
 void ViewerFrame::onLayer(wxCommandEvent& ev)
 {
-	if (!ctl_) return;
-	auto& l = ctl_->layers();
-	const bool on = ev.IsChecked();
-	switch (ev.GetId())
-	{
-		case ID_LAYER_CLOUD:
-			l.cloud = on;
-			break;
-		case ID_LAYER_T0:
-			l.tier0 = on;
-			break;
-		case ID_LAYER_T1:
-			l.tier1 = on;
-			break;
-		case ID_LAYER_T2:
-			l.tier2 = on;
-			break;
-		case ID_LAYER_EST:
-			l.estimated = on;
-			break;
-		case ID_LAYER_GT:
-			l.groundTruth = on;
-			break;
-	}
-	refreshViews();
+	opt_.layers.on[size_t(ev.GetId() - ID_LAYER_FIRST)] = ev.IsChecked();
+	showLayers();  // hiding is at once; a layer shown comes with the next view
+	canvas_->Refresh(false);
+	if (worker_) worker_->setLayers(opt_.layers);
 }
 
 void ViewerFrame::onAbout(wxCommandEvent&)
@@ -489,42 +531,47 @@ void ViewerFrame::onAbout(wxCommandEvent&)
 	info.SetName("bims-viewer");
 	info.SetDescription(
 	    "Replay of RGB-D + IMU rawlogs with Bayesian independent motion "
-	    "segmentation (Lobo et al., MFI 2012).\nTier 0 occupancy: blue; "
-	    "tier 1 background subtraction: yellow; tier 2 flow consistency: "
-	    "red.");
+	    "segmentation (Lobo et al., MFI 2012).\nMoving points and tier 2: "
+	    "red; tier 1 background subtraction: yellow; tier 0 occupancy: faint "
+	    "blue (View menu).");
 	wxAboutBox(info, this);
 }
 
-void ViewerFrame::startBatchScreenshot()
+void ViewerFrame::batchScreenshot()
 {
-	// Wait until the canvas has a size and has rendered once, then capture
-	// the next render, then quit.
-	++batchWaitTicks_;
+	// Once the window is shown and the target frame drawn: capture the next
+	// render, then quit. (The time limit counts while the replay is idle:
+	// reaching a far frame may take long.)
+	if (worker_->waitIdle(0)) ++batchWaitTicks_;
 	std::string err;
 	if (!batchCaptureRequested_)
 	{
 		if (!IsShownOnScreen() || canvas_->GetClientSize().x < 10) return;
-		refreshViews();
+		if (!shown_ || shown_->frame != batchTarget_ || ackPending_ ||
+		    worker_->latest() != shown_ || !worker_->waitIdle(0))
+			return;
 		canvas_->requestCapture(opt_.screenshot);
 		canvas_->Refresh(false);
+		canvas_->Update();
 		batchCaptureRequested_ = true;
 	}
 	else if (canvas_->captureDone(&err))
 	{
-		batchTimer_.Stop();
+		opt_.screenshot.clear();  // done: the timer stops calling
 		if (!err.empty())
 		{
 			std::cerr << "bims-viewer: error: " << err << "\n";
 			exitCode = 1;
 		}
 		else
-			std::cout << "bims-viewer: wrote " << opt_.screenshot << std::endl;
+			std::cout << "bims-viewer: wrote " << canvas_->capturePath()
+			          << std::endl;
 		if (!opt_.keepOpen || !err.empty()) Close(true);
 		return;
 	}
-	if (batchWaitTicks_ > 300)  // 30 s
+	if (batchWaitTicks_ > 50 * 120)  // 2 min at 20 ms
 	{
-		batchTimer_.Stop();
+		opt_.screenshot.clear();
 		std::cerr << "bims-viewer: error: the 3D view was never drawn (no "
 		             "OpenGL on this display?)\n";
 		exitCode = 1;

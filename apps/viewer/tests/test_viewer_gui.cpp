@@ -1,7 +1,9 @@
 // bims-viewer under Xvfb: the real wx window with MRPT's GL canvas opens the
 // bundled rawlog, steps frames with the pipeline, and the 3D view it drew
 // (read back from the canvas) shows the three tier colours.
+#include <bims/common/json.h>
 #include <bims/viewer/panels.h>
+#include <bims_test/data.h>
 #include <bims_test/text.h>
 #include <gtest/gtest.h>
 
@@ -11,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
+#include <regex>
 #include <sstream>
 
 namespace
@@ -45,7 +48,8 @@ TEST(GuiViewer, XvfbScreenshotShowsTheThreeTierColours)
 	    std::string(BIMS_XVFB_RUN) +
 	    " -a -s '-screen 0 1280x900x24 +extension GLX' '" + kViewer + "' '" +
 	    kRawlog + "' --config '" + BIMS_SOURCE_DIR +
-	    "/config/default.ini' --max-frames 45 --size 1200x800 --screenshot '" +
+	    "/config/default.ini' --layers all --max-frames 45 --size 1200x800 "
+	    "--screenshot '" +
 	    shot + "' > '" + log + "' 2>&1";
 	// (frame 45: with the map-anchored egomotion tier 1 agrees with tier 2
 	// almost everywhere by frame 15, and its yellow hides behind the red)
@@ -79,8 +83,9 @@ TEST(GuiViewer, XScreenshotOfTheWholeWindowShowsTiersAndPanels)
 	    " -a -s '-screen 0 1200x800x24 +extension GLX' '" + BIMS_SOURCE_DIR +
 	    "/apps/viewer/tests/xshot.sh' '" + own + "' '" + xshot + "' '" +
 	    kViewer + "' '" + kRawlog + "' --config '" + BIMS_SOURCE_DIR +
-	    "/config/default.ini' --max-frames 15 --size 1200x800 > '" + log +
-	    "' 2>&1";
+	    "/config/default.ini' --layers all --max-frames 15 --size 1200x800 > "
+	    "'" +
+	    log + "' 2>&1";
 	ASSERT_EQ(run(cmd), 0) << slurp(log);
 	const cv::Mat img = cv::imread(xshot, cv::IMREAD_COLOR);
 	ASSERT_FALSE(img.empty()) << slurp(log);
@@ -165,7 +170,8 @@ TEST(GuiViewer, NoDisplayGivesAClearErrorAndNonZeroExit)
 	                   "/never.png' > '" + log + "' 2>&1");
 	EXPECT_NE(rc, 0);
 	EXPECT_NE(rc, -1);  // exited, did not crash
-	EXPECT_FALSE(slurp(log).empty());
+	EXPECT_NE(slurp(log).find("no display"), std::string::npos) << slurp(log);
+	EXPECT_NE(slurp(log).find("xvfb-run"), std::string::npos) << slurp(log);
 }
 
 TEST(GuiViewer, MissingRawlogIsAnErrorBeforeAnyWindow)
@@ -197,4 +203,195 @@ TEST(GuiViewer, WithoutConfigItUsesShareBimsDefaultIniAndSaysWhich)
 	    used, std::string(BIMS_BINARY_DIR) + "/share/bims/default.ini"))
 	    << used;
 	EXPECT_NE(used.find("/share/bims/default.ini"), std::string::npos) << used;
+}
+
+namespace
+{
+/** A fresh folder of this test under the build tree. */
+std::string testDir(const std::string& name)
+{
+	const std::string d = kOut + "/" + name;
+	std::filesystem::remove_all(d);
+	std::filesystem::create_directories(d);
+	return d;
+}
+
+/** The simulator's crowded scene at 640x480 (100 frames) in \a dir. */
+std::string crowded640(const std::string& dir)
+{
+	const std::string out = dir + "/crowded.rawlog";
+	const std::string cmd = std::string(BIMS_BIN_DIR) + "/bims-sim '" +
+	                        BIMS_SOURCE_DIR + "/config/sim/crowded.ini' -o '" +
+	                        out + "' --max-frames 100 -q > '" + dir +
+	                        "/sim.log' 2>&1";
+	EXPECT_EQ(run(cmd), 0) << slurp(dir + "/sim.log");
+	return out;
+}
+
+cv::Rect rectOf(const bims::Json& r)
+{
+	return cv::Rect(r[0].get<int>(), r[1].get<int>(), r[2].get<int>(),
+	                r[3].get<int>());
+}
+
+/** Frame N and last M of the counter "N / M" and of the status bar's
+ * "frame N/M ...". */
+std::pair<std::string, std::string> counterAndStatusFrame(const bims::Json& s)
+{
+	std::smatch a, b;
+	const std::string counter = s["counter"].get<std::string>();
+	const std::string status = s["status"].get<std::string>();
+	std::regex_search(counter, a, std::regex(R"((\d+) / (\d+))"));
+	std::regex_search(status, b, std::regex(R"(^frame (\d+)/(\d+))"));
+	return {a.size() == 3 ? a[1].str() + "/" + a[2].str() : "?" + counter,
+	        b.size() == 3 ? b[1].str() + "/" + b[2].str() : "?" + status};
+}
+
+/** Plays \a args (after the viewer) under Xvfb with one CPU kept busy by
+ * another process, and checks two X screenshots taken 3 s apart while it
+ * plays: the slider has moved (its state and its pixels), the counter
+ * matches the status bar, each 2D panel is at least a fifth of the
+ * window's width and shows an image, the 3D view has changed. Returns the
+ * second screenshot and its 3D view's rectangle. */
+std::pair<cv::Mat, cv::Rect> checkPlayingWindow(const std::string& dir,
+                                                const std::string& args,
+                                                int panelsWithImages = 5)
+{
+	const std::string prefix = dir + "/shot";
+	const std::string log = dir + "/viewer.log";
+	const std::string cmd =
+	    "XSHOT_BUSY=1 " + std::string(BIMS_XVFB_RUN) +
+	    " -a -s '-screen 0 1280x900x24 +extension GLX' '" + BIMS_SOURCE_DIR +
+	    "/apps/viewer/tests/xshot.sh' play2 '" + prefix + "' '" + kViewer +
+	    "' " + args + " --size 1280x800 > '" + log + "' 2>&1";
+	EXPECT_EQ(run(cmd), 0) << slurp(log);
+	const cv::Mat a = cv::imread(prefix + ".1.png", cv::IMREAD_COLOR);
+	const cv::Mat b = cv::imread(prefix + ".2.png", cv::IMREAD_COLOR);
+	if (a.empty() || b.empty())
+	{
+		ADD_FAILURE() << "no screenshots: " << slurp(log);
+		return {};
+	}
+	const auto s1 = bims::Json::parse(slurp(prefix + ".1.json"));
+	const auto s2 = bims::Json::parse(slurp(prefix + ".2.json"));
+	// the slider follows playback
+	EXPECT_LT(s1["slider"].get<int>(), s2["slider"].get<int>()) << s1 << "\n"
+	                                                            << s2;
+	EXPECT_EQ(s2["slider"].get<int>(), s2["frame"].get<int>());
+	const cv::Rect sl = rectOf(s2["slider_rect"]);
+	EXPECT_GT(cv::norm(a(sl), b(sl), cv::NORM_L1), 0)
+	    << "the slider did not move on screen";
+	// the frame counter matches the status bar
+	for (const auto* s : {&s1, &s2})
+	{
+		const auto [counter, status] = counterAndStatusFrame(*s);
+		EXPECT_EQ(counter, status) << *s;
+	}
+	// each 2D panel at least a fifth of the window's width, with an image
+	const int W = s2["window"][2].get<int>();
+	int k = 0;
+	for (const auto& r : s2["panels"])
+	{
+		const cv::Rect pr = rectOf(r);
+		EXPECT_GE(pr.width * 5, W) << "panel " << k << " " << r;
+		// below the caption: an image (a panel without one says why, in
+		// a line of text on grey)
+		const cv::Rect body(pr.x, pr.y + 20, pr.width, pr.height - 20);
+		cv::Scalar mean, sd;
+		cv::meanStdDev(b(body & cv::Rect(0, 0, b.cols, b.rows)), mean, sd);
+		if (k < panelsWithImages)
+		{
+			EXPECT_GT(sd[0] + sd[1] + sd[2], 30.0) << "panel " << k << " blank";
+		}
+		++k;
+	}
+	EXPECT_EQ(k, 5);
+	// the 3D view differs between the two
+	const cv::Rect v3 = rectOf(s2["view3d"]);
+	EXPECT_GE(v3.width * 3, W);
+	EXPECT_GT(cv::norm(a(v3), b(v3), cv::NORM_L1) / v3.area(), 1.0)
+	    << "the 3D view did not change";
+	return {b, v3};
+}
+}  // namespace
+
+// The 640x480 simulation played with the CPU kept busy: the pipeline runs
+// off the GUI thread, the window keeps drawing the newest frame.
+TEST(GuiViewer, PlayingVgaUnderLoadKeepsSliderCounterPanelsAndViewLive)
+{
+	const std::string dir = testDir("playing_vga");
+	const std::string in = crowded640(dir);
+	const auto [img, v3] =
+	    checkPlayingWindow(dir, "'" + in + "' --config '" + BIMS_SOURCE_DIR +
+	                                "/config/default.ini' --speed 0.5");
+	if (img.empty()) return;
+	// what moves is shown: red in the 3D view (moving points and voxels)
+	const auto c = bims::viewer::tierColourFractions(img(v3));
+	EXPECT_GT(c.red, 0.002);
+}
+
+// The same for a bims-run output folder shown with --results, which also
+// says nothing of parameters it does not use.
+TEST(GuiViewer, ResultsModePlaysWithTheSameLayoutAndShowsWhatMoves)
+{
+	const std::string dir = testDir("results_vga");
+	const std::string in = crowded640(dir);
+	ASSERT_EQ(run(std::string(BIMS_BIN_DIR) + "/bims-run '" + BIMS_SOURCE_DIR +
+	              "/config/default.ini' '" + in + "' -o '" + dir +
+	              "/out' -q > '" + dir + "/run.log' 2>&1"),
+	          0)
+	    << slurp(dir + "/run.log");
+	const auto [img, v3] = checkPlayingWindow(
+	    dir, "'" + in + "' --results '" + dir + "/out' --speed 0.5",
+	    2);  // RGB + mask, depth; no pipeline: no flow
+	EXPECT_EQ(slurp(dir + "/viewer.log").find("parameters from"),
+	          std::string::npos)
+	    << slurp(dir + "/viewer.log");
+	if (img.empty()) return;
+	// the moving points of the cloud, red from the results' masks
+	const auto c = bims::viewer::tierColourFractions(img(v3));
+	EXPECT_GT(c.red, 0.002);
+}
+
+// The Bonn slice (640x480 real crowd) where ../shared/data is at hand.
+TEST(GuiViewer, PlayingTheBonnSliceKeepsTheWindowLive)
+{
+	if (!std::filesystem::exists(bims::test::kBonnCrowd + "/depth.txt"))
+		GTEST_SKIP() << "no Bonn sample at " << bims::test::kBonnCrowd;
+	const std::string dir = testDir("playing_bonn");
+	ASSERT_EQ(
+	    run(std::string(BIMS_BIN_DIR) + "/bims-import-tum '" +
+	        bims::test::kBonnCrowd + "' -o '" + dir + "/bonn.rawlog' -c '" +
+	        BIMS_SOURCE_DIR + "/config/bonn.ini' --max-frames 120 -q > '" +
+	        dir + "/import.log' 2>&1"),
+	    0)
+	    << slurp(dir + "/import.log");
+	checkPlayingWindow(dir, "'" + dir + "/bonn.rawlog' --config '" +
+	                            BIMS_SOURCE_DIR + "/config/bonn.ini'");
+}
+
+// --paused shows the first frame (not "-1 / N" and empty panels).
+TEST(GuiViewer, PausedShowsTheFirstFrame)
+{
+	const std::string dir = testDir("paused");
+	const std::string own = dir + "/own.png";
+	const std::string state = dir + "/state.json";
+	const std::string log = dir + "/viewer.log";
+	const std::string cmd =
+	    std::string(BIMS_XVFB_RUN) +
+	    " -a -s '-screen 0 1200x800x24 +extension GLX' '" + BIMS_SOURCE_DIR +
+	    "/apps/viewer/tests/xshot.sh' - '" + dir + "/x.png' '" + kViewer +
+	    "' '" + kRawlog + "' --paused --size 1200x800 --state-file '" + state +
+	    "' > '" + log + "' 2>&1";
+	ASSERT_EQ(run(cmd), 0) << slurp(log);
+	const auto s = bims::Json::parse(slurp(state));
+	EXPECT_EQ(s["frame"].get<int>(), 0) << s;
+	EXPECT_EQ(s["counter"].get<std::string>(), "0 / 149") << s;
+	EXPECT_FALSE(s["playing"].get<bool>()) << s;
+	const cv::Mat img = cv::imread(dir + "/x.png", cv::IMREAD_COLOR);
+	ASSERT_FALSE(img.empty());
+	const cv::Rect rgb = rectOf(s["panels"][0]);
+	cv::Scalar mean, sd;
+	cv::meanStdDev(img(rgb), mean, sd);
+	EXPECT_GT(sd[0] + sd[1] + sd[2], 20.0) << "the RGB panel is blank";
 }

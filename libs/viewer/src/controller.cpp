@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
 
@@ -39,24 +41,6 @@ std::string defaultGroundTruth(const std::string& rawlog)
 	return mrpt::system::fileExists(gt) ? gt : std::string();
 }
 }  // namespace
-
-const char* toString(Panel p)
-{
-	switch (p)
-	{
-		case Panel::RgbMask:
-			return "RGB + moving mask";
-		case Panel::Depth:
-			return "Depth";
-		case Panel::FlowObserved:
-			return "Observed flow";
-		case Panel::FlowExpected:
-			return "Expected flow";
-		case Panel::Labels:
-			return "Diff labels";
-	}
-	return "?";
-}
 
 ReplayController::ReplayController(const ViewerOptions& opt) : opt_(opt)
 {
@@ -186,6 +170,14 @@ size_t ReplayController::advance(double wallSeconds, size_t maxSteps)
 	return n;
 }
 
+double ReplayController::secondsToNextFrame() const
+{
+	if (!playing_ || atEnd()) return std::numeric_limits<double>::infinity();
+	if (cur_ < 0) return 0;
+	const double dt = frameTime(static_cast<size_t>(cur_ + 1)) - clock_;
+	return std::max(0.0, dt / speed_);
+}
+
 const pipeline::FrameResult* ReplayController::result() const
 {
 	return (pipe_ && cur_ >= 0) ? &pipe_->last() : nullptr;
@@ -207,7 +199,7 @@ cv::Mat ReplayController::currentMask() const
 
 cv::Mat ReplayController::panel(Panel p) const
 {
-	if (!frame_) return cv::Mat(240, 320, CV_8UC3, cv::Scalar(64, 64, 64));
+	if (!frame_) return placeholderPanel({320, 240}, "no frame yet");
 	const auto& scan = *frame_->scan;
 	cv::Mat bgr = intensityBgr(scan);
 	const cv::Size size =
@@ -215,21 +207,32 @@ cv::Mat ReplayController::panel(Panel p) const
 	                           static_cast<int>(scan.rangeImage.rows()))
 	                : bgr.size();
 	const auto* r = result();
+	// why a flow panel is empty
+	const char* noFlow = !r           ? "pipeline off: no flow"
+	                     : r->flowOff ? "depth only: flow tier off"
+	                                  : "no flow on the first frame";
 	switch (p)
 	{
 		case Panel::RgbMask:
-			if (bgr.empty()) break;
-			return overlayMask(bgr, currentMask());
+		{
+			if (!bgr.empty()) return overlayMask(bgr, currentMask());
+			// depth only: the mask over the depth in grey
+			cv::Mat d = depthColour(scan), grey;
+			if (d.empty()) return placeholderPanel(size, "no image");
+			cv::cvtColor(d, grey, cv::COLOR_BGR2GRAY);
+			cv::cvtColor(grey, grey, cv::COLOR_GRAY2BGR);
+			return overlayMask(grey, currentMask());
+		}
 		case Panel::Depth:
 		{
 			cv::Mat d = depthColour(scan);
 			if (!d.empty()) return d;
-			break;
+			return placeholderPanel(size, "no valid depth");
 		}
 		case Panel::FlowObserved:
 		case Panel::FlowExpected:
 		{
-			if (!r) break;
+			if (!r || r->flowObserved.empty()) break;
 			// One magnitude scale for both, so that they compare.
 			double maxMag = 0;
 			for (const cv::Mat* f : {&r->flowObserved, &r->flowExpected})
@@ -248,10 +251,15 @@ cv::Mat ReplayController::panel(Panel p) const
 			    std::max(1.0, 0.5 * maxMag), size);
 		}
 		case Panel::Labels:
-			if (!r) break;
+			if (!r || r->labels.empty()) break;
 			return labelsColour(r->labels, bgr);
 	}
-	return cv::Mat(size, CV_8UC3, cv::Scalar(64, 64, 64));
+	return placeholderPanel(size, noFlow);
+}
+
+std::string ReplayController::counterText() const
+{
+	return std::to_string(cur_) + " / " + std::to_string(frameCount() - 1);
 }
 
 std::string ReplayController::statusText() const

@@ -108,6 +108,23 @@ cv::Mat flowColour(const cv::Mat& flow, double maxMagPx, cv::Size size)
 	return out;
 }
 
+cv::Mat placeholderPanel(cv::Size size, const std::string& why)
+{
+	cv::Mat img(size, CV_8UC3, cv::Scalar(64, 64, 64));
+	const int font = cv::FONT_HERSHEY_SIMPLEX;
+	int base = 0;
+	const cv::Size t = cv::getTextSize(why, font, 1.0, 2, &base);
+	// scaled to 80 % of the width at most
+	const double scale = std::min(1.0, 0.8 * size.width / std::max(1, t.width));
+	const cv::Size ts(static_cast<int>(t.width * scale),
+	                  static_cast<int>(t.height * scale));
+	cv::putText(img, why,
+	            {(size.width - ts.width) / 2, (size.height + ts.height) / 2},
+	            font, scale, cv::Scalar(200, 200, 200),
+	            std::max(1, static_cast<int>(2 * scale)), cv::LINE_AA);
+	return img;
+}
+
 cv::Mat labelsColour(const cv::Mat& labels, const cv::Mat& bgr)
 {
 	cv::Mat grey, out;

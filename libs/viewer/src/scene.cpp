@@ -1,16 +1,22 @@
-// The 3D view: registered cloud, the three tiers, trajectories.
+// The 3D view: registered cloud, the three tiers, trajectories, built as a
+// FrameView.
 #include <bims/common/frames.h>
+#include <bims/eval/rgbd_frame.h>
 #include <bims/viewer/controller.h>
+#include <bims/viewer/panels.h>
 
 #include <mrpt/maps/CColouredPointsMap.h>
 #include <mrpt/obs/T3DPointsProjectionParams.h>
 #include <mrpt/opengl/CFBORender.h>
 #include <mrpt/opengl/CGridPlaneXY.h>
 #include <mrpt/opengl/COctoMapVoxels.h>
+#include <mrpt/opengl/CPointCloud.h>
 #include <mrpt/opengl/CPointCloudColoured.h>
 #include <mrpt/opengl/CSetOfLines.h>
 #include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/opengl/stock_objects.h>
+
+#include <opencv2/imgproc.hpp>
 
 namespace bims::viewer
 {
@@ -60,65 +66,101 @@ mrpt::opengl::CSetOfLines::Ptr polyline(const Trajectory& traj,
 	}
 	return l;
 }
+
+/** The scan's points in {W}, coloured by its image (a grey shade for a
+ * depth-only scan) with the pixels of \a mask pure red. MRPT unprojects and
+ * colours them (its camera model, one home), from a copy of the scan whose
+ * image is the tinted one. */
+mrpt::opengl::CPointCloudColoured::Ptr registeredCloud(
+    const mrpt::obs::CObservation3DRangeScan& scan, const cv::Mat& mask,
+    const mrpt::poses::CPose3D& T_WC, int decimation)
+{
+	const cv::Size size(static_cast<int>(scan.rangeImage.cols()),
+	                    static_cast<int>(scan.rangeImage.rows()));
+	cv::Mat bgr = intensityBgr(scan);
+	if (bgr.empty())
+		bgr = cv::Mat(size, CV_8UC3, cv::Scalar(170, 170, 170));
+	else if (bgr.size() != size)
+		cv::resize(bgr, bgr, size, 0, 0, cv::INTER_AREA);
+	else
+		bgr = bgr.clone();
+	if (!mask.empty())
+	{
+		cv::Mat m = mask;
+		if (m.size() != size) cv::resize(m, m, size, 0, 0, cv::INTER_NEAREST);
+		bgr.setTo(cv::Scalar(0, 0, 255), m);
+	}
+	mrpt::obs::CObservation3DRangeScan tinted = scan;
+	eval::attachColour(tinted, bgr);
+	mrpt::maps::CColouredPointsMap pts;
+	mrpt::obs::T3DPointsProjectionParams pp;
+	pp.decimation =
+	    (size.width % decimation == 0 && size.height % decimation == 0)
+	        ? decimation
+	        : 1;
+	tinted.unprojectInto(pts, pp);  // {S}, sensorPose not applied
+	auto cloud = mrpt::opengl::CPointCloudColoured::Create();
+	cloud->setName("cloud");
+	cloud->loadFromPointsMap(&pts);
+	cloud->setPointSize(2.0f);
+	cloud->setPose(T_WC + (mrpt::poses::CPose3D() - T_SC()));  // T_WS
+	return cloud;
+}
+
+/** Tier 0's occupied voxels as small faint points: the static scene as
+ * context, never hiding what moves. */
+mrpt::opengl::CPointCloud::Ptr faintVoxels(
+    const std::vector<mrpt::math::TPoint3D>& centres)
+{
+	auto pts = mrpt::opengl::CPointCloud::Create();
+	pts->setName("tier0_occupancy");
+	pts->setColor_u8(mrpt::img::TColor(70, 100, 210));
+	pts->setPointSize(2.0f);
+	for (const auto& c : centres)
+		pts->insertPoint(static_cast<float>(c.x), static_cast<float>(c.y),
+		                 static_cast<float>(c.z));
+	return pts;
+}
 }  // namespace
 
-void ReplayController::fillScene(mrpt::opengl::COpenGLScene& scene) const
+std::shared_ptr<FrameView> ReplayController::view() const
 {
 	using namespace mrpt::opengl;
-	scene.clear();
-	auto vp = scene.getViewport();
-	vp->setCustomBackgroundColor(mrpt::img::TColorf(0.12f, 0.12f, 0.14f));
-
-	auto grid = CGridPlaneXY::Create(-5, 5, -5, 5, 0, 0.5);
-	grid->setColor_u8(mrpt::img::TColor(90, 90, 90));
-	scene.insert(grid);
-	scene.insert(stock_objects::CornerXYZSimple(0.3f, 2.0f));
+	auto v = std::make_shared<FrameView>();
+	v->frame = cur_;
+	v->frameCount = frameCount();
+	v->mask = currentMask();
+	for (size_t i = 0; i < kPanelCount; ++i)
+		v->panels[i] = panel(static_cast<Panel>(i));
+	v->counter = counterText();
+	v->status = statusText();
+	v->follow = suggestedCamera();
 
 	const mrpt::poses::CPose3D T_WC = currentPose();
-
-	if (layers_.cloud && frame_)
-	{
-		mrpt::maps::CColouredPointsMap pts;
-		mrpt::obs::T3DPointsProjectionParams pp;
-		auto& scan = *frame_->scan;
-		const int d = opt_.cloudDecimation;
-		pp.decimation =
-		    (scan.rangeImage.cols() % d == 0 && scan.rangeImage.rows() % d == 0)
-		        ? d
-		        : 1;
-		scan.unprojectInto(pts, pp);  // {S}, sensorPose not applied
-		auto cloud = CPointCloudColoured::Create();
-		cloud->setName("cloud");
-		cloud->loadFromPointsMap(&pts);
-		cloud->setPointSize(2.0f);
-		cloud->setPose(T_WC + (mrpt::poses::CPose3D() - T_SC()));  // T_WS
-		scene.insert(cloud);
-	}
-
+	auto& L = v->layers;
+	if (layers_[Layer::Cloud] && frame_)
+		L[size_t(Layer::Cloud)] = registeredCloud(*frame_->scan, currentMask(),
+		                                          T_WC, opt_.cloudDecimation);
 	if (pipe_)
 	{
 		const auto& g = pipe_->grids();
 		const double vs = g.params().voxel_size;
-		if (layers_.tier0)
-		{
-			auto o = CSetOfObjects::Create();
-			g.occupancy()->getVisualizationInto(*o);  // blue, P(O) > 0.5
-			scene.insert(o);
-		}
-		if (layers_.tier1)
-			scene.insert(voxelCubes(g.background()->movingCells(), 1.15 * vs,
-			                        mrpt::img::TColor(255, 255, 0),
-			                        "tier1_moving"));
-		if (layers_.tier2)
-			scene.insert(voxelCubes(g.flow()->movingCells(), 1.3 * vs,
-			                        mrpt::img::TColor(255, 0, 0),
-			                        "tier2_moving"));
+		if (layers_[Layer::Tier0])
+			L[size_t(Layer::Tier0)] =
+			    faintVoxels(g.occupancy()->cellsAbove(0.5));
+		if (layers_[Layer::Tier1])
+			L[size_t(Layer::Tier1)] =
+			    voxelCubes(g.background()->movingCells(), 1.15 * vs,
+			               mrpt::img::TColor(255, 255, 0), "tier1_moving");
+		if (layers_[Layer::Tier2])
+			L[size_t(Layer::Tier2)] =
+			    voxelCubes(g.flow()->movingCells(), 1.3 * vs,
+			               mrpt::img::TColor(255, 0, 0), "tier2_moving");
 	}
-
-	if (layers_.estimated && est_.size() > 1)
-		scene.insert(
-		    polyline(est_, {}, mrpt::img::TColor(0, 220, 220), "estimated"));
-	if (layers_.groundTruth && gt_.size() > 1)
+	if (layers_[Layer::Estimated] && est_.size() > 1)
+		L[size_t(Layer::Estimated)] =
+		    polyline(est_, {}, mrpt::img::TColor(0, 220, 220), "estimated");
+	if (layers_[Layer::GroundTruth] && gt_.size() > 1)
 	{
 		// Ground truth aligned to the estimate at the first frame shown.
 		mrpt::poses::CPose3D align;
@@ -132,16 +174,22 @@ void ReplayController::fillScene(mrpt::opengl::COpenGLScene& scene) const
 			    });
 			align = est_.front().T_WC + (mrpt::poses::CPose3D() - g0.T_WC);
 		}
-		scene.insert(
-		    polyline(gt_, align, mrpt::img::TColor(0, 200, 0), "ground_truth"));
+		L[size_t(Layer::GroundTruth)] =
+		    polyline(gt_, align, mrpt::img::TColor(0, 200, 0), "ground_truth");
 	}
 	if (frame_)
 	{
 		auto cam = stock_objects::CornerXYZSimple(0.15f, 3.0f);
 		cam->setName("camera");
 		cam->setPose(T_WC);
-		scene.insert(cam);
+		v->sensor = cam;
 	}
+	return v;
+}
+
+void ReplayController::fillScene(mrpt::opengl::COpenGLScene& scene) const
+{
+	showView(scene, *view(), layers_);
 }
 
 ViewCamera ReplayController::suggestedCamera() const

@@ -7,10 +7,13 @@
 #include <bims/pipeline/run.h>
 #include <bims/viewer/controller.h>
 #include <bims/viewer/panels.h>
+#include <bims/viewer/replay_worker.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <functional>
+#include <thread>
 
 #include <mrpt/system/filesystem.h>
 
@@ -227,6 +230,7 @@ TEST(ReplayController, OffscreenViewShowsTheThreeTierColours)
 {
 	auto o = sampleOptions();
 	ReplayController c(o);
+	c.layers() = LayerVisibility::parse("all");
 	c.seek(14);
 	ASSERT_NE(c.result(), nullptr);
 	ASSERT_GT(c.pipelineObj()->grids().background()->movingCells().size(), 0u);
@@ -240,15 +244,73 @@ TEST(ReplayController, OffscreenViewShowsTheThreeTierColours)
 	EXPECT_GT(tc.red, 0.0002);
 
 	// Each tier toggled off disappears from the picture.
-	c.layers().tier0 = false;
-	c.layers().tier1 = false;
-	c.layers().tier2 = false;
-	c.layers().cloud = false;
+	for (Layer l : {Layer::Tier0, Layer::Tier1, Layer::Tier2, Layer::Cloud})
+		c.layers()[l] = false;
 	const auto none = tierColourFractions(
 	    c.renderOffscreen(c.suggestedCamera(), 320, 240).asCvMatRef());
 	EXPECT_LT(none.blue, 0.0005);
 	EXPECT_LT(none.yellow, 0.0005);
 	EXPECT_LT(none.red, 0.0005);
+}
+
+// What moves is shown first: by default the static tier-0 voxels are off,
+// the cloud's moving points are pure red; with tier 0 on, drawn as faint
+// points, the red stays visible (the static voxels do not cover it).
+TEST(ReplayController, ByDefaultTheViewShowsWhatMovesAndNotTheStaticMap)
+{
+	ReplayController c(sampleOptions());
+	EXPECT_FALSE(c.layers()[Layer::Tier0]);
+	c.seek(30);
+	ASSERT_GT(cv::countNonZero(c.currentMask()), 50);
+	const auto v = c.view();
+	EXPECT_EQ(v->frame, 30);
+	EXPECT_EQ(v->counter, "30 / 149");
+	EXPECT_EQ(v->status.rfind("frame 30/149", 0), 0u) << v->status;
+	EXPECT_EQ(v->layer(Layer::Tier0), nullptr);  // not even built
+	ASSERT_NE(v->layer(Layer::Cloud), nullptr);
+	// the cloud alone: its moving points are red
+	LayerVisibility cloudOnly = LayerVisibility::parse("cloud");
+	mrpt::opengl::COpenGLScene scene;
+	showView(scene, *v, cloudOnly);
+	ASSERT_NE(scene.getByName("cloud"), nullptr);
+	c.layers() = cloudOnly;
+	const auto cloud = tierColourFractions(
+	    c.renderOffscreen(c.suggestedCamera(), 640, 480).asCvMatRef());
+	EXPECT_GT(cloud.red, 0.001);
+
+	c.layers() = LayerVisibility();  // the default
+	const auto defImg = c.renderOffscreen(c.suggestedCamera(), 640, 480);
+	defImg.saveToFile(std::string(BIMS_BINARY_DIR) +
+	                  "/test_viewer_default.png");
+	const auto def = tierColourFractions(defImg.asCvMatRef());
+	c.layers()[Layer::Tier0] = true;
+	const auto withT0 = tierColourFractions(
+	    c.renderOffscreen(c.suggestedCamera(), 640, 480).asCvMatRef());
+	EXPECT_GT(withT0.blue, 0.002);  // the faint static map is there
+	EXPECT_GT(def.red, 0.002);
+	EXPECT_GT(withT0.red, 0.7 * def.red) << "static voxels hide what moves";
+}
+
+TEST(LayerVisibility, ParsesNamesAndRefusesUnknownOnes)
+{
+	const auto v = LayerVisibility::parse("cloud,tier2,gt");
+	EXPECT_TRUE(v[Layer::Cloud]);
+	EXPECT_TRUE(v[Layer::Tier2]);
+	EXPECT_TRUE(v[Layer::GroundTruth]);
+	EXPECT_FALSE(v[Layer::Tier0]);
+	EXPECT_FALSE(v[Layer::Estimated]);
+	EXPECT_TRUE(LayerVisibility::parse("all")[Layer::Tier0]);
+	EXPECT_FALSE(LayerVisibility::parse("none")[Layer::Cloud]);
+	try
+	{
+		LayerVisibility::parse("cloud,tier3");
+		FAIL() << "no throw";
+	}
+	catch (const std::invalid_argument& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("'tier3'"), std::string::npos);
+		EXPECT_NE(std::string(e.what()).find("tier0"), std::string::npos);
+	}
 }
 
 namespace
@@ -405,4 +467,137 @@ TEST(BatchAndLive, GiveTheSameFramesPosesAndMasks)
 	const std::string input = sampleWithFaults("batch_and_live");
 	const auto batch = batchFrames(input);
 	EXPECT_EQ(expectLiveSame(input, batch).scansOutOfOrder, 1u);
+}
+
+namespace
+{
+/** The moving masks of the sample's frames, as the controller alone (on
+ * this thread) shows them. */
+std::vector<cv::Mat> controllerMasks()
+{
+	ReplayController c(sampleOptions());
+	std::vector<cv::Mat> masks;
+	while (c.step()) masks.push_back(c.currentMask().clone());
+	return masks;
+}
+
+bool sameMask(const cv::Mat& a, const cv::Mat& b)
+{
+	return a.size() == b.size() && (a.empty() || cv::countNonZero(a != b) == 0);
+}
+}  // namespace
+
+// Every frame: a GUI that draws each view it gets sees every frame, in
+// order, with the masks the controller gives on one thread.
+TEST(ReplayWorker, EveryFrameModeDrawsEveryFrameWithTheSameMasks)
+{
+	const auto want = controllerMasks();
+	ASSERT_EQ(want.size(), 150u);
+	ReplayWorker w(sampleOptions(), LayerVisibility());
+	EXPECT_EQ(w.frameCount(), 150u);
+	w.setMode(PlayMode::EveryFrame);
+	w.setSpeed(20);
+	w.play(true);
+	std::vector<long> seen;
+	uint64_t last = 0;
+	for (int spins = 0; spins < 200000 && (seen.empty() || seen.back() < 149);
+	     ++spins)
+	{
+		const auto v = w.latest();
+		if (!v || v->seq == last)
+		{
+			std::this_thread::sleep_for(std::chrono::microseconds(200));
+			continue;
+		}
+		last = v->seq;
+		if (v->frame >= 0)
+		{
+			seen.push_back(v->frame);
+			EXPECT_TRUE(sameMask(v->mask, want[size_t(v->frame)]))
+			    << "frame " << v->frame;
+			EXPECT_EQ(v->counter, std::to_string(v->frame) + " / 149");
+		}
+		w.drawn(v->seq);
+	}
+	ASSERT_EQ(seen.size(), 150u);
+	for (size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], long(i));
+	ASSERT_TRUE(w.waitIdle(30));
+	EXPECT_EQ(w.state().processed, 150u);
+	EXPECT_EQ(w.state().notDrawn, 0u);
+	EXPECT_FALSE(w.state().playing);  // stopped at the end
+	EXPECT_EQ(w.takeError(), "");
+}
+
+// Real time: a GUI that never finishes drawing does not hold the pipeline
+// back; every frame is processed, those finished while the GUI was busy are
+// counted as not drawn, and the newest is drawn once the GUI is free.
+TEST(ReplayWorker, RealTimeModeNeverWaitsForTheGui)
+{
+	ReplayWorker w(sampleOptions(), LayerVisibility());
+	w.setSpeed(20);
+	w.play(true);
+	ASSERT_TRUE(w.waitIdle(60));
+	const auto st = w.state();
+	EXPECT_EQ(st.processed, 150u);
+	EXPECT_FALSE(st.playing);
+	auto v = w.latest();
+	ASSERT_NE(v, nullptr);
+	EXPECT_EQ(v->seq, 1u);  // the only view built: the GUI never drew it
+	EXPECT_LE(v->frame, 0);
+	// frames 1..148 were finished while that view was still being drawn
+	EXPECT_EQ(st.notDrawn, v->frame < 0 ? 149u : 148u);
+	w.drawn(v->seq);
+	ASSERT_TRUE(w.waitIdle(30));
+	v = w.latest();
+	EXPECT_EQ(v->frame, 149);  // the newest, once the GUI is free
+	EXPECT_EQ(v->seq, 2u);
+}
+
+// Step, seek and restart run on the replay thread and are exact; a seek
+// is interrupted by a later one; the layers are rebuilt on request.
+TEST(ReplayWorker, StepSeekAndRestartAreExact)
+{
+	const auto want = controllerMasks();
+	ReplayWorker w(sampleOptions(), LayerVisibility());
+	const auto settle = [&]
+	{
+		for (int i = 0; i < 100; ++i)  // the GUI draws whatever comes
+		{
+			EXPECT_TRUE(w.waitIdle(30));
+			const auto v = w.latest();
+			if (!v) continue;
+			w.drawn(v->seq);
+			if (w.waitIdle(0.01) && w.latest()->seq == v->seq) return v;
+		}
+		ADD_FAILURE() << "never settled";
+		return w.latest();
+	};
+	w.step();
+	w.step();
+	w.step();
+	auto v = settle();
+	EXPECT_EQ(v->frame, 2);
+	EXPECT_TRUE(sameMask(v->mask, want[2]));
+	w.seek(120);
+	w.seek(40);  // interrupts (or follows) the first
+	v = settle();
+	EXPECT_EQ(v->frame, 40);
+	EXPECT_TRUE(sameMask(v->mask, want[40]));
+	EXPECT_EQ(w.state().processed, 41u);
+	w.seek(12);  // back: the pipeline restarts and runs 0..12
+	v = settle();
+	EXPECT_EQ(v->frame, 12);
+	EXPECT_TRUE(sameMask(v->mask, want[12]));
+	w.withController([](ReplayController& c)
+	                 { EXPECT_EQ(c.pipelineObj()->framesProcessed(), 13u); });
+	EXPECT_EQ(v->layer(Layer::Tier0), nullptr);
+	w.setLayers(LayerVisibility::parse("all"));
+	v = settle();
+	EXPECT_EQ(v->frame, 12);
+	EXPECT_NE(v->layer(Layer::Tier0), nullptr);
+	w.restart();
+	v = settle();
+	EXPECT_EQ(v->frame, 0);
+	EXPECT_TRUE(sameMask(v->mask, want[0]));
+	w.seek(149);  // the destructor stops a long seek
 }

@@ -8,6 +8,7 @@
 #include <bims/common/trajectory.h>
 #include <bims/pipeline/pipeline.h>
 #include <bims/pipeline/stepper.h>
+#include <bims/viewer/frame_view.h>
 #include <bims/viewer/replay_source.h>
 
 #include <mrpt/img/CImage.h>
@@ -33,36 +34,6 @@ struct ViewerOptions
 	bool runPipeline = true;
 	/** Pixel step of the registered cloud (1 = every pixel). */
 	int cloudDecimation = 2;
-};
-
-/** Which layers the 3D view shows. */
-struct LayerVisibility
-{
-	bool cloud = true;        ///< current frame's registered cloud (RGB)
-	bool tier0 = true;        ///< occupied voxels, blue
-	bool tier1 = true;        ///< tier-1 moving voxels, yellow
-	bool tier2 = true;        ///< tier-2 moving voxels, red
-	bool estimated = true;    ///< estimated trajectory, cyan
-	bool groundTruth = true;  ///< ground-truth trajectory, green
-};
-
-/** The 2D panels. */
-enum class Panel
-{
-	RgbMask,       ///< intensity image with the moving mask in red
-	Depth,         ///< depth, jet colour map
-	FlowObserved,  ///< observed backward flow (HSV code)
-	FlowExpected,  ///< expected backward flow from depth + egomotion
-	Labels         ///< flow labels: Diff red, notDiff green
-};
-const char* toString(Panel p);
-
-/** An orbit camera of the 3D view (MRPT's CCamera parameters). */
-struct ViewCamera
-{
-	float pointX = 0, pointY = 0, pointZ = 0;  ///< look-at point in {W} [m]
-	float zoom = 5;                            ///< distance [m]
-	float azimuthDeg = -135, elevationDeg = 30;
 };
 
 class ReplayController
@@ -98,6 +69,9 @@ class ReplayController
 	 * (at most \a maxSteps; a slow pipeline makes playback lag, not skip).
 	 * Stops playing at the end. Returns the number of frames stepped. */
 	size_t advance(double wallSeconds, size_t maxSteps = 1);
+	/** Wall time until the next frame is due at the play clock [s] (0 when
+	 * due; infinity when paused or at the end). */
+	double secondsToNextFrame() const;
 
 	// --- content ------------------------------------------------------------
 	LayerVisibility& layers() { return layers_; }
@@ -115,7 +89,11 @@ class ReplayController
 	 * results, ground truth, or identity, in this order. */
 	mrpt::poses::CPose3D currentPose() const;
 
-	/** Replaces the scene's content (main viewport) with the layers. */
+	/** The current frame as the GUI draws it, with the visible layers
+	 * (layers()) built. */
+	std::shared_ptr<FrameView> view() const;
+	/** Replaces the scene's content (main viewport) with view()'s visible
+	 * layers. */
 	void fillScene(mrpt::opengl::COpenGLScene& scene) const;
 	/** A camera looking at the current frame's cloud from behind-above. */
 	ViewCamera suggestedCamera() const;
@@ -123,6 +101,8 @@ class ReplayController
 	cv::Mat panel(Panel p) const;
 	/** The moving mask shown (pipeline or results folder; may be empty). */
 	cv::Mat currentMask() const;
+	/** "12 / 149": the position of the current frame and of the last. */
+	std::string counterText() const;
 	/** One status line: frame, time, pose, moving pixels, timings. */
 	std::string statusText() const;
 

@@ -5,6 +5,7 @@
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
 #include <opencv2/core.hpp>
+#include <string>
 
 namespace bims::viewer
 {
@@ -31,6 +32,10 @@ cv::Mat flowColour(const cv::Mat& flow, double maxMagPx, cv::Size size);
 /** Flow labels (CV_8SC1: -1 none, 0 notDiff, 1 Diff) over a dimmed grey
  * copy of \a bgr: Diff red, notDiff green, none unchanged. */
 cv::Mat labelsColour(const cv::Mat& labels, const cv::Mat& bgr);
+
+/** A grey panel of \a size saying why there is no image (\a why, one short
+ * line, centred). */
+cv::Mat placeholderPanel(cv::Size size, const std::string& why);
 
 /** Fractions of the pixels of a BGR image whose colour is, by hue, the
  * tier-0 blue, tier-1 yellow or tier-2 red of the 3D view (saturation and
