@@ -212,6 +212,19 @@ void ViewerFrame::buildLayout()
 		    right, viewer::toString(static_cast<viewer::Panel>(i)));
 		grid->Add(panels_[i], 1, wxEXPAND);
 	}
+	// the sixth cell: what the colours of the 3D view mean
+	auto* legend = new wxStaticText(right, wxID_ANY,
+	                                "3D view\n"
+	                                "  red: moving points,\n"
+	                                "     tier-2 moving voxels\n"
+	                                "  yellow: tier-1 moving voxels\n"
+	                                "  faint blue: tier 0 (View menu)\n"
+	                                "  cyan: estimate; green: truth\n\n"
+	                                "Mouse: drag to orbit, wheel to\n"
+	                                "  zoom, shift-drag to pan\n"
+	                                "Keys: Space play/pause,\n"
+	                                "  Right step, Home restart");
+	grid->Add(legend, 1, wxEXPAND | wxALL, 6);
 	right->SetSizer(grid);
 	split->SplitVertically(canvas_, right, opt_.width / 2);
 	split->SetSashGravity(0.5);
@@ -376,9 +389,13 @@ void ViewerFrame::writeState()
 	Json panels = Json::array();
 	for (const auto* p : panels_) panels.push_back(screenRect(p));
 	j["panels"] = panels;
+	// written when it changes (a draw, a resize, the replay's counts)
+	std::string text = jsonText(j);
+	if (text == stateWritten_) return;
 	try
 	{
 		writeJsonFile(opt_.stateFile, j);
+		stateWritten_ = std::move(text);
 	}
 	catch (const std::exception& e)
 	{
@@ -412,6 +429,7 @@ void ViewerFrame::onTimer(wxTimerEvent&)
 	const auto v = worker_->latest();
 	if (v && v != shown_ && !ackPending_) draw(v);
 	updateControls();
+	writeState();
 	if (!opt_.screenshot.empty()) batchScreenshot();
 }
 

@@ -85,6 +85,7 @@ class ViewerFrame : public wxFrame
 	wxStaticText* frameLabel_ = nullptr;
 	wxTimer timer_;
 	std::string pngDir_;
+	std::string stateWritten_;  ///< the --state-file's last text
 	int batchTarget_ = 0;
 	int batchWaitTicks_ = 0;
 	bool batchCaptureRequested_ = false;
