@@ -1,6 +1,7 @@
 // bims-viewer under Xvfb: the real wx window with MRPT's GL canvas opens the
 // bundled rawlog, steps frames with the pipeline, and the 3D view it drew
 // (read back from the canvas) shows the three tier colours.
+#include <bims/common/frame_files.h>
 #include <bims/common/json.h>
 #include <bims/viewer/panels.h>
 #include <bims_test/data.h>
@@ -420,4 +421,29 @@ TEST(GuiViewer, PausedShowsTheFirstFrame)
 	cv::Scalar mean, sd;
 	cv::meanStdDev(img(rgb), mean, sd);
 	EXPECT_GT(sd[0] + sd[1] + sd[2], 20.0) << "the RGB panel is blank";
+}
+
+// A PNG sequence holds every frame played, in order, none skipped (it
+// plays every frame: each is drawn and written before the next runs).
+TEST(GuiViewer, PngSequenceWritesEveryFrameInOrder)
+{
+	const std::string dir = testDir("png_sequence");
+	const std::string log = dir + "/viewer.log";
+	const std::string cmd =
+	    "XSHOT_BUSY=1 " + std::string(BIMS_XVFB_RUN) +
+	    " -a -s '-screen 0 1200x800x24 +extension GLX' '" + BIMS_SOURCE_DIR +
+	    "/apps/viewer/tests/xshot.sh' - '" + dir + "/x.png' '" + kViewer +
+	    "' '" + kRawlog + "' --size 900x600 --png-sequence '" + dir +
+	    "/seq' > '" + log + "' 2>&1";
+	ASSERT_EQ(run(cmd), 0) << slurp(log);
+	std::vector<std::string> names;
+	for (const auto& e : std::filesystem::directory_iterator(dir + "/seq"))
+		if (e.path().extension() == ".png")  // not a .partial cut by the kill
+			names.push_back(e.path().filename().string());
+	std::sort(names.begin(), names.end());
+	ASSERT_GE(names.size(), 5u) << slurp(log);
+	for (size_t i = 0; i < names.size(); ++i)
+		EXPECT_EQ(names[i], bims::frameFileName(i)) << "a frame was skipped";
+	const cv::Mat last = cv::imread(dir + "/seq/" + names.back());
+	EXPECT_NEAR(last.cols, 450, 30);  // the 3D view: half the window
 }
