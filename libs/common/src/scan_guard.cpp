@@ -98,13 +98,6 @@ std::string printable(std::string s)
 	return s;
 }
 
-/** Whether a rows x cols image passes the limits. */
-bool saneSize(uint64_t rows, uint64_t cols)
-{
-	return rows <= kMaxImageSide && cols <= kMaxImageSide &&
-	       rows * cols <= kMaxImagePixels;
-}
-
 std::string tooLarge(const std::string& owner, const std::string& what,
                      uint64_t rows, uint64_t cols)
 {
@@ -112,35 +105,6 @@ std::string tooLarge(const std::string& owner, const std::string& what,
 	       " x " + std::to_string(cols) + " (rows x columns), beyond the " +
 	       std::to_string(kMaxImageSide) + " per side and " +
 	       std::to_string(kMaxImagePixels) + " pixels a rawlog may hold";
-}
-
-/** The height and width a JPEG's frame header (its SOF marker) declares,
- * or nullopt when the \a n bytes at \a p hold none before the image data. */
-std::optional<std::pair<uint32_t, uint32_t>> jpegSize(const uint8_t* p,
-                                                      size_t n)
-{
-	if (n < 2 || p[0] != 0xff || p[1] != 0xd8) return std::nullopt;  // SOI
-	size_t i = 2;
-	while (i + 4 <= n && p[i] == 0xff)
-	{
-		const uint8_t marker = p[i + 1];
-		if (marker == 0xff)  // fill byte
-		{
-			i++;
-			continue;
-		}
-		// SOF0-SOF15 but DHT (c4), JPG (c8), DAC (cc): height, width
-		if (marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 &&
-		    marker != 0xc8 && marker != 0xcc)
-		{
-			if (i + 9 > n) return std::nullopt;
-			return std::make_pair(uint32_t(p[i + 5]) << 8 | p[i + 6],
-			                      uint32_t(p[i + 7]) << 8 | p[i + 8]);
-		}
-		if (marker == 0xda || marker == 0xd9) return std::nullopt;  // SOS, EOI
-		i += 2 + (size_t(p[i + 2]) << 8 | p[i + 3]);  // the segment
-	}
-	return std::nullopt;
 }
 
 /** The class MRPT's reader takes an object header's name for: a name with
@@ -414,7 +378,7 @@ class ObservationWalker
 	{
 		const uint64_t rows = c_.read<uint32_t>(), cols = c_.read<uint32_t>();
 		if (!c_.ok()) return false;
-		if (!saneSize(rows, cols))
+		if (!imageSizeWithinLimits(rows, cols))
 		{
 			problem = tooLarge(what_, what, rows, cols);
 			return false;
@@ -466,10 +430,10 @@ class ObservationWalker
 			          "JPEG start of image)";
 			return false;
 		}
-		if (const auto hw = jpegSize(bytes, n);
-		    hw && !saneSize(hw->first, hw->second))
+		if (const auto h = imageHeader(bytes, n);
+		    h && !imageSizeWithinLimits(h->height, h->width))
 		{
-			problem = tooLarge(what_, what, hw->first, hw->second);
+			problem = tooLarge(what_, what, h->height, h->width);
 			return false;
 		}
 		const cv::Mat raw(1, static_cast<int>(n), CV_8UC1,
@@ -637,7 +601,7 @@ class ObservationWalker
 			if (w < 0 && h < 0)  // raw BGR
 			{
 				const uint64_t rw = -int64_t{w}, rh = -int64_t{h};
-				if (!saneSize(rh, rw))
+				if (!imageSizeWithinLimits(rh, rw))
 				{
 					problem = tooLarge(what_, what, rh, rw);
 					return false;
@@ -660,7 +624,7 @@ class ObservationWalker
 		const uint64_t size = c_.read<uint32_t>();
 		const int32_t depth = version >= 9 ? c_.read<int32_t>() : 0;
 		if (!c_.ok()) return false;
-		if (!saneSize(h, w))
+		if (!imageSizeWithinLimits(h, w))
 		{
 			problem = tooLarge(what_, what, h, w);
 			return false;
@@ -709,7 +673,7 @@ class ObservationWalker
 		c_.skip(1);
 		const uint64_t size = c_.read<uint32_t>();
 		if (!c_.ok()) return false;
-		if (!saneSize(h, w))
+		if (!imageSizeWithinLimits(h, w))
 		{
 			problem = tooLarge(what_, what, h, w);
 			return false;

@@ -9,6 +9,8 @@
 // and refuses declared sizes no real sensor produces.
 #pragma once
 
+#include <bims/common/image_file.h>
+
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -17,10 +19,9 @@
 
 namespace bims
 {
-/** Largest image side and pixel count a rawlog's scan may declare (a 16384 x
- * 4096 image; real RGB-D sensors give at most a few megapixels). */
-constexpr uint32_t kMaxImageSide = 16384;
-constexpr uint64_t kMaxImagePixels = uint64_t{1} << 26;
+// The largest image side and pixel count a rawlog's scan may declare are
+// those of every image input (bims/common/image_file.h: a 16384 x 4096
+// image; real RGB-D sensors give at most a few megapixels).
 /** Largest string or byte block (labels, file names, a JPEG image) an
  * observation may declare. */
 constexpr uint64_t kMaxStringBytes = uint64_t{1} << 26;

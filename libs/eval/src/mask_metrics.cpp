@@ -1,3 +1,4 @@
+#include <bims/common/image_file.h>
 #include <bims/eval/mask_metrics.h>
 #include <map>
 #include <tuple>
@@ -219,8 +220,7 @@ MaskMetrics voxelMaskMetrics(const cv::Mat& gt, const cv::Mat& pred,
 
 cv::Mat loadMask(const std::string& path)
 {
-	const cv::Mat m = cv::imread(path, cv::IMREAD_UNCHANGED);
-	if (m.empty()) throw std::runtime_error(path + ": cannot read mask image");
+	const cv::Mat m = readImageFile(path, cv::IMREAD_UNCHANGED, "mask image");
 	if (m.type() != CV_8UC1)
 		throw std::runtime_error(
 		    path + ": mask must be an 8-bit single-channel PNG (got " +

@@ -1,4 +1,5 @@
 #include <bims/common/config.h>
+#include <bims/common/image_file.h>
 #include <bims/eval/rgbd_frame.h>
 #include <mrpt/core/Clock.h>
 
@@ -12,9 +13,7 @@ using mrpt::obs::CObservation3DRangeScan;
 
 cv::Mat readDepthPng(const std::string& path)
 {
-	cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
-	if (raw.empty())
-		throw std::runtime_error(path + ": cannot read depth image");
+	cv::Mat raw = readImageFile(path, cv::IMREAD_UNCHANGED, "depth image");
 	if (raw.type() != CV_16UC1)
 		throw std::runtime_error(path +
 		                         ": depth must be a 16-bit single-channel PNG");

@@ -1,3 +1,4 @@
+#include <bims/common/image_file.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
@@ -178,10 +179,8 @@ StrayImportSummary importStray(const std::string& folder,
 		cv::Mat conf;
 		if (cap.hasConfidence)
 		{
-			conf = cv::imread(f.confidencePath, cv::IMREAD_UNCHANGED);
-			if (conf.empty())
-				throw std::runtime_error(f.confidencePath +
-				                         ": cannot read confidence image");
+			conf = readImageFile(f.confidencePath, cv::IMREAD_UNCHANGED,
+			                     "confidence image");
 			if (conf.type() != CV_8UC1)
 				throw std::runtime_error(
 				    f.confidencePath +

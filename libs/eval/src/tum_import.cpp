@@ -1,4 +1,5 @@
 #include <bims/common/app.h>
+#include <bims/common/image_file.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
@@ -40,9 +41,8 @@ mrpt::obs::CObservation3DRangeScan::Ptr loadFrame(const TumFrame& frame,
 {
 	const auto& cam = params.camera;
 	auto o = loadDepthFrame(frame.depthPath, frame.t, params);
-	const cv::Mat rgb = cv::imread(frame.rgbPath, cv::IMREAD_COLOR);
-	if (rgb.empty())
-		throw std::runtime_error(frame.rgbPath + ": cannot read colour image");
+	const cv::Mat rgb =
+	    readImageFile(frame.rgbPath, cv::IMREAD_COLOR, "colour image");
 	if (rgb.cols != cam.width || rgb.rows != cam.height)
 		throw std::runtime_error(
 		    frame.rgbPath + ": colour image is " + std::to_string(rgb.cols) +

@@ -4,6 +4,7 @@
 #include <bims/common/trajectory.h>
 #include <bims/eval/tum_import.h>
 #include <bims_test/data.h>
+#include <bims_test/png_bomb.h>
 #include <bims_test/run_command.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
@@ -549,6 +550,38 @@ TEST(ImportTum, AFailedImportLeavesNoRawlogUnderItsName)
 	EXPECT_EQ(ok.code, 0) << ok.out;
 	EXPECT_GT(fs::file_size(out), 0u);
 	EXPECT_FALSE(fs::exists(out + ".partial"));
+}
+
+// Issue 39's reproduction: a PNG of ~100 bytes declaring 30000 x 30000
+// RGBA 16-bit took 7.1 GB in bims-import-tum (as a depth image) and
+// bims-eval masks (as a label); both refuse it from its header now.
+TEST(Apps, ADecompressionBombIsRefusedFromItsHeader)
+{
+	const auto d = tmpDir("png_bomb");
+	fs::create_directories(d + "/rgb");
+	fs::create_directories(d + "/depth");
+	ASSERT_TRUE(cv::imwrite(d + "/rgb/a.png",
+	                        cv::Mat(480, 640, CV_8UC3, cv::Scalar(9, 9, 9))));
+	bims::test::writePngBomb(d + "/depth/a.png");
+	std::ofstream(d + "/rgb.txt") << "1.0 rgb/a.png\n";
+	std::ofstream(d + "/depth.txt") << "1.0 depth/a.png\n";
+	auto r = run(kBin + "/bims-import-tum " + d + " -o " + d + "/x.rawlog -q");
+	EXPECT_EQ(r.code, 1) << r.out;
+	EXPECT_NE(r.out.find("depth/a.png: cannot read depth image: declares "
+	                     "30000 x 30000 pixels in its PNG header"),
+	          std::string::npos)
+	    << r.out;
+
+	fs::create_directories(d + "/gt");
+	fs::create_directories(d + "/pred");
+	bims::test::writePngBomb(d + "/gt/000000.png");
+	cv::imwrite(d + "/pred/000000.png", cv::Mat(8, 8, CV_8UC1, cv::Scalar(0)));
+	r = run(kBin + "/bims-eval masks " + d + "/gt " + d + "/pred");
+	EXPECT_EQ(r.code, 1) << r.out;
+	EXPECT_NE(r.out.find("gt/000000.png: cannot read mask image: declares "
+	                     "30000 x 30000"),
+	          std::string::npos)
+	    << r.out;
 }
 
 TEST(Apps, NoProgramWritesOverItsInput)

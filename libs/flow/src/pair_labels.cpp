@@ -2,6 +2,7 @@
 #include <bims/common/clock.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
+#include <bims/common/image_file.h>
 #include <bims/common/output_paths.h>
 #include <bims/flow/expected_flow.h>
 #include <bims/flow/observed_flow.h>
@@ -23,11 +24,7 @@ namespace
 {
 cv::Mat readImage(const std::string& path, int flags)
 {
-	if (!mrpt::system::fileExists(path))
-		throw std::runtime_error(path + ": no such file");
-	cv::Mat m = cv::imread(path, flags);
-	if (m.empty()) throw std::runtime_error(path + ": cannot decode image");
-	return m;
+	return readImageFile(path, flags, "image");
 }
 }  // namespace
 

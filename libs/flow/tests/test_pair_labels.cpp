@@ -2,6 +2,7 @@
 // line, the labels of one pair, the overlay, the files written.
 #include <bims/common/app.h>
 #include <bims/flow/pair_labels.h>
+#include <bims_test/png_bomb.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 
@@ -167,5 +168,12 @@ TEST(PairLabels, TheRunWritesFourPicturesAndNamesBadInputs)
 	EXPECT_EQ(errorOf(bad), d + "/none.ini: no such config file");
 	bad = o;
 	bad.rgb1 = d + "/none.png";
-	EXPECT_EQ(errorOf(bad), d + "/none.png: no such file");
+	EXPECT_EQ(errorOf(bad), d + "/none.png: cannot read image: no such file");
+	// a decompression bomb: refused from its header (bims/common/image_file.h)
+	bad = o;
+	bims::test::writePngBomb(d + "/bomb.png");
+	bad.rgb0 = d + "/bomb.png";
+	EXPECT_NE(errorOf(bad).find("declares 30000 x 30000 pixels"),
+	          std::string::npos)
+	    << errorOf(bad);
 }

@@ -9,11 +9,13 @@
 #include <bims/common/app.h>
 #include <bims/common/frame_files.h>
 #include <bims/common/frames.h>
+#include <bims/common/image_file.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/maps/export.h>
 #include <bims/maps/motion_grids.h>
+#include <filesystem>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/img/CImage.h>
@@ -86,7 +88,11 @@ int main(int argc, char** argv)
 			    if (k >= frames || k >= int(traj.size())) break;
 			    const auto T_WS = traj[k].T_WC + (-bims::T_SC());
 			    const std::string name = "/masks/" + bims::frameFileName(k);
-			    const cv::Mat m = cv::imread(gt + name, cv::IMREAD_GRAYSCALE);
+			    const cv::Mat m =
+			        std::filesystem::exists(gt + name)
+			            ? bims::readImageFile(gt + name, cv::IMREAD_GRAYSCALE,
+			                                  "mask")
+			            : cv::Mat();
 			    bims::maps::PixelLabels labels;
 			    if (!m.empty())
 			    {

@@ -1,4 +1,5 @@
 #include <bims/common/frame_files.h>
+#include <bims/common/image_file.h>
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
 #include <bims/ego/flags.h>
@@ -19,7 +20,7 @@ cv::Mat feedbackMask(const std::string& dir, const SourceFrame& f)
 	if (dir.empty() || f.index == 0) return {};
 	const std::string p = dir + "/" + frameFileName(f.index - 1);
 	if (!std::filesystem::exists(p)) return {};
-	cv::Mat mask = cv::imread(p, cv::IMREAD_UNCHANGED);
+	cv::Mat mask = readImageFile(p, cv::IMREAD_UNCHANGED, "mask");
 	const auto& depth = f.scan->rangeImage;
 	if (mask.type() != CV_8UC1 || mask.cols != static_cast<int>(depth.cols()) ||
 	    mask.rows != static_cast<int>(depth.rows()))

@@ -1,5 +1,6 @@
 #include <bims/common/frame_files.h>
 #include <bims/common/frames.h>
+#include <bims/common/image_file.h>
 #include <bims/viewer/controller.h>
 #include <bims/viewer/panels.h>
 
@@ -126,7 +127,7 @@ void ReplayController::loadResultsFrame()
 	const std::string p =
 	    opt_.resultsDir + "/masks/" + frameFileName(frame_->index);
 	if (mrpt::system::fileExists(p))
-		resultsMask_ = cv::imread(p, cv::IMREAD_GRAYSCALE);
+		resultsMask_ = readImageFile(p, cv::IMREAD_GRAYSCALE, "mask");
 }
 
 void ReplayController::seek(size_t i)

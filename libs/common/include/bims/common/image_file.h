@@ -1,0 +1,50 @@
+// The one guarded reader of image files given as input (TUM folders, Stray
+// captures, labels, masks, the flow tools): the size an image declares in
+// its header is checked against limits before anything is decoded, so that
+// a few-kB PNG declaring 30000 x 30000 pixels is refused, not decoded into
+// gigabytes. The rawlog reader checks the images inside a rawlog against
+// the same limits (scan_guard).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace cv
+{
+class Mat;
+}
+
+namespace bims
+{
+/** Largest image a bims input may hold: per side, and in pixels. */
+constexpr uint32_t kMaxImageSide = 16384;
+constexpr uint64_t kMaxImagePixels = uint64_t{1} << 26;  // 67 Mpx
+
+/** What an image file's header declares. */
+struct ImageHeader
+{
+	const char* format = "";  ///< "PNG", "JPEG", "TIFF", "BMP"
+	uint32_t width = 0, height = 0;
+};
+
+/** The format and size the \a n bytes at \a p declare (PNG's IHDR, JPEG's
+ * frame header, TIFF's first directory, BMP's info header); nullopt when
+ * they are none of these formats or end before the size. */
+std::optional<ImageHeader> imageHeader(const uint8_t* p, size_t n);
+
+/** Whether a rows x cols image is within kMaxImageSide / kMaxImagePixels. */
+bool imageSizeWithinLimits(uint64_t rows, uint64_t cols);
+
+/** Reads the image file \a path as cv::imread(path, \a flags) does, but
+ * first checks that it is a readable file in one of the formats of
+ * imageHeader() whose declared size is within the limits; decodes only
+ * then. Throws std::runtime_error "PATH: cannot read WHAT: why" (\a what:
+ * e.g. "depth image", "label"; why: no such file, a folder, empty, not an
+ * image of those formats, a size beyond the limits (with the size and the
+ * format), or bytes that do not decode). */
+cv::Mat readImageFile(const std::string& path, int flags,
+                      const std::string& what = "image");
+
+}  // namespace bims
