@@ -109,6 +109,86 @@ void PartialFile::commit()
 	done_ = true;
 }
 
+PartialDir::PartialDir(std::string finalPath, OutputFolderLayout layout)
+    : final_(std::move(finalPath)),
+      partial_(final_ + ".partial"),
+      layout_(std::move(layout))
+{
+	std::error_code ec;
+	fs::remove_all(partial_, ec);  // a killed run's: bims's by its name
+	if (ec)
+		throw std::runtime_error(partial_ +
+		                         ": cannot remove the folder a stopped run "
+		                         "left: " +
+		                         ec.message());
+	makeDirs(partial_);
+}
+
+PartialDir::~PartialDir()
+{
+	if (done_) return;
+	std::error_code ec;
+	fs::remove_all(partial_, ec);
+}
+
+void PartialDir::commit()
+{
+	if (done_) return;
+	const auto fail = [&](const std::string& what, const std::error_code& ec)
+	{
+		return std::runtime_error(final_ + ": " + what + ": " + ec.message() +
+		                          " (the new files stay in " + partial_ + ")");
+	};
+	std::error_code ec;
+	const auto st = fs::symlink_status(final_, ec);
+	if (fs::is_symlink(st))
+	{
+		if (!fs::remove(final_, ec) || ec)
+			throw fail("cannot replace the symbolic link", ec);
+	}
+	else if (fs::exists(st))
+	{
+		if (!fs::is_directory(st))
+			throw std::runtime_error(final_ +
+			                         ": exists and is not a folder (the new "
+			                         "files stay in " +
+			                         partial_ + ")");
+		prepareOutputFolder(final_, layout_, true);  // the earlier run's
+		if (fs::is_empty(final_, ec)) fs::remove(final_, ec);
+	}
+	if (!fs::exists(fs::symlink_status(final_, ec)))
+	{
+		fs::rename(partial_, final_, ec);
+		if (ec) throw fail("cannot rename " + partial_ + " to it", ec);
+		done_ = true;
+		return;
+	}
+	// PATH holds other files than an earlier run's: move ours in
+	std::vector<fs::path> files;
+	for (const auto& e : fs::recursive_directory_iterator(partial_))
+		if (!e.is_directory()) files.push_back(e.path());
+	for (const auto& f : files)
+	{
+		const fs::path to = fs::path(final_) / fs::relative(f, partial_);
+		fs::create_directories(to.parent_path(), ec);
+		if (!ec) fs::rename(f, to, ec);
+		if (ec) throw fail("cannot move " + f.string() + " into it", ec);
+	}
+	fs::remove_all(partial_, ec);
+	done_ = true;
+}
+
+std::string groundTruthDirFor(const std::string& rawlogPath)
+{
+	fs::path p(rawlogPath);
+	if (p.extension() == ".rawlog" || p.extension() == ".gz")
+	{
+		p.replace_extension();
+		if (p.extension() == ".rawlog") p.replace_extension();
+	}
+	return p.string() + "_gt";
+}
+
 void writeFileAtomically(const std::string& path, const std::string& bytes)
 {
 	PartialFile part(path);

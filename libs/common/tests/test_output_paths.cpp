@@ -234,3 +234,71 @@ TEST(OutputPaths, OverwriteRemovesALinkOfTheLayoutNotItsTarget)
 	EXPECT_FALSE(fs::is_symlink(fs::symlink_status(d + "/out/metrics.json")));
 	EXPECT_TRUE(fs::exists(d + "/precious.txt"));
 }
+
+// A folder output appears only whole: written aside, put in place by
+// commit() (an earlier run's files replaced, others kept), dropped without.
+TEST(OutputPaths, APartialDirIsPutInPlaceWholeOrNotAtAll)
+{
+	const std::string d = fresh("partial_dir");
+	const bims::OutputFolderLayout layout{{"groundtruth.txt"},
+	                                      {{"masks", ".png"}}};
+	const auto write = [](const std::string& p, const std::string& text)
+	{
+		fs::create_directories(fs::path(p).parent_path());
+		std::ofstream(p) << text;
+	};
+	// into nothing: renamed
+	{
+		bims::PartialDir gt(d + "/x_gt", layout);
+		EXPECT_EQ(gt.path(), d + "/x_gt.partial");
+		write(gt.path() + "/groundtruth.txt", "one");
+		write(gt.path() + "/masks/000000.png", "m0");
+		write(gt.path() + "/masks/000001.png", "m1");
+		EXPECT_FALSE(fs::exists(d + "/x_gt"));
+		gt.commit();
+	}
+	EXPECT_EQ(slurp(d + "/x_gt/groundtruth.txt"), "one");
+	EXPECT_FALSE(fs::exists(d + "/x_gt.partial"));
+	// dropped (an error on the way): the earlier folder as it was
+	{
+		bims::PartialDir gt(d + "/x_gt", layout);
+		write(gt.path() + "/groundtruth.txt", "two");
+	}
+	EXPECT_EQ(slurp(d + "/x_gt/groundtruth.txt"), "one");
+	EXPECT_FALSE(fs::exists(d + "/x_gt.partial"));
+	// over an earlier run with a user's file: the run's files replaced
+	// (its extra mask gone), the user's kept
+	write(d + "/x_gt/notes.txt", "mine");
+	write(d + "/x_gt.partial/stale.png", "a killed run's");
+	{
+		bims::PartialDir gt(d + "/x_gt", layout);
+		EXPECT_FALSE(fs::exists(gt.path() + "/stale.png"));
+		write(gt.path() + "/groundtruth.txt", "three");
+		write(gt.path() + "/masks/000000.png", "n0");
+		gt.commit();
+	}
+	EXPECT_EQ(slurp(d + "/x_gt/groundtruth.txt"), "three");
+	EXPECT_EQ(slurp(d + "/x_gt/masks/000000.png"), "n0");
+	EXPECT_FALSE(fs::exists(d + "/x_gt/masks/000001.png"));
+	EXPECT_EQ(slurp(d + "/x_gt/notes.txt"), "mine");
+	EXPECT_FALSE(fs::exists(d + "/x_gt.partial"));
+	// a symbolic link at the name: replaced, its target untouched
+	write(d + "/elsewhere/groundtruth.txt", "theirs");
+	fs::create_directory_symlink(d + "/elsewhere", d + "/y_gt");
+	{
+		bims::PartialDir gt(d + "/y_gt", layout);
+		write(gt.path() + "/groundtruth.txt", "ours");
+		gt.commit();
+	}
+	EXPECT_FALSE(fs::is_symlink(d + "/y_gt"));
+	EXPECT_EQ(slurp(d + "/y_gt/groundtruth.txt"), "ours");
+	EXPECT_EQ(slurp(d + "/elsewhere/groundtruth.txt"), "theirs");
+}
+
+TEST(OutputPaths, GroundTruthDirDropsTheRawlogExtensions)
+{
+	EXPECT_EQ(bims::groundTruthDirFor("a/b.rawlog"), "a/b_gt");
+	EXPECT_EQ(bims::groundTruthDirFor("a/b.rawlog.gz"), "a/b_gt");
+	EXPECT_EQ(bims::groundTruthDirFor("b.gz"), "b_gt");
+	EXPECT_EQ(bims::groundTruthDirFor("b.bin"), "b.bin_gt");
+}

@@ -52,17 +52,6 @@ mrpt::obs::CObservation3DRangeScan::Ptr loadFrame(const TumFrame& frame,
 	return o;
 }
 
-std::string groundTruthDirFor(const std::string& rawlogPath)
-{
-	fs::path p(rawlogPath);
-	if (p.extension() == ".rawlog" || p.extension() == ".gz")
-	{
-		p.replace_extension();
-		if (p.extension() == ".rawlog") p.replace_extension();
-	}
-	return p.string() + "_gt";
-}
-
 namespace
 {
 void writeCalibration(const std::string& path, const ImportParams& params)
@@ -92,8 +81,12 @@ ImportSummary importTum(const std::string& folder, const std::string& outRawlog,
 
 	ImportSummary sum;
 	sum.gtDir = groundTruthDirFor(outRawlog);
-	makeDirs(sum.gtDir);
-	writeCalibration(sum.gtDir + "/calibration.ini", params);
+	// OUT_gt.partial/ until the rawlog is complete: a failed import leaves
+	// the earlier rawlog and its ground truth as they were
+	static const OutputFolderLayout gtLayout{
+	    {"calibration.ini", "groundtruth.txt"}, {}};
+	PartialDir gtPart(sum.gtDir, gtLayout);
+	writeCalibration(gtPart.path() + "/calibration.ini", params);
 
 	// Ground truth: T_WC of the optical frame at each frame's stamp.
 	if (tum.hasGroundTruth)
@@ -111,7 +104,7 @@ ImportSummary importTum(const std::string& folder, const std::string& outRawlog,
 		}
 		sum.gtPoses = sum.groundTruth.size();
 		saveTumTrajectory(
-		    sum.gtDir + "/groundtruth.txt", sum.groundTruth,
+		    gtPart.path() + "/groundtruth.txt", sum.groundTruth,
 		    std::string("T_WC of the camera optical frame at each 3D scan's "
 		                "stamp, from ") +
 		        folder + "/groundtruth.txt" +
@@ -175,6 +168,7 @@ ImportSummary importTum(const std::string& folder, const std::string& outRawlog,
 	}
 	w.close();
 	part.commit();
+	gtPart.commit();
 	bar.finish();
 	return sum;
 }

@@ -6,6 +6,7 @@
 #include <bims_test/data.h>
 #include <bims_test/png_bomb.h>
 #include <bims_test/run_command.h>
+#include <bims_test/text.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFile.h>
@@ -550,6 +551,58 @@ TEST(ImportTum, AFailedImportLeavesNoRawlogUnderItsName)
 	EXPECT_EQ(ok.code, 0) << ok.out;
 	EXPECT_GT(fs::file_size(out), 0u);
 	EXPECT_FALSE(fs::exists(out + ".partial"));
+	EXPECT_TRUE(fs::exists(d + "/x_gt/calibration.ini"));
+	EXPECT_FALSE(fs::exists(d + "/x_gt.partial"));
+}
+
+// Issue 39's reproduction: a failed import left OUT_gt/ with the new
+// ground truth beside the old rawlog. Now the earlier pair stays whole.
+TEST(ImportTum, AFailedImportLeavesTheEarlierRawlogAndGroundTruthTogether)
+{
+	const auto d = tmpDir("import_gt_pair");
+	fs::create_directories(d + "/rgb");
+	fs::create_directories(d + "/depth");
+	std::string rgbTxt, depthTxt, gtTxt;
+	for (int i = 0; i < 3; ++i)
+	{
+		const std::string n = std::to_string(i) + ".png";
+		const std::string t = "1." + std::to_string(i);
+		ASSERT_TRUE(cv::imwrite(d + "/rgb/" + n,
+		                        cv::Mat(48, 64, CV_8UC3, cv::Scalar(9, 9, 9))));
+		ASSERT_TRUE(cv::imwrite(d + "/depth/" + n,
+		                        cv::Mat(48, 64, CV_16UC1, cv::Scalar(5000))));
+		rgbTxt += t + " rgb/" + n + "\n";
+		depthTxt += t + " depth/" + n + "\n";
+		gtTxt += t + " " + std::to_string(0.1 * i) + " 0 0 0 0 0 1\n";
+	}
+	std::ofstream(d + "/rgb.txt") << rgbTxt;
+	std::ofstream(d + "/depth.txt") << depthTxt;
+	std::ofstream(d + "/groundtruth.txt") << gtTxt;
+	std::ofstream(d + "/cam.ini") << "[camera]\nfx = 50\nfy = 50\ncx = 32\n"
+	                                 "cy = 24\nwidth = 64\nheight = 48\n"
+	                                 "depth_scale = 5000\n";
+	const std::string out = d + "/k.rawlog";
+	const std::string cmd = kBin + "/bims-import-tum " + d + " -o " + out +
+	                        " -c " + d + "/cam.ini -q";
+	auto r = run(cmd + " --max-frames 2");
+	ASSERT_EQ(r.code, 0) << r.out;
+	const auto gt = [&]
+	{ return bims::test::fileText(d + "/k_gt/groundtruth.txt"); };
+	const std::string rawlogBefore = bims::test::fileText(out), gtBefore = gt();
+	ASSERT_EQ(bims::loadTumTrajectory(d + "/k_gt/groundtruth.txt").size(), 2u);
+	// all three frames, the third's depth image broken: the import fails
+	std::ofstream(d + "/depth/2.png") << "not a png";
+	r = run(cmd);
+	EXPECT_EQ(r.code, 1) << r.out;
+	EXPECT_EQ(bims::test::fileText(out), rawlogBefore);
+	EXPECT_EQ(gt(), gtBefore) << "a new ground truth beside the old rawlog";
+	EXPECT_FALSE(fs::exists(d + "/k_gt.partial"));
+	// whole again: both replaced together
+	ASSERT_TRUE(cv::imwrite(d + "/depth/2.png",
+	                        cv::Mat(48, 64, CV_16UC1, cv::Scalar(5000))));
+	r = run(cmd);
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_EQ(bims::loadTumTrajectory(d + "/k_gt/groundtruth.txt").size(), 3u);
 }
 
 // Issue 39's reproduction: a PNG of ~100 bytes declaring 30000 x 30000

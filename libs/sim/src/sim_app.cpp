@@ -57,14 +57,15 @@ std::string imuFromTum(const std::string& tum, const std::string& out,
 	const auto traj = loadTumTrajectory(tum);
 	std::vector<ImuTruth> truth;
 	const auto obs = synthesizeImu(traj, p, seed, &truth);
-	PartialFile part(out);  // renamed once complete
+	PartialFile part(out);  // both renamed once complete
+	PartialDir gt(groundTruthDirFor(out), groundTruthLayout());
 	RawlogWriter w(part.path(), 1);
 	for (const auto& o : obs) w.write(*o);
 	w.close();
+	saveImuTruth(gt.path() + "/imu.txt", truth);
 	part.commit();
-	const std::string gtDir = groundTruthDirFor(out);
-	makeDirs(gtDir);
-	saveImuTruth(gtDir + "/imu.txt", truth);
+	gt.commit();
+	const std::string& gtDir = gt.finalPath();
 	return mrpt::format(
 	    "bims-sim: %zu synthetic IMU samples (label %s) from %zu "
 	    "poses -> %s, truth in %s/imu.txt\n",
@@ -93,12 +94,15 @@ int runSim(const SimOptions& o)
 	                         o.config.value_or("")},
 	                        {o.out, groundTruthDirFor(o.out)});
 
-	// after the checks, before any work: an earlier run's ground truth
-	// would mix with this one's (a shorter run leaves its extra masks)
+	// after the checks, before any work: an earlier run's ground truth is
+	// refused without --overwrite; with it, it is replaced only once the
+	// new one is complete (PartialDir), so that it never mixes with this
+	// one's (a shorter run would leave its extra masks)
 	auto prepareGroundTruthDir = [&]
 	{
-		prepareOutputFolder(groundTruthDirFor(o.out), groundTruthLayout(),
-		                    o.overwrite);
+		if (!o.overwrite)
+			prepareOutputFolder(groundTruthDirFor(o.out), groundTruthLayout(),
+			                    false);
 	};
 	if (o.imu_from_tum)
 	{

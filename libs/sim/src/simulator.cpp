@@ -148,16 +148,6 @@ void writeCalibration(const SimConfig& cfg, const std::string& path)
 }
 }  // namespace
 
-std::string groundTruthDirFor(const std::string& rawlogPath)
-{
-	std::string base = rawlogPath;
-	const std::string ext = ".rawlog";
-	if (base.size() > ext.size() &&
-	    base.compare(base.size() - ext.size(), ext.size(), ext) == 0)
-		base.resize(base.size() - ext.size());
-	return base + "_gt";
-}
-
 const OutputFolderLayout& groundTruthLayout()
 {
 	static const OutputFolderLayout layout{
@@ -175,7 +165,11 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	const std::clock_t cpuStart = std::clock();
 	SimStats st;
 	st.gtDir = groundTruthDirFor(outRawlog);
-	makeDirs(st.gtDir + "/masks");
+	// OUT_gt.partial/ beside OUT.rawlog.partial, both put in place at the
+	// end: a killed run leaves the earlier pair as it was
+	PartialDir gtPart(st.gtDir, groundTruthLayout());
+	const std::string gt = gtPart.path();
+	makeDirs(gt + "/masks");
 
 	const Scene scene = cfg.buildScene();
 	const HandheldMotion motion(cfg.motion);
@@ -185,12 +179,13 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	RawlogWriter out(part.path(), cfg.seq.gzLevel);
 
 	// The ground truth grows frame by frame beside the rawlog, whose gzip
-	// stream is flushed after every frame: a killed run leaves both readable
-	// up to the last whole frame (docs/sim.md).
-	writeCalibration(cfg, st.gtDir + "/calibration.ini");
-	AppendFile gtPoses(st.gtDir + "/groundtruth.txt");
-	AppendFile gtImu(st.gtDir + "/imu.txt");
-	AppendFile gtObjects(st.gtDir + "/objects.txt");
+	// stream is flushed after every frame: a killed run leaves both
+	// (OUT.rawlog.partial, OUT_gt.partial/) readable up to the last whole
+	// frame (docs/sim.md).
+	writeCalibration(cfg, gt + "/calibration.ini");
+	AppendFile gtPoses(gt + "/groundtruth.txt");
+	AppendFile gtImu(gt + "/imu.txt");
+	AppendFile gtObjects(gt + "/objects.txt");
 	gtPoses.append(tumHeader(
 	    "bims-sim ground truth: camera optical frame poses T_WC, world z up, "
 	    "x north"));
@@ -243,9 +238,9 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 		const std::string name = "/masks/" + frameFileName(j);
 		const cv::Mat mask(frame.height, frame.width, CV_8UC1,
 		                   frame.mask.data());
-		writeImageFile(st.gtDir + name, mask);
+		writeImageFile(gt + name, mask);
 		if (j == previewFrame)
-			writePreview(frame, cfg.depth.maxRange, st.gtDir + "/preview.png");
+			writePreview(frame, cfg.depth.maxRange, gt + "/preview.png");
 		size_t nMoving = 0;
 		for (auto m : frame.mask) nMoving += m ? 1 : 0;
 		movingSum += double(nMoving) / double(frame.mask.size());
@@ -267,10 +262,10 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	writeImuUntil(double(std::max(0, done - 1)) / cfg.seq.fps +
 	              0.5 / cfg.seq.fps);
 	out.close();
-	part.commit();
-	bar.finish();
-
 	for (auto* f : {&gtPoses, &gtImu, &gtObjects}) f->close();
+	part.commit();
+	gtPart.commit();
+	bar.finish();
 
 	st.frames = size_t(done);
 	st.imuSamples = nextImu;

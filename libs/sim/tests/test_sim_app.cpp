@@ -444,7 +444,7 @@ TEST(BimsSim, SigintAndSigtermEndACompleteShorterSequence)
 		const int rc = bims::test::signalWhenExists(
 		    {kBin + "/bims-sim", kSrc + "/rawlogs/pendulum_slow.ini", "-o",
 		     d + "/x.rawlog", "--max-frames", "3000", "-q"},
-		    d + "/log", d + "/x_gt/masks/000005.png", sig);
+		    d + "/log", d + "/x_gt.partial/masks/000005.png", sig);
 		const std::string log = readFile(d + "/log");
 		EXPECT_EQ(rc, code) << log;
 		EXPECT_NE(log.find(std::string("interrupted by ") + name + " after "),
@@ -474,21 +474,24 @@ TEST(BimsSim, SigintAndSigtermEndACompleteShorterSequence)
 			masks++;
 		EXPECT_EQ(masks, scans);
 		EXPECT_FALSE(std::filesystem::exists(d + "/x.rawlog.partial"));
+		EXPECT_FALSE(std::filesystem::exists(d + "/x_gt.partial"));
 	}
 }
 
 TEST(BimsSim, AKilledRunLeavesEveryFrameWrittenSoFarReadable)
 {
-	// SIGKILL cannot be caught: the rawlog stays a .partial, but its gzip
-	// stream is flushed after each frame and the ground truth grows line by
-	// line, so both read back up to the last whole frame
+	// SIGKILL cannot be caught: the rawlog and its ground truth stay
+	// OUT.rawlog.partial and OUT_gt.partial/, but the rawlog's gzip stream is
+	// flushed after each frame and the ground truth grows line by line, so
+	// both read back up to the last whole frame
 	const std::string d = tmpDir("sigkill");
 	const int rc = bims::test::signalWhenExists(
 	    {kBin + "/bims-sim", kSrc + "/rawlogs/pendulum_slow.ini", "-o",
 	     d + "/x.rawlog", "--frames", "3000", "-q"},
-	    d + "/log", d + "/x_gt/masks/000005.png", SIGKILL);
+	    d + "/log", d + "/x_gt.partial/masks/000005.png", SIGKILL);
 	ASSERT_EQ(rc, -SIGKILL) << readFile(d + "/log");
 	EXPECT_FALSE(std::filesystem::exists(d + "/x.rawlog"));
+	EXPECT_FALSE(std::filesystem::exists(d + "/x_gt"));
 	size_t scans = 0;
 	std::string torn;  // the reader's message at a torn end, if any
 	try
@@ -509,13 +512,48 @@ TEST(BimsSim, AKilledRunLeavesEveryFrameWrittenSoFarReadable)
 	EXPECT_GE(scans, 6u) << torn;
 	EXPECT_LT(scans, 3000u);
 	// each ground-truth line follows its frame's flush
-	const auto poses = bims::loadTumTrajectory(d + "/x_gt/groundtruth.txt");
+	const auto poses =
+	    bims::loadTumTrajectory(d + "/x_gt.partial/groundtruth.txt");
 	EXPECT_LE(poses.size(), scans);
 	EXPECT_GE(poses.size() + 1, scans);
-	const std::string imu = readFile(d + "/x_gt/imu.txt");
+	const std::string imu = readFile(d + "/x_gt.partial/imu.txt");
 	ASSERT_FALSE(imu.empty());
 	EXPECT_EQ(imu.back(), '\n');
-	EXPECT_TRUE(std::filesystem::exists(d + "/x_gt/calibration.ini"));
+	EXPECT_TRUE(std::filesystem::exists(d + "/x_gt.partial/calibration.ini"));
+}
+
+// Issue 39's reproduction: `bims-sim --overwrite` killed left the old
+// rawlog beside a new ground truth. Now the earlier pair stays whole.
+TEST(BimsSim, AKilledOverwriteLeavesTheEarlierRawlogAndGroundTruthTogether)
+{
+	const std::string d = tmpDir("sigkill_overwrite");
+	std::string out;
+	ASSERT_EQ(run("'" + kBin + "/bims-sim' '" + kSrc +
+	                  "/rawlogs/pendulum_slow.ini' -o '" + d +
+	                  "/x.rawlog' --max-frames 3 -q",
+	              out),
+	          0)
+	    << out;
+	const std::string rawlogBefore = readFile(d + "/x.rawlog");
+	const std::string gtBefore = readFile(d + "/x_gt/groundtruth.txt");
+	const int rc = bims::test::signalWhenExists(
+	    {kBin + "/bims-sim", kSrc + "/rawlogs/pendulum_slow.ini", "-o",
+	     d + "/x.rawlog", "--frames", "3000", "-q", "--overwrite"},
+	    d + "/log", d + "/x_gt.partial/masks/000005.png", SIGKILL);
+	ASSERT_EQ(rc, -SIGKILL) << readFile(d + "/log");
+	EXPECT_EQ(readFile(d + "/x.rawlog"), rawlogBefore);
+	EXPECT_EQ(readFile(d + "/x_gt/groundtruth.txt"), gtBefore);
+	EXPECT_TRUE(std::filesystem::exists(d + "/x_gt/masks/000002.png"));
+	EXPECT_FALSE(std::filesystem::exists(d + "/x_gt/masks/000003.png"));
+	// the next run clears the killed one's folder and puts its pair in place
+	ASSERT_EQ(run("'" + kBin + "/bims-sim' '" + kSrc +
+	                  "/rawlogs/pendulum_slow.ini' -o '" + d +
+	                  "/x.rawlog' --max-frames 4 -q --overwrite",
+	              out),
+	          0)
+	    << out;
+	EXPECT_FALSE(std::filesystem::exists(d + "/x_gt.partial"));
+	EXPECT_EQ(bims::loadTumTrajectory(d + "/x_gt/groundtruth.txt").size(), 4u);
 }
 
 TEST(BimsSim, AnEarlierRunsGroundTruthIsRefusedUnlessOverwrite)

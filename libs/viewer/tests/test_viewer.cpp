@@ -500,8 +500,11 @@ TEST(ReplayWorker, EveryFrameModeDrawsEveryFrameWithTheSameMasks)
 	w.play(true);
 	std::vector<long> seen;
 	uint64_t last = 0;
-	for (int spins = 0; spins < 200000 && (seen.empty() || seen.back() < 149);
-	     ++spins)
+	// (a generous wall-time limit: sanitizer builds run 3-10x slower)
+	const auto until =
+	    std::chrono::steady_clock::now() + std::chrono::minutes(8);
+	while ((seen.empty() || seen.back() < 149) &&
+	       std::chrono::steady_clock::now() < until)
 	{
 		const auto v = w.latest();
 		if (!v || v->seq == last)

@@ -81,6 +81,38 @@ class PartialFile
 	bool done_ = false;
 };
 
+/** A folder output (a rawlog's OUT_gt/) written as PATH.partial/ (a stale
+ * one from a killed run is removed first) and put in place by commit():
+ * an earlier run's files of \a layout in PATH are removed then (nothing
+ * else; a symbolic link at PATH is replaced, never followed), and the new
+ * folder renamed to PATH (its files moved in when PATH holds other files).
+ * Dropped without commit(), PATH.partial/ is removed and PATH stays as it
+ * was: a failed or killed run never leaves a new ground truth beside an old
+ * rawlog. Commit it right after the rawlog's PartialFile. */
+class PartialDir
+{
+ public:
+	PartialDir(std::string finalPath, OutputFolderLayout layout);
+	~PartialDir();
+	PartialDir(const PartialDir&) = delete;
+	PartialDir& operator=(const PartialDir&) = delete;
+
+	/** Where to write: PATH.partial. */
+	const std::string& path() const { return partial_; }
+	const std::string& finalPath() const { return final_; }
+	/** Puts the folder in place; throws naming PATH on failure. */
+	void commit();
+
+ private:
+	std::string final_, partial_;
+	OutputFolderLayout layout_;
+	bool done_ = false;
+};
+
+/** "OUT_gt" for "OUT.rawlog" (also "OUT.rawlog.gz", "OUT.gz": the
+ * extensions removed, "_gt" appended): where a rawlog's ground truth is. */
+std::string groundTruthDirFor(const std::string& rawlogPath);
+
 /** A file that grows record by record (trajectory.txt, frames.csv, a plain
  * rawlog), for a run that may stop at any time: created (truncated; a
  * symbolic link there replaced), each append() reaches the OS at once and

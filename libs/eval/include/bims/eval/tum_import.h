@@ -154,9 +154,6 @@ struct ImportSummary
 	Trajectory groundTruth;  ///< what groundtruth.txt holds (T_WC at frames)
 };
 
-/** "OUT_gt" for "OUT.rawlog" (extension removed, "_gt" appended). */
-std::string groundTruthDirFor(const std::string& rawlogPath);
-
 /** Imports \a folder into \a outRawlog and writes OUT_gt/calibration.ini
  * ([camera], [sensors]) and, if the folder has ground truth,
  * OUT_gt/groundtruth.txt: T_WC of the camera's optical frame interpolated

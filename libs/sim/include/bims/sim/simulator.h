@@ -75,9 +75,6 @@ struct SimStats
 	bool interrupted = false;   ///< stopped early by \a stop (frames < asked)
 };
 
-/** Folder of the ground truth of a rawlog: "<path without .rawlog>_gt". */
-std::string groundTruthDirFor(const std::string& rawlogPath);
-
 /** Every file bims-sim writes into the ground-truth folder (runSimulation,
  * saveImuTruth): an earlier run's are refused or cleared by
  * bims::prepareOutputFolder (bims-sim --overwrite). */
