@@ -142,6 +142,22 @@ const char* version()
 	return BIMS_VERSION;
 }
 
+std::string withoutBacktrace(const std::string& what)
+{
+	if (std::getenv("BIMS_BACKTRACE")) return what;
+	std::string out, line;
+	std::istringstream in(what);
+	while (std::getline(in, line))
+	{
+		if (line.rfind("Call stack backtrace:", 0) == 0) break;
+		if (line.find("==== MRPT exception ====") != std::string::npos)
+			continue;
+		if (line.empty()) continue;
+		out += (out.empty() ? "" : "; ") + line;
+	}
+	return out.empty() ? what : out;
+}
+
 int runApp(const std::string& program, const std::function<int()>& body)
 {
 	try
@@ -166,7 +182,8 @@ int runApp(const std::string& program, const std::function<int()>& body)
 	}
 	catch (const std::exception& e)
 	{
-		std::fprintf(stderr, "%s: error: %s\n", program.c_str(), e.what());
+		std::fprintf(stderr, "%s: error: %s\n", program.c_str(),
+		             withoutBacktrace(e.what()).c_str());
 		return 1;
 	}
 }

@@ -1,3 +1,4 @@
+#include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <mrpt/config/CConfigFile.h>
 
@@ -65,11 +66,36 @@ void checkIniFile(const std::string& path)
 	bool inSection = false;
 	for (int n = 1; std::getline(f, line); n++)
 	{
-		const std::string t = trim(line);
 		const auto at = path + ":" + std::to_string(n) + ": ";
-		if (t.empty() || t[0] == ';' || t[0] == '#' || t[0] == '@' ||
-		    t.rfind("//", 0) == 0)
+		if (n == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0)
+			throw ConfigError(at +
+			                  "the file starts with a UTF-8 byte-order mark "
+			                  "(BOM): save it without one (MRPT would read "
+			                  "its first line wrong)");
+		if (std::any_of(line.begin(), line.end(),
+		                [](char ch)
+		                {
+			                const auto c = static_cast<unsigned char>(ch);
+			                return c < 0x20 && c != '\t' && c != '\r';
+		                }))
+			throw ConfigError(at +
+			                  "binary bytes: not a text .ini file (another "
+			                  "file, e.g. a rawlog, given in its place?)");
+		const std::string t = trim(line);
+		if (t.empty() || t[0] == ';' || t[0] == '#' || t.rfind("//", 0) == 0)
 			continue;
+		if (t[0] == '@')
+		{
+			// MRPT 2.5.8 reads @define; any other directive it skips
+			if (t.rfind("@define", 0) != 0 ||
+			    (t.size() > 7 &&
+			     !std::isspace(static_cast<unsigned char>(t[7]))))
+				throw ConfigError(at + "'" + t.substr(0, t.find(' ')) +
+				                  "': MRPT's reader takes only @define "
+				                  "(an @include would be skipped silently: "
+				                  "copy the settings into this file)");
+			continue;
+		}
 		if (t[0] == '[')
 		{
 			if (t.back() != ']')
@@ -99,6 +125,20 @@ void checkIniFile(const std::string& path)
 			throw ConfigError(at + "[" + section + "] " + key +
 			                  " given twice (first on line " +
 			                  std::to_string(it->second) + ")");
+	}
+}
+
+std::unique_ptr<mrpt::config::CConfigFile> openIniFile(const std::string& path)
+{
+	checkIniFile(path);
+	try
+	{
+		return std::make_unique<mrpt::config::CConfigFile>(path);
+	}
+	catch (const std::exception& e)
+	{
+		// e.g. ${UNDEFINED}: MRPT's message without its backtrace
+		throw ConfigError(path + ": " + withoutBacktrace(e.what()));
 	}
 }
 

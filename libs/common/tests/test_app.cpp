@@ -96,3 +96,12 @@ TEST(Progress, DurationsReadAsMinutesAndHours)
 	EXPECT_EQ(bims::formatDuration(125), "2 min 05 s");
 	EXPECT_EQ(bims::formatDuration(3725), "1 h 02 min");
 }
+
+TEST(App, AnMrptExceptionIsCutToItsMessage)
+{
+	const std::string mrpt =
+	    "==== MRPT exception ====\nLine 2: Unknown variable `${X}`\nCall "
+	    "stack backtrace:\n[0 ]     0x7f5284debb28\n[1 ]     0x55cc13dc3cf4\n";
+	EXPECT_EQ(bims::withoutBacktrace(mrpt), "Line 2: Unknown variable `${X}`");
+	EXPECT_EQ(bims::withoutBacktrace("a.ini: plain"), "a.ini: plain");
+}

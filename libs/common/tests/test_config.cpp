@@ -196,3 +196,42 @@ TEST(IniSyntax, EveryBundledIniPasses)
 	}
 	EXPECT_GT(n, 5u);
 }
+
+// What MRPT's reader would take wrong or silently skip is refused, naming
+// the file and line; MRPT's own errors come out on one line.
+TEST(IniSyntax, BomIncludeAndBinaryBytesAreRefused)
+{
+	const auto bom = iniError("\xEF\xBB\xBF[a]\nx = 1\n", "bom.ini");
+	EXPECT_NE(bom.find("bom.ini:1: the file starts with a UTF-8 byte-order "
+	                   "mark"),
+	          std::string::npos)
+	    << bom;
+	const auto inc = iniError("@include other.ini\n[a]\nx = 1\n", "inc.ini");
+	EXPECT_NE(inc.find("inc.ini:1: '@include': MRPT's reader takes only "
+	                   "@define"),
+	          std::string::npos)
+	    << inc;
+	EXPECT_NE(iniError("[a]\n@defineX 1\n", "d.ini").find("d.ini:2:"),
+	          std::string::npos);
+	const auto bin =
+	    iniError(std::string("[a]\nx = 1\n\x01\x02\x03\n", 13), "bin.ini");
+	EXPECT_NE(bin.find("bin.ini:3: binary bytes: not a text .ini file"),
+	          std::string::npos)
+	    << bin;
+}
+
+TEST(IniSyntax, OpenIniFileTurnsMrptErrorsIntoOneLine)
+{
+	const auto p = bims::test::tmpPath("undefined_var.ini");
+	std::ofstream(p) << "[a]\nx = ${UNDEFINED_BIMS_VAR}\n";
+	const auto e = errorOf([&] { bims::openIniFile(p); });
+	EXPECT_EQ(e.rfind(p + ": ", 0), 0u) << e;
+	EXPECT_NE(e.find("UNDEFINED_BIMS_VAR"), std::string::npos) << e;
+	EXPECT_EQ(e.find("backtrace"), std::string::npos) << e;
+	EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+	// @define works as MRPT reads it
+	const auto q = bims::test::tmpPath("define_var.ini");
+	std::ofstream(q) << "@define V 0.25\n[a]\nx = ${V}\n";
+	const auto cfg = bims::openIniFile(q);
+	EXPECT_DOUBLE_EQ(cfg->read_double("a", "x", 0), 0.25);
+}

@@ -351,10 +351,9 @@ void EgoConfig::loadFromFile(const std::string& path)
 {
 	if (!mrpt::system::fileExists(path))
 		throw UsageError(path + ": no such config file");
-	bims::checkIniFile(path);
-	mrpt::config::CConfigFile cfg(path);
-	checkExperimentSections(cfg);
-	loadFromConfigFile(cfg, false);
+	const auto cfg = bims::openIniFile(path);
+	checkExperimentSections(*cfg);
+	loadFromConfigFile(*cfg, false);
 }
 
 void EgoConfig::overrideSensorSections(const mrpt::config::CConfigFileBase& cal)

@@ -57,9 +57,8 @@ int runStrayImport(const StrayImportRunOptions& o)
 	{
 		if (!std::filesystem::exists(*o.config))
 			throw std::runtime_error(*o.config + ": config file not found");
-		checkIniFile(*o.config);
-		mrpt::config::CConfigFile cfg(*o.config);
-		params.loadFromConfigFile(cfg);
+		const auto cfg = openIniFile(*o.config);
+		params.loadFromConfigFile(*cfg);
 	}
 	else
 		std::fprintf(stderr,

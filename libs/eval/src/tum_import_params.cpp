@@ -9,6 +9,15 @@ void CameraIntrinsics::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& cfg, const std::string& section)
 {
 	ConfigSection s(cfg, section);
+	// as bims-run reads [camera]: the six together or none of them (none:
+	// the defaults, TUM's camera), never some mixed with defaults
+	std::string given, missing;
+	for (const char* k : {"fx", "fy", "cx", "cy", "width", "height"})
+		(s.has(k) ? given : missing) += std::string(" ") + k;
+	if (!given.empty() && !missing.empty())
+		s.fail(given.substr(1, given.find(' ', 1) - 1),
+		       "fx fy cx cy width height: all or none; given:" + given +
+		           ", missing:" + missing);
 	width = static_cast<int>(s.getInt("width", width, 1, 100000));
 	height = static_cast<int>(s.getInt("height", height, 1, 100000));
 	fx = s.getDouble("fx", fx, 1e-3, 1e6);

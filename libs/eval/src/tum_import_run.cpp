@@ -1,4 +1,5 @@
 #include <bims/common/app.h>
+#include <bims/common/config.h>
 #include <bims/common/output_paths.h>
 #include <bims/eval/pose_utils.h>
 #include <bims/eval/tum_import_run.h>
@@ -50,14 +51,23 @@ int runImport(const ImportRunOptions& o)
 	{
 		if (!std::filesystem::exists(*o.config))
 			throw std::runtime_error(*o.config + ": config file not found");
-		cfg = std::make_unique<mrpt::config::CConfigFile>(*o.config);
+		cfg = openIniFile(*o.config);
+		std::vector<std::string> sections;
+		cfg->getAllSections(sections);
+		if (sections.empty())
+			throw ConfigError(*o.config +
+			                  ": no settings at all (an empty file?); without "
+			                  "--config bims-import-tum uses the TUM default "
+			                  "camera");
 		params.loadFromConfigFile(*cfg);
 	}
-	else
-		std::fprintf(stderr,
-		             "bims-import-tum: no --config: using the TUM default "
-		             "camera (fx=fy=525, cx=319.5, cy=239.5, 640x480, depth "
-		             "scale 5000)\n");
+	if (!cfg || !cfg->sectionExists("camera"))
+		std::fprintf(
+		    stderr,
+		    "bims-import-tum: %s: using the TUM default camera "
+		    "(fx=fy=525, cx=319.5, cy=239.5, 640x480, depth scale "
+		    "5000)\n",
+		    cfg ? ("no [camera] in " + *o.config).c_str() : "no --config");
 
 	ImportOptions opt;
 	opt.maxFrames = o.max_frames;

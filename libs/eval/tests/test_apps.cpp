@@ -179,7 +179,9 @@ TEST(ImportTum, BadInputIsAClearError)
 	          std::string::npos)
 	    << r.out;
 	// Unknown key in the config.
-	std::ofstream(d + "/c.ini") << "[camera]\nfx = 500\nfxx = 3\n";
+	std::ofstream(d + "/c.ini")
+	    << "[camera]\nfx = 500\nfy = 500\ncx = 320\ncy = 240\n"
+	       "width = 640\nheight = 480\nfxx = 3\n";
 	r = run(kBin + "/bims-import-tum " + d + " -o " + d +
 	        "/x.rawlog --config " + d + "/c.ini");
 	EXPECT_EQ(r.code, 1);
@@ -553,6 +555,51 @@ TEST(ImportTum, AFailedImportLeavesNoRawlogUnderItsName)
 	EXPECT_FALSE(fs::exists(out + ".partial"));
 	EXPECT_TRUE(fs::exists(d + "/x_gt/calibration.ini"));
 	EXPECT_FALSE(fs::exists(d + "/x_gt.partial"));
+}
+
+// Issue 39's reproduction: bims-import-tum -c read its .ini without the
+// strict reader (exit 0 with the TUM default camera for a binary, empty or
+// BOM file, duplicate keys, a [camera] with only fx; a raw MRPT exception
+// for a folder). Each is now an error naming the file.
+TEST(ImportTum, TheConfigIsReadStrictly)
+{
+	const auto d = tmpDir("import_strict_ini");
+	fs::create_directories(d + "/rgb");
+	fs::create_directories(d + "/depth");
+	ASSERT_TRUE(cv::imwrite(d + "/rgb/a.png",
+	                        cv::Mat(48, 64, CV_8UC3, cv::Scalar(9, 9, 9))));
+	ASSERT_TRUE(cv::imwrite(d + "/depth/a.png",
+	                        cv::Mat(48, 64, CV_16UC1, cv::Scalar(5000))));
+	std::ofstream(d + "/rgb.txt") << "1.0 rgb/a.png\n";
+	std::ofstream(d + "/depth.txt") << "1.0 depth/a.png\n";
+	fs::create_directories(d + "/cfg_dir");
+	const std::vector<std::pair<std::string, std::string>> cases = {
+	    {std::string("\x7f\x45\x4c\x46\x02\x01\x01\x00", 8), "binary bytes"},
+	    {"", "no settings at all"},
+	    {"\xEF\xBB\xBF[camera]\nfx = 50\n", "byte-order mark"},
+	    {"[camera]\nfx = 50\nfx = 51\n", "fx given twice"},
+	    {"[camera]\nfx = 50\n",
+	     "all or none; given: fx, missing: fy cx cy "
+	     "width height"},
+	};
+	int k = 0;
+	for (const auto& [text, want] : cases)
+	{
+		const std::string ini = d + "/c" + std::to_string(k++) + ".ini";
+		std::ofstream(ini, std::ios::binary) << text;
+		const auto r = run(kBin + "/bims-import-tum " + d + " -o " + d +
+		                   "/x.rawlog -q -c " + ini);
+		EXPECT_EQ(r.code, 1) << r.out;
+		EXPECT_NE(r.out.find(ini + ":"), std::string::npos) << r.out;
+		EXPECT_NE(r.out.find(want), std::string::npos) << r.out;
+		EXPECT_FALSE(fs::exists(d + "/x.rawlog")) << r.out;
+	}
+	const auto r = run(kBin + "/bims-import-tum " + d + " -o " + d +
+	                   "/x.rawlog -c " + d + "/cfg_dir");
+	EXPECT_EQ(r.code, 1) << r.out;
+	EXPECT_NE(r.out.find("cfg_dir: not a regular file"), std::string::npos)
+	    << r.out;
+	EXPECT_EQ(r.out.find("backtrace"), std::string::npos) << r.out;
 }
 
 // Issue 39's reproduction: a failed import left OUT_gt/ with the new

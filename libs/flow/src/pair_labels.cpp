@@ -102,10 +102,9 @@ int runFlowLabels(const FlowLabelsOptions& o)
 	{
 		if (!mrpt::system::fileExists(*o.config))
 			throw std::runtime_error(*o.config + ": no such config file");
-		checkIniFile(*o.config);
-		mrpt::config::CConfigFile cfg(*o.config);
-		checkExperimentSections(cfg);
-		params.loadFromConfigFile(cfg, "flow");
+		const auto cfg = openIniFile(*o.config);
+		checkExperimentSections(*cfg);
+		params.loadFromConfigFile(*cfg, "flow");
 	}
 	const cv::Mat rgb0 = readImage(o.rgb0, cv::IMREAD_COLOR);
 	const cv::Mat rgb1 = readImage(o.rgb1, cv::IMREAD_COLOR);

@@ -101,8 +101,7 @@ GrabApp::GrabApp(const GrabOptions& o) : o_(o)
 	if (!mrpt::system::fileExists(o.grabIni))
 		throw std::runtime_error("cannot open '" + o.grabIni + "'");
 
-	checkIniFile(o.grabIni);
-	ini_ = std::make_unique<mrpt::config::CConfigFile>(o.grabIni);
+	ini_ = openIniFile(o.grabIni);
 	grabber_ = std::make_unique<Grabber>(*ini_);  // throws without devices
 	for (const auto& s : grabber_->describe())
 		std::cerr << "bims-grab: " << s << "\n";

@@ -182,9 +182,7 @@ void ExperimentConfig::loadFromFile(const std::string& path)
 {
 	if (!mrpt::system::fileExists(path))
 		throw ConfigError(path + ": no such config file");
-	bims::checkIniFile(path);
-	mrpt::config::CConfigFile cfg(path);
-	loadFromConfigFile(cfg);
+	loadFromConfigFile(*bims::openIniFile(path));
 }
 
 void ExperimentConfig::setVariant(Variant v)

@@ -49,10 +49,9 @@ std::string imuFromTum(const std::string& tum, const std::string& out,
 	{
 		std::ifstream f(iniPath);
 		if (!f) throw std::runtime_error(iniPath + ": cannot open IMU config");
-		checkIniFile(iniPath);
-		mrpt::config::CConfigFile ini(iniPath);
-		checkSections(ini, {"imu", "calibration"});
-		p.loadFromConfigFile(ini, "imu", "calibration");
+		const auto ini = openIniFile(iniPath);
+		checkSections(*ini, {"imu", "calibration"});
+		p.loadFromConfigFile(*ini, "imu", "calibration");
 	}
 	const auto traj = loadTumTrajectory(tum);
 	std::vector<ImuTruth> truth;

@@ -22,8 +22,8 @@ SimConfig SimConfig::load(const std::string& path)
 		std::ifstream f(path);
 		if (!f) throw std::runtime_error(path + ": cannot open scene file");
 	}
-	bims::checkIniFile(path);
-	mrpt::config::CConfigFile ini(path);
+	const auto file = bims::openIniFile(path);
+	const mrpt::config::CConfigFile& ini = *file;
 	SimConfig c;
 	c.file = path;
 	checkSections(ini,

@@ -22,10 +22,9 @@ void overrideSensorSectionsFrom(ego::EgoConfig& ec, const std::string& calib,
 {
 	if (!mrpt::system::fileExists(calib))
 		throw UsageError(calib + ": no such " + noSuch);
-	checkIniFile(calib);
-	mrpt::config::CConfigFile cal(calib);
-	checkExperimentSections(cal);
-	ec.overrideSensorSections(cal);
+	const auto cal = openIniFile(calib);
+	checkExperimentSections(*cal);
+	ec.overrideSensorSections(*cal);
 }
 
 ego::EgoConfig odometryConfig(const OdometryRunOptions& o)

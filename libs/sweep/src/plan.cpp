@@ -100,8 +100,8 @@ std::string derive(
 
 SweepSpec SweepSpec::load(const std::string& path)
 {
-	checkIniFile(path);
-	mrpt::config::CConfigFile cfg(path);
+	const auto file = openIniFile(path);
+	const mrpt::config::CConfigFile& cfg = *file;
 	checkSections(cfg, {"sweep", "grid"});
 	SweepSpec spec;
 	spec.file = path;

@@ -13,8 +13,13 @@ namespace bims
 {
 /** Runs \a body, turning any exception into "PROGRAM: error: what" on stderr
  * and exit code 1 (2 for command-line usage errors). Libraries throw; only
- * main() decides to exit. */
+ * main() decides to exit. An MRPT exception's text is cut to its message
+ * (withoutBacktrace). */
 int runApp(const std::string& program, const std::function<int()>& body);
+
+/** \a what on one line without MRPT's "==== MRPT exception ====" header and
+ * its call stack backtrace (kept when the environment has BIMS_BACKTRACE). */
+std::string withoutBacktrace(const std::string& what);
 
 /** bims's version (the CMake project's), for every program's --version. */
 const char* version();

@@ -6,7 +6,10 @@
 #pragma once
 
 #include <bims/common/choice.h>
+#include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileBase.h>
+
+#include <memory>
 
 #include <set>
 #include <stdexcept>
@@ -25,11 +28,18 @@ class ConfigError : public std::runtime_error
 /** Checks the syntax of the .ini file \a path before MRPT reads it (MRPT
  * keeps the last of two equal keys or sections and skips malformed lines
  * silently). Throws ConfigError naming the file and the line for: a path
- * that is not a readable regular file, a line that is neither `[section]`,
- * `key = value`, a comment (`;`, `#`, `//`) nor an MRPT directive (`@...`),
+ * that is not a readable regular file, a UTF-8 byte-order mark at its
+ * start, a line that is neither `[section]`, `key = value`, a comment (`;`,
+ * `#`, `//`) nor MRPT's `@define` (other directives, e.g. `@include`, MRPT
+ * skips silently),
  * a key before the first section, a section or a key (within its section)
  * given twice; names compare without case, as MRPT looks them up. */
 void checkIniFile(const std::string& path);
+
+/** The one way bims opens an .ini: checkIniFile(path), then MRPT's reader;
+ * an error of MRPT's (an undefined ${VAR}, ...) becomes a ConfigError
+ * naming the file, on one line. */
+std::unique_ptr<mrpt::config::CConfigFile> openIniFile(const std::string& path);
 
 /** The file name behind a config object ("<memory>" when there is none). */
 std::string configSourceName(const mrpt::config::CConfigFileBase& cfg);
