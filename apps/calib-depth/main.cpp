@@ -49,7 +49,8 @@ int main(int argc, char** argv)
 		    bims::parseCommandLine(cmd, argc, argv);
 		    return bims::source::runDepthCalibration(
 		        {cfgArg.getValue(), inArg.getValue(), framesArg.getValue(),
-		         posesArg.getValue(), outArg.getValue(), maxArg.getValue(),
+		         posesArg.getValue(), outArg.getValue(),
+		         bims::inRange(maxArg, 1e-6, 1.0, "a fraction of the depth"),
 		         !quiet.getValue()});
 	    });
 }

@@ -37,6 +37,7 @@ int cmdDepthConsistency(int argc, char** argv)
 	                               "use only the first N scans (0 = all)",
 	                               false, 0, "N", cmd);
 	bims::parseCommandLine(cmd, argc, argv);
+	bims::inRange(maxFrames, 0, 100000000, "0 = all");
 	if (gap.getValue() < 1) throw std::runtime_error("--gap must be >= 1");
 
 	const auto gt = bims::loadTumTrajectory(gtArg.getValue());

@@ -146,9 +146,11 @@ int cmdMasks(int argc, char** argv)
 	TCLAP::SwitchArg quiet("q", "quiet", "no per-frame lines, no progress",
 	                       cmd);
 	bims::parseCommandLine(cmd, argc, argv, {{"--plot-dir", "--out"}});
-	const std::vector<std::string> inputs = {
-	    gtArg.getValue(), predArg.getValue(), depth.getValue(),
-	    framesCsv.getValue()};
+	std::vector<std::string> inputs = {gtArg.getValue(), predArg.getValue(),
+	                                   depth.getValue(), framesCsv.getValue()};
+	// the masks in the two folders are inputs too (--json PRED/000000.png)
+	for (const std::string& dir : {gtArg.getValue(), predArg.getValue()})
+		for (auto& f : bims::frameFilesIn(dir)) inputs.push_back(std::move(f));
 	bims::checkOutputsSpareInputs(inputs,
 	                              bims::givenValues(plotDir, json, strip));
 

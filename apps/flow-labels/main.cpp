@@ -51,6 +51,12 @@ int main(int argc, char** argv)
 		        "", "pose", "T_C0C1 as 'x y z yaw pitch roll' (m, deg)", false,
 		        "0 0 0 0 0 0", "POSE", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::inRange(aScale, 1e-6, 1e9);
+		    // 0 (fx, fy) and -1 (cx, cy): from the image size when not given
+		    if (aFx.isSet()) bims::inRange(aFx, 1e-3, 1e6);
+		    if (aFy.isSet()) bims::inRange(aFy, 1e-3, 1e6);
+		    if (aCx.isSet()) bims::inRange(aCx, -1e6, 1e6);
+		    if (aCy.isSet()) bims::inRange(aCy, -1e6, 1e6);
 		    return bims::flow::runFlowLabels(
 		        {aRgb0.getValue(), aRgb1.getValue(), aDepth1.getValue(),
 		         aOut.getValue(), bims::givenValue(aCfg), aScale.getValue(),

@@ -58,9 +58,11 @@ int main(int argc, char** argv)
 		    // Ctrl-C from now on: clean stop
 		    const auto& stop = bims::installStopSignals();
 		    bims::grab::GrabApp app({aCfg.getValue(), aOut.getValue(),
-		                             aFrames.getValue(), aSeg.getValue(),
-		                             aExp.getValue(), aViewer.getValue(),
-		                             !aQuiet.getValue(), &stop});
+		                             bims::inRange(aFrames, 0, 100000000,
+		                                           "0 = [global] max_frames"),
+		                             aSeg.getValue(), aExp.getValue(),
+		                             aViewer.getValue(), !aQuiet.getValue(),
+		                             &stop});
 		    const int code = app.run();
 		    // The rawlog is closed and everything is printed: leave without
 		    // the drivers' destructors. OpenNI2's Dummy driver crashes in its

@@ -33,7 +33,7 @@ int main(int argc, char** argv)
 		        "experiment .ini: [import_stray] (min_confidence, colour "
 		        "size), [sensors] labels (e.g. config/stray.ini)",
 		        false, "", "stray.ini", cmd);
-		    TCLAP::ValueArg<size_t> maxFrames(
+		    TCLAP::ValueArg<long> maxFrames(
 		        "", "max-frames", "import only the first N frames (0 = all)",
 		        false, 0, "N", cmd);
 		    TCLAP::ValueArg<int> gz(
@@ -45,7 +45,8 @@ int main(int argc, char** argv)
 		    o.folder = folder.getValue();
 		    o.out = out.getValue();
 		    o.config = bims::givenValue(config);
-		    o.max_frames = maxFrames.getValue();
+		    o.max_frames = static_cast<size_t>(
+		        bims::inRange(maxFrames, 0L, 100000000L, "0 = all"));
 		    o.gz = gz.getValue();
 		    o.progress = !quiet.getValue();
 		    return bims::eval::runStrayImport(o);

@@ -37,7 +37,7 @@ int main(int argc, char** argv)
 		        "ground truth is the Bonn RGB-D Dynamic marker pose: convert "
 		        "it to the camera (same as [import] bonn_gt = true)",
 		        cmd);
-		    TCLAP::ValueArg<size_t> maxFrames(
+		    TCLAP::ValueArg<long> maxFrames(
 		        "", "max-frames", "import only the first N frames (0 = all)",
 		        false, 0, "N", cmd);
 		    TCLAP::ValueArg<int> gz(
@@ -56,11 +56,17 @@ int main(int argc, char** argv)
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv, {{"--output", "--out"}});
 		    bims::eval::ImportRunOptions o{
-		        folder.getValue(),        out.getValue(),
-		        bims::givenValue(config), bonn.getValue(),
-		        maxFrames.getValue(),     gz.getValue(),
-		        synth.getValue(),         seed.getValue(),
-		        !quiet.getValue(),        {}};
+		        folder.getValue(),
+		        out.getValue(),
+		        bims::givenValue(config),
+		        bonn.getValue(),
+		        static_cast<size_t>(
+		            bims::inRange(maxFrames, 0L, 100000000L, "0 = all")),
+		        gz.getValue(),
+		        synth.getValue(),
+		        seed.getValue(),
+		        !quiet.getValue(),
+		        {}};
 #ifdef BIMS_HAVE_SIM
 		    o.synthesize = bims::sim::synthesizeImportImu;
 #endif

@@ -61,7 +61,7 @@ int main(int argc, char** argv)
 		        "R_IC at each frame (TUM, translation 0; compare with "
 		        "bims-eval attitude)",
 		        false, "", "ATT.txt", cmd);
-		    TCLAP::ValueArg<size_t> maxArg(
+		    TCLAP::ValueArg<long> maxArg(
 		        "", "max-frames", "stop after N frames", false, 0, "N", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv, {{"-c", "--calib"}});
@@ -70,6 +70,8 @@ int main(int argc, char** argv)
 		        {cfgArg.getValue(), inArg.getValue(), outArg.getValue(),
 		         calibArg.getValue(), givenValue(modeArg), givenValue(aidArg),
 		         givenValue(csvArg), givenValue(masksArg), givenValue(gtArg),
-		         maxArg.getValue(), !quiet.getValue(), givenValue(attArg)});
+		         static_cast<size_t>(
+		             bims::inRange(maxArg, 0L, 100000000L, "0 = all")),
+		         !quiet.getValue(), givenValue(attArg)});
 	    });
 }

@@ -121,10 +121,16 @@ int main(int argc, char** argv)
 		                                       false, "1280x800", "WxH", cmd);
 		    bims::parseCommandLine(cmd, argc, argv,
 		                           {{"--frames", "--max-frames"}});
+		    std::vector<std::string> inputs = {aIn.getValue(), aRes.getValue(),
+		                                       aCfg.getValue(), aGt.getValue()};
+		    if (aRes.isSet())  // a results folder's files are inputs too
+		    {
+			    inputs.push_back(aRes.getValue() + "/trajectory.txt");
+			    for (auto& f : bims::frameFilesIn(aRes.getValue() + "/masks"))
+				    inputs.push_back(std::move(f));
+		    }
 		    bims::checkOutputsSpareInputs(
-		        {aIn.getValue(), aRes.getValue(), aCfg.getValue(),
-		         aGt.getValue()},
-		        bims::givenValues(aShot, aSeq, aState));
+		        inputs, bims::givenValues(aShot, aSeq, aState));
 
 		    auto& o = gOptions;
 		    // Default parameters: share/bims/default.ini of the build tree or
@@ -140,7 +146,8 @@ int main(int argc, char** argv)
 		        (o.viewer.resultsDir.empty() || aRunPipe.getValue());
 		    o.paused = aPaused.getValue();
 		    o.speed = aSpeed.getValue();
-		    o.frames = aFrames.getValue();
+		    o.frames =
+		        aFrames.isSet() ? bims::inRange(aFrames, 0, 100000000) : -1;
 		    o.screenshot = aShot.getValue();
 		    o.keepOpen = aKeep.getValue();
 		    o.pngDir = aSeq.getValue();

@@ -363,6 +363,43 @@ TEST(Cli, AFrameRangeBeyondTheInputIsAUsageErrorBeforeAnyWork)
 	EXPECT_TRUE(fs::is_empty(d));  // nothing written
 }
 
+// Issue 39: --max-frames -1 meant "all" in four programs, and
+// --max-correction -1, --depth-scale 0, --fx -542 were taken. Each numeric
+// option is range-checked where the program reads it, before any work.
+TEST(Cli, NumericOptionsOutOfTheirRangeAreUsageErrors)
+{
+	const std::string d = bims::test::freshTmpDir("bims_test_cli", "numeric");
+	const std::string png = kSrc + "/rawlogs/pendulum_slow_gt/masks/000000.png";
+	for (const auto& [args, want] :
+	     std::vector<std::pair<std::string, std::string>>{
+	         {"bims-import-tum " + d + " -o " + d + "/x.rawlog --max-frames -1",
+	          "--max-frames -1: out of range [0, 100000000]"},
+	         {"bims-import-stray " + d + " -o " + d +
+	              "/x.rawlog --max-frames -1",
+	          "--max-frames -1: out of range"},
+	         {"bims-odom " + kConfig + " " + kSample + " -o " + d +
+	              "/t.txt --max-frames -1",
+	          "--max-frames -1: out of range"},
+	         {"bims-eval depth-consistency " + kSample + " " + kSrc +
+	              "/rawlogs/pendulum_slow_gt/groundtruth.txt --max-frames -2",
+	          "--max-frames -2: out of range"},
+	         {"bims-calib-depth " + kConfig + " " + kSample + " -o " + d +
+	              "/c.ini --max-correction -1",
+	          "--max-correction -1: out of range"},
+	         {"bims-flow-labels " + png + " " + png + " " + png + " -o " + d +
+	              "/f --depth-scale 0",
+	          "--depth-scale 0: out of range"},
+	         {"bims-flow-labels " + png + " " + png + " " + png + " -o " + d +
+	              "/f --fx -542",
+	          "--fx -542: out of range"}})
+	{
+		const auto r = bims::test::runCommand(kBin + "/" + args);
+		EXPECT_EQ(r.code, 2) << args << "\n" << r.out;
+		EXPECT_NE(r.out.find(want), std::string::npos) << args << "\n" << r.out;
+	}
+	EXPECT_TRUE(fs::is_empty(d));  // nothing written
+}
+
 TEST(Cli, MapsFigureTakesItsOutputAsOOrAsTheThirdWordOnce)
 {
 	if (!built("bims-maps-figure")) GTEST_SKIP() << "not built";

@@ -301,3 +301,27 @@ TEST(GrabApp, AFullDiskOrAnUnwritableOutputStopsWithAnErrorNamingTheFile)
 	          std::string::npos)
 	    << slurp(log);
 }
+
+// Issue 39's reproduction: the rawlog a grab .ini replays its IMU from is
+// an input too; -o naming it was written over (16.6 MB became 0.77 MB).
+TEST(GrabApp, TheReplayedImuFileOfTheIniIsNeverTheOutput)
+{
+	const std::string d = kOut + "/replay_alias";
+	ASSERT_EQ(run("rm -rf '" + d + "' && mkdir -p '" + d + "'"), 0);
+	std::filesystem::copy_file(
+	    std::string(BIMS_SOURCE_DIR) + "/rawlogs/pendulum_slow.rawlog",
+	    d + "/x.rawlog");
+	const auto size = std::filesystem::file_size(d + "/x.rawlog");
+	std::ofstream(d + "/d.ini")
+	    << "[RGBD]\ndriver=OpenNI2\nsensorLabel=RGBD\ndevice_uri=Dummy\n"
+	       "[IMU]\ndriver=RawlogImu\nsensorLabel=IMU\nfile=x.rawlog\n"
+	       "source_label=IMU\n";
+	const std::string log = d + "/log";
+	EXPECT_EQ(run("cd '" + d + "' && '" + kGrab + "' d.ini -o x.rawlog " +
+	              "--max-frames 3 > '" + log + "' 2>&1"),
+	          2)
+	    << slurp(log);
+	EXPECT_NE(slurp(log).find("would overwrite the input"), std::string::npos)
+	    << slurp(log);
+	EXPECT_EQ(std::filesystem::file_size(d + "/x.rawlog"), size);
+}

@@ -110,6 +110,33 @@ TEST(RunApp, SymlinkedOutputFilesAreReplacedNotFollowed)
 	EXPECT_EQ(bims::Json::parse(slurp(out + "/metrics.json"))["status"], "ok");
 }
 
+// Issue 39's reproduction: a symbolic link at masks/ was followed: the
+// masks went into its target, and --overwrite emptied the target.
+TEST(RunApp, ASymlinkedMasksFolderIsNeverFollowedNorEmptied)
+{
+	const auto d = tmpDir("symlinked_masks");
+	fs::create_directories(d + "/keep");
+	fs::create_directories(d + "/out");
+	std::ofstream(d + "/keep/000000.png") << "x";
+	fs::create_directory_symlink(d + "/keep", d + "/out/masks");
+	const std::string args = q(kConfig) + " " + q(kSample) + " -o " +
+	                         q(d + "/out") + " --frames 0:2 -q";
+	const auto refused = run(args);
+	EXPECT_EQ(refused.code, 2) << refused.out;
+	EXPECT_NE(refused.out.find("masks: a symbolic link where the run writes "
+	                           "a folder of its own"),
+	          std::string::npos)
+	    << refused.out;
+	const auto r = run(args + " --overwrite");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_EQ(slurp(d + "/keep/000000.png"), "x");  // the target untouched
+	EXPECT_EQ(std::distance(fs::directory_iterator(d + "/keep"),
+	                        fs::directory_iterator()),
+	          1);
+	EXPECT_FALSE(fs::is_symlink(d + "/out/masks"));
+	EXPECT_TRUE(fs::exists(d + "/out/masks/000001.png"));
+}
+
 namespace
 {
 /** The files below \a dir, as paths relative to it, sorted. */

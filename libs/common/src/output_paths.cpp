@@ -47,6 +47,9 @@ std::runtime_error systemError(const std::string& path, const char* what)
 void checkOutputsSpareInputs(const std::vector<std::string>& inputs,
                              const std::vector<std::string>& outputs)
 {
+	std::vector<fs::path> resolvedIn;  // once: a folder may hold thousands
+	for (const auto& in : inputs)
+		resolvedIn.push_back(in.empty() ? fs::path() : resolved(in));
 	for (const auto& out : outputs)
 	{
 		if (out.empty())
@@ -54,10 +57,11 @@ void checkOutputsSpareInputs(const std::vector<std::string>& inputs,
 			    "the output path is empty (nothing would be "
 			    "written)");
 		const fs::path ro = resolved(out);
-		for (const auto& in : inputs)
+		for (size_t k = 0; k < inputs.size(); ++k)
 		{
+			const auto& in = inputs[k];
 			if (in.empty()) continue;
-			const fs::path ri = resolved(in);
+			const fs::path& ri = resolvedIn[k];
 			if (!within(ri, ro)) continue;
 			const std::string both =
 			    ro == fs::path(out) && ri == fs::path(in)
@@ -310,6 +314,12 @@ std::vector<std::string> earlierOutputs(const std::string& dir,
 	for (const auto& [sub, ext] : layout.frameFolders)
 	{
 		const fs::path d = sub.empty() ? fs::path(dir) : fs::path(dir) / sub;
+		if (!sub.empty() && fs::is_symlink(d, ec))
+		{
+			// the link itself, never what it points to
+			found.push_back(d.string());
+			continue;
+		}
 		if (!fs::is_directory(d, ec)) continue;
 		for (const auto& e : fs::directory_iterator(d, ec))
 		{
@@ -325,6 +335,18 @@ std::vector<std::string> earlierOutputs(const std::string& dir,
 	return found;
 }
 
+std::vector<std::string> frameFilesIn(const std::string& dir,
+                                      const std::string& ext)
+{
+	std::vector<std::string> files;
+	std::error_code ec;
+	for (const auto& e : fs::directory_iterator(dir, ec))
+		if (isFrameFileName(e.path().filename().string(), ext))
+			files.push_back(e.path().string());
+	std::sort(files.begin(), files.end());
+	return files;
+}
+
 size_t prepareOutputFolder(const std::string& dir,
                            const OutputFolderLayout& layout, bool overwrite,
                            const std::string& overwriteFlag)
@@ -332,6 +354,16 @@ size_t prepareOutputFolder(const std::string& dir,
 	namespace fs = std::filesystem;
 	const auto found = earlierOutputs(dir, layout);
 	if (found.empty()) return 0;
+	if (!overwrite)
+		for (const auto& f : found)
+			if (std::error_code ec; fs::is_symlink(f, ec))
+				throw UsageError(
+				    f +
+				    ": a symbolic link where the run writes a folder of its "
+				    "own: remove it, or give " +
+				    overwriteFlag +
+				    " to replace the link (what it points to is never "
+				    "touched)");
 	if (!overwrite)
 		throw UsageError(
 		    dir + ": holds the outputs of an earlier run (" +

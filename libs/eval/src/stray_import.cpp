@@ -71,7 +71,29 @@ StrayImportSummary importStray(const std::string& folder,
                                const StrayImportParams& params,
                                const StrayImportOptions& options)
 {
-	const StrayCapture cap = readStrayCapture(folder);
+	return importStray(readStrayCapture(folder), outRawlog, params, options);
+}
+
+std::vector<std::string> strayInputFiles(const StrayCapture& cap)
+{
+	std::vector<std::string> files;
+	for (const char* name : {"odometry.csv", "imu.csv", "camera_matrix.csv"})
+		files.push_back(cap.path + "/" + name);
+	files.push_back(cap.videoPath);
+	for (const auto& f : cap.frames)
+	{
+		files.push_back(f.depthPath);
+		files.push_back(f.confidencePath);
+	}
+	return files;
+}
+
+StrayImportSummary importStray(const StrayCapture& cap,
+                               const std::string& outRawlog,
+                               const StrayImportParams& params,
+                               const StrayImportOptions& options)
+{
+	const std::string& folder = cap.path;
 	std::vector<StrayFrame> frames = cap.frames;
 	if (options.maxFrames > 0 && frames.size() > options.maxFrames)
 		frames.resize(options.maxFrames);

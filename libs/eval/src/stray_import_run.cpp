@@ -72,7 +72,12 @@ int runStrayImport(const StrayImportRunOptions& o)
 	opt.maxFrames = o.max_frames;
 	opt.gzLevel = o.gz;
 	opt.progress = o.progress;
-	const auto sum = importStray(o.folder, o.out, params, opt);
+	// the capture's files are inputs too: -o FOLDER/imu.csv is refused
+	const StrayCapture cap = readStrayCapture(o.folder);
+	auto inputs = strayInputFiles(cap);
+	inputs.push_back(o.config.value_or(""));
+	checkOutputsSpareInputs(inputs, {o.out, strayReferencePathFor(o.out)});
+	const auto sum = importStray(cap, o.out, params, opt);
 	std::fputs(strayImportReport(o.out, sum).c_str(), stdout);
 	return 0;
 }

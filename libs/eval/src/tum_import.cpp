@@ -52,6 +52,20 @@ mrpt::obs::CObservation3DRangeScan::Ptr loadFrame(const TumFrame& frame,
 	return o;
 }
 
+std::vector<std::string> tumInputFiles(const TumFolder& tum)
+{
+	std::vector<std::string> files;
+	for (const char* list :
+	     {"rgb.txt", "depth.txt", "groundtruth.txt", "accelerometer.txt"})
+		files.push_back(tum.path + "/" + list);
+	for (const auto& f : tum.frames)
+	{
+		files.push_back(f.rgbPath);
+		files.push_back(f.depthPath);
+	}
+	return files;
+}
+
 namespace
 {
 void writeCalibration(const std::string& path, const ImportParams& params)

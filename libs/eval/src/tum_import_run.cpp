@@ -61,6 +61,12 @@ int runImport(const ImportRunOptions& o)
 			                  "camera");
 		params.loadFromConfigFile(*cfg);
 	}
+	{
+		// the folder's files are inputs too: -o FOLDER/rgb.txt is refused
+		auto inputs = tumInputFiles(readTumFolder(o.folder, params));
+		inputs.push_back(o.config.value_or(""));
+		checkOutputsSpareInputs(inputs, {o.out, groundTruthDirFor(o.out)});
+	}
 	if (!cfg || !cfg->sectionExists("camera"))
 		std::fprintf(
 		    stderr,

@@ -721,6 +721,39 @@ TEST(Apps, NoProgramWritesOverItsInput)
 		    << args << "\n"
 		    << r.out;
 	}
+	// Issue 39's reproductions: a file of an input folder (a TUM folder's
+	// rgb.txt, a mask of the masks evaluated or fed back) was written over
+	// with exit 0
+	fs::create_directories(d + "/tum/rgb");
+	fs::create_directories(d + "/tum/depth");
+	std::ofstream(d + "/tum/rgb.txt") << "1.0 rgb/a.png\n";
+	std::ofstream(d + "/tum/depth.txt") << "1.0 depth/a.png\n";
+	fs::create_directories(d + "/gt_masks");
+	fs::create_directories(d + "/pred");
+	for (const char* m :
+	     {"/gt_masks/000000.png", "/pred/000000.png", "/pred/000001.png"})
+		cv::imwrite(d + m, cv::Mat(8, 8, CV_8UC1, cv::Scalar(0)));
+	const auto maskSize = fs::file_size(d + "/pred/000000.png");
+	for (const std::string& args :
+	     {"bims-import-tum " + d + "/tum -o " + d + "/tum/rgb.txt",
+	      "bims-eval masks " + d + "/gt_masks " + d + "/pred --json " + d +
+	          "/pred/000000.png",
+	      "bims-eval masks " + d + "/gt_masks " + d + "/pred --strip " + d +
+	          "/pred/000001.png",
+	      "bims-odom " + cfg + " " + in + " --masks " + d + "/pred -o " + d +
+	          "/pred/000000.png",
+	      "bims-odom " + cfg + " " + in + " --masks " + d + "/pred -o " + d +
+	          "/t.txt --csv " + d + "/pred/000001.png"})
+	{
+		const ::Run r = run(kBin + "/" + args);
+		EXPECT_EQ(r.code, 2) << args << "\n" << r.out;
+		EXPECT_NE(r.out.find("would overwrite the input"), std::string::npos)
+		    << args << "\n"
+		    << r.out;
+	}
+	EXPECT_EQ(bims::test::fileText(d + "/tum/rgb.txt"), "1.0 rgb/a.png\n");
+	EXPECT_EQ(fs::file_size(d + "/pred/000000.png"), maskSize);
+	EXPECT_EQ(fs::file_size(d + "/pred/000001.png"), maskSize);
 	if (fs::exists(kBin + "/bims-viewer"))  // built with the GUI
 	{
 		const ::Run r =
@@ -729,6 +762,17 @@ TEST(Apps, NoProgramWritesOverItsInput)
 		EXPECT_EQ(r.code, 2) << r.out;
 		EXPECT_NE(r.out.find("would overwrite the input"), std::string::npos)
 		    << r.out;
+		// screenshots into a results folder's masks
+		fs::create_directories(d + "/results/masks");
+		std::ofstream(d + "/results/trajectory.txt") << "";
+		cv::imwrite(d + "/results/masks/000000.png",
+		            cv::Mat(8, 8, CV_8UC1, cv::Scalar(0)));
+		const ::Run v =
+		    run(kBin + "/bims-viewer " + in + " --results " + d +
+		        "/results --png-sequence " + d +
+		        "/results/masks --max-frames 2 --screenshot " + d + "/v.png");
+		EXPECT_EQ(v.code, 2) << v.out;
+		EXPECT_NE(v.out.find("contains the input"), std::string::npos) << v.out;
 	}
 	EXPECT_EQ(fs::file_size(in), size);
 	EXPECT_EQ(fs::file_size(cfg), fs::file_size(std::string(BIMS_SOURCE_DIR) +

@@ -1,5 +1,6 @@
 #include <bims/common/app.h>
 #include <bims/common/config.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/share.h>
 #include <bims/grab/grab_app.h>
 #include <bims/pipeline/mask_overlay.h>
@@ -103,6 +104,8 @@ GrabApp::GrabApp(const GrabOptions& o) : o_(o)
 
 	ini_ = openIniFile(o.grabIni);
 	grabber_ = std::make_unique<Grabber>(*ini_);  // throws without devices
+	// the files its .ini names are inputs too (a replayed IMU rawlog)
+	checkOutputsSpareInputs(grabber_->inputFiles(), {o.out});
 	for (const auto& s : grabber_->describe())
 		std::cerr << "bims-grab: " << s << "\n";
 

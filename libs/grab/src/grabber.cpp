@@ -66,6 +66,14 @@ std::vector<std::string> Grabber::describe() const
 	return out;
 }
 
+std::vector<std::string> Grabber::inputFiles() const
+{
+	std::vector<std::string> files;
+	for (const auto& i : imus_)
+		for (auto& f : i->inputFiles()) files.push_back(std::move(f));
+	return files;
+}
+
 GrabStats Grabber::run(RawlogWriter& out, const std::atomic<bool>& stop,
                        size_t maxFrames, const GrabCallback& cb)
 {

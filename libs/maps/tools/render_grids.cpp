@@ -65,7 +65,7 @@ int main(int argc, char** argv)
 			        "word");
 		    const std::string out =
 		        aOutOpt.isSet() ? aOutOpt.getValue() : aOut.getValue();
-		    const int frames = aFrames.getValue();
+		    const int frames = bims::inRange(aFrames, 1, 100000000);
 		    const double voxel = aVoxel.getValue();
 		    if (frames < 1) throw bims::UsageError("--max-frames must be >= 1");
 		    if (!(voxel > 0)) throw bims::UsageError("--voxel must be > 0");

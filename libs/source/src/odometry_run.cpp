@@ -122,9 +122,12 @@ int runOdometry(const OdometryRunOptions& o)
 	std::vector<std::string> outputs = {o.out};
 	if (o.csv) outputs.insert(outputs.begin(), *o.csv);
 	if (o.attitude) outputs.insert(outputs.begin(), *o.attitude);
-	checkOutputsSpareInputs(
-	    {o.config, o.rawlog, o.calib, o.masks.value_or(""), o.gt.value_or("")},
-	    outputs);
+	std::vector<std::string> inputs = {o.config, o.rawlog, o.calib,
+	                                   o.masks.value_or(""), o.gt.value_or("")};
+	// the masks fed back are inputs too (-o MASKS/000000.png)
+	if (o.masks)
+		for (auto& f : frameFilesIn(*o.masks)) inputs.push_back(std::move(f));
+	checkOutputsSpareInputs(inputs, outputs);
 	const ego::EgoConfig ec = odometryConfig(o);
 	ego::Odometry odo(ec);
 	Trajectory traj, attitude;

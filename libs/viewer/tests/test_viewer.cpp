@@ -471,11 +471,33 @@ TEST(BatchAndLive, GiveTheSameFramesPosesAndMasks)
 
 namespace
 {
-/** The moving masks of the sample's frames, as the controller alone (on
- * this thread) shows them. */
-std::vector<cv::Mat> controllerMasks()
+/** The sample's first 40 frames with their IMU samples, in a folder of
+ * \a test (the worker tests play it to its end: 40 frames keep them short
+ * under the sanitizers). */
+ViewerOptions shortSample(const std::string& test)
 {
-	ReplayController c(sampleOptions());
+	const std::string path =
+	    bims::test::freshTmpDir("bims_test_viewer", test) + "/in.rawlog";
+	RawlogReader in(kRawlog);
+	RawlogWriter out(path);
+	size_t scans = 0;
+	while (auto o = in.next())
+	{
+		if (IS_CLASS(*o, mrpt::obs::CObservation3DRangeScan) && ++scans > 40)
+			break;
+		out.write(*o);
+	}
+	out.close();
+	ViewerOptions v = sampleOptions();
+	v.rawlog = path;
+	return v;
+}
+
+/** The moving masks of \a o's frames, as the controller alone (on this
+ * thread) shows them. */
+std::vector<cv::Mat> controllerMasks(const ViewerOptions& o)
+{
+	ReplayController c(o);
 	std::vector<cv::Mat> masks;
 	while (c.step()) masks.push_back(c.currentMask().clone());
 	return masks;
@@ -491,10 +513,11 @@ bool sameMask(const cv::Mat& a, const cv::Mat& b)
 // order, with the masks the controller gives on one thread.
 TEST(ReplayWorker, EveryFrameModeDrawsEveryFrameWithTheSameMasks)
 {
-	const auto want = controllerMasks();
-	ASSERT_EQ(want.size(), 150u);
-	ReplayWorker w(sampleOptions(), LayerVisibility());
-	EXPECT_EQ(w.frameCount(), 150u);
+	const auto o = shortSample("every_frame");
+	const auto want = controllerMasks(o);
+	ASSERT_EQ(want.size(), 40u);
+	ReplayWorker w(o, LayerVisibility());
+	EXPECT_EQ(w.frameCount(), 40u);
 	w.setMode(PlayMode::EveryFrame);
 	w.setSpeed(20);
 	w.play(true);
@@ -503,7 +526,7 @@ TEST(ReplayWorker, EveryFrameModeDrawsEveryFrameWithTheSameMasks)
 	// (a generous wall-time limit: sanitizer builds run 3-10x slower)
 	const auto until =
 	    std::chrono::steady_clock::now() + std::chrono::minutes(8);
-	while ((seen.empty() || seen.back() < 149) &&
+	while ((seen.empty() || seen.back() < 39) &&
 	       std::chrono::steady_clock::now() < until)
 	{
 		const auto v = w.latest();
@@ -518,14 +541,14 @@ TEST(ReplayWorker, EveryFrameModeDrawsEveryFrameWithTheSameMasks)
 			seen.push_back(v->frame);
 			EXPECT_TRUE(sameMask(v->mask, want[size_t(v->frame)]))
 			    << "frame " << v->frame;
-			EXPECT_EQ(v->counter, std::to_string(v->frame) + " / 149");
+			EXPECT_EQ(v->counter, std::to_string(v->frame) + " / 39");
 		}
 		w.drawn(v->seq);
 	}
-	ASSERT_EQ(seen.size(), 150u);
+	ASSERT_EQ(seen.size(), 40u);
 	for (size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], long(i));
 	ASSERT_TRUE(w.waitIdle(30));
-	EXPECT_EQ(w.state().processed, 150u);
+	EXPECT_EQ(w.state().processed, 40u);
 	EXPECT_EQ(w.state().notDrawn, 0u);
 	EXPECT_FALSE(w.state().playing);  // stopped at the end
 	EXPECT_EQ(w.takeError(), "");
@@ -536,23 +559,23 @@ TEST(ReplayWorker, EveryFrameModeDrawsEveryFrameWithTheSameMasks)
 // counted as not drawn, and the newest is drawn once the GUI is free.
 TEST(ReplayWorker, RealTimeModeNeverWaitsForTheGui)
 {
-	ReplayWorker w(sampleOptions(), LayerVisibility());
+	ReplayWorker w(shortSample("real_time"), LayerVisibility());
 	w.setSpeed(20);
 	w.play(true);
-	ASSERT_TRUE(w.waitIdle(60));
+	ASSERT_TRUE(w.waitIdle(300));
 	const auto st = w.state();
-	EXPECT_EQ(st.processed, 150u);
+	EXPECT_EQ(st.processed, 40u);
 	EXPECT_FALSE(st.playing);
 	auto v = w.latest();
 	ASSERT_NE(v, nullptr);
 	EXPECT_EQ(v->seq, 1u);  // the only view built: the GUI never drew it
 	EXPECT_LE(v->frame, 0);
-	// frames 1..148 were finished while that view was still being drawn
-	EXPECT_EQ(st.notDrawn, v->frame < 0 ? 149u : 148u);
+	// frames 1..38 were finished while that view was still being drawn
+	EXPECT_EQ(st.notDrawn, v->frame < 0 ? 39u : 38u);
 	w.drawn(v->seq);
 	ASSERT_TRUE(w.waitIdle(30));
 	v = w.latest();
-	EXPECT_EQ(v->frame, 149);  // the newest, once the GUI is free
+	EXPECT_EQ(v->frame, 39);  // the newest, once the GUI is free
 	EXPECT_EQ(v->seq, 2u);
 }
 
@@ -560,8 +583,9 @@ TEST(ReplayWorker, RealTimeModeNeverWaitsForTheGui)
 // is interrupted by a later one; the layers are rebuilt on request.
 TEST(ReplayWorker, StepSeekAndRestartAreExact)
 {
-	const auto want = controllerMasks();
-	ReplayWorker w(sampleOptions(), LayerVisibility());
+	const auto o = shortSample("step_seek");
+	const auto want = controllerMasks(o);
+	ReplayWorker w(o, LayerVisibility());
 	const auto settle = [&]
 	{
 		for (int i = 0; i < 100; ++i)  // the GUI draws whatever comes
@@ -581,12 +605,12 @@ TEST(ReplayWorker, StepSeekAndRestartAreExact)
 	auto v = settle();
 	EXPECT_EQ(v->frame, 2);
 	EXPECT_TRUE(sameMask(v->mask, want[2]));
-	w.seek(120);
-	w.seek(40);  // interrupts (or follows) the first
+	w.seek(35);
+	w.seek(25);  // interrupts (or follows) the first
 	v = settle();
-	EXPECT_EQ(v->frame, 40);
-	EXPECT_TRUE(sameMask(v->mask, want[40]));
-	EXPECT_EQ(w.state().processed, 41u);
+	EXPECT_EQ(v->frame, 25);
+	EXPECT_TRUE(sameMask(v->mask, want[25]));
+	EXPECT_EQ(w.state().processed, 26u);
 	w.seek(12);  // back: the pipeline restarts and runs 0..12
 	v = settle();
 	EXPECT_EQ(v->frame, 12);
@@ -602,5 +626,5 @@ TEST(ReplayWorker, StepSeekAndRestartAreExact)
 	v = settle();
 	EXPECT_EQ(v->frame, 0);
 	EXPECT_TRUE(sameMask(v->mask, want[0]));
-	w.seek(149);  // the destructor stops a long seek
+	w.seek(39);  // the destructor stops a seek
 }

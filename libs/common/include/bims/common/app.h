@@ -5,6 +5,7 @@
 #include <functional>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -134,6 +135,25 @@ auto givenValue(Arg& arg)
 {
 	if (!arg.isSet()) return std::nullopt;
 	return arg.getValue();
+}
+
+/** The value of a numeric TCLAP option, checked to lie in [\a lo, \a hi]
+ * (NaN never does): a UsageError "--NAME V: out of range [lo, hi]" (with
+ * \a hint when given) otherwise. Each program states each option's range
+ * where it reads it. */
+template <class Arg, class T>
+auto inRange(Arg& arg, T lo, T hi, const std::string& hint = "")
+    -> std::decay_t<decltype(arg.getValue())>
+{
+	const auto v = arg.getValue();
+	if (!(v >= lo && v <= hi))
+	{
+		std::ostringstream s;
+		s << "--" << arg.getName() << " " << v << ": out of range [" << lo
+		  << ", " << hi << "]" << (hint.empty() ? "" : " (" + hint + ")");
+		throw UsageError(s.str());
+	}
+	return v;
 }
 
 /** From now on SIGINT and SIGTERM ask the program to stop cleanly: the

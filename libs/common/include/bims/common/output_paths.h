@@ -19,8 +19,11 @@ namespace bims
  * output path, an output that is an input, or an output folder that
  * contains an input. Paths are compared after resolving symbolic links, `.`
  * and `..` (std::filesystem::weakly_canonical), so a link or a relative
- * path to an input is the input. Empty input strings (optional arguments
- * not given) are ignored. Throws UsageError naming both paths. */
+ * path to an input is the input. \a inputs: every file and folder the
+ * program reads: also the files an input folder holds that it reads (a TUM
+ * folder's lists and images, the masks of a mask folder: frameFilesIn)
+ * and the files its .ini files name; empty strings (optional arguments not
+ * given) are ignored. Throws UsageError naming both paths. */
 void checkOutputsSpareInputs(const std::vector<std::string>& inputs,
                              const std::vector<std::string>& outputs);
 
@@ -29,6 +32,11 @@ void checkOutputsSpareInputs(const std::vector<std::string>& inputs,
  * link. Throws naming the path if it is a folder or the link cannot be
  * removed. */
 void replaceSymlink(const std::string& path);
+
+/** The per-frame files (a number, then \a ext: 000042.png) directly in
+ * \a dir, sorted: the inputs a folder of masks or labels holds. */
+std::vector<std::string> frameFilesIn(const std::string& dir,
+                                      const std::string& ext = ".png");
 
 /** What a program writes into an output folder, for refusing a folder that
  * holds an earlier run and for clearing exactly that run with --overwrite. */
@@ -45,7 +53,9 @@ struct OutputFolderLayout
 };
 
 /** The files of \a layout found in \a dir (paths inside it, sorted); none
- * when \a dir does not exist. Anything else in \a dir is not listed. */
+ * when \a dir does not exist. Anything else in \a dir is not listed. A
+ * per-frame sub-folder that is a symbolic link is listed as itself (the
+ * link), never followed. */
 std::vector<std::string> earlierOutputs(const std::string& dir,
                                         const OutputFolderLayout& layout);
 
@@ -53,7 +63,9 @@ std::vector<std::string> earlierOutputs(const std::string& dir,
  * of \a layout (an earlier run), throws UsageError naming the folder and
  * one of them, and suggesting \a overwriteFlag; with \a overwrite, removes
  * those files (and the per-frame sub-folders left empty) instead, never
- * anything else, and returns how many it removed. */
+ * anything else, and returns how many it removed. A per-frame sub-folder
+ * that is a symbolic link is refused (naming it) or, with \a overwrite,
+ * the link is removed: what it points to is never emptied. */
 size_t prepareOutputFolder(const std::string& dir,
                            const OutputFolderLayout& layout, bool overwrite,
                            const std::string& overwriteFlag = "--overwrite");

@@ -100,6 +100,9 @@ void readStrayCameraMatrix(const std::string& path, double K[3][3]);
  * rgb.mp4 when present (a note once on stderr when not). */
 StrayCapture readStrayCapture(const std::string& folder);
 
+/** Every file of \a cap the import reads (the output guard's inputs). */
+std::vector<std::string> strayInputFiles(const StrayCapture& cap);
+
 /** The depth grid's intrinsics: camera_matrix.csv's (of a colourWidth x
  * colourHeight colour image) scaled to width x height: fx, cx times
  * width / colourWidth; fy, cy times height / colourHeight. No distortion. */
@@ -144,6 +147,11 @@ std::string strayReferencePathFor(const std::string& rawlogPath);
  * frame) in time order, IMU first at equal stamps. Throws
  * std::runtime_error naming the file (and row) on bad input. */
 StrayImportSummary importStray(const std::string& folder,
+                               const std::string& outRawlog,
+                               const StrayImportParams& params,
+                               const StrayImportOptions& options);
+/** The same for a capture already read (readStrayCapture). */
+StrayImportSummary importStray(const StrayCapture& cap,
                                const std::string& outRawlog,
                                const StrayImportParams& params,
                                const StrayImportOptions& options);

@@ -114,6 +114,10 @@ struct TumFolder
  * missing files, malformed lines or when no frame pairs. */
 TumFolder readTumFolder(const std::string& folder, const ImportParams& params);
 
+/** Every file of \a tum the import reads: its lists and the images of its
+ * frames (the output guard's inputs). */
+std::vector<std::string> tumInputFiles(const TumFolder& tum);
+
 /** Reads a 16-bit depth PNG and returns metres as CV_32F (0 = invalid).
  * Throws naming the file if missing, not 16-bit single channel, or not of
  * the camera's size. */

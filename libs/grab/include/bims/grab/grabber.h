@@ -67,6 +67,9 @@ class Grabber
 
 	/** One line per sensor. */
 	std::vector<std::string> describe() const;
+	/** The files its sensors read (a replayed IMU rawlog), for the output
+	 * guard: bims-grab refuses to write over them. */
+	std::vector<std::string> inputFiles() const;
 	const GlobalGrabParams& global() const { return global_; }
 
  private:

@@ -21,6 +21,8 @@ class ImuSource
 	 * on the host clock. Throws std::runtime_error if the device is lost. */
 	virtual std::vector<mrpt::obs::CObservationIMU::Ptr> poll() = 0;
 	virtual std::string describe() const = 0;
+	/** The files it reads (a replayed rawlog), for the output guard. */
+	virtual std::vector<std::string> inputFiles() const { return {}; }
 };
 
 /** Creates the IMU source of one grab .ini section by its driver=:
@@ -52,6 +54,7 @@ class RawlogImuSource : public ImuSource
 	                const std::string& outLabel, bool loop);
 	std::vector<mrpt::obs::CObservationIMU::Ptr> poll() override;
 	std::string describe() const override;
+	std::vector<std::string> inputFiles() const override { return {path_}; }
 	size_t samplesInFile() const { return samples_.size(); }
 
  private:
