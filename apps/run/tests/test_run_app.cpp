@@ -110,6 +110,33 @@ TEST(RunApp, SymlinkedOutputFilesAreReplacedNotFollowed)
 	EXPECT_EQ(bims::Json::parse(slurp(out + "/metrics.json"))["status"], "ok");
 }
 
+// Issue 39's reproductions: a missing second rawlog was never mentioned
+// (exit 0 after the first, with --frames) and a folder given as the rawlog
+// gave MRPT's exception with a backtrace and left an output folder. Every
+// input is checked before any output; a TUM folder is told to be imported.
+TEST(RunApp, EveryInputRawlogIsCheckedBeforeAnyOutput)
+{
+	const auto d = tmpDir("inputs_first");
+	fs::create_directories(d + "/tum");
+	std::ofstream(d + "/tum/rgb.txt") << "1.0 rgb/a.png\n";
+	const auto missing =
+	    run(q(kConfig) + " " + q(kSample) + " " + q(d + "/nope.rawlog") +
+	        " -o " + q(d + "/out") + " --frames 0:3 -q");
+	EXPECT_EQ(missing.code, 1) << missing.out;
+	EXPECT_NE(missing.out.find(d + "/nope.rawlog: no such rawlog file"),
+	          std::string::npos)
+	    << missing.out;
+	const auto folder =
+	    run(q(kConfig) + " " + q(d + "/tum") + " -o " + q(d + "/out") + " -q");
+	EXPECT_EQ(folder.code, 1) << folder.out;
+	EXPECT_NE(folder.out.find("a TUM RGB-D folder; import it first: "
+	                          "bims-import-tum"),
+	          std::string::npos)
+	    << folder.out;
+	EXPECT_EQ(folder.out.find("backtrace"), std::string::npos) << folder.out;
+	EXPECT_FALSE(fs::exists(d + "/out"));  // nothing made
+}
+
 // Issue 39's reproduction: a symbolic link at masks/ was followed: the
 // masks went into its target, and --overwrite emptied the target.
 TEST(RunApp, ASymlinkedMasksFolderIsNeverFollowedNorEmptied)

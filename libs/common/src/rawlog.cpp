@@ -3,6 +3,10 @@
 
 #include <zlib.h>
 
+#include <fstream>
+
+#include <filesystem>
+
 #include <mrpt/img/CImage.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -190,10 +194,36 @@ std::string rawlogImagesDirectory(const std::string& rawlogPath)
 	return dir + mrpt::system::extractFileName(rawlogPath) + "_Images";
 }
 
+void checkRawlogPath(const std::string& path)
+{
+	namespace fs = std::filesystem;
+	std::error_code ec;
+	const auto st = fs::status(path, ec);
+	if (!fs::exists(st)) throw RawlogError(path + ": no such rawlog file");
+	if (fs::is_directory(st))
+	{
+		const auto has = [&](const char* f)
+		{ return fs::exists(fs::path(path) / f, ec); };
+		std::string hint;
+		if (has("rgb.txt") || has("depth.txt"))
+			hint = ": a TUM RGB-D folder; import it first: bims-import-tum " +
+			       path + " -o OUT.rawlog -c CONFIG.ini";
+		else if (has("odometry.csv"))
+			hint =
+			    ": a Stray Scanner capture; import it first: "
+			    "bims-import-stray " +
+			    path + " -o OUT.rawlog -c config/stray.ini";
+		throw RawlogError(path + ": a folder, not a rawlog file" + hint);
+	}
+	if (!fs::is_regular_file(st))
+		throw RawlogError(path + ": not a regular file, not a rawlog");
+	if (!std::ifstream(path))
+		throw RawlogError(path + ": cannot open rawlog file (permissions?)");
+}
+
 RawlogReader::RawlogReader(const std::string& path) : path_(path)
 {
-	if (!mrpt::system::fileExists(path))
-		throw RawlogError(path + ": no such rawlog file");
+	checkRawlogPath(path);
 	if (!in_.open(path)) throw RawlogError(path + ": cannot open rawlog file");
 	arch_ = std::make_unique<BufferedInArchive>(in_);
 	const std::string imgDir = rawlogImagesDirectory(path);

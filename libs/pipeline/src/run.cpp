@@ -185,7 +185,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	}
 	catch (const std::exception& e)
 	{
-		sum.error = e.what();
+		sum.error = withoutBacktrace(e.what());
 	}
 	if (input)
 	{

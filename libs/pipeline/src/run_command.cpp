@@ -31,6 +31,9 @@ int runExitCode(const RunSummary& s, int signal)
 
 int runFromCommandLine(const RunCommand& c)
 {
+	// every input before any output: a typo in the second rawlog is an
+	// error before the first is run and before OUTDIR is made
+	for (const auto& r : c.rawlogs) checkRawlogPath(r);
 	auto inputs = c.rawlogs;
 	inputs.push_back(c.config);
 	checkOutputsSpareInputs(inputs, {c.outDir});

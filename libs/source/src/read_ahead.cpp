@@ -1,4 +1,5 @@
 #include "read_ahead.h"
+#include <bims/common/app.h>
 
 #include <bims/common/clock.h>
 #include <bims/common/cpu_time.h>
@@ -89,7 +90,7 @@ ReadAhead::Item ReadAhead::readOne(std::string& error)
 	}
 	catch (const std::exception& e)
 	{
-		error = e.what();
+		error = withoutBacktrace(e.what());
 		if (error.empty()) error = "rawlog reading failed";
 		error_ = error;
 		it.obs.reset();

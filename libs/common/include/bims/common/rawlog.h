@@ -40,6 +40,12 @@ std::string rawlogImagesDirectory(const std::string& rawlogPath);
  * read. */
 uint64_t rawlogDataBytes(const std::string& path);
 
+/** Throws RawlogError naming \a path unless it is a readable regular file:
+ * missing, a folder (with the importer to use when it is a TUM RGB-D folder
+ * or a Stray Scanner capture), or unreadable. Programs check every input
+ * rawlog with it before they write anything. */
+void checkRawlogPath(const std::string& path);
+
 class RawlogReader
 {
  public:
