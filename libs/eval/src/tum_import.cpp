@@ -88,7 +88,14 @@ ImportSummary importTum(const std::string& folder, const std::string& outRawlog,
                         const ImportParams& params,
                         const ImportOptions& options)
 {
-	TumFolder tum = readTumFolder(folder, params);
+	return importTum(readTumFolder(folder, params), outRawlog, params, options);
+}
+
+ImportSummary importTum(TumFolder tum, const std::string& outRawlog,
+                        const ImportParams& params,
+                        const ImportOptions& options)
+{
+	const std::string& folder = tum.path;
 	if (options.maxFrames > 0 && tum.frames.size() > options.maxFrames)
 		tum.frames.resize(options.maxFrames);
 	const double t0 = tum.frames.front().t, t1 = tum.frames.back().t;

@@ -61,12 +61,11 @@ int runImport(const ImportRunOptions& o)
 			                  "camera");
 		params.loadFromConfigFile(*cfg);
 	}
-	{
-		// the folder's files are inputs too: -o FOLDER/rgb.txt is refused
-		auto inputs = tumInputFiles(readTumFolder(o.folder, params));
-		inputs.push_back(o.config.value_or(""));
-		checkOutputsSpareInputs(inputs, {o.out, groundTruthDirFor(o.out)});
-	}
+	// read once; its files are inputs too: -o FOLDER/rgb.txt is refused
+	TumFolder tum = readTumFolder(o.folder, params);
+	auto inputs = tumInputFiles(tum);
+	inputs.push_back(o.config.value_or(""));
+	checkOutputsSpareInputs(inputs, {o.out, groundTruthDirFor(o.out)});
 	if (!cfg || !cfg->sectionExists("camera"))
 		std::fprintf(
 		    stderr,
@@ -97,7 +96,7 @@ int runImport(const ImportRunOptions& o)
 		opt.extra = o.synthesize(gt, params.imuLabel, cfg.get(), o.seed);
 	}
 
-	const auto sum = importTum(o.folder, o.out, params, opt);
+	const auto sum = importTum(std::move(tum), o.out, params, opt);
 	std::fputs(
 	    importReport(o.out, sum, o.synth_imu, bonnConverted, params).c_str(),
 	    stdout);

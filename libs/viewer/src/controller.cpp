@@ -200,62 +200,72 @@ cv::Mat ReplayController::currentMask() const
 
 cv::Mat ReplayController::panel(Panel p) const
 {
-	if (!frame_) return placeholderPanel({320, 240}, "no frame yet");
+	return panels()[static_cast<size_t>(p)];
+}
+
+std::array<cv::Mat, kPanelCount> ReplayController::panels() const
+{
+	std::array<cv::Mat, kPanelCount> out;
+	const auto at = [&](Panel p) -> cv::Mat& { return out[size_t(p)]; };
+	if (!frame_)
+	{
+		for (auto& m : out) m = placeholderPanel({320, 240}, "no frame yet");
+		return out;
+	}
+	// each image converted once for all five panels
 	const auto& scan = *frame_->scan;
-	cv::Mat bgr = intensityBgr(scan);
+	const cv::Mat bgr = intensityBgr(scan);
+	const cv::Mat depth = depthColour(scan);
 	const cv::Size size =
 	    bgr.empty() ? cv::Size(static_cast<int>(scan.rangeImage.cols()),
 	                           static_cast<int>(scan.rangeImage.rows()))
 	                : bgr.size();
+	const cv::Mat mask = currentMask();
+	if (!bgr.empty())
+		at(Panel::RgbMask) = overlayMask(bgr, mask);
+	else if (!depth.empty())  // depth only: the mask over the depth in grey
+	{
+		cv::Mat grey;
+		cv::cvtColor(depth, grey, cv::COLOR_BGR2GRAY);
+		cv::cvtColor(grey, grey, cv::COLOR_GRAY2BGR);
+		at(Panel::RgbMask) = overlayMask(grey, mask);
+	}
+	else
+		at(Panel::RgbMask) = placeholderPanel(size, "no image");
+	at(Panel::Depth) =
+	    depth.empty() ? placeholderPanel(size, "no valid depth") : depth;
+
 	const auto* r = result();
 	// why a flow panel is empty
 	const char* noFlow = !r           ? "pipeline off: no flow"
 	                     : r->flowOff ? "depth only: flow tier off"
 	                                  : "no flow on the first frame";
-	switch (p)
+	if (r && !r->flowObserved.empty())
 	{
-		case Panel::RgbMask:
+		// One magnitude scale for both, so that they compare.
+		double maxMag = 0;
+		for (const cv::Mat* f : {&r->flowObserved, &r->flowExpected})
 		{
-			if (!bgr.empty()) return overlayMask(bgr, currentMask());
-			// depth only: the mask over the depth in grey
-			cv::Mat d = depthColour(scan), grey;
-			if (d.empty()) return placeholderPanel(size, "no image");
-			cv::cvtColor(d, grey, cv::COLOR_BGR2GRAY);
-			cv::cvtColor(grey, grey, cv::COLOR_GRAY2BGR);
-			return overlayMask(grey, currentMask());
+			if (f->empty()) continue;
+			for (int v = 0; v < f->rows; ++v)
+				for (int u = 0; u < f->cols; ++u)
+				{
+					const auto x = f->at<cv::Vec2f>(v, u);
+					const double m = std::hypot(x[0], x[1]);
+					if (std::isfinite(m)) maxMag = std::max(maxMag, m);
+				}
 		}
-		case Panel::Depth:
-		{
-			cv::Mat d = depthColour(scan);
-			if (!d.empty()) return d;
-			return placeholderPanel(size, "no valid depth");
-		}
-		case Panel::FlowObserved:
-		case Panel::FlowExpected:
-		{
-			if (!r || r->flowObserved.empty()) break;
-			// One magnitude scale for both, so that they compare.
-			double maxMag = 0;
-			for (const cv::Mat* f : {&r->flowObserved, &r->flowExpected})
-			{
-				if (f->empty()) continue;
-				for (int v = 0; v < f->rows; ++v)
-					for (int u = 0; u < f->cols; ++u)
-					{
-						const auto x = f->at<cv::Vec2f>(v, u);
-						const double m = std::hypot(x[0], x[1]);
-						if (std::isfinite(m)) maxMag = std::max(maxMag, m);
-					}
-			}
-			return flowColour(
-			    p == Panel::FlowObserved ? r->flowObserved : r->flowExpected,
-			    std::max(1.0, 0.5 * maxMag), size);
-		}
-		case Panel::Labels:
-			if (!r || r->labels.empty()) break;
-			return labelsColour(r->labels, bgr);
+		const double scale = std::max(1.0, 0.5 * maxMag);
+		at(Panel::FlowObserved) = flowColour(r->flowObserved, scale, size);
+		at(Panel::FlowExpected) = flowColour(r->flowExpected, scale, size);
 	}
-	return placeholderPanel(size, noFlow);
+	else
+		at(Panel::FlowObserved) = at(Panel::FlowExpected) =
+		    placeholderPanel(size, noFlow);
+	at(Panel::Labels) = r && !r->labels.empty()
+	                        ? labelsColour(r->labels, bgr)
+	                        : placeholderPanel(size, noFlow);
+	return out;
 }
 
 std::string ReplayController::counterText() const

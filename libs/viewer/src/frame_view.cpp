@@ -8,44 +8,29 @@
 
 namespace bims::viewer
 {
+namespace
+{
+/** Each layer's --layers name and View-menu title, in Layer order. */
+constexpr struct
+{
+	const char* name;
+	const char* title;
+} kLayers[kLayerCount] = {{"cloud", "Registered &cloud (moving points red)"},
+                          {"tier0", "Tier &0 occupied voxels (faint blue)"},
+                          {"tier1", "Tier &1 moving voxels (yellow)"},
+                          {"tier2", "Tier &2 moving voxels (red)"},
+                          {"trajectory", "&Estimated trajectory (cyan)"},
+                          {"gt", "&Ground truth (green)"}};
+}  // namespace
+
 const char* layerName(Layer l)
 {
-	switch (l)
-	{
-		case Layer::Cloud:
-			return "cloud";
-		case Layer::Tier0:
-			return "tier0";
-		case Layer::Tier1:
-			return "tier1";
-		case Layer::Tier2:
-			return "tier2";
-		case Layer::Estimated:
-			return "trajectory";
-		case Layer::GroundTruth:
-			return "gt";
-	}
-	return "?";
+	return kLayers[static_cast<size_t>(l)].name;
 }
 
 const char* layerTitle(Layer l)
 {
-	switch (l)
-	{
-		case Layer::Cloud:
-			return "Registered &cloud (moving points red)";
-		case Layer::Tier0:
-			return "Tier &0 occupied voxels (faint blue)";
-		case Layer::Tier1:
-			return "Tier &1 moving voxels (yellow)";
-		case Layer::Tier2:
-			return "Tier &2 moving voxels (red)";
-		case Layer::Estimated:
-			return "&Estimated trajectory (cyan)";
-		case Layer::GroundTruth:
-			return "&Ground truth (green)";
-	}
-	return "?";
+	return kLayers[static_cast<size_t>(l)].title;
 }
 
 LayerVisibility LayerVisibility::parse(const std::string& list)

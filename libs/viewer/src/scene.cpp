@@ -130,8 +130,7 @@ std::shared_ptr<FrameView> ReplayController::view() const
 	v->frame = cur_;
 	v->frameCount = frameCount();
 	v->mask = currentMask();
-	for (size_t i = 0; i < kPanelCount; ++i)
-		v->panels[i] = panel(static_cast<Panel>(i));
+	v->panels = panels();
 	v->counter = counterText();
 	v->status = statusText();
 	v->follow = suggestedCamera();

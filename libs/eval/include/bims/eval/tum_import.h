@@ -165,5 +165,9 @@ struct ImportSummary
 ImportSummary importTum(const std::string& folder, const std::string& outRawlog,
                         const ImportParams& params,
                         const ImportOptions& options);
+/** The same for a folder already read (readTumFolder). */
+ImportSummary importTum(TumFolder tum, const std::string& outRawlog,
+                        const ImportParams& params,
+                        const ImportOptions& options);
 
 }  // namespace bims::eval

@@ -99,6 +99,8 @@ class ReplayController
 	ViewCamera suggestedCamera() const;
 	/** One 2D panel as BGR (CV_8UC3); a grey image when not available. */
 	cv::Mat panel(Panel p) const;
+	/** All five panels in Panel order (each image converted once). */
+	std::array<cv::Mat, kPanelCount> panels() const;
 	/** The moving mask shown (pipeline or results folder; may be empty). */
 	cv::Mat currentMask() const;
 	/** "12 / 149": the position of the current frame and of the last. */
