@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 namespace bims::grab
 {
@@ -187,8 +188,17 @@ OpenNI2Source::~OpenNI2Source()
 	// OpenNI2's Dummy driver (Debian 2.2.0.33) keeps its frame thread
 	// running after stop()/destroy() and then calls into the freed stream
 	// (a crash a few ms later). Its streams are therefore left open (a few
-	// hundred kB, once per Dummy source) instead of being destroyed.
-	if (p_.uri == "Dummy") (void)d_.release();
+	// hundred kB, once per Dummy source) instead of being destroyed. They
+	// stay reachable from a static list until exit, so a leak checker sees
+	// them kept on purpose, not lost (whether or not the driver's thread
+	// has started).
+	if (p_.uri == "Dummy")
+	{
+		static auto* const kept = new std::vector<Impl*>;
+		static std::mutex m;
+		const std::lock_guard<std::mutex> lock(m);
+		kept->push_back(d_.release());
+	}
 }
 
 std::string OpenNI2Source::describe() const
