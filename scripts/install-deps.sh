@@ -12,6 +12,7 @@ PACKAGES=(
   libopenni2-dev openni2-utils
   libwxgtk3.2-dev
   liboctomap-dev
+  librosbag-storage-dev libcv-bridge-dev libsensor-msgs-dev pluginlib-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth imagemagick xdotool x11-apps libgl1-mesa-dri
 )

@@ -33,7 +33,7 @@ const std::vector<std::string> kPrograms = {
     "bims-calib-depth", "bims-import-tum",  "bims-import-stray",
     "bims-eval traj",   "bims-eval masks",  "bims-eval depth-consistency",
     "bims-info",        "bims-flow-labels", "bims-flow-check",
-    "bims-sweep",       "bims-maps-figure"};
+    "bims-sweep",       "bims-maps-figure", "bims-import-bag"};
 
 bool built(const std::string& program)
 {
@@ -131,16 +131,16 @@ TEST(Cli, SharedOptionsAreSpelledTheSameWayInEveryProgram)
 	    "--max_frames", "--frame", "--nframes",  "--silent"};
 	// who must have them: outputs (-o), a progress line or chatter (-q)
 	const std::set<std::string> withOut = {
-	    "bims-run",         "bims-sim",       "bims-grab",
-	    "bims-odom",        "bims-calib-imu", "bims-calib-depth",
-	    "bims-import-tum",  "bims-eval traj", "bims-eval masks",
-	    "bims-flow-labels", "bims-sweep",     "bims-maps-figure",
-	    "bims-import-stray"};
+	    "bims-run",          "bims-sim",       "bims-grab",
+	    "bims-odom",         "bims-calib-imu", "bims-calib-depth",
+	    "bims-import-tum",   "bims-eval traj", "bims-eval masks",
+	    "bims-flow-labels",  "bims-sweep",     "bims-maps-figure",
+	    "bims-import-stray", "bims-import-bag"};
 	const std::set<std::string> withQuiet = {
-	    "bims-run",        "bims-sim",         "bims-grab",
-	    "bims-odom",       "bims-calib-imu",   "bims-calib-depth",
-	    "bims-import-tum", "bims-eval masks",  "bims-flow-check",
-	    "bims-sweep",      "bims-import-stray"};
+	    "bims-run",        "bims-sim",          "bims-grab",
+	    "bims-odom",       "bims-calib-imu",    "bims-calib-depth",
+	    "bims-import-tum", "bims-eval masks",   "bims-flow-check",
+	    "bims-sweep",      "bims-import-stray", "bims-import-bag"};
 	size_t checked = 0;
 	for (const auto& p : kPrograms)
 	{
@@ -375,6 +375,9 @@ TEST(Cli, NumericOptionsOutOfTheirRangeAreUsageErrors)
 	         {"bims-import-tum " + d + " -o " + d + "/x.rawlog --max-frames -1",
 	          "--max-frames -1: out of range [0, 100000000]"},
 	         {"bims-import-stray " + d + " -o " + d +
+	              "/x.rawlog --max-frames -1",
+	          "--max-frames -1: out of range"},
+	         {"bims-import-bag " + d + "/x.bag -o " + d +
 	              "/x.rawlog --max-frames -1",
 	          "--max-frames -1: out of range"},
 	         {"bims-odom " + kConfig + " " + kSample + " -o " + d +

@@ -11,6 +11,7 @@ const std::vector<std::string>& experimentSections()
 	    "calibration",   // R_IC, IMU-camera time offset
 	    "import",        // TUM/Bonn import (association, ground truth)
 	    "import_stray",  // Stray Scanner import (confidence, colour size)
+	    "import_bag",    // ROS 1 bag import (topics, pairing)
 	    "attitude",      // ego: IMU attitude filter
 	    "tracker",       // ego: gyro-aided KLT
 	    "translation",   // ego: robust translation / refinement

@@ -28,9 +28,12 @@ CObservation3DRangeScan::Ptr depthObservation(const cv::Mat& depth,
 {
 	const int W = static_cast<int>(camera.ncols),
 	          H = static_cast<int>(camera.nrows);
-	if (depth.type() != CV_16UC1 || depth.cols != W || depth.rows != H)
+	const bool metric = depth.type() == CV_32FC1;
+	if ((depth.type() != CV_16UC1 && !metric) || depth.cols != W ||
+	    depth.rows != H)
 		throw std::invalid_argument(
-		    "depthObservation: a CV_16UC1 image of the camera's size " +
+		    "depthObservation: a CV_16UC1 or CV_32FC1 image of the camera's "
+		    "size " +
 		    std::to_string(W) + "x" + std::to_string(H) + " expected");
 	auto o = CObservation3DRangeScan::Create();
 	o->sensorLabel = label;
@@ -43,14 +46,24 @@ CObservation3DRangeScan::Ptr depthObservation(const cv::Mat& depth,
 	o->stdError = 0.01f;
 	o->rangeImage_setSize(H, W);
 	const double k = metresPerUnit / rangeUnits;
+	auto toUnits = [&](double value)
+	{
+		// no reading: 0, negative, NaN, infinite or beyond the range image
+		const double units = std::round(value * k);
+		return units > 0 && units <= 65535 ? static_cast<uint16_t>(units)
+		                                   : uint16_t(0);
+	};
 	for (int v = 0; v < H; v++)
 	{
-		const uint16_t* r = depth.ptr<uint16_t>(v);
-		for (int u = 0; u < W; u++)
+		if (metric)
 		{
-			const double units = std::round(r[u] * k);
-			o->rangeImage(v, u) =
-			    units > 65535 ? 0 : static_cast<uint16_t>(units);
+			const float* r = depth.ptr<float>(v);
+			for (int u = 0; u < W; u++) o->rangeImage(v, u) = toUnits(r[u]);
+		}
+		else
+		{
+			const uint16_t* r = depth.ptr<uint16_t>(v);
+			for (int u = 0; u < W; u++) o->rangeImage(v, u) = toUnits(r[u]);
 		}
 	}
 	o->cameraParams = camera;
@@ -73,6 +86,29 @@ void attachColour(CObservation3DRangeScan& obs, const cv::Mat& bgr)
 	obs.hasIntensityImage = true;
 	obs.intensityImageChannel = CObservation3DRangeScan::CH_VISIBLE;
 	obs.intensityImage = mrpt::img::CImage(bgr, mrpt::img::DEEP_COPY);
+}
+
+mrpt::obs::CObservationIMU::Ptr imuObservation(const std::string& label,
+                                               double t, const double* gyro,
+                                               const double* accel,
+                                               const double* mag)
+{
+	using namespace mrpt::obs;
+	auto m = CObservationIMU::Create();
+	m->sensorLabel = label;
+	m->timestamp = mrpt::Clock::fromDouble(t);
+	auto put =
+	    [&](const double* v, TIMUDataIndex x, TIMUDataIndex y, TIMUDataIndex z)
+	{
+		if (!v) return;
+		m->set(x, v[0]);
+		m->set(y, v[1]);
+		m->set(z, v[2]);
+	};
+	put(gyro, IMU_WX, IMU_WY, IMU_WZ);
+	put(accel, IMU_X_ACC, IMU_Y_ACC, IMU_Z_ACC);
+	put(mag, IMU_MAG_X, IMU_MAG_Y, IMU_MAG_Z);
+	return m;
 }
 
 void loadImportLabels(const mrpt::config::CConfigFileBase& cfg,

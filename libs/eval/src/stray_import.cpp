@@ -42,19 +42,11 @@ size_t videoFrameCount(cv::VideoCapture& video, const std::string& path)
 /** The IMU sample as the rawlog's observation: specific force -a (Apple's
  * accelerometer points down at rest; a specific force points up), the
  * gyro as is; no magnetometer, no orientation. */
-mrpt::obs::CObservationIMU::Ptr imuObservation(const StrayImuSample& s,
-                                               const std::string& label)
+mrpt::obs::CObservationIMU::Ptr strayImuObservation(const StrayImuSample& s,
+                                                    const std::string& label)
 {
-	auto m = mrpt::obs::CObservationIMU::Create();
-	m->sensorLabel = label;
-	m->timestamp = mrpt::Clock::fromDouble(s.t);
-	m->set(mrpt::obs::IMU_X_ACC, -s.a[0]);
-	m->set(mrpt::obs::IMU_Y_ACC, -s.a[1]);
-	m->set(mrpt::obs::IMU_Z_ACC, -s.a[2]);
-	m->set(mrpt::obs::IMU_WX, s.alpha[0]);
-	m->set(mrpt::obs::IMU_WY, s.alpha[1]);
-	m->set(mrpt::obs::IMU_WZ, s.alpha[2]);
-	return m;
+	const double f[3] = {-s.a[0], -s.a[1], -s.a[2]};
+	return imuObservation(label, s.t, s.alpha, f, nullptr);
 }
 }  // namespace
 
@@ -187,7 +179,7 @@ StrayImportSummary importStray(const StrayCapture& cap,
 	{
 		if (it.kind == 0)
 		{
-			w.write(*imuObservation(cap.imu[it.i], params.imu_label));
+			w.write(*strayImuObservation(cap.imu[it.i], params.imu_label));
 			sum.imu++;
 			continue;
 		}

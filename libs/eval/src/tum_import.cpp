@@ -177,12 +177,8 @@ ImportSummary importTum(TumFolder tum, const std::string& outRawlog,
 		else
 		{
 			const auto& a = tum.accel[it.i];
-			auto m = mrpt::obs::CObservationIMU::Create();
-			m->sensorLabel = params.accelLabel;
-			m->timestamp = mrpt::Clock::fromDouble(a.t);
-			m->set(mrpt::obs::IMU_X_ACC, a.a[0]);
-			m->set(mrpt::obs::IMU_Y_ACC, a.a[1]);
-			m->set(mrpt::obs::IMU_Z_ACC, a.a[2]);
+			const auto m =
+			    imuObservation(params.accelLabel, a.t, nullptr, a.a, nullptr);
 			w.write(*m);
 			sum.accel++;
 		}

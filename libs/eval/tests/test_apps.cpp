@@ -459,10 +459,10 @@ TEST(Apps, HelpExitsCleanlyAndBadOptionsAreUsageErrors)
 	// exiting: no program may go on with empty arguments after them.
 	for (const std::string app :
 	     {"bims-run", "bims-odom", "bims-sim", "bims-import-tum",
-	      "bims-import-stray", "bims-flow-check", "bims-flow-labels",
-	      "bims-calib-imu", "bims-calib-depth", "bims-info", "bims-maps-figure",
-	      "bims-grab", "bims-sweep", "bims-eval masks", "bims-eval traj",
-	      "bims-eval depth-consistency"})
+	      "bims-import-stray", "bims-import-bag", "bims-flow-check",
+	      "bims-flow-labels", "bims-calib-imu", "bims-calib-depth", "bims-info",
+	      "bims-maps-figure", "bims-grab", "bims-sweep", "bims-eval masks",
+	      "bims-eval traj", "bims-eval depth-consistency"})
 	{
 		if (!fs::exists(kBin + "/" + app.substr(0, app.find(' '))))
 			continue;  // bims-grab without OpenNI2
@@ -710,7 +710,10 @@ TEST(Apps, NoProgramWritesOverItsInput)
 	      "bims-import-stray " + d + " -o " + d + "/../aliases",
 	      "bims-import-stray " + d + " -o " + cfg + " -c " + cfg,
 	      "bims-import-stray " + d + " -o " + d + "/x.rawlog -c " + d +
-	          "/x_arkit_reference.txt"})
+	          "/x_arkit_reference.txt",
+	      "bims-import-bag " + in + " -o " + in,
+	      "bims-import-bag " + in + " -o " + d + "/x.rawlog -c " + d +
+	          "/x.rawlog"})
 	{
 		const ::Run r = run(kBin + "/" + args);
 		EXPECT_EQ(r.code, 2) << args << "\n" << r.out;

@@ -128,8 +128,9 @@ std::string configReference()
 	    "`config/paper.ini`\nis the paper's literal model. An absent key "
 	    "keeps its default, an unknown key\nor a value out of range is an "
 	    "error naming the file, the section and the key.\n"
-	    "`[import]` and `[import_stray]` (read by `bims-import-tum` and "
-	    "`bims-import-stray` only,\n`docs/eval.md`) and MRPT map "
+	    "`[import]`, `[import_stray]` and `[import_bag]` (read by "
+	    "`bims-import-tum`,\n`bims-import-stray` and `bims-import-bag` "
+	    "only: `docs/eval.md`, `docs/import-bag.md`)\nand MRPT map "
 	    "definitions (`[map...]`) are not listed.\n";
 	const ExperimentConfig defaults;
 	forEachSection(defaults,
@@ -173,8 +174,8 @@ void ExperimentConfig::loadFromConfigFile(
 	pipeline.loadFromConfigFile(cfg, "pipeline");
 	output.loadFromConfigFile(cfg, "output");
 	// import settings live in the same file (config/bonn.ini,
-	// config/stray.ini) but are read by bims-import-tum and
-	// bims-import-stray only.
+	// config/stray.ini, config/realsense.ini) but are read by the importers
+	// only.
 	if (pipeline.variant == Variant::FusedRaycast) setVariant(pipeline.variant);
 }
 

@@ -93,6 +93,7 @@ TEST(PipelineConfig, EffectiveIniReadBackIsTheSameConfiguration)
 	    {"paper.ini", loaded("paper.ini")},
 	    {"bonn.ini", loaded("bonn.ini")},
 	    {"stray.ini", loaded("stray.ini")},
+	    {"realsense.ini", loaded("realsense.ini")},
 	    {"default.ini --variant fused-raycast", raycast}};
 	for (const auto& [name, c] : cases)
 	{
@@ -117,6 +118,17 @@ TEST(PipelineConfig, EffectiveIniReadBackIsTheSameConfiguration)
 	    fromText("[calibration]\nR_IC = 0 0 1  -1 0 0.0001  0 -1 0\n");
 	EXPECT_EQ(fromText(tilted.effectiveIni()).ego.calibration.R_IC,
 	          tilted.ego.calibration.R_IC);
+}
+
+TEST(PipelineConfig, TheRealSensePresetGivesTheImuInTheOpticalFrame)
+{
+	// config/realsense.ini (bims-import-bag's [import_bag] aside):
+	// realsense-ros's IMU in the optical axes, no magnetometer
+	const ExperimentConfig s = loaded("realsense.ini");
+	EXPECT_EQ(s.ego.calibration.R_IC, Eigen::Matrix3d::Identity());
+	EXPECT_TRUE(s.ego.calibration.has_R_IC);
+	EXPECT_FALSE(s.ego.attitude.use_magnetometer);
+	EXPECT_EQ(s.ego.sensors.imu_label, "IMU");
 }
 
 TEST(PipelineConfig, TheStrayPresetGivesTheIphoneImuMounting)
@@ -146,8 +158,9 @@ TEST(PipelineConfig, EffectiveIniHasEverySectionAndAMeaningPerKey)
 	std::vector<std::string> sections;
 	m.getAllSections(sections);
 	// all but [camera] (only when a file gives intrinsics), [import]
-	// (bims-import-tum's) and [import_stray] (bims-import-stray's)
-	EXPECT_EQ(sections.size(), bims::experimentSections().size() - 3);
+	// (bims-import-tum's), [import_stray] (bims-import-stray's) and
+	// [import_bag] (bims-import-bag's)
+	EXPECT_EQ(sections.size(), bims::experimentSections().size() - 4);
 	for (const char* s : {"sensors", "calibration", "depth_correction",
 	                      "attitude", "tracker", "translation", "odometry",
 	                      "anchor", "flow", "grids", "pipeline", "output"})

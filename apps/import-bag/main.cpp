@@ -1,0 +1,63 @@
+// bims-import-bag BAG... -o OUT.rawlog [--layout tum|realsense|auto]
+//   [-c CONFIG.ini] [--max-frames N] [--gz L] [--topics] [-q]
+// Converts ROS 1 bags (sensor_msgs/Image depth and colour, CameraInfo, Imu,
+// MagneticField) into a bims rawlog. See docs/import-bag.md.
+#include <bims/bag/bag_import_run.h>
+#include <bims/common/app.h>
+
+#include <mrpt/3rdparty/tclap/CmdLine.h>
+
+int main(int argc, char** argv)
+{
+	return bims::runApp(
+	    "bims-import-bag",
+	    [&]()
+	    {
+		    TCLAP::CmdLine cmd(
+		        "Import ROS 1 bags (depth and colour sensor_msgs/Image, "
+		        "their CameraInfo, sensor_msgs/Imu or separate accelerometer "
+		        "and gyro topics, MagneticField) into a rawlog of RGB-D "
+		        "frames and IMU samples. Depth and colour are paired by "
+		        "stamp; the stamps are the messages' header stamps. Several "
+		        "bags are read as one recording.",
+		        ' ', bims::version());
+		    TCLAP::UnlabeledMultiArg<std::string> bags(
+		        "BAG", "ROS 1 bag files (.bag)", true, "BAG", cmd);
+		    TCLAP::ValueArg<std::string> out("o", "out", "output rawlog", false,
+		                                     "", "OUT.rawlog", cmd);
+		    TCLAP::ValueArg<std::string> layout(
+		        "", "layout",
+		        "preset topics: realsense (realsense-ros, aligned depth), tum "
+		        "(TUM RGB-D's bags), auto (default: the first whose depth "
+		        "topic the bag has)",
+		        false, "", "realsense|tum|auto", cmd);
+		    TCLAP::ValueArg<std::string> config(
+		        "c", "config",
+		        "experiment .ini: [import_bag] topics and pairing, [camera] "
+		        "intrinsics over the bag's CameraInfo, [sensors] labels (e.g. "
+		        "config/realsense.ini)",
+		        false, "", "CONFIG.ini", cmd);
+		    TCLAP::ValueArg<long> maxFrames(
+		        "", "max-frames", "import only the first N frames (0 = all)",
+		        false, 0, "N", cmd);
+		    TCLAP::ValueArg<int> gz(
+		        "", "gz", "gzip level of the rawlog, 0 = plain (default 1)",
+		        false, 1, "L", cmd);
+		    TCLAP::SwitchArg topics(
+		        "", "topics", "list the bags' topics and types, import nothing",
+		        cmd);
+		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
+		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::bag::BagImportRunOptions o;
+		    o.bags = bags.getValue();
+		    o.out = out.getValue();
+		    o.config = bims::givenValue(config);
+		    o.layout = bims::givenValue(layout);
+		    o.max_frames = static_cast<size_t>(
+		        bims::inRange(maxFrames, 0L, 100000000L, "0 = all"));
+		    o.gz = gz.getValue();
+		    o.progress = !quiet.getValue();
+		    o.listTopics = topics.getValue();
+		    return bims::bag::runBagImport(o);
+	    });
+}

@@ -1,0 +1,186 @@
+// Import of ROS 1 bags (sensor_msgs/Image depth and colour, CameraInfo, Imu,
+// optional MagneticField) into a bims rawlog, with Debian's rosbag_storage
+// (docs/import-bag.md). Depth and colour are paired by stamp as the TUM
+// importer pairs them (associateGreedy); IMU samples keep their own stamps;
+// the stamps are the messages' header stamps (the sensors' clock), never
+// the bag's record times. A bag of TUM RGB-D's layout gives the same rawlog
+// as the TUM folder of the same frames.
+#pragma once
+
+#include <bims/common/choice.h>
+#include <bims/common/options.h>
+#include <bims/eval/tum_import.h>
+#include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/img/TCamera.h>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace bims::bag
+{
+/** The topic names of the layouts users meet most (--layout). */
+enum class BagLayout
+{
+	Auto,       ///< the first preset whose depth topic the bag has
+	RealSense,  ///< realsense-ros: aligned depth, colour, imu or accel+gyro
+	Tum         ///< TUM RGB-D's own bags: depth in metres, accel-only /imu
+};
+inline Choices<BagLayout> choices(BagLayout)
+{
+	static constexpr ChoiceName<BagLayout> t[] = {
+	    {BagLayout::Auto, "auto"},
+	    {BagLayout::RealSense, "realsense"},
+	    {BagLayout::Tum, "tum"}};
+	return t;
+}
+
+/** The topics read. An empty name: not read. */
+struct BagTopics
+{
+	std::string depth;       ///< sensor_msgs/Image, 16UC1 mm or 32FC1 m
+	std::string colour;      ///< sensor_msgs/Image, rgb8 bgr8 mono8
+	std::string cameraInfo;  ///< sensor_msgs/CameraInfo of the depth image
+	std::string imu;         ///< sensor_msgs/Imu (gyro and/or accel)
+	std::string accel;       ///< sensor_msgs/Imu, accelerometer only
+	std::string gyro;        ///< sensor_msgs/Imu, gyro only (merged)
+	std::string mag;         ///< sensor_msgs/MagneticField
+};
+
+/** The preset topics of \a layout (Auto: none). */
+BagTopics layoutTopics(BagLayout layout);
+
+/** What bims-import-bag reads from an experiment .ini: [import_bag]
+ * (describe()), [camera] (intrinsics overriding the bag's CameraInfo: all
+ * of fx fy cx cy width height or none) and [sensors] (the labels). */
+struct BagImportParams
+{
+	/** [import_bag] layout (--layout overrides): whose preset topics. */
+	BagLayout layout = BagLayout::Auto;
+	/** [import_bag] depth_topic ... mag_topic: each replaces the preset's
+	 * topic when given ("none": not read). */
+	BagTopics topics;
+	/** [import_bag] max_time_gap_s: max |t_colour - t_depth| to pair. */
+	double maxTimeGap = 0.02;
+	/** [import_bag] timestamp: the stamp of a frame (depth by default). */
+	eval::TimestampSource timestampFrom = eval::TimestampSource::Depth;
+	/** [import_bag] range_units: metres per unit of the range image. */
+	double rangeUnits = 0.001;
+	/** [import_bag] accel_label: the label of IMU samples without a gyro
+	 * (TUM's accelerometer), as bims-import-tum's [import] accel_label. */
+	std::string accelLabel = "ACCEL";
+	/** [camera] when the file gives it: the bag's CameraInfo is then only
+	 * checked against the image size. */
+	std::optional<mrpt::img::TCamera> camera;
+	std::string cameraFrom;  ///< "[camera] of FILE" when given
+	/** [sensors] rgbd_label, imu_label. */
+	std::string rgbdLabel = "RGBD", imuLabel = "IMU";
+
+	/** The keys of [import_bag] (bims/common/options.h). */
+	void describe(OptionVisitor& v);
+	/** Checks the file's sections (bims::checkExperimentSections) and reads
+	 * [import_bag], [camera] and [sensors] strictly: unknown keys and values
+	 * out of range are errors naming file, section and key. */
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
+};
+
+/** The topics read with \a layout (not Auto): the preset's, each replaced
+ * by the one \a given names ("none": not read). */
+BagTopics resolveTopics(const BagTopics& given, BagLayout layout);
+
+/** One topic of a bag: name, message type, message count. */
+struct BagTopicInfo
+{
+	std::string name, type;
+	size_t messages = 0;
+};
+
+/** The topics of \a bagPaths (all bags together), sorted by name. Throws
+ * std::runtime_error naming the bag when it cannot be opened (missing,
+ * not a bag, unindexed: a recording cut short). */
+std::vector<BagTopicInfo> bagTopics(const std::vector<std::string>& bagPaths);
+
+/** "  /camera/imu  sensor_msgs/Imu  2000 messages" lines. */
+std::string describeTopics(const std::vector<BagTopicInfo>& topics);
+
+/** The layout whose depth topic \a topics has (RealSense first); throws
+ * naming the bags and listing their topics when none does. */
+BagLayout detectLayout(const std::vector<BagTopicInfo>& topics,
+                       const std::string& bagNames);
+
+/** One IMU sample of the merged stream [s, rad/s, m/s^2, T]. */
+struct ImuSample
+{
+	double t = 0;
+	bool hasGyro = false, hasAccel = false, hasMag = false;
+	double w[3] = {}, a[3] = {}, m[3] = {};
+};
+
+/** Merges separate accelerometer and gyro streams (time-sorted) into whole
+ * samples at the gyro's stamps: the accelerometer linearly interpolated
+ * between its two samples around each gyro stamp. Gyro samples outside the
+ * accelerometer's time span are left out and counted in \a leftOut. */
+std::vector<ImuSample> mergeAccelGyro(const std::vector<ImuSample>& accel,
+                                      const std::vector<ImuSample>& gyro,
+                                      size_t& leftOut);
+
+/** Adds the magnetometer (time-sorted) to \a imu, linearly interpolated
+ * at each sample's stamp within the magnetometer's time span (outside:
+ * none). */
+void attachMagnetometer(std::vector<ImuSample>& imu,
+                        const std::vector<ImuSample>& mag);
+
+/** A ROS stamp (sec, nsec) as seconds, correctly rounded (the double
+ * nearest to the decimal "sec.nnnnnnnnn", as a TUM file's stamp is
+ * parsed). */
+double stampSeconds(uint32_t sec, uint32_t nsec);
+
+struct BagImportOptions
+{
+	size_t maxFrames = 0;  ///< 0 = all
+	int gzLevel = 1;       ///< 0 = plain rawlog, 1..9 gzip
+	bool progress = true;  ///< progress line on stderr
+};
+
+struct BagImportSummary
+{
+	size_t frames = 0;                             ///< 3D scans written
+	size_t depthMessages = 0, colourMessages = 0;  ///< read in the bags
+	size_t unpaired = 0;       ///< depth images without colour within the gap
+	size_t stampsBack = 0;     ///< images whose stamp was not after the last
+	size_t imu = 0;            ///< IMU observations written (imuLabel)
+	size_t accelOnly = 0;      ///< of them, accelerometer only (accelLabel)
+	size_t imuLeftOut = 0;     ///< gyro samples outside the accel's span
+	size_t imuStampsBack = 0;  ///< IMU samples not after the last, left out
+	size_t imuOutside = 0;     ///< IMU samples outside the frames' time span
+	bool imuHasGyro = false, imuHasAccel = false, imuHasMag = false;
+	std::string imuSource;      ///< "imu topic /x", "accel /a + gyro /g merged"
+	int width = 0, height = 0;  ///< the images [px]
+	std::string depthEncoding, colourEncoding;
+	mrpt::img::TCamera camera;  ///< the scans' intrinsics
+	std::string cameraFrom;     ///< "CameraInfo /x" or "[camera] of FILE"
+	/** The CameraInfo has non-zero distortion coefficients, which the
+	 * pinhole model of bims leaves out (images are not undistorted). */
+	bool distortionIgnored = false;
+	std::string distortionModel;         ///< its distortion_model then
+	BagTopics topics;                    ///< the topics read
+	BagLayout layout = BagLayout::Auto;  ///< whose presets (Auto: none)
+};
+
+/** Imports \a bagPaths (read as one recording) into \a outRawlog (written
+ * as OUT.rawlog.partial, renamed when complete): frames and IMU samples in
+ * time order, IMU first at equal stamps; IMU samples outside the frames'
+ * time span are left out as the TUM importer does. Throws
+ * std::runtime_error naming the bag (and topic, message and stamp) on bad
+ * input: a missing topic (listing the topics the bags have), a wrong
+ * encoding, a CameraInfo that disagrees with the image size, a message that
+ * cannot be read. When a message of a frame cannot be read, the whole
+ * frames before it are kept: the rawlog is renamed into place with them,
+ * and the error says how many. */
+BagImportSummary importBag(const std::vector<std::string>& bagPaths,
+                           const std::string& outRawlog,
+                           const BagImportParams& params,
+                           const BagImportOptions& options);
+
+}  // namespace bims::bag

@@ -1,0 +1,765 @@
+#include <bims/bag/bag_import.h>
+#include <bims/common/output_paths.h>
+#include <bims/common/progress.h>
+#include <bims/common/rawlog.h>
+#include <bims/eval/association.h>
+#include <bims/eval/rgbd_frame.h>
+#include <cv_bridge/cv_bridge.h>
+#include <mrpt/core/format.h>
+#include <rosbag/bag.h>
+#include <rosbag/exceptions.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/Imu.h>
+#include <sensor_msgs/MagneticField.h>
+#include <sensor_msgs/image_encodings.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <set>
+#include <stdexcept>
+
+// A message read for its header stamp only (the first pass over the images:
+// their pixels are read once, in the second). Every ROS message with a
+// std_msgs/Header starts with it: seq, stamp (sec, nsec), frame_id.
+namespace bims::bag
+{
+struct StampOnly
+{
+	uint32_t sec = 0, nsec = 0;
+};
+}  // namespace bims::bag
+
+namespace ros::message_traits
+{
+template <>
+struct MD5Sum<bims::bag::StampOnly>
+{
+	static const char* value() { return "*"; }
+	static const char* value(const bims::bag::StampOnly&) { return "*"; }
+};
+template <>
+struct DataType<bims::bag::StampOnly>
+{
+	static const char* value() { return "*"; }
+	static const char* value(const bims::bag::StampOnly&) { return "*"; }
+};
+template <>
+struct Definition<bims::bag::StampOnly>
+{
+	static const char* value() { return ""; }
+	static const char* value(const bims::bag::StampOnly&) { return ""; }
+};
+}  // namespace ros::message_traits
+
+namespace ros::serialization
+{
+template <>
+struct Serializer<bims::bag::StampOnly>
+{
+	template <typename Stream>
+	inline static void read(Stream& stream, bims::bag::StampOnly& m)
+	{
+		uint32_t seq = 0;
+		stream.next(seq);
+		stream.next(m.sec);
+		stream.next(m.nsec);
+	}
+};
+}  // namespace ros::serialization
+
+namespace bims::bag
+{
+namespace fs = std::filesystem;
+
+double stampSeconds(uint32_t sec, uint32_t nsec)
+{
+	char buf[32];
+	std::snprintf(buf, sizeof(buf), "%u.%09u", sec, nsec);
+	return std::strtod(buf, nullptr);
+}
+
+namespace
+{
+using Bags = std::vector<std::unique_ptr<rosbag::Bag>>;
+
+Bags openBags(const std::vector<std::string>& paths)
+{
+	Bags bags;
+	for (const auto& p : paths)
+	{
+		std::error_code ec;
+		if (!fs::exists(p, ec)) throw std::runtime_error(p + ": no such bag");
+		if (fs::is_directory(p, ec))
+			throw std::runtime_error(
+			    p + ": a folder, not a ROS 1 bag" +
+			    (fs::exists(fs::path(p) / "metadata.yaml", ec)
+			         ? " (a ROS 2 bag: convert it to ROS 1, e.g. with the "
+			           "rosbags package's rosbags-convert)"
+			         : ""));
+		auto b = std::make_unique<rosbag::Bag>();
+		try
+		{
+			b->open(p, rosbag::bagmode::Read);
+		}
+		catch (const rosbag::BagUnindexedException&)
+		{
+			throw std::runtime_error(
+			    p +
+			    ": the bag has no index (its recording was cut short, or is "
+			    "still being written): ROS's 'rosbag reindex' rebuilds it "
+			    "(Debian's python3-rosbag), then import it again");
+		}
+		catch (const std::exception& e)
+		{
+			// a bag whose header is there but whose end is not: cut short
+			std::ifstream f(p, std::ios::binary);
+			char magic[13] = {};
+			f.read(magic, 12);
+			if (std::string(magic) == "#ROSBAG V2.0")
+				throw std::runtime_error(
+				    p + ": a ROS 1 bag cut short or damaged (" + e.what() +
+				    "): ROS's 'rosbag reindex' (Debian's python3-rosbag) "
+				    "rebuilds its index from the whole messages it holds, "
+				    "then import it again");
+			throw std::runtime_error(
+			    p +
+			    ": not a readable ROS 1 bag (it does not start with "
+			    "'#ROSBAG V2.0'): " +
+			    e.what());
+		}
+		bags.push_back(std::move(b));
+	}
+	return bags;
+}
+
+std::string joined(const std::vector<std::string>& v)
+{
+	std::string s;
+	for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+	return s;
+}
+
+/** Where a message is: "BAG: topic /x, message #n (stamp s)". */
+std::string where(const rosbag::MessageInstance& m, size_t n, double t = -1)
+{
+	std::string s = "topic " + m.getTopic() + ", message #" +
+	                std::to_string(n + 1) + " of it";
+	if (t >= 0) s += mrpt::format(" (stamp %.6f)", t);
+	return s;
+}
+
+std::vector<BagTopicInfo> topicsOf(const Bags& bags)
+{
+	std::map<std::string, BagTopicInfo> m;
+	for (const auto& b : bags)
+	{
+		rosbag::View all(*b);
+		for (const auto* c : all.getConnections())
+		{
+			auto& t = m[c->topic];
+			t.name = c->topic;
+			t.type = c->datatype;
+		}
+		for (auto& [name, t] : m)
+		{
+			rosbag::View one(*b, rosbag::TopicQuery(name));
+			t.messages += one.size();
+		}
+	}
+	std::vector<BagTopicInfo> out;
+	for (auto& [name, t] : m) out.push_back(t);
+	return out;
+}
+
+const BagTopicInfo* findTopic(const std::vector<BagTopicInfo>& topics,
+                              const std::string& name)
+{
+	for (const auto& t : topics)
+		if (t.name == name) return &t;
+	return nullptr;
+}
+
+/** The channels a sensor_msgs/Imu holds: a covariance whose first element
+ * is -1 marks the quantity as not measured (the message's convention). */
+ImuSample imuSample(const sensor_msgs::Imu& m, double t)
+{
+	ImuSample s;
+	s.t = t;
+	s.hasGyro = m.angular_velocity_covariance[0] != -1;
+	s.hasAccel = m.linear_acceleration_covariance[0] != -1;
+	s.w[0] = m.angular_velocity.x;
+	s.w[1] = m.angular_velocity.y;
+	s.w[2] = m.angular_velocity.z;
+	s.a[0] = m.linear_acceleration.x;
+	s.a[1] = m.linear_acceleration.y;
+	s.a[2] = m.linear_acceleration.z;
+	return s;
+}
+
+double lerp(double a, double b, double f)
+{
+	return a + (b - a) * f;
+}
+
+/** The image of one message as OpenCV sees it, after the checks a corrupt
+ * or foreign message fails: encoding, size, step, data length. */
+cv_bridge::CvImageConstPtr checkedImage(
+    const boost::shared_ptr<const sensor_msgs::Image>& img,
+    const std::set<std::string>& encodings, const char* what, int width,
+    int height, const std::string& target)
+{
+	if (!encodings.count(img->encoding))
+	{
+		std::vector<std::string> e(encodings.begin(), encodings.end());
+		throw std::runtime_error(std::string(what) + " encoding '" +
+		                         img->encoding + "' is not supported (" +
+		                         joined(e) + ")");
+	}
+	if (static_cast<int>(img->width) != width ||
+	    static_cast<int>(img->height) != height)
+		throw std::runtime_error(mrpt::format("%s is %ux%u, the camera %dx%d",
+		                                      what, img->width, img->height,
+		                                      width, height));
+	const size_t bpp = static_cast<size_t>(
+	    sensor_msgs::image_encodings::numChannels(img->encoding) *
+	    sensor_msgs::image_encodings::bitDepth(img->encoding) / 8);
+	if (img->step < img->width * bpp ||
+	    img->data.size() < static_cast<size_t>(img->step) * img->height)
+		throw std::runtime_error(mrpt::format(
+		    "%s has %zu bytes of data for %u rows of step %u (%ux%u %s): "
+		    "corrupt",
+		    what, img->data.size(), img->height, img->step, img->width,
+		    img->height, img->encoding.c_str()));
+	if (img->is_bigendian && bpp > 1 && img->encoding != "rgb8" &&
+	    img->encoding != "bgr8")
+		throw std::runtime_error(std::string(what) +
+		                         " is big-endian: not supported");
+	return cv_bridge::toCvShare(img, target);
+}
+
+}  // namespace
+
+namespace
+{
+/** The topics on one line, for an error: "/a (type, N messages), ...". */
+std::string topicList(const std::vector<BagTopicInfo>& topics)
+{
+	std::string s;
+	for (const auto& t : topics)
+		s += (s.empty() ? "" : ", ") + t.name + " (" + t.type + ", " +
+		     std::to_string(t.messages) +
+		     (t.messages == 1 ? " message)" : " messages)");
+	return s.empty() ? "no topic" : s;
+}
+}  // namespace
+
+std::vector<BagTopicInfo> bagTopics(const std::vector<std::string>& bagPaths)
+{
+	return topicsOf(openBags(bagPaths));
+}
+
+std::string describeTopics(const std::vector<BagTopicInfo>& topics)
+{
+	std::string s;
+	for (const auto& t : topics)
+		s += mrpt::format("  %-45s %-28s %zu message%s\n", t.name.c_str(),
+		                  t.type.c_str(), t.messages,
+		                  t.messages == 1 ? "" : "s");
+	return s.empty() ? "  (no topics)\n" : s;
+}
+
+BagLayout detectLayout(const std::vector<BagTopicInfo>& topics,
+                       const std::string& bagNames)
+{
+	for (const auto l : {BagLayout::RealSense, BagLayout::Tum})
+		if (findTopic(topics, layoutTopics(l).depth)) return l;
+	throw std::runtime_error(
+	    bagNames + ": no depth topic of a known layout (realsense: " +
+	    layoutTopics(BagLayout::RealSense).depth +
+	    ", tum: " + layoutTopics(BagLayout::Tum).depth +
+	    "); name yours in [import_bag] depth_topic (-c). The bag has: " +
+	    topicList(topics));
+}
+
+std::vector<ImuSample> mergeAccelGyro(const std::vector<ImuSample>& accel,
+                                      const std::vector<ImuSample>& gyro,
+                                      size_t& leftOut)
+{
+	std::vector<ImuSample> out;
+	leftOut = 0;
+	size_t j = 0;
+	for (const auto& g : gyro)
+	{
+		while (j + 1 < accel.size() && accel[j + 1].t < g.t) j++;
+		if (accel.empty() || g.t < accel.front().t || g.t > accel.back().t)
+		{
+			leftOut++;
+			continue;
+		}
+		ImuSample s = g;
+		s.hasGyro = true;
+		s.hasAccel = true;
+		const auto& a0 = accel[j];
+		const auto& a1 = accel[std::min(j + 1, accel.size() - 1)];
+		const double f =
+		    a1.t > a0.t ? std::clamp((g.t - a0.t) / (a1.t - a0.t), 0.0, 1.0)
+		                : 0.0;
+		for (int k = 0; k < 3; k++) s.a[k] = lerp(a0.a[k], a1.a[k], f);
+		out.push_back(s);
+	}
+	return out;
+}
+
+void attachMagnetometer(std::vector<ImuSample>& imu,
+                        const std::vector<ImuSample>& mag)
+{
+	if (mag.empty()) return;
+	size_t j = 0;
+	for (auto& s : imu)
+	{
+		if (s.t < mag.front().t || s.t > mag.back().t) continue;
+		while (j + 1 < mag.size() && mag[j + 1].t < s.t) j++;
+		const auto& m0 = mag[j];
+		const auto& m1 = mag[std::min(j + 1, mag.size() - 1)];
+		const double f =
+		    m1.t > m0.t ? std::clamp((s.t - m0.t) / (m1.t - m0.t), 0.0, 1.0)
+		                : 0.0;
+		for (int k = 0; k < 3; k++) s.m[k] = lerp(m0.m[k], m1.m[k], f);
+		s.hasMag = true;
+	}
+}
+
+namespace
+{
+/** An image message found in the first pass: its stamp and where it is. */
+struct ImageRef
+{
+	double t = 0;
+	size_t n = 0;  ///< its index on its topic
+	rosbag::MessageInstance msg;
+};
+
+/** Everything the first pass reads: the images' stamps, the camera, the
+ * IMU streams. */
+struct Index
+{
+	std::vector<ImageRef> depth, colour;
+	boost::shared_ptr<sensor_msgs::CameraInfo> info;
+	size_t infoMessages = 0;
+	std::vector<ImuSample> imu, accel, gyro, mag;
+};
+
+void requireType(const std::vector<BagTopicInfo>& topics,
+                 const std::string& name, const std::string& type,
+                 const std::string& bagNames)
+{
+	const auto* t = findTopic(topics, name);
+	if (t && t->type != type)
+		throw std::runtime_error(bagNames + ": topic " + name + " is " +
+		                         t->type + ", expected " + type +
+		                         (t->type == "sensor_msgs/CompressedImage"
+		                              ? " (compressed images are not read "
+		                                "yet: record the raw topic)"
+		                              : ""));
+}
+
+/** The topics actually read: those of the layout the bag has, and every
+ * topic the .ini names explicitly (missing: an error). */
+BagTopics chooseTopics(const BagImportParams& params,
+                       const std::vector<BagTopicInfo>& topics,
+                       const std::string& bagNames, BagLayout& layout)
+{
+	layout = params.layout;
+	if (layout == BagLayout::Auto)
+		layout = params.topics.depth.empty() || params.topics.depth == "none"
+		             ? detectLayout(topics, bagNames)
+		             : BagLayout::Auto;
+	BagTopics t = resolveTopics(params.topics, layout);
+	auto missing = [&](const std::string& name, const char* what)
+	{
+		return std::runtime_error(
+		    bagNames + ": no " + what + " topic " + name +
+		    " (--layout, or [import_bag] of -c, names another). The bag "
+		    "has: " +
+		    topicList(topics));
+	};
+	if (t.depth.empty())
+		throw std::runtime_error(bagNames +
+		                         ": no depth topic ([import_bag] depth_topic)");
+	if (!findTopic(topics, t.depth)) throw missing(t.depth, "depth");
+	// a topic the .ini names must be there; a preset's may be absent
+	auto keep =
+	    [&](std::string& name, const std::string& given, const char* what)
+	{
+		if (name.empty() || findTopic(topics, name)) return;
+		if (!given.empty()) throw missing(name, what);
+		name.clear();
+	};
+	keep(t.colour, params.topics.colour, "colour");
+	keep(t.cameraInfo, params.topics.cameraInfo, "CameraInfo");
+	keep(t.imu, params.topics.imu, "IMU");
+	keep(t.accel, params.topics.accel, "accelerometer");
+	keep(t.gyro, params.topics.gyro, "gyro");
+	keep(t.mag, params.topics.mag, "magnetometer");
+	if (!t.imu.empty()) t.accel.clear(), t.gyro.clear();  // one IMU
+	if (t.cameraInfo.empty() && !params.camera)
+		throw std::runtime_error(
+		    bagNames +
+		    ": no CameraInfo topic for the intrinsics; name it in "
+		    "[import_bag] camera_info_topic or give [camera] fx fy cx cy "
+		    "width height (-c). The bag has: " +
+		    topicList(topics));
+	requireType(topics, t.depth, "sensor_msgs/Image", bagNames);
+	requireType(topics, t.colour, "sensor_msgs/Image", bagNames);
+	requireType(topics, t.cameraInfo, "sensor_msgs/CameraInfo", bagNames);
+	for (const auto* n : {&t.imu, &t.accel, &t.gyro})
+		requireType(topics, *n, "sensor_msgs/Imu", bagNames);
+	requireType(topics, t.mag, "sensor_msgs/MagneticField", bagNames);
+	return t;
+}
+
+/** The first pass: every message of the chosen topics in the bags' time
+ * order; the images' header stamps only. */
+Index readIndex(const Bags& bags, const BagTopics& t,
+                const std::string& bagNames, BagImportSummary& sum)
+{
+	std::vector<std::string> names;
+	for (const auto* n : {&t.depth, &t.colour, &t.cameraInfo, &t.imu, &t.accel,
+	                      &t.gyro, &t.mag})
+		if (!n->empty()) names.push_back(*n);
+	rosbag::View view;
+	for (const auto& b : bags) view.addQuery(*b, rosbag::TopicQuery(names));
+
+	Index ix;
+	std::map<std::string, size_t> count;
+	std::map<std::string, double> last;
+	auto stampBack = [&](const std::string& topic, double s)
+	{
+		auto it = last.find(topic);
+		if (it != last.end() && s <= it->second) return true;
+		last[topic] = s;
+		return false;
+	};
+	for (const rosbag::MessageInstance& m : view)
+	{
+		const std::string& topic = m.getTopic();
+		const size_t n = count[topic]++;
+		try
+		{
+			if (topic == t.depth || topic == t.colour)
+			{
+				const auto s = m.instantiate<StampOnly>();
+				const double ts = stampSeconds(s->sec, s->nsec);
+				if (stampBack(topic, ts))
+				{
+					sum.stampsBack++;
+					continue;
+				}
+				(topic == t.depth ? ix.depth : ix.colour).push_back({ts, n, m});
+			}
+			else if (topic == t.cameraInfo)
+			{
+				auto ci = m.instantiate<sensor_msgs::CameraInfo>();
+				if (!ix.info) ix.info = ci;
+				ix.infoMessages++;
+			}
+			else if (topic == t.mag)
+			{
+				const auto mf = m.instantiate<sensor_msgs::MagneticField>();
+				ImuSample s;
+				s.t = stampSeconds(mf->header.stamp.sec, mf->header.stamp.nsec);
+				if (stampBack(topic, s.t))
+				{
+					sum.imuStampsBack++;
+					continue;
+				}
+				s.hasMag = true;
+				// tesla to gauss (MRPT's IMU_MAG_* unit)
+				s.m[0] = mf->magnetic_field.x * 1e4;
+				s.m[1] = mf->magnetic_field.y * 1e4;
+				s.m[2] = mf->magnetic_field.z * 1e4;
+				ix.mag.push_back(s);
+			}
+			else
+			{
+				const auto im = m.instantiate<sensor_msgs::Imu>();
+				ImuSample s = imuSample(
+				    *im,
+				    stampSeconds(im->header.stamp.sec, im->header.stamp.nsec));
+				if (stampBack(topic, s.t))
+				{
+					sum.imuStampsBack++;
+					continue;
+				}
+				if (topic == t.imu) ix.imu.push_back(s);
+				if (topic == t.accel)
+				{
+					s.hasGyro = false;
+					ix.accel.push_back(s);
+				}
+				if (topic == t.gyro)
+				{
+					s.hasAccel = false;
+					ix.gyro.push_back(s);
+				}
+			}
+		}
+		catch (const std::exception& e)
+		{
+			throw std::runtime_error(bagNames + ": " + where(m, n) +
+			                         " cannot be read: " + e.what());
+		}
+	}
+	sum.depthMessages = ix.depth.size();
+	sum.colourMessages = ix.colour.size();
+	if (ix.depth.empty())
+		throw std::runtime_error(bagNames + ": topic " + t.depth +
+		                         " has no image with a stamp after the one "
+		                         "before it");
+	return ix;
+}
+
+struct Frame
+{
+	double t = 0;
+	const ImageRef* depth = nullptr;
+	const ImageRef* colour = nullptr;
+};
+
+std::vector<Frame> pairFrames(const Index& ix, const BagImportParams& params,
+                              const std::string& bagNames,
+                              BagImportSummary& sum)
+{
+	std::vector<Frame> frames;
+	if (ix.colour.empty())
+		for (const auto& d : ix.depth) frames.push_back({d.t, &d, nullptr});
+	else
+	{
+		std::vector<double> tc, td;
+		for (const auto& c : ix.colour) tc.push_back(c.t);
+		for (const auto& d : ix.depth) td.push_back(d.t);
+		// sorted already (stamps that go back were left out)
+		for (const auto& [i, j] :
+		     eval::associateGreedy(tc, td, params.maxTimeGap))
+		{
+			Frame f;
+			f.depth = &ix.depth[j];
+			f.colour = &ix.colour[i];
+			f.t = params.timestampFrom == eval::TimestampSource::Rgb
+			          ? f.colour->t
+			          : f.depth->t;
+			frames.push_back(f);
+		}
+		if (frames.empty())
+			throw std::runtime_error(
+			    bagNames + ": no depth and colour images within " +
+			    mrpt::format("%g", params.maxTimeGap) +
+			    " s of each other ([import_bag] max_time_gap_s)");
+		std::stable_sort(frames.begin(), frames.end(),
+		                 [](const Frame& a, const Frame& b)
+		                 { return a.t < b.t; });
+	}
+	sum.unpaired = ix.depth.size() - frames.size();
+	return frames;
+}
+
+mrpt::img::TCamera cameraOf(const Index& ix, const BagImportParams& params,
+                            const BagTopics& t, const std::string& bagNames,
+                            BagImportSummary& sum)
+{
+	if (params.camera)
+	{
+		sum.cameraFrom = params.cameraFrom;
+		return *params.camera;
+	}
+	if (!ix.info)
+		throw std::runtime_error(bagNames + ": topic " + t.cameraInfo +
+		                         " has no message");
+	const auto& ci = *ix.info;
+	const double fx = ci.K[0], fy = ci.K[4], cx = ci.K[2], cy = ci.K[5];
+	if (!(fx > 0 && fy > 0 && std::isfinite(fx) && std::isfinite(fy) &&
+	      std::isfinite(cx) && std::isfinite(cy)) ||
+	    ci.width == 0 || ci.height == 0)
+		throw std::runtime_error(mrpt::format(
+		    "%s: topic %s: CameraInfo K = [%g 0 %g; 0 %g %g] of a %ux%u "
+		    "image is not a camera",
+		    bagNames.c_str(), t.cameraInfo.c_str(), fx, cx, fy, cy, ci.width,
+		    ci.height));
+	mrpt::img::TCamera c;
+	c.ncols = ci.width;
+	c.nrows = ci.height;
+	c.setIntrinsicParamsFromValues(fx, fy, cx, cy);
+	c.distortion = mrpt::img::DistortionModel::none;
+	sum.cameraFrom = "CameraInfo " + t.cameraInfo;
+	for (const double k : ci.D) sum.distortionIgnored |= k != 0;
+	if (sum.distortionIgnored) sum.distortionModel = ci.distortion_model;
+	return c;
+}
+
+/** The IMU stream written: the Imu topic, or accel and gyro merged, with
+ * the magnetometer attached. */
+std::vector<ImuSample> imuStream(Index& ix, const BagTopics& t,
+                                 BagImportSummary& sum)
+{
+	std::vector<ImuSample> out;
+	if (!t.imu.empty())
+	{
+		out = std::move(ix.imu);
+		sum.imuSource = "topic " + t.imu;
+	}
+	else if (!t.accel.empty() && !t.gyro.empty())
+	{
+		out = mergeAccelGyro(ix.accel, ix.gyro, sum.imuLeftOut);
+		sum.imuSource = "topics " + t.accel + " and " + t.gyro +
+		                " merged at the gyro's stamps";
+	}
+	else if (!t.accel.empty() || !t.gyro.empty())
+	{
+		out = std::move(t.accel.empty() ? ix.gyro : ix.accel);
+		sum.imuSource = "topic " + (t.accel.empty() ? t.gyro : t.accel);
+	}
+	if (!t.mag.empty())
+	{
+		attachMagnetometer(out, ix.mag);
+		sum.imuSource += " with the magnetometer of " + t.mag;
+	}
+	return out;
+}
+
+}  // namespace
+
+BagImportSummary importBag(const std::vector<std::string>& bagPaths,
+                           const std::string& outRawlog,
+                           const BagImportParams& params,
+                           const BagImportOptions& options)
+{
+	if (bagPaths.empty()) throw std::runtime_error("no bag to import");
+	const Bags bags = openBags(bagPaths);
+	const std::string bagNames = joined(bagPaths);
+	const auto topics = topicsOf(bags);
+
+	BagImportSummary sum;
+	BagLayout layout = BagLayout::Auto;
+	const BagTopics t = chooseTopics(params, topics, bagNames, layout);
+	sum.topics = t;
+	sum.layout = layout;
+	Index ix = readIndex(bags, t, bagNames, sum);
+	std::vector<Frame> frames = pairFrames(ix, params, bagNames, sum);
+	if (options.maxFrames > 0 && frames.size() > options.maxFrames)
+		frames.resize(options.maxFrames);
+	const mrpt::img::TCamera cam = cameraOf(ix, params, t, bagNames, sum);
+	if (ix.info &&
+	    (ix.info->width != cam.ncols || ix.info->height != cam.nrows))
+		throw std::runtime_error(mrpt::format(
+		    "%s: topic %s: CameraInfo of a %ux%u image, but %s says %ux%u",
+		    bagNames.c_str(), t.cameraInfo.c_str(), ix.info->width,
+		    ix.info->height, sum.cameraFrom.c_str(), cam.ncols, cam.nrows));
+	sum.camera = cam;
+	sum.width = static_cast<int>(cam.ncols);
+	sum.height = static_cast<int>(cam.nrows);
+	const std::vector<ImuSample> imu = imuStream(ix, t, sum);
+
+	// frames and IMU samples in time order, IMU first at equal stamps; the
+	// IMU within the frames' span (as bims-import-tum)
+	const double t0 = frames.front().t, t1 = frames.back().t;
+	struct Item
+	{
+		double t;
+		int kind;  // 0 IMU, 1 frame
+		size_t i;
+	};
+	std::vector<Item> items;
+	for (size_t i = 0; i < imu.size(); i++)
+		if (imu[i].t >= t0 && imu[i].t <= t1)
+			items.push_back({imu[i].t, 0, i});
+		else
+			sum.imuOutside++;
+	for (size_t i = 0; i < frames.size(); i++)
+		items.push_back({frames[i].t, 1, i});
+	std::stable_sort(items.begin(), items.end(),
+	                 [](const Item& a, const Item& b)
+	                 { return a.t < b.t || (a.t == b.t && a.kind < b.kind); });
+
+	static const std::set<std::string> depthEncodings = {"16UC1", "32FC1",
+	                                                     "mono16"};
+	static const std::set<std::string> colourEncodings = {"rgb8", "bgr8",
+	                                                      "mono8"};
+	const int W = sum.width, H = sum.height;
+	PartialFile part(outRawlog);
+	RawlogWriter w(part.path(), options.gzLevel);
+	ProgressBar bar("import", frames.size(), options.progress);
+	for (const auto& it : items)
+	{
+		if (it.kind == 0)
+		{
+			const auto& s = imu[it.i];
+			const bool accelOnly = !s.hasGyro;
+			w.write(*eval::imuObservation(
+			    accelOnly ? params.accelLabel : params.imuLabel, s.t,
+			    s.hasGyro ? s.w : nullptr, s.hasAccel ? s.a : nullptr,
+			    s.hasMag ? s.m : nullptr));
+			sum.imu++;
+			sum.accelOnly += accelOnly;
+			sum.imuHasGyro |= s.hasGyro;
+			sum.imuHasAccel |= s.hasAccel;
+			sum.imuHasMag |= s.hasMag;
+			continue;
+		}
+		const Frame& f = frames[it.i];
+		const ImageRef* current = f.depth;
+		try
+		{
+			const auto d = f.depth->msg.instantiate<sensor_msgs::Image>();
+			if (!d) throw std::runtime_error("not a sensor_msgs/Image");
+			const auto dcv =
+			    checkedImage(d, depthEncodings, "the depth image", W, H, "");
+			sum.depthEncoding = d->encoding;
+			// REP 118: 16UC1 millimetres, 32FC1 metres
+			auto o = eval::depthObservation(
+			    dcv->image, dcv->image.type() == CV_32FC1 ? 1.0 : 0.001, cam,
+			    params.rgbdLabel, f.t, params.rangeUnits);
+			if (f.colour)
+			{
+				current = f.colour;
+				const auto c = f.colour->msg.instantiate<sensor_msgs::Image>();
+				if (!c) throw std::runtime_error("not a sensor_msgs/Image");
+				sum.colourEncoding = c->encoding;
+				eval::attachColour(
+				    *o, checkedImage(c, colourEncodings, "the colour image", W,
+				                     H, "bgr8")
+				            ->image);
+			}
+			w.write(*o);
+		}
+		catch (const std::exception& e)
+		{
+			const std::string what =
+			    bagNames + ": " + where(current->msg, current->n, current->t) +
+			    ": " + e.what();
+			if (sum.frames == 0) throw std::runtime_error(what);
+			// the whole frames before it are kept
+			w.close();
+			part.commit();
+			throw std::runtime_error(
+			    what +
+			    mrpt::format("; the %zu whole frames before it are in ",
+			                 sum.frames) +
+			    outRawlog);
+		}
+		bar.update(++sum.frames);
+	}
+	w.close();
+	part.commit();
+	bar.finish();
+	return sum;
+}
+
+}  // namespace bims::bag

@@ -1,0 +1,130 @@
+#include <bims/bag/bag_import.h>
+#include <bims/common/config.h>
+#include <bims/common/experiment.h>
+#include <bims/eval/rgbd_frame.h>
+
+namespace bims::bag
+{
+BagTopics layoutTopics(BagLayout layout)
+{
+	BagTopics t;
+	switch (layout)
+	{
+		case BagLayout::RealSense:
+			// realsense-ros (ROS 1) with align_depth:=true; its IMU comes
+			// as one topic (unite_imu_method) or as two at their own rates
+			t.depth = "/camera/aligned_depth_to_color/image_raw";
+			t.colour = "/camera/color/image_raw";
+			t.cameraInfo = "/camera/color/camera_info";
+			t.imu = "/camera/imu";
+			t.accel = "/camera/accel/sample";
+			t.gyro = "/camera/gyro/sample";
+			break;
+		case BagLayout::Tum:
+			// the TUM RGB-D benchmark's bags: depth registered to colour,
+			// in metres; the Kinect's accelerometer
+			t.depth = "/camera/depth/image";
+			t.colour = "/camera/rgb/image_color";
+			t.cameraInfo = "/camera/rgb/camera_info";
+			t.imu = "/imu";
+			break;
+		case BagLayout::Auto:
+			break;
+	}
+	return t;
+}
+
+BagTopics resolveTopics(const BagTopics& given, BagLayout layout)
+{
+	BagTopics t = layoutTopics(layout);
+	auto pick = [](std::string& preset, const std::string& g)
+	{
+		if (g == "none")
+			preset.clear();
+		else if (!g.empty())
+			preset = g;
+	};
+	pick(t.depth, given.depth);
+	pick(t.colour, given.colour);
+	pick(t.cameraInfo, given.cameraInfo);
+	pick(t.imu, given.imu);
+	pick(t.accel, given.accel);
+	pick(t.gyro, given.gyro);
+	pick(t.mag, given.mag);
+	return t;
+}
+
+void BagImportParams::describe(OptionVisitor& v)
+{
+	v.choice("layout", layout,
+	         "whose preset topics: realsense (realsense-ros, aligned "
+	         "depth), tum (TUM RGB-D's bags), auto (the first whose depth "
+	         "topic the bag has); --layout overrides");
+	// each topic key: empty takes the layout's topic, "none" reads none
+	v.text("depth_topic", topics.depth,
+	       "depth image topic, 16UC1 mm or 32FC1 m (empty: the layout's; "
+	       "none: not read)");
+	v.text("colour_topic", topics.colour,
+	       "colour image topic, rgb8 bgr8 mono8 (empty: the layout's)");
+	v.text("camera_info_topic", topics.cameraInfo,
+	       "CameraInfo topic of the registered depth image (empty: the "
+	       "layout's)");
+	v.text("imu_topic", topics.imu,
+	       "sensor_msgs/Imu topic (empty: the layout's; none: not read)");
+	v.text("accel_topic", topics.accel,
+	       "accelerometer-only Imu topic, merged with gyro_topic (empty: "
+	       "the layout's)");
+	v.text("gyro_topic", topics.gyro,
+	       "gyro-only Imu topic; the merged IMU has its rate (empty: the "
+	       "layout's)");
+	v.text("mag_topic", topics.mag,
+	       "sensor_msgs/MagneticField topic (empty: the layout's)");
+	v.real("max_time_gap_s", maxTimeGap, 0.0, 10.0,
+	       "max |t_colour - t_depth| to pair a depth and a colour image [s]");
+	v.choice("timestamp", timestampFrom,
+	         "which image's stamp a frame takes (the geometry's: depth)");
+	v.real("range_units", rangeUnits, 1e-6, 0.1,
+	       "metres per unit of the rawlog's uint16 range image");
+	v.text("accel_label", accelLabel,
+	       "sensor label of IMU samples without a gyro (an accelerometer: "
+	       "TUM's /imu)");
+}
+
+void BagImportParams::loadFromConfigFile(
+    const mrpt::config::CConfigFileBase& cfg)
+{
+	checkExperimentSections(cfg);
+	readOptions(*this, cfg, "import_bag");
+	{
+		ConfigSection s(cfg, "import_bag");
+		if (accelLabel.empty()) s.fail("accel_label", "must not be empty");
+		if (accelLabel.find("SYNTH") != std::string::npos)
+			s.fail("accel_label",
+			       "'" + accelLabel +
+			           "': a bag's accelerometer is a real sensor; a label "
+			           "with SYNTH is the synthetic IMU's");
+	}
+	ConfigSection cam(cfg, "camera");
+	bool any = false;
+	for (const char* k : {"fx", "fy", "cx", "cy", "width", "height"})
+		any = any || cam.has(k);
+	if (cam.has("depth_scale"))
+		cam.fail("depth_scale",
+		         "does not apply to a bag: its depth encoding says the "
+		         "unit (16UC1 millimetres, 32FC1 metres; ROS REP 118)");
+	if (any)
+	{
+		eval::CameraIntrinsics c;
+		c.loadFromConfigFile(cfg, "camera");
+		camera = c.asTCamera();
+		cameraFrom = "[camera] of " + cam.file();
+	}
+	else
+	{
+		cam.allow("max_range");
+		cam.finish();
+	}
+	eval::loadImportLabels(cfg, rgbdLabel, imuLabel);
+}
+
+}  // namespace bims::bag

@@ -1,0 +1,130 @@
+#include <bims/bag/bag_import_run.h>
+#include <bims/common/app.h>
+#include <bims/common/config.h>
+#include <bims/common/output_paths.h>
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/core/format.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+namespace bims::bag
+{
+namespace
+{
+std::string channels(const BagImportSummary& s)
+{
+	std::string c;
+	if (s.imuHasGyro) c += "gyro";
+	if (s.imuHasAccel) c += std::string(c.empty() ? "" : ", ") + "accel";
+	if (s.imuHasMag) c += std::string(c.empty() ? "" : ", ") + "mag";
+	return c.empty() ? "nothing" : c;
+}
+}  // namespace
+
+std::string bagImportReport(const std::string& out, const BagImportSummary& sum,
+                            const BagImportParams& params)
+{
+	std::string r = mrpt::format(
+	    "%s: %zu RGB-D frames of %dx%d (depth %s from %s, %s)\n", out.c_str(),
+	    sum.frames, sum.width, sum.height, sum.depthEncoding.c_str(),
+	    sum.topics.depth.c_str(),
+	    sum.topics.colour.empty()
+	        ? "no colour"
+	        : ("colour " + sum.colourEncoding + " from " + sum.topics.colour)
+	              .c_str());
+	if (sum.layout != BagLayout::Auto)
+		r += "layout: " + std::string(choices(sum.layout).name(sum.layout)) +
+		     "\n";
+	r += mrpt::format("intrinsics from %s: fx %.4f fy %.4f cx %.4f cy %.4f\n",
+	                  sum.cameraFrom.c_str(), sum.camera.fx(), sum.camera.fy(),
+	                  sum.camera.cx(), sum.camera.cy());
+	if (sum.distortionIgnored)
+		r += "the CameraInfo's " + sum.distortionModel +
+		     " distortion is not modelled: the images are used as they are "
+		     "(a pinhole camera)\n";
+	if (sum.unpaired > 0)
+		r += mrpt::format(
+		    "%zu of %zu depth images had no colour image within %g s "
+		    "([import_bag] max_time_gap_s): left out\n",
+		    sum.unpaired, sum.depthMessages, params.maxTimeGap);
+	if (sum.stampsBack > 0)
+		r += mrpt::format(
+		    "%zu images had a stamp not after the one before on their "
+		    "topic: left out\n",
+		    sum.stampsBack);
+	if (sum.imuSource.empty())
+		r += "no IMU topic\n";
+	else
+	{
+		r += mrpt::format("%zu IMU samples (%s) from %s", sum.imu,
+		                  channels(sum).c_str(), sum.imuSource.c_str());
+		if (sum.accelOnly == sum.imu && sum.imu > 0)
+			r += ", labelled " + params.accelLabel + " (no gyro)";
+		else if (sum.accelOnly > 0)
+			r += mrpt::format(", labelled %s (%zu without gyro: %s)",
+			                  params.imuLabel.c_str(), sum.accelOnly,
+			                  params.accelLabel.c_str());
+		else
+			r += ", labelled " + params.imuLabel;
+		r += "\n";
+		if (sum.imuOutside > 0)
+			r += mrpt::format(
+			    "%zu IMU samples outside the frames' time span: left out\n",
+			    sum.imuOutside);
+		if (sum.imuLeftOut > 0)
+			r += mrpt::format(
+			    "%zu gyro samples outside the accelerometer's time span: "
+			    "left out\n",
+			    sum.imuLeftOut);
+		if (sum.imuStampsBack > 0)
+			r += mrpt::format(
+			    "%zu IMU samples had a stamp not after the one before: left "
+			    "out\n",
+			    sum.imuStampsBack);
+	}
+	return r;
+}
+
+int runBagImport(const BagImportRunOptions& o)
+{
+	if (o.bags.empty()) throw UsageError("no bag given");
+	if (o.gz < 0 || o.gz > 9) throw UsageError("--gz must be in 0..9");
+	std::vector<std::string> inputs = o.bags;
+	inputs.push_back(o.config.value_or(""));
+	if (o.listTopics)
+	{
+		std::fputs(describeTopics(bagTopics(o.bags)).c_str(), stdout);
+		return 0;
+	}
+	if (o.out.empty()) throw UsageError("-o OUT.rawlog is required");
+	checkOutputsSpareInputs(inputs, {o.out});
+
+	BagImportParams params;
+	if (o.config)
+	{
+		if (!std::filesystem::exists(*o.config))
+			throw std::runtime_error(*o.config + ": config file not found");
+		const auto cfg = openIniFile(*o.config);
+		params.loadFromConfigFile(*cfg);
+	}
+	if (o.layout)
+	{
+		const auto c = choices(BagLayout::Auto);
+		const auto l = c.find(*o.layout);
+		if (!l)
+			throw UsageError("--layout " + *o.layout +
+			                 ": one of auto, realsense, tum");
+		params.layout = *l;
+	}
+	BagImportOptions opt;
+	opt.maxFrames = o.max_frames;
+	opt.gzLevel = o.gz;
+	opt.progress = o.progress;
+	const auto sum = importBag(o.bags, o.out, params, opt);
+	std::fputs(bagImportReport(o.out, sum, params).c_str(), stdout);
+	return 0;
+}
+
+}  // namespace bims::bag

@@ -1,0 +1,619 @@
+// bims-import-bag against bags the tests write themselves with the rosbag
+// API, from the bundled sample's simulated frames and IMU: every pixel,
+// stamp and axis checked against the sample; the accelerometer and gyro of
+// RealSense's two topics merged; a TUM-layout bag equal, byte for byte, to
+// the TUM folder of the same frames; and the bad bags users meet.
+#include <bims/bag/bag_import.h>
+#include <bims/bag/bag_import_run.h>
+#include <bims/common/config.h>
+#include <bims/common/rawlog.h>
+#include <bims/ego/attitude_filter.h>
+#include <bims/eval/tum_import.h>
+#include <bims_test/bag_writer.h>
+#include <bims_test/run_command.h>
+#include <bims_test/sample.h>
+#include <bims_test/text.h>
+#include <bims_test/tmp_dir.h>
+#include <gtest/gtest.h>
+#include <mrpt/core/format.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationIMU.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace
+{
+namespace fs = std::filesystem;
+using namespace bims;
+using namespace bims::test;
+using mrpt::obs::CObservation3DRangeScan;
+using mrpt::obs::CObservationIMU;
+
+const std::string kImport = std::string(BIMS_BIN_DIR) + "/bims-import-bag";
+const std::string kRun = std::string(BIMS_BIN_DIR) + "/bims-run";
+
+/** The first frames of the bundled sample and the IMU samples between. */
+struct Sample
+{
+	std::vector<CObservation3DRangeScan::Ptr> frames;
+	std::vector<CObservationIMU::Ptr> imu;
+};
+
+const Sample& sample()
+{
+	static const Sample s = []
+	{
+		Sample r;
+		RawlogReader in(test::kSample);
+		while (auto o = in.next())
+		{
+			if (auto f = std::dynamic_pointer_cast<CObservation3DRangeScan>(o))
+			{
+				f->load();
+				r.frames.push_back(f);
+				if (r.frames.size() == 24) break;
+			}
+			else if (auto m = std::dynamic_pointer_cast<CObservationIMU>(o))
+				r.imu.push_back(m);
+		}
+		return r;
+	}();
+	return s;
+}
+
+struct Imported
+{
+	std::vector<CObservation3DRangeScan::Ptr> frames;
+	std::vector<CObservationIMU::Ptr> imu;
+};
+
+Imported readRawlog(const std::string& path)
+{
+	Imported r;
+	RawlogReader in(path);
+	while (auto o = in.next())
+	{
+		if (auto f = std::dynamic_pointer_cast<CObservation3DRangeScan>(o))
+			r.frames.push_back(f);
+		else if (auto m = std::dynamic_pointer_cast<CObservationIMU>(o))
+			r.imu.push_back(m);
+	}
+	return r;
+}
+
+bag::BagImportSummary import(const std::string& bagPath, const std::string& out,
+                             bag::BagImportParams p = {})
+{
+	bag::BagImportOptions o;
+	o.progress = false;
+	o.gzLevel = 0;
+	return bag::importBag({bagPath}, out, p, o);
+}
+
+std::string errorOf(const std::function<void()>& f)
+{
+	try
+	{
+		f();
+	}
+	catch (const std::exception& e)
+	{
+		return e.what();
+	}
+	return "(no error)";
+}
+
+/** Every frame of \a got equals the sample's: range image, colour, stamp
+ * (to the microsecond of the bag), camera. */
+void expectTheSampleFrames(const Imported& got, size_t n)
+{
+	const auto& s = sample();
+	ASSERT_EQ(got.frames.size(), n);
+	for (size_t k = 0; k < n; k++)
+	{
+		const auto& a = *got.frames[k];
+		const auto& b = *s.frames[k];
+		EXPECT_NEAR(secondsOf(a.timestamp), secondsOf(b.timestamp), 1.1e-6);
+		EXPECT_EQ(a.sensorLabel, "RGBD");
+		EXPECT_TRUE(a.range_is_depth);
+		ASSERT_EQ(a.rangeImage.rows(), b.rangeImage.rows());
+		ASSERT_EQ(a.rangeImage.cols(), b.rangeImage.cols());
+		EXPECT_FLOAT_EQ(a.rangeUnits, 0.001f);
+		EXPECT_TRUE((a.rangeImage.array() == b.rangeImage.array()).all())
+		    << "frame " << k;
+		EXPECT_DOUBLE_EQ(a.cameraParams.fx(), b.cameraParams.fx());
+		EXPECT_DOUBLE_EQ(a.cameraParams.cy(), b.cameraParams.cy());
+		ASSERT_TRUE(a.hasIntensityImage);
+		cv::Mat d;
+		cv::absdiff(bgrOf(a), bgrOf(b), d);
+		EXPECT_EQ(cv::countNonZero(d.reshape(1)), 0) << "frame " << k;
+	}
+}
+
+TEST(ImportBag, RealSenseLayoutKeepsEveryPixelStampAndAxis)
+{
+	for (const auto c : {rosbag::compression::Uncompressed,
+	                     rosbag::compression::LZ4, rosbag::compression::BZ2})
+	{
+		SCOPED_TRACE(static_cast<int>(c));
+		const auto d = test::freshTmpDir("bims_bag", "realsense");
+		BagSpec spec;
+		spec.compression = c;
+		spec.colour = c == rosbag::compression::LZ4 ? "bgr8" : "rgb8";
+		writeBag(d + "/rs.bag", spec, sample().frames, sample().imu);
+		const auto sum = import(d + "/rs.bag", d + "/rs.rawlog");
+		EXPECT_EQ(sum.layout, bag::BagLayout::RealSense);
+		EXPECT_EQ(sum.frames, 24u);
+		const auto got = readRawlog(d + "/rs.rawlog");
+		expectTheSampleFrames(got, 24);
+		// the IMU within the frames' span, every axis as recorded
+		const auto& s = sample();
+		const double t0 = secondsOf(s.frames.front()->timestamp);
+		std::vector<CObservationIMU::Ptr> want;
+		for (const auto& m : s.imu)
+			if (secondsOf(m->timestamp) >= t0 - 1e-6) want.push_back(m);
+		ASSERT_EQ(got.imu.size(), want.size());
+		EXPECT_EQ(sum.imuOutside, s.imu.size() - want.size());
+		using namespace mrpt::obs;
+		for (size_t i = 0; i < want.size(); i++)
+		{
+			EXPECT_EQ(got.imu[i]->sensorLabel, "IMU");
+			EXPECT_NEAR(secondsOf(got.imu[i]->timestamp),
+			            secondsOf(want[i]->timestamp), 1.1e-6);
+			for (auto k :
+			     {IMU_WX, IMU_WY, IMU_WZ, IMU_X_ACC, IMU_Y_ACC, IMU_Z_ACC})
+				EXPECT_EQ(got.imu[i]->get(k), want[i]->get(k)) << i;
+			EXPECT_FALSE(got.imu[i]->has(IMU_MAG_X));
+		}
+	}
+}
+
+/** R_WI of the attitude filter fed \a imu (label IMU), at \a stamps. */
+std::vector<Eigen::Quaterniond> attitudes(
+    const std::vector<CObservationIMU::Ptr>& imu,
+    const std::vector<double>& stamps)
+{
+	ego::AttitudeFilter f;
+	std::vector<Eigen::Quaterniond> out;
+	size_t i = 0;
+	for (double t : stamps)
+	{
+		for (; i < imu.size() && secondsOf(imu[i]->timestamp) <= t; i++)
+			f.add(ego::imuSampleFrom(*imu[i]));
+		const auto q = f.attitudeAt(t);
+		out.push_back(q ? *q : Eigen::Quaterniond(0, 0, 0, 0));
+	}
+	return out;
+}
+
+TEST(ImportBag, SeparateAccelAndGyroAreMergedIntoWholeSamplesAtTheGyroRate)
+{
+	const auto d = test::freshTmpDir("bims_bag", "split");
+	BagSpec spec;
+	spec.splitImu = true;
+	spec.mag = true;
+	spec.compression = rosbag::compression::LZ4;
+	writeBag(d + "/split.bag", spec, sample().frames, sample().imu);
+	bag::BagImportParams p;
+	p.topics.mag = "/imu/mag";
+	const auto sum = import(d + "/split.bag", d + "/split.rawlog", p);
+	const auto got = readRawlog(d + "/split.rawlog");
+	expectTheSampleFrames(got, 24);
+	EXPECT_NE(sum.imuSource.find("merged"), std::string::npos);
+	EXPECT_TRUE(sum.imuHasGyro && sum.imuHasAccel && sum.imuHasMag);
+
+	// the gyro's stamps, each sample whole; the IMU written directly
+	const auto& s = sample();
+	const double t0 = secondsOf(s.frames.front()->timestamp),
+	             t1 = secondsOf(s.frames[23]->timestamp);
+	std::vector<CObservationIMU::Ptr> direct;
+	for (const auto& m : s.imu)
+		if (secondsOf(m->timestamp) >= t0 - 1e-6 &&
+		    secondsOf(m->timestamp) <= t1 + 1e-6)
+			direct.push_back(m);
+	using namespace mrpt::obs;
+	ASSERT_GE(got.imu.size() + 1, direct.size());  // the last may lack accel
+	ASSERT_LE(got.imu.size(), direct.size());
+	for (size_t i = 0; i < got.imu.size(); i++)
+	{
+		const auto& g = *got.imu[i];
+		EXPECT_NEAR(secondsOf(g.timestamp), secondsOf(direct[i]->timestamp),
+		            1.1e-6);
+		for (auto k : {IMU_WX, IMU_WY, IMU_WZ})
+			EXPECT_EQ(g.get(k), direct[i]->get(k));
+		for (auto k : {IMU_X_ACC, IMU_Y_ACC, IMU_Z_ACC, IMU_MAG_X})
+			EXPECT_TRUE(g.has(k));
+		EXPECT_NEAR(g.get(IMU_MAG_X), direct[i]->get(IMU_MAG_X), 1e-9);
+	}
+	// the attitude filter on the merged samples, against the same on the
+	// IMU written directly: within 0.1 degrees at every frame
+	std::vector<double> stamps;
+	for (size_t k = 1; k < 23; k++)
+		stamps.push_back(secondsOf(s.frames[k]->timestamp));
+	const auto a = attitudes(got.imu, stamps), b = attitudes(direct, stamps);
+	double worst = 0;
+	for (size_t k = 0; k < stamps.size(); k++)
+		worst = std::max(worst, a[k].angularDistance(b[k]) * 180 / M_PI);
+	EXPECT_LT(worst, 0.1);
+	EXPECT_GT(a.back().norm(), 0.5);  // the filter ran
+}
+
+TEST(ImportBag, MergingInterpolatesTheAccelerometerAndCountsWhatItLeavesOut)
+{
+	std::vector<bag::ImuSample> accel(3), gyro(5);
+	for (int i = 0; i < 3; i++)
+	{
+		accel[i].t = 1.0 + 0.02 * i;
+		accel[i].a[0] = 10.0 * i;
+	}
+	for (int i = 0; i < 5; i++) gyro[i].t = 0.995 + 0.01 * i;
+	size_t leftOut = 0;
+	const auto m = bag::mergeAccelGyro(accel, gyro, leftOut);
+	// 0.995 is before the accelerometer
+	ASSERT_EQ(m.size(), 4u);
+	EXPECT_EQ(leftOut, 1u);
+	EXPECT_NEAR(m[0].a[0], 2.5, 1e-9);   // at 1.005
+	EXPECT_NEAR(m[1].a[0], 7.5, 1e-9);   // at 1.015
+	EXPECT_NEAR(m[2].a[0], 12.5, 1e-9);  // at 1.025
+	EXPECT_NEAR(m[3].a[0], 17.5, 1e-9);  // at 1.035
+	gyro.push_back(gyro.back());
+	gyro.back().t = 1.045;  // after it
+	bag::mergeAccelGyro(accel, gyro, leftOut);
+	EXPECT_EQ(leftOut, 2u);
+	EXPECT_TRUE(m[0].hasGyro && m[0].hasAccel);
+}
+
+TEST(ImportBag, StampsAreTheDecimalsOfTheirSecondsAndNanoseconds)
+{
+	EXPECT_EQ(bag::stampSeconds(1305031102, 175304000),
+	          std::strtod("1305031102.175304", nullptr));
+	EXPECT_EQ(bag::stampSeconds(0, 1), 1e-9);
+	EXPECT_EQ(bag::stampSeconds(12, 0), 12.0);
+}
+
+/** The sample as a TUM RGB-D folder: rgb.txt, depth.txt (PNGs, 5000 per
+ * metre), accelerometer.txt; stamps with 6 decimals. */
+void writeTumFolder(const std::string& dir, size_t n)
+{
+	fs::create_directories(dir + "/rgb");
+	fs::create_directories(dir + "/depth");
+	std::ofstream rgb(dir + "/rgb.txt"), depth(dir + "/depth.txt"),
+	    acc(dir + "/accelerometer.txt");
+	rgb << "# colour images\n# file\n# timestamp filename\n";
+	depth << "# depth maps\n# file\n# timestamp filename\n";
+	acc << "# accelerometer data\n# file\n# timestamp ax ay az\n";
+	const auto& s = sample();
+	char t[64];
+	size_t i = 0;
+	for (size_t k = 0; k < n; k++)
+	{
+		const auto& f = *s.frames[k];
+		const double tf = secondsOf(f.timestamp);
+		for (; i < s.imu.size() && secondsOf(s.imu[i]->timestamp) <= tf; i++)
+		{
+			using namespace mrpt::obs;
+			const auto& o = *s.imu[i];
+			const ros::Time ti = rosTime(secondsOf(o.timestamp));
+			// every digit: the file's values are the bag's
+			acc << mrpt::format("%u.%06u %.17g %.17g %.17g\n", ti.sec,
+			                    ti.nsec / 1000, o.get(IMU_X_ACC),
+			                    o.get(IMU_Y_ACC), o.get(IMU_Z_ACC));
+		}
+		const ros::Time rt = rosTime(tf);
+		std::snprintf(t, sizeof(t), "%u.%06u", rt.sec, rt.nsec / 1000);
+		cv::Mat png(f.rangeImage.rows(), f.rangeImage.cols(), CV_16UC1);
+		for (int v = 0; v < png.rows; v++)
+			for (int u = 0; u < png.cols; u++)
+				png.at<uint16_t>(v, u) = tumUnits(f, v, u);
+		cv::imwrite(dir + "/depth/" + t + ".png", png);
+		cv::imwrite(dir + "/rgb/" + t + ".png", bgrOf(f));
+		rgb << t << " rgb/" << t << ".png\n";
+		depth << t << " depth/" << t << ".png\n";
+	}
+}
+
+/** Where two rawlogs first differ: the observation and what in it. */
+std::string firstDifference(const std::string& a, const std::string& b)
+{
+	RawlogReader ra(a), rb(b);
+	for (size_t i = 0;; i++)
+	{
+		const auto oa = ra.next(), ob = rb.next();
+		if (!oa || !ob) return oa || ob ? "one ends first" : "none found";
+		std::string what;
+		if (oa->GetRuntimeClass() != ob->GetRuntimeClass())
+			what = "class";
+		else if (oa->sensorLabel != ob->sensorLabel)
+			what = "label";
+		else if (oa->timestamp != ob->timestamp)
+			what = mrpt::format("stamp %.9f vs %.9f", secondsOf(oa->timestamp),
+			                    secondsOf(ob->timestamp));
+		auto ia = std::dynamic_pointer_cast<CObservationIMU>(oa),
+		     ib = std::dynamic_pointer_cast<CObservationIMU>(ob);
+		if (what.empty() && ia && ib &&
+		    ia->rawMeasurements != ib->rawMeasurements)
+			what = "IMU values";
+		auto fa = std::dynamic_pointer_cast<CObservation3DRangeScan>(oa),
+		     fb = std::dynamic_pointer_cast<CObservation3DRangeScan>(ob);
+		if (what.empty() && fa && fb)
+		{
+			if (!(fa->rangeImage.array() == fb->rangeImage.array()).all())
+				what = "range image";
+			else if (fa->cameraParams.intrinsicParams !=
+			         fb->cameraParams.intrinsicParams)
+				what = "camera";
+		}
+		if (!what.empty())
+			return "observation " + std::to_string(i) + " (" + oa->sensorLabel +
+			       "): " + what;
+	}
+}
+
+TEST(ImportBag, ATumLayoutBagGivesTheRawlogOfTheTumFolderOfTheSameFrames)
+{
+	const auto d = test::freshTmpDir("bims_bag", "tum");
+	BagSpec spec;
+	spec.tum = true;
+	spec.compression = rosbag::compression::BZ2;
+	spec.frames = 12;
+	writeBag(d + "/tum.bag", spec, sample().frames, sample().imu);
+	writeTumFolder(d + "/folder", 12);
+	const auto& f0 = *sample().frames[0];
+	eval::ImportParams tp;
+	tp.camera.fx = f0.cameraParams.fx();
+	tp.camera.fy = f0.cameraParams.fy();
+	tp.camera.cx = f0.cameraParams.cx();
+	tp.camera.cy = f0.cameraParams.cy();
+	tp.camera.width = static_cast<int>(f0.cameraParams.ncols);
+	tp.camera.height = static_cast<int>(f0.cameraParams.nrows);
+	eval::ImportOptions to;
+	to.progress = false;
+	to.gzLevel = 0;
+	eval::importTum(d + "/folder", d + "/folder.rawlog", tp, to);
+
+	bag::BagImportParams bp;
+	bp.layout = bag::BagLayout::Tum;
+	const auto sum = import(d + "/tum.bag", d + "/bag.rawlog", bp);
+	EXPECT_EQ(sum.frames, 12u);
+	EXPECT_EQ(sum.depthEncoding, "32FC1");
+	EXPECT_GT(sum.accelOnly, 0u);
+	EXPECT_EQ(sum.accelOnly, sum.imu);
+	const std::string a = test::fileText(d + "/folder.rawlog"),
+	                  b = test::fileText(d + "/bag.rawlog");
+	ASSERT_GT(a.size(), 1000000u);
+	EXPECT_TRUE(a == b) << a.size() << " vs " << b.size() << " bytes; "
+	                    << firstDifference(d + "/folder.rawlog",
+	                                       d + "/bag.rawlog");
+	const auto got = readRawlog(d + "/bag.rawlog");
+	ASSERT_FALSE(got.imu.empty());
+	EXPECT_EQ(got.imu[0]->sensorLabel, "ACCEL");
+	EXPECT_FALSE(got.imu[0]->has(mrpt::obs::IMU_WX));
+}
+
+TEST(ImportBag, TheProgramImportsBothPresetsAndBimsRunsTheResult)
+{
+	const auto d = test::freshTmpDir("bims_bag", "app");
+	BagSpec rs;
+	rs.frames = 12;
+	writeBag(d + "/rs.bag", rs, sample().frames, sample().imu);
+	auto r = test::runCommand("'" + kImport + "' '" + d + "/rs.bag' --topics");
+	EXPECT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("/camera/aligned_depth_to_color/image_raw"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("sensor_msgs/Imu"), std::string::npos) << r.out;
+
+	r = test::runCommand("'" + kImport + "' '" + d + "/rs.bag' -o '" + d +
+	                     "/rs.rawlog' -q");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("12 RGB-D frames of 320x240"), std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("IMU samples (gyro, accel) from topic /camera/imu"),
+	          std::string::npos)
+	    << r.out;
+	r = test::runCommand("'" + kRun + "' '" + test::kDefaultConfig + "' '" + d +
+	                     "/rs.rawlog' -o '" + d + "/run' -q");
+	EXPECT_EQ(r.code, 0) << r.out;
+	EXPECT_TRUE(fs::exists(d + "/run/masks/000011.png")) << r.out;
+
+	BagSpec tum;
+	tum.tum = true;
+	tum.frames = 12;
+	writeBag(d + "/tum.bag", tum, sample().frames, sample().imu);
+	r = test::runCommand("'" + kImport + "' '" + d + "/tum.bag' -o '" + d +
+	                     "/tum.rawlog' -q --layout tum");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("labelled ACCEL (no gyro)"), std::string::npos)
+	    << r.out;
+	r = test::runCommand("'" + kRun + "' '" + test::kDefaultConfig + "' '" + d +
+	                     "/tum.rawlog' -o '" + d + "/runtum' -q");
+	EXPECT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("ACCEL"), std::string::npos) << r.out;
+}
+
+TEST(ImportBag, ConfigKeysAreStrictAndThePresetSetsTheLayout)
+{
+	bag::BagImportParams p;
+	p.loadFromConfigFile(
+	    *openIniFile(test::kSourceDir + "/config/realsense.ini"));
+	EXPECT_EQ(p.layout, bag::BagLayout::RealSense);
+	EXPECT_FALSE(p.camera);  // the bag's CameraInfo
+	const auto t = bag::resolveTopics(p.topics, p.layout);
+	EXPECT_EQ(t.gyro, "/camera/gyro/sample");
+
+	const auto d = test::freshTmpDir("bims_bag", "ini");
+	bag::BagImportParams last;  // of the last file read
+	auto errorFor = [&](const std::string& text)
+	{
+		{
+			std::ofstream(d + "/x.ini") << text;
+		}
+		last = {};
+		return errorOf(
+		    [&] { last.loadFromConfigFile(*openIniFile(d + "/x.ini")); });
+	};
+	auto e = errorFor("[import_bag]\ndepth_topik = /d\n");
+	EXPECT_NE(e.find("depth_topik"), std::string::npos) << e;
+	EXPECT_NE(e.find("x.ini"), std::string::npos) << e;
+	e = errorFor("[import_bag]\nlayout = kinect\n");
+	EXPECT_NE(e.find("kinect"), std::string::npos) << e;
+	e = errorFor("[import_bag]\naccel_label = ACC_SYNTH\n");
+	EXPECT_NE(e.find("SYNTH"), std::string::npos) << e;
+	e = errorFor("[camera]\nfx = 500\n");
+	EXPECT_NE(e.find("all or none"), std::string::npos) << e;
+	e = errorFor("[camera]\ndepth_scale = 5000\n");
+	EXPECT_NE(e.find("REP 118"), std::string::npos) << e;
+
+	// [camera] overrides the bag's CameraInfo; "none" drops a preset topic
+	EXPECT_EQ(errorFor("[camera]\nfx = 500\nfy = 501\ncx = 160\ncy = 120\n"
+	                   "width = 320\nheight = 240\n[import_bag]\n"
+	                   "colour_topic = none\n"),
+	          "(no error)");
+	BagSpec spec;
+	spec.frames = 3;
+	writeBag(d + "/rs.bag", spec, sample().frames, sample().imu);
+	const auto sum = import(d + "/rs.bag", d + "/o.rawlog", last);
+	EXPECT_EQ(sum.camera.fy(), 501);
+	EXPECT_NE(sum.cameraFrom.find("x.ini"), std::string::npos);
+	EXPECT_TRUE(sum.topics.colour.empty());
+	EXPECT_FALSE(readRawlog(d + "/o.rawlog").frames[0]->hasIntensityImage);
+}
+
+TEST(ImportBag, ABagWithoutTheTopicsListsTheTopicsItHas)
+{
+	const auto d = test::freshTmpDir("bims_bag", "topics");
+	{
+		rosbag::Bag b(d + "/other.bag", rosbag::bagmode::Write);
+		b.write("/scan_cloud", ros::Time(1), imuMsg(*sample().imu[0], 1, 1));
+	}
+	const auto e = errorOf([&] { import(d + "/other.bag", d + "/o.rawlog"); });
+	EXPECT_NE(e.find(d + "/other.bag"), std::string::npos) << e;
+	EXPECT_NE(e.find("/scan_cloud"), std::string::npos) << e;
+	EXPECT_NE(e.find("sensor_msgs/Imu"), std::string::npos) << e;
+	EXPECT_FALSE(fs::exists(d + "/o.rawlog"));
+
+	// a topic the .ini names must be there
+	BagSpec spec;
+	spec.frames = 3;
+	writeBag(d + "/rs.bag", spec, sample().frames, sample().imu);
+	bag::BagImportParams p;
+	p.topics.colour = "/camera/rgb/nope";
+	const auto e2 = errorOf([&] { import(d + "/rs.bag", d + "/o.rawlog", p); });
+	EXPECT_NE(e2.find("no colour topic /camera/rgb/nope"), std::string::npos)
+	    << e2;
+	EXPECT_NE(e2.find("/camera/color/image_raw"), std::string::npos) << e2;
+}
+
+TEST(ImportBag, AWrongEncodingOrSizeIsAnErrorNamingTopicAndMessage)
+{
+	const auto d = test::freshTmpDir("bims_bag", "encoding");
+	BagSpec spec;
+	spec.frames = 3;
+	spec.colour = "rgba8";
+	writeBag(d + "/rgba.bag", spec, sample().frames, sample().imu);
+	auto e = errorOf([&] { import(d + "/rgba.bag", d + "/o.rawlog"); });
+	EXPECT_NE(e.find("/camera/color/image_raw, message #1"), std::string::npos)
+	    << e;
+	EXPECT_NE(e.find("'rgba8' is not supported"), std::string::npos) << e;
+	EXPECT_FALSE(fs::exists(d + "/o.rawlog"));
+
+	// a CameraInfo of another size than the images
+	{
+		rosbag::Bag b(d + "/info.bag", rosbag::bagmode::Write);
+		const auto& f = *sample().frames[0];
+		auto info = infoMsg(f);
+		info.width = 640;
+		const ros::Time t = rosTime(secondsOf(f.timestamp));
+		b.write("/camera/color/camera_info", t, info);
+		b.write("/camera/aligned_depth_to_color/image_raw", t,
+		        depthMsg(f, false));
+	}
+	e = errorOf([&] { import(d + "/info.bag", d + "/o.rawlog"); });
+	EXPECT_NE(e.find("the depth image is 320x240, the camera 640x240"),
+	          std::string::npos)
+	    << e;
+}
+
+TEST(ImportBag, ACorruptFrameKeepsTheWholeFramesBeforeIt)
+{
+	const auto d = test::freshTmpDir("bims_bag", "corrupt");
+	{
+		rosbag::Bag b(d + "/c.bag", rosbag::bagmode::Write);
+		for (size_t k = 0; k < 5; k++)
+		{
+			const auto& f = *sample().frames[k];
+			const ros::Time t = rosTime(secondsOf(f.timestamp));
+			auto depth = depthMsg(f, false);
+			if (k == 3) depth.data.resize(depth.data.size() / 2);
+			b.write("/camera/color/camera_info", t, infoMsg(f));
+			b.write("/camera/aligned_depth_to_color/image_raw", t, depth);
+		}
+	}
+	const auto e = errorOf([&] { import(d + "/c.bag", d + "/c.rawlog"); });
+	EXPECT_NE(e.find("message #4 of it"), std::string::npos) << e;
+	EXPECT_NE(e.find("corrupt"), std::string::npos) << e;
+	EXPECT_NE(e.find("the 3 whole frames before it are in"), std::string::npos)
+	    << e;
+	EXPECT_EQ(readRawlog(d + "/c.rawlog").frames.size(), 3u);
+}
+
+TEST(ImportBag, TruncatedMissingAndForeignFilesAreClearErrors)
+{
+	const auto d = test::freshTmpDir("bims_bag", "files");
+	BagSpec spec;
+	spec.frames = 4;
+	writeBag(d + "/whole.bag", spec, sample().frames, sample().imu);
+	const auto size = fs::file_size(d + "/whole.bag");
+	fs::copy_file(d + "/whole.bag", d + "/cut.bag");
+	fs::resize_file(d + "/cut.bag", size * 2 / 3);
+	auto e = errorOf([&] { import(d + "/cut.bag", d + "/o.rawlog"); });
+	EXPECT_NE(e.find(d + "/cut.bag"), std::string::npos) << e;
+	EXPECT_NE(e.find("rosbag reindex"), std::string::npos) << e;
+
+	e = errorOf([&] { import(d + "/none.bag", d + "/o.rawlog"); });
+	EXPECT_NE(e.find("none.bag: no such bag"), std::string::npos) << e;
+	{
+		std::ofstream(d + "/text.bag") << "hello\n";
+	}
+	e = errorOf([&] { import(d + "/text.bag", d + "/o.rawlog"); });
+	EXPECT_NE(e.find("text.bag: not a readable ROS 1 bag"), std::string::npos)
+	    << e;
+	EXPECT_FALSE(fs::exists(d + "/o.rawlog"));
+}
+
+TEST(ImportBag, StampsThatGoBackAreLeftOutAndCounted)
+{
+	const auto d = test::freshTmpDir("bims_bag", "back");
+	{
+		rosbag::Bag b(d + "/back.bag", rosbag::bagmode::Write);
+		for (size_t k : {0, 1, 2, 1, 3})  // the fourth goes back in time
+		{
+			const auto& f = *sample().frames[k];
+			const ros::Time t = rosTime(secondsOf(f.timestamp));
+			auto info = infoMsg(f);
+			info.D[0] = 0.05;  // a lens distortion bims does not model
+			b.write("/camera/color/camera_info", t, info);
+			b.write("/camera/aligned_depth_to_color/image_raw", t,
+			        depthMsg(f, false));
+		}
+	}
+	const auto sum = import(d + "/back.bag", d + "/back.rawlog");
+	EXPECT_EQ(sum.frames, 4u);
+	EXPECT_EQ(sum.stampsBack, 1u);
+	EXPECT_TRUE(sum.distortionIgnored);  // and said in the report
+	EXPECT_NE(bag::bagImportReport("o", sum, {})
+	              .find("plumb_bob distortion "
+	                    "is not modelled"),
+	          std::string::npos);
+	EXPECT_TRUE(sum.topics.colour.empty());  // the preset's is absent
+	const auto got = readRawlog(d + "/back.rawlog");
+	ASSERT_EQ(got.frames.size(), 4u);
+	EXPECT_FALSE(got.frames[0]->hasIntensityImage);
+}
+
+}  // namespace
