@@ -17,14 +17,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <set>
 #include <stdexcept>
+#include <thread>
 
 // A message read for its header stamp only (the first pass over the images:
 // their pixels are read once, in the second). Every ROS message with a
@@ -634,6 +639,81 @@ std::vector<ImuSample> imuStream(Index& ix, const BagTopics& t,
 	return out;
 }
 
+/** Makes n observations in order on a thread of its own, at most
+ * kAhead before the one the caller takes; the first error ends it and is
+ * handed over in its place. */
+class AheadQueue
+{
+ public:
+	struct Made
+	{
+		mrpt::obs::CObservation::Ptr obs;
+		std::string error;  ///< not empty: making it failed (and the rest)
+	};
+	using Maker = std::function<mrpt::obs::CObservation::Ptr(size_t)>;
+
+	AheadQueue(size_t n, Maker make)
+	    : make_(std::move(make)), thread_([this, n] { loop(n); })
+	{
+	}
+	~AheadQueue() { join(); }
+	AheadQueue(const AheadQueue&) = delete;
+	AheadQueue& operator=(const AheadQueue&) = delete;
+
+	/** The next observation, waiting for it. */
+	Made pop()
+	{
+		std::unique_lock<std::mutex> lock(m_);
+		cv_.wait(lock, [&] { return !q_.empty(); });
+		Made made = std::move(q_.front());
+		q_.pop_front();
+		cv_.notify_all();
+		return made;
+	}
+	/** Stops making and waits for the thread. */
+	void join()
+	{
+		{
+			const std::lock_guard<std::mutex> lock(m_);
+			stop_ = true;
+		}
+		cv_.notify_all();
+		if (thread_.joinable()) thread_.join();
+	}
+
+ private:
+	static constexpr size_t kAhead = 4;
+	void loop(size_t n)
+	{
+		for (size_t k = 0; k < n; k++)
+		{
+			Made made;
+			try
+			{
+				made.obs = make_(k);
+			}
+			catch (const std::exception& e)
+			{
+				made.error = e.what();
+			}
+			const bool failed = !made.error.empty();
+			std::unique_lock<std::mutex> lock(m_);
+			cv_.wait(lock, [&] { return q_.size() < kAhead || stop_; });
+			if (stop_) return;
+			q_.push_back(std::move(made));
+			cv_.notify_all();
+			if (failed) return;
+		}
+	}
+
+	Maker make_;
+	std::mutex m_;
+	std::condition_variable cv_;
+	std::deque<Made> q_;
+	bool stop_ = false;
+	std::thread thread_;  // last: started once the rest is built
+};
+
 }  // namespace
 
 BagImportSummary importBag(const std::vector<std::string>& bagPaths,
@@ -688,30 +768,23 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 	                 [](const Item& a, const Item& b)
 	                 { return a.t < b.t || (a.t == b.t && a.kind < b.kind); });
 
+	// Decoding (the bag's chunks, the images' conversion) on a thread of its
+	// own, a few observations ahead of the writing (and its compression).
 	static const std::set<std::string> depthEncodings = {"16UC1", "32FC1",
 	                                                     "mono16"};
 	static const std::set<std::string> colourEncodings = {"rgb8", "bgr8",
 	                                                      "mono8"};
 	const int W = sum.width, H = sum.height;
-	PartialFile part(outRawlog);
-	RawlogWriter w(part.path(), options.gzLevel);
-	ProgressBar bar("import", frames.size(), options.progress);
-	for (const auto& it : items)
+	std::string depthEncoding, colourEncoding;  // the decoder's
+	auto decode = [&](const Item& it) -> mrpt::obs::CObservation::Ptr
 	{
 		if (it.kind == 0)
 		{
 			const auto& s = imu[it.i];
-			const bool accelOnly = !s.hasGyro;
-			w.write(*eval::imuObservation(
-			    accelOnly ? params.accelLabel : params.imuLabel, s.t,
+			return eval::imuObservation(
+			    s.hasGyro ? params.imuLabel : params.accelLabel, s.t,
 			    s.hasGyro ? s.w : nullptr, s.hasAccel ? s.a : nullptr,
-			    s.hasMag ? s.m : nullptr));
-			sum.imu++;
-			sum.accelOnly += accelOnly;
-			sum.imuHasGyro |= s.hasGyro;
-			sum.imuHasAccel |= s.hasAccel;
-			sum.imuHasMag |= s.hasMag;
-			continue;
+			    s.hasMag ? s.m : nullptr);
 		}
 		const Frame& f = frames[it.i];
 		const ImageRef* current = f.depth;
@@ -721,7 +794,7 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 			if (!d) throw std::runtime_error("not a sensor_msgs/Image");
 			const auto dcv =
 			    checkedImage(d, depthEncodings, "the depth image", W, H, "");
-			sum.depthEncoding = d->encoding;
+			depthEncoding = d->encoding;
 			// REP 118: 16UC1 millimetres, 32FC1 metres
 			auto o = eval::depthObservation(
 			    dcv->image, dcv->image.type() == CV_32FC1 ? 1.0 : 0.001, cam,
@@ -731,31 +804,57 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 				current = f.colour;
 				const auto c = f.colour->msg.instantiate<sensor_msgs::Image>();
 				if (!c) throw std::runtime_error("not a sensor_msgs/Image");
-				sum.colourEncoding = c->encoding;
+				colourEncoding = c->encoding;
 				eval::attachColour(
 				    *o, checkedImage(c, colourEncodings, "the colour image", W,
 				                     H, "bgr8")
 				            ->image);
 			}
-			w.write(*o);
+			return o;
 		}
 		catch (const std::exception& e)
 		{
-			const std::string what =
+			throw std::runtime_error(
 			    bagNames + ": " + where(current->msg, current->n, current->t) +
-			    ": " + e.what();
-			if (sum.frames == 0) throw std::runtime_error(what);
+			    ": " + e.what());
+		}
+	};
+	AheadQueue ahead(items.size(), [&](size_t k) { return decode(items[k]); });
+
+	PartialFile part(outRawlog);
+	RawlogWriter w(part.path(), options.gzLevel);
+	ProgressBar bar("import", frames.size(), options.progress);
+	for (size_t k = 0; k < items.size(); k++)
+	{
+		const auto next = ahead.pop();
+		if (!next.error.empty())
+		{
+			if (sum.frames == 0) throw std::runtime_error(next.error);
 			// the whole frames before it are kept
 			w.close();
 			part.commit();
 			throw std::runtime_error(
-			    what +
+			    next.error +
 			    mrpt::format("; the %zu whole frames before it are in ",
 			                 sum.frames) +
 			    outRawlog);
 		}
-		bar.update(++sum.frames);
+		w.write(*next.obs);
+		if (items[k].kind == 1)
+		{
+			bar.update(++sum.frames);
+			continue;
+		}
+		const auto& s = imu[items[k].i];
+		sum.imu++;
+		sum.accelOnly += !s.hasGyro;
+		sum.imuHasGyro |= s.hasGyro;
+		sum.imuHasAccel |= s.hasAccel;
+		sum.imuHasMag |= s.hasMag;
 	}
+	ahead.join();
+	sum.depthEncoding = depthEncoding;
+	sum.colourEncoding = colourEncoding;
 	w.close();
 	part.commit();
 	bar.finish();
