@@ -8,7 +8,7 @@ CMAKE_ARGS ?=
 # Build trees made here use Ninja and a unity build (CMake joins ~8 sources
 # of a target into one compile: the MRPT/Eigen/OpenCV headers and templates
 # are parsed and instantiated once per batch, not per file). Both cut a
-# clean build by about 40% (docs/results.md, "Build time"); UNITY=OFF gives
+# clean build by about 40% (docs/journal/build-and-ci.md, "Build time"); UNITY=OFF gives
 # one compile per file (a change then rebuilds only its own file).
 GENERATOR ?= Ninja
 UNITY ?= ON

@@ -1,6 +1,6 @@
-// The baseline of docs/results.md "Egomotion in a crowd": OpenCV contrib's
-// frame-to-frame dense odometry (cv::rgbd::RgbdICPOdometry, or its ICP /
-// photometric variants) on the RGB-D frames of a rawlog, with OpenCV's
+// The baseline of docs/journal/egomotion.md "Egomotion in a crowd": OpenCV
+// contrib's frame-to-frame dense odometry (cv::rgbd::RgbdICPOdometry, or its
+// ICP / photometric variants) on the RGB-D frames of a rawlog, with OpenCV's
 // defaults, written as a TUM trajectory.
 //
 //   rgbd_odometry_baseline CONFIG.ini IN.rawlog -o TRAJ.txt

@@ -3,7 +3,7 @@
 #
 #   scripts/fuzz.sh TARGET SECONDS [JOBS]
 #
-# TARGET: rawlog | ini | tum | labels. Builds the target with clang,
+# TARGET: rawlog | ini | tum | labels | image | stray. Builds the target with clang,
 # AddressSanitizer, UndefinedBehaviorSanitizer and libFuzzer in build-fuzz/
 # (BIMS_FUZZ_BUILD=DIR for another folder; GUI, OpenNI2 and benchmarks
 # off), seeds a working corpus from tests/fuzz/corpus/TARGET (and config/
@@ -15,8 +15,8 @@ set -euo pipefail
 TARGET=${1:?usage: scripts/fuzz.sh TARGET SECONDS [JOBS]}
 SECONDS_TOTAL=${2:?usage: scripts/fuzz.sh TARGET SECONDS [JOBS]}
 JOBS=${3:-1}
-case "$TARGET" in rawlog | ini | tum | labels) ;; *)
-	echo "fuzz.sh: unknown target '$TARGET' (rawlog, ini, tum, labels)" >&2
+case "$TARGET" in rawlog | ini | tum | labels | image | stray) ;; *)
+	echo "fuzz.sh: unknown target '$TARGET' (rawlog, ini, tum, labels, image, stray)" >&2
 	exit 2
 	;;
 esac

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The segmentation table of docs/EVALUATION (docs/results.md) on every simulator
+# The segmentation table of docs/EVALUATION (docs/journal/pipeline.md) on every simulator
 # preset: bottom tier only, flow only, fused (decay = all, the paper's literal
 # model), fused (the config's decay), fused + ray cast, side by side on the same
 # frames, pixel level and voxel level (bims-eval masks --voxel-size 0.05). Not

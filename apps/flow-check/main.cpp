@@ -15,7 +15,7 @@
 // median |observed - expected| flow, plus the rotation / translation of each
 // pose against gt and flow. A summary (mean over frames) ends the output.
 // --strip writes a picture: for each listed frame the RGB image with the
-// used pose's Diff pixels in red (docs/results.md). The logic:
+// used pose's Diff pixels in red (docs/journal/pipeline.md). The logic:
 // bims/check/flow_check.h, bims/flow/pose_check.h.
 #include <bims/check/flow_check.h>
 #include <bims/common/app.h>

@@ -3,7 +3,7 @@
 // entirely static by the flow labels (flow-only variant, config/bonn.ini,
 // vision-only egomotion: the recording has no IMU), while frames with
 // walking people are not. Frames are read straight from the TUM folder
-// (no rawlog written). Figures in docs/results.md (Pipeline section).
+// (no rawlog written). Figures in docs/journal/pipeline.md.
 #include <bims/ego/depth_correction.h>
 #include <bims/eval/mask_labels.h>
 #include <bims/eval/mask_metrics.h>

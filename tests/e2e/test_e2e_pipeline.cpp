@@ -114,7 +114,7 @@ TEST(EndToEnd, SegmentsThePendulumOnTheBundledSample)
 TEST(EndToEnd, FusionBeatsEachIsolatedVariantOnTheWholeSample)
 {
 	// The paper's claim, on all 150 frames of the bundled sample, with the
-	// frustum decay. Measured (docs/results.md) with the map-anchored
+	// frustum decay. Measured (docs/journal/egomotion.md) with the map-anchored
 	// egomotion: bottom-only 0.923, flow-only 0.720, fused 0.931. Before it
 	// (frame-to-frame egomotion): 0.843, 0.710, 0.901: the exact
 	// registration lifted the bottom tier most, and the fusion's lead over

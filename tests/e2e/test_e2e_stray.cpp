@@ -3,7 +3,7 @@
 // imported with config/stray.ini, run by bims-run's runExperiment with the
 // same preset, its trajectory against ARKit's poses and its masks against the
 // capture's proxy labels. Regression floors of the figures of
-// bench/stray_real.sh (docs/results.md, "A phone's LiDAR and IMU").
+// bench/stray_real.sh (docs/journal/phone-lidar-imu.md).
 #include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
 #include <bims/eval/mask_labels.h>

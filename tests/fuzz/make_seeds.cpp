@@ -58,7 +58,7 @@ int main(int argc, char** argv)
 	try
 	{
 		const fs::path out = argv[2];
-		for (const char* d : {"rawlog", "labels", "tum"})
+		for (const char* d : {"rawlog", "labels", "tum", "image", "stray"})
 			fs::create_directories(out / d);
 		{
 			bims::RawlogReader in(argv[1]);
@@ -100,6 +100,34 @@ int main(int argc, char** argv)
 		          "# timestamp tx ty tz qx qy qz qw\n"
 		          "1.0 0 0 0 0 0 0 1\n1.04 0.01 0 0 0 0 0 1\n--\n"
 		          "1.0 0 0 9.81\n");
+		// one small image of each kind the readers meet: 16-bit depth PNG,
+		// colour PNG and JPEG, TIFF, BMP
+		cv::Mat depth(6, 8, CV_16UC1, cv::Scalar(1234));
+		depth(cv::Rect(0, 0, 3, 2)).setTo(0);
+		cv::Mat colour(6, 8, CV_8UC3, cv::Scalar(30, 120, 200));
+		const std::pair<const char*, const cv::Mat*> images[] = {
+		    {"depth.png", &depth},
+		    {"colour.png", &colour},
+		    {"colour.jpg", &colour},
+		    {"colour.tiff", &colour},
+		    {"colour.bmp", &colour}};
+		for (const auto& [name, img] : images)
+		{
+			std::vector<uint8_t> bytes;
+			const std::string n = name;
+			cv::imencode(n.substr(n.find('.')), *img, bytes);
+			std::ofstream(out / "image" / name, std::ios::binary)
+			    .write(reinterpret_cast<const char*>(bytes.data()),
+			           static_cast<std::streamsize>(bytes.size()));
+		}
+		writeText(out / "stray" / "capture",
+		          "timestamp, frame, x, y, z, qx, qy, qz, qw\n"
+		          "0.5, 000000, 0, 0, 0, 0, 0, 0, 1\n"
+		          "0.516, 000001, 0.01, 0, 0, 0, 0, 0.0087, 0.99996\n--\n"
+		          "timestamp, a_x, a_y, a_z, alpha_x, alpha_y, alpha_z\n"
+		          "0.49, 0.01, -1.0, 0.02, 0.1, 0, 0\n"
+		          "0.50, 0.01, -0.99, 0.02, 0.1, 0.01, 0\n--\n"
+		          "1400.0, 0.0, 960.0\n0.0, 1400.0, 720.0\n0.0, 0.0, 1.0\n");
 		std::cout << "seeds in " << out.string() << "\n";
 	}
 	catch (const std::exception& e)

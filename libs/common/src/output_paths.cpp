@@ -44,6 +44,31 @@ std::runtime_error systemError(const std::string& path, const char* what)
 }
 }  // namespace
 
+void checkOutputFilesWritable(const std::vector<std::string>& files)
+{
+	for (const auto& f : files)
+	{
+		if (f.empty()) continue;
+		std::error_code ec;
+		if (fs::is_directory(f, ec))
+			throw std::runtime_error(f +
+			                         ": is a folder; a file is written "
+			                         "there");
+		fs::path dir = fs::path(f).parent_path();
+		if (dir.empty()) dir = ".";
+		if (!fs::exists(dir, ec))
+			throw std::runtime_error("cannot write " + f + ": its folder " +
+			                         dir.string() + " does not exist");
+		if (!fs::is_directory(dir, ec))
+			throw std::runtime_error("cannot write " + f + ": " + dir.string() +
+			                         " is not a folder");
+		if (access(dir.c_str(), W_OK | X_OK) != 0)
+			throw std::runtime_error("cannot write " + f + ": its folder " +
+			                         dir.string() + " is not writable (" +
+			                         std::strerror(errno) + ")");
+	}
+}
+
 void checkOutputsSpareInputs(const std::vector<std::string>& inputs,
                              const std::vector<std::string>& outputs)
 {

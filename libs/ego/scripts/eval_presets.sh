@@ -1,5 +1,5 @@
 #!/bin/sh
-# Egomotion variants on simulator presets, side by side (docs/results.md,
+# Egomotion variants on simulator presets, side by side (docs/journal/egomotion.md,
 # "Egomotion"). Usage, from the repository root after building:
 #   libs/ego/scripts/eval_presets.sh BUILD_DIR DATA_DIR [PRESET...]
 # DATA_DIR/<preset>.rawlog and DATA_DIR/<preset>_gt/ must exist, made by

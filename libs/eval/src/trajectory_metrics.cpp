@@ -54,11 +54,17 @@ void requireSorted(const Trajectory& t, const char* what)
 			throw std::invalid_argument(std::string(what) +
 			                            " trajectory is not sorted by time");
 }
-std::string spanText(const Trajectory& t)
+/** "[t0, t1] s"; an estimate's with the time offset added to its stamps
+ * (what the association compares) when there is one. */
+std::string spanText(const Trajectory& t, double offset = 0)
 {
 	std::ostringstream ss;
 	ss.precision(3);
 	ss << std::fixed << "[" << t.front().t << ", " << t.back().t << "] s";
+	if (offset != 0)
+		ss << " ("
+		   << "[" << t.front().t + offset << ", " << t.back().t + offset
+		   << "] s with the time offset " << std::showpos << offset << " s)";
 	return ss.str();
 }
 }  // namespace
@@ -78,7 +84,7 @@ AteResult computeAte(const Trajectory& gt, const Trajectory& est,
 	if (r.pairs.empty())
 		throw std::invalid_argument(
 		    "no time overlap between ground truth " + spanText(gt) +
-		    " and estimate " + spanText(est) + " within " +
+		    " and estimate " + spanText(est, opt.timeOffset) + " within " +
 		    std::to_string(opt.maxTimeDifference) + " s");
 	if (r.pairs.size() < 3)
 		throw std::invalid_argument(
@@ -150,7 +156,7 @@ RpeResult computeRpe(const Trajectory& gt, const Trajectory& est,
 		std::ostringstream ss;
 		ss << "only " << r.pairs.size() << " RPE pairs (delta " << opt.delta
 		   << " s) between ground truth " << spanText(gt) << " and estimate "
-		   << spanText(est)
+		   << spanText(est, opt.timeOffset)
 		   << ": no time overlap or the estimate is shorter than delta";
 		throw std::invalid_argument(ss.str());
 	}

@@ -78,7 +78,7 @@ TEST(BonnGroundTruth, ConvertedPosesRegisterDepthFrames)
 	}
 	// (i, j, max median |dz| with converted poses [m]). Measured: 0.025,
 	// 0.047, 0.046 m; raw marker poses 0.127, 0.273, 0.203 m; assuming no
-	// motion 0.102, 0.203, 0.191 m (docs/results.md).
+	// motion 0.102, 0.203, 0.191 m (docs/journal/evaluation.md).
 	const std::tuple<size_t, size_t, double> pairs[] = {
 	    {0, 15, 0.035}, {0, 30, 0.06}, {20, 55, 0.06}};
 	for (const auto& [i, j, maxMedian] : pairs)

@@ -2,6 +2,8 @@
 #include <bims/eval/trajectory_metrics.h>
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <cmath>
 
 using bims::StampedPose;
@@ -101,6 +103,24 @@ TEST(Ate, BadInputIsAnError)
 	{
 		EXPECT_NE(std::string(e.what()).find("no time overlap"),
 		          std::string::npos);
+	}
+	// issue 39: with a time offset the estimate's span is given as the
+	// association sees it, shifted
+	ev::AteOptions shifted;
+	shifted.timeOffset = 50;
+	try
+	{
+		ev::computeAte(gt, late, shifted);
+		FAIL();
+	}
+	catch (const std::invalid_argument& e)
+	{
+		const std::string what = e.what();
+		const double t0 = late.front().t + 50, t1 = late.back().t + 50;
+		char want[96];
+		std::snprintf(want, sizeof(want),
+		              "[%.3f, %.3f] s with the time offset +50.000 s", t0, t1);
+		EXPECT_NE(what.find(want), std::string::npos) << what;
 	}
 	Trajectory two(gt.begin(), gt.begin() + 2);
 	EXPECT_THROW(ev::computeAte(gt, two), std::invalid_argument);

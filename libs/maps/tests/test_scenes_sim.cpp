@@ -29,7 +29,7 @@ class SimCamera
 	 * grazing-angle limits and projector shadows kept): with the default
 	 * noise, decay = raycast frees surface voxels that noisy rays of other
 	 * pixels pass through, and tier 1 then flags several % of a static
-	 * scene (docs/results.md, "Voxel grids"); that is the model's
+	 * scene (docs/journal/voxel-grids.md, "Voxel grids"); that is the model's
 	 * behaviour, not what these tests are about. */
 	static sim::DepthParams depth()
 	{

@@ -2,6 +2,7 @@
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
 #include <bims/common/output_paths.h>
+#include <bims/common/rawlog.h>
 #include <bims/common/stats.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/so3.h>
@@ -128,6 +129,8 @@ int runOdometry(const OdometryRunOptions& o)
 	if (o.masks)
 		for (auto& f : frameFilesIn(*o.masks)) inputs.push_back(std::move(f));
 	checkOutputsSpareInputs(inputs, outputs);
+	// written at the end of the run: a folder that is not there is said now
+	checkOutputFilesWritable(outputs);
 	const ego::EgoConfig ec = odometryConfig(o);
 	ego::Odometry odo(ec);
 	Trajectory traj, attitude;
@@ -153,46 +156,66 @@ int runOdometry(const OdometryRunOptions& o)
 			throw std::runtime_error(*o.masks + ": mask directory not found");
 		ro.masks_dir = *o.masks;
 	}
-	const auto st = replayRawlog(
-	    o.rawlog, odo,
-	    [&](const ego::FrameEgomotion& r,
-	        const mrpt::obs::CObservation3DRangeScan& scan)
-	    {
-		    if (r.flags & ego::kFlagOutOfOrder || r.flags & ego::kFlagBadImage)
-			    return;  // no pose for this frame
-		    traj.push_back({r.t, r.T_WC});
-		    if (const auto R = o.attitude ? odo.imuRotation(r.t) : std::nullopt)
-			    attitude.push_back(
-			        {r.t, ego::toPose(*R, Eigen::Vector3d::Zero())});
-		    msIn.push_back(r.ms_input);
-		    msTrack.push_back(r.ms_track);
-		    msMotion.push_back(r.ms_motion);
-		    msEgo.push_back(r.ms_track + r.ms_motion);
-		    // Tracker accuracy against the ground truth.
-		    TrackerTruth truth;
-		    ego::RgbdFrame cur;
-		    if (!gt.empty() && ego::rgbdFrameFrom(scan, ec.camera, cur).empty())
+	const char* mode = choiceName(ec.odometry.mode);
+	const char* aid = ec.odometry.gyro_aid ? "true" : "false";
+	const std::string header =
+	    std::string("bims-odom mode=") + mode + " gyro_aid=" + aid;
+	ReplayStats st;
+	try
+	{
+		st = replayRawlog(
+		    o.rawlog, odo,
+		    [&](const ego::FrameEgomotion& r,
+		        const mrpt::obs::CObservation3DRangeScan& scan)
 		    {
-			    const StampedPose* g1 = gtAt(r.t);
-			    const StampedPose* g0 = gtAt(prevT);
-			    if (g0 && g1 && !prevDepth.empty())
-				    truth = trackerAgainstTruth(
-				        r, prevDepth, cur.K, g1->T_WC - g0->T_WC, r.t - prevT);
-			    prevDepth = cur.depth;
-		    }
-		    prevT = r.t;
-		    if (csv) csv->append(odometryCsvLine(r, truth));
-	    },
-	    ro);
+			    if (r.flags & ego::kFlagOutOfOrder ||
+			        r.flags & ego::kFlagBadImage)
+				    return;  // no pose for this frame
+			    traj.push_back({r.t, r.T_WC});
+			    if (const auto R =
+			            o.attitude ? odo.imuRotation(r.t) : std::nullopt)
+				    attitude.push_back(
+				        {r.t, ego::toPose(*R, Eigen::Vector3d::Zero())});
+			    msIn.push_back(r.ms_input);
+			    msTrack.push_back(r.ms_track);
+			    msMotion.push_back(r.ms_motion);
+			    msEgo.push_back(r.ms_track + r.ms_motion);
+			    // Tracker accuracy against the ground truth.
+			    TrackerTruth truth;
+			    ego::RgbdFrame cur;
+			    if (!gt.empty() &&
+			        ego::rgbdFrameFrom(scan, ec.camera, cur).empty())
+			    {
+				    const StampedPose* g1 = gtAt(r.t);
+				    const StampedPose* g0 = gtAt(prevT);
+				    if (g0 && g1 && !prevDepth.empty())
+					    truth = trackerAgainstTruth(r, prevDepth, cur.K,
+					                                g1->T_WC - g0->T_WC,
+					                                r.t - prevT);
+				    prevDepth = cur.depth;
+			    }
+			    prevT = r.t;
+			    if (csv) csv->append(odometryCsvLine(r, truth));
+		    },
+		    ro);
+	}
+	catch (const RawlogError& e)
+	{
+		// a rawlog cut short: the poses of the frames before the cut are
+		// kept, as bims-run keeps its outputs
+		if (traj.empty()) throw;
+		if (csv) csv->close();
+		saveTumTrajectory(
+		    o.out, traj, header + " (the input ended early: " + e.what() + ")");
+		throw std::runtime_error(std::string(e.what()) + "; the poses of the " +
+		                         std::to_string(traj.size()) +
+		                         " frames before it are in " + o.out);
+	}
 	if (traj.empty())
 		throw std::runtime_error(
 		    o.rawlog + ": no usable RGB-D frame (check [sensors] rgbd_label)");
 	if (csv) csv->close();
-	const char* mode = choiceName(ec.odometry.mode);
-	const char* aid = ec.odometry.gyro_aid ? "true" : "false";
-	saveTumTrajectory(
-	    o.out, traj,
-	    std::string("bims-odom mode=") + mode + " gyro_aid=" + aid);
+	saveTumTrajectory(o.out, traj, header);
 	if (o.attitude)
 	{
 		if (attitude.empty())

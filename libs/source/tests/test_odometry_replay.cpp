@@ -1,7 +1,7 @@
 // End to end on the bundled simulator sample (rawlogs/pendulum_slow.rawlog,
 // 150 frames 320x240 with IMU, made by bims-sim): the drift of T_C0C against
 // the ground truth (from frame 30 on) stays below bounds measured when this
-// test was written (docs/results.md, "Egomotion"), in both modes.
+// test was written (docs/journal/egomotion.md, "Egomotion"), in both modes.
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 using namespace bims::source;
@@ -177,4 +178,60 @@ TEST(OdometryRun, RunsTheSampleIntoATrajectoryCsvAndSummary)
 	auto noMasks = o;
 	noMasks.masks = d + "/none";
 	EXPECT_THROW(runOdometry(noMasks), std::runtime_error);
+}
+
+// Issue 39: an output folder that is not there was found after the whole
+// run; a rawlog cut short gave no trajectory at all.
+TEST(OdometryRun,
+     AnUnwritableOutputIsSaidBeforeTheRunAndACutRawlogKeepsItsPoses)
+{
+	const std::string d = bims::test::freshTmpDir("bims_test_source", "cut");
+	OdometryRunOptions o;
+	o.config = kDefaultConfig;
+	o.rawlog = kSample;
+	o.out = d + "/no/such/folder/traj.txt";
+	o.progress = false;
+	try
+	{
+		runOdometry(o);
+		FAIL();
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("does not exist"),
+		          std::string::npos)
+		    << e.what();
+	}
+
+	// the sample cut to 40 % of its bytes
+	const std::string cut = d + "/cut.rawlog";
+	{
+		std::ifstream in(kSample, std::ios::binary);
+		std::string bytes((std::istreambuf_iterator<char>(in)),
+		                  std::istreambuf_iterator<char>());
+		std::ofstream(cut, std::ios::binary)
+		    .write(bytes.data(),
+		           static_cast<std::streamsize>(bytes.size() * 4 / 10));
+	}
+	o.rawlog = cut;
+	o.out = d + "/traj.txt";
+	std::string what;
+	testing::internal::CaptureStderr();
+	try
+	{
+		runOdometry(o);
+	}
+	catch (const std::runtime_error& e)
+	{
+		what = e.what();
+	}
+	testing::internal::GetCapturedStderr();
+	EXPECT_NE(what.find("cut.rawlog"), std::string::npos) << what;
+	EXPECT_NE(what.find("frames before it are in " + o.out), std::string::npos)
+	    << what;
+	const auto poses = bims::loadTumTrajectory(o.out).size();
+	EXPECT_GT(poses, 20u);
+	EXPECT_LT(poses, 150u);
+	EXPECT_NE(what.find(std::to_string(poses) + " frames"), std::string::npos)
+	    << what;
 }

@@ -167,8 +167,8 @@ int stopSignal();
 /** Tells the C library's allocator to keep freed memory for reuse instead
  * of returning it to the system at once: per-frame image buffers (several
  * MB at 640x480) then cost no page faults each frame (~5 ms of CPU per VGA
- * frame in bims-run; docs/results.md). For programs that process frames
- * in a loop; call once at the start of main(). */
+ * frame in bims-run; docs/journal/pipeline.md). For programs that process
+ * frames in a loop; call once at the start of main(). */
 void keepFreedMemoryForReuse();
 
 /** "3,40,7" -> {3, 7, 40} (frame indices of a command-line flag); throws

@@ -15,6 +15,13 @@ class Mat;
 
 namespace bims
 {
+/** Throws std::runtime_error naming the file when an output file cannot be
+ * written where it goes: its folder missing, not a folder, or not writable
+ * (access(2)), or the path itself a folder. For programs that write their
+ * files at the end of a long run: checked before any work. Empty strings
+ * (optional outputs not given) are ignored. */
+void checkOutputFilesWritable(const std::vector<std::string>& files);
+
 /** Refuses, before any work, outputs that would destroy an input: an empty
  * output path, an output that is an input, or an output folder that
  * contains an input. Paths are compared after resolving symbolic links, `.`

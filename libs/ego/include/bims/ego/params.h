@@ -289,7 +289,7 @@ struct AnchorParams
 	 * moving_prediction.h) before it excludes pixels from the alignment
 	 * and from the keyframe the frame may become; false: the previous mask
 	 * is used as it is. Off by default: measured no better on the Bonn
-	 * slice and the presets, and worse on one (docs/results.md). */
+	 * slice and the presets, and worse on one (docs/journal/egomotion.md). */
 	bool predict_mask = false;
 	/** The predicted mask grows by this many pixels a side (the movers' own
 	 * motion between two frames, the prediction's error) [px]. */

@@ -17,9 +17,9 @@ struct TensorBuffers
 };
 
 /** [flow] dis_preset = auto: DIS "ultrafast" on images at least this wide,
- * "fast" on smaller ones (measured in docs/results.md: at 640x480 ultrafast
- * keeps the fused F1 within 0.003 of fast for 5 ms less CPU per frame; at
- * 320x240 it loses up to 0.07 of flow-only F1 and 0.009 fused). */
+ * "fast" on smaller ones (measured in docs/journal/optical-flow.md: at 640x480
+ * ultrafast keeps the fused F1 within 0.003 of fast for 5 ms less CPU per
+ * frame; at 320x240 it loses up to 0.07 of flow-only F1 and 0.009 fused). */
 constexpr int kDisUltrafastMinWidth = 640;
 /** The DIS preset ObservedFlow uses for \a preset on images \a width wide
  * (the images DIS sees: after [flow] downscale). */
