@@ -421,3 +421,26 @@ TEST(Cli, MapsFigureTakesItsOutputAsOOrAsTheThirdWordOnce)
 	}
 	EXPECT_FALSE(fs::exists(d + "/a.png") || fs::exists(d + "/b.png"));
 }
+
+// Issue 37: a program without its arguments said only TCLAP's "One or
+// more required arguments missing!", never which.
+TEST(Cli, MissingArgumentsAreNamed)
+{
+	for (const auto& [args, want] :
+	     std::vector<std::pair<std::string, std::vector<std::string>>>{
+	         {"bims-run", {"bims-run: usage error: missing", "-o"}},
+	         {"bims-odom " + kConfig, {"missing", "<IN.rawlog>", "-o"}},
+	         {"bims-import-bag", {"missing <BAG>"}},
+	         {"bims-import-bag x.bag", {"-o OUT.rawlog is required"}},
+	         {"bims-sim", {"bims-sim: usage error: missing", "-o"}},
+	         {"bims-import-stray", {"missing", "<FOLDER>", "-o"}}})
+	{
+		if (!built(args.substr(0, args.find(' ')))) continue;
+		const auto r = bims::test::runCommand(kBin + "/" + args);
+		EXPECT_EQ(r.code, 2) << args << "\n" << r.out;
+		for (const auto& w : want)
+			EXPECT_NE(r.out.find(w), std::string::npos)
+			    << args << ": " << w << "\n"
+			    << r.out;
+	}
+}

@@ -249,4 +249,13 @@ std::set<size_t> parseIndexList(const std::string& text,
 	return out;
 }
 
+void printMissingArguments(const std::string& argv0, const std::string& list)
+{
+	const auto slash = argv0.rfind('/');
+	const std::string program =
+	    slash == std::string::npos ? argv0 : argv0.substr(slash + 1);
+	std::fprintf(stderr, "%s: usage error: missing %s; see --help\n",
+	             program.c_str(), list.c_str());
+}
+
 }  // namespace bims

@@ -92,6 +92,10 @@ std::vector<OptionName> declaredOptions(CmdLine& cmd)
 	return known;
 }
 
+/** "PROGRAM: usage error: missing LIST; see --help" on stderr (\a argv0:
+ * the program's path). */
+void printMissingArguments(const std::string& argv0, const std::string& list);
+
 /** Parses the command line with MRPT's TCLAP (CmdLine in
  * mrpt/3rdparty/tclap/CmdLine.h), which prints --help, --version and parse
  * errors itself and then returns false instead of exiting: throws
@@ -114,6 +118,16 @@ void parseCommandLine(CmdLine& cmd, int argc, char** argv,
 		help |= a == "-h" || a == "--help" || a == "--version";
 	if (!help) checkOptionNames(n, words.data(), known);
 	if (cmd.parse(n, words.data())) return;
+	if (!help)
+	{
+		// TCLAP says only "one or more required arguments missing": name them
+		std::string missing;
+		for (const auto* a : cmd.getArgList())
+			if (a->isRequired() && !a->isSet())
+				missing += (missing.empty() ? "" : ", ") + a->shortID();
+		if (!missing.empty())
+			printMissingArguments(args.empty() ? "" : args[0], missing);
+	}
 	throw ExitRequest{help ? 0 : 2};
 }
 
