@@ -357,7 +357,13 @@ TEST(EndToEnd, RawlogWithoutImuRunsVisionOnly)
 	EXPECT_TRUE(imu.error.empty()) << imu.error;
 	EXPECT_EQ(imu.framesFlaggedBy.at("imu_missing"), 20u);
 	const std::string text = formatSummary(imu);
-	EXPECT_NE(text.find("flagged frames by egomotion flag: imu_missing 20"),
+	EXPECT_NE(text.find("frames per egomotion flag: imu_missing 20"),
+	          std::string::npos)
+	    << text;
+	// vision measured every frame's motion: no frame is a failure, though
+	// every one carries a flag
+	EXPECT_EQ(imu.framesNotMeasured, 0u);
+	EXPECT_NE(text.find(" frames (0 with the motion not measured) of "),
 	          std::string::npos)
 	    << text;
 	EXPECT_NE(text.find("note: no IMU samples in the input with sensor label "
@@ -377,6 +383,7 @@ TEST(EndToEnd, RawlogWithoutImuRunsVisionOnly)
 	std::ifstream mf(dir + "/out/metrics.json");
 	const auto m = bims::Json::parse(mf);
 	EXPECT_EQ(m["frames_flagged_by"]["imu_missing"], 20);
+	EXPECT_EQ(m["frames_not_measured"], 0);
 	EXPECT_NE(m["notes"][0].get<std::string>().find("fell back to vision"),
 	          std::string::npos);
 }

@@ -163,9 +163,9 @@ int runFlowCheck(const FlowCheckOptions& o)
 	std::fputs(summary(rows).c_str(), stdout);
 	std::printf(
 	    "run: mean moving-pixel fraction %.2f %% (%s), %zu of "
-	    "%zu frames flagged by egomotion\n",
+	    "%zu frames with the motion not measured\n",
 	    100 * sum.meanMovingPixelFraction, sum.variant.c_str(),
-	    sum.framesFlagged, sum.framesProcessed);
+	    sum.framesNotMeasured, sum.framesProcessed);
 	if (o.strip)
 	{
 		if (tiles.empty())

@@ -28,7 +28,7 @@ for p in $PRESETS; do
 			ate=$(echo "$ev" | awk '/^ate_rmse/{print $2}')
 			rt=$(echo "$ev" | awk '/^rpe_trans_rmse/{print $2}')
 			rr=$(echo "$ev" | awk '/^rpe_rot_rmse/{print $2}')
-			fl=$(echo "$log" | sed -n 's/.*frames (\([0-9]*\) flagged).*/\1/p')
+			fl=$(echo "$log" | sed -n 's/.*frames (\([0-9]*\) with the motion not measured).*/\1/p')
 			ms=$(echo "$log" | sed -n 's/.*egomotion \([0-9.]*\) .*/\1/p')
 			echo "| $p | $mode, gyro_aid=$aid | $ate | $rt | $rr | $fl | $ms |"
 		done

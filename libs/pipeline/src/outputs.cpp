@@ -236,6 +236,7 @@ void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
 	j["config"] = pipe.config().source;
 	j["frames_processed"] = sum.framesProcessed;
 	j["frames_flagged"] = sum.framesFlagged;
+	j["frames_not_measured"] = sum.framesNotMeasured;
 	j["frames_flagged_by"] = sum.framesFlaggedBy;
 	j["notes"] = sum.notes;
 	j["scans_read"] = sum.scansRead;

@@ -124,6 +124,8 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		const uint32_t counted =
 		    flags & ~static_cast<uint32_t>(ego::kFlagFirstFrame);
 		if (counted) sum.framesFlagged++;
+		if (!r.ego.ok() && !(flags & ego::kFlagFirstFrame))
+			sum.framesNotMeasured++;
 		for (const char* name : ego::flagNames(counted))
 			sum.framesFlaggedBy[name]++;
 		stage["read"].push_back(f.cost.readMs);
@@ -269,9 +271,9 @@ std::string formatSummary(const RunSummary& s)
 	std::ostringstream o;
 	char buf[256];
 	std::snprintf(buf, sizeof(buf),
-	              "variant %s: %zu frames (%zu flagged) of %zu 3D scans, %zu "
-	              "IMU samples, %.1f s of data\n",
-	              s.variant.c_str(), s.framesProcessed, s.framesFlagged,
+	              "variant %s: %zu frames (%zu with the motion not measured) "
+	              "of %zu 3D scans, %zu IMU samples, %.1f s of data\n",
+	              s.variant.c_str(), s.framesProcessed, s.framesNotMeasured,
 	              s.scansRead, s.imuRead, s.dataSeconds);
 	o << buf;
 	std::snprintf(buf, sizeof(buf),
@@ -301,7 +303,7 @@ std::string formatSummary(const RunSummary& s)
 		std::stable_sort(by.begin(), by.end(),
 		                 [](const auto& a, const auto& b)
 		                 { return a.second > b.second; });
-		o << "flagged frames by egomotion flag:";
+		o << "frames per egomotion flag:";
 		for (size_t k = 0; k < by.size(); ++k)
 			o << (k ? ", " : " ") << by[k].first << " " << by[k].second;
 		o << " (docs/ego.md)\n";

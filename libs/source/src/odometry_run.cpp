@@ -232,7 +232,8 @@ int runOdometry(const OdometryRunOptions& o)
 	           pEgo = Percentiles::of(msEgo);
 	std::fprintf(
 	    stderr,
-	    "bims-odom: %zu frames (%zu flagged), %zu IMU samples; mode=%s "
+	    "bims-odom: %zu frames (%zu with the motion not measured), %zu IMU "
+	    "samples; mode=%s "
 	    "gyro_aid=%s\n"
 	    "bims-odom: ms/frame median (p95): input %.2f (%.2f), tracking "
 	    "%.2f (%.2f), motion %.2f (%.2f), egomotion %.2f (%.2f)\n",

@@ -35,6 +35,10 @@ struct RunSummary : source::FrameOrderStats
 {
 	size_t framesProcessed = 0;
 	size_t framesFlagged = 0;  ///< frames with an egomotion flag
+	/** Frames whose motion was not measured, the pose predicted instead
+	 * (ego::FrameEgomotion::ok() false; the first frame, the reference,
+	 * aside). A flag alone (anchored, new_keyframe, ...) is no failure. */
+	size_t framesNotMeasured = 0;
 	/** Frames per egomotion flag by name (ego::flagNames; first_frame not
 	 * counted). */
 	std::map<std::string, size_t> framesFlaggedBy;
