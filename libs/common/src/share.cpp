@@ -54,6 +54,29 @@ std::string findShareFile(const std::string& name)
 	return findShareFile(name, executableDir());
 }
 
+std::string resolvePreset(const std::string& path)
+{
+	std::error_code ec;
+	if (path.empty() || fs::exists(path, ec) || fs::path(path).is_absolute())
+		return path;
+	const std::string preset = findShareFile(path);
+	return preset.empty() ? path : preset;
+}
+
+std::string presetHint(const std::string& path)
+{
+	if (path.empty() || fs::path(path).is_absolute()) return "";
+	const std::string exe = executableDir();
+	const std::string own =
+	    exe.empty()
+	        ? std::string()
+	        : (fs::path(exe) / BIMS_SHARE_FROM_BIN).lexically_normal().string();
+	return " (nor a preset of that name in " +
+	       (own.empty() ? installedShareDir()
+	                    : own + " or " + installedShareDir()) +
+	       ")";
+}
+
 std::string defaultExperimentIni()
 {
 	return findShareFile("default.ini");

@@ -99,3 +99,34 @@ TEST(Share, ProgramsWithoutAnIniUseDefaultIniAndSayWhichFile)
 	          "parameters from built-in defaults (no share/bims/default.ini "
 	          "found)");
 }
+
+// Issue 37: 'bims-run bonn.ini ...' and 'bims-sim sim/crowded.ini' gave "no
+// such config file" outside the source tree, and the error did not say
+// where presets are.
+TEST(Share, APresetIsFoundByItsNameAndAMissingOneSaysWhereItLooked)
+{
+	const auto cwd = fs::current_path();
+	const auto d = fs::temp_directory_path() / "bims_test_share_preset";
+	fs::remove_all(d);
+	fs::create_directories(d);
+	fs::current_path(d);  // no bonn.ini here
+	const std::string bonn = bims::resolvePreset("bonn.ini");
+	const std::string crowded = bims::resolvePreset("sim/crowded.ini");
+	const std::string none = bims::resolvePreset("none.ini");
+	std::ofstream("bonn.ini") << "[sensors]\n";  // a file of that name wins
+	const std::string local = bims::resolvePreset("bonn.ini");
+	fs::current_path(cwd);
+	EXPECT_EQ(bonn, bims::findShareFile("bonn.ini"));
+	EXPECT_EQ(crowded, bims::findShareFile("sim/crowded.ini"));
+	EXPECT_EQ(local, "bonn.ini");
+	EXPECT_EQ(none, "none.ini");
+	const std::string hint = bims::presetHint("none.ini");
+	EXPECT_NE(hint.find("nor a preset of that name in "), std::string::npos);
+	EXPECT_NE(
+	    hint.find(
+	        fs::path(bims::findShareFile("bonn.ini")).parent_path().string()),
+	    std::string::npos)
+	    << hint;
+	EXPECT_EQ(bims::presetHint("/abs/none.ini"), "");
+	EXPECT_EQ(bims::resolvePreset("/abs/bonn.ini"), "/abs/bonn.ini");
+}

@@ -1,6 +1,7 @@
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
+#include <bims/common/share.h>
 #include <bims/ego/params.h>
 #include <bims/ego/so3.h>
 
@@ -347,10 +348,11 @@ void EgoConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	sensors.loadFromConfigFile(cfg);
 }
 
-void EgoConfig::loadFromFile(const std::string& path)
+void EgoConfig::loadFromFile(const std::string& given)
 {
+	const std::string path = resolvePreset(given);  // "stray.ini": a preset
 	if (!mrpt::system::fileExists(path))
-		throw UsageError(path + ": no such config file");
+		throw UsageError(path + ": no such config file" + presetHint(path));
 	const auto cfg = bims::openIniFile(path);
 	checkExperimentSections(*cfg);
 	loadFromConfigFile(*cfg, false);

@@ -1,6 +1,7 @@
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
+#include <bims/common/share.h>
 #include <bims/pipeline/config.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileMemory.h>
@@ -179,10 +180,11 @@ void ExperimentConfig::loadFromConfigFile(
 	if (pipeline.variant == Variant::FusedRaycast) setVariant(pipeline.variant);
 }
 
-void ExperimentConfig::loadFromFile(const std::string& path)
+void ExperimentConfig::loadFromFile(const std::string& given)
 {
+	const std::string path = resolvePreset(given);  // "bonn.ini": a preset
 	if (!mrpt::system::fileExists(path))
-		throw ConfigError(path + ": no such config file");
+		throw ConfigError(path + ": no such config file" + presetHint(path));
 	loadFromConfigFile(*bims::openIniFile(path));
 }
 

@@ -1,4 +1,5 @@
 #include <bims/common/config.h>
+#include <bims/common/share.h>
 #include <bims/sim/simulator.h>
 #include <mrpt/config/CConfigFile.h>
 
@@ -16,11 +17,15 @@ bool startsWith(const std::string& s, const std::string& p)
 }
 }  // namespace
 
-SimConfig SimConfig::load(const std::string& path)
+SimConfig SimConfig::load(const std::string& given)
 {
+	// "sim/crowded.ini": the preset of share/bims
+	const std::string path = bims::resolvePreset(given);
 	{
 		std::ifstream f(path);
-		if (!f) throw std::runtime_error(path + ": cannot open scene file");
+		if (!f)
+			throw std::runtime_error(path + ": cannot open scene file" +
+			                         bims::presetHint(path));
 	}
 	const auto file = bims::openIniFile(path);
 	const mrpt::config::CConfigFile& ini = *file;

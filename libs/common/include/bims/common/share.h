@@ -25,6 +25,18 @@ std::string findShareFile(const std::string& name);
 /** findShareFile() as if the program lived in \a exeDir (for tests). */
 std::string findShareFile(const std::string& name, const std::string& exeDir);
 
+/** A config file the user named: \a path itself when there is a file or
+ * folder there; else, for a relative path, the preset of that name in
+ * share/bims (findShareFile: "bonn.ini", "sim/crowded.ini") when there is
+ * one; else \a path unchanged (its reader's error then names it, with
+ * presetHint). */
+std::string resolvePreset(const std::string& path);
+
+/** What an error about a missing config file adds: " (nor a preset of that
+ * name in DIR)" with the share/bims folder looked in, "" for an absolute
+ * path. */
+std::string presetHint(const std::string& path);
+
 /** The experiment .ini of a program whose command line names none:
  * share/bims/default.ini, or "" (the built-in defaults of
  * pipeline::ExperimentConfig) when there is none. */
