@@ -209,10 +209,37 @@ ImuSample imuSample(const sensor_msgs::Imu& m, double t)
 	return s;
 }
 
-double lerp(double a, double b, double f)
+/** One vector of a time-sorted stream (the accelerometer's, the
+ * magnetometer's) linearly interpolated at increasing stamps: the one rule
+ * of both merges. */
+class StreamInterpolator
 {
-	return a + (b - a) * f;
-}
+ public:
+	using Vector = double (ImuSample::*)[3];
+	StreamInterpolator(const std::vector<ImuSample>& stream, Vector v)
+	    : s_(stream), v_(v)
+	{
+	}
+	/** The vector at \a t (not before the previous call's) into \a out;
+	 * false outside the stream's time span. */
+	bool at(double t, double out[3])
+	{
+		if (s_.empty() || t < s_.front().t || t > s_.back().t) return false;
+		while (j_ + 1 < s_.size() && s_[j_ + 1].t < t) j_++;
+		const ImuSample& a = s_[j_];
+		const ImuSample& b = s_[std::min(j_ + 1, s_.size() - 1)];
+		const double f =
+		    b.t > a.t ? std::clamp((t - a.t) / (b.t - a.t), 0.0, 1.0) : 0.0;
+		for (int k = 0; k < 3; k++)
+			out[k] = (a.*v_)[k] + ((b.*v_)[k] - (a.*v_)[k]) * f;
+		return true;
+	}
+
+ private:
+	const std::vector<ImuSample>& s_;
+	Vector v_;
+	size_t j_ = 0;
+};
 
 /** The image of one message as OpenCV sees it, after the checks a corrupt
  * or foreign message fails: encoding, size, step, data length. */
@@ -300,24 +327,17 @@ std::vector<ImuSample> mergeAccelGyro(const std::vector<ImuSample>& accel,
 {
 	std::vector<ImuSample> out;
 	leftOut = 0;
-	size_t j = 0;
+	StreamInterpolator a(accel, &ImuSample::a);
 	for (const auto& g : gyro)
 	{
-		while (j + 1 < accel.size() && accel[j + 1].t < g.t) j++;
-		if (accel.empty() || g.t < accel.front().t || g.t > accel.back().t)
+		ImuSample s = g;
+		if (!a.at(g.t, s.a))
 		{
 			leftOut++;
 			continue;
 		}
-		ImuSample s = g;
 		s.hasGyro = true;
 		s.hasAccel = true;
-		const auto& a0 = accel[j];
-		const auto& a1 = accel[std::min(j + 1, accel.size() - 1)];
-		const double f =
-		    a1.t > a0.t ? std::clamp((g.t - a0.t) / (a1.t - a0.t), 0.0, 1.0)
-		                : 0.0;
-		for (int k = 0; k < 3; k++) s.a[k] = lerp(a0.a[k], a1.a[k], f);
 		out.push_back(s);
 	}
 	return out;
@@ -326,20 +346,9 @@ std::vector<ImuSample> mergeAccelGyro(const std::vector<ImuSample>& accel,
 void attachMagnetometer(std::vector<ImuSample>& imu,
                         const std::vector<ImuSample>& mag)
 {
-	if (mag.empty()) return;
-	size_t j = 0;
+	StreamInterpolator m(mag, &ImuSample::m);
 	for (auto& s : imu)
-	{
-		if (s.t < mag.front().t || s.t > mag.back().t) continue;
-		while (j + 1 < mag.size() && mag[j + 1].t < s.t) j++;
-		const auto& m0 = mag[j];
-		const auto& m1 = mag[std::min(j + 1, mag.size() - 1)];
-		const double f =
-		    m1.t > m0.t ? std::clamp((s.t - m0.t) / (m1.t - m0.t), 0.0, 1.0)
-		                : 0.0;
-		for (int k = 0; k < 3; k++) s.m[k] = lerp(m0.m[k], m1.m[k], f);
-		s.hasMag = true;
-	}
+		if (m.at(s.t, s.m)) s.hasMag = true;
 }
 
 namespace
