@@ -2,24 +2,41 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <stdexcept>
 
 #include <unistd.h>
 
 namespace bims::fuzz
 {
-const std::string& scratchDir()
+namespace
 {
-	static const std::string dir = []
+/** A folder of its own for the files one run writes, removed at exit (a
+ *  replay test or a fuzzing run leaves nothing behind in TMPDIR). */
+struct ScratchDir
+{
+	std::string path;
+	ScratchDir()
 	{
 		const char* tmp = std::getenv("TMPDIR");
-		std::string tpl =
-		    std::string(tmp && *tmp ? tmp : "/tmp") + "/bims-fuzz-XXXXXX";
-		if (!mkdtemp(tpl.data()))
+		path = std::string(tmp && *tmp ? tmp : "/tmp") + "/bims-fuzz-XXXXXX";
+		if (!mkdtemp(path.data()))
 			throw std::runtime_error("fuzz: cannot make a scratch folder");
-		return tpl;
-	}();
-	return dir;
+	}
+	~ScratchDir()
+	{
+		std::error_code ec;
+		std::filesystem::remove_all(path, ec);
+	}
+	ScratchDir(const ScratchDir&) = delete;
+	ScratchDir& operator=(const ScratchDir&) = delete;
+};
+}  // namespace
+
+const std::string& scratchDir()
+{
+	static const ScratchDir dir;
+	return dir.path;
 }
 
 std::string writeFile(const std::string& name, const uint8_t* data, size_t size)
