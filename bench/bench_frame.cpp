@@ -3,7 +3,8 @@
 // the observed flow (DIS presets x downscale, Farneback), and the flow
 // stages as the pipeline runs them with an experiment's [flow] section:
 // the derotated observed flow and its parts (warp, structure tensor, DIS,
-// composition), the expected flow and the labels. One JSON object per
+// composition), the expected flow and the labels; the surface fill of a
+// mask. One JSON object per
 // measurement on stdout (json_reporter.h); "proc_cpu_ms" is the CPU time of
 // the whole process per iteration (OpenCV's worker threads included).
 //
@@ -28,6 +29,7 @@
 #include <bims/flow/consistency.h>
 #include <bims/flow/expected_flow.h>
 #include <bims/flow/observed_flow.h>
+#include <bims/pipeline/surface_fill.h>
 
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -189,6 +191,28 @@ void benchMaskDilate(bm::State& st)
 	const cv::Mat k =
 	    cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(17, 17));
 	for (auto _ : st) cv::dilate(mask, out, k);
+}
+
+// The surface fill of a mask whose disc covers a third of the image's
+// height (bims/pipeline/surface_fill.h): labelling the depth's surfaces,
+// the distance to the moving pixels and the fill. Any surface up to the
+// whole image may be filled here, so every step runs.
+void benchSurfaceFill(bm::State& st)
+{
+	const cv::Mat& depth = g_pair.cur.depth;
+	cv::Mat mask(depth.size(), CV_8UC1, cv::Scalar(0)), m;
+	cv::circle(mask, {mask.cols / 2, mask.rows / 2}, mask.rows / 6, 255, -1);
+	bims::pipeline::SurfaceFillParams p;
+	p.maxArea = 1.0;
+	p.minMoving = 0.01;
+	bims::pipeline::SurfaceFillStats fs;
+	for (auto _ : st)
+	{
+		mask.copyTo(m);
+		fs = bims::pipeline::fillMovingSurfaces(depth, g_pair.cur.K, m, p);
+	}
+	st.counters["filled"] = fs.filled;
+	st.counters["added"] = fs.added;
 }
 
 void benchObserved(bm::State& st, bims::flow::FlowParams p)
@@ -354,6 +378,7 @@ void registerAll()
 	reg("tracker/pyramid", benchPyramid);
 	reg("tracker/fast", benchFast);
 	reg("tracker/mask_dilate", benchMaskDilate);
+	reg("surface_fill", benchSurfaceFill);
 	for (const char* preset : {"ultrafast", "fast", "medium"})
 		for (int ds : {1, 2})
 		{

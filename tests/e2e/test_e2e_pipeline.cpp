@@ -167,25 +167,39 @@ TEST(EndToEnd, DepthOnlyRunsTiers0And1WithoutTheFlowTier)
 	cfg.loadFromFile(kConfig);
 	bims::Trajectory est;
 	size_t flowOff = 0, measured = 0, frames = 0;
+	long filled = 0;
 	RunSummary sum;
-	const auto m =
-	    score(cfg, Variant::Fused, 149, &sum, depthOnly,
-	          [&](const FrameResult& r)
-	          {
-		          ++frames;
-		          flowOff += r.flowOff;
-		          EXPECT_TRUE(r.ego.flags & bims::ego::kFlagNoImage);
-		          EXPECT_TRUE(r.labels.empty());
-		          EXPECT_EQ(cv::countNonZero(r.maskFlow), 0);
-		          EXPECT_EQ(cv::countNonZero(r.maskTier2 != r.maskTier1), 0);
-		          if (r.index > 0) measured += r.ego.ok();
-		          est.push_back({r.t, r.T_WC});
-	          });
+	const auto m = score(
+	    cfg, Variant::Fused, 149, &sum, depthOnly,
+	    [&](const FrameResult& r)
+	    {
+		    ++frames;
+		    flowOff += r.flowOff;
+		    EXPECT_TRUE(r.ego.flags & bims::ego::kFlagNoImage);
+		    EXPECT_TRUE(r.labels.empty());
+		    EXPECT_EQ(cv::countNonZero(r.maskFlow), 0);
+		    EXPECT_EQ(cv::countNonZero(r.maskTier2 != r.maskTier1), 0);
+		    // The surface fill (on frames without the flow tier) only
+		    // adds to the tier's decision, and says how much.
+		    EXPECT_EQ(cv::countNonZero(r.maskTier2 & ~r.mask), 0);
+		    EXPECT_EQ(cv::countNonZero(r.mask) - cv::countNonZero(r.maskTier2),
+		              r.surfaceFill.added);
+		    filled += r.surfaceFill.added;
+		    if (r.index > 0) measured += r.ego.ok();
+		    est.push_back({r.t, r.T_WC});
+	    });
 	EXPECT_EQ(flowOff, frames);
 	EXPECT_EQ(sum.framesWithoutFlow, frames);
 	EXPECT_EQ(sum.framesFlaggedBy.at("no_image"), frames);
-	ASSERT_FALSE(sum.notes.empty());
-	EXPECT_NE(sum.notes.back().find("depth only"), std::string::npos);
+	ASSERT_GE(sum.notes.size(), 2u);
+	EXPECT_NE(sum.notes[sum.notes.size() - 2].find("depth only"),
+	          std::string::npos);
+	EXPECT_NE(sum.notes.back().find(std::to_string(filled) +
+	                                " more pixels moving on " +
+	                                std::to_string(sum.framesSurfaceFilled)),
+	          std::string::npos)
+	    << sum.notes.back();
+	EXPECT_EQ(sum.pixelsSurfaceFilled, static_cast<size_t>(filled));
 	// measured by the alignment (anchored) on almost every frame
 	EXPECT_GE(measured, frames - 1 - 3);
 	const auto gt =
@@ -196,6 +210,22 @@ TEST(EndToEnd, DepthOnlyRunsTiers0And1WithoutTheFlowTier)
 	            measured, frames - 1);
 	EXPECT_LT(ate, 0.02);
 	EXPECT_GT(m.f1(), 0.85);
+	// Without the fill: the tier's own decision.
+	cfg.pipeline.surface_fill = bims::pipeline::SurfaceFill::Off;
+	const auto off =
+	    score(cfg, Variant::Fused, 149, nullptr, depthOnly,
+	          [&](const FrameResult& r)
+	          {
+		          EXPECT_EQ(cv::countNonZero(r.mask != r.maskTier2), 0);
+		          EXPECT_EQ(r.surfaceFill.added, 0);
+	          });
+	std::printf(
+	    "depth only: F1 %.4f (P %.4f R %.4f), %ld pixels filled; "
+	    "without the fill %.4f (P %.4f R %.4f)\n",
+	    m.f1(), m.precision(), m.recall(), filled, off.f1(), off.precision(),
+	    off.recall());
+	EXPECT_GT(filled, 0);
+	EXPECT_GE(m.recall(), off.recall());
 }
 
 // One IMU stamp of the sample shifted by +1e5 s (issue 39: it released every
@@ -376,6 +406,7 @@ TEST(EndToEnd, RawlogWithoutImuRunsVisionOnly)
 	std::getline(csv, first);
 	std::getline(csv, second);
 	EXPECT_EQ(header.substr(header.rfind(',') + 1), "ego_flag_names");
+	EXPECT_NE(header.find(",ms_total,filled_px,"), std::string::npos) << header;
 	EXPECT_EQ(first.substr(first.rfind(',') + 1), "first_frame|imu_missing");
 	EXPECT_NE(second.substr(second.rfind(',') + 1).find("imu_missing"),
 	          std::string::npos)

@@ -35,6 +35,18 @@ void PipelineParams::describe(OptionVisitor& v)
 	       "0's decay of a frame on another during the next frame");
 	v.integer("opencv_threads", opencv_threads, 0, 64,
 	          "OpenCV's thread pool (0 = its default, 1 = none)");
+	v.choice("surface_fill", surface_fill,
+	         "when a depth surface mostly called moving is moving whole: "
+	         "depth-only = on frames without the flow tier");
+	v.real("surface_depth_jump", surface.depthJump, 0.001, 0.5,
+	       "neighbouring pixels are on one surface when their depths differ "
+	       "by less than this share of the larger");
+	v.real("surface_min_moving", surface.minMoving, 0.01, 1.0,
+	       "share of a surface's pixels called moving for all of it to be");
+	v.real("surface_max_area", surface.maxArea, 0.0, 1.0,
+	       "surfaces larger than this share of the image are never filled");
+	v.real("surface_margin", surface.margin, 0.0, 10.0,
+	       "a surface is filled only this far [m] from its moving pixels");
 }
 
 void PipelineParams::loadFromConfigFile(

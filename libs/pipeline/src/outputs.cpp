@@ -82,7 +82,7 @@ OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
 	csv_->append(
 	    "index,t,ego_flags,correspondences,inliers,residual_m,hit_voxels,"
 	    "moving_voxels,moving_px,diff_px,notdiff_px,"
-	    "ms_input,ms_ego,ms_flow,ms_grids,ms_total,ego_flag_names\n");
+	    "ms_input,ms_ego,ms_flow,ms_grids,ms_total,filled_px,ego_flag_names\n");
 	if (p_.labelled_rawlog)
 		rawlog_ = std::make_unique<RawlogWriter>(dir_ + "/segmented.rawlog",
 		                                         p_.labelled_rawlog_gz_level);
@@ -145,12 +145,12 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 	char buf[512];
 	std::snprintf(buf, sizeof(buf),
 	              "%zu,%.6f,%u,%d,%d,%.5f,%zu,%zu,%d,%zu,%zu,%.3f,%.3f,%.3f,%."
-	              "3f,%.3f,%s\n",
+	              "3f,%.3f,%d,%s\n",
 	              r.index, r.t, r.ego.flags, r.ego.correspondences,
 	              r.ego.inliers, r.ego.residual_rms_m, r.hitVoxels,
 	              r.movingVoxels, cv::countNonZero(r.mask), r.labelStats.diff,
 	              r.labelStats.notDiff, r.ms.input, r.ms.ego, r.ms.flow,
-	              r.ms.grids, r.ms.total,
+	              r.ms.grids, r.ms.total, r.surfaceFill.added,
 	              ego::flagsToString(r.ego.flags).c_str());
 	csv_->append(buf);
 }
@@ -252,6 +252,8 @@ void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
 	j["static_map_voxels"] = staticVoxels_;
 	j["frames_flow_ahead"] = sum.framesFlowAhead;
 	j["frames_without_flow"] = sum.framesWithoutFlow;
+	j["frames_surface_filled"] = sum.framesSurfaceFilled;
+	j["pixels_surface_filled"] = sum.pixelsSurfaceFilled;
 	j["imu_rejected"] = sum.imuRejected;
 	j["imu_out_of_order"] = sum.imuOutOfOrder;
 	j["imu_bad_stamp"] = sum.imuBadStamp;

@@ -324,7 +324,6 @@ void Pipeline::runGrids(const maps::PixelLabels* labels, FrameResult& r,
 	r.maskTier2 = toMat(g.maskTier2(), size);
 	r.hitVoxels = g.hitVoxels;
 	r.cloudStats = g.stats;
-	r.ms.grids = msSince(t);
 	switch (maskTier(cfg_.pipeline.variant))
 	{
 		case 1:
@@ -341,6 +340,19 @@ void Pipeline::runGrids(const maps::PixelLabels* labels, FrameResult& r,
 			r.mask = r.maskFlow;
 			r.movingVoxels = 0;
 	}
+	// The tracker of the next frame keeps its features off the tier's own
+	// decision: the fill is for the output (a filled false alarm fed back
+	// would take a whole static surface from the tracker).
+	feedback_ = r.mask;
+	const auto fill = cfg_.pipeline.surface_fill;
+	if (fill == SurfaceFill::Always ||
+	    (fill == SurfaceFill::DepthOnly && r.flowOff))
+	{
+		r.mask = r.mask.clone();  // the tier's own mask stays as it was
+		r.surfaceFill = fillMovingSurfaces(cur_.depth, cur_.K, r.mask,
+		                                   cfg_.pipeline.surface);
+	}
+	r.ms.grids = msSince(t);
 	// The decay last: nothing above reads tier 0 (setDeferDecay).
 	if (grids_.decayPending())
 		decaying_ = postTask(*decayThread_,
@@ -360,8 +372,9 @@ void Pipeline::finishFrame(FrameResult& r)
 		r.mask = cv::Mat::zeros(cur_.size(), CV_8UC1);
 		r.movingVoxelCentres.clear();
 		r.movingVoxels = 0;
+		r.surfaceFill = {};
+		feedback_ = r.mask;
 	}
-	feedback_ = r.mask;
 	std::swap(prev_, cur_);
 	havePrev_ = true;
 	++nFrames_;

@@ -121,6 +121,11 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		sum.framesProcessed++;
 		if (r.flowAhead) sum.framesFlowAhead++;
 		if (r.flowOff) sum.framesWithoutFlow++;
+		if (r.surfaceFill.added > 0)
+		{
+			sum.framesSurfaceFilled++;
+			sum.pixelsSurfaceFilled += static_cast<size_t>(r.surfaceFill.added);
+		}
 		const uint32_t counted =
 		    flags & ~static_cast<uint32_t>(ego::kFlagFirstFrame);
 		if (counted) sum.framesFlagged++;
@@ -243,6 +248,14 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		    "only): the flow tier was off for them (tier 1 decided, tier 2 "
 		    "equals it) and their egomotion came from the keyframe "
 		    "alignment's geometric term alone (flagged no_image)");
+	if (sum.framesSurfaceFilled > 0)
+		sum.notes.push_back(
+		    "the surface fill ([pipeline] surface_fill) called " +
+		    std::to_string(sum.pixelsSurfaceFilled) +
+		    " more pixels moving on " +
+		    std::to_string(sum.framesSurfaceFilled) +
+		    " frames: the rest of depth surfaces the tiers called mostly "
+		    "moving (frames.csv filled_px)");
 	for (auto& [name, v] : stage) sum.stageMs[name] = Percentiles::of(v);
 	sum.dataSeconds = std::isnan(firstT) ? 0 : lastT - firstT;
 	sum.meanMovingPixelFraction =

@@ -11,6 +11,7 @@
 #include <bims/ego/params.h>
 #include <bims/flow/params.h>
 #include <bims/maps/grid_params.h>
+#include <bims/pipeline/surface_fill.h>
 
 #include <mrpt/config/CConfigFileBase.h>
 
@@ -37,6 +38,26 @@ inline Choices<Variant> choices(Variant)
 	    {Variant::FusedRaycast, "fused-raycast"}};
 	return t;
 }
+/** [pipeline] surface_fill: when a depth surface mostly called moving is
+ * called moving whole (bims/pipeline/surface_fill.h). */
+enum class SurfaceFill
+{
+	Off,
+	/** Only on frames without the flow tier (depth only): the flow tier
+	 * sees a surface's own motion, which the fill stands in for. */
+	DepthOnly,
+	Always
+};
+
+inline Choices<SurfaceFill> choices(SurfaceFill)
+{
+	static constexpr ChoiceName<SurfaceFill> t[] = {
+	    {SurfaceFill::Off, "off"},
+	    {SurfaceFill::DepthOnly, "depth-only"},
+	    {SurfaceFill::Always, "always"}};
+	return t;
+}
+
 /** The grid tier whose MAP is the variant's mask: 1 or 2, or 0 for the
  * flow labels alone (the one place that says it: the pipeline's mask and
  * exclude_moving tier, the outputs' static map). */
@@ -76,6 +97,11 @@ struct PipelineParams
 	 * pool, each call runs on the thread that makes it); 0 = OpenCV's
 	 * default (one per core). */
 	int opencv_threads = 0;
+	/** When the variant's mask is filled over each depth surface mostly
+	 * called moving (bims/pipeline/surface_fill.h). */
+	SurfaceFill surface_fill = SurfaceFill::DepthOnly;
+	/** surface_depth_jump, surface_min_moving, surface_max_area. */
+	SurfaceFillParams surface;
 
 	/** Every key of the section (bims/common/options.h). */
 	void describe(OptionVisitor& v);

@@ -38,8 +38,9 @@ struct StageTimes
 	 * flow_thread: what is left of the observed flow after the egomotion) */
 	double flow = 0;
 	double observed = 0;  ///< the observed flow alone, on whichever thread
-	double grids = 0;     ///< cloud building (or waiting for it) + the tiers
-	double cloud = 0;     ///< building the FrameCloud, on whichever thread
+	/** cloud building (or waiting for it) + the tiers + the surface fill */
+	double grids = 0;
+	double cloud = 0;  ///< building the FrameCloud, on whichever thread
 	/** tier 0's decay (frustum, raycast) of the previous frame on the decay
 	 * thread (with cloud_thread; else it is part of grids), which this
 	 * frame waited for before its grids; 0 if none */
@@ -65,8 +66,11 @@ struct FrameResult
 	bool flowOff = false;
 	/** its observed flow ran during the previous frame (flow_lookahead) */
 	bool flowAhead = false;
-	/** The variant's moving-pixel mask (CV_8UC1, 255 = moving). */
+	/** The variant's moving-pixel mask (CV_8UC1, 255 = moving): its tier's
+	 * decision, with [pipeline] surface_fill its surfaces filled. */
 	cv::Mat mask;
+	/** What the surface fill added to the tier's decision. */
+	SurfaceFillStats surfaceFill;
 	/** The three decisions side by side (CV_8UC1, 255 = moving). */
 	cv::Mat maskTier1, maskTier2, maskFlow;
 	/** Flow labels (CV_8SC1: -1 none, 0 notDiff, 1 Diff); empty on frame 0. */

@@ -51,6 +51,10 @@ struct RunSummary : source::FrameOrderStats
 	/** frames without a flow tier (no image in them or in the frame
 	 * before: depth only; FrameResult::flowOff) */
 	size_t framesWithoutFlow = 0;
+	/** frames whose mask the surface fill added to ([pipeline]
+	 * surface_fill), and the pixels it added over the run */
+	size_t framesSurfaceFilled = 0;
+	size_t pixelsSurfaceFilled = 0;
 	/** Wall time of the whole run: reading, every frame, every output
 	 * (static map included; metrics.json excepted). */
 	double seconds = 0;

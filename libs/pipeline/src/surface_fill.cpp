@@ -1,0 +1,165 @@
+#include <bims/pipeline/surface_fill.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+namespace bims::pipeline
+{
+namespace
+{
+bool valid(float z)
+{
+	return z > 0.f && std::isfinite(z);
+}
+
+/** Whether two readings are on one surface (both valid, no jump). */
+bool joined(float a, float b, float jump)
+{
+	return valid(a) && valid(b) && std::abs(a - b) < jump * std::max(a, b);
+}
+}  // namespace
+
+SurfaceFillStats fillMovingSurfaces(const cv::Mat& depth,
+                                    const Eigen::Matrix3d& K, cv::Mat& mask,
+                                    const SurfaceFillParams& p)
+{
+	if (depth.type() != CV_32FC1 || mask.type() != CV_8UC1 ||
+	    depth.size() != mask.size())
+		throw std::invalid_argument(
+		    "fillMovingSurfaces: a CV_32FC1 depth and a CV_8UC1 mask of one "
+		    "size are needed");
+	SurfaceFillStats st;
+	if (cv::countNonZero(mask) == 0) return st;
+	const int h = depth.rows, w = depth.cols;
+	const auto jump = static_cast<float>(p.depthJump);
+
+	// Interior pixels: a reading joined to each of its neighbours in the
+	// image (four, fewer on its border). The rest (edges, holes) separate
+	// the surfaces.
+	cv::Mat inner(depth.size(), CV_8UC1, cv::Scalar(0));
+	for (int y = 0; y < h; ++y)
+	{
+		const float* row = depth.ptr<float>(y);
+		const float* up = y > 0 ? depth.ptr<float>(y - 1) : nullptr;
+		const float* down = y + 1 < h ? depth.ptr<float>(y + 1) : nullptr;
+		uint8_t* in = inner.ptr<uint8_t>(y);
+		for (int x = 0; x < w; ++x)
+		{
+			const float z = row[x];
+			in[x] = valid(z) && (x == 0 || joined(z, row[x - 1], jump)) &&
+			        (x + 1 == w || joined(z, row[x + 1], jump)) &&
+			        (!up || joined(z, up[x], jump)) &&
+			        (!down || joined(z, down[x], jump));
+		}
+	}
+	// connectedComponents without its statistics: they cost twice the
+	// labelling (3.6 against 1.2 ms at 640x480), and the areas are counted
+	// below with the moving pixels.
+	cv::Mat labels;
+	const int n = cv::connectedComponents(inner, labels, 4, CV_32S);
+
+	std::vector<int> moving(static_cast<size_t>(n), 0);
+	std::vector<int> area(static_cast<size_t>(n), 0);
+	for (int y = 0; y < h; ++y)
+	{
+		const int* l = labels.ptr<int>(y);
+		const uint8_t* m = mask.ptr<uint8_t>(y);
+		for (int x = 0; x < w; ++x)
+		{
+			const auto k = static_cast<size_t>(l[x]);
+			++area[k];
+			if (m[x]) ++moving[k];
+		}
+	}
+	const double maxArea = p.maxArea * h * w;
+	std::vector<uint8_t> fill(static_cast<size_t>(n), 0);
+	for (size_t k = 1; k < fill.size(); ++k)
+	{
+		if (moving[k] == 0) continue;
+		++st.surfaces;
+		if (area[k] <= maxArea && moving[k] >= p.minMoving * area[k])
+		{
+			fill[k] = 1;
+			++st.filled;
+		}
+	}
+	if (st.filled == 0) return st;
+
+	// How far each pixel is from the nearest moving one, in the image and
+	// turned into metres at its depth: the fill stays near what moves, not
+	// over the floor that a mover's feet join to its legs. On blocks of
+	// kBlock x kBlock pixels (a block is moving when one of its pixels is):
+	// the distance is a tolerance, and the transform of the whole image
+	// would cost more than the rest of the fill (3.3 ms at 640x480).
+	constexpr int kBlock = 4;
+	cv::Mat blocks, notMoving, dist;
+	cv::resize(mask, blocks,
+	           cv::Size((w + kBlock - 1) / kBlock, (h + kBlock - 1) / kBlock),
+	           0, 0, cv::INTER_AREA);
+	cv::compare(blocks, 0, notMoving, cv::CMP_EQ);
+	cv::distanceTransform(notMoving, dist, cv::DIST_L2, cv::DIST_MASK_3);
+	const double reach = p.margin * K(0, 0) / kBlock;  // [blocks x m]
+	auto near = [&](int y, int x, float z)
+	{
+		return dist.at<float>(std::min(y / kBlock, dist.rows - 1),
+		                      std::min(x / kBlock, dist.cols - 1)) *
+		           z <=
+		       reach;
+	};
+
+	// The interior of each filled surface near its moving pixels, then its
+	// rim: a pixel with a reading joined to a filled interior one of its
+	// eight neighbours (the surface's own edge pixels, not the far side of
+	// its depth edges).
+	for (int y = 0; y < h; ++y)
+	{
+		const float* row = depth.ptr<float>(y);
+		const int* l = labels.ptr<int>(y);
+		uint8_t* m = mask.ptr<uint8_t>(y);
+		for (int x = 0; x < w; ++x)
+		{
+			const auto k = static_cast<size_t>(l[x]);
+			if (m[x] || !fill[k] || !near(y, x, row[x])) continue;
+			m[x] = 255;
+			++st.added;
+		}
+	}
+	auto joinedFilled = [&](int y, int x, float z)
+	{
+		return labels.at<int>(y, x) > 0 && mask.at<uint8_t>(y, x) &&
+		       fill[static_cast<size_t>(labels.at<int>(y, x))] &&
+		       joined(z, depth.at<float>(y, x), jump);
+	};
+	for (int y = 0; y < h; ++y)
+	{
+		const float* row = depth.ptr<float>(y);
+		const int* l = labels.ptr<int>(y);
+		uint8_t* m = mask.ptr<uint8_t>(y);
+		for (int x = 0; x < w; ++x)
+		{
+			const float z = row[x];
+			if (m[x] || l[x] > 0 || !valid(z) || !near(y, x, z)) continue;
+			bool rim = false;
+			for (int dy = -1; dy <= 1 && !rim; ++dy)
+				for (int dx = -1; dx <= 1 && !rim; ++dx)
+				{
+					const int yy = y + dy, xx = x + dx;
+					rim = (dx || dy) && yy >= 0 && yy < h && xx >= 0 &&
+					      xx < w && joinedFilled(yy, xx, z);
+				}
+			if (rim)
+			{
+				m[x] = 255;
+				++st.added;
+			}
+		}
+	}
+	return st;
+}
+
+}  // namespace bims::pipeline
