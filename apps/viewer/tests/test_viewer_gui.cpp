@@ -3,17 +3,20 @@
 // (read back from the canvas) shows the three tier colours.
 #include <bims/common/frame_files.h>
 #include <bims/common/json.h>
+#include <bims/common/rawlog.h>
 #include <bims/viewer/panels.h>
 #include <bims_test/data.h>
 #include <bims_test/text.h>
 #include <gtest/gtest.h>
 
+#include <mrpt/obs/CObservation3DRangeScan.h>
 #include <sys/wait.h>
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <regex>
 #include <sstream>
 
@@ -391,6 +394,90 @@ TEST(GuiViewer, PlayingAPhoneCaptureKeepsTheLayoutAtItsImageSize)
 	                   "'" + dir + "/stray.rawlog' --config '" +
 	                       BIMS_SOURCE_DIR + "/config/stray.ini'",
 	                   2);  // mask over grey depth, depth; no flow
+}
+
+namespace
+{
+/** The camera model of \a c scaled by 2 and cropped by \a top rows. */
+mrpt::img::TCamera scaledAndCropped(mrpt::img::TCamera c, int top)
+{
+	c.ncols *= 2;
+	c.nrows = c.nrows * 2 - 2 * top;
+	c.fx(c.fx() * 2);
+	c.fy(c.fy() * 2);
+	c.cx(c.cx() * 2);
+	c.cy(c.cy() * 2 - top);
+	return c;
+}
+
+/** The first \a frames scans of the 640x480 \a in as 1280x720 (each image
+ * doubled, 120 rows cut off top and bottom, the intrinsics alike), with the
+ * IMU samples between them. */
+void upscaleTo720p(const std::string& in, const std::string& out, int frames)
+{
+	bims::RawlogReader r(in);
+	bims::RawlogWriter w(out, 1);
+	int scans = 0;
+	while (auto o = r.next())
+	{
+		auto* s = dynamic_cast<mrpt::obs::CObservation3DRangeScan*>(o.get());
+		if (s)
+		{
+			if (scans++ == frames) break;
+			const auto& ri = s->rangeImage;
+			cv::Mat d(static_cast<int>(ri.rows()), static_cast<int>(ri.cols()),
+			          CV_16UC1);
+			for (int y = 0; y < d.rows; ++y)
+				for (int x = 0; x < d.cols; ++x)
+					d.at<uint16_t>(y, x) = ri(y, x);
+			cv::resize(d, d, cv::Size(), 2, 2, cv::INTER_NEAREST);
+			d = d(cv::Rect(0, 120, 1280, 720)).clone();
+			s->rangeImage.resize(d.rows, d.cols);
+			for (int y = 0; y < d.rows; ++y)
+				for (int x = 0; x < d.cols; ++x)
+					s->rangeImage(y, x) = d.at<uint16_t>(y, x);
+			cv::Mat img =
+			    s->intensityImage.asCvMat<cv::Mat>(mrpt::img::SHALLOW_COPY);
+			cv::resize(img, img, cv::Size(), 2, 2, cv::INTER_LINEAR);
+			s->intensityImage = mrpt::img::CImage(
+			    img(cv::Rect(0, 120, 1280, 720)).clone(), mrpt::img::DEEP_COPY);
+			s->cameraParams = scaledAndCropped(s->cameraParams, 120);
+			s->cameraParamsIntensity =
+			    scaledAndCropped(s->cameraParamsIntensity, 120);
+		}
+		w.write(*o);
+	}
+}
+}  // namespace
+
+// A 1280x720 recording (the simulation doubled and cut to 16:9): the panels
+// keep its aspect ratio, the window stays live.
+TEST(GuiViewer, PlayingA720pRecordingKeepsTheLayoutAtItsImageSize)
+{
+	const std::string dir = testDir("playing_720p");
+	const std::string in = dir + "/crowded720.rawlog";
+	upscaleTo720p(crowded640(dir), in, 80);
+	const auto [img, v3] =
+	    checkPlayingWindow(dir, "'" + in + "' --config '" + BIMS_SOURCE_DIR +
+	                                "/config/default.ini' --speed 0.25");
+	if (img.empty()) return;
+	// The depth panel (jet colours, no flat row): the rows that show the
+	// image, below the caption, are 9/16 of its width; the rest of the cell
+	// is the flat background.
+	const auto s = bims::Json::parse(slurp(dir + "/shot.2.json"));
+	const cv::Rect pr = rectOf(s["panels"][1]);
+	const cv::Rect body = cv::Rect(pr.x, pr.y + 20, pr.width, pr.height - 20) &
+	                      cv::Rect(0, 0, img.cols, img.rows);
+	int imageRows = 0;
+	for (int y = body.y; y < body.y + body.height; ++y)
+	{
+		cv::Scalar mean, sd;
+		cv::meanStdDev(img(cv::Rect(body.x + 2, y, body.width - 4, 1)), mean,
+		               sd);
+		imageRows += sd[0] + sd[1] + sd[2] > 10;
+	}
+	EXPECT_NEAR(imageRows, body.width * 9.0 / 16.0, 4) << pr;
+	EXPECT_LT(imageRows, body.height - 10) << "no band: 4:3, not 16:9";
 }
 
 // --paused shows the first frame (not "-1 / N" and empty panels).

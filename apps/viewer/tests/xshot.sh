@@ -31,11 +31,14 @@ if [ "$own" = "play2" ]; then
 	"$@" --state-file "$state" &
 	pid=$!
 	i=0
-	while [ ! -s "$state" ] && [ "$i" -lt 600 ]; do
+	# until the state file says a frame was drawn (it is written at open,
+	# with frame -1: a large first frame may take seconds under load)
+	drawn() { grep -q '"frame": *[0-9]' "$state" 2>/dev/null; }
+	while ! drawn && [ "$i" -lt 1200 ]; do
 		sleep 0.1
 		i=$((i + 1))
 	done
-	[ -s "$state" ] || finish 4
+	drawn || finish 4
 	sleep 1
 	for k in 1 2; do
 		import -window root "$xshot.$k.png" || finish 5
