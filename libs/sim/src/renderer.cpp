@@ -84,6 +84,7 @@ void RgbParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
                                    const std::string& section)
 {
 	ConfigSection s(cfg, section);
+	enabled = s.getBool("enabled", enabled);
 	noiseSigma = s.getDouble("noise_sigma", noiseSigma, 0, 100);
 	ambient = s.getDouble("ambient", ambient, 0, 1);
 	const auto l = s.getDoubles(

@@ -62,10 +62,13 @@ mrpt::obs::CObservation3DRangeScan::Ptr makeScan(const SimConfig& cfg,
 	o->cameraParamsIntensity = o->cameraParams;
 	o->relativePoseIntensityWRTDepth =
 	    mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
-	o->hasIntensityImage = true;
-	o->intensityImageChannel = CObservation3DRangeScan::CH_VISIBLE;
-	o->intensityImage.loadFromMemoryBuffer(
-	    unsigned(f.width), unsigned(f.height), true, f.rgb.data(), true);
+	o->hasIntensityImage = cfg.rgb.enabled;
+	if (cfg.rgb.enabled)
+	{
+		o->intensityImageChannel = CObservation3DRangeScan::CH_VISIBLE;
+		o->intensityImage.loadFromMemoryBuffer(
+		    unsigned(f.width), unsigned(f.height), true, f.rgb.data(), true);
+	}
 	if (cfg.seq.pixelLabels)
 	{
 		// Label 0, bit 0 of each pixel; written in one buffer (MRPT's bytes).

@@ -147,6 +147,36 @@ TEST(BimsSim, RawlogRoundTripsThroughMrptReader)
 	          std::string::npos);
 }
 
+// [rgb] enabled = false: a depth-only sensor. The scans carry no intensity
+// image, the depth is the same as with one (same seed).
+TEST(BimsSim, WithoutRgbTheScansAreDepthOnlyWithTheSameDepth)
+{
+	const std::string a = tmpDir("with_rgb"), b = tmpDir("depth_only");
+	mrpt::obs::CRawlog ra, rb;
+	ASSERT_TRUE(ra.loadFromRawLogFile(simulate(a, kSmallScene, "--seed 3")));
+	ASSERT_TRUE(rb.loadFromRawLogFile(simulate(
+	    b, std::string(kSmallScene) + "\n[rgb]\nenabled=false\n", "--seed 3")));
+	ASSERT_EQ(ra.size(), rb.size());
+	size_t scans = 0;
+	for (size_t i = 0; i < ra.size(); i++)
+	{
+		const auto sa =
+		    std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(
+		        ra.getAsObservation(i));
+		const auto sb =
+		    std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(
+		        rb.getAsObservation(i));
+		ASSERT_EQ(!sa, !sb) << i;
+		if (!sa) continue;
+		++scans;
+		EXPECT_TRUE(sa->hasIntensityImage);
+		EXPECT_FALSE(sb->hasIntensityImage);
+		EXPECT_TRUE(sb->intensityImage.isEmpty());
+		EXPECT_TRUE(sa->rangeImage == sb->rangeImage) << "scan " << scans;
+	}
+	EXPECT_EQ(scans, 12u);
+}
+
 TEST(BimsSim, RawlogEditListsBothSensorsAtTheirRates)
 {
 	std::string out;

@@ -58,6 +58,9 @@ struct DepthParams
 /** [rgb]: shading and image noise. */
 struct RgbParams
 {
+	/** false: depth only, the scans carry no intensity image (a phone's
+	 * LiDAR without its video, a time-of-flight camera). */
+	bool enabled = true;
 	double noiseSigma = 2.0;  ///< white noise per channel [grey levels]
 	double ambient = 0.45;    ///< ambient light fraction
 	Eigen::Vector3d lightDir_W{0.4, 0.3,
