@@ -47,6 +47,9 @@ void PipelineParams::describe(OptionVisitor& v)
 	       "surfaces larger than this share of the image are never filled");
 	v.real("surface_margin", surface.margin, 0.0, 10.0,
 	       "a surface is filled only this far [m] from its moving pixels");
+	v.real("surface_horizontal_deg", surface.horizontalDeg, 0.0, 89.0,
+	       "with the IMU's gravity, pixels within this angle of horizontal "
+	       "(floors) belong to no surface (0 = off)");
 }
 
 void PipelineParams::loadFromConfigFile(

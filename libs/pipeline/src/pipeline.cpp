@@ -5,6 +5,7 @@
 #include <chrono>
 #include <functional>
 #include <future>
+#include <optional>
 #include <stdexcept>
 
 #include "worker.h"
@@ -349,8 +350,15 @@ void Pipeline::runGrids(const maps::PixelLabels* labels, FrameResult& r,
 	    (fill == SurfaceFill::DepthOnly && r.flowOff))
 	{
 		r.mask = r.mask.clone();  // the tier's own mask stays as it was
-		r.surfaceFill = fillMovingSurfaces(cur_.depth, cur_.K, r.mask,
-		                                   cfg_.pipeline.surface);
+		// Up in the camera's axes from the IMU's attitude, once it has
+		// converged (gravity; no heading needed).
+		std::optional<Eigen::Vector3d> up;
+		if (!odom_.attitude().converging(cur_.t))
+			if (const auto R_WC = odom_.imuRotation(cur_.t))
+				up = R_WC->transpose() * Eigen::Vector3d::UnitZ();
+		r.surfaceFill =
+		    fillMovingSurfaces(cur_.depth, cur_.K, r.mask,
+		                       cfg_.pipeline.surface, up ? &*up : nullptr);
 	}
 	r.ms.grids = msSince(t);
 	// The decay last: nothing above reads tier 0 (setDeferDecay).

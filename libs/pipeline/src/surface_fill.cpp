@@ -1,5 +1,6 @@
 #include <bims/pipeline/surface_fill.h>
 
+#include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -22,11 +23,48 @@ bool joined(float a, float b, float jump)
 {
 	return valid(a) && valid(b) && std::abs(a - b) < jump * std::max(a, b);
 }
+/** Marks 2 in \a inner the interior pixels whose surface is within
+ * p.horizontalDeg of horizontal: its normal (from the neighbours kStep
+ * pixels away on either side) within that angle of \a upC. */
+void cutHorizontal(const cv::Mat& depth, const Eigen::Matrix3d& K,
+                   const Eigen::Vector3d& upC, const SurfaceFillParams& p,
+                   cv::Mat& inner)
+{
+	constexpr int kStep = 2;
+	const int h = depth.rows, w = depth.cols;
+	const double fx = K(0, 0), fy = K(1, 1), cx = K(0, 2), cy = K(1, 2);
+	const double cosMax = std::cos(p.horizontalDeg * M_PI / 180.0);
+	const Eigen::Vector3d up = upC.normalized();
+	auto point = [&](int y, int x)
+	{
+		const double z = depth.at<float>(y, x);
+		return Eigen::Vector3d((x - cx) * z / fx, (y - cy) * z / fy, z);
+	};
+	for (int y = kStep; y + kStep < h; ++y)
+	{
+		uint8_t* in = inner.ptr<uint8_t>(y);
+		for (int x = kStep; x + kStep < w; ++x)
+		{
+			if (!in[x]) continue;
+			const float l = depth.at<float>(y, x - kStep),
+			            r = depth.at<float>(y, x + kStep),
+			            u = depth.at<float>(y - kStep, x),
+			            d = depth.at<float>(y + kStep, x);
+			if (!valid(l) || !valid(r) || !valid(u) || !valid(d)) continue;
+			const Eigen::Vector3d n =
+			    (point(y, x + kStep) - point(y, x - kStep))
+			        .cross(point(y + kStep, x) - point(y - kStep, x));
+			const double len = n.norm();
+			if (len > 0 && std::abs(n.dot(up)) > cosMax * len) in[x] = 2;
+		}
+	}
+}
 }  // namespace
 
 SurfaceFillStats fillMovingSurfaces(const cv::Mat& depth,
                                     const Eigen::Matrix3d& K, cv::Mat& mask,
-                                    const SurfaceFillParams& p)
+                                    const SurfaceFillParams& p,
+                                    const Eigen::Vector3d* upC)
 {
 	if (depth.type() != CV_32FC1 || mask.type() != CV_8UC1 ||
 	    depth.size() != mask.size())
@@ -56,6 +94,14 @@ SurfaceFillStats fillMovingSurfaces(const cv::Mat& depth,
 			        (!up || joined(z, up[x], jump)) &&
 			        (!down || joined(z, down[x], jump));
 		}
+	}
+	// Horizontal pixels (2 in inner): in no surface, and never filled.
+	cv::Mat flat;
+	if (upC && p.horizontalDeg > 0)
+	{
+		cutHorizontal(depth, K, *upC, p, inner);
+		cv::compare(inner, 2, flat, cv::CMP_EQ);
+		inner.setTo(0, flat);
 	}
 	// connectedComponents without its statistics: they cost twice the
 	// labelling (3.6 against 1.2 ms at 640x480), and the areas are counted
@@ -143,7 +189,9 @@ SurfaceFillStats fillMovingSurfaces(const cv::Mat& depth,
 		for (int x = 0; x < w; ++x)
 		{
 			const float z = row[x];
-			if (m[x] || l[x] > 0 || !valid(z) || !near(y, x, z)) continue;
+			if (m[x] || l[x] > 0 || !valid(z) || !near(y, x, z) ||
+			    (!flat.empty() && flat.at<uint8_t>(y, x)))
+				continue;
 			bool rim = false;
 			for (int dy = -1; dy <= 1 && !rim; ++dy)
 				for (int dx = -1; dx <= 1 && !rim; ++dx)

@@ -136,6 +136,41 @@ TEST(SurfaceFill, DepthJumpsSeparateSurfacesAndSlopesDoNot)
 	EXPECT_EQ(count(mask, cv::Rect(80, 0, 80, kH)), 0);
 }
 
+TEST(SurfaceFill, WithGravityAFloorJoinsNoSurfaceAndIsNeverFilled)
+{
+	// The camera 1 m above a floor, looking level (y down): floor row v at
+	// depth 150 / (v - 60); a box 3 m away standing on it (columns 60-99,
+	// rows 70-109, 0.2-1.0 m below the camera), its foot at the floor's
+	// depth: one surface without gravity.
+	cv::Mat depth(kH, kW, CV_32FC1, cv::Scalar(0.0f));
+	for (int v = 61; v < kH; ++v)
+		depth.row(v).setTo(150.0f / static_cast<float>(v - 60));
+	const cv::Rect box(60, 70, 40, 40);
+	depth(box).setTo(3.0f);
+	cv::Mat mask(kH, kW, CV_8UC1, cv::Scalar(0));
+	mask(cv::Rect(60, 70, 40, 16)).setTo(255);  // 40 % of the box
+	SurfaceFillParams p;
+	p.maxArea = 0.2;
+	p.margin = 10;
+	// Without gravity the box and the floor are one surface, too large.
+	cv::Mat noUp = mask.clone();
+	EXPECT_EQ(fillMovingSurfaces(depth, intrinsics(), noUp, p).filled, 0);
+	EXPECT_EQ(cv::countNonZero(noUp), 40 * 16);
+	// With it the floor is cut away: the box alone is filled, the floor
+	// not at all (its foot's two rows are where the normals mix).
+	const Eigen::Vector3d up(0, -1, 0);
+	cv::Mat withUp = mask.clone();
+	const auto st = fillMovingSurfaces(depth, intrinsics(), withUp, p, &up);
+	EXPECT_EQ(st.filled, 1);
+	EXPECT_EQ(count(withUp, cv::Rect(60, 70, 40, 38)), 40 * 38);
+	EXPECT_EQ(count(withUp, cv::Rect(0, 110, kW, kH - 110)), 0);
+	EXPECT_EQ(cv::countNonZero(withUp(cv::Rect(0, 0, 60, kH))), 0);
+	// horizontalDeg = 0: off, as without gravity.
+	p.horizontalDeg = 0;
+	cv::Mat off = mask.clone();
+	EXPECT_EQ(fillMovingSurfaces(depth, intrinsics(), off, p, &up).filled, 0);
+}
+
 TEST(SurfaceFill, WrongTypesOrSizesAreRefused)
 {
 	cv::Mat mask(kH, kW, CV_8UC1, cv::Scalar(255));

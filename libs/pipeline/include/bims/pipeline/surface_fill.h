@@ -28,6 +28,11 @@ struct SurfaceFillParams
 	 * of its moving pixels (in the image, at the pixel's depth) are filled:
 	 * not a floor that a mover's feet join to its legs. */
 	double margin = 0.2;
+	/** With the direction up in the camera's axes (the IMU's gravity),
+	 * pixels whose surface lies within this angle [deg] of horizontal
+	 * (floors, table tops) belong to no surface: a mover's feet do not join
+	 * it to the floor. 0: off. */
+	double horizontalDeg = 30;
 };
 
 struct SurfaceFillStats
@@ -40,12 +45,14 @@ struct SurfaceFillStats
 /** Fills \a mask (CV_8UC1, 255 = moving, the size of \a depth) over every
  * surface of \a depth (CV_32FC1 [m], 0 or NaN = no reading; \a K its
  * intrinsics) that the parameters select, within the margin of its
- * moving pixels; pixels already moving stay moving, pixels without a
+ * moving pixels; \a upC (optional): up in the camera's axes, for
+ * horizontalDeg; pixels already moving stay moving, pixels without a
  * reading are never added. Writes into \a mask's own data: clone a mask
  * that shares its data first. Throws std::invalid_argument when the sizes
  * or types differ. */
 SurfaceFillStats fillMovingSurfaces(const cv::Mat& depth,
                                     const Eigen::Matrix3d& K, cv::Mat& mask,
-                                    const SurfaceFillParams& p);
+                                    const SurfaceFillParams& p,
+                                    const Eigen::Vector3d* upC = nullptr);
 
 }  // namespace bims::pipeline
