@@ -9,13 +9,30 @@ function(bims_target_defaults tgt)
   target_compile_options(${tgt} PRIVATE -Wall -Wextra -ffp-contract=off)
 endfunction()
 
-# bims_add_library(NAME sim SOURCES ... DEPS ... [NO_INSTALL])
+# bims_exclude_if_untested(target label...): TARGET is left out of the
+# default build when the tests of every LABEL are (BIMS_SKIP_TEST_LABELS):
+# such a tree builds what its suite runs, e.g. the sanitizer tree of make
+# test-sanitize (no cli and sweep tests) builds neither bims-sweep nor
+# bims-maps-figure and the two flow tools. Without LABELs, nothing is left out.
+function(bims_exclude_if_untested tgt)
+  if(NOT ARGN)
+    return()
+  endif()
+  foreach(label ${ARGN})
+    if(NOT label IN_LIST BIMS_SKIP_TEST_LABELS)
+      return()
+    endif()
+  endforeach()
+  set_target_properties(${tgt} PROPERTIES EXCLUDE_FROM_ALL ON)
+endfunction()
+
+# bims_add_library(NAME sim SOURCES ... DEPS ... [NO_INSTALL] [TESTED_BY label...])
 # Creates static library bims_<NAME> with alias bims::<NAME>; public headers in
 # libs/<NAME>/include/bims/<NAME>/. Unless NO_INSTALL, the library joins the
 # exported package (bims::<NAME> for find_package(bims), cmake/BimsInstall.cmake)
 # and its headers are installed into include/bims/<NAME>/.
 function(bims_add_library)
-  cmake_parse_arguments(A "NO_INSTALL" "NAME" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
+  cmake_parse_arguments(A "NO_INSTALL" "NAME" "SOURCES;DEPS;PRIVATE_DEPS;TESTED_BY" ${ARGN})
   set(tgt bims_${A_NAME})
   add_library(${tgt} STATIC ${A_SOURCES})
   add_library(bims::${A_NAME} ALIAS ${tgt})
@@ -26,6 +43,7 @@ function(bims_add_library)
   set_target_properties(${tgt} PROPERTIES POSITION_INDEPENDENT_CODE ON
                                           EXPORT_NAME ${A_NAME})
   bims_target_defaults(${tgt})
+  bims_exclude_if_untested(${tgt} ${A_TESTED_BY})
   if(NOT A_NO_INSTALL)
     install(TARGETS ${tgt} EXPORT bimsTargets
             ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
@@ -34,13 +52,16 @@ function(bims_add_library)
   endif()
 endfunction()
 
-# bims_add_app(NAME bims-sim SOURCES ... DEPS ... [SUMMARY "one line"]): an
-# executable in build/bin, and its man page (bims_add_man_page).
+# bims_add_app(NAME bims-sim SOURCES ... DEPS ... [SUMMARY "one line"]
+# [TESTED_BY label...]): an executable in build/bin, and its man page
+# (bims_add_man_page). TESTED_BY: the labels of the only tests that run it
+# (bims_exclude_if_untested).
 function(bims_add_app)
-  cmake_parse_arguments(A "" "NAME;SUMMARY" "SOURCES;DEPS" ${ARGN})
+  cmake_parse_arguments(A "" "NAME;SUMMARY" "SOURCES;DEPS;TESTED_BY" ${ARGN})
   add_executable(${A_NAME} ${A_SOURCES})
   target_link_libraries(${A_NAME} PRIVATE ${A_DEPS})
   bims_target_defaults(${A_NAME})
+  bims_exclude_if_untested(${A_NAME} ${A_TESTED_BY})
   install(TARGETS ${A_NAME} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
   bims_add_man_page(${A_NAME} "${A_SUMMARY}")
 endfunction()
@@ -62,7 +83,8 @@ endif()
 # bims_add_man_page(program "summary"): PROGRAM.1 from `program --help`
 # (target PROGRAM-man, part of the default build).
 function(bims_add_man_page program summary)
-  if(NOT BIMS_MAN_DIR)
+  get_target_property(left_out ${program} EXCLUDE_FROM_ALL)
+  if(NOT BIMS_MAN_DIR OR left_out)
     return()
   endif()
   if(NOT summary)
@@ -84,6 +106,7 @@ function(bims_add_man_page program summary)
 endfunction()
 
 # bims_add_gtest(NAME test_x SOURCES ... DEPS ... [LABELS ...] [TIMEOUT s])
+# (none when one of its LABELS is in BIMS_SKIP_TEST_LABELS)
 # A gtest executable in build/bin, its cases registered with CTest one by one.
 # Compile definitions give the tests the source tree, the shared data folder and
 # the binary folder (where the apps are).
@@ -92,6 +115,11 @@ function(bims_add_gtest)
   if(NOT BIMS_BUILD_TESTS)
     return()
   endif()
+  foreach(label ${A_LABELS})
+    if(label IN_LIST BIMS_SKIP_TEST_LABELS)
+      return()
+    endif()
+  endforeach()
   if(NOT A_TIMEOUT)
     set(A_TIMEOUT 300)
   endif()
