@@ -27,6 +27,7 @@ if [ -z "$DATA" ]; then
 	trap 'rm -rf "$DATA"' EXIT
 fi
 mkdir -p "$DATA"
+. scripts/sim_experiment.sh
 
 echo "| preset | surface_fill | precision | recall | F1 | ATE RMSE [m] |"
 echo "|---|---|---|---|---|---|"
@@ -36,17 +37,9 @@ for p in $PRESETS; do
 	gt="$DATA/${p}_gt"
 	{ cat "config/sim/$p.ini"; printf '\n[rgb]\nenabled=false\n'; } > "$scene"
 	[ -f "$rl" ] || "$BIN/bims-sim" "$scene" -o "$rl" -r "$RES" --max-frames "$FRAMES" --seed 1 -q >&2
-	ric=$(awk -F= '/^R_IC=/{print $2}' "$gt/calibration.ini")
-	off=$(awk -F= '/^time_offset_s=/{print $2}' "$gt/calibration.ini")
 	for fill in off depth-only; do
 		cfg="$DATA/${p}_$fill.ini"
-		awk -v ric="$ric" -v off="$off" -v fill="$fill" '
-			/^\[/ {sec=$0}
-			sec=="[calibration]" && /^R_IC=/ {print "R_IC=" ric; next}
-			sec=="[calibration]" && /^time_offset_s=/ {print "time_offset_s=" off; next}
-			sec=="[pipeline]" && /^surface_fill=/ {print "surface_fill=" fill; next}
-			sec=="[output]" && /^(moving_ply|static_map|labelled_rawlog)=/ {sub(/=.*/, "=false")}
-			{print}' config/default.ini > "$cfg"
+		sim_experiment_config "$gt/calibration.ini" "$cfg" pipeline.surface_fill=$fill
 		out="$DATA/out_${p}_$fill"
 		"$BIN/bims-run" "$cfg" "$rl" -o "$out" --overwrite -q > "$out.log" 2>&1 ||
 			{ echo "| $p | $fill | run failed: see $out.log | | | |"; continue; }

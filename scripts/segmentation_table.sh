@@ -26,20 +26,7 @@ if [ -z "$DATA" ]; then
 fi
 mkdir -p "$DATA"
 
-# default.ini with [calibration] taken from CALIB.ini and [grids] decay=$3
-make_config() {
-	local calib=$1 out=$2 decay=$3
-	local ric off
-	ric=$(awk -F= '/^R_IC=/{print $2}' "$calib")
-	off=$(awk -F= '/^time_offset_s=/{print $2}' "$calib")
-	awk -v ric="$ric" -v off="$off" -v decay="$decay" '
-		/^\[/ {sec=$0}
-		sec=="[calibration]" && /^R_IC=/ {print "R_IC=" ric; next}
-		sec=="[calibration]" && /^time_offset_s=/ {print "time_offset_s=" off; next}
-		sec=="[grids]" && /^decay=/ && decay!="" {print "decay=" decay; next}
-		sec=="[output]" && /^(moving_ply|static_map|labelled_rawlog)=/ {sub(/=.*/, "=false")}
-		{print}' config/default.ini > "$out"
-}
+. scripts/sim_experiment.sh
 
 echo "| preset | variant | precision | recall | F1 | IoU | voxel F1 | ATE RMSE [m] | ms/frame (pipeline, median) |"
 echo "|---|---|---|---|---|---|---|---|---|"
@@ -49,8 +36,8 @@ for p in $PRESETS; do
 	if [ ! -f "$rl" ]; then
 		"$BIN/bims-sim" "config/sim/$p.ini" -o "$rl" -r "$RES" --max-frames "$FRAMES" --seed 1 -q >&2
 	fi
-	make_config "$gt/calibration.ini" "$DATA/$p.ini" ""
-	make_config "$gt/calibration.ini" "$DATA/${p}_all.ini" all
+	sim_experiment_config "$gt/calibration.ini" "$DATA/$p.ini"
+	sim_experiment_config "$gt/calibration.ini" "$DATA/${p}_all.ini" grids.decay=all
 	for row in "bottom-only bottom-only $p" "flow-only flow-only $p" \
 		"fused,decay=all fused ${p}_all" "fused fused $p" \
 		"fused+raycast fused-raycast $p"; do

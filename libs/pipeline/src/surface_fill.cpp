@@ -1,11 +1,12 @@
 #include <bims/pipeline/surface_fill.h>
 
+#include <bims/ego/rgbd_input.h>
+
 #include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -32,13 +33,13 @@ void cutHorizontal(const cv::Mat& depth, const Eigen::Matrix3d& K,
 {
 	constexpr int kStep = 2;
 	const int h = depth.rows, w = depth.cols;
-	const double fx = K(0, 0), fy = K(1, 1), cx = K(0, 2), cy = K(1, 2);
 	const double cosMax = std::cos(p.horizontalDeg * M_PI / 180.0);
 	const Eigen::Vector3d up = upC.normalized();
 	auto point = [&](int y, int x)
 	{
-		const double z = depth.at<float>(y, x);
-		return Eigen::Vector3d((x - cx) * z / fx, (y - cy) * z / fy, z);
+		return ego::backProject(
+		    K, cv::Point2f(static_cast<float>(x), static_cast<float>(y)),
+		    depth.at<float>(y, x));
 	};
 	for (int y = kStep; y + kStep < h; ++y)
 	{
