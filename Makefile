@@ -13,8 +13,12 @@ CMAKE_ARGS ?=
 GENERATOR ?= Ninja
 UNITY ?= ON
 TREE_ARGS = -G "$(GENERATOR)" -DCMAKE_UNITY_BUILD=$(UNITY)
+# On CI (CI=true) a compiler warning is an error (BIMS_WERROR).
+ifeq ($(CI),true)
+TREE_ARGS += -DBIMS_WERROR=ON
+endif
 
-.PHONY: all deps configure build test test-sanitize demo bench fuzz format clean
+.PHONY: all deps configure build test test-sanitize demo bench fuzz format format-check clean
 
 all: build
 
@@ -70,8 +74,14 @@ bench: build
 fuzz:
 	@./scripts/fuzz.sh $(TARGET) $(SECONDS)
 
+FORMAT_SOURCES = find apps libs tests bench examples -name '*.cpp' -o -name '*.h' 2>/dev/null
 format:
-	@find apps libs tests bench -name '*.cpp' -o -name '*.h' | xargs -r clang-format -i
+	@$(FORMAT_SOURCES) | xargs -r clang-format -i
+
+# Fails naming each file and line that make format would change (.ci/run).
+format-check: deps
+	@$(FORMAT_SOURCES) | xargs -r clang-format --dry-run --Werror
+	@echo "[format] every source file is formatted"
 
 clean:
 	rm -rf $(BUILD_DIR)

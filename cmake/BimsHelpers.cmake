@@ -6,7 +6,8 @@
 # compiler may use FMA (e.g. -march=native on a CPU that has it).
 function(bims_target_defaults tgt)
   target_compile_features(${tgt} PUBLIC cxx_std_17)
-  target_compile_options(${tgt} PRIVATE -Wall -Wextra -ffp-contract=off)
+  target_compile_options(${tgt} PRIVATE -Wall -Wextra -ffp-contract=off
+                                        $<$<BOOL:${BIMS_WERROR}>:-Werror>)
 endfunction()
 
 # bims_exclude_if_untested(target label...): TARGET is left out of the
