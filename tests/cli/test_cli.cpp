@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "bims_test/text.h"
 
 namespace fs = std::filesystem;
 
@@ -38,14 +39,6 @@ const std::vector<std::string> kPrograms = {
 bool built(const std::string& program)
 {
 	return fs::exists(kBin + "/" + program.substr(0, program.find(' ')));
-}
-
-std::string slurp(const std::string& path)
-{
-	std::ifstream f(path);
-	std::stringstream s;
-	s << f.rdbuf();
-	return s.str();
 }
 
 /** An option as --help prints it: "-o <OUTDIR>,  --out <OUTDIR>". */
@@ -88,7 +81,7 @@ std::map<std::string, Option> optionsOf(const std::string& program)
 std::map<std::string, std::set<std::string>> docsTable()
 {
 	std::map<std::string, std::set<std::string>> rows;
-	std::istringstream in(slurp(kSrc + "/docs/cli.md"));
+	std::istringstream in(bims::test::fileText(kSrc + "/docs/cli.md"));
 	const std::regex name("`(--?[a-z][a-z0-9-]*)");
 	bool inTable = false;  // the table under "## Every option"
 	for (std::string l; std::getline(in, l);)
@@ -206,7 +199,7 @@ TEST(Cli, EveryOptionOfEveryProgramIsInTheOneTableOfDocsCli)
 		EXPECT_TRUE(listed) << n << " is not in this test's list of programs";
 	}
 	// README links the table
-	EXPECT_NE(slurp(kSrc + "/README.md").find("docs/cli.md"),
+	EXPECT_NE(bims::test::fileText(kSrc + "/README.md").find("docs/cli.md"),
 	          std::string::npos);
 }
 
@@ -219,7 +212,7 @@ TEST(Cli, EachProgramHasAManPageNamingItsOptions)
 		const std::string program = p.substr(0, p.find(' '));
 		const std::string page = kManDir + "/" + program + ".1";
 		ASSERT_TRUE(fs::exists(page)) << page;
-		const std::string text = slurp(page);
+		const std::string text = bims::test::fileText(page);
 		EXPECT_NE(text.find(".SH NAME\n" + program + " \\- "),
 		          std::string::npos)
 		    << page;
@@ -283,7 +276,7 @@ TEST(Cli, RedirectedLongCommandsPrintPlainProgressLinesWithTotalRateAndEta)
 	    "(" + kBin + "/bims-sim " + kSrc + "/config/sim/pendulum_slow.ini -o " +
 	    d + "/s.rawlog -r 320x240 --max-frames 20 2> " + d + "/sim.err)");
 	ASSERT_EQ(sim.code, 0) << sim.out;
-	const std::string err = slurp(d + "/sim.err");
+	const std::string err = bims::test::fileText(d + "/sim.err");
 	EXPECT_EQ(err.find('\r'), std::string::npos);
 	const std::regex simLine(
 	    R"(^bims-sim: \d+/20 frames \(\d+ %\), [0-9.]+ frames/s, [0-9.]+ s, ETA [0-9.]+ s$)");
@@ -299,8 +292,8 @@ TEST(Cli, RedirectedLongCommandsPrintPlainProgressLinesWithTotalRateAndEta)
 	const auto run = bims::test::runCommand("(" + kBin + "/bims-run " +
 	                                        kConfig + " " + kSample + " -o " +
 	                                        d + "/out 2> " + d + "/run.err)");
-	ASSERT_EQ(run.code, 0) << run.out << slurp(d + "/run.err");
-	const std::string rerr = slurp(d + "/run.err");
+	ASSERT_EQ(run.code, 0) << run.out << bims::test::fileText(d + "/run.err");
+	const std::string rerr = bims::test::fileText(d + "/run.err");
 	EXPECT_EQ(rerr.find('\r'), std::string::npos);
 	const std::regex runLine(
 	    R"(^bims-run: \d+/~\d+ frames \(\d+ %\), [0-9.]+ frames/s, [0-9.]+ s, ETA [0-9.]+ s, frame \d+$)");
@@ -318,15 +311,17 @@ TEST(Cli, RedirectedLongCommandsPrintPlainProgressLinesWithTotalRateAndEta)
 	const std::regex odomLine(
 	    R"(^bims-odom: \d+/~\d+ frames \(\d+ %\), [0-9.]+ frames/s, [0-9.]+ s, ETA [0-9.]+ s$)");
 	n = 0;
-	for (const auto& l : linesWith(slurp(d + "/odom.err"), "bims-odom: "))
+	for (const auto& l :
+	     linesWith(bims::test::fileText(d + "/odom.err"), "bims-odom: "))
 		n += std::regex_match(l, odomLine);
-	EXPECT_GE(n, 3u) << slurp(d + "/odom.err");
+	EXPECT_GE(n, 3u) << bims::test::fileText(d + "/odom.err");
 	// -q: none
 	const auto quiet = bims::test::runCommand(
 	    "(" + kBin + "/bims-run " + kConfig + " " + kSample + " -o " + d +
 	    "/out2 --frames 0:4 -q 2> " + d + "/q.err)");
 	ASSERT_EQ(quiet.code, 0) << quiet.out;
-	EXPECT_TRUE(linesWith(slurp(d + "/q.err"), " frames (").empty());
+	EXPECT_TRUE(
+	    linesWith(bims::test::fileText(d + "/q.err"), " frames (").empty());
 }
 
 TEST(Cli, AFrameRangeBeyondTheInputIsAUsageErrorBeforeAnyWork)

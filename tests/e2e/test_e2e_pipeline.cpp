@@ -21,6 +21,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
+#include "bims_test/text.h"
 
 namespace fs = std::filesystem;
 using namespace bims::pipeline;
@@ -438,18 +439,12 @@ TEST(EndToEnd, UnknownSensorLabelIsAnErrorNamingTheFile)
 
 namespace
 {
-std::string readAll(const std::string& path)
-{
-	std::ifstream f(path, std::ios::binary);
-	return std::string((std::istreambuf_iterator<char>(f)),
-	                   std::istreambuf_iterator<char>());
-}
 
 /** frames.csv without its timing columns (ms_*, the last five). */
 std::string csvWithoutTimes(const std::string& path)
 {
 	// the columns named ms_* dropped
-	std::istringstream in(readAll(path));
+	std::istringstream in(bims::test::fileText(path));
 	std::string line, out;
 	std::vector<bool> timing;
 	while (std::getline(in, line))
@@ -557,7 +552,8 @@ TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 		// (booleans: gtest's diff of two large strings would not end)
 		for (const char* f : {"trajectory.txt", "segmented.rawlog",
 		                      "static_map.ply", "moving_voxels/000015.ply"})
-			EXPECT_TRUE(readAll(a + "/" + f) == readAll(b + "/" + f))
+			EXPECT_TRUE(bims::test::fileText(a + "/" + f) ==
+			            bims::test::fileText(b + "/" + f))
 			    << f << " differs (" << name << ")";
 		EXPECT_TRUE(csvWithoutTimes(a + "/frames.csv") ==
 		            csvWithoutTimes(b + "/frames.csv"))
@@ -566,7 +562,8 @@ TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 		{
 			char f[32];
 			std::snprintf(f, sizeof(f), "/masks/%06d.png", i);
-			EXPECT_TRUE(readAll(a + f) == readAll(b + f))
+			EXPECT_TRUE(bims::test::fileText(a + f) ==
+			            bims::test::fileText(b + f))
 			    << f << " differs (" << name << ")";
 		}
 	}
@@ -576,12 +573,13 @@ TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 		    runWith(false, false, "sequential_raycast", Variant::FusedRaycast);
 		const std::string rb =
 		    runWith(true, true, "lookahead_raycast", Variant::FusedRaycast);
-		EXPECT_FALSE(readAll(ra + "/static_map.ply") ==
-		             readAll(a + "/static_map.ply"))
+		EXPECT_FALSE(bims::test::fileText(ra + "/static_map.ply") ==
+		             bims::test::fileText(a + "/static_map.ply"))
 		    << "the ray cast must change the static map";
 		for (const char* f : {"static_map.ply", "masks/000015.png",
 		                      "masks/000019.png", "trajectory.txt"})
-			EXPECT_TRUE(readAll(ra + "/" + f) == readAll(rb + "/" + f))
+			EXPECT_TRUE(bims::test::fileText(ra + "/" + f) ==
+			            bims::test::fileText(rb + "/" + f))
 			    << f << " differs (ray cast)";
 		EXPECT_TRUE(csvWithoutTimes(ra + "/frames.csv") ==
 		            csvWithoutTimes(rb + "/frames.csv"))
@@ -620,11 +618,12 @@ TEST(EndToEnd, LabelledRawlogIsPlainByDefaultAndGzipOnRequest)
 		const auto sum = runExperiment(c, opt);
 		ASSERT_TRUE(sum.error.empty()) << sum.error;
 		const std::string f = opt.outDir + "/segmented.rawlog";
-		const std::string head = readAll(f).substr(0, 2);
+		const std::string head = bims::test::fileText(f).substr(0, 2);
 		EXPECT_EQ(head == "\x1f\x8b", level > 0) << "level " << level;
 		EXPECT_EQ(labelMasks(f).size(), 4u);
 		// metrics.json reports reading and writing with the pipeline stages
-		const std::string j = readAll(opt.outDir + "/metrics.json");
+		const std::string j =
+		    bims::test::fileText(opt.outDir + "/metrics.json");
 		for (const char* k :
 		     {"\"read\"", "\"outputs\"", "\"egomotion\"", "\"grids_cloud\"",
 		      "\"cpu_seconds\"", "\"fps\"", "\"peak_resident_mib\""})
@@ -652,10 +651,11 @@ TEST(EndToEnd, RawlogEditOpensTheLabelledRawlog)
 	                       "/segmented.rawlog' > '" + log + "' 2>&1")
 	                          .c_str()),
 	          0)
-	    << readAll(log);
-	EXPECT_NE(readAll(log).find("Observations format               : Yes"),
+	    << bims::test::fileText(log);
+	EXPECT_NE(bims::test::fileText(log).find(
+	              "Observations format               : Yes"),
 	          std::string::npos)
-	    << readAll(log);
+	    << bims::test::fileText(log);
 }
 
 TEST(EndToEnd, WriteErrorStopsTheRunNamingTheFileAndKeepsEarlierFrames)
@@ -682,10 +682,12 @@ TEST(EndToEnd, WriteErrorStopsTheRunNamingTheFileAndKeepsEarlierFrames)
 		                      "moving_voxels/000002.ply", "metrics.json"})
 			EXPECT_TRUE(fs::exists(opt.outDir + "/" + f)) << f;
 		EXPECT_FALSE(fs::exists(opt.outDir + "/masks/000004.png"));
-		EXPECT_NE(readAll(opt.outDir + "/metrics.json").find("000003.png"),
+		EXPECT_NE(bims::test::fileText(opt.outDir + "/metrics.json")
+		              .find("000003.png"),
 		          std::string::npos);
 		// frames.csv: header + frames 0-2; the labelled rawlog reads cleanly
-		const std::string csv = readAll(opt.outDir + "/frames.csv");
+		const std::string csv =
+		    bims::test::fileText(opt.outDir + "/frames.csv");
 		EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4) << csv;
 		EXPECT_EQ(labelMasks(opt.outDir + "/segmented.rawlog").size(), 3u);
 	}
@@ -712,14 +714,16 @@ TEST(EndToEnd, ARunFromItsEffectiveIniWritesTheSameOutputs)
 	};
 	const std::string a = runFrom(cfg, "from_config");
 	ASSERT_TRUE(fs::exists(a + "/effective.ini"));
-	EXPECT_TRUE(readAll(a + "/effective.ini") == cfg.effectiveIni());
+	EXPECT_TRUE(bims::test::fileText(a + "/effective.ini") ==
+	            cfg.effectiveIni());
 	ExperimentConfig again;
 	again.loadFromFile(a + "/effective.ini");
 	EXPECT_EQ(again.pipeline.variant, Variant::FusedRaycast);
 	const std::string b = runFrom(again, "from_effective");
 	for (const char* f : {"effective.ini", "trajectory.txt", "segmented.rawlog",
 	                      "static_map.ply", "moving_voxels/000012.ply"})
-		EXPECT_TRUE(readAll(a + "/" + f) == readAll(b + "/" + f))
+		EXPECT_TRUE(bims::test::fileText(a + "/" + f) ==
+		            bims::test::fileText(b + "/" + f))
 		    << f << " differs";
 	EXPECT_TRUE(csvWithoutTimes(a + "/frames.csv") ==
 	            csvWithoutTimes(b + "/frames.csv"));
@@ -727,15 +731,16 @@ TEST(EndToEnd, ARunFromItsEffectiveIniWritesTheSameOutputs)
 	{
 		char f[32];
 		std::snprintf(f, sizeof(f), "/masks/%06d.png", i);
-		EXPECT_TRUE(readAll(a + f) == readAll(b + f)) << f << " differs";
+		EXPECT_TRUE(bims::test::fileText(a + f) == bims::test::fileText(b + f))
+		    << f << " differs";
 	}
 	// and the run differs from one of another configuration (the check can
 	// fail)
 	ExperimentConfig paper;
 	paper.loadFromFile(std::string(BIMS_SOURCE_DIR) + "/config/paper.ini");
 	const std::string c = runFrom(paper, "from_paper");
-	EXPECT_FALSE(readAll(a + "/trajectory.txt") ==
-	             readAll(c + "/trajectory.txt"));
+	EXPECT_FALSE(bims::test::fileText(a + "/trajectory.txt") ==
+	             bims::test::fileText(c + "/trajectory.txt"));
 }
 
 // The grids unproject a frame's depth with the camera model its egomotion and

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <sstream>
 #include <utility>
+#include "bims_test/text.h"
 
 namespace
 {
@@ -39,13 +40,6 @@ std::pair<std::string, std::string> freshOutput(const std::string& name)
 	return {out, kOut + "/" + name + ".log"};
 }
 
-std::string slurp(const std::string& p)
-{
-	std::ifstream f(p);
-	std::stringstream s;
-	s << f.rdbuf();
-	return s.str();
-}
 }  // namespace
 
 TEST(CalibDepthApp, AnUndistortedSensorGetsAlmostNoCorrection)
@@ -56,7 +50,7 @@ TEST(CalibDepthApp, AnUndistortedSensorGetsAlmostNoCorrection)
 	                  "' -q",
 	              log),
 	          0)
-	    << slurp(log);
+	    << bims::test::fileText(log);
 	mrpt::config::CConfigFile f(out);
 	bims::ego::DepthCorrectionParams p;
 	p.loadFromConfigFile(f);
@@ -80,8 +74,9 @@ TEST(CalibDepthApp, PosesThatDoNotFitAreRefusedNotWritten)
 	// the 320 x 240 sample's frame-to-frame vision odometry is too poor
 	// (0.34 deg per frame) for a fit: refused with a reason
 	EXPECT_EQ(run(kSample + "--frames 0:40 -o '" + out + "' -q", log), 1);
-	EXPECT_NE(slurp(log).find("do not fit a static scene"), std::string::npos)
-	    << slurp(log);
+	EXPECT_NE(bims::test::fileText(log).find("do not fit a static scene"),
+	          std::string::npos)
+	    << bims::test::fileText(log);
 	EXPECT_FALSE(std::ifstream(out).good());
 	// bad arguments are usage errors
 	EXPECT_EQ(run(kSample + "--frames 9:2 -o '" + out + "'", log), 2);
@@ -89,5 +84,6 @@ TEST(CalibDepthApp, PosesThatDoNotFitAreRefusedNotWritten)
 	                  out + "'",
 	              log),
 	          1);
-	EXPECT_NE(slurp(log).find("/nonexistent.rawlog"), std::string::npos);
+	EXPECT_NE(bims::test::fileText(log).find("/nonexistent.rawlog"),
+	          std::string::npos);
 }

@@ -24,13 +24,6 @@ const std::string kIni =
     std::string(BIMS_SOURCE_DIR) + "/apps/grab/examples/dummy_replayed_imu.ini";
 const std::string kOut = std::string(BIMS_BINARY_DIR) + "/grab_test";
 
-std::string slurp(const std::string& p)
-{
-	std::ifstream f(p);
-	std::stringstream s;
-	s << f.rdbuf();
-	return s.str();
-}
 int run(const std::string& cmd)
 {
 	const int rc = std::system(cmd.c_str());
@@ -97,7 +90,7 @@ TEST(GrabApp, GrabsNFramesFromTheDummyDeviceWithTheReplayedImu)
 	ASSERT_EQ(run("'" + kGrab + "' '" + kIni + "' -o '" + out +
 	              "' --max-frames 20 > '" + log + "' 2>&1"),
 	          0)
-	    << slurp(log);
+	    << bims::test::fileText(log);
 	const Content c = readBack(out);
 	EXPECT_FALSE(c.truncated);
 	EXPECT_EQ(c.scans, 20u);
@@ -110,7 +103,8 @@ TEST(GrabApp, GrabsNFramesFromTheDummyDeviceWithTheReplayedImu)
 	EXPECT_LT(span, 3.0);
 	EXPECT_GT(c.imu, static_cast<size_t>(50 * span));
 	EXPECT_LT(c.imu, static_cast<size_t>(200 * (span + 1)));
-	EXPECT_NE(slurp(log).find("20 RGB-D frames"), std::string::npos);
+	EXPECT_NE(bims::test::fileText(log).find("20 RGB-D frames"),
+	          std::string::npos);
 	// Stamps are UNIX time of this host (one clock for all sensors).
 	const double now = std::chrono::duration<double>(
 	                       std::chrono::system_clock::now().time_since_epoch())
@@ -130,11 +124,11 @@ TEST(GrabApp, ViewerWithoutADisplayFailsBeforeAnySensorOpens)
 	    run("env -u DISPLAY -u WAYLAND_DISPLAY '" + kGrab + "' '" + kIni +
 	        "' -o '" + out + "' --max-frames 20 --viewer > '" + log + "' 2>&1"),
 	    1)
-	    << slurp(log);
+	    << bims::test::fileText(log);
 	const double s =
 	    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
 	        .count();
-	const std::string text = slurp(log);
+	const std::string text = bims::test::fileText(log);
 	EXPECT_NE(text.find("bims-grab: error: --viewer needs a display (DISPLAY "
 	                    "is not set)"),
 	          std::string::npos)
@@ -156,8 +150,8 @@ TEST(GrabApp, OldSpellingsStillWorkWithANote)
 	        "' --frames 3 --live-segmentation --experiment '" +
 	        BIMS_SOURCE_DIR + "/config/default.ini' -q > '" + log + "' 2>&1"),
 	    0)
-	    << slurp(log);
-	const std::string text = slurp(log);
+	    << bims::test::fileText(log);
+	const std::string text = bims::test::fileText(log);
 	EXPECT_NE(text.find("bims-grab: note: --frames 3 is now --max-frames 3\n"),
 	          std::string::npos)
 	    << text;
@@ -177,9 +171,9 @@ TEST(GrabApp, LiveSegmentationWithoutExperimentUsesShareBimsDefaultIni)
 	ASSERT_EQ(run("'" + kGrab + "' '" + kIni + "' -o '" + out +
 	              "' --max-frames 3 --live-segmentation > '" + log + "' 2>&1"),
 	          0)
-	    << slurp(log);
+	    << bims::test::fileText(log);
 	// build/bin/bims-grab -> build/share/bims/default.ini, named
-	const std::string msg = slurp(log);
+	const std::string msg = bims::test::fileText(log);
 	const std::string used = bims::test::restOfLineAfter(
 	    msg, "bims-grab: live segmentation: parameters from ");
 	ASSERT_FALSE(used.empty()) << msg;
@@ -197,8 +191,8 @@ TEST(GrabApp, NoDeviceIsAClearErrorNotAnAbort)
 	                   << "/no_such_recording.oni\n";
 	const int rc = run("'" + kGrab + "' '" + ini + "' -o '" + kOut +
 	                   "/nodev.rawlog' > '" + log + "' 2>&1");
-	EXPECT_EQ(rc, 1) << slurp(log);
-	const std::string msg = slurp(log);
+	EXPECT_EQ(rc, 1) << bims::test::fileText(log);
+	const std::string msg = bims::test::fileText(log);
 	EXPECT_NE(msg.find("bims-grab: error: OpenNI2: cannot open device"),
 	          std::string::npos)
 	    << msg;
@@ -215,7 +209,7 @@ TEST(GrabApp, BadConfigNamesFileSectionAndKey)
 		EXPECT_EQ(run("'" + kGrab + "' '" + ini + "' -o '" + kOut +
 		              "/bad.rawlog' > '" + log + "' 2>&1"),
 		          1);
-		return slurp(log);
+		return bims::test::fileText(log);
 	};
 	const std::string msg =
 	    grabWith("[RGBD]\ndriver=OpenNI2\ndevice_uri=Dummy\nframe_rate=30\n");
@@ -282,11 +276,11 @@ TEST(GrabApp, AFullDiskOrAnUnwritableOutputStopsWithAnErrorNamingTheFile)
 	              "' '" + kIni + "' -o '" + out + "' --max-frames 200\" > '" +
 	              log + "' 2>&1"),
 	          1)
-	    << slurp(log);
-	EXPECT_NE(
-	    slurp(log).find("error: grabbing stopped: " + out + ": write failed"),
-	    std::string::npos)
-	    << slurp(log);
+	    << bims::test::fileText(log);
+	EXPECT_NE(bims::test::fileText(log).find("error: grabbing stopped: " + out +
+	                                         ": write failed"),
+	          std::string::npos)
+	    << bims::test::fileText(log);
 	const Content c = readBack(out);
 	EXPECT_GE(c.scans, 1u);
 	EXPECT_LT(c.scans, 200u);
@@ -297,9 +291,9 @@ TEST(GrabApp, AFullDiskOrAnUnwritableOutputStopsWithAnErrorNamingTheFile)
 	EXPECT_EQ(run("'" + kGrab + "' '" + kIni + "' -o '" + file +
 	              "/x.rawlog' --max-frames 5 > '" + log + "' 2>&1"),
 	          1);
-	EXPECT_NE(slurp(log).find(file + "/x.rawlog: cannot create"),
+	EXPECT_NE(bims::test::fileText(log).find(file + "/x.rawlog: cannot create"),
 	          std::string::npos)
-	    << slurp(log);
+	    << bims::test::fileText(log);
 }
 
 // Issue 39's reproduction: the rawlog a grab .ini replays its IMU from is
@@ -320,8 +314,9 @@ TEST(GrabApp, TheReplayedImuFileOfTheIniIsNeverTheOutput)
 	EXPECT_EQ(run("cd '" + d + "' && '" + kGrab + "' d.ini -o x.rawlog " +
 	              "--max-frames 3 > '" + log + "' 2>&1"),
 	          2)
-	    << slurp(log);
-	EXPECT_NE(slurp(log).find("would overwrite the input"), std::string::npos)
-	    << slurp(log);
+	    << bims::test::fileText(log);
+	EXPECT_NE(bims::test::fileText(log).find("would overwrite the input"),
+	          std::string::npos)
+	    << bims::test::fileText(log);
 	EXPECT_EQ(std::filesystem::file_size(d + "/x.rawlog"), size);
 }

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include "bims_test/text.h"
 
 namespace fs = std::filesystem;
 
@@ -32,13 +33,6 @@ bims::test::CommandResult run(const std::string& args)
 std::string tmpDir(const std::string& name)
 {
 	return bims::test::freshTmpDir("bims_test_run_app", name);
-}
-std::string slurp(const std::string& p)
-{
-	std::ifstream f(p, std::ios::binary);
-	std::stringstream s;
-	s << f.rdbuf();
-	return s.str();
 }
 std::string q(const std::string& s)
 {
@@ -99,7 +93,7 @@ TEST(RunApp, SymlinkedOutputFilesAreReplacedNotFollowed)
 	const auto r = run(q(kConfig) + " " + q(kSample) + " -o " + q(out) +
 	                   " --frames 0:2 --overwrite -q");
 	ASSERT_EQ(r.code, 0) << r.out;
-	EXPECT_EQ(slurp(d + "/precious.txt"), "precious");
+	EXPECT_EQ(bims::test::fileText(d + "/precious.txt"), "precious");
 	for (const char* f :
 	     {"trajectory.txt", "frames.csv", "metrics.json", "segmented.rawlog",
 	      "static_map.ply", "masks/000001.png", "moving_voxels/000001.ply"})
@@ -107,7 +101,9 @@ TEST(RunApp, SymlinkedOutputFilesAreReplacedNotFollowed)
 		EXPECT_FALSE(fs::is_symlink(fs::symlink_status(out + "/" + f))) << f;
 		EXPECT_GT(fs::file_size(out + "/" + f), 0u) << f;
 	}
-	EXPECT_EQ(bims::Json::parse(slurp(out + "/metrics.json"))["status"], "ok");
+	EXPECT_EQ(bims::Json::parse(
+	              bims::test::fileText(out + "/metrics.json"))["status"],
+	          "ok");
 }
 
 // Issue 39's reproductions: a missing second rawlog was never mentioned
@@ -156,7 +152,8 @@ TEST(RunApp, ASymlinkedMasksFolderIsNeverFollowedNorEmptied)
 	    << refused.out;
 	const auto r = run(args + " --overwrite");
 	ASSERT_EQ(r.code, 0) << r.out;
-	EXPECT_EQ(slurp(d + "/keep/000000.png"), "x");  // the target untouched
+	EXPECT_EQ(bims::test::fileText(d + "/keep/000000.png"),
+	          "x");  // the target untouched
 	EXPECT_EQ(std::distance(fs::directory_iterator(d + "/keep"),
 	                        fs::directory_iterator()),
 	          1);
@@ -219,8 +216,9 @@ TEST(RunApp, AnEarlierRunIsRefusedAndOverwriteClearsItsFilesOnly)
 	for (const char* f :
 	     {"masks/000002.png", "masks/000004.png", "moving_voxels/000004.ply"})
 		EXPECT_FALSE(fs::exists(out + "/" + f)) << f;
-	EXPECT_EQ(
-	    bims::Json::parse(slurp(out + "/metrics.json"))["frames_processed"], 2);
+	EXPECT_EQ(bims::Json::parse(bims::test::fileText(
+	              out + "/metrics.json"))["frames_processed"],
+	          2);
 }
 
 namespace
@@ -228,7 +226,7 @@ namespace
 /** default.ini with [output] as given (the other sections as they are). */
 std::string configWithOutput(const std::string& dir, const std::string& out)
 {
-	std::string ini = slurp(kConfig);
+	std::string ini = bims::test::fileText(kConfig);
 	ini = ini.substr(0, ini.find("[output]")) + "[output]\n" + out;
 	const std::string path = dir + "/exp.ini";
 	std::ofstream(path) << ini;
@@ -246,7 +244,7 @@ bims::test::CommandResult runLimited(int kib, const std::string& args)
 
 size_t lineCount(const std::string& path)
 {
-	const std::string s = slurp(path);
+	const std::string s = bims::test::fileText(path);
 	return static_cast<size_t>(std::count(s.begin(), s.end(), '\n'));
 }
 /** bims-run CONFIG on the sample into DIR/out with files limited to \a kib
@@ -288,8 +286,8 @@ TEST(RunApp, AFullDiskStopsTheRunAtTheFirstFailedWriteNamingTheFile)
 	    framesWhenFull(d, ini, 14, {"trajectory.txt", "frames.csv"}, &full);
 	EXPECT_GT(frames, 5u);
 	// every file holds whole lines, the same frames; every mask is whole
-	const std::string traj = slurp(d + "/out/trajectory.txt");
-	const std::string csv = slurp(d + "/out/frames.csv");
+	const std::string traj = bims::test::fileText(d + "/out/trajectory.txt");
+	const std::string csv = bims::test::fileText(d + "/out/frames.csv");
 	ASSERT_FALSE(csv.empty());
 	EXPECT_EQ(traj.back(), '\n');
 	EXPECT_EQ(csv.back(), '\n');
@@ -303,7 +301,8 @@ TEST(RunApp, AFullDiskStopsTheRunAtTheFirstFailedWriteNamingTheFile)
 	}
 	EXPECT_LE(masks, frames + 1);
 	// the error is in metrics.json too
-	EXPECT_NE(slurp(d + "/out/metrics.json").find(full + ": write failed"),
+	EXPECT_NE(bims::test::fileText(d + "/out/metrics.json")
+	              .find(full + ": write failed"),
 	          std::string::npos);
 }
 
@@ -334,11 +333,14 @@ TEST(RunApp, SigintAndSigtermStopAfterTheCurrentFrameWithEverythingWritten)
 	     {std::tuple{SIGINT, 130, "SIGINT"}, {SIGTERM, 143, "SIGTERM"}})
 	{
 		const auto d = tmpDir(name);
-		EXPECT_EQ(interruptedRun(d, sig), code) << slurp(d + "/log");
-		EXPECT_NE(slurp(d + "/log").find(std::string("interrupted by ") + name),
+		EXPECT_EQ(interruptedRun(d, sig), code)
+		    << bims::test::fileText(d + "/log");
+		EXPECT_NE(bims::test::fileText(d + "/log")
+		              .find(std::string("interrupted by ") + name),
 		          std::string::npos)
-		    << slurp(d + "/log");
-		const auto m = bims::Json::parse(slurp(d + "/out/metrics.json"));
+		    << bims::test::fileText(d + "/log");
+		const auto m =
+		    bims::Json::parse(bims::test::fileText(d + "/out/metrics.json"));
 		EXPECT_EQ(m["status"], "interrupted");
 		const size_t frames = m["frames_processed"];
 		EXPECT_GE(frames, 5u);  // masks/000005.png was being written
@@ -367,7 +369,7 @@ TEST(RunApp, AfterSigkillEveryFileIsWholeAndNoMetricsSaysDone)
 	    << "{\"status\": \"ok\"}\n";  // stale
 	EXPECT_EQ(interruptedRun(d, SIGKILL), -SIGKILL);
 	EXPECT_FALSE(fs::exists(d + "/out/metrics.json"));
-	const std::string csv = slurp(d + "/out/frames.csv");
+	const std::string csv = bims::test::fileText(d + "/out/frames.csv");
 	ASSERT_FALSE(csv.empty());
 	EXPECT_EQ(csv.back(), '\n');
 	// a frame in frames.csv has its mask and PLY, each whole
@@ -380,8 +382,8 @@ TEST(RunApp, AfterSigkillEveryFileIsWholeAndNoMetricsSaysDone)
 		const long i = std::stol(line.substr(0, line.find(',')));
 		EXPECT_GT(fs::file_size(d + "/out/masks/" + bims::frameFileName(i)), 0u)
 		    << i;
-		const std::string ply =
-		    slurp(d + "/out/moving_voxels/" + bims::frameFileName(i, "ply"));
+		const std::string ply = bims::test::fileText(
+		    d + "/out/moving_voxels/" + bims::frameFileName(i, "ply"));
 		const auto n = std::stoul(ply.substr(ply.find("element vertex ") + 15));
 		const auto body = ply.substr(ply.find("end_header\n") + 11);
 		EXPECT_EQ(
@@ -422,7 +424,7 @@ TEST(RunApp, PrintConfigIsTheEffectiveIniOfARun)
 	const auto r = run(q(paper) + " " + q(kSample) + " --frames 0:1 -q -o " +
 	                   q(d + "/out"));
 	ASSERT_EQ(r.code, 0) << r.out;
-	EXPECT_EQ(slurp(d + "/out/effective.ini"), p.out);
+	EXPECT_EQ(bims::test::fileText(d + "/out/effective.ini"), p.out);
 	// usage errors
 	const auto two = run("--print-config " + q(kConfig) + " " + q(kConfig));
 	EXPECT_EQ(two.code, 2) << two.out;

@@ -16,6 +16,7 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "bims_test/text.h"
 
 namespace fs = std::filesystem;
 
@@ -33,13 +34,6 @@ bims::test::CommandResult sweep(const std::string& args)
 std::string tmpDir(const std::string& name)
 {
 	return bims::test::freshTmpDir("bims_test_sweep_app", name);
-}
-std::string slurp(const std::string& p)
-{
-	std::ifstream f(p, std::ios::binary);
-	std::stringstream s;
-	s << f.rdbuf();
-	return s.str();
 }
 std::string q(const std::string& s)
 {
@@ -65,7 +59,7 @@ std::vector<std::string> split(const std::string& line)
 /** results.csv as rows of column -> value (no quoted cells expected). */
 std::vector<std::map<std::string, std::string>> readCsv(const std::string& p)
 {
-	std::istringstream f(slurp(p));
+	std::istringstream f(bims::test::fileText(p));
 	std::string line;
 	std::getline(f, line);
 	const auto head = split(line);
@@ -85,7 +79,7 @@ std::vector<std::map<std::string, std::string>> readCsv(const std::string& p)
  * whether OpenCV decodes it to that size. */
 cv::Size pngSize(const std::string& p)
 {
-	const std::string b = slurp(p);
+	const std::string b = bims::test::fileText(p);
 	if (b.size() < 24 || b.compare(0, 8, "\x89PNG\r\n\x1a\n") != 0 ||
 	    b.compare(12, 4, "IHDR") != 0)
 		return {0, 0};
@@ -128,7 +122,7 @@ TEST(SweepApp, TwoByTwoGridRunsFourRunsInParallelIntoOneTable)
 	EXPECT_NE(r.out.find(": ok, "), std::string::npos) << r.out;
 
 	const auto rows = readCsv(out + "/results.csv");
-	ASSERT_EQ(rows.size(), 4u) << slurp(out + "/results.csv");
+	ASSERT_EQ(rows.size(), 4u) << bims::test::fileText(out + "/results.csv");
 	std::set<std::pair<std::string, std::string>> combos;
 	for (const auto& row : rows)
 	{
@@ -140,13 +134,14 @@ TEST(SweepApp, TwoByTwoGridRunsFourRunsInParallelIntoOneTable)
 		EXPECT_GT(number(row.at("stage_ms.total.median")), 0);
 		// the run used its derived config: bims-run says which variant
 		const std::string dir = out + "/runs/" + row.at("id");
-		const auto m = bims::Json::parse(slurp(dir + "/out/metrics.json"));
+		const auto m =
+		    bims::Json::parse(bims::test::fileText(dir + "/out/metrics.json"));
 		EXPECT_EQ(m["variant"], row.at("pipeline.variant"));
 		EXPECT_EQ(m["config"], dir + "/config.ini");
-		EXPECT_NE(slurp(dir + "/config.ini")
+		EXPECT_NE(bims::test::fileText(dir + "/config.ini")
 		              .find("voxel_size = " + row.at("grids.voxel_size")),
 		          std::string::npos);
-		EXPECT_NE(slurp(dir + "/log.txt").find("outputs in"),
+		EXPECT_NE(bims::test::fileText(dir + "/log.txt").find("outputs in"),
 		          std::string::npos);
 	}
 	EXPECT_EQ(combos, (std::set<std::pair<std::string, std::string>>{
@@ -155,7 +150,7 @@ TEST(SweepApp, TwoByTwoGridRunsFourRunsInParallelIntoOneTable)
 	                      {"0.1", "fused"},
 	                      {"0.1", "flow-only"}}));
 	EXPECT_EQ(rows[0].at("id"), "1_voxel_size=0.05_variant=fused");
-	const std::string md = slurp(out + "/results.md");
+	const std::string md = bims::test::fileText(out + "/results.md");
 	for (const auto& row : rows)
 		EXPECT_NE(md.find("| " + row.at("id") + " | "), std::string::npos)
 		    << md;
@@ -167,7 +162,7 @@ TEST(SweepApp, AFailedRunIsReportedAndTheSweepGoesOnThenExits1)
 	const auto d = tmpDir("failed_run");
 	// a rawlog cut after a few frames: bims-run stops at the cut, exit 1
 	{
-		const std::string b = slurp(kSample);
+		const std::string b = bims::test::fileText(kSample);
 		std::ofstream(d + "/cut.rawlog", std::ios::binary)
 		    << b.substr(0, 300000);
 	}
@@ -188,7 +183,7 @@ TEST(SweepApp, AFailedRunIsReportedAndTheSweepGoesOnThenExits1)
 	EXPECT_EQ(rows[1].at("id"), "2_pendulum_slow");
 	EXPECT_EQ(rows[1].at("status"), "ok");
 	EXPECT_GT(number(rows[1].at("fps")), 0);
-	EXPECT_NE(slurp(out + "/results.md").find("## Runs not ok"),
+	EXPECT_NE(bims::test::fileText(out + "/results.md").find("## Runs not ok"),
 	          std::string::npos);
 	EXPECT_EQ(pngSize(out + "/results.png"), cv::Size(1024, 640));
 }
@@ -201,10 +196,10 @@ TEST(SweepApp, JobsFileLinesRunWithBashAndCollectGathersThem)
 	const std::string out = d + "/out", jobs = d + "/jobs.txt";
 	const auto r = sweep(q(ini) + " -o " + q(out) + " --jobs-file " + q(jobs));
 	ASSERT_EQ(r.code, 0) << r.out;
-	std::istringstream f(slurp(jobs));
+	std::istringstream f(bims::test::fileText(jobs));
 	std::vector<std::string> lines;
 	for (std::string l; std::getline(f, l);) lines.push_back(l);
-	ASSERT_EQ(lines.size(), 2u) << slurp(jobs);
+	ASSERT_EQ(lines.size(), 2u) << bims::test::fileText(jobs);
 	const std::string dir1 = out + "/runs/1_variant=fused";
 	EXPECT_TRUE(fs::exists(dir1 + "/config.ini"));
 	EXPECT_FALSE(fs::exists(dir1 + "/out"));  // nothing ran
@@ -217,7 +212,8 @@ TEST(SweepApp, JobsFileLinesRunWithBashAndCollectGathersThem)
 		const auto j = bims::test::runCommand("bash " + q(job));
 		EXPECT_EQ(j.code, 0) << lines[i] << "\n" << j.out;
 	}
-	EXPECT_NE(slurp(dir1 + "/log.txt").find("outputs in"), std::string::npos);
+	EXPECT_NE(bims::test::fileText(dir1 + "/log.txt").find("outputs in"),
+	          std::string::npos);
 
 	const auto c = sweep("--collect " + q(out));
 	ASSERT_EQ(c.code, 0) << c.out;
@@ -307,13 +303,13 @@ TEST(SweepApp, SigintStopsLaunchingAndInterruptsTheRunningRunCleanly)
 	const int code = bims::test::signalWhenExists(
 	    {kBin + "/bims-sweep", ini, "-o", out, "-j", "1"}, d + "/log.txt",
 	    out + "/runs/1_voxel_size=0.05/out/trajectory.txt", SIGINT);
-	const std::string log = slurp(d + "/log.txt");
+	const std::string log = bims::test::fileText(d + "/log.txt");
 	EXPECT_EQ(code, 128 + SIGINT) << log;
 	EXPECT_NE(log.find("interrupted: 1 of 2 runs not started"),
 	          std::string::npos)
 	    << log;
 	const auto m = bims::Json::parse(
-	    slurp(out + "/runs/1_voxel_size=0.05/out/metrics.json"));
+	    bims::test::fileText(out + "/runs/1_voxel_size=0.05/out/metrics.json"));
 	EXPECT_EQ(m["status"], "interrupted");
 	EXPECT_LT(m["frames_processed"].get<int>(), 150);
 	EXPECT_FALSE(fs::exists(out + "/runs/2_voxel_size=0.1/log.txt"));

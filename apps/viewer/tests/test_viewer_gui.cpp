@@ -27,14 +27,6 @@ const std::string kRawlog =
     std::string(BIMS_SOURCE_DIR) + "/rawlogs/pendulum_slow.rawlog";
 const std::string kOut = std::string(BIMS_BINARY_DIR) + "/gui_test";
 
-std::string slurp(const std::string& p)
-{
-	std::ifstream f(p);
-	std::stringstream s;
-	s << f.rdbuf();
-	return s.str();
-}
-
 int run(const std::string& cmd)
 {
 	const int rc = std::system(cmd.c_str());
@@ -57,9 +49,9 @@ TEST(GuiViewer, XvfbScreenshotShowsTheThreeTierColours)
 	    shot + "' > '" + log + "' 2>&1";
 	// (frame 45: with the map-anchored egomotion tier 1 agrees with tier 2
 	// almost everywhere by frame 15, and its yellow hides behind the red)
-	ASSERT_EQ(run(cmd), 0) << slurp(log);
+	ASSERT_EQ(run(cmd), 0) << bims::test::fileText(log);
 	const cv::Mat img = cv::imread(shot, cv::IMREAD_COLOR);
-	ASSERT_FALSE(img.empty()) << slurp(log);
+	ASSERT_FALSE(img.empty()) << bims::test::fileText(log);
 	EXPECT_GT(img.cols, 300);
 	EXPECT_GT(img.rows, 300);
 	const auto c = bims::viewer::tierColourFractions(img);
@@ -90,9 +82,9 @@ TEST(GuiViewer, XScreenshotOfTheWholeWindowShowsTiersAndPanels)
 	    "/config/default.ini' --layers all --max-frames 15 --size 1200x800 > "
 	    "'" +
 	    log + "' 2>&1";
-	ASSERT_EQ(run(cmd), 0) << slurp(log);
+	ASSERT_EQ(run(cmd), 0) << bims::test::fileText(log);
 	const cv::Mat img = cv::imread(xshot, cv::IMREAD_COLOR);
-	ASSERT_FALSE(img.empty()) << slurp(log);
+	ASSERT_FALSE(img.empty()) << bims::test::fileText(log);
 	const auto c = bims::viewer::tierColourFractions(img);
 	EXPECT_GT(c.blue, 0.002) << "tier 0 (blue) missing";
 	EXPECT_GT(c.yellow, 0.0001) << "tier 1 (yellow) missing";
@@ -157,9 +149,9 @@ TEST(GuiViewer, PanelsKeepTheirWidthWhilePlaying)
 	    kRawlog + "' --config '" + BIMS_SOURCE_DIR +
 	    "/config/default.ini' --speed 0.25 --size 1200x800 > '" + log +
 	    "' 2>&1";
-	ASSERT_EQ(run(cmd), 0) << slurp(log);
+	ASSERT_EQ(run(cmd), 0) << bims::test::fileText(log);
 	const cv::Mat img = cv::imread(xshot, cv::IMREAD_COLOR);
-	ASSERT_FALSE(img.empty()) << slurp(log);
+	ASSERT_FALSE(img.empty()) << bims::test::fileText(log);
 	const auto e = panelExtent(img, 100);
 	EXPECT_GE(e.widestRun, 150) << "image panels collapsed: " << xshot;
 	EXPECT_GE(e.rows, img.rows / 2) << "image panels collapsed: " << xshot;
@@ -174,8 +166,10 @@ TEST(GuiViewer, NoDisplayGivesAClearErrorAndNonZeroExit)
 	                   "/never.png' > '" + log + "' 2>&1");
 	EXPECT_NE(rc, 0);
 	EXPECT_NE(rc, -1);  // exited, did not crash
-	EXPECT_NE(slurp(log).find("no display"), std::string::npos) << slurp(log);
-	EXPECT_NE(slurp(log).find("xvfb-run"), std::string::npos) << slurp(log);
+	EXPECT_NE(bims::test::fileText(log).find("no display"), std::string::npos)
+	    << bims::test::fileText(log);
+	EXPECT_NE(bims::test::fileText(log).find("xvfb-run"), std::string::npos)
+	    << bims::test::fileText(log);
 }
 
 TEST(GuiViewer, MissingRawlogIsAnErrorBeforeAnyWindow)
@@ -185,9 +179,10 @@ TEST(GuiViewer, MissingRawlogIsAnErrorBeforeAnyWindow)
 	const int rc = run("env -u DISPLAY '" + kViewer +
 	                   "' /nonexistent/x.rawlog > '" + log + "' 2>&1");
 	EXPECT_EQ(rc, 1);
-	EXPECT_NE(slurp(log).find("cannot open rawlog '/nonexistent/x.rawlog'"),
+	EXPECT_NE(bims::test::fileText(log).find(
+	              "cannot open rawlog '/nonexistent/x.rawlog'"),
 	          std::string::npos)
-	    << slurp(log);
+	    << bims::test::fileText(log);
 }
 
 TEST(GuiViewer, WithoutConfigItUsesShareBimsDefaultIniAndSaysWhich)
@@ -197,7 +192,7 @@ TEST(GuiViewer, WithoutConfigItUsesShareBimsDefaultIniAndSaysWhich)
 	ASSERT_EQ(run("mkdir -p '" + kOut + "'"), 0);
 	run("env -u DISPLAY -u WAYLAND_DISPLAY '" + kViewer + "' > '" + log +
 	    "' 2>&1");
-	const std::string msg = slurp(log);
+	const std::string msg = bims::test::fileText(log);
 	const std::string used =
 	    bims::test::restOfLineAfter(msg, "bims-viewer: parameters from ");
 	ASSERT_FALSE(used.empty()) << msg;
@@ -228,7 +223,7 @@ std::string crowded640(const std::string& dir)
 	                        BIMS_SOURCE_DIR + "/config/sim/crowded.ini' -o '" +
 	                        out + "' --max-frames 100 -q > '" + dir +
 	                        "/sim.log' 2>&1";
-	EXPECT_EQ(run(cmd), 0) << slurp(dir + "/sim.log");
+	EXPECT_EQ(run(cmd), 0) << bims::test::fileText(dir + "/sim.log");
 	return out;
 }
 
@@ -268,16 +263,16 @@ std::pair<cv::Mat, cv::Rect> checkPlayingWindow(const std::string& dir,
 	    " -a -s '-screen 0 1280x900x24 +extension GLX' '" + BIMS_SOURCE_DIR +
 	    "/apps/viewer/tests/xshot.sh' play2 '" + prefix + "' '" + kViewer +
 	    "' " + args + " --size 1280x800 > '" + log + "' 2>&1";
-	EXPECT_EQ(run(cmd), 0) << slurp(log);
+	EXPECT_EQ(run(cmd), 0) << bims::test::fileText(log);
 	const cv::Mat a = cv::imread(prefix + ".1.png", cv::IMREAD_COLOR);
 	const cv::Mat b = cv::imread(prefix + ".2.png", cv::IMREAD_COLOR);
 	if (a.empty() || b.empty())
 	{
-		ADD_FAILURE() << "no screenshots: " << slurp(log);
+		ADD_FAILURE() << "no screenshots: " << bims::test::fileText(log);
 		return {};
 	}
-	const auto s1 = bims::Json::parse(slurp(prefix + ".1.json"));
-	const auto s2 = bims::Json::parse(slurp(prefix + ".2.json"));
+	const auto s1 = bims::Json::parse(bims::test::fileText(prefix + ".1.json"));
+	const auto s2 = bims::Json::parse(bims::test::fileText(prefix + ".2.json"));
 	// the slider follows playback
 	EXPECT_LT(s1["slider"].get<int>(), s2["slider"].get<int>()) << s1 << "\n"
 	                                                            << s2;
@@ -345,13 +340,13 @@ TEST(GuiViewer, ResultsModePlaysWithTheSameLayoutAndShowsWhatMoves)
 	              "/config/default.ini' '" + in + "' -o '" + dir +
 	              "/out' -q > '" + dir + "/run.log' 2>&1"),
 	          0)
-	    << slurp(dir + "/run.log");
+	    << bims::test::fileText(dir + "/run.log");
 	const auto [img, v3] = checkPlayingWindow(
 	    dir, "'" + in + "' --results '" + dir + "/out' --speed 0.5",
 	    2);  // RGB + mask, depth; no pipeline: no flow
-	EXPECT_EQ(slurp(dir + "/viewer.log").find("parameters from"),
+	EXPECT_EQ(bims::test::fileText(dir + "/viewer.log").find("parameters from"),
 	          std::string::npos)
-	    << slurp(dir + "/viewer.log");
+	    << bims::test::fileText(dir + "/viewer.log");
 	if (img.empty()) return;
 	// the moving points of the cloud, red from the results' masks
 	const auto c = bims::viewer::tierColourFractions(img(v3));
@@ -370,7 +365,7 @@ TEST(GuiViewer, PlayingTheBonnSliceKeepsTheWindowLive)
 	        BIMS_SOURCE_DIR + "/config/bonn.ini' --max-frames 120 -q > '" +
 	        dir + "/import.log' 2>&1"),
 	    0)
-	    << slurp(dir + "/import.log");
+	    << bims::test::fileText(dir + "/import.log");
 	checkPlayingWindow(dir, "'" + dir + "/bonn.rawlog' --config '" +
 	                            BIMS_SOURCE_DIR + "/config/bonn.ini'");
 }
@@ -389,7 +384,7 @@ TEST(GuiViewer, PlayingAPhoneCaptureKeepsTheLayoutAtItsImageSize)
 	              "/stray.rawlog' -c '" + BIMS_SOURCE_DIR +
 	              "/config/stray.ini' -q > '" + dir + "/import.log' 2>&1"),
 	          0)
-	    << slurp(dir + "/import.log");
+	    << bims::test::fileText(dir + "/import.log");
 	checkPlayingWindow(dir,
 	                   "'" + dir + "/stray.rawlog' --config '" +
 	                       BIMS_SOURCE_DIR + "/config/stray.ini'",
@@ -464,7 +459,8 @@ TEST(GuiViewer, PlayingA720pRecordingKeepsTheLayoutAtItsImageSize)
 	// The depth panel (jet colours, no flat row): the rows that show the
 	// image, below the caption, are 9/16 of its width; the rest of the cell
 	// is the flat background.
-	const auto s = bims::Json::parse(slurp(dir + "/shot.2.json"));
+	const auto s =
+	    bims::Json::parse(bims::test::fileText(dir + "/shot.2.json"));
 	const cv::Rect pr = rectOf(s["panels"][1]);
 	const cv::Rect body = cv::Rect(pr.x, pr.y + 20, pr.width, pr.height - 20) &
 	                      cv::Rect(0, 0, img.cols, img.rows);
@@ -493,8 +489,8 @@ TEST(GuiViewer, PausedShowsTheFirstFrame)
 	    "/apps/viewer/tests/xshot.sh' - '" + dir + "/x.png' '" + kViewer +
 	    "' '" + kRawlog + "' --paused --size 1200x800 --state-file '" + state +
 	    "' > '" + log + "' 2>&1";
-	ASSERT_EQ(run(cmd), 0) << slurp(log);
-	const auto s = bims::Json::parse(slurp(state));
+	ASSERT_EQ(run(cmd), 0) << bims::test::fileText(log);
+	const auto s = bims::Json::parse(bims::test::fileText(state));
 	EXPECT_EQ(s["frame"].get<int>(), 0) << s;
 	EXPECT_EQ(s["counter"].get<std::string>(), "0 / 149") << s;
 	EXPECT_FALSE(s["playing"].get<bool>()) << s;
@@ -522,13 +518,13 @@ TEST(GuiViewer, PngSequenceWritesEveryFrameInOrder)
 	    "/apps/viewer/tests/xshot.sh' - '" + dir + "/x.png' '" + kViewer +
 	    "' '" + kRawlog + "' --size 900x600 --png-sequence '" + dir +
 	    "/seq' > '" + log + "' 2>&1";
-	ASSERT_EQ(run(cmd), 0) << slurp(log);
+	ASSERT_EQ(run(cmd), 0) << bims::test::fileText(log);
 	std::vector<std::string> names;
 	for (const auto& e : std::filesystem::directory_iterator(dir + "/seq"))
 		if (e.path().extension() == ".png")  // not a .partial cut by the kill
 			names.push_back(e.path().filename().string());
 	std::sort(names.begin(), names.end());
-	ASSERT_GE(names.size(), 5u) << slurp(log);
+	ASSERT_GE(names.size(), 5u) << bims::test::fileText(log);
 	for (size_t i = 0; i < names.size(); ++i)
 		EXPECT_EQ(names[i], bims::frameFileName(i)) << "a frame was skipped";
 	const cv::Mat last = cv::imread(dir + "/seq/" + names.back());

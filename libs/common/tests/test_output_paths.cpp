@@ -13,6 +13,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "bims_test/text.h"
 #include "tmp_path.h"
 
 namespace fs = std::filesystem;
@@ -26,13 +27,6 @@ std::string fresh(const std::string& name)
 	fs::remove_all(d);
 	fs::create_directories(d);
 	return d;
-}
-std::string slurp(const std::string& p)
-{
-	std::ifstream f(p);
-	std::stringstream s;
-	s << f.rdbuf();
-	return s.str();
 }
 /** The message of the UsageError that \a f throws ("" if none). */
 template <class F>
@@ -110,14 +104,14 @@ TEST(OutputPaths, AWrittenFileReplacesASymlinkAndLeavesItsTarget)
 	std::ofstream(d + "/target.txt") << "precious";
 	fs::create_symlink(d + "/target.txt", d + "/out.txt");
 	bims::writeFileAtomically(d + "/out.txt", "new");
-	EXPECT_EQ(slurp(d + "/target.txt"), "precious");
+	EXPECT_EQ(bims::test::fileText(d + "/target.txt"), "precious");
 	EXPECT_FALSE(fs::is_symlink(fs::symlink_status(d + "/out.txt")));
-	EXPECT_EQ(slurp(d + "/out.txt"), "new");
+	EXPECT_EQ(bims::test::fileText(d + "/out.txt"), "new");
 	// the same for a streamed file prepared with replaceSymlink
 	fs::create_symlink(d + "/target.txt", d + "/streamed.txt");
 	bims::replaceSymlink(d + "/streamed.txt");
 	std::ofstream(d + "/streamed.txt") << "new";
-	EXPECT_EQ(slurp(d + "/target.txt"), "precious");
+	EXPECT_EQ(bims::test::fileText(d + "/target.txt"), "precious");
 	EXPECT_THROW(bims::replaceSymlink(d), std::runtime_error);  // a folder
 }
 
@@ -132,13 +126,13 @@ TEST(OutputPaths, APartialFileAppearsOnlyWhenCommitted)
 		// dropped without commit: an error on the way
 	}
 	EXPECT_FALSE(fs::exists(d + "/out.rawlog.partial"));
-	EXPECT_EQ(slurp(d + "/out.rawlog"), "old");
+	EXPECT_EQ(bims::test::fileText(d + "/out.rawlog"), "old");
 	{
 		bims::PartialFile p(d + "/out.rawlog");
 		std::ofstream(p.path()) << "whole";
 		p.commit();
 	}
-	EXPECT_EQ(slurp(d + "/out.rawlog"), "whole");
+	EXPECT_EQ(bims::test::fileText(d + "/out.rawlog"), "whole");
 	EXPECT_FALSE(fs::exists(d + "/out.rawlog.partial"));
 }
 
@@ -167,7 +161,7 @@ TEST(OutputPaths, AFailedAppendLeavesTheFileAtItsLastWholeRecord)
 	    });
 	EXPECT_EQ(code, 3);
 	EXPECT_EQ(fs::file_size(path), 90u);  // 5 whole records
-	EXPECT_EQ(slurp(path).back(), '\n');
+	EXPECT_EQ(bims::test::fileText(path).back(), '\n');
 }
 
 TEST(OutputPaths, AFolderOfAnEarlierRunIsRefusedThenClearedOfItsFilesOnly)
@@ -257,14 +251,14 @@ TEST(OutputPaths, APartialDirIsPutInPlaceWholeOrNotAtAll)
 		EXPECT_FALSE(fs::exists(d + "/x_gt"));
 		gt.commit();
 	}
-	EXPECT_EQ(slurp(d + "/x_gt/groundtruth.txt"), "one");
+	EXPECT_EQ(bims::test::fileText(d + "/x_gt/groundtruth.txt"), "one");
 	EXPECT_FALSE(fs::exists(d + "/x_gt.partial"));
 	// dropped (an error on the way): the earlier folder as it was
 	{
 		bims::PartialDir gt(d + "/x_gt", layout);
 		write(gt.path() + "/groundtruth.txt", "two");
 	}
-	EXPECT_EQ(slurp(d + "/x_gt/groundtruth.txt"), "one");
+	EXPECT_EQ(bims::test::fileText(d + "/x_gt/groundtruth.txt"), "one");
 	EXPECT_FALSE(fs::exists(d + "/x_gt.partial"));
 	// over an earlier run with a user's file: the run's files replaced
 	// (its extra mask gone), the user's kept
@@ -277,10 +271,10 @@ TEST(OutputPaths, APartialDirIsPutInPlaceWholeOrNotAtAll)
 		write(gt.path() + "/masks/000000.png", "n0");
 		gt.commit();
 	}
-	EXPECT_EQ(slurp(d + "/x_gt/groundtruth.txt"), "three");
-	EXPECT_EQ(slurp(d + "/x_gt/masks/000000.png"), "n0");
+	EXPECT_EQ(bims::test::fileText(d + "/x_gt/groundtruth.txt"), "three");
+	EXPECT_EQ(bims::test::fileText(d + "/x_gt/masks/000000.png"), "n0");
 	EXPECT_FALSE(fs::exists(d + "/x_gt/masks/000001.png"));
-	EXPECT_EQ(slurp(d + "/x_gt/notes.txt"), "mine");
+	EXPECT_EQ(bims::test::fileText(d + "/x_gt/notes.txt"), "mine");
 	EXPECT_FALSE(fs::exists(d + "/x_gt.partial"));
 	// a symbolic link at the name: replaced, its target untouched
 	write(d + "/elsewhere/groundtruth.txt", "theirs");
@@ -291,8 +285,8 @@ TEST(OutputPaths, APartialDirIsPutInPlaceWholeOrNotAtAll)
 		gt.commit();
 	}
 	EXPECT_FALSE(fs::is_symlink(d + "/y_gt"));
-	EXPECT_EQ(slurp(d + "/y_gt/groundtruth.txt"), "ours");
-	EXPECT_EQ(slurp(d + "/elsewhere/groundtruth.txt"), "theirs");
+	EXPECT_EQ(bims::test::fileText(d + "/y_gt/groundtruth.txt"), "ours");
+	EXPECT_EQ(bims::test::fileText(d + "/elsewhere/groundtruth.txt"), "theirs");
 }
 
 TEST(OutputPaths, GroundTruthDirDropsTheRawlogExtensions)

@@ -8,19 +8,13 @@
 #include <fstream>
 #include <sstream>
 
+#include "bims_test/text.h"
 #include "tmp_path.h"
 
 namespace fs = std::filesystem;
 
 namespace
 {
-std::string slurp(const std::string& p)
-{
-	std::ifstream f(p);
-	std::stringstream s;
-	s << f.rdbuf();
-	return s.str();
-}
 }  // namespace
 
 TEST(Share, ExecutableDirIsTheFolderOfThisTest)
@@ -43,10 +37,12 @@ TEST(Share, TheBuildTreeHoldsTheConfigsOfTheSourceTree)
 		    << p;
 		EXPECT_EQ(p, fs::path(p).lexically_normal().string());
 	}
-	EXPECT_EQ(slurp(bims::findShareFile("default.ini")),
-	          slurp(std::string(BIMS_SOURCE_DIR) + "/config/default.ini"));
-	EXPECT_EQ(slurp(bims::findShareFile("sim/crowded.ini")),
-	          slurp(std::string(BIMS_SOURCE_DIR) + "/config/sim/crowded.ini"));
+	EXPECT_EQ(bims::test::fileText(bims::findShareFile("default.ini")),
+	          bims::test::fileText(std::string(BIMS_SOURCE_DIR) +
+	                               "/config/default.ini"));
+	EXPECT_EQ(bims::test::fileText(bims::findShareFile("sim/crowded.ini")),
+	          bims::test::fileText(std::string(BIMS_SOURCE_DIR) +
+	                               "/config/sim/crowded.ini"));
 }
 
 TEST(Share, AbsentFileOrAFolderIsEmpty)

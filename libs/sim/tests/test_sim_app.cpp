@@ -27,6 +27,7 @@
 #include <regex>
 #include <sstream>
 #include <tuple>
+#include "bims_test/text.h"
 
 namespace
 {
@@ -52,13 +53,6 @@ int run(const std::string& cmd, std::string& out)
 	while ((n = fread(buf, 1, sizeof(buf), p)) > 0) out.append(buf, n);
 	const int st = pclose(p);
 	return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-std::string readFile(const std::string& path)
-{
-	std::ifstream f(path, std::ios::binary);
-	std::stringstream ss;
-	ss << f.rdbuf();
-	return ss.str();
 }
 void writeFile(const std::string& path, const std::string& text)
 {
@@ -140,10 +134,10 @@ TEST(BimsSim, RawlogRoundTripsThroughMrptReader)
 	ASSERT_FALSE(m.empty());
 	EXPECT_EQ(m.type(), CV_8UC1);
 	EXPECT_EQ(m.cols, 320);
-	EXPECT_FALSE(readFile(gt + "/imu.txt").empty());
-	EXPECT_NE(readFile(gt + "/objects.txt").find(" pendulum "),
+	EXPECT_FALSE(bims::test::fileText(gt + "/imu.txt").empty());
+	EXPECT_NE(bims::test::fileText(gt + "/objects.txt").find(" pendulum "),
 	          std::string::npos);
-	EXPECT_NE(readFile(gt + "/calibration.ini").find("R_IC="),
+	EXPECT_NE(bims::test::fileText(gt + "/calibration.ini").find("R_IC="),
 	          std::string::npos);
 }
 
@@ -292,18 +286,20 @@ TEST(BimsSim, SameSeedGivesIdenticalBytesOtherSeedDiffers)
 	const std::string fa = simulate(a, kSmallScene, "--seed 5 --max-frames 4");
 	const std::string fb = simulate(b, kSmallScene, "--seed 5 --max-frames 4");
 	const std::string fc = simulate(c, kSmallScene, "--seed 6 --max-frames 4");
-	EXPECT_EQ(readFile(fa), readFile(fb));
+	EXPECT_EQ(bims::test::fileText(fa), bims::test::fileText(fb));
 	for (const char* g : {"groundtruth.txt", "imu.txt", "objects.txt",
 	                      "calibration.ini", "masks/000003.png"})
-		EXPECT_EQ(readFile(a + "/out_gt/" + g), readFile(b + "/out_gt/" + g))
+		EXPECT_EQ(bims::test::fileText(a + "/out_gt/" + g),
+		          bims::test::fileText(b + "/out_gt/" + g))
 		    << g;
-	EXPECT_NE(readFile(fa), readFile(fc));
-	EXPECT_NE(readFile(a + "/out_gt/imu.txt"), readFile(c + "/out_gt/imu.txt"));
+	EXPECT_NE(bims::test::fileText(fa), bims::test::fileText(fc));
+	EXPECT_NE(bims::test::fileText(a + "/out_gt/imu.txt"),
+	          bims::test::fileText(c + "/out_gt/imu.txt"));
 	// Geometry does not depend on the noise seed.
-	EXPECT_EQ(readFile(a + "/out_gt/groundtruth.txt"),
-	          readFile(c + "/out_gt/groundtruth.txt"));
-	EXPECT_EQ(readFile(a + "/out_gt/masks/000003.png"),
-	          readFile(c + "/out_gt/masks/000003.png"));
+	EXPECT_EQ(bims::test::fileText(a + "/out_gt/groundtruth.txt"),
+	          bims::test::fileText(c + "/out_gt/groundtruth.txt"));
+	EXPECT_EQ(bims::test::fileText(a + "/out_gt/masks/000003.png"),
+	          bims::test::fileText(c + "/out_gt/masks/000003.png"));
 }
 
 TEST(BimsSim, BadInputGivesClearErrorAndNonZeroExit)
@@ -383,7 +379,7 @@ TEST(BimsSim, ImuFromTumTrajectoryIsLabelledSynthetic)
 		n++;
 	}
 	EXPECT_EQ(n, 197u);  // 59/30 s at 100 Hz, both ends
-	EXPECT_FALSE(readFile(d + "/imu_gt/imu.txt").empty());
+	EXPECT_FALSE(bims::test::fileText(d + "/imu_gt/imu.txt").empty());
 	ASSERT_EQ(run("'" + kBin + "/bims-info' '" + d + "/imu.rawlog'", out), 0)
 	    << out;
 	EXPECT_NE(out.find("IMU_SYNTH"), std::string::npos) << out;
@@ -405,7 +401,7 @@ TEST(BimsInfo, SummarisesSensorsAndRejectsBadFiles)
 	          1);
 	EXPECT_NE(out.find("missing.rawlog"), std::string::npos) << out;
 	// Truncated file: an error naming the file, not a silent short summary.
-	const std::string bytes = readFile(f);
+	const std::string bytes = bims::test::fileText(f);
 	std::ofstream(d + "/trunc.rawlog", std::ios::binary)
 	    .write(bytes.data(), bytes.size() / 2);
 	EXPECT_EQ(run("'" + kBin + "/bims-info' '" + d + "/trunc.rawlog'", out), 1)
@@ -475,7 +471,7 @@ TEST(BimsSim, SigintAndSigtermEndACompleteShorterSequence)
 		    {kBin + "/bims-sim", kSrc + "/rawlogs/pendulum_slow.ini", "-o",
 		     d + "/x.rawlog", "--max-frames", "3000", "-q"},
 		    d + "/log", d + "/x_gt.partial/masks/000005.png", sig);
-		const std::string log = readFile(d + "/log");
+		const std::string log = bims::test::fileText(d + "/log");
 		EXPECT_EQ(rc, code) << log;
 		EXPECT_NE(log.find(std::string("interrupted by ") + name + " after "),
 		          std::string::npos)
@@ -519,7 +515,7 @@ TEST(BimsSim, AKilledRunLeavesEveryFrameWrittenSoFarReadable)
 	    {kBin + "/bims-sim", kSrc + "/rawlogs/pendulum_slow.ini", "-o",
 	     d + "/x.rawlog", "--frames", "3000", "-q"},
 	    d + "/log", d + "/x_gt.partial/masks/000005.png", SIGKILL);
-	ASSERT_EQ(rc, -SIGKILL) << readFile(d + "/log");
+	ASSERT_EQ(rc, -SIGKILL) << bims::test::fileText(d + "/log");
 	EXPECT_FALSE(std::filesystem::exists(d + "/x.rawlog"));
 	EXPECT_FALSE(std::filesystem::exists(d + "/x_gt"));
 	size_t scans = 0;
@@ -546,7 +542,7 @@ TEST(BimsSim, AKilledRunLeavesEveryFrameWrittenSoFarReadable)
 	    bims::loadTumTrajectory(d + "/x_gt.partial/groundtruth.txt");
 	EXPECT_LE(poses.size(), scans);
 	EXPECT_GE(poses.size() + 1, scans);
-	const std::string imu = readFile(d + "/x_gt.partial/imu.txt");
+	const std::string imu = bims::test::fileText(d + "/x_gt.partial/imu.txt");
 	ASSERT_FALSE(imu.empty());
 	EXPECT_EQ(imu.back(), '\n');
 	EXPECT_TRUE(std::filesystem::exists(d + "/x_gt.partial/calibration.ini"));
@@ -564,15 +560,16 @@ TEST(BimsSim, AKilledOverwriteLeavesTheEarlierRawlogAndGroundTruthTogether)
 	              out),
 	          0)
 	    << out;
-	const std::string rawlogBefore = readFile(d + "/x.rawlog");
-	const std::string gtBefore = readFile(d + "/x_gt/groundtruth.txt");
+	const std::string rawlogBefore = bims::test::fileText(d + "/x.rawlog");
+	const std::string gtBefore =
+	    bims::test::fileText(d + "/x_gt/groundtruth.txt");
 	const int rc = bims::test::signalWhenExists(
 	    {kBin + "/bims-sim", kSrc + "/rawlogs/pendulum_slow.ini", "-o",
 	     d + "/x.rawlog", "--frames", "3000", "-q", "--overwrite"},
 	    d + "/log", d + "/x_gt.partial/masks/000005.png", SIGKILL);
-	ASSERT_EQ(rc, -SIGKILL) << readFile(d + "/log");
-	EXPECT_EQ(readFile(d + "/x.rawlog"), rawlogBefore);
-	EXPECT_EQ(readFile(d + "/x_gt/groundtruth.txt"), gtBefore);
+	ASSERT_EQ(rc, -SIGKILL) << bims::test::fileText(d + "/log");
+	EXPECT_EQ(bims::test::fileText(d + "/x.rawlog"), rawlogBefore);
+	EXPECT_EQ(bims::test::fileText(d + "/x_gt/groundtruth.txt"), gtBefore);
 	EXPECT_TRUE(std::filesystem::exists(d + "/x_gt/masks/000002.png"));
 	EXPECT_FALSE(std::filesystem::exists(d + "/x_gt/masks/000003.png"));
 	// the next run clears the killed one's folder and puts its pair in place
@@ -605,7 +602,8 @@ TEST(BimsSim, AnEarlierRunsGroundTruthIsRefusedUnlessOverwrite)
 	EXPECT_TRUE(std::filesystem::exists(d + "/out_gt/masks/000001.png"));
 	EXPECT_FALSE(std::filesystem::exists(d + "/out_gt/masks/000002.png"));
 	EXPECT_FALSE(std::filesystem::exists(d + "/out_gt/masks/000003.png"));
-	EXPECT_EQ(readFile(d + "/out_gt/notes.txt"), "mine");  // not its file
+	EXPECT_EQ(bims::test::fileText(d + "/out_gt/notes.txt"),
+	          "mine");  // not its file
 }
 
 TEST(BimsSim, TheGroundTruthLayoutNamesEveryFileARunWrites)

@@ -18,6 +18,7 @@
 #include <set>
 #include <sstream>
 #include <thread>
+#include "bims_test/text.h"
 
 namespace fs = std::filesystem;
 namespace sw = bims::sweep;
@@ -30,13 +31,6 @@ const std::string kDefault =
 std::string tmpDir(const std::string& name)
 {
 	return bims::test::freshTmpDir("bims_test_sweep", name);
-}
-std::string slurp(const std::string& p)
-{
-	std::ifstream f(p, std::ios::binary);
-	std::stringstream s;
-	s << f.rdbuf();
-	return s.str();
 }
 void put(const std::string& path, const std::string& text)
 {
@@ -187,7 +181,7 @@ TEST(SweepPlan, OverridesAreCheckedByBimsRunsLoaderNamingKeyValueAndConfig)
 	}
 	// a config that is bad by itself is named as itself
 	const auto d = sweepFolder("bad_base", head + "grids.voxel_size = 0.1\n");
-	std::string b = slurp(kDefault);
+	std::string b = bims::test::fileText(kDefault);
 	b.insert(b.find("[grids]\n") + 8, "typo = 1\n");
 	put(d + "/sub/b.ini", b);
 	const std::string e = planError(d);
@@ -209,7 +203,8 @@ TEST(SweepPlan, RoundTripsThroughSweepJsonAndRunFolders)
 	EXPECT_FALSE(
 	    fs::exists(sw::runOutDir(out, plan.runs[0].id) + "/metrics.json"));
 	for (const auto& r : plan.runs)
-		EXPECT_EQ(slurp(sw::runDir(out, r.id) + "/config.ini"), r.configText);
+		EXPECT_EQ(bims::test::fileText(sw::runDir(out, r.id) + "/config.ini"),
+		          r.configText);
 	const auto back = sw::SweepPlan::readJson(out + "/sweep.json");
 	EXPECT_EQ(back.name, "sweep");
 	EXPECT_EQ(back.frames, "2:5");
@@ -257,21 +252,21 @@ TEST(SweepProcesses, AtMostNRunAtOnceEachWithItsLogAndExitCode)
 		EXPECT_TRUE(out[i].started);
 		EXPECT_EQ(out[i].exitCode, i);
 		EXPECT_GE(out[i].seconds, 0.25);
-		EXPECT_EQ(slurp(d + "/log" + std::to_string(i) + ".txt"),
+		EXPECT_EQ(bims::test::fileText(d + "/log" + std::to_string(i) + ".txt"),
 		          "job " + std::to_string(i) + "\n");
 	}
 	EXPECT_EQ(out[4].exitCode, 127);
-	EXPECT_NE(
-	    slurp(d + "/log4.txt").find("cannot execute " + d + "/no_such_program"),
-	    std::string::npos);
+	EXPECT_NE(bims::test::fileText(d + "/log4.txt")
+	              .find("cannot execute " + d + "/no_such_program"),
+	          std::string::npos);
 	EXPECT_EQ(order.size(), 5u);
 	// two at a time: both first jobs started before either ended, never a
 	// third at once
 	int now = 0, most = 0;
-	std::istringstream t(slurp(trace));
+	std::istringstream t(bims::test::fileText(trace));
 	for (std::string w; t >> w;)
 		most = std::max(most, now += w == "start" ? 1 : -1);
-	EXPECT_EQ(most, 2) << slurp(trace);
+	EXPECT_EQ(most, 2) << bims::test::fileText(trace);
 }
 
 TEST(SweepProcesses, StopLaunchesNoMoreAndPassesTheSignalOnOnce)
@@ -304,7 +299,7 @@ TEST(SweepProcesses, StopLaunchesNoMoreAndPassesTheSignalOnOnce)
 	    15.0);
 	EXPECT_TRUE(out[0].started);
 	EXPECT_EQ(out[0].exitCode, 9);
-	EXPECT_EQ(slurp(d + "/log0.txt"), "got INT\n");
+	EXPECT_EQ(bims::test::fileText(d + "/log0.txt"), "got INT\n");
 	EXPECT_FALSE(out[1].started);
 	EXPECT_FALSE(out[2].started);
 	EXPECT_EQ(out[2].exitCode, -1);

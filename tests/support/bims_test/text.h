@@ -3,6 +3,7 @@
 
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 namespace bims::test
@@ -18,10 +19,14 @@ inline std::string restOfLineAfter(const std::string& text,
 	return text.substr(from, text.find('\n', from) - from);
 }
 
-/** The whole text of the file at \a path ("" when it cannot be read). */
+/** The whole content of the file at \a path. A file that cannot be opened
+ * throws (the test fails naming it): a comparison of two files that were
+ * never written must not pass as two empty texts. A test that expects a file
+ * to be absent says so with std::filesystem::exists. */
 inline std::string fileText(const std::string& path)
 {
-	std::ifstream f(path);
+	std::ifstream f(path, std::ios::binary);
+	if (!f) throw std::runtime_error("test: cannot read file '" + path + "'");
 	std::stringstream s;
 	s << f.rdbuf();
 	return s.str();
