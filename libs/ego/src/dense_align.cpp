@@ -229,7 +229,8 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 			continue;
 		}
 		const float iz = 1.f / Z;
-		const float u = fx * X * iz + cx, v = fy * Y * iz + cy;
+		float u, v;
+		denseProject(X, Y, iz, fx, fy, cx, cy, u, v);
 		if (!(u > -0.5f && v > -0.5f && u < W - 0.5f && v < H - 0.5f))
 		{
 			if (counts) out.cost += rhoMax;
@@ -279,7 +280,7 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 		double rg = 0, invSg = 1;
 		if (hasNormal)
 		{
-			rg = q.nx * X + q.ny * Y + q.nz * Z - q.d;
+			rg = pointToPlaneResidual(X, Y, Z, q.nx, q.ny, q.nz, q.d);
 			invSg = 1 / (p.geo_sigma_m + p.geo_sigma_z2 * zr * zr);
 			tg = Tukey::at(rg * invSg * invC, c);
 		}
@@ -294,12 +295,8 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 		if (hasNormal && normalEquations)
 		{
 			// point-to-plane: d r / d(v, w) = [n, X x n]
-			const float Jg[6] = {q.nx,
-			                     q.ny,
-			                     q.nz,
-			                     Y * q.nz - Z * q.ny,
-			                     Z * q.nx - X * q.nz,
-			                     X * q.ny - Y * q.nx};
+			float Jg[6];
+			pointToPlaneJacobian(X, Y, Z, q.nx, q.ny, q.nz, Jg);
 			// weight s^2 / sg^2
 			rows->add(Jg, tg.s * invSg, rg);
 		}
@@ -331,10 +328,8 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 		out.photoW += wp;
 		if (wp <= 0 || !normalEquations) continue;
 		const float gx = bil(&RefPixel::gx), gy = bil(&RefPixel::gy);
-		const float g0 = gx * fx * iz, g1 = gy * fy * iz,
-		            g2 = -(gx * fx * X + gy * fy * Y) * iz * iz;
-		const float Jp[6] = {
-		    g0, g1, g2, Y * g2 - Z * g1, Z * g0 - X * g2, X * g1 - Y * g0};
+		float Jp[6];
+		photometricJacobian(X, Y, Z, iz, gx, gy, fx, fy, Jp);
 		rows->add(Jp, tp.s * photoRootScale, rp);
 	}
 	if (rows) rows->get(out.H, out.b);

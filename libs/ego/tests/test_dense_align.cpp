@@ -1,4 +1,5 @@
-// Dense alignment and map-anchored tracking on exact synthetic frames.
+// Dense alignment and map-anchored tracking on exact synthetic frames; the
+// alignment's Jacobians against central differences.
 #include <bims/ego/dense_align.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/keyframe_anchor.h>
@@ -7,6 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "synth_scene.h"
@@ -475,4 +479,130 @@ TEST(KeyframeAnchor, OdometryUsesTheVetoedMask)
 				EXPECT_GT(e.anchor.excluded_fraction, 0.25);
 		}
 	}
+}
+
+namespace
+{
+/** A smooth grey image I(u, v) (for the photometric Jacobian: its gradient
+ * is exact) and its gradient [grey/px]. */
+double smoothGrey(double u, double v)
+{
+	return 120 + 40 * std::sin(0.05 * u + 0.3) * std::cos(0.04 * v - 0.2) +
+	       0.002 * u * v;
+}
+Eigen::Vector2d smoothGreyGradient(double u, double v)
+{
+	return {0.05 * 40 * std::cos(0.05 * u + 0.3) * std::cos(0.04 * v - 0.2) +
+	            0.002 * v,
+	        -0.04 * 40 * std::sin(0.05 * u + 0.3) * std::sin(0.04 * v - 0.2) +
+	            0.002 * u};
+}
+
+/** The current point p at the pose (R, t) after the increment d = (v, w),
+ * as alignDense() applies it (R <- Exp(w) R, t <- Exp(w) t + v). */
+Eigen::Vector3d movedPoint(const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                           const Eigen::Vector3d& p,
+                           const Eigen::Matrix<double, 6, 1>& d)
+{
+	const Eigen::Matrix3d dR = expSO3(d.tail<3>());
+	return dR * R * p + (dR * t + d.head<3>());
+}
+
+/** Largest |analytic - numeric| over Jacobian rows, absolute and relative
+ * to each row's largest numeric entry. */
+struct MaxErr
+{
+	double abs = 0, rel = 0;
+	/** Adds a row; returns its relative error. */
+	template <typename T>
+	double add(const T* a, const double* n)
+	{
+		double scale = 0, row = 0;
+		for (int i = 0; i < 6; i++) scale = std::max(scale, std::abs(n[i]));
+		for (int i = 0; i < 6; i++)
+		{
+			const double e = std::abs(double(a[i]) - n[i]);
+			abs = std::max(abs, e);
+			row = std::max(row, e / scale);
+		}
+		rel = std::max(rel, row);
+		return row;
+	}
+};
+}  // namespace
+
+// The point-to-plane and photometric Jacobians of alignDense() against
+// central differences of their residuals under the alignment's increment, at
+// random poses, points, planes and image positions.
+TEST(DenseAlign, JacobianMatchesCentralDifferences)
+{
+	std::mt19937 rng(20240611);
+	std::uniform_real_distribution<double> U(-1, 1), Zd(0.5, 5);
+	const Eigen::Matrix3d K = K320();
+	const double fx = K(0, 0), fy = K(1, 1), cx = K(0, 2), cy = K(1, 2);
+	const double h = 1e-6, tol = 1e-5;
+	MaxErr geo, photo;
+	MaxErr inFloat;  // float against double instantiation
+	int n = 0;
+	while (n < 40)
+	{
+		const Eigen::Matrix3d R =
+		    expSO3(0.4 * Eigen::Vector3d(U(rng), U(rng), U(rng)));
+		const Eigen::Vector3d t = 0.3 * Eigen::Vector3d(U(rng), U(rng), U(rng));
+		const double z = Zd(rng);
+		const Eigen::Vector3d p(0.6 * z * U(rng), 0.45 * z * U(rng), z);
+		const Eigen::Vector3d X = R * p + t;
+		if (X.z() < 0.3) continue;
+		++n;
+		// a plane through a point near X
+		const Eigen::Vector3d nrm =
+		    Eigen::Vector3d(U(rng), U(rng), U(rng) - 1.5).normalized();
+		const double dpl =
+		    nrm.dot(X + 0.05 * Eigen::Vector3d(U(rng), U(rng), U(rng)));
+		const auto rGeo = [&](const Eigen::Vector3d& Y)
+		{
+			return pointToPlaneResidual(Y.x(), Y.y(), Y.z(), nrm.x(), nrm.y(),
+			                            nrm.z(), dpl);
+		};
+		const auto rPhoto = [&](const Eigen::Vector3d& Y)
+		{
+			double u, v;
+			denseProject(Y.x(), Y.y(), 1 / Y.z(), fx, fy, cx, cy, u, v);
+			return smoothGrey(u, v);
+		};
+		double Jg[6], Jp[6], ng[6], np[6];
+		pointToPlaneJacobian(X.x(), X.y(), X.z(), nrm.x(), nrm.y(), nrm.z(),
+		                     Jg);
+		double u, v;
+		denseProject(X.x(), X.y(), 1 / X.z(), fx, fy, cx, cy, u, v);
+		const Eigen::Vector2d g = smoothGreyGradient(u, v);
+		photometricJacobian(X.x(), X.y(), X.z(), 1 / X.z(), g.x(), g.y(), fx,
+		                    fy, Jp);
+		for (int k = 0; k < 6; k++)
+		{
+			Eigen::Matrix<double, 6, 1> d = Eigen::Matrix<double, 6, 1>::Zero();
+			d(k) = h;
+			const Eigen::Vector3d Xp = movedPoint(R, t, p, d),
+			                      Xm = movedPoint(R, t, p, -d);
+			ng[k] = (rGeo(Xp) - rGeo(Xm)) / (2 * h);
+			np[k] = (rPhoto(Xp) - rPhoto(Xm)) / (2 * h);
+		}
+		EXPECT_LT(geo.add(Jg, ng), tol) << "point-to-plane, sample " << n;
+		EXPECT_LT(photo.add(Jp, np), tol) << "photometric, sample " << n;
+		// the float instantiation (the one the alignment runs): the same
+		// to float precision
+		float Jgf[6], Jpf[6];
+		pointToPlaneJacobian(float(X.x()), float(X.y()), float(X.z()),
+		                     float(nrm.x()), float(nrm.y()), float(nrm.z()),
+		                     Jgf);
+		photometricJacobian(float(X.x()), float(X.y()), float(X.z()),
+		                    1.f / float(X.z()), float(g.x()), float(g.y()),
+		                    float(fx), float(fy), Jpf);
+		EXPECT_LT(inFloat.add(Jgf, Jg), 1e-5) << "point-to-plane, sample " << n;
+		EXPECT_LT(inFloat.add(Jpf, Jp), 1e-5) << "photometric, sample " << n;
+	}
+	std::printf(
+	    "point-to-plane: max abs %.2e, rel %.2e; photometric: max abs "
+	    "%.2e, rel %.2e; float: rel %.2e\n",
+	    geo.abs, geo.rel, photo.abs, photo.rel, inFloat.rel);
 }

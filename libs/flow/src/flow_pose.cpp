@@ -39,6 +39,19 @@ struct Sample
 };
 }  // namespace
 
+Eigen::Matrix<double, 2, 6> flowPoseJacobian(const Eigen::Vector3d& q,
+                                             double fx, double fy)
+{
+	const double iz = 1.0 / q.z();
+	Eigen::Matrix<double, 2, 3> Jp;
+	Jp << fx * iz, 0, -fx * q.x() * iz * iz, 0, fy * iz, -fy * q.y() * iz * iz;
+	Eigen::Matrix<double, 3, 6> Jq;
+	Jq << 0, q.z(), -q.y(), 1, 0, 0,  //
+	    -q.z(), 0, q.x(), 0, 1, 0,    //
+	    q.y(), -q.x(), 0, 0, 0, 1;    // d(q + w x q + d)/d(w, d)
+	return Jp * Jq;
+}
+
 FlowPoseParams flowPoseParamsFrom(const FlowParams& f)
 {
 	FlowPoseParams p;
@@ -208,14 +221,7 @@ FlowPoseResult refinePoseWithFlow(const cv::Mat& observed, const cv::Mat& depth,
 			const Eigen::Vector3d q = R * S[i].p + t;
 			if (q.z() <= 1e-6) continue;
 			const double iz = 1.0 / q.z();
-			Eigen::Matrix<double, 2, 3> Jp;
-			Jp << fx * iz, 0, -fx * q.x() * iz * iz, 0, fy * iz,
-			    -fy * q.y() * iz * iz;
-			Eigen::Matrix<double, 3, 6> Jq;
-			Jq << 0, q.z(), -q.y(), 1, 0, 0,  //
-			    -q.z(), 0, q.x(), 0, 1, 0,    //
-			    q.y(), -q.x(), 0, 0, 0, 1;    // d(q + w x q + d)/d(w, d)
-			const Eigen::Matrix<double, 2, 6> A = Jp * Jq;
+			const Eigen::Matrix<double, 2, 6> A = flowPoseJacobian(q, fx, fy);
 			const Eigen::Vector2d rr(S[i].x.x() - (fx * q.x() * iz + cx),
 			                         S[i].x.y() - (fy * q.y() * iz + cy));
 			H.noalias() += w * A.transpose() * A;

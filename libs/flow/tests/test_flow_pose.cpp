@@ -1,10 +1,15 @@
-// Dense-flow pose refinement, structure tensor, visibility gate, depth edges.
+// Dense-flow pose refinement (and its Jacobian against central differences),
+// structure tensor, visibility gate, depth edges.
 #include <bims/flow/consistency.h>
 #include <bims/flow/expected_flow.h>
 #include <bims/flow/flow_pose.h>
 #include <bims/flow/observed_flow.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "test_util.h"
@@ -215,4 +220,64 @@ TEST(Consistency, DepthEdgesGetNoLabel)
 	const cv::Mat lab = labelConsistency(obs, exp, depth, cam, T, p);
 	EXPECT_EQ(lab.at<int8_t>(H / 2, W / 2), kNoLabel);
 	EXPECT_EQ(lab.at<int8_t>(H / 2, W / 4), kNotDiff);
+}
+
+// The Jacobian of refinePoseWithFlow()'s flow residual (observed position -
+// projection) against central differences under the fit's increment
+// (w, v): R <- Exp(w) R, t <- Exp(w) t + v; random poses and points.
+TEST(FlowPose, JacobianMatchesCentralDifferences)
+{
+	const auto cam = test::vgaCamera();
+	const double fx = cam.fx(), fy = cam.fy(), cx = cam.cx(), cy = cam.cy();
+	std::mt19937 rng(20240611);
+	std::uniform_real_distribution<double> U(-1, 1), Zd(0.5, 5);
+	const auto Exp = [](const Eigen::Vector3d& w)
+	{
+		const double th = w.norm();
+		return th > 0 ? Eigen::AngleAxisd(th, w / th).toRotationMatrix()
+		              : Eigen::Matrix3d(Eigen::Matrix3d::Identity());
+	};
+	const double h = 1e-6, tol = 1e-5;
+	double maxAbs = 0, maxRel = 0;
+	int n = 0;
+	while (n < 40)
+	{
+		const Eigen::Matrix3d R =
+		    Exp(0.4 * Eigen::Vector3d(U(rng), U(rng), U(rng)));
+		const Eigen::Vector3d t = 0.3 * Eigen::Vector3d(U(rng), U(rng), U(rng));
+		const double z = Zd(rng);
+		const Eigen::Vector3d p(0.6 * z * U(rng), 0.45 * z * U(rng), z);
+		const Eigen::Vector3d q = R * p + t;
+		if (q.z() < 0.3) continue;
+		++n;
+		// an observed position a few pixels off the projection
+		const Eigen::Vector2d x(fx * q.x() / q.z() + cx + 5 * U(rng),
+		                        fy * q.y() / q.z() + cy + 5 * U(rng));
+		const auto residual = [&](const Eigen::Matrix<double, 6, 1>& xi)
+		{
+			const Eigen::Matrix3d dR = Exp(xi.head<3>());
+			const Eigen::Vector3d qq = dR * R * p + (dR * t + xi.tail<3>());
+			return Eigen::Vector2d(x.x() - (fx * qq.x() / qq.z() + cx),
+			                       x.y() - (fy * qq.y() / qq.z() + cy));
+		};
+		// the residual's Jacobian is minus the projection's
+		const Eigen::Matrix<double, 2, 6> J = -flowPoseJacobian(q, fx, fy);
+		Eigen::Matrix<double, 2, 6> num;
+		for (int k = 0; k < 6; k++)
+		{
+			Eigen::Matrix<double, 6, 1> d = Eigen::Matrix<double, 6, 1>::Zero();
+			d(k) = h;
+			num.col(k) = (residual(d) - residual(-d)) / (2 * h);
+		}
+		for (int row = 0; row < 2; row++)
+		{
+			// relative to the row's largest entry
+			const double scale = num.row(row).cwiseAbs().maxCoeff();
+			const double e = (J.row(row) - num.row(row)).cwiseAbs().maxCoeff();
+			maxAbs = std::max(maxAbs, e);
+			maxRel = std::max(maxRel, e / scale);
+			EXPECT_LT(e / scale, tol) << "sample " << n << ", row " << row;
+		}
+	}
+	std::printf("flow residual: max abs %.2e, rel %.2e\n", maxAbs, maxRel);
 }

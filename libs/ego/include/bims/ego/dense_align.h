@@ -122,6 +122,60 @@ struct InitialGuess
 	Eigen::Vector3d t;
 };
 
+// The per-point terms of alignDense(), on a current point moved by the pose
+// estimate into the reference camera: X = R_RC p + t_RC = (X, Y, Z). The
+// Jacobians are w.r.t. the increment (v, w) (translation first, then
+// rotation [m, rad]) applied on the left, as the alignment applies it:
+// R <- Exp(w) R, t <- Exp(w) t + v, i.e. X <- Exp(w) X + v. Templates on
+// the scalar: the alignment runs them in float (tests in double).
+
+/** Pinhole projection (u, v) of X with iz = 1 / Z. */
+template <typename T>
+inline void denseProject(T X, T Y, T iz, T fx, T fy, T cx, T cy, T& u, T& v)
+{
+	u = fx * X * iz + cx;
+	v = fy * Y * iz + cy;
+}
+
+/** Point-to-plane residual n . X - d of the reference plane (n, d). */
+template <typename T>
+inline T pointToPlaneResidual(T X, T Y, T Z, T nx, T ny, T nz, T d)
+{
+	return nx * X + ny * Y + nz * Z - d;
+}
+
+/** Its Jacobian w.r.t. (v, w): [n, X x n]. */
+template <typename T>
+inline void pointToPlaneJacobian(T X, T Y, T Z, T nx, T ny, T nz, T J[6])
+{
+	J[0] = nx;
+	J[1] = ny;
+	J[2] = nz;
+	J[3] = Y * nz - Z * ny;
+	J[4] = Z * nx - X * nz;
+	J[5] = X * ny - Y * nx;
+}
+
+/** Jacobian w.r.t. (v, w) of the photometric residual I(u, v) - grey (grey
+ * and the brightness offset fixed), with (u, v) = denseProject(X) and
+ * (gx, gy) the reference's gradient of I there [grey/px] (the alignment
+ * interpolates its Sobel gradients), iz = 1 / Z:
+ * g = dI/dX = (gx fx iz, gy fy iz, -(gx fx X + gy fy Y) iz^2),
+ * J = [g, X x g]. */
+template <typename T>
+inline void photometricJacobian(T X, T Y, T Z, T iz, T gx, T gy, T fx, T fy,
+                                T J[6])
+{
+	const T g0 = gx * fx * iz, g1 = gy * fy * iz,
+	        g2 = -(gx * fx * X + gy * fy * Y) * iz * iz;
+	J[0] = g0;
+	J[1] = g1;
+	J[2] = g2;
+	J[3] = Y * g2 - Z * g1;
+	J[4] = Z * g0 - X * g2;
+	J[5] = X * g1 - Y * g0;
+}
+
 /** Aligns \a cur to \a ref (ref.isReference()) from the initial guess
  * (R_init, t_init) = T_RC. \param R_prior optional prior on R_RC with
  * std. dev. \a sigmaPrior_rad (the IMU's rotation); sigmaPrior_rad = 0

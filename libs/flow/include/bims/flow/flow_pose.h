@@ -13,6 +13,7 @@
 #include <mrpt/poses/CPose3D.h>
 #include <opencv2/core.hpp>
 
+#include <Eigen/Core>
 #include <string>
 
 namespace bims::flow
@@ -68,6 +69,15 @@ FlowPoseResult refinePoseWithFlow(const cv::Mat& observed, const cv::Mat& depth,
                                   const FlowPoseParams& p,
                                   const cv::Mat* exclude = nullptr,
                                   const cv::Mat* tensor = nullptr);
+
+/** refinePoseWithFlow()'s Gauss-Newton Jacobian of one sample: the 2x6
+ * Jacobian of the projection (fx x / z + cx, fy y / z + cy) of
+ * q = R p + t = (x, y, z) (the sample in the previous camera) w.r.t. the
+ * increment (w, v) (rotation first [rad], then translation [m]) applied on
+ * the left, as the fit applies it: R <- Exp(w) R, t <- Exp(w) t + v. The
+ * flow residual (observed - projection) has minus this Jacobian. */
+Eigen::Matrix<double, 2, 6> flowPoseJacobian(const Eigen::Vector3d& q,
+                                             double fx, double fy);
 
 /** The [flow] refine_* keys as FlowPoseParams (mode from refine_pose,
  * which must not be "none"; depth range up to max_depth_m). */
