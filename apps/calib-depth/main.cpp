@@ -5,10 +5,10 @@
 // between frame pairs at known poses (--poses, a TUM trajectory) or at the
 // poses of bims' own frame-to-frame vision odometry (no ground truth
 // needed). Writes a [depth_correction] section to paste into (or include
-// with) the experiment .ini. The run: bims::source::runDepthCalibration
+// with) the experiment .ini. The run: bims::apps::runDepthCalibration
 // (calibration_run.h).
+#include <bims/apps/calibration_run.h>
 #include <bims/common/app.h>
-#include <bims/source/calibration_run.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
@@ -47,7 +47,7 @@ int main(int argc, char** argv)
 		        false, 0.1, "FRACTION", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
-		    return bims::source::runDepthCalibration(
+		    return bims::apps::runDepthCalibration(
 		        {cfgArg.getValue(), inArg.getValue(), framesArg.getValue(),
 		         posesArg.getValue(), outArg.getValue(),
 		         bims::inRange(maxArg, 1e-6, 1.0, "a fraction of the depth"),

@@ -4,9 +4,9 @@
 // gyro integrated over the same interval gives R_IprevI, and R_IC solves
 // Log(R_IprevI) = R_IC Log(R_CprevC) robustly (docs/ego.md). When the
 // config already holds an R_IC, the angle between the two is reported.
-// The run: bims::source::runImuCalibration (calibration_run.h).
+// The run: bims::apps::runImuCalibration (calibration_run.h).
+#include <bims/apps/calibration_run.h>
 #include <bims/common/app.h>
-#include <bims/source/calibration_run.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
@@ -43,7 +43,7 @@ int main(int argc, char** argv)
 		        0.3, "DEG", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv, {{"-c", "--calib"}});
-		    return bims::source::runImuCalibration(
+		    return bims::apps::runImuCalibration(
 		        {cfgArg.getValue(), inArg.getValue(), calibArg.getValue(),
 		         bims::givenValue(outArg), minAngle.getValue(), thr.getValue(),
 		         !quiet.getValue()});

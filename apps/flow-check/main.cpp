@@ -16,8 +16,8 @@
 // pose against gt and flow. A summary (mean over frames) ends the output.
 // --strip writes a picture: for each listed frame the RGB image with the
 // used pose's Diff pixels in red (docs/journal/pipeline.md). The logic:
-// bims/check/flow_check.h, bims/flow/pose_check.h.
-#include <bims/check/flow_check.h>
+// bims/apps/flow_check.h, bims/flow/pose_check.h.
+#include <bims/apps/flow_check.h>
 #include <bims/common/app.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
@@ -53,7 +53,7 @@ int main(int argc, char** argv)
 		    TCLAP::SwitchArg aQuiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
 		    using bims::givenValue;
-		    return bims::check::runFlowCheck(
+		    return bims::apps::runFlowCheck(
 		        {aCfg.getValue(), aIn.getValue(), aGt.getValue(),
 		         aFrames.getValue(), givenValue(aCsv), givenValue(aStrip),
 		         aStripFrames.getValue(), aVariant.getValue(),

@@ -4,8 +4,8 @@
 // Egomotion alone: writes the camera trajectory T_WC in the TUM format and a
 // per-stage timing summary. Works with or without IMU data in the rawlog
 // (mode = vision for data without IMU).
+#include <bims/apps/odometry_run.h>
 #include <bims/common/app.h>
-#include <bims/source/odometry_run.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
@@ -66,7 +66,7 @@ int main(int argc, char** argv)
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv, {{"-c", "--calib"}});
 		    using bims::givenValue;
-		    return bims::source::runOdometry(
+		    return bims::apps::runOdometry(
 		        {cfgArg.getValue(), inArg.getValue(), outArg.getValue(),
 		         calibArg.getValue(), givenValue(modeArg), givenValue(aidArg),
 		         givenValue(csvArg), givenValue(masksArg), givenValue(gtArg),

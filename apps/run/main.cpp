@@ -11,9 +11,9 @@
 // effective.ini (every parameter used), and prints a summary table.
 // --print-config prints that effective.ini (of CONFIG.ini, or of the built-in
 // defaults) and exits. See docs/pipeline.md and docs/config.md. The run:
-// bims::pipeline::runFromCommandLine (run.h).
+// bims::apps::runFromCommandLine (bims/apps/run_command.h).
+#include <bims/apps/run_command.h>
 #include <bims/common/app.h>
-#include <bims/pipeline/run.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
 int main(int argc, char** argv)
@@ -23,7 +23,7 @@ int main(int argc, char** argv)
 	    "bims-run",
 	    [&]()
 	    {
-		    if (const auto rc = bims::pipeline::printConfigIfAsked(argc, argv))
+		    if (const auto rc = bims::apps::printConfigIfAsked(argc, argv))
 			    return *rc;
 		    TCLAP::CmdLine cmd(
 		        "bims: Bayesian independent motion segmentation of RGB-D + IMU "
@@ -58,7 +58,7 @@ int main(int argc, char** argv)
 		        "[CONFIG.ini]",
 		        cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
-		    return bims::pipeline::runFromCommandLine(
+		    return bims::apps::runFromCommandLine(
 		        {aCfg.getValue(), aIn.getValue(), aOut.getValue(),
 		         aFrames.getValue(), bims::givenValue(aVariant),
 		         aOverwrite.getValue(), !aQuiet.getValue(),

@@ -1,11 +1,11 @@
+#include <bims/apps/calibration_run.h>
+#include <bims/apps/odometry_run.h>
 #include <bims/common/app.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/so3.h>
-#include <bims/source/calibration_run.h>
 #include <bims/source/frame_source.h>
-#include <bims/source/odometry_run.h>
 
 #include <mrpt/system/filesystem.h>
 
@@ -13,8 +13,13 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace bims::source
+namespace bims::apps
 {
+using source::ReplayOptions;
+using source::ReplayStats;
+using source::replayRawlog;
+using source::FrameRange;
+
 void RotationPairCollector::addFrame(const ego::FrameEgomotion& r)
 {
 	if (r.ok() && !(r.flags & ego::kFlagFirstFrame) && std::isfinite(tPrev_))
@@ -217,4 +222,4 @@ int runDepthCalibration(const DepthCalibrationOptions& o)
 	return 0;
 }
 
-}  // namespace bims::source
+}  // namespace bims::apps

@@ -1,4 +1,4 @@
-#include <bims/check/flow_check.h>
+#include <bims/apps/flow_check.h>
 #include <bims/common/app.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
@@ -15,7 +15,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
-namespace bims::check
+namespace bims::apps
 {
 using flow::PoseSourceCheck;
 using mrpt::poses::CPose3D;
@@ -178,4 +178,4 @@ int runFlowCheck(const FlowCheckOptions& o)
 	return 0;
 }
 
-}  // namespace bims::check
+}  // namespace bims::apps

@@ -1,3 +1,4 @@
+#include <bims/apps/odometry_run.h>
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
@@ -6,7 +7,6 @@
 #include <bims/common/stats.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/so3.h>
-#include <bims/source/odometry_run.h>
 
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/system/filesystem.h>
@@ -16,8 +16,12 @@
 #include <cstdio>
 #include <memory>
 
-namespace bims::source
+namespace bims::apps
 {
+using source::ReplayOptions;
+using source::ReplayStats;
+using source::replayRawlog;
+
 void overrideSensorSectionsFrom(ego::EgoConfig& ec, const std::string& calib,
                                 const std::string& noSuch)
 {
@@ -258,4 +262,4 @@ int runOdometry(const OdometryRunOptions& o)
 	return 0;
 }
 
-}  // namespace bims::source
+}  // namespace bims::apps

@@ -1,16 +1,41 @@
 // bims-run's command: the options of its command line into a run
 // (runExperiment) and its report.
+#include <bims/apps/run_command.h>
 #include <bims/common/app.h>
 #include <bims/common/choice.h>
 #include <bims/common/output_paths.h>
-#include <bims/pipeline/run.h>
+#include <bims/common/rawlog.h>
 
 #include <csignal>
 #include <cstdio>
 #include <stdexcept>
 
-namespace bims::pipeline
+namespace bims::apps
 {
+using pipeline::RunOptions;
+using pipeline::frameRangeOption;
+using pipeline::runOutputLayout;
+using pipeline::formatSummary;
+using pipeline::runExperiment;
+
+using pipeline::Variant;
+
+std::optional<int> printConfigIfAsked(int argc, char** argv)
+{
+	std::vector<std::string> args(argv + 1, argv + argc);
+	const auto it = std::find(args.begin(), args.end(), "--print-config");
+	if (it == args.end()) return std::nullopt;
+	args.erase(it);
+	if (args.size() > 1 || (args.size() == 1 && args[0].rfind("-", 0) == 0))
+		throw UsageError(
+		    "--print-config takes at most one experiment .ini and nothing "
+		    "else: bims-run --print-config [CONFIG.ini]");
+	ExperimentConfig cfg;
+	if (!args.empty()) cfg.loadFromFile(args[0]);
+	std::printf("%s", cfg.effectiveIni().c_str());
+	return 0;
+}
+
 void applyVariantOption(ExperimentConfig& cfg, const std::string& name)
 {
 	try
@@ -72,4 +97,4 @@ int runFromCommandLine(const RunCommand& c)
 	return runExitCode(sum, sig);
 }
 
-}  // namespace bims::pipeline
+}  // namespace bims::apps

@@ -1,10 +1,10 @@
 // The calibration programs' runs (calibration_run.h): the gyro/vision
 // rotation pairs, bims-calib-imu's .ini, the size of a depth correction and
 // both runs on the bundled sample.
+#include <bims/apps/calibration_run.h>
 #include <bims/common/app.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/so3.h>
-#include <bims/source/calibration_run.h>
 #include <bims_test/sample.h>
 #include <bims_test/text.h>
 #include <bims_test/tmp_dir.h>
@@ -18,7 +18,7 @@
 #include <fstream>
 #include <sstream>
 
-using namespace bims::source;
+using namespace bims::apps;
 
 namespace
 {

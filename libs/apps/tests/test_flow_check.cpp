@@ -1,7 +1,8 @@
 // bims-flow-check's logic (flow_check.h): its lines, its summary, a strip
 // tile, and a run over the bundled sample.
-#include <bims/check/flow_check.h>
+#include <bims/apps/flow_check.h>
 #include <bims/common/app.h>
+#include <bims_test/sample.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 
@@ -12,15 +13,14 @@
 #include <fstream>
 #include <sstream>
 
-using namespace bims::check;
+using namespace bims::apps;
 using bims::flow::PoseSourceCheck;
 
 namespace
 {
-const std::string kSrc = BIMS_SOURCE_DIR;
-const std::string kSample = kSrc + "/rawlogs/pendulum_slow.rawlog";
-const std::string kGt = kSrc + "/rawlogs/pendulum_slow_gt/groundtruth.txt";
-const std::string kConfig = kSrc + "/config/default.ini";
+using bims::test::kSample;
+const std::string kGt = bims::test::kSampleGt + "groundtruth.txt";
+using bims::test::kDefaultConfig;
 
 PoseSourceCheck counting()
 {
@@ -92,7 +92,7 @@ TEST(FlowCheck, RunsTheSampleIntoTableCsvSummaryAndStrip)
 {
 	const std::string d = bims::test::freshTmpDir("bims_test_check", "run");
 	FlowCheckOptions o;
-	o.config = kConfig;
+	o.config = kDefaultConfig;
 	o.rawlog = kSample;
 	o.gt = kGt;
 	o.frames = "0:8";
@@ -122,7 +122,7 @@ TEST(FlowCheck, RunsTheSampleIntoTableCsvSummaryAndStrip)
 TEST(FlowCheck, BadOptionsAreUsageErrorsBeforeAnyRun)
 {
 	FlowCheckOptions o;
-	o.config = kConfig;
+	o.config = kDefaultConfig;
 	o.rawlog = kSample;
 	o.gt = kGt;
 	o.progress = false;

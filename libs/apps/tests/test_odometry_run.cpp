@@ -1,10 +1,10 @@
 // bims-odom's run (odometry_run.h): its configuration from the options, the
 // tracker's accuracy against the truth, the CSV and the whole run on the
 // bundled sample.
+#include <bims/apps/odometry_run.h>
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/trajectory.h>
-#include <bims/source/odometry_run.h>
 #include <bims_test/sample.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
@@ -17,7 +17,7 @@
 #include <iterator>
 #include <sstream>
 
-using namespace bims::source;
+using namespace bims::apps;
 
 namespace
 {

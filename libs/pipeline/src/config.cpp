@@ -163,22 +163,6 @@ std::string configReference()
 	return md;
 }
 
-std::optional<int> printConfigIfAsked(int argc, char** argv)
-{
-	std::vector<std::string> args(argv + 1, argv + argc);
-	const auto it = std::find(args.begin(), args.end(), "--print-config");
-	if (it == args.end()) return std::nullopt;
-	args.erase(it);
-	if (args.size() > 1 || (args.size() == 1 && args[0].rfind("-", 0) == 0))
-		throw UsageError(
-		    "--print-config takes at most one experiment .ini and nothing "
-		    "else: bims-run --print-config [CONFIG.ini]");
-	ExperimentConfig cfg;
-	if (!args.empty()) cfg.loadFromFile(args[0]);
-	std::printf("%s", cfg.effectiveIni().c_str());
-	return 0;
-}
-
 void ExperimentConfig::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& cfg)
 {

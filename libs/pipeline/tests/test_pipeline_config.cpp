@@ -319,36 +319,3 @@ TEST(FrameRange, ParsesInclusiveRanges)
 	EXPECT_THROW(FrameRange::parse("3"), std::invalid_argument);
 	EXPECT_THROW(FrameRange::parse("-1:3"), std::invalid_argument);
 }
-
-TEST(RunCommand, VariantOptionSetsTheVariantOrIsAUsageError)
-{
-	bims::pipeline::ExperimentConfig cfg;
-	bims::pipeline::applyVariantOption(cfg, "fused-raycast");
-	EXPECT_EQ(cfg.pipeline.variant, bims::pipeline::Variant::FusedRaycast);
-	bims::pipeline::applyVariantOption(cfg, "flow-only");
-	EXPECT_EQ(cfg.pipeline.variant, bims::pipeline::Variant::FlowOnly);
-	try
-	{
-		bims::pipeline::applyVariantOption(cfg, "bogus");
-		FAIL() << "no error for --variant bogus";
-	}
-	catch (const bims::UsageError& e)
-	{
-		EXPECT_EQ(std::string(e.what()).rfind("--variant: ", 0), 0u)
-		    << e.what();
-		EXPECT_NE(std::string(e.what()).find("bogus"), std::string::npos)
-		    << e.what();
-	}
-	EXPECT_EQ(cfg.pipeline.variant, bims::pipeline::Variant::FlowOnly);
-}
-
-TEST(RunCommand, ExitCodeOfARunIsItsStatus)
-{
-	bims::pipeline::RunSummary s;
-	EXPECT_EQ(bims::pipeline::runExitCode(s, 0), 0);
-	s.error = "truncated";
-	EXPECT_EQ(bims::pipeline::runExitCode(s, 0), 1);
-	s.interrupted = true;  // interrupted wins: 128 + the signal
-	EXPECT_EQ(bims::pipeline::runExitCode(s, SIGTERM), 128 + SIGTERM);
-	EXPECT_EQ(bims::pipeline::runExitCode(s, 0), 128 + SIGINT);
-}

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace bims::source
+namespace bims::apps
 {
 /** What bims-calib-imu's command line gives. */
 struct ImuCalibrationOptions
@@ -92,4 +92,4 @@ double largestDepthCorrection(const ego::DepthCorrectionParams& p,
  * are thrown. */
 int runDepthCalibration(const DepthCalibrationOptions& o);
 
-}  // namespace bims::source
+}  // namespace bims::apps

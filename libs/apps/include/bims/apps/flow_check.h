@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-namespace bims::check
+namespace bims::apps
 {
 /** What bims-flow-check's command line gives (nullopt: not given). */
 struct FlowCheckOptions
@@ -58,4 +58,4 @@ cv::Mat stripTile(const mrpt::obs::CObservation3DRangeScan& scan,
  * everything; returns the exit code (0), errors are thrown. */
 int runFlowCheck(const FlowCheckOptions& o);
 
-}  // namespace bims::check
+}  // namespace bims::apps

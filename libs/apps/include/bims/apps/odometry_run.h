@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-namespace bims::source
+namespace bims::apps
 {
 /** What bims-odom's command line gives (nullopt: option not given). */
 struct OdometryRunOptions
@@ -84,4 +84,4 @@ std::string odometryCsvLine(const ego::FrameEgomotion& r,
  * code (0); errors are thrown. */
 int runOdometry(const OdometryRunOptions& o);
 
-}  // namespace bims::source
+}  // namespace bims::apps

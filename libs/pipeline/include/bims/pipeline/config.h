@@ -163,10 +163,4 @@ struct ExperimentConfig
  * meaning, from the same description as effectiveIni(). */
 std::string configReference();
 
-/** bims-run --print-config [CONFIG.ini]: when \a argv holds
- * "--print-config", prints the effective configuration of CONFIG.ini (or of
- * the built-in defaults) on stdout and returns 0; nullopt otherwise. Any
- * other argument is a bims::UsageError. */
-std::optional<int> printConfigIfAsked(int argc, char** argv);
-
 }  // namespace bims::pipeline

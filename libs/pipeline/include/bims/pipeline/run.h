@@ -1,6 +1,7 @@
 // A whole run over rawlog files: reading, IMU/camera ordering, the frame
-// range, the outputs of bims-run and the summary. Shared by bims-run (batch)
-// and the viewer/grabber front ends.
+// range, the outputs of bims-run and the summary: the batch way to run
+// (bims-run's command, bims/apps/run_command.h; bims-flow-check; bims-sweep's
+// runs through bims-run).
 #pragma once
 
 #include <bims/common/output_paths.h>
@@ -124,40 +125,5 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt);
 
 /** The summary as an aligned text table. */
 std::string formatSummary(const RunSummary& s);
-
-/** What bims-run's command line gives (bims-run CONFIG.ini IN.rawlog...
- * -o OUTDIR). */
-struct RunCommand
-{
-	std::string config;                ///< experiment .ini
-	std::vector<std::string> rawlogs;  ///< read one after the other
-	std::string outDir;                ///< output folder
-	std::string frames;                ///< --frames A:B ("": all)
-	/** --variant NAME, overriding [pipeline] variant */
-	std::optional<std::string> variant;
-	bool overwrite = false;  ///< clear an earlier run's outputs in outDir
-	bool progress = true;    ///< progress line on stderr
-	/** Called once the config is read, before the frame range is checked:
-	 * the flag that stops the run after the current frame when it turns
-	 * true (main(): bims::installStopSignals; a signal before it still ends
-	 * the program at once). Empty: never stopped. */
-	std::function<const std::atomic<bool>&()> installStop;
-};
-
-/** --variant \a name: cfg.setVariant of the parsed name; a bad name is a
- * UsageError "--variant: ..." naming the choices. */
-void applyVariantOption(ExperimentConfig& cfg, const std::string& name);
-
-/** bims-run's exit code for a finished run: 128 + \a signal when it was
- * interrupted (SIGINT's when \a signal is 0), 1 when an error stopped it,
- * else 0. */
-int runExitCode(const RunSummary& s, int signal);
-
-/** bims-run: checks that no output is an input, reads the config (and
- * --variant), checks the frame range, prepares the output folder (the
- * --overwrite note on stderr), runs the experiment, prints the summary and
- * where the outputs are, and the error or the interruption on stderr
- * (stopSignal() names the signal). Returns the exit code (runExitCode). */
-int runFromCommandLine(const RunCommand& c);
 
 }  // namespace bims::pipeline
