@@ -8,8 +8,8 @@
 // frame 1's depth and the relative pose T_{C0 C1} (identity by default: a still
 // camera), and the Diff/notDiff labels; writes colour pictures and prints
 // per-stage timings. Useful to tune [flow] on real sensor data.
+#include <bims/apps/flow_labels_run.h>
 #include <bims/common/app.h>
-#include <bims/flow/pair_labels.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
@@ -57,7 +57,7 @@ int main(int argc, char** argv)
 		    if (aFy.isSet()) bims::inRange(aFy, 1e-3, 1e6);
 		    if (aCx.isSet()) bims::inRange(aCx, -1e6, 1e6);
 		    if (aCy.isSet()) bims::inRange(aCy, -1e6, 1e6);
-		    return bims::flow::runFlowLabels(
+		    return bims::apps::runFlowLabels(
 		        {aRgb0.getValue(), aRgb1.getValue(), aDepth1.getValue(),
 		         aOut.getValue(), bims::givenValue(aCfg), aScale.getValue(),
 		         aFx.getValue(), aFy.getValue(), aCx.getValue(), aCy.getValue(),

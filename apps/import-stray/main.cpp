@@ -3,8 +3,8 @@
 // Converts a Stray Scanner capture (depth/, confidence/, rgb.mp4,
 // camera_matrix.csv, odometry.csv, imu.csv) into a bims rawlog plus ARKit's
 // poses in OUT_arkit_reference.txt. See docs/eval.md.
+#include <bims/apps/stray_import_run.h>
 #include <bims/common/app.h>
-#include <bims/eval/stray_import_run.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
@@ -41,7 +41,7 @@ int main(int argc, char** argv)
 		        false, 1, "L", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
-		    bims::eval::StrayImportRunOptions o;
+		    bims::apps::StrayImportRunOptions o;
 		    o.folder = folder.getValue();
 		    o.out = out.getValue();
 		    o.config = bims::givenValue(config);
@@ -49,6 +49,6 @@ int main(int argc, char** argv)
 		        bims::inRange(maxFrames, 0L, 100000000L, "0 = all"));
 		    o.gz = gz.getValue();
 		    o.progress = !quiet.getValue();
-		    return bims::eval::runStrayImport(o);
+		    return bims::apps::runStrayImport(o);
 	    });
 }

@@ -2,11 +2,8 @@
 //   [--max-frames N] [--synth-imu [--seed N]] [--gz L]
 // Converts a TUM RGB-D-layout folder into a bims rawlog plus OUT_gt/
 // (groundtruth.txt, calibration.ini). See docs/eval.md.
+#include <bims/apps/tum_import_run.h>
 #include <bims/common/app.h>
-#include <bims/eval/tum_import_run.h>
-#ifdef BIMS_HAVE_SIM
-#include <bims/sim/imu.h>
-#endif
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
@@ -55,7 +52,7 @@ int main(int argc, char** argv)
 		        "N", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv, {{"--output", "--out"}});
-		    bims::eval::ImportRunOptions o{
+		    bims::apps::ImportRunOptions o{
 		        folder.getValue(),
 		        out.getValue(),
 		        bims::givenValue(config),
@@ -67,9 +64,6 @@ int main(int argc, char** argv)
 		        seed.getValue(),
 		        !quiet.getValue(),
 		        {}};
-#ifdef BIMS_HAVE_SIM
-		    o.synthesize = bims::sim::synthesizeImportImu;
-#endif
-		    return bims::eval::runImport(o);
+		    return bims::apps::runImport(o);
 	    });
 }

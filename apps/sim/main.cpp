@@ -4,8 +4,8 @@
 //   bims-sim --imu-from-tum GT.txt -o IMU.rawlog [--seed N]
 //            [--config imu.ini]
 // See docs/sim.md.
+#include <bims/apps/sim_run.h>
 #include <bims/common/app.h>
-#include <bims/sim/sim_app.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
@@ -56,14 +56,14 @@ int main(int argc, char** argv)
 		        cmd, argc, argv,
 		        {{"--frames", "--max-frames"}, {"-f", "--max-frames"}});
 		    using bims::givenValue;
-		    bims::sim::SimOptions o{givenValue(scene),    out.getValue(),
-		                            seed.getValue(),      givenValue(frames),
-		                            givenValue(res),      givenValue(tum),
-		                            givenValue(config),   givenValue(preview),
-		                            overwrite.getValue(), !quiet.getValue()};
+		    bims::apps::SimOptions o{givenValue(scene),    out.getValue(),
+		                             seed.getValue(),      givenValue(frames),
+		                             givenValue(res),      givenValue(tum),
+		                             givenValue(config),   givenValue(preview),
+		                             overwrite.getValue(), !quiet.getValue()};
 		    // SIGINT / SIGTERM: stop after the current frame, write it all
 		    if (o.scene && !o.imu_from_tum)
 			    o.stop = &bims::installStopSignals();
-		    return bims::sim::runSim(o);
+		    return bims::apps::runSim(o);
 	    });
 }

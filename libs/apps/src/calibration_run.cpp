@@ -15,10 +15,10 @@
 
 namespace bims::apps
 {
-using source::ReplayOptions;
-using source::ReplayStats;
-using source::replayRawlog;
 using source::FrameRange;
+using source::ReplayOptions;
+using source::replayRawlog;
+using source::ReplayStats;
 
 void RotationPairCollector::addFrame(const ego::FrameEgomotion& r)
 {

@@ -19,8 +19,8 @@
 namespace bims::apps
 {
 using source::ReplayOptions;
-using source::ReplayStats;
 using source::replayRawlog;
+using source::ReplayStats;
 
 void overrideSensorSectionsFrom(ego::EgoConfig& ec, const std::string& calib,
                                 const std::string& noSuch)

@@ -12,11 +12,11 @@
 
 namespace bims::apps
 {
-using pipeline::RunOptions;
-using pipeline::frameRangeOption;
-using pipeline::runOutputLayout;
 using pipeline::formatSummary;
+using pipeline::frameRangeOption;
 using pipeline::runExperiment;
+using pipeline::RunOptions;
+using pipeline::runOutputLayout;
 
 using pipeline::Variant;
 

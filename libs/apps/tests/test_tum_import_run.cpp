@@ -1,11 +1,11 @@
 // bims-import-tum's run (tum_import_run.h) called directly: the report,
 // the option checks and the synthetic IMU asked of the program's hook.
+#include <bims/apps/tum_import_run.h>
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/eval/pose_utils.h>
-#include <bims/eval/tum_import_run.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 #include <mrpt/obs/CObservationIMU.h>
@@ -45,11 +45,11 @@ std::string tumFolder(const std::string& name, bool withGt)
 
 /** The message of the exception of type E that runImport(o) throws. */
 template <class E>
-std::string errorOf(const bims::eval::ImportRunOptions& o)
+std::string errorOf(const bims::apps::ImportRunOptions& o)
 {
 	try
 	{
-		bims::eval::runImport(o);
+		bims::apps::runImport(o);
 	}
 	catch (const E& e)
 	{
@@ -65,7 +65,7 @@ TEST(ImportRun, TheReportNamesFramesImuAndGroundTruth)
 	bims::eval::ImportParams p;
 	s.frames = 3;
 	s.gtDir = "x_gt";
-	EXPECT_EQ(bims::eval::importReport("x.rawlog", s, false, false, p),
+	EXPECT_EQ(bims::apps::importReport("x.rawlog", s, false, false, p),
 	          "x.rawlog: 3 RGB-D frames, 0 IMU observations\n"
 	          "x_gt: no groundtruth.txt in the folder\n");
 	s.imu = 7;
@@ -73,7 +73,7 @@ TEST(ImportRun, TheReportNamesFramesImuAndGroundTruth)
 	s.accel = 5;
 	s.gtPoses = 2;
 	s.framesWithoutGt = 1;
-	EXPECT_EQ(bims::eval::importReport("x.rawlog", s, true, true, p),
+	EXPECT_EQ(bims::apps::importReport("x.rawlog", s, true, true, p),
 	          "x.rawlog: 3 RGB-D frames, 7 IMU observations (synthetic, label "
 	          "'IMU_SYNTH'), 5 accelerometer samples of accelerometer.txt "
 	          "(label 'ACCEL', accelerometer only)\n"
@@ -84,7 +84,7 @@ TEST(ImportRun, TheReportNamesFramesImuAndGroundTruth)
 TEST(ImportRun, BadOptionsAreErrorsBeforeAnyOutput)
 {
 	const auto d = tumFolder("bad", false);
-	bims::eval::ImportRunOptions o;
+	bims::apps::ImportRunOptions o;
 	o.folder = d;
 	o.out = d + "/x.rawlog";
 	o.progress = false;
@@ -95,11 +95,7 @@ TEST(ImportRun, BadOptionsAreErrorsBeforeAnyOutput)
 	EXPECT_EQ(errorOf<std::runtime_error>(o),
 	          d + "/none.ini: config file not found");
 	o.config.reset();
-	o.synth_imu = true;
-	EXPECT_EQ(errorOf<bims::UsageError>(o),
-	          "--synth-imu: this build has no simulator library (libs/sim)");
-	o.synthesize = [](auto&&...)
-	{ return std::vector<mrpt::obs::CObservation::Ptr>{}; };
+	o.synth_imu = true;  // with the simulator's synthesis (the default)
 	EXPECT_EQ(errorOf<std::runtime_error>(o),
 	          d + ": --synth-imu needs groundtruth.txt to synthesise from");
 	EXPECT_FALSE(fs::exists(o.out));
@@ -109,7 +105,7 @@ TEST(ImportRun, SynthImuTakesTheConvertedTruthLabelCalibrationAndSeed)
 {
 	const auto d = tumFolder("synth", true);
 	std::ofstream(d + "/c.ini") << "[sensors]\nimu_label = XS\n";
-	bims::eval::ImportRunOptions o;
+	bims::apps::ImportRunOptions o;
 	o.folder = d;
 	o.out = d + "/x.rawlog";
 	o.config = d + "/c.ini";
@@ -133,7 +129,7 @@ TEST(ImportRun, SynthImuTakesTheConvertedTruthLabelCalibrationAndSeed)
 		imu->timestamp = mrpt::Clock::fromDouble(1.05);
 		return std::vector<mrpt::obs::CObservation::Ptr>{imu};
 	};
-	EXPECT_EQ(bims::eval::runImport(o), 0);
+	EXPECT_EQ(bims::apps::runImport(o), 0);
 	ASSERT_EQ(given.size(), 6u);
 	const auto raw = bims::loadTumTrajectory(d + "/groundtruth.txt");
 	EXPECT_TRUE(given[2].T_WC.asTPose() ==
@@ -161,12 +157,12 @@ TEST(ImportRun, AccelerometerTxtIsARealSensorWithItsOwnLabel)
 	std::ofstream(d + "/accelerometer.txt")
 	    << "# accelerometer data\n1.02 0.1 -9.8 0.2\n1.05 0.0 -9.7 0.1\n";
 	std::ofstream(d + "/c.ini") << "[sensors]\nimu_label = IMU_SYNTH\n";
-	bims::eval::ImportRunOptions o;
+	bims::apps::ImportRunOptions o;
 	o.folder = d;
 	o.out = d + "/x.rawlog";
 	o.config = d + "/c.ini";
 	o.progress = false;
-	ASSERT_EQ(bims::eval::runImport(o), 0);
+	ASSERT_EQ(bims::apps::runImport(o), 0);
 	std::vector<std::string> labels;
 	std::vector<double> ay;
 	bims::RawlogReader r(o.out);
@@ -183,7 +179,7 @@ TEST(ImportRun, AccelerometerTxtIsARealSensorWithItsOwnLabel)
 	// Another label by [import] accel_label; a synthetic-looking one refused.
 	std::ofstream(d + "/c.ini") << "[import]\naccel_label = PHONE_ACC\n";
 	o.out = d + "/y.rawlog";
-	ASSERT_EQ(bims::eval::runImport(o), 0);
+	ASSERT_EQ(bims::apps::runImport(o), 0);
 	bims::RawlogReader r2(o.out);
 	size_t phone = 0;
 	while (auto obs = r2.next()) phone += obs->sensorLabel == "PHONE_ACC";

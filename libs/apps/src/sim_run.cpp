@@ -1,10 +1,10 @@
+#include <bims/apps/sim_run.h>
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/sim/imu.h>
-#include <bims/sim/sim_app.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/format.h>
 
@@ -14,8 +14,14 @@
 #include <fstream>
 #include <stdexcept>
 
-namespace bims::sim
+namespace bims::apps
 {
+using sim::groundTruthLayout;
+using sim::ImuParams;
+using sim::ImuTruth;
+using sim::SimConfig;
+using sim::SimStats;
+
 SimConfig simConfigFor(const SimOptions& o)
 {
 	auto cfg = SimConfig::load(o.scene.value_or(""));
@@ -135,4 +141,4 @@ int runSim(const SimOptions& o)
 	return 0;
 }
 
-}  // namespace bims::sim
+}  // namespace bims::apps

@@ -1,11 +1,11 @@
 // bims-sim's run (sim_app.h) called directly: the options' checks, the
 // scene run's configuration, the IMU synthesis from a TUM trajectory and
 // the summary line; the synthetic IMU of bims-import-tum --synth-imu.
+#include <bims/apps/sim_run.h>
 #include <bims/common/app.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/sim/imu.h>
-#include <bims/sim/sim_app.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
@@ -25,11 +25,11 @@ std::string runDir(const std::string& name)
 }
 
 /** The UsageError message of runSim(o) ("" when none is thrown). */
-std::string usageError(const bims::sim::SimOptions& o)
+std::string usageError(const bims::apps::SimOptions& o)
 {
 	try
 	{
-		bims::sim::runSim(o);
+		bims::apps::runSim(o);
 	}
 	catch (const bims::UsageError& e)
 	{
@@ -41,14 +41,14 @@ std::string usageError(const bims::sim::SimOptions& o)
 
 TEST(SimRun, TheOptionsOverrideTheScene)
 {
-	bims::sim::SimOptions o;
+	bims::apps::SimOptions o;
 	o.scene = kScene;
-	const auto plain = bims::sim::simConfigFor(o);
+	const auto plain = bims::apps::simConfigFor(o);
 	EXPECT_EQ(plain.camera.width, 640);
 	o.max_frames = 3;
 	o.resolution = "320x240";
 	o.preview = 2;
-	const auto cfg = bims::sim::simConfigFor(o);
+	const auto cfg = bims::apps::simConfigFor(o);
 	EXPECT_EQ(cfg.seq.frames, 3);
 	EXPECT_EQ(cfg.camera.width, 320);
 	EXPECT_EQ(cfg.camera.height, 240);
@@ -57,7 +57,7 @@ TEST(SimRun, TheOptionsOverrideTheScene)
 TEST(SimRun, BadOptionsAreUsageErrorsBeforeAnyOutput)
 {
 	const auto d = runDir("usage");
-	bims::sim::SimOptions o;
+	bims::apps::SimOptions o;
 	o.out = d + "/x.rawlog";
 	EXPECT_EQ(usageError(o), "missing SCENE.ini (or --imu-from-tum)");
 	o.scene = kScene;
@@ -92,7 +92,7 @@ TEST(SimRun, ImuFromTumWritesTheRawlogAndTheTruth)
 		                mrpt::poses::CPose3D(0.01 * i, 0, 0, 0.02 * i, 0, 0)});
 	bims::saveTumTrajectory(d + "/gt.txt", traj);
 	const std::string line =
-	    bims::sim::imuFromTum(d + "/gt.txt", d + "/imu.rawlog", 5, "");
+	    bims::apps::imuFromTum(d + "/gt.txt", d + "/imu.rawlog", 5, "");
 	bims::RawlogReader r(d + "/imu.rawlog");
 	size_t n = 0;
 	while (r.next()) n++;
@@ -102,17 +102,17 @@ TEST(SimRun, ImuFromTumWritesTheRawlogAndTheTruth)
 	                    "poses -> " +
 	                    d + "/imu.rawlog, truth in " + d + "/imu_gt/imu.txt\n");
 	EXPECT_TRUE(fs::exists(d + "/imu_gt/imu.txt"));
-	EXPECT_THROW(bims::sim::imuFromTum(d + "/gt.txt", d + "/b.rawlog", 5,
-	                                   d + "/none.ini"),
+	EXPECT_THROW(bims::apps::imuFromTum(d + "/gt.txt", d + "/b.rawlog", 5,
+	                                    d + "/none.ini"),
 	             std::runtime_error);
 }
 
 TEST(SimRun, TheSummaryLineNamesTheFramesRatesAndTruth)
 {
-	bims::sim::SimOptions o;
+	bims::apps::SimOptions o;
 	o.scene = kScene;
 	o.resolution = "320x240";
-	const auto cfg = bims::sim::simConfigFor(o);
+	const auto cfg = bims::apps::simConfigFor(o);
 	bims::sim::SimStats st;
 	st.frames = 4;
 	st.imuSamples = 12;
@@ -121,67 +121,9 @@ TEST(SimRun, TheSummaryLineNamesTheFramesRatesAndTruth)
 	st.renderSeconds = 0.5;
 	st.movingFraction = 0.125;
 	st.gtDir = "out_gt";
-	EXPECT_EQ(bims::sim::simSummary(st, cfg),
+	EXPECT_EQ(bims::apps::simSummary(st, cfg),
 	          "bims-sim: 4 frames 320x240 + 12 IMU samples in 2.00 s wall, "
 	          "1.00 s CPU (2.0 frames/s wall, 4.0 frames/s per CPU second, "
 	          "render 8.0 frames/s wall); moving pixels 12.5 %; ground truth "
 	          "in out_gt\n");
-}
-
-TEST(SynthCalibration, RIcOrItsAnglesAndTheTimeOffsetFromCalibration)
-{
-	bims::sim::ImuParams imu;
-	mrpt::config::CConfigFileMemory none;
-	const Eigen::Matrix3d before = imu.R_IC;
-	bims::sim::loadSynthCalibration(none, imu);  // no section: unchanged
-	EXPECT_TRUE(imu.R_IC.isApprox(before));
-	EXPECT_EQ(imu.timeOffsetS, 0.0);
-
-	mrpt::config::CConfigFileMemory ini(std::string(
-	    "[calibration]\nR_IC = 0 0 1 1 0 0 0 1 0\ntime_offset_s = 0.01\n"));
-	bims::sim::loadSynthCalibration(ini, imu);
-	Eigen::Matrix3d M;
-	M << 0, 0, 1, 1, 0, 0, 0, 1, 0;
-	EXPECT_TRUE(imu.R_IC.isApprox(M));
-	EXPECT_DOUBLE_EQ(imu.timeOffsetS, 0.01);
-
-	mrpt::config::CConfigFileMemory angles(
-	    std::string("[calibration]\nR_IC_ypr_deg = 90 0 -90\n"));
-	bims::sim::loadSynthCalibration(angles, imu);
-	bims::sim::ImuParams ypr;
-	ypr.setR_IC_ypr(90, 0, -90);
-	EXPECT_TRUE(imu.R_IC.isApprox(ypr.R_IC));
-	EXPECT_EQ(imu.timeOffsetS, 0.0);
-
-	mrpt::config::CConfigFileMemory bad(
-	    std::string("[calibration]\nR_IC = 1 1 1 1 0 0 0 1 0\n"));
-	try
-	{
-		bims::sim::loadSynthCalibration(bad, imu);
-		ADD_FAILURE() << "no error for a matrix that is no rotation";
-	}
-	catch (const std::exception& e)
-	{
-		EXPECT_NE(std::string(e.what()).find("R_IC: not a rotation matrix"),
-		          std::string::npos)
-		    << e.what();
-	}
-}
-
-TEST(SynthCalibration, ImportImuIsLabelledSyntheticAndTakesTheTimeOffset)
-{
-	bims::Trajectory gt;
-	for (int i = 0; i < 10; i++)
-		gt.push_back(
-		    {5.0 + 0.1 * i, mrpt::poses::CPose3D(0.01 * i, 0, 0, 0, 0, 0)});
-	const auto plain = bims::sim::synthesizeImportImu(gt, "XSENS", nullptr, 1);
-	ASSERT_FALSE(plain.empty());
-	EXPECT_EQ(plain.front()->sensorLabel, "XSENS_SYNTH");
-	mrpt::config::CConfigFileMemory ini(
-	    std::string("[calibration]\ntime_offset_s = 0.5\n"));
-	const auto shifted = bims::sim::synthesizeImportImu(gt, "XSENS", &ini, 1);
-	ASSERT_EQ(shifted.size(), plain.size());
-	EXPECT_NEAR(mrpt::Clock::toDouble(shifted.front()->timestamp) -
-	                mrpt::Clock::toDouble(plain.front()->timestamp),
-	            0.5, 1e-6);
 }

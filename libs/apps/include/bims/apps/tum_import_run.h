@@ -16,12 +16,12 @@
 #include <string>
 #include <vector>
 
-namespace bims::eval
+namespace bims::apps
 {
 /** IMU readings synthesised from the ground truth \a gt (T_WC of the
  * camera), labelled \a imuLabel, with the [calibration] of \a calibration
- * (nullptr: none) and \a seed: libs/sim's sim::synthesizeImportImu, given
- * by the program (eval does not depend on the simulator). */
+ * (nullptr: none) and \a seed: libs/sim's sim::synthesizeImportImu unless
+ * a caller gives another (a test's). */
 using ImuSynthesis = std::function<std::vector<mrpt::obs::CObservation::Ptr>(
     const Trajectory& gt, const std::string& imuLabel,
     const mrpt::config::CConfigFileBase* calibration, uint64_t seed)>;
@@ -32,22 +32,23 @@ struct ImportRunOptions
 	std::string folder;                 ///< TUM RGB-D folder
 	std::string out;                    ///< output rawlog
 	std::optional<std::string> config;  ///< experiment .ini
-	bool bonn_gt = false;     ///< the ground truth is Bonn's marker pose
-	size_t max_frames = 0;    ///< import only the first N frames (0: all)
-	int gz = 1;               ///< gzip level of the rawlog (0: plain)
-	bool synth_imu = false;   ///< add synthetic IMU readings
-	uint64_t seed = 1;        ///< random seed of synth_imu
-	bool progress = true;     ///< progress line on stderr
-	ImuSynthesis synthesize;  ///< for synth_imu (empty: a build without sim)
+	bool bonn_gt = false;    ///< the ground truth is Bonn's marker pose
+	size_t max_frames = 0;   ///< import only the first N frames (0: all)
+	int gz = 1;              ///< gzip level of the rawlog (0: plain)
+	bool synth_imu = false;  ///< add synthetic IMU readings
+	uint64_t seed = 1;       ///< random seed of synth_imu
+	bool progress = true;    ///< progress line on stderr
+	ImuSynthesis
+	    synthesize;  ///< for synth_imu (empty: sim::synthesizeImportImu)
 };
 
 /** The lines bims-import-tum prints on stdout after importing into
  * \a out: frames, IMU observations (\a synthetic: marked so) and
  * accelerometer samples with their labels (\a params), then the ground
  * truth's poses (\a bonnConverted: marked so) or its absence. */
-std::string importReport(const std::string& out, const ImportSummary& sum,
+std::string importReport(const std::string& out, const eval::ImportSummary& sum,
                          bool synthetic, bool bonnConverted,
-                         const ImportParams& params);
+                         const eval::ImportParams& params);
 
 /** bims-import-tum: checks the options (UsageError; no output may be an
  * input), reads the config (a note on stderr without one), synthesises the
@@ -55,4 +56,4 @@ std::string importReport(const std::string& out, const ImportSummary& sum,
  * program's exit code (0); errors are thrown. */
 int runImport(const ImportRunOptions& o);
 
-}  // namespace bims::eval
+}  // namespace bims::apps

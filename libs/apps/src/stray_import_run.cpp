@@ -1,7 +1,7 @@
+#include <bims/apps/stray_import_run.h>
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/output_paths.h>
-#include <bims/eval/stray_import_run.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/format.h>
 
@@ -10,8 +10,17 @@
 #include <memory>
 #include <stdexcept>
 
-namespace bims::eval
+namespace bims::apps
 {
+using eval::importStray;
+using eval::readStrayCapture;
+using eval::StrayCapture;
+using eval::StrayImportOptions;
+using eval::StrayImportParams;
+using eval::StrayImportSummary;
+using eval::strayInputFiles;
+using eval::strayReferencePathFor;
+
 std::string strayImportReport(const std::string& out,
                               const StrayImportSummary& sum)
 {
@@ -82,4 +91,4 @@ int runStrayImport(const StrayImportRunOptions& o)
 	return 0;
 }
 
-}  // namespace bims::eval
+}  // namespace bims::apps

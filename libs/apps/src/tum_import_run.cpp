@@ -1,8 +1,9 @@
+#include <bims/apps/tum_import_run.h>
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/output_paths.h>
 #include <bims/eval/pose_utils.h>
-#include <bims/eval/tum_import_run.h>
+#include <bims/sim/imu.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/format.h>
 
@@ -11,8 +12,17 @@
 #include <memory>
 #include <stdexcept>
 
-namespace bims::eval
+namespace bims::apps
 {
+using eval::bonnMarkerToCamera;
+using eval::ImportOptions;
+using eval::ImportParams;
+using eval::ImportSummary;
+using eval::importTum;
+using eval::readTumFolder;
+using eval::TumFolder;
+using eval::tumInputFiles;
+
 std::string importReport(const std::string& out, const ImportSummary& sum,
                          bool synthetic, bool bonnConverted,
                          const ImportParams& params)
@@ -82,9 +92,6 @@ int runImport(const ImportRunOptions& o)
 	const bool bonnConverted = opt.bonnGt || params.bonnGt;
 	if (o.synth_imu)
 	{
-		if (!o.synthesize)
-			throw UsageError(
-			    "--synth-imu: this build has no simulator library (libs/sim)");
 		const auto tum = readTumFolder(o.folder, params);
 		if (!tum.hasGroundTruth)
 			throw std::runtime_error(
@@ -93,7 +100,10 @@ int runImport(const ImportRunOptions& o)
 		Trajectory gt = tum.groundTruth;
 		if (bonnConverted)
 			for (auto& p : gt) p.T_WC = bonnMarkerToCamera(p.T_WC);
-		opt.extra = o.synthesize(gt, params.imuLabel, cfg.get(), o.seed);
+		const ImuSynthesis synthesize =
+		    o.synthesize ? o.synthesize
+		                 : ImuSynthesis(sim::synthesizeImportImu);
+		opt.extra = synthesize(gt, params.imuLabel, cfg.get(), o.seed);
 	}
 
 	const auto sum = importTum(std::move(tum), o.out, params, opt);
@@ -103,4 +113,4 @@ int runImport(const ImportRunOptions& o)
 	return 0;
 }
 
-}  // namespace bims::eval
+}  // namespace bims::apps

@@ -9,7 +9,7 @@
 #include <optional>
 #include <string>
 
-namespace bims::eval
+namespace bims::apps
 {
 /** What bims-import-stray's command line gives (nullopt: not given). */
 struct StrayImportRunOptions
@@ -27,7 +27,7 @@ struct StrayImportRunOptions
  * threshold and the share of depth readings it dropped, the reference
  * trajectory's poses and the frames left out of it. */
 std::string strayImportReport(const std::string& out,
-                              const StrayImportSummary& sum);
+                              const eval::StrayImportSummary& sum);
 
 /** bims-import-stray: checks the options (UsageError; no output may be an
  * input), reads the config (a note on stderr without one), imports and
@@ -35,4 +35,4 @@ std::string strayImportReport(const std::string& out,
  * are thrown. */
 int runStrayImport(const StrayImportRunOptions& o);
 
-}  // namespace bims::eval
+}  // namespace bims::apps

@@ -11,7 +11,7 @@
 #include <optional>
 #include <string>
 
-namespace bims::sim
+namespace bims::apps
 {
 /** What bims-sim's command line gives (nullopt: option not given). */
 struct SimOptions
@@ -36,7 +36,7 @@ struct SimOptions
 /** The scene run of \a o: its scene .ini with --max-frames and
  * --resolution applied. Throws UsageError for a bad --max-frames,
  * --resolution or --preview (a frame index out of the run). */
-SimConfig simConfigFor(const SimOptions& o);
+sim::SimConfig simConfigFor(const SimOptions& o);
 
 /** IMU readings synthesised from the TUM trajectory \a tum (T_WC) with
  * \a seed and the [imu] and [calibration] of \a iniPath ("": the default
@@ -47,7 +47,7 @@ std::string imuFromTum(const std::string& tum, const std::string& out,
 
 /** The line bims-sim prints on stderr after a simulation of \a cfg (with
  * its newline). */
-std::string simSummary(const SimStats& st, const SimConfig& cfg);
+std::string simSummary(const sim::SimStats& st, const sim::SimConfig& cfg);
 
 /** bims-sim: checks the options (UsageError; no output may be an input,
  * an earlier run's ground truth is refused unless overwrite), then runs
@@ -56,4 +56,4 @@ std::string simSummary(const SimStats& st, const SimConfig& cfg);
  * errors are thrown. */
 int runSim(const SimOptions& o);
 
-}  // namespace bims::sim
+}  // namespace bims::apps
