@@ -118,6 +118,10 @@ FrameEgomotion Odometry::processFrame(
 	return r;
 }
 
+// One frame in named steps: the previous frame's moving mask (guarded,
+// vetoed by the geometry), the IMU's prediction, the tracker, the
+// frame-to-frame estimate, the pose it predicts, the alignment to the static
+// scene's keyframes, and the commit of the frame as the next one's previous.
 FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 {
 	FrameEgomotion r;
@@ -131,6 +135,22 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	}
 	++nFrames_;
 	lastAnchored_ = false;
+	const cv::Mat moving = takeMovingMask(mask, r);
+	mask = moving.empty() ? nullptr : &moving;
+	const ImuPrediction imu = predictFromImu(f.t);
+	if (!havePrev_) return firstFrame(f, imu, mask, r);
+	track(f, imu, mask, r);
+	const auto t2 = std::chrono::steady_clock::now();
+	FrameToFrame m = estimate(f, imu, r);
+	predictPose(imu, m, r);
+	if (cfg_.anchor.enable) anchorToKeyframes(f, mask, m, r);
+	r.ms_motion = msSince(t2);
+	commit(f, imu, m, r);
+	return r;
+}
+
+cv::Mat Odometry::takeMovingMask(const cv::Mat* mask, FrameEgomotion& r)
+{
 	const bool anchoring = cfg_.anchor.enable;
 	// What moved in the previous frame: the caller's mask (segmentation;
 	// none before a previous frame). Not used when it covers too much of
@@ -161,56 +181,66 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		if (vetoed > 0) r.flags |= kFlagMaskVetoed;
 		r.mask_vetoed = vetoed;
 	}
-	mask = moving.empty() ? nullptr : &moving;
 	// The previous frame becomes a keyframe now that its moving mask is
 	// known (the same mask, after the same guard).
 	if (anchoring && anchor_.addPending(moving)) r.flags |= kFlagNewKeyframe;
-	const bool imuMode = cfg_.odometry.mode == OdometryMode::Imu;
-	uint32_t imuFlags = 0;
-	const auto R_WC_imu = imuRotation(f.t, &imuFlags);
-	const auto R_WC_gyro = imuRotation(f.t, nullptr, true);
-	std::optional<Eigen::Matrix3d> R_rel_gyro;
-	if (R_WC_gyro && R_WC_gyroPrev_)
-		R_rel_gyro = R_WC_gyroPrev_->transpose() * *R_WC_gyro;
+	return moving;
+}
 
-	// First frame: the reference (IMU attitude when there is one).
-	if (!havePrev_)
+Odometry::ImuPrediction Odometry::predictFromImu(double t) const
+{
+	ImuPrediction p;
+	p.R_WC = imuRotation(t, &p.flags);
+	p.R_WC_gyro = imuRotation(t, nullptr, true);
+	if (p.R_WC_gyro && R_WC_gyroPrev_)
+		p.R_rel_gyro = R_WC_gyroPrev_->transpose() * *p.R_WC_gyro;
+	return p;
+}
+
+FrameEgomotion Odometry::firstFrame(const RgbdFrame& f,
+                                    const ImuPrediction& imu,
+                                    const cv::Mat* mask, FrameEgomotion r)
+{
+	// The reference: the IMU attitude when there is one.
+	if (imu.R_WC)
 	{
-		if (R_WC_imu)
-		{
-			R_WC_ = *R_WC_imu;
-			r.R_source = RotationSource::Imu;
-		}
-		T_WC_ = toPose(R_WC_, t_WC_);
-		const auto t1 = std::chrono::steady_clock::now();
-		if (f.hasImage())
-			klt_.track(f.grey, f.K, nullptr, mask);
-		else
-			klt_.reset();
-		r.ms_track = msSince(t1);
-		if (anchoring)
-		{
-			r.anchor = anchor_.track(f, R_WC_, t_WC_, {}, nullptr, cv::Mat());
-			anchor_.wantKeyframe(r.anchor, R_WC_, t_WC_, true);
-			r.ms_anchor = r.anchor.ms;
-		}
-		r.T_WC = T_WC_;
-		r.flags = kFlagFirstFrame | (imuMode ? imuFlags : 0) |
-		          (f.hasImage() ? 0u : uint32_t(kFlagNoImage));
-		havePrev_ = true;
-		tPrev_ = f.t;
-		depthPrev_ = f.depth.clone();
-		R_WC_imuPrev_ = R_WC_imu;
-		R_WC_gyroPrev_ = R_WC_gyro;
-		return r;
+		R_WC_ = *imu.R_WC;
+		r.R_source = RotationSource::Imu;
 	}
+	T_WC_ = toPose(R_WC_, t_WC_);
+	const auto t1 = std::chrono::steady_clock::now();
+	if (f.hasImage())
+		klt_.track(f.grey, f.K, nullptr, mask);
+	else
+		klt_.reset();
+	r.ms_track = msSince(t1);
+	if (cfg_.anchor.enable)
+	{
+		r.anchor = anchor_.track(f, R_WC_, t_WC_, {}, nullptr, cv::Mat());
+		anchor_.wantKeyframe(r.anchor, R_WC_, t_WC_, true);
+		r.ms_anchor = r.anchor.ms;
+	}
+	r.T_WC = T_WC_;
+	const bool imuMode = cfg_.odometry.mode == OdometryMode::Imu;
+	r.flags = kFlagFirstFrame | (imuMode ? imu.flags : 0) |
+	          (f.hasImage() ? 0u : uint32_t(kFlagNoImage));
+	havePrev_ = true;
+	tPrev_ = f.t;
+	depthPrev_ = f.depth.clone();
+	R_WC_imuPrev_ = imu.R_WC;
+	R_WC_gyroPrev_ = imu.R_WC_gyro;
+	return r;
+}
 
+void Odometry::track(const RgbdFrame& f, const ImuPrediction& imu,
+                     const cv::Mat* mask, FrameEgomotion& r)
+{
 	// Rotation prediction for the tracker.
 	std::optional<Eigen::Matrix3d> R_pred;
 	if (cfg_.odometry.gyro_aid)
 	{
-		if (R_rel_gyro)
-			R_pred = R_rel_gyro;
+		if (imu.R_rel_gyro)
+			R_pred = imu.R_rel_gyro;
 		else
 		{
 			R_pred = lastR_rel_;  // constant angular velocity
@@ -222,8 +252,7 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	// (else constant velocity) and the last translation, then measured by
 	// the keyframe alignment alone (geometric term). The tracker starts
 	// afresh at the next frame with an image.
-	const bool image = f.hasImage();
-	if (image)
+	if (f.hasImage())
 	{
 		r.tracks = klt_.track(f.grey, f.K, R_pred ? &*R_pred : nullptr, mask);
 		r.tracker = klt_.stats();
@@ -235,10 +264,12 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		r.flags |= kFlagNoImage;
 	}
 	r.ms_track = msSince(t1);
+}
 
-	const auto t2 = std::chrono::steady_clock::now();
+std::vector<Correspondence> Odometry::correspondences(
+    const RgbdFrame& f, FrameEgomotion& r, std::vector<int>& corrTrack) const
+{
 	std::vector<Correspondence> corr;
-	std::vector<int> corrTrack;
 	r.trackInlier.assign(r.tracks.size(), -1);
 	const double zmin = cfg_.translation.min_depth_m,
 	             zmax = cfg_.translation.max_depth_m;
@@ -256,38 +287,50 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 		corrTrack.push_back(static_cast<int>(i));
 	}
 	r.correspondences = static_cast<int>(corr.size());
+	return corr;
+}
 
+Odometry::FrameToFrame Odometry::estimate(const RgbdFrame& f,
+                                          const ImuPrediction& imu,
+                                          FrameEgomotion& r)
+{
+	std::vector<int> corrTrack;
+	const std::vector<Correspondence> corr = correspondences(f, r, corrTrack);
+	const bool image = f.hasImage();
+	const bool imuMode = cfg_.odometry.mode == OdometryMode::Imu;
+	FrameToFrame out;
 	// The IMU gives the inter-frame rotation only with a gyro chain over
 	// the interval or an IMU attitude at the previous frame: otherwise
 	// (e.g. the IMU starts after the first frame) R_WC_^T R_WC_imu would be
 	// the jump from the unanchored start to the filter's attitude, not a
 	// motion. Such a frame takes the vision estimate.
-	const bool anchorNow = imuMode && R_WC_imu.has_value() &&
-	                       !R_rel_gyro.has_value() &&
-	                       !R_WC_imuPrev_.has_value();
-	const bool useImu = imuMode && R_WC_imu.has_value() && !anchorNow;
-	const bool filterConverging =
+	out.reanchorWorld = imuMode && imu.R_WC.has_value() &&
+	                    !imu.R_rel_gyro.has_value() &&
+	                    !R_WC_imuPrev_.has_value();
+	out.useImu = imuMode && imu.R_WC.has_value() && !out.reanchorWorld;
+	out.filterConverging =
 	    att_.converging(f.t + cfg_.calibration.time_offset_s);
 	Eigen::Matrix3d R_imuRel = Eigen::Matrix3d::Identity();
-	if (imuMode) r.flags |= imuFlags;
+	if (imuMode) r.flags |= imu.flags;
 	MotionEstimate m;
-	if (useImu)
+	if (out.useImu)
 	{
 		// Relative prior anchored on the absolute IMU attitude, so that the
 		// estimated R_WC never drifts from the filter's.
 		// Inter-frame rotation from the gyro; the absolute attitude pulled
 		// towards the filter's by attitude_blend per frame (no drift, and
 		// no correction noise in the inter-frame rotations).
-		Eigen::Matrix3d R_new = *R_WC_imu;
-		if (R_rel_gyro)
+		Eigen::Matrix3d R_new = *imu.R_WC;
+		if (imu.R_rel_gyro)
 		{
-			const Eigen::Matrix3d R_pred = R_WC_ * *R_rel_gyro;
+			const Eigen::Matrix3d R_pred = R_WC_ * *imu.R_rel_gyro;
 			const double blend =
-			    filterConverging && !cfg_.odometry.follow_converging_attitude
+			    out.filterConverging &&
+			            !cfg_.odometry.follow_converging_attitude
 			        ? 0.0
 			        : cfg_.odometry.attitude_blend;
 			R_new =
-			    R_pred * expSO3(blend * logSO3(R_pred.transpose() * *R_WC_imu));
+			    R_pred * expSO3(blend * logSO3(R_pred.transpose() * *imu.R_WC));
 		}
 		const Eigen::Matrix3d R_rel = R_WC_.transpose() * R_new;
 		R_imuRel = R_rel;
@@ -318,12 +361,10 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	else if (image && !m.ok)
 		r.flags |= kFlagTooFewInliers;
 
-	Eigen::Matrix3d R_rel;
-	Eigen::Vector3d t_rel;
 	if (image && !(r.flags & (kFlagTooFewTracks | kFlagTooFewInliers)))
 	{
-		R_rel = m.R_CprevC;
-		t_rel = m.t_CprevC;
+		out.R_rel = m.R_CprevC;
+		out.t_rel = m.t_CprevC;
 		r.inliers = m.inliers;
 		r.residual_rms_m = m.residual_rms_m;
 		for (size_t k = 0; k < corrTrack.size(); k++)
@@ -333,107 +374,118 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	{
 		// Failure: keep going with the best guess (IMU rotation if any,
 		// else constant velocity); the flags say the motion is not measured.
-		R_rel = useImu ? R_imuRel : lastR_rel_;
-		t_rel = lastT_rel_;
-		r.R_source = useImu ? RotationSource::Imu : RotationSource::None;
+		out.R_rel = out.useImu ? R_imuRel : lastR_rel_;
+		out.t_rel = lastT_rel_;
+		r.R_source = out.useImu ? RotationSource::Imu : RotationSource::None;
 	}
-	R_rel = orthonormalize(R_rel);
+	out.R_rel = orthonormalize(out.R_rel);
+	return out;
+}
+
+void Odometry::predictPose(const ImuPrediction& imu, const FrameToFrame& m,
+                           FrameEgomotion& r)
+{
 	R_WCprev_ = R_WC_;
 	t_WCprev_ = t_WC_;
 	haveMotion_ = true;
-	t_WC_ += R_WC_ * t_rel;
+	t_WC_ += R_WC_ * m.t_rel;
 	// While the attitude filter is still converging its absolute attitude
 	// moves fast: follow it for the absolute R_WC, but never feed that
 	// convergence into the inter-frame rotation used above.
-	if (useImu && filterConverging && cfg_.odometry.follow_converging_attitude)
-		R_WC_ = *R_WC_imu;
+	if (m.useImu && m.filterConverging &&
+	    cfg_.odometry.follow_converging_attitude)
+		R_WC_ = *imu.R_WC;
 	else
-		R_WC_ = orthonormalize(R_WC_ * R_rel);
-	if (anchorNow)
+		R_WC_ = orthonormalize(R_WC_ * m.R_rel);
+	if (m.reanchorWorld)
 	{
 		// Rotate the world so that R_WC is the filter's from now on.
-		const Eigen::Matrix3d R_fix = *R_WC_imu * R_WC_.transpose();
-		R_WC_ = *R_WC_imu;
+		const Eigen::Matrix3d R_fix = *imu.R_WC * R_WC_.transpose();
+		R_WC_ = *imu.R_WC;
 		t_WC_ = R_fix * t_WC_;
 		R_WCprev_ = R_fix * R_WCprev_;
 		t_WCprev_ = R_fix * t_WCprev_;
 		r.flags |= kFlagWorldReanchored;
 		anchor_.clear();  // the keyframes are in the old world
 	}
-	if (anchoring)
+}
+
+void Odometry::anchorToKeyframes(const RgbdFrame& f, const cv::Mat* mask,
+                                 FrameToFrame& m, FrameEgomotion& r)
+{
+	// Measure the pose against the static scene, from the
+	// frame-to-frame guess (and the IMU rotation as the prior).
+	// The frame-to-frame estimate first; the constant-velocity
+	// prediction as a second guess (features on people can corrupt the
+	// first).
+	const InitialGuess constVel{
+	    m.useImu ? R_WC_ : Eigen::Matrix3d(R_WCprev_ * lastR_rel_),
+	    t_WCprev_ + R_WCprev_ * lastT_rel_};
+	const Eigen::Matrix3d R_prior = R_WC_;
+	// The previous frame's movers where they are expected in this one,
+	// with the motion predicted as for the alignment's second guess (the
+	// gyro's rotation, else the last frame's; the last translation), not
+	// the frame-to-frame estimate that features on movers can corrupt.
+	cv::Mat exclude;
+	double excluded = 0;
+	if (mask)
 	{
-		// Measure the pose against the static scene, from the
-		// frame-to-frame guess (and the IMU rotation as the prior).
-		// The frame-to-frame estimate first; the constant-velocity
-		// prediction as a second guess (features on people can corrupt the
-		// first).
-		const InitialGuess constVel{
-		    useImu ? R_WC_ : Eigen::Matrix3d(R_WCprev_ * lastR_rel_),
-		    t_WCprev_ + R_WCprev_ * lastT_rel_};
-		const Eigen::Matrix3d R_prior = R_WC_;
-		// The previous frame's movers where they are expected in this one,
-		// with the motion predicted as for the alignment's second guess (the
-		// gyro's rotation, else the last frame's; the last translation), not
-		// the frame-to-frame estimate that features on movers can corrupt.
-		cv::Mat exclude;
-		double excluded = 0;
-		if (mask)
+		exclude = cfg_.anchor.predict_mask
+		              ? predictMovingMask(*mask, depthPrev_, f.K,
+		                                  predictRotation(f.t), lastT_rel_,
+		                                  cfg_.anchor.mask_margin_px)
+		              : *mask;
+		if (tooLarge(exclude, &excluded))
 		{
-			exclude = cfg_.anchor.predict_mask
-			              ? predictMovingMask(*mask, depthPrev_, f.K,
-			                                  predictRotation(f.t), lastT_rel_,
-			                                  cfg_.anchor.mask_margin_px)
-			              : *mask;
-			if (tooLarge(exclude, &excluded))
-			{
-				r.flags |= kFlagMaskIgnored;
-				exclude.release();
-			}
+			r.flags |= kFlagMaskIgnored;
+			exclude.release();
 		}
-		r.anchor = anchor_.track(f, R_WC_, t_WC_, {constVel},
-		                         useImu ? &R_prior : nullptr, exclude);
-		r.anchor.excluded_fraction = excluded;
-		r.ms_anchor = r.anchor.ms;
-		if (r.anchor.maskIgnored) r.flags |= kFlagMaskIgnored;
-		bool lost = false;
-		if (r.anchor.accepted)
-		{
-			R_WC_ = orthonormalize(r.anchor.R_WC);
-			t_WC_ = r.anchor.t_WC;
-			R_rel = R_WCprev_.transpose() * R_WC_;
-			t_rel = R_WCprev_.transpose() * (t_WC_ - t_WCprev_);
-			r.flags |= kFlagAnchored;
-			if (r.anchor.relocalised) r.flags |= kFlagAnchorRelocalised;
-			anchorFailures_ = 0;
-			lastAnchored_ = true;
-		}
-		else if (r.anchor.tried)
-		{
-			r.flags |= kFlagAnchorFailed;
-			lost = ++anchorFailures_ >= cfg_.anchor.lost_frames;
-		}
-		if (lost)
-		{
-			// Go on from this frame's (frame-to-frame) pose: it becomes a
-			// keyframe; the older keyframes stay for when the view returns.
-			r.flags |= kFlagAnchorLost;
-			anchorFailures_ = 0;
-		}
-		anchor_.wantKeyframe(r.anchor, R_WC_, t_WC_,
-		                     lost || (r.flags & kFlagWorldReanchored));
 	}
-	lastR_rel_ = R_rel;
-	lastT_rel_ = t_rel;
+	r.anchor = anchor_.track(f, R_WC_, t_WC_, {constVel},
+	                         m.useImu ? &R_prior : nullptr, exclude);
+	r.anchor.excluded_fraction = excluded;
+	r.ms_anchor = r.anchor.ms;
+	if (r.anchor.maskIgnored) r.flags |= kFlagMaskIgnored;
+	bool lost = false;
+	if (r.anchor.accepted)
+	{
+		R_WC_ = orthonormalize(r.anchor.R_WC);
+		t_WC_ = r.anchor.t_WC;
+		m.R_rel = R_WCprev_.transpose() * R_WC_;
+		m.t_rel = R_WCprev_.transpose() * (t_WC_ - t_WCprev_);
+		r.flags |= kFlagAnchored;
+		if (r.anchor.relocalised) r.flags |= kFlagAnchorRelocalised;
+		anchorFailures_ = 0;
+		lastAnchored_ = true;
+	}
+	else if (r.anchor.tried)
+	{
+		r.flags |= kFlagAnchorFailed;
+		lost = ++anchorFailures_ >= cfg_.anchor.lost_frames;
+	}
+	if (lost)
+	{
+		// Go on from this frame's (frame-to-frame) pose: it becomes a
+		// keyframe; the older keyframes stay for when the view returns.
+		r.flags |= kFlagAnchorLost;
+		anchorFailures_ = 0;
+	}
+	anchor_.wantKeyframe(r.anchor, R_WC_, t_WC_,
+	                     lost || (r.flags & kFlagWorldReanchored));
+}
+
+void Odometry::commit(const RgbdFrame& f, const ImuPrediction& imu,
+                      const FrameToFrame& m, FrameEgomotion& r)
+{
+	lastR_rel_ = m.R_rel;
+	lastT_rel_ = m.t_rel;
 	T_WC_ = toPose(R_WC_, t_WC_);
 	r.T_WC = T_WC_;
-	r.T_CprevC = toPose(R_rel, t_rel);
-	r.ms_motion = msSince(t2);
-
+	r.T_CprevC = toPose(m.R_rel, m.t_rel);
 	tPrev_ = f.t;
 	depthPrev_ = f.depth.clone();
-	R_WC_imuPrev_ = R_WC_imu;
-	R_WC_gyroPrev_ = R_WC_gyro;
-	return r;
+	R_WC_imuPrev_ = imu.R_WC;
+	R_WC_gyroPrev_ = imu.R_WC_gyro;
 }
 
 bool Odometry::tooLarge(const cv::Mat& moving, double* share) const

@@ -125,6 +125,58 @@ class Odometry
 	size_t framesProcessed() const { return nFrames_; }
 
  private:
+	/** What the IMU says of a frame at camera time t: R_WC from the attitude
+	 * filter, from the gyro chain alone, the gyro's rotation since the
+	 * previous frame, and the IMU's kFlag* bits. */
+	struct ImuPrediction
+	{
+		std::optional<Eigen::Matrix3d> R_WC, R_WC_gyro, R_rel_gyro;
+		uint32_t flags = 0;
+	};
+	/** The frame-to-frame motion of a frame and how it was reached. */
+	struct FrameToFrame
+	{
+		Eigen::Matrix3d R_rel;  ///< R_CprevC
+		Eigen::Vector3d t_rel;  ///< t_CprevC
+		bool useImu = false;    ///< the rotation is the IMU's
+		/** the IMU's first attitude: the world turns to it this frame */
+		bool reanchorWorld = false;
+		bool filterConverging = false;  ///< the attitude filter converges
+	};
+
+	// The steps of processFrame, in order.
+	/** The previous frame's mask as the tracker takes it: guarded
+	 * (tooLarge), vetoed by the geometry; the previous frame becomes a
+	 * keyframe with it. Empty: none. */
+	cv::Mat takeMovingMask(const cv::Mat* mask, FrameEgomotion& r);
+	ImuPrediction predictFromImu(double t) const;
+	/** The first frame: the reference pose (the IMU's attitude if any). */
+	FrameEgomotion firstFrame(const RgbdFrame& f, const ImuPrediction& imu,
+	                          const cv::Mat* mask, FrameEgomotion r);
+	/** The gyro-aided KLT (nothing on a depth-only frame). */
+	void track(const RgbdFrame& f, const ImuPrediction& imu,
+	           const cv::Mat* mask, FrameEgomotion& r);
+	/** The tracks with depth in range as 3D correspondences; \a corrTrack
+	 * gets each one's track index. */
+	std::vector<Correspondence> correspondences(
+	    const RgbdFrame& f, FrameEgomotion& r,
+	    std::vector<int>& corrTrack) const;
+	/** The frame-to-frame motion: IMU rotation + robust translation, or
+	 * vision SE(3); the best guess when it fails. */
+	FrameToFrame estimate(const RgbdFrame& f, const ImuPrediction& imu,
+	                      FrameEgomotion& r);
+	/** The pose that motion predicts (the IMU's attitude while the filter
+	 * converges; the world turned to the IMU's first attitude). */
+	void predictPose(const ImuPrediction& imu, const FrameToFrame& m,
+	                 FrameEgomotion& r);
+	/** The pose measured against the static scene's keyframes ([anchor]):
+	 * when accepted it replaces the prediction and \a m's motion. */
+	void anchorToKeyframes(const RgbdFrame& f, const cv::Mat* mask,
+	                       FrameToFrame& m, FrameEgomotion& r);
+	/** The frame becomes the next one's previous. */
+	void commit(const RgbdFrame& f, const ImuPrediction& imu,
+	            const FrameToFrame& m, FrameEgomotion& r);
+
 	/** Whether \a moving covers more than [anchor] max_excluded_fraction of
 	 * the image: then it is not used (the one rule for the previous
 	 * frame's mask and its prediction). \param share gets the share. */
