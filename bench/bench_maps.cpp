@@ -188,8 +188,8 @@ void benchTier(bm::State& st, const Cloud& c, double voxel, std::string decay,
 				mg.background()->store(f, p1);
 				break;
 			case Stage::Tier2:
-				mg.flow()->posterior(f, labels, p1, p2);
-				mg.flow()->store(f, p2);
+				mg.flowConsistency()->posterior(f, labels, p1, p2);
+				mg.flowConsistency()->store(f, p2);
 				break;
 			case Stage::All3:
 				mg.processFrame(f, &labels);
@@ -230,7 +230,7 @@ mrpt::obs::CObservation3DRangeScan::Ptr thinned(const Cloud& c, int s)
 size_t gridsBytes(const MotionGrids& mg)
 {
 	return mg.occupancy()->memoryBytes() + mg.background()->memoryBytes() +
-	       mg.flow()->memoryBytes();
+	       mg.flowConsistency()->memoryBytes();
 }
 
 // The cloud seen from the k-th place of a 7 x 7 lattice 12 m apart in x, y

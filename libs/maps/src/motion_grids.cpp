@@ -10,13 +10,13 @@ const PixelMask MotionFrameResult::kNoMask;
 
 MotionGrids::MotionGrids(const GridParams& p)
     : p_(p),
-      t0_(std::make_shared<COccupancyBayesGrid>(p)),
-      t1_(std::make_shared<CBackgroundSubtractionGrid>(p)),
-      t2_(std::make_shared<CFlowConsistencyGrid>(p)),
+      tier0_(std::make_shared<COccupancyBayesGrid>(p)),
+      tier1_(std::make_shared<CBackgroundSubtractionGrid>(p)),
+      tier2_(std::make_shared<CFlowConsistencyGrid>(p)),
       builder_(p)
 {
-	t1_->linkOccupancy(t0_);
-	t2_->linkOccupancy(t0_);
+	tier1_->linkOccupancy(tier0_);
+	tier2_->linkOccupancy(tier0_);
 }
 
 void MotionGrids::setDecisionTier(int tier)
@@ -30,14 +30,14 @@ void MotionGrids::setDecisionTier(int tier)
 void MotionGrids::clear()
 {
 	decaying_.reset();
-	t0_->clear();
-	t1_->clear();
-	t2_->clear();
+	tier0_->clear();
+	tier1_->clear();
+	tier2_->clear();
 }
 
 void MotionGrids::applyPendingDecay() const
 {
-	t0_->applyPendingDecay();
+	tier0_->applyPendingDecay();
 	decaying_.reset();
 }
 
@@ -86,10 +86,10 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 		throw std::invalid_argument(
 		    "MotionGrids::processFrame: frame keyed for another voxel size");
 	applyPendingDecay();  // the last frame's, if the caller has not
-	t0_->setDeferDecay(deferDecay_ && &f == frame_.get());
+	tier0_->setDeferDecay(deferDecay_ && &f == frame_.get());
 	result_ = MotionFrameResult();
 	result_.stats = f.stats;
-	t0_->accountFrame(f.stats);
+	tier0_->accountFrame(f.stats);
 	if (f.stats.badPose) return result_;
 	const auto t0 = std::chrono::steady_clock::now();
 	static const PixelLabels none;
@@ -102,25 +102,26 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 	{
 		// (1)+(2): tier 0 hands out O- of the hit voxels, then folds the
 		// frame in.
-		t0_->integrate(f, &prior_);
+		tier0_->integrate(f, &prior_);
 		// (3) tier 1 from O-, tier 2 from tier 1 and the flow labels.
-		t1_->posterior(f, prior_, post1_);
-		t2_->posterior(f, labels ? *labels : none, post1_, post2_);
+		tier1_->posterior(f, prior_, post1_);
+		tier2_->posterior(f, labels ? *labels : none, post1_, post2_);
 	}
 	else
 	{
 		// O- first (with its neighbourhood), both posteriors, then tier 0
 		// folds the frame in: with exclude_moving only the voxels the
 		// decision tier calls static (the moving ones keep their belief).
-		t0_->beginFrame(f, prior_);
+		tier0_->beginFrame(f, prior_);
 		const std::vector<float>* o = &prior_;
 		if (neighbours)
 		{
-			t0_->neighbourhoodMaxPrior(f, prior_, p_.bg_neighbourhood, priorN_);
+			tier0_->neighbourhoodMaxPrior(f, prior_, p_.bg_neighbourhood,
+			                              priorN_);
 			o = &priorN_;
 		}
-		t1_->posterior(f, *o, post1_);
-		t2_->posterior(f, labels ? *labels : none, post1_, post2_);
+		tier1_->posterior(f, *o, post1_);
+		tier2_->posterior(f, labels ? *labels : none, post1_, post2_);
 		if (exclude)
 		{
 			const auto& dec = decisionTier_ == 1 || flowOff ? post1_ : post2_;
@@ -130,10 +131,10 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 			hold_.resize(f.cells.size());
 			for (size_t i = 0; i < f.cells.size(); ++i)
 				hold_[i] = dec[i] > 0 || (either && post1_[i] > 0);
-			t0_->integratePending(f, &hold_);
+			tier0_->integratePending(f, &hold_);
 		}
 		else
-			t0_->integratePending(f, nullptr);
+			tier0_->integratePending(f, nullptr);
 	}
 	// (4) MAP per voxel; masks.
 	result_.hitVoxels = f.cells.size();
@@ -157,12 +158,12 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 		cells = buf;
 	}
 	// One sweep over the cells and readings stores both tiers.
-	CMotionGridBase::storePair(*t1_, std::move(post1_), *t2_, std::move(post2_),
-	                           f, cells);
-	result_.mask1_ = &t1_->lastMovingMask();
-	result_.mask2_ = &t2_->lastMovingMask();
+	CMotionGridBase::storePair(*tier1_, std::move(post1_), *tier2_,
+	                           std::move(post2_), f, cells);
+	result_.mask1_ = &tier1_->lastMovingMask();
+	result_.mask2_ = &tier2_->lastMovingMask();
 	result_.updateMs = msSince(t0);
-	if (t0_->decayPending()) decaying_ = frame_;
+	if (tier0_->decayPending()) decaying_ = frame_;
 	return result_;
 }
 

@@ -57,8 +57,9 @@ TEST(Export, StaticMapExcludesMovingVoxels)
 {
 	auto& mg = scenario();
 	const auto all = staticOccupiedKeys(*mg.occupancy(), nullptr);
-	const auto stat = staticOccupiedKeys(*mg.occupancy(), mg.flow().get());
-	ASSERT_GT(mg.flow()->movingCells().size(), 5u);
+	const auto stat =
+	    staticOccupiedKeys(*mg.occupancy(), mg.flowConsistency().get());
+	ASSERT_GT(mg.flowConsistency()->movingCells().size(), 5u);
 	EXPECT_LT(stat.size(), all.size());
 	// No voxel of the box region in the static map.
 	for (const auto& k : stat)
@@ -74,7 +75,8 @@ TEST(Export, PlyHeaderAndSize)
 {
 	auto& mg = scenario();
 	const auto path = tmpPath("static.ply");
-	const size_t n = writeStaticPly(path, *mg.occupancy(), mg.flow().get());
+	const size_t n =
+	    writeStaticPly(path, *mg.occupancy(), mg.flowConsistency().get());
 	std::ifstream f(path, std::ios::binary);
 	std::string line, header;
 	while (std::getline(f, line) && line != "end_header") header += line + "\n";
@@ -95,7 +97,8 @@ TEST(Export, OctomapBtReadsBackWithTheSameOccupiedVoxels)
 	auto& mg = scenario();
 	const auto path = tmpPath("static.bt");
 	testing::internal::CaptureStderr();
-	const size_t n = writeStaticOctomap(path, *mg.occupancy(), mg.flow().get());
+	const size_t n =
+	    writeStaticOctomap(path, *mg.occupancy(), mg.flowConsistency().get());
 	// (liboctomap's own writer prints " done." there)
 	EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
 	ASSERT_GT(n, 100u);
@@ -107,7 +110,8 @@ TEST(Export, OctomapBtReadsBackWithTheSameOccupiedVoxels)
 		if (tree.isNodeOccupied(*it))
 			occ += size_t(1) << (3 * (tree.getTreeDepth() - it.getDepth()));
 	EXPECT_EQ(occ, n);
-	for (const auto& k : staticOccupiedKeys(*mg.occupancy(), mg.flow().get()))
+	for (const auto& k :
+	     staticOccupiedKeys(*mg.occupancy(), mg.flowConsistency().get()))
 	{
 		const auto c = mg.occupancy()->centerOf(k);
 		auto* node = tree.search(c.x, c.y, c.z);
@@ -122,7 +126,7 @@ TEST(Export, VisualisationUsesThePaperColours)
 	mrpt::opengl::CSetOfObjects o0, o1, o2;
 	mg.occupancy()->getVisualizationInto(o0);
 	mg.background()->getVisualizationInto(o1);
-	mg.flow()->getVisualizationInto(o2);
+	mg.flowConsistency()->getVisualizationInto(o2);
 	auto colourOf = [](const mrpt::opengl::CSetOfObjects& o)
 	{
 		auto v = o.getByClass<mrpt::opengl::COctoMapVoxels>();

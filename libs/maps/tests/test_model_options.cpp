@@ -196,7 +196,7 @@ TEST(ModelOptions, ExcludeMovingFollowsTheDecisionTier)
 	PixelLabels diff(4, 1, 1);
 	mg.processFrame(f, &diff);
 	EXPECT_LT(mg.background()->lastPosterior()[0], 0);
-	EXPECT_GT(mg.flow()->lastPosterior()[0], 0);
+	EXPECT_GT(mg.flowConsistency()->lastPosterior()[0], 0);
 	// Held in tier 0: still the unknown prior.
 	EXPECT_NEAR(fromFixed(mg.occupancy()->logOddsFixed(obj)), logit(0.97),
 	            1e-5);
@@ -205,7 +205,7 @@ TEST(ModelOptions, ExcludeMovingFollowsTheDecisionTier)
 	g.timestamp = mrpt::Clock::time_point(mrpt::Clock::duration(2));
 	PixelLabels same(4, 1, 0);
 	mg.processFrame(g, &same);
-	EXPECT_LT(mg.flow()->lastPosterior()[0], 0);
+	EXPECT_LT(mg.flowConsistency()->lastPosterior()[0], 0);
 	EXPECT_GT(fromFixed(mg.occupancy()->logOddsFixed(obj)), logit(0.97));
 }
 
@@ -277,7 +277,8 @@ TEST(ModelOptions, ExcludeByEitherHoldsWhatTier1CallsMovingAgainstTheFlow)
 		ASSERT_LT(io, cells.size());
 		EXPECT_GT(mg.background()->lastPosterior()[io], 0)
 		    << bims::choiceName(by);
-		EXPECT_LT(mg.flow()->lastPosterior()[io], 0) << bims::choiceName(by);
+		EXPECT_LT(mg.flowConsistency()->lastPosterior()[io], 0)
+		    << bims::choiceName(by);
 		if (by == ExcludeBy::Decision)
 			EXPECT_GT(mg.occupancy()->logOddsFixed(obj), before);
 		else  // either, and auto without ray casting

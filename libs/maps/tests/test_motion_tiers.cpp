@@ -82,9 +82,9 @@ TEST(MotionGrids, SameResultAsIndividualMapsThroughInsertObservation)
 		t2.insertObservation(*scan, T);
 		ASSERT_EQ(res.maskTier1().data, t1.lastMovingMask().data);
 		ASSERT_EQ(res.maskTier2().data, t2.lastMovingMask().data);
-		ASSERT_EQ(mg.flow()->lastPosterior(), t2.lastPosterior());
+		ASSERT_EQ(mg.flowConsistency()->lastPosterior(), t2.lastPosterior());
 		ASSERT_EQ(mg.background()->lastCells(), t1.lastCells());
-		ASSERT_EQ(mg.flow()->lastCells(), t2.lastCells());
+		ASSERT_EQ(mg.flowConsistency()->lastCells(), t2.lastCells());
 		scene.pop_back();
 	}
 }
@@ -107,7 +107,7 @@ TEST(MotionGrids, SharedCellsOfTheLastFrameAreNeverOverwritten)
 		auto scan = renderScan(scene, T, 40, 30, 60, f);
 		mg.processFrame(*scan, T, nullptr);
 		ASSERT_EQ(mg.background()->lastCells(), mg.lastFrame().cells);
-		ASSERT_EQ(mg.flow()->lastCells(), mg.lastFrame().cells);
+		ASSERT_EQ(mg.flowConsistency()->lastCells(), mg.lastFrame().cells);
 		copies.push_back(*mg.background());
 		cellsSeen.push_back(mg.lastFrame().cells);
 		postSeen.push_back(mg.background()->lastPosterior());
@@ -142,9 +142,9 @@ TEST(MotionGrids, LastFrameCellsAndMasksAreHandedOverWithoutACopy)
 		}
 		const auto& res = mg.processFrame(mg.lastFrame(), nullptr);
 		EXPECT_EQ(mg.background()->lastCells().data(), fr.cells.data());
-		EXPECT_EQ(mg.flow()->lastCells().data(), fr.cells.data());
+		EXPECT_EQ(mg.flowConsistency()->lastCells().data(), fr.cells.data());
 		EXPECT_EQ(&res.maskTier1(), &mg.background()->lastMovingMask());
-		EXPECT_EQ(&res.maskTier2(), &mg.flow()->lastMovingMask());
+		EXPECT_EQ(&res.maskTier2(), &mg.flowConsistency()->lastMovingMask());
 		EXPECT_EQ(res.maskTier1().width, 40);
 		before = fr.cells;
 	}
@@ -176,7 +176,7 @@ TEST(MotionGrids, TierProbabilityIsTheLastFramesPosterior)
 	mg.processFrame(frameAt(p, {a, b}, {4, 1}, {0, 0, 0}, 1), nullptr);
 	for (const CMotionGridBase* m :
 	     {static_cast<const CMotionGridBase*>(mg.background().get()),
-	      static_cast<const CMotionGridBase*>(mg.flow().get())})
+	      static_cast<const CMotionGridBase*>(mg.flowConsistency().get())})
 		for (size_t i = 0; i < 2; ++i)
 		{
 			const auto pr = m->probabilityAt(m->centerOf(m->lastCells()[i]));
@@ -273,9 +273,9 @@ TEST(FlowGrid, LabelsMoveTheDecisionAsTheModelSays)
 	PixelLabels diff(3, 1, 1), same(3, 1, 0);
 	std::vector<float> post;
 	std::vector<float> t1 = {float(l1)};
-	mg.flow()->posterior(fr, diff, t1, post);
+	mg.flowConsistency()->posterior(fr, diff, t1, post);
 	EXPECT_GT(post[0], 0);
-	mg.flow()->posterior(fr, same, t1, post);
+	mg.flowConsistency()->posterior(fr, same, t1, post);
 	EXPECT_LT(post[0], l1);
 	// Veto: Diff readings alone carry no evidence.
 	GridParams pv = p;
@@ -284,8 +284,9 @@ TEST(FlowGrid, LabelsMoveTheDecisionAsTheModelSays)
 	veto.posterior(fr, diff, t1, post);
 	EXPECT_NEAR(post[0], l1, 1e-6);
 	// Wrong label size is an error, not a silently wrong answer.
-	EXPECT_THROW(mg.flow()->posterior(fr, PixelLabels(4, 1, 1), t1, post),
-	             std::invalid_argument);
+	EXPECT_THROW(
+	    mg.flowConsistency()->posterior(fr, PixelLabels(4, 1, 1), t1, post),
+	    std::invalid_argument);
 }
 
 namespace
@@ -456,7 +457,8 @@ TEST(MotionGrids, DeferredDecayGivesTheSameMapsAndMasks)
 				EXPECT_EQ(ra.maskTier2().data, rb.maskTier2().data);
 				EXPECT_EQ(a.background()->lastPosterior(),
 				          b.background()->lastPosterior());
-				EXPECT_EQ(a.flow()->lastPosterior(), b.flow()->lastPosterior());
+				EXPECT_EQ(a.flowConsistency()->lastPosterior(),
+				          b.flowConsistency()->lastPosterior());
 				EXPECT_EQ(ra.movingTier1, rb.movingTier1);
 				aBefore = bytesOf(*a.occupancy());
 			}

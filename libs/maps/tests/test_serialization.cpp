@@ -80,18 +80,19 @@ TEST(Serialization, MotionTiersRoundTrip)
 	MotionGrids mg(p);
 	feed(mg, 4);
 	auto t1 = roundTrip(*mg.background());
-	auto t2 = roundTrip(*mg.flow());
+	auto t2 = roundTrip(*mg.flowConsistency());
 	ASSERT_TRUE(t1 && t2);
 	EXPECT_EQ(t1->lastPosterior(), mg.background()->lastPosterior());
-	EXPECT_EQ(t2->lastPosterior(), mg.flow()->lastPosterior());
-	EXPECT_EQ(t2->lastMovingMask().data, mg.flow()->lastMovingMask().data);
+	EXPECT_EQ(t2->lastPosterior(), mg.flowConsistency()->lastPosterior());
+	EXPECT_EQ(t2->lastMovingMask().data,
+	          mg.flowConsistency()->lastMovingMask().data);
 	EXPECT_EQ(t2->lastMovingMask().width, 48);
 	EXPECT_EQ(t1->movingCells().size(), mg.background()->movingCells().size());
 	EXPECT_EQ(t1->frameCount(), 4u);
 	// Every stored decision, and nothing more.
 	for (const CMotionGridBase* m :
 	     {static_cast<const CMotionGridBase*>(mg.background().get()),
-	      static_cast<const CMotionGridBase*>(mg.flow().get())})
+	      static_cast<const CMotionGridBase*>(mg.flowConsistency().get())})
 	{
 		auto b = roundTrip(*m);
 		size_t n = 0, moving = 0;

@@ -125,7 +125,7 @@ int main(int argc, char** argv)
 		    t12->resizeVoxelSets(1);
 		    const auto& c1 = grids.background()->lastCells();
 		    const auto& l1 = grids.background()->lastPosterior();
-		    const auto& l2 = grids.flow()->lastPosterior();
+		    const auto& l2 = grids.flowConsistency()->lastPosterior();
 		    size_t n1 = 0, n2 = 0;
 		    for (size_t i = 0; i < c1.size(); ++i)
 		    {
@@ -157,7 +157,8 @@ int main(int argc, char** argv)
 		    img.saveToFile(out);
 		    std::cout << k << " frames; " << grids.occupancy()->asString()
 		              << "\n"
-		              << grids.flow()->asString() << "\nwrote " << out << "\n";
+		              << grids.flowConsistency()->asString() << "\nwrote "
+		              << out << "\n";
 		    return 0;
 	    });
 }

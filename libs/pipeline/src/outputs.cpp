@@ -149,7 +149,7 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 	              r.index, r.t, r.ego.flags, r.ego.correspondences,
 	              r.ego.inliers, r.ego.residual_rms_m, r.hitVoxels,
 	              r.movingVoxels, cv::countNonZero(r.mask), r.labelStats.diff,
-	              r.labelStats.notDiff, r.ms.input, r.ms.ego, r.ms.flow,
+	              r.labelStats.notDiff, r.ms.input, r.ms.egomotion, r.ms.flow,
 	              r.ms.grids, r.ms.total, r.surfaceFill.added,
 	              ego::flagsToString(r.ego.flags).c_str());
 	csv_->append(buf);
@@ -202,15 +202,15 @@ size_t OutputWriter::close(const Pipeline& pipe)
 	size_t nStatic = 0;
 	const auto& g = pipe.grids();
 	const maps::CMotionGridBase* motion = nullptr;
-	switch (maskTier(pipe.config().pipeline.variant))
+	switch (maskSource(pipe.config().pipeline.variant))
 	{
-		case 1:
+		case MaskSource::Tier1:
 			motion = g.background().get();
 			break;
-		case 2:
-			motion = g.flow().get();
+		case MaskSource::Tier2:
+			motion = g.flowConsistency().get();
 			break;
-		default:
+		case MaskSource::FlowLabels:
 			break;  // the flow labels alone: no grid says moving
 	}
 	if (p_.static_map && pipe.framesProcessed() > 0)

@@ -51,7 +51,8 @@ Pipeline::Pipeline(const ExperimentConfig& cfg)
 {
 	// exclude_moving: the variant's own tier decides what is moving (tier
 	// 2 for the flow labels alone, whose voxels tier 2 accumulates).
-	grids_.setDecisionTier(maskTier(cfg.pipeline.variant) == 1 ? 1 : 2);
+	grids_.setDecisionTier(
+	    maskSource(cfg.pipeline.variant) == MaskSource::Tier1 ? 1 : 2);
 	if (cfg.pipeline.flow_thread)
 		flowThread_ = std::make_unique<SerialWorker>(1, true, "bims-flow");
 	if (cfg.pipeline.cloud_thread)
@@ -255,7 +256,7 @@ void Pipeline::egomotion(FrameResult& r)
 	r.ego = odom_.processFrame(cur_, fb);
 	r.T_WC = r.ego.T_WC;
 	r.T_CprevC = r.ego.T_CprevC;
-	r.ms.ego = msSince(t);
+	r.ms.egomotion = msSince(t);
 }
 
 void Pipeline::startNextJobs(const mrpt::obs::CObservation3DRangeScan& scan,
@@ -267,7 +268,7 @@ void Pipeline::startNextJobs(const mrpt::obs::CObservation3DRangeScan& scan,
 	const maps::Intrinsics K{cur_.size().width, cur_.size().height,
 	                         cur_.K(0, 0),      cur_.K(1, 1),
 	                         cur_.K(0, 2),      cur_.K(1, 2)};
-	jobs.buildHere = [this, &scan, K, T_WC = r.T_WC, &ms = r.ms.cloud]
+	jobs.buildHere = [this, &scan, K, T_WC = r.T_WC, &ms = r.ms.gridsCloud]
 	{
 		const auto t = Clock::now();
 		grids_.buildFrame(scan, K, T_WC);
@@ -285,7 +286,7 @@ void Pipeline::flowLabels(FrameJobs* jobs, FrameResult& r,
 	if (jobs)
 	{
 		const Observed o = jobs->observed();
-		r.ms.observed = o.ms;
+		r.ms.flowObserved = o.ms;
 		const cv::Mat& obs = o.flow;
 		const auto cam = cur_.camera();
 		if (cfg_.flow.refine_pose != flow::RefinePose::None)
@@ -317,7 +318,7 @@ void Pipeline::runGrids(const maps::PixelLabels* labels, FrameResult& r,
 {
 	// The three tiers, then the variant's mask.
 	const auto t = Clock::now();
-	r.ms.decayPrev = settleDecay();
+	r.ms.gridsDecay = settleDecay();
 	jobs.built();
 	const auto& g = grids_.processFrame(grids_.lastFrame(), labels, r.flowOff);
 	const cv::Size size = cur_.size();
@@ -325,21 +326,22 @@ void Pipeline::runGrids(const maps::PixelLabels* labels, FrameResult& r,
 	r.maskTier2 = toMat(g.maskTier2(), size);
 	r.hitVoxels = g.hitVoxels;
 	r.cloudStats = g.stats;
-	switch (maskTier(cfg_.pipeline.variant))
+	switch (maskSource(cfg_.pipeline.variant))
 	{
-		case 1:
+		case MaskSource::Tier1:
 			r.mask = r.maskTier1;
 			r.movingVoxels = g.movingTier1;
 			r.movingVoxelCentres = grids_.background()->movingCells();
 			break;
-		case 2:
+		case MaskSource::Tier2:
 			r.mask = r.maskTier2;
 			r.movingVoxels = g.movingTier2;
-			r.movingVoxelCentres = grids_.flow()->movingCells();
+			r.movingVoxelCentres = grids_.flowConsistency()->movingCells();
 			break;
-		default:
+		case MaskSource::FlowLabels:
 			r.mask = r.maskFlow;
 			r.movingVoxels = 0;
+			break;
 	}
 	// The tracker of the next frame keeps its features off the tier's own
 	// decision: the fill is for the output (a filled false alarm fed back

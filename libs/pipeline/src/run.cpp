@@ -137,12 +137,14 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		stage["read_cpu"].push_back(f.cost.readCpuMs);
 		stage["wait_input"].push_back(f.cost.waitMs);
 		stage["input"].push_back(r.ms.input);
-		stage["egomotion"].push_back(r.ms.ego);
+		stage["egomotion"].push_back(r.ms.egomotion);
 		stage["flow"].push_back(r.ms.flow);
-		if (r.ms.observed > 0) stage["flow_observed"].push_back(r.ms.observed);
+		if (r.ms.flowObserved > 0)
+			stage["flow_observed"].push_back(r.ms.flowObserved);
 		stage["grids"].push_back(r.ms.grids);
-		stage["grids_cloud"].push_back(r.ms.cloud);
-		if (r.ms.decayPrev > 0) stage["grids_decay"].push_back(r.ms.decayPrev);
+		stage["grids_cloud"].push_back(r.ms.gridsCloud);
+		if (r.ms.gridsDecay > 0)
+			stage["grids_decay"].push_back(r.ms.gridsDecay);
 		stage["total"].push_back(r.ms.total);
 		const double validPx = static_cast<double>(r.cloudStats.valid);
 		if (validPx > 0) movingFracSum += cv::countNonZero(r.mask) / validPx;

@@ -296,8 +296,8 @@ std::string ReplayController::statusText() const
 		s.precision(1);
 		s << "  moving " << (valid > 0 ? 100.0 * moving / valid : 0.0)
 		  << "% px, " << r->movingVoxels << " voxels  [" << r->ms.total
-		  << " ms: ego " << r->ms.ego << ", flow " << r->ms.flow << ", grids "
-		  << r->ms.grids << "]";
+		  << " ms: ego " << r->ms.egomotion << ", flow " << r->ms.flow
+		  << ", grids " << r->ms.grids << "]";
 	}
 	s.precision(2);
 	s << "  x" << speed_;

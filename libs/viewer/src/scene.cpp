@@ -153,7 +153,7 @@ std::shared_ptr<FrameView> ReplayController::view() const
 			               mrpt::img::TColor(255, 255, 0), "tier1_moving");
 		if (layers_[Layer::Tier2])
 			L[size_t(Layer::Tier2)] =
-			    voxelCubes(g.flow()->movingCells(), 1.3 * vs,
+			    voxelCubes(g.flowConsistency()->movingCells(), 1.3 * vs,
 			               mrpt::img::TColor(255, 0, 0), "tier2_moving");
 	}
 	if (layers_[Layer::Estimated] && est_.size() > 1)

@@ -234,7 +234,8 @@ TEST(ReplayController, OffscreenViewShowsTheThreeTierColours)
 	c.seek(14);
 	ASSERT_NE(c.result(), nullptr);
 	ASSERT_GT(c.pipelineObj()->grids().background()->movingCells().size(), 0u);
-	ASSERT_GT(c.pipelineObj()->grids().flow()->movingCells().size(), 0u);
+	ASSERT_GT(c.pipelineObj()->grids().flowConsistency()->movingCells().size(),
+	          0u);
 	const auto img = c.renderOffscreen(c.suggestedCamera(), 640, 480);
 	ASSERT_EQ(img.getWidth(), 640u);
 	img.saveToFile(std::string(BIMS_BINARY_DIR) + "/test_viewer_offscreen.png");

@@ -78,13 +78,17 @@ class MotionGrids
 	std::shared_ptr<COccupancyBayesGrid> occupancy() const
 	{
 		applyPendingDecay();
-		return t0_;
+		return tier0_;
 	}
 	std::shared_ptr<CBackgroundSubtractionGrid> background() const
 	{
-		return t1_;
+		return tier1_;
 	}
-	std::shared_ptr<CFlowConsistencyGrid> flow() const { return t2_; }
+	/** Tier 2 (flow consistency). */
+	std::shared_ptr<CFlowConsistencyGrid> flowConsistency() const
+	{
+		return tier2_;
+	}
 	const GridParams& params() const { return p_; }
 	void clear();
 
@@ -99,7 +103,7 @@ class MotionGrids
 	 * of these grids but buildFrame(), e.g. during the next frame's
 	 * egomotion. A frame not built by buildFrame() is decayed at once. */
 	void setDeferDecay(bool on) { deferDecay_ = on; }
-	bool decayPending() const { return t0_->decayPending(); }
+	bool decayPending() const { return tier0_->decayPending(); }
 	void applyPendingDecay() const;
 
 	/** Which tier's MAP decides "moving" for exclude_moving (1 or 2;
@@ -109,9 +113,9 @@ class MotionGrids
 
  private:
 	GridParams p_;
-	std::shared_ptr<COccupancyBayesGrid> t0_;
-	std::shared_ptr<CBackgroundSubtractionGrid> t1_;
-	std::shared_ptr<CFlowConsistencyGrid> t2_;
+	std::shared_ptr<COccupancyBayesGrid> tier0_;
+	std::shared_ptr<CBackgroundSubtractionGrid> tier1_;
+	std::shared_ptr<CFlowConsistencyGrid> tier2_;
 	/** Builds the next frame into the spare buffer (\a build(frame)) and
 	 * makes it lastFrame(). */
 	template <class Build>

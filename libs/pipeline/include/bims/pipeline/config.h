@@ -21,7 +21,7 @@
 namespace bims::pipeline
 {
 /** Which decision the output mask (and the tracker's feedback) uses
- * (docs/EVALUATION table). */
+ * (bims-run --variant; the variants compared in docs/results.md). */
 enum class Variant
 {
 	BottomOnly,   ///< tier-1 MAP (background subtraction)
@@ -58,12 +58,23 @@ inline Choices<SurfaceFill> choices(SurfaceFill)
 	return t;
 }
 
-/** The grid tier whose MAP is the variant's mask: 1 or 2, or 0 for the
- * flow labels alone (the one place that says it: the pipeline's mask and
- * exclude_moving tier, the outputs' static map). */
-constexpr int maskTier(Variant v)
+/** Where a variant's moving mask comes from: the MAP of tier 1
+ * (background subtraction) or tier 2 (flow consistency), or the flow labels
+ * alone (no grid). */
+enum class MaskSource
 {
-	return v == Variant::BottomOnly ? 1 : v == Variant::FlowOnly ? 0 : 2;
+	FlowLabels,
+	Tier1,
+	Tier2
+};
+
+/** The variant's mask source (the one place that says it: the pipeline's
+ * mask and exclude_moving tier, the outputs' static map). */
+constexpr MaskSource maskSource(Variant v)
+{
+	return v == Variant::BottomOnly ? MaskSource::Tier1
+	       : v == Variant::FlowOnly ? MaskSource::FlowLabels
+	                                : MaskSource::Tier2;
 }
 
 /** [pipeline] */

@@ -1,12 +1,17 @@
-// Per-frame orchestration (docs/architecture.md):
-//   egomotion -> tier 1 reads O- -> tier 0 update -> flow labels -> tier 2
-//   -> MAP -> moving voxels -> moving-pixel mask (fed back to the tracker).
-// No I/O: the caller feeds observations in time order. One thread of its own
-// ([pipeline] flow_thread): the observed flow of a frame runs there while the
-// egomotion runs on the caller's thread; told the next frame ([pipeline]
-// flow_lookahead), the observed flow of that frame starts there while this
-// frame's grids run; the FrameCloud of a frame is built on a thread of its
-// own ([pipeline] cloud_thread) while the labels run (docs/pipeline.md).
+// One frame, in order (docs/architecture.md, docs/pipeline.md):
+//   egomotion (fed the previous frame's mask) -> observed and expected flow
+//   -> Diff/notDiff labels -> the frame's voxel cloud -> the grids: tier 0
+//   hands out O- -> tier 1 (background subtraction) -> tier 2 (with the flow
+//   labels); tier 0 folds the frame in (with exclude_moving after the
+//   posteriors, the voxels the decision tier calls static only) -> MAP ->
+//   moving voxels and the moving-pixel mask -> the surface fill (output only)
+//   -> the tier's mask fed back to the tracker.
+// No I/O: the caller feeds observations in time order. Up to four threads
+// beside the caller's: the observed flow ([pipeline] flow_thread) runs
+// during the egomotion, and, told the next frame (flow_lookahead), that
+// frame's observed flow during this frame's grids; the voxel cloud
+// (cloud_thread) is built while the labels run; tier 0's decay of a frame
+// runs during the next frame until its grids need it.
 #pragma once
 
 #include <bims/ego/odometry.h>
@@ -32,19 +37,20 @@ class SerialWorker;
 /** Wall time of each stage of one frame [ms]. */
 struct StageTimes
 {
-	double input = 0;  ///< decoding images, depth conversion
-	double ego = 0;    ///< tracking + motion estimation
+	// named as metrics.json's stages (RunSummary::stageMs)
+	double input = 0;      ///< decoding images, depth conversion
+	double egomotion = 0;  ///< tracking + motion estimation
 	/** observed + expected flow + labels, on the caller's thread (with
 	 * flow_thread: what is left of the observed flow after the egomotion) */
 	double flow = 0;
-	double observed = 0;  ///< the observed flow alone, on whichever thread
+	double flowObserved = 0;  ///< the observed flow alone, on whichever thread
 	/** cloud building (or waiting for it) + the tiers + the surface fill */
 	double grids = 0;
-	double cloud = 0;  ///< building the FrameCloud, on whichever thread
+	double gridsCloud = 0;  ///< building the FrameCloud, on whichever thread
 	/** tier 0's decay (frustum, raycast) of the previous frame on the decay
 	 * thread (with cloud_thread; else it is part of grids), which this
 	 * frame waited for before its grids; 0 if none */
-	double decayPrev = 0;
+	double gridsDecay = 0;
 	double total = 0;
 };
 
