@@ -2,7 +2,7 @@
 //   [-c CONFIG.ini] [--max-frames N] [--gz L] [--topics] [-q]
 // Converts ROS 1 bags (sensor_msgs/Image depth and colour, CameraInfo, Imu,
 // MagneticField) into a bims rawlog. See docs/import-bag.md.
-#include <bims/bag/bag_import_run.h>
+#include <bims/apps/bag_import_run.h>
 #include <bims/common/app.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
@@ -48,7 +48,7 @@ int main(int argc, char** argv)
 		        cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
-		    bims::bag::BagImportRunOptions o;
+		    bims::apps::BagImportRunOptions o;
 		    o.bags = bags.getValue();
 		    o.out = out.getValue();
 		    o.config = bims::givenValue(config);
@@ -58,6 +58,6 @@ int main(int argc, char** argv)
 		    o.gz = gz.getValue();
 		    o.progress = !quiet.getValue();
 		    o.listTopics = topics.getValue();
-		    return bims::bag::runBagImport(o);
+		    return bims::apps::runBagImport(o);
 	    });
 }

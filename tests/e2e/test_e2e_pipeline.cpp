@@ -327,7 +327,7 @@ TEST(EndToEnd, TruncatedRawlogStopsWithAClearErrorAndKeepsPartialOutputs)
 		std::ofstream f(cut, std::ios::app | std::ios::binary);
 		bims::RawlogReader in(kSample);
 		std::string tmp = dir + "/one.rawlog";
-		for (int i = 0; i < 40; i++) in.next();
+		for (int i = 0; i < 40; i++) ASSERT_TRUE(in.next());
 		bims::RawlogWriter w(tmp, 0);
 		mrpt::obs::CObservation::Ptr o;
 		do o = in.next();

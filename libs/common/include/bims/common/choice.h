@@ -78,8 +78,8 @@ class Choices
 std::string choiceList(const std::vector<std::string>& names);
 
 /** "'x' is not one of a|b|c": the error text for a bad name. */
-std::string badChoiceMessage(const std::string& value,
-                             const std::vector<std::string>& names);
+[[nodiscard]] std::string badChoiceMessage(
+    const std::string& value, const std::vector<std::string>& names);
 
 /** The .ini name of \a v (its enum's table, found by ADL). */
 template <typename E>

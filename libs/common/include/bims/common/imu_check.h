@@ -17,7 +17,8 @@ namespace bims
  * rad/s, Euler angles 100 rad, quaternion components 1.01, velocity 1e4
  * m/s, position and altitude 1e8 m, magnetic field 1e4, pressure 1e7 Pa,
  * temperature 1000 degC. */
-std::string imuSampleProblem(const mrpt::obs::CObservationIMU& imu);
+[[nodiscard]] std::string imuSampleProblem(
+    const mrpt::obs::CObservationIMU& imu);
 
 /** The IMU samples a replay does not use (imuSampleProblem), for bims-run
  * and bims-odom alike: each is counted and warned about, naming the rawlog
@@ -28,9 +29,9 @@ class RejectedImuSamples
 	/** imuSampleProblem(imu); when not empty, a warning on stderr ("PROG:
 	 * warning: PATH: observation #N (IMU, t T): PROBLEM; sample not used";
 	 * none when \a prog is null) and \a t [s] remembered. */
-	std::string check(const mrpt::obs::CObservationIMU& imu, double t,
-	                  const char* prog, const std::string& path,
-	                  size_t obsIndex);
+	[[nodiscard]] std::string check(const mrpt::obs::CObservationIMU& imu,
+	                                double t, const char* prog,
+	                                const std::string& path, size_t obsIndex);
 	/** Whether samples stamped at or before \a t were rejected since the
 	 * last call (each sample answers once). */
 	bool upTo(double t);

@@ -56,7 +56,7 @@ class RawlogReader
 
 	/** Next observation, or nullptr at the clean end of the file. Throws
 	 * RawlogError naming the file and the entry on truncation or corruption. */
-	mrpt::obs::CObservation::Ptr next();
+	[[nodiscard]] mrpt::obs::CObservation::Ptr next();
 
 	/** Bytes of data read so far (decompressed), of rawlogDataBytes(). */
 	uint64_t bytesRead() const;

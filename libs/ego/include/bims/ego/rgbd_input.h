@@ -42,8 +42,9 @@ struct RgbdFrame
  * intensity image gives a depth-only frame (grey empty).
  * \return empty string on success, else what is wrong (no range image,
  * sizes differ, camera size disagrees with [camera]). */
-std::string rgbdFrameFrom(const mrpt::obs::CObservation3DRangeScan& obs,
-                          const CameraParams& cam, RgbdFrame& out);
+[[nodiscard]] std::string rgbdFrameFrom(
+    const mrpt::obs::CObservation3DRangeScan& obs, const CameraParams& cam,
+    RgbdFrame& out);
 
 /** The intrinsics of \a obs's range image: \a cam when given (its size
  * must match), else the observation's cameraParams. \return empty string

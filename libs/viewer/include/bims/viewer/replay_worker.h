@@ -88,13 +88,13 @@ class ReplayWorker
 	WorkerState state() const;
 	/** The error that stopped the replay thread's last command ("" none);
 	 * cleared by the call. */
-	std::string takeError();
+	[[nodiscard]] std::string takeError();
 	/** Calls \a f on the replay thread with the controller and waits for it
 	 * (tests, or reading the pipeline's state between frames). */
 	void withController(const std::function<void(ReplayController&)>& f);
 	/** Waits until no command is queued or running and playback has
 	 * stopped (end reached or paused), at most \a seconds; true if so. */
-	bool waitIdle(double seconds) const;
+	[[nodiscard]] bool waitIdle(double seconds) const;
 
  private:
 	using Command = std::function<void()>;

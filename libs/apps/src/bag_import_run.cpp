@@ -1,4 +1,4 @@
-#include <bims/bag/bag_import_run.h>
+#include <bims/apps/bag_import_run.h>
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/output_paths.h>
@@ -9,8 +9,16 @@
 #include <filesystem>
 #include <stdexcept>
 
-namespace bims::bag
+namespace bims::apps
 {
+using bag::BagImportOptions;
+using bag::BagImportParams;
+using bag::BagImportSummary;
+using bag::BagLayout;
+using bag::bagTopics;
+using bag::describeTopics;
+using bag::importBag;
+
 namespace
 {
 std::string channels(const BagImportSummary& s)
@@ -127,4 +135,4 @@ int runBagImport(const BagImportRunOptions& o)
 	return 0;
 }
 
-}  // namespace bims::bag
+}  // namespace bims::apps

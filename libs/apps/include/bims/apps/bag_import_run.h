@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace bims::bag
+namespace bims::apps
 {
 /** What bims-import-bag's command line gives (nullopt: not given). */
 struct BagImportRunOptions
@@ -29,8 +29,9 @@ struct BagImportRunOptions
  * the frames (size, encodings, the intrinsics and where they came from),
  * the images left out and why, the IMU samples with their channels and
  * labels. */
-std::string bagImportReport(const std::string& out, const BagImportSummary& sum,
-                            const BagImportParams& params);
+std::string bagImportReport(const std::string& out,
+                            const bag::BagImportSummary& sum,
+                            const bag::BagImportParams& params);
 
 /** bims-import-bag: checks the options (UsageError; no output may be an
  * input), reads the config, imports and prints bagImportReport (or, with
@@ -38,4 +39,4 @@ std::string bagImportReport(const std::string& out, const BagImportSummary& sum,
  * errors are thrown. */
 int runBagImport(const BagImportRunOptions& o);
 
-}  // namespace bims::bag
+}  // namespace bims::apps
