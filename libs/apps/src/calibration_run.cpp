@@ -16,6 +16,7 @@
 namespace bims::apps
 {
 using source::FrameRange;
+using source::frameRangeOption;
 using source::ReplayOptions;
 using source::replayRawlog;
 using source::ReplayStats;
