@@ -18,16 +18,12 @@ FRAMES=${4:-150}
 shift $(($# < 4 ? $# : 4))
 cd "$(dirname "$0")/.."
 BIN="$BUILD_DIR/bin"
-PRESETS=${*:-$(ls config/sim/*.ini | xargs -n1 basename | sed 's/\.ini$//')}
 for b in bims-sim bims-run bims-eval; do
 	[ -x "$BIN/$b" ] || { echo "depth_only_sim.sh: $BIN/$b missing (build first)" >&2; exit 1; }
 done
-if [ -z "$DATA" ]; then
-	DATA=$(mktemp -d)
-	trap 'rm -rf "$DATA"' EXIT
-fi
-mkdir -p "$DATA"
 . scripts/sim_experiment.sh
+PRESETS=$(sim_presets "$@")
+sim_data_dir
 
 echo "| preset | surface_fill | precision | recall | F1 | ATE RMSE [m] |"
 echo "|---|---|---|---|---|---|"

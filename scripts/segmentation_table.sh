@@ -19,14 +19,10 @@ FRAMES=${4:-150}
 shift $(($# < 4 ? $# : 4))
 cd "$(dirname "$0")/.."
 BIN="$BUILD_DIR/bin"
-PRESETS=${*:-$(ls config/sim/*.ini | xargs -n1 basename | sed 's/\.ini$//')}
-if [ -z "$DATA" ]; then
-	DATA=$(mktemp -d)
-	trap 'rm -rf "$DATA"' EXIT
-fi
-mkdir -p "$DATA"
 
 . scripts/sim_experiment.sh
+PRESETS=$(sim_presets "$@")
+sim_data_dir
 
 echo "| preset | variant | precision | recall | F1 | IoU | voxel F1 | ATE RMSE [m] | ms/frame (pipeline, median) |"
 echo "|---|---|---|---|---|---|---|---|---|"

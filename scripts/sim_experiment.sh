@@ -2,12 +2,32 @@
 # Sourced by the simulator benchmarks (scripts/segmentation_table.sh,
 # bench/depth_only_sim.sh), from the repository root:
 #
+#   sim_presets [PRESET...]   the presets given, else every config/sim/*.ini
+#   sim_data_dir              DATA made (a temporary folder removed at exit
+#                             when DATA is unset)
+#
 #   sim_experiment_config CALIB.ini OUT.ini [SECTION.KEY=VALUE...]
 #
 # writes config/default.ini to OUT.ini with R_IC and time_offset_s of
 # [calibration] taken from CALIB.ini (a simulation's ground truth), the heavy
 # per-frame outputs off (moving_ply, static_map, labelled_rawlog) and each
 # SECTION.KEY given set to VALUE (keys that config/default.ini holds).
+sim_presets() {
+	if [ $# -gt 0 ]; then
+		echo "$*"
+	else
+		ls config/sim/*.ini | xargs -n1 basename | sed 's/\.ini$//'
+	fi
+}
+
+sim_data_dir() {
+	if [ -z "${DATA:-}" ]; then
+		DATA=$(mktemp -d)
+		trap 'rm -rf "$DATA"' EXIT
+	fi
+	mkdir -p "$DATA"
+}
+
 sim_experiment_config() {
 	local calib=$1 out=$2
 	shift 2

@@ -1,4 +1,5 @@
 #include <bims/apps/bag_import_run.h>
+#include <bims/apps/import_options.h>
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/output_paths.h>
@@ -98,7 +99,7 @@ std::string bagImportReport(const std::string& out, const BagImportSummary& sum,
 int runBagImport(const BagImportRunOptions& o)
 {
 	if (o.bags.empty()) throw UsageError("no bag given");
-	if (o.gz < 0 || o.gz > 9) throw UsageError("--gz must be in 0..9");
+	checkGzLevel(o.gz);
 	std::vector<std::string> inputs = o.bags;
 	inputs.push_back(o.config.value_or(""));
 	if (o.listTopics)
@@ -110,13 +111,8 @@ int runBagImport(const BagImportRunOptions& o)
 	checkOutputsSpareInputs(inputs, {o.out});
 
 	BagImportParams params;
-	if (o.config)
-	{
-		if (!std::filesystem::exists(*o.config))
-			throw std::runtime_error(*o.config + ": config file not found");
-		const auto cfg = openIniFile(*o.config);
+	if (const auto cfg = openImportConfig(o.config))
 		params.loadFromConfigFile(*cfg);
-	}
 	if (o.layout)
 	{
 		const auto c = choices(BagLayout::Auto);

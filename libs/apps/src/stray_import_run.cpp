@@ -1,3 +1,4 @@
+#include <bims/apps/import_options.h>
 #include <bims/apps/stray_import_run.h>
 #include <bims/common/app.h>
 #include <bims/common/config.h>
@@ -60,15 +61,10 @@ int runStrayImport(const StrayImportRunOptions& o)
 {
 	checkOutputsSpareInputs({o.folder, o.config.value_or("")},
 	                        {o.out, strayReferencePathFor(o.out)});
-	if (o.gz < 0 || o.gz > 9) throw UsageError("--gz must be in 0..9");
+	checkGzLevel(o.gz);
 	StrayImportParams params;
-	if (o.config)
-	{
-		if (!std::filesystem::exists(*o.config))
-			throw std::runtime_error(*o.config + ": config file not found");
-		const auto cfg = openIniFile(*o.config);
+	if (const auto cfg = openImportConfig(o.config))
 		params.loadFromConfigFile(*cfg);
-	}
 	else
 		std::fprintf(stderr,
 		             "bims-import-stray: no --config: [import_stray] "

@@ -1,3 +1,4 @@
+#include <bims/apps/import_options.h>
 #include <bims/apps/tum_import_run.h>
 #include <bims/common/app.h>
 #include <bims/common/config.h>
@@ -54,14 +55,11 @@ int runImport(const ImportRunOptions& o)
 {
 	checkOutputsSpareInputs({o.folder, o.config.value_or("")},
 	                        {o.out, groundTruthDirFor(o.out)});
-	if (o.gz < 0 || o.gz > 9) throw UsageError("--gz must be in 0..9");
+	checkGzLevel(o.gz);
 	ImportParams params;
-	std::unique_ptr<mrpt::config::CConfigFile> cfg;
-	if (o.config)
+	const auto cfg = openImportConfig(o.config);
+	if (cfg)
 	{
-		if (!std::filesystem::exists(*o.config))
-			throw std::runtime_error(*o.config + ": config file not found");
-		cfg = openIniFile(*o.config);
 		std::vector<std::string> sections;
 		cfg->getAllSections(sections);
 		if (sections.empty())

@@ -144,16 +144,24 @@ inline T pointToPlaneResidual(T X, T Y, T Z, T nx, T ny, T nz, T d)
 	return nx * X + ny * Y + nz * Z - d;
 }
 
+/** The row of a residual whose gradient w.r.t. the point X is g, w.r.t.
+ * the increment (v, w) that moves X to X + v + w x X: [g, X x g]. */
+template <typename T>
+inline void poseRow(T X, T Y, T Z, T g0, T g1, T g2, T J[6])
+{
+	J[0] = g0;
+	J[1] = g1;
+	J[2] = g2;
+	J[3] = Y * g2 - Z * g1;
+	J[4] = Z * g0 - X * g2;
+	J[5] = X * g1 - Y * g0;
+}
+
 /** Its Jacobian w.r.t. (v, w): [n, X x n]. */
 template <typename T>
 inline void pointToPlaneJacobian(T X, T Y, T Z, T nx, T ny, T nz, T J[6])
 {
-	J[0] = nx;
-	J[1] = ny;
-	J[2] = nz;
-	J[3] = Y * nz - Z * ny;
-	J[4] = Z * nx - X * nz;
-	J[5] = X * ny - Y * nx;
+	poseRow(X, Y, Z, nx, ny, nz, J);
 }
 
 /** Jacobian w.r.t. (v, w) of the photometric residual I(u, v) - grey (grey
@@ -168,12 +176,7 @@ inline void photometricJacobian(T X, T Y, T Z, T iz, T gx, T gy, T fx, T fy,
 {
 	const T g0 = gx * fx * iz, g1 = gy * fy * iz,
 	        g2 = -(gx * fx * X + gy * fy * Y) * iz * iz;
-	J[0] = g0;
-	J[1] = g1;
-	J[2] = g2;
-	J[3] = Y * g2 - Z * g1;
-	J[4] = Z * g0 - X * g2;
-	J[5] = X * g1 - Y * g0;
+	poseRow(X, Y, Z, g0, g1, g2, J);
 }
 
 /** Aligns \a cur to \a ref (ref.isReference()) from the initial guess
