@@ -17,18 +17,34 @@ std::string rgbdFrameFrom(const mrpt::obs::CObservation3DRangeScan& obs,
 	if (!obs.hasRangeImage || obs.rangeImage.rows() == 0)
 		return "no range image";
 	const_cast<mrpt::obs::CObservation3DRangeScan&>(obs).load();
-	const int H = static_cast<int>(obs.rangeImage.rows());
-	const int W = static_cast<int>(obs.rangeImage.cols());
-	if (!obs.hasIntensityImage || obs.intensityImage.isEmpty())
+	cv::Mat image;
+	if (obs.hasIntensityImage && !obs.intensityImage.isEmpty())
+		image = obs.intensityImage.asCvMat<cv::Mat>(mrpt::img::SHALLOW_COPY);
+	Eigen::Matrix3d K;
+	if (std::string why = intrinsicsOf(obs, cam, K); !why.empty()) return why;
+	return rgbdFrameFrom(depthImageOf(obs), image, K, out);
+}
+
+std::string rgbdFrameFrom(const DepthImage& depth, const cv::Mat& image,
+                          const Eigen::Matrix3d& K, RgbdFrame& out)
+{
+	// Buffers shared with another frame (or not owned) are replaced, not
+	// written into: a frame handed on keeps its images.
+	for (cv::Mat* m : {&out.grey, &out.depth, &out.raw})
+		if (!m->u || m->u->refcount > 1) m->release();
+	out.stamp = depth.timestamp;
+	if (depth.timestamp != mrpt::Clock::time_point{})
+		out.t = mrpt::Clock::toDouble(depth.timestamp);
+	if (depth.empty()) return "no range image";
+	const int H = depth.height, W = depth.width;
+	if (image.empty())
 		out.grey.release();  // depth only
 	else
 	{
-		cv::Mat img =
-		    obs.intensityImage.asCvMat<cv::Mat>(mrpt::img::SHALLOW_COPY);
-		if (img.channels() == 3)
-			cv::cvtColor(img, out.grey, cv::COLOR_BGR2GRAY);
-		else if (img.channels() == 1)
-			out.grey = img;
+		if (image.channels() == 3)
+			cv::cvtColor(image, out.grey, cv::COLOR_BGR2GRAY);
+		else if (image.channels() == 1)
+			out.grey = image;
 		else
 			return "intensity image has an unsupported channel count";
 		if (out.grey.depth() != CV_8U) return "intensity image is not 8-bit";
@@ -41,22 +57,28 @@ std::string rgbdFrameFrom(const mrpt::obs::CObservation3DRangeScan& obs,
 			return os.str();
 		}
 	}
-	if (std::string why = intrinsicsOf(obs, cam, out.K); !why.empty())
-		return why;
-	const float units = obs.rangeUnits;
+	out.K = K;
+	const float units = depth.units;
 	if (!(units > 0) || !std::isfinite(units))
 		return "invalid rangeUnits " + std::to_string(units) +
 		       " (a finite value > 0 expected)";
+	// The readings as read (what the voxel cloud is built from), and the
+	// metric depth from them.
+	cv::Mat(H, W, CV_16UC1, const_cast<uint16_t*>(depth.data),
+	        depth.stride * sizeof(uint16_t))
+	    .copyTo(out.raw);
+	out.units = units;
+	out.rangeIsDepth = depth.isDepth;
 	out.depth.create(H, W, CV_32FC1);
-	const double fx = out.K(0, 0), fy = out.K(1, 1), cx = out.K(0, 2),
-	             cy = out.K(1, 2);
+	const double fx = K(0, 0), fy = K(1, 1), cx = K(0, 2), cy = K(1, 2);
 	for (int v = 0; v < H; v++)
 	{
+		const uint16_t* in = out.raw.ptr<uint16_t>(v);
 		float* row = out.depth.ptr<float>(v);
 		for (int u = 0; u < W; u++)
 		{
-			float z = obs.rangeImage(v, u) * units;
-			if (!obs.range_is_depth && z > 0)
+			float z = in[u] * units;
+			if (!depth.isDepth && z > 0)
 			{
 				const double a = (u - cx) / fx, b = (v - cy) / fy;
 				z = static_cast<float>(z / std::sqrt(1 + a * a + b * b));
@@ -65,6 +87,20 @@ std::string rgbdFrameFrom(const mrpt::obs::CObservation3DRangeScan& obs,
 		}
 	}
 	return {};
+}
+
+DepthImage RgbdFrame::rawDepth() const
+{
+	DepthImage d;
+	if (raw.empty()) return d;
+	d.data = raw.ptr<uint16_t>(0);
+	d.width = raw.cols;
+	d.height = raw.rows;
+	d.stride = raw.step1();
+	d.units = units;
+	d.isDepth = rangeIsDepth;
+	d.timestamp = stamp;
+	return d;
 }
 
 mrpt::img::TCamera RgbdFrame::camera() const

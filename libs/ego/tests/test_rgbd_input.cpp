@@ -96,3 +96,32 @@ TEST(RgbdInput, AScanWithoutAnImageIsADepthOnlyFrame)
 	s.hasRangeImage = false;
 	EXPECT_EQ(bims::ego::rgbdFrameFrom(s, {}, f), "no range image");
 }
+
+TEST(RgbdInput, DecodingIntoAFrameWhoseImagesAreSharedLeavesThemAlone)
+{
+	// A colour scan (its grey image is the decoder's own buffer).
+	auto colour = [](int level, uint16_t raw)
+	{
+		auto s = scan(32, 24);
+		s.rangeImage.fill(raw);
+		s.intensityImage.resize(32, 24, mrpt::img::CH_RGB);
+		s.intensityImage.filledRectangle(
+		    0, 0, 31, 23, mrpt::img::TColor(level, level, level));
+		return s;
+	};
+	bims::ego::RgbdFrame f;
+	ASSERT_EQ(bims::ego::rgbdFrameFrom(colour(90, 1500), {}, f), "");
+	const bims::ego::RgbdFrame handedOn = f;  // shares f's images
+	ASSERT_EQ(bims::ego::rgbdFrameFrom(colour(200, 2500), {}, f), "");
+	EXPECT_EQ(handedOn.grey.at<uint8_t>(5, 5), 90);
+	EXPECT_FLOAT_EQ(handedOn.depth.at<float>(5, 5), 1.5f);
+	EXPECT_EQ(handedOn.raw.at<uint16_t>(5, 5), 1500);
+	EXPECT_EQ(f.grey.at<uint8_t>(5, 5), 200);
+	EXPECT_FLOAT_EQ(f.depth.at<float>(5, 5), 2.5f);
+	EXPECT_EQ(f.raw.at<uint16_t>(5, 5), 2500);
+	// a frame nobody else holds keeps its buffers (no allocation per frame)
+	const uint8_t* depthBuffer = f.depth.data;
+	ASSERT_EQ(bims::ego::rgbdFrameFrom(colour(60, 1000), {}, f), "");
+	EXPECT_EQ(f.depth.data, depthBuffer);
+	EXPECT_FLOAT_EQ(f.depth.at<float>(5, 5), 1.0f);
+}

@@ -285,18 +285,24 @@ void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
                               const Intrinsics& cam,
                               const mrpt::poses::CPose3D& T_WC, FrameCloud& out)
 {
+	build(depthImageOf(scan), cam, T_WC, out);
+}
+
+void FrameCloudBuilder::build(const DepthImage& img, const Intrinsics& cam,
+                              const mrpt::poses::CPose3D& T_WC, FrameCloud& out)
+{
 	resetFrame(out, true);
 	out.voxel_size = p_.voxel_size;
-	out.timestamp = scan.timestamp;
+	out.timestamp = img.timestamp;
 	// Before an error or an empty frame, the readings of the last frame go.
 	auto fail = [&](const std::string& what)
 	{
 		resetFrame(out);
 		throw std::invalid_argument("bims::maps::FrameCloudBuilder: scan '" +
-		                            scan.sensorLabel + "'" + what);
+		                            img.label + "'" + what);
 	};
-	if (!scan.hasRangeImage) fail(" has no range image");
-	const int W = int(scan.rangeImage.cols()), H = int(scan.rangeImage.rows());
+	if (img.empty()) fail(" has no range image");
+	const int W = img.width, H = img.height;
 	if (cam.width != W || cam.height != H)
 		fail(": camera size " + std::to_string(cam.width) + "x" +
 		     std::to_string(cam.height) + " differs from the range image " +
@@ -327,11 +333,11 @@ void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
 	uint64_t* runKey = growTo(runKey_, N + 1);
 	uint32_t* runStart = growTo(runStart_, N + 1);
 
-	const double units = scan.rangeUnits;
+	const double units = img.units;
 	const double maxR = p_.max_range;
 	const double ifx = 1 / cam.fx, ify = 1 / cam.fy;
 	const double cx = cam.cx, cy = cam.cy;
-	const bool isDepth = scan.range_is_depth;
+	const bool isDepth = img.isDepth;
 	// Per column: 1 + xn^2 and xn * R.col0 (the terms of the unprojection
 	// that depend on u only, computed as per pixel before), one array each.
 	colTab_.resize(4 * size_t(W));
@@ -392,7 +398,7 @@ void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
 		const double b[3] = {yn * R(0, 1) + R(0, 2), yn * R(1, 1) + R(1, 2),
 		                     yn * R(2, 1) + R(2, 2)};
 		const uint32_t rowPix = uint32_t(size_t(v) * W);
-		const uint16_t* rawRow = &scan.rangeImage(v, 0);
+		const uint16_t* rawRow = img.row(v);
 		float* depthRow = depth + rowPix;
 		// One pixel, any case (the fast path in scalar code).
 		auto pixel = [&](int u)

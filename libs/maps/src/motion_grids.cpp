@@ -58,11 +58,17 @@ const FrameCloud& MotionGrids::buildFrame(
 	return buildInto([&](FrameCloud& f) { builder_.build(scan, T_WS, f); });
 }
 
-const FrameCloud& MotionGrids::buildFrame(
-    const mrpt::obs::CObservation3DRangeScan& scan, const Intrinsics& K,
-    const mrpt::poses::CPose3D& T_WC)
+const FrameCloud& MotionGrids::buildFrame(const DepthImage& depth,
+                                          const Intrinsics& K,
+                                          const mrpt::poses::CPose3D& T_WC)
 {
-	return buildInto([&](FrameCloud& f) { builder_.build(scan, K, T_WC, f); });
+	return buildInto([&](FrameCloud& f) { builder_.build(depth, K, T_WC, f); });
+}
+
+const MotionFrameResult& MotionGrids::processBuiltFrame(
+    const PixelLabels* labels, bool flowOff)
+{
+	return processFrame(*frame_, labels, flowOff);
 }
 
 const MotionFrameResult& MotionGrids::processFrame(

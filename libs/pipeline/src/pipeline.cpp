@@ -102,6 +102,22 @@ Pipeline::Observed Pipeline::observe(const cv::Mat& prevGrey,
 	return o;
 }
 
+std::string Pipeline::decode(const FrameInput& in, ego::RgbdFrame& out) const
+{
+	if (in.scan) return ego::rgbdFrameFrom(*in.scan, cfg_.ego.camera, out);
+	if (!in.frame) return "no frame";
+	const ego::RgbdFrame& f = *in.frame;
+	const cv::Size size = f.depth.size();
+	if (f.depth.empty() || f.depth.type() != CV_32FC1)
+		return "the depth is not a CV_32FC1 image";
+	if (f.raw.type() != CV_16UC1 || f.raw.size() != size)
+		return "the raw depth is not a CV_16UC1 image of the depth's size";
+	if (!f.grey.empty() && (f.grey.type() != CV_8UC1 || f.grey.size() != size))
+		return "the image is not a CV_8UC1 image of the depth's size";
+	out = f;  // headers: the frame's images are shared, not copied
+	return {};
+}
+
 bool Pipeline::Lookahead::holds(size_t i, size_t frames) const
 {
 	return index == i && after + 1 == frames && observed.valid();
@@ -117,14 +133,15 @@ void Pipeline::Lookahead::drop()
 void Pipeline::startLookahead(const Next& next)
 {
 	ahead_.drop();
-	if (!next.scan || !flowThread_ || !cfg_.pipeline.flow_lookahead) return;
+	if ((!next.scan && !next.frame) || !flowThread_ ||
+	    !cfg_.pipeline.flow_lookahead)
+		return;
 	const auto t = Clock::now();
 	// A frame that cannot be decoded, or that the next call would not pair
 	// with this one, is left to that call (which reports it).
 	ego::RgbdFrame& f = ahead_.frame;
-	if (!ego::rgbdFrameFrom(*next.scan, cfg_.ego.camera, f).empty() ||
-	    !f.hasImage() || !cur_.hasImage() || f.size() != cur_.size() ||
-	    !(f.t > cur_.t))
+	if (!decode(next, f).empty() || !f.hasImage() || !cur_.hasImage() ||
+	    f.size() != cur_.size() || !(f.t > cur_.t))
 		return;
 	ahead_.inputMs = msSince(t);
 	// What the next call would predict at its start: the egomotion of this
@@ -173,11 +190,28 @@ struct Pipeline::FrameJobs
 const FrameResult& Pipeline::processFrame(
     const mrpt::obs::CObservation3DRangeScan& scan, size_t index, Next next)
 {
+	FrameInput in;
+	in.scan = &scan;
+	in.index = index;
+	return processFrame(in, next);
+}
+
+const FrameResult& Pipeline::processFrame(const ego::RgbdFrame& frame,
+                                          size_t index, Next next)
+{
+	FrameInput in;
+	in.frame = &frame;
+	in.index = index;
+	return processFrame(in, next);
+}
+
+const FrameResult& Pipeline::processFrame(const FrameInput& in, Next next)
+{
 	const auto t0 = Clock::now();
 	FrameResult r;
-	r.index = index;
+	r.index = in.index;
 	FrameJobs jobs;
-	takeInput(scan, r, jobs);
+	takeInput(in, r, jobs);
 	// The flow tier needs an image in both frames: without (depth only) it
 	// is off for the frame, and tier 1 decides (tier 2 = tier 1).
 	r.flowOff = !cur_.hasImage() || (havePrev_ && !prev_.hasImage());
@@ -190,10 +224,10 @@ const FrameResult& Pipeline::processFrame(
 	// ahead and the cloud start after it.
 	const bool mayCorrect = cfg_.flow.refine_pose != flow::RefinePose::None &&
 	                        cfg_.flow.refine_to_ego;
-	if (!mayCorrect) startNextJobs(scan, next, r, jobs);
+	if (!mayCorrect) startNextJobs(next, r, jobs);
 	maps::PixelLabels labels;
 	flowLabels(haveFlow ? &jobs : nullptr, r, labels);
-	if (mayCorrect) startNextJobs(scan, next, r, jobs);
+	if (mayCorrect) startNextJobs(next, r, jobs);
 	runGrids(haveFlow ? &labels : nullptr, r, jobs);
 	finishFrame(r);
 	r.ms.total = msSince(t0);
@@ -201,8 +235,7 @@ const FrameResult& Pipeline::processFrame(
 	return res_;
 }
 
-void Pipeline::takeInput(const mrpt::obs::CObservation3DRangeScan& scan,
-                         FrameResult& r, FrameJobs& jobs)
+void Pipeline::takeInput(const FrameInput& in, FrameResult& r, FrameJobs& jobs)
 {
 	// The frame decoded by the previous call's look ahead, with its observed
 	// flow on the way (only if the frame that queued it completed: prev_ is
@@ -220,10 +253,12 @@ void Pipeline::takeInput(const mrpt::obs::CObservation3DRangeScan& scan,
 	{
 		const auto t = Clock::now();
 		ahead_.drop();
-		const std::string why = ego::rgbdFrameFrom(scan, cfg_.ego.camera, cur_);
+		const std::string why = decode(in, cur_);
 		if (!why.empty())
-			throw std::runtime_error("3D scan #" + std::to_string(r.index) +
-			                         " ('" + scan.sensorLabel + "'): " + why);
+			throw std::runtime_error(
+			    "3D scan #" + std::to_string(r.index) + " ('" +
+			    (in.scan ? in.scan->sensorLabel : std::string("frame")) +
+			    "'): " + why);
 		r.ms.input = msSince(t);
 	}
 	r.t = cur_.t;
@@ -259,8 +294,7 @@ void Pipeline::egomotion(FrameResult& r)
 	r.ms.egomotion = msSince(t);
 }
 
-void Pipeline::startNextJobs(const mrpt::obs::CObservation3DRangeScan& scan,
-                             const Next& next, FrameResult& r, FrameJobs& jobs)
+void Pipeline::startNextJobs(const Next& next, FrameResult& r, FrameJobs& jobs)
 {
 	startLookahead(next);
 	// The cloud: this frame's depth with its camera model at its final pose
@@ -268,10 +302,11 @@ void Pipeline::startNextJobs(const mrpt::obs::CObservation3DRangeScan& scan,
 	const maps::Intrinsics K{cur_.size().width, cur_.size().height,
 	                         cur_.K(0, 0),      cur_.K(1, 1),
 	                         cur_.K(0, 2),      cur_.K(1, 2)};
-	jobs.buildHere = [this, &scan, K, T_WC = r.T_WC, &ms = r.ms.gridsCloud]
+	jobs.buildHere =
+	    [this, depth = cur_.rawDepth(), K, T_WC = r.T_WC, &ms = r.ms.gridsCloud]
 	{
 		const auto t = Clock::now();
-		grids_.buildFrame(scan, K, T_WC);
+		grids_.buildFrame(depth, K, T_WC);
 		ms = msSince(t);
 	};
 	if (cloudThread_) jobs.building = postTask(*cloudThread_, jobs.buildHere);
@@ -320,7 +355,7 @@ void Pipeline::runGrids(const maps::PixelLabels* labels, FrameResult& r,
 	const auto t = Clock::now();
 	r.ms.gridsDecay = settleDecay();
 	jobs.built();
-	const auto& g = grids_.processFrame(grids_.lastFrame(), labels, r.flowOff);
+	const auto& g = grids_.processBuiltFrame(labels, r.flowOff);
 	const cv::Size size = cur_.size();
 	r.maskTier1 = toMat(g.maskTier1(), size);
 	r.maskTier2 = toMat(g.maskTier2(), size);

@@ -111,9 +111,8 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 
 	FrameStepper stepper(pipe);
 	// after a frame ran: its statistics and outputs
-	auto process = [&](const source::SourceFrame& f)
+	auto process = [&](const source::SourceFrame& f, const FrameResult& r)
 	{
-		const FrameResult& r = pipe.last();
 		stage["total_cpu"].push_back(stepper.lastCpuMs());
 		checkFiniteOutputs(r);
 		uint32_t flags = r.ego.flags;
@@ -187,7 +186,8 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 			auto f = input->next();
 			end = !f;
 			if (f) stepper.add(std::move(*f));
-			while (auto done = stepper.run(end)) process(*done);
+			while (auto done = stepper.run(end))
+				process(done->input, done->result);
 		}
 		if (out && !sum.interrupted)
 			for (const auto& o : input->takeTrailing()) out->writeOther(o);

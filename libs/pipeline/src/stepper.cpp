@@ -18,7 +18,7 @@ void FrameStepper::add(source::SourceFrame f)
 	frames_.push_back(std::move(f));
 }
 
-std::optional<source::SourceFrame> FrameStepper::run(bool end)
+std::optional<SteppedFrame> FrameStepper::run(bool end)
 {
 	if (frames_.empty() || (lookahead_ && !end && frames_.size() < 2))
 		return std::nullopt;
@@ -26,11 +26,14 @@ std::optional<source::SourceFrame> FrameStepper::run(bool end)
 	frames_.pop_front();
 	Pipeline::Next next;
 	if (lookahead_ && !frames_.empty())
-		next = {frames_.front().scan.get(), frames_.front().index};
+	{
+		next.scan = frames_.front().scan.get();
+		next.index = frames_.front().index;
+	}
 	const double cpu0 = threadCpuMs();
-	pipe_.processFrame(*f.scan, f.index, next);
+	const FrameResult& r = pipe_.processFrame(*f.scan, f.index, next);
 	cpuMs_ = threadCpuMs() - cpu0;
-	return f;
+	return SteppedFrame{std::move(f), r};
 }
 
 LiveSegmentation::LiveSegmentation(const ExperimentConfig& cfg,
@@ -48,7 +51,7 @@ void LiveSegmentation::runReady(bool end, const OnFrame& onFrame)
 {
 	while (auto f = order_.pop()) stepper_.add(std::move(*f));
 	while (auto done = stepper_.run(end))
-		if (onFrame) onFrame(*done, pipe_.last());
+		if (onFrame) onFrame(done->input, done->result);
 }
 
 void LiveSegmentation::push(const mrpt::obs::CObservation::Ptr& obs,

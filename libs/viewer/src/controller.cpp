@@ -104,15 +104,23 @@ bool ReplayController::step()
 	if (!stepper_)
 		f = src_->next();
 	else
+	{
 		// as bims-run runs them (pipeline::FrameStepper)
-		while (!(f = stepper_->run(srcEnded_)) && !srcEnded_)
+		for (;;)
 		{
+			if (auto done = stepper_->run(srcEnded_))
+			{
+				est_.push_back({done->input.t, done->result.T_WC});
+				f = std::move(done->input);
+				break;
+			}
+			if (srcEnded_) break;
 			auto in = src_->next();
 			srcEnded_ = !in;
 			if (in) stepper_->add(std::move(*in));
 		}
+	}
 	if (!f) return false;
-	if (pipe_) est_.push_back({f->t, pipe_->last().T_WC});
 	++cur_;
 	frame_ = std::move(f);
 	loadResultsFrame();

@@ -2,6 +2,7 @@
 // grey image, a metric depth image registered to it, and the intrinsics.
 #pragma once
 
+#include <bims/common/depth_image.h>
 #include <bims/ego/params.h>
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -25,6 +26,12 @@ struct RgbdFrame
 	cv::Mat grey;   ///< CV_8UC1 of the depth's size, or empty (depth only)
 	cv::Mat depth;  ///< CV_32FC1 optical-axis depth [m], 0 = no reading
 	Eigen::Matrix3d K = Eigen::Matrix3d::Identity();  ///< intrinsics [px]
+	/** The depth readings as read (CV_16UC1, x units [m]; Euclidean ranges
+	 * when !rangeIsDepth), depth's source and the voxel cloud's. */
+	cv::Mat raw;
+	float units = 0;
+	bool rangeIsDepth = true;
+	mrpt::Clock::time_point stamp{};  ///< t as MRPT's clock (exact)
 
 	/** Whether the frame has an image (else depth only). */
 	bool hasImage() const { return !grey.empty(); }
@@ -34,6 +41,8 @@ struct RgbdFrame
 	/** K and the image size as MRPT's camera model (what the flow stage
 	 * takes). */
 	mrpt::img::TCamera camera() const;
+	/** The raw readings as a view (valid while the frame lives). */
+	DepthImage rawDepth() const;
 };
 
 /** Fills \a out from \a obs (intensity -> grey, rangeImage * rangeUnits ->
@@ -45,6 +54,14 @@ struct RgbdFrame
 [[nodiscard]] std::string rgbdFrameFrom(
     const mrpt::obs::CObservation3DRangeScan& obs, const CameraParams& cam,
     RgbdFrame& out);
+/** The same from a depth image (its readings are copied), an image (BGR
+ * or grey, 8-bit, the depth's size; empty: depth only) and the intrinsics
+ * \a K; out.t from the depth's timestamp when it has one. What the scan's
+ * version does after reading the scan. */
+[[nodiscard]] std::string rgbdFrameFrom(const DepthImage& depth,
+                                        const cv::Mat& image,
+                                        const Eigen::Matrix3d& K,
+                                        RgbdFrame& out);
 
 /** The intrinsics of \a obs's range image: \a cam when given (its size
  * must match), else the observation's cameraParams. \return empty string

@@ -7,6 +7,7 @@
 // voxels (cells), so unprojection and voxel keying happen once per frame.
 #pragma once
 
+#include <bims/common/depth_image.h>
 #include <bims/maps/flat_hash_map.h>
 #include <bims/maps/grid_params.h>
 #include <bims/maps/pixel_maps.h>
@@ -104,15 +105,18 @@ class FrameCloudBuilder
 	explicit FrameCloudBuilder(const GridParams& p = {});
 	void setParams(const GridParams& p);
 
-	/** From the scan's depth/range image (rangeImage x rangeUnits;
-	 * Euclidean ranges when range_is_depth is false), unprojected with the
-	 * camera model \a K (its size must be the range image's) at the pose
-	 * \a T_WC of the optical frame {C} in {W}: the caller's camera model
-	 * and pose, the ones its egomotion and flow use (the scan's own
-	 * cameraParams and sensorPose are not read). A non-finite pose yields
-	 * an empty frame with stats.badPose = true. Throws
-	 * std::invalid_argument if the scan has no range image, \a K's size
-	 * differs from the image or its focal lengths are not > 0. */
+	/** From a depth/range image (readings x units; Euclidean ranges when
+	 * \a img.isDepth is false), unprojected with the camera model \a K
+	 * (its size must be the image's) at the pose \a T_WC of the optical
+	 * frame {C} in {W}: the caller's camera model and pose, the ones its
+	 * egomotion and flow use. A non-finite pose yields an empty frame with
+	 * stats.badPose = true. Throws std::invalid_argument if the image is
+	 * empty, \a K's size differs from it or its focal lengths are not
+	 * > 0. */
+	void build(const DepthImage& img, const Intrinsics& K,
+	           const mrpt::poses::CPose3D& T_WC, FrameCloud& out);
+	/** The same from a scan's range image (depthImageOf(scan)): the scan's
+	 * own cameraParams and sensorPose are not read. */
 	void build(const mrpt::obs::CObservation3DRangeScan& scan,
 	           const Intrinsics& K, const mrpt::poses::CPose3D& T_WC,
 	           FrameCloud& out);

@@ -61,15 +61,18 @@ class MotionGrids
 	 * the caller prepares the labels. */
 	const FrameCloud& buildFrame(const mrpt::obs::CObservation3DRangeScan& scan,
 	                             const mrpt::poses::CPose3D& T_WS);
-	/** Same with the caller's camera model \a K and optical-frame pose
-	 * \a T_WC (FrameCloudBuilder::build: the scan's cameraParams are not
-	 * read). */
-	const FrameCloud& buildFrame(const mrpt::obs::CObservation3DRangeScan& scan,
-	                             const Intrinsics& K,
+	/** Same from a depth image with the caller's camera model \a K and
+	 * optical-frame pose \a T_WC (FrameCloudBuilder::build). */
+	const FrameCloud& buildFrame(const DepthImage& depth, const Intrinsics& K,
 	                             const mrpt::poses::CPose3D& T_WC);
+	/** processFrame() of the frame built last (buildFrame): its cells go
+	 * to tiers 1 and 2 without a copy, and with setDeferDecay() its decay
+	 * waits for applyPendingDecay(). */
+	const MotionFrameResult& processBuiltFrame(const PixelLabels* labels,
+	                                           bool flowOff);
 	/** The FrameCloud of the last processFrame(scan, ...) / buildFrame.
-	 * processFrame(lastFrame(), ...) hands its cells to tiers 1 and 2
-	 * without a copy; the next buildFrame() builds into another buffer. */
+	 * processFrame(lastFrame(), ...) equals processBuiltFrame(); the next
+	 * buildFrame() builds into another buffer. */
 	const FrameCloud& lastFrame() const { return *frame_; }
 	const MotionFrameResult& lastResult() const { return result_; }
 

@@ -93,12 +93,16 @@ struct FrameResult
 	StageTimes ms;
 };
 
-/** The frame after the one Pipeline::processFrame() runs, already at hand. */
-struct NextFrame
+/** A frame for Pipeline::processFrame(): its 3D scan (decoded by the
+ * pipeline) or its frame already decoded, and its 3D-scan index. */
+struct FrameInput
 {
 	const mrpt::obs::CObservation3DRangeScan* scan = nullptr;
+	const ego::RgbdFrame* frame = nullptr;  ///< used when scan is null
 	size_t index = 0;
 };
+/** The frame after the one Pipeline::processFrame() runs, already at hand. */
+using NextFrame = FrameInput;
 
 class Pipeline
 {
@@ -128,6 +132,15 @@ class Pipeline
 	const FrameResult& processFrame(
 	    const mrpt::obs::CObservation3DRangeScan& scan, size_t index,
 	    Next next = {});
+	/** The same for a frame decoded by the caller (ego::rgbdFrameFrom: the
+	 * same results as its scan). Its images are shared, not copied: the
+	 * pipeline reads them until the frame after the next one (the flow
+	 * pairs a frame with the one before), so they must not be written
+	 * meanwhile. Throws std::runtime_error for images of other types or
+	 * sizes. */
+	const FrameResult& processFrame(const ego::RgbdFrame& frame, size_t index,
+	                                Next next = {});
+	const FrameResult& processFrame(const FrameInput& in, Next next = {});
 
 	const FrameResult& last() const { return res_; }
 	const ExperimentConfig& config() const { return cfg_; }
@@ -163,13 +176,13 @@ class Pipeline
 	                 const Eigen::Matrix3d& R_derot);
 	// The steps of processFrame(), in their order (pipeline.cpp).
 	struct FrameJobs;
-	void takeInput(const mrpt::obs::CObservation3DRangeScan& scan,
-	               FrameResult& r, FrameJobs& jobs);
+	/** \a in into \a out; what is wrong, or empty. */
+	std::string decode(const FrameInput& in, ego::RgbdFrame& out) const;
+	void takeInput(const FrameInput& in, FrameResult& r, FrameJobs& jobs);
 	void startObservedFlow(FrameJobs& jobs);
 	void egomotion(FrameResult& r);
 	/** The next frame's look ahead, and this frame's FrameCloud. */
-	void startNextJobs(const mrpt::obs::CObservation3DRangeScan& scan,
-	                   const Next& next, FrameResult& r, FrameJobs& jobs);
+	void startNextJobs(const Next& next, FrameResult& r, FrameJobs& jobs);
 	/** \a jobs null: no previous frame to take the flow from. */
 	void flowLabels(FrameJobs* jobs, FrameResult& r, maps::PixelLabels& labels);
 	void runGrids(const maps::PixelLabels* labels, FrameResult& r,

@@ -17,6 +17,14 @@
 
 namespace bims::pipeline
 {
+/** A frame FrameStepper::run() ran: the input and what it produced (the
+ * pipeline's last(): valid until the next frame runs). */
+struct SteppedFrame
+{
+	source::SourceFrame input;
+	const FrameResult& result;
+};
+
 class FrameStepper
 {
  public:
@@ -25,9 +33,9 @@ class FrameStepper
 	/** Takes the input's next frame: its IMU samples go to the pipeline. */
 	void add(source::SourceFrame f);
 	/** Runs the oldest frame added, if it may run now (looking ahead: once
-	 * the frame after it is at hand, or at the \a end of the input). Returns
-	 * it (its results: pipeline().last()), or nullopt. */
-	std::optional<source::SourceFrame> run(bool end = false);
+	 * the frame after it is at hand, or at the \a end of the input).
+	 * Returns it with its result, or nullopt. */
+	std::optional<SteppedFrame> run(bool end = false);
 	/** CPU time of the calling thread in the last run() that ran a frame
 	 * [ms]. */
 	double lastCpuMs() const { return cpuMs_; }
