@@ -325,17 +325,11 @@ void Pipeline::flowLabels(FrameJobs* jobs, FrameResult& r,
 		const cv::Mat& obs = o.flow;
 		const auto cam = cur_.camera();
 		if (cfg_.flow.refine_pose != flow::RefinePose::None)
-		{
-			r.flowPose = flow::refinePoseWithFlow(
-			    obs, cur_.depth, cam, r.T_CprevC,
-			    flow::flowPoseParamsFrom(cfg_.flow), nullptr, &o.tensor);
-			if (r.flowPose.ok)
-			{
-				r.T_CprevC = r.flowPose.T_CprevC;
-				if (cfg_.flow.refine_to_ego)
-					r.T_WC = odom_.correctLastMotion(r.T_CprevC);
-			}
-		}
+			commitMotion(
+			    flow::refinePoseWithFlow(obs, cur_.depth, cam, r.T_CprevC,
+			                             flow::flowPoseParamsFrom(cfg_.flow),
+			                             nullptr, &o.tensor),
+			    r);
 		const cv::Mat exp =
 		    flow::expectedFlow(cfg_.flow.expected, cur_.depth, cam, r.T_CprevC);
 		r.labels = flow::labelConsistency(obs, exp, cur_.depth, cam, r.T_CprevC,
@@ -346,6 +340,18 @@ void Pipeline::flowLabels(FrameJobs* jobs, FrameResult& r,
 		labels = toPixelLabels(r.labels);
 	}
 	r.ms.flow = msSince(t);
+}
+
+void Pipeline::commitMotion(const flow::FlowPoseResult& proposed,
+                            FrameResult& r)
+{
+	// The flow proposes, the pipeline decides: an accepted refinement is the
+	// frame's motion, and with refine_to_ego the odometry's last motion too
+	// (so its next prediction and the cloud's pose follow it).
+	r.flowPose = proposed;
+	if (!proposed.ok) return;
+	r.T_CprevC = proposed.T_CprevC;
+	if (cfg_.flow.refine_to_ego) r.T_WC = odom_.correctLastMotion(r.T_CprevC);
 }
 
 void Pipeline::runGrids(const maps::PixelLabels* labels, FrameResult& r,

@@ -185,6 +185,8 @@ class Pipeline
 	void startNextJobs(const Next& next, FrameResult& r, FrameJobs& jobs);
 	/** \a jobs null: no previous frame to take the flow from. */
 	void flowLabels(FrameJobs* jobs, FrameResult& r, maps::PixelLabels& labels);
+	/** The dense flow's proposed motion, committed when it is accepted. */
+	void commitMotion(const flow::FlowPoseResult& proposed, FrameResult& r);
 	void runGrids(const maps::PixelLabels* labels, FrameResult& r,
 	              FrameJobs& jobs);
 	void finishFrame(FrameResult& r);
