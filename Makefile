@@ -56,7 +56,7 @@ SAN_EXCLUDE_TESTS = ^(Raycast\.SameCellsBlocksAndOrderAsThePerCellWalk|Apps\.Hel
 test-sanitize: deps
 	@if [ ! -f $(SAN_BUILD_DIR)/CMakeCache.txt ]; then \
 	  cmake -S . -B $(SAN_BUILD_DIR) $(TREE_ARGS) -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG=-O1 -DBIMS_SANITIZE=address,undefined \
-	    -DBIMS_BUILD_GUI=OFF -DBIMS_BUILD_BENCH=OFF -DBIMS_SKIP_TEST_LABELS='$(SAN_SKIP_LABELS)' \
+	    -DBIMS_BUILD_GUI=OFF -DBIMS_BUILD_BENCH=OFF -DBIMS_BUILD_PYTHON=OFF -DBIMS_SKIP_TEST_LABELS='$(SAN_SKIP_LABELS)' \
 	    $(CMAKE_ARGS); \
 	fi
 	cmake --build $(SAN_BUILD_DIR) -j$(JOBS)

@@ -28,7 +28,7 @@ BUILD=${BIMS_FUZZ_BUILD:-$ROOT/build-fuzz}
 SAN="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fsanitize=fuzzer-no-link"
 if [ ! -f "$BUILD/CMakeCache.txt" ]; then
 	CC=clang CXX=clang++ cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-		-DBIMS_FUZZ=ON -DBIMS_BUILD_GUI=OFF -DBIMS_WITH_OPENNI2=OFF -DBIMS_BUILD_BENCH=OFF \
+		-DBIMS_FUZZ=ON -DBIMS_BUILD_GUI=OFF -DBIMS_WITH_OPENNI2=OFF -DBIMS_BUILD_BENCH=OFF -DBIMS_BUILD_PYTHON=OFF \
 		"-DCMAKE_CXX_FLAGS=$SAN" > /dev/null
 fi
 cmake --build "$BUILD" --target "fuzz_$TARGET" -j"$(nproc)" > "$BUILD/build_$TARGET.log" 2>&1 ||

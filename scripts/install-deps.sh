@@ -15,6 +15,7 @@ PACKAGES=(
   librosbag-storage-dev libcv-bridge-dev libsensor-msgs-dev pluginlib-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth imagemagick xdotool x11-apps libgl1-mesa-dri
+  python3-dev pybind11-dev python3-numpy python3-opencv
 )
 if [ "${1:-}" = fuzz ]; then
   PACKAGES+=(clang libclang-rt-14-dev)

@@ -50,6 +50,9 @@ bool parseLong(const std::string& s, long& out)
 }
 }  // namespace
 
+// checkIniFile's checks on the lines of \a f (\a path in the messages)
+void checkIniStream(std::istream& f, const std::string& path);
+
 void checkIniFile(const std::string& path)
 {
 	std::error_code ec;
@@ -60,6 +63,17 @@ void checkIniFile(const std::string& path)
 		                : ": no such config file"));
 	std::ifstream f(path);
 	if (!f) throw ConfigError(path + ": cannot open config file");
+	checkIniStream(f, path);
+}
+
+void checkIniText(const std::string& text, const std::string& name)
+{
+	std::istringstream in(text);
+	checkIniStream(in, name);
+}
+
+void checkIniStream(std::istream& f, const std::string& path)
+{
 	std::map<std::string, int> sections;  // lower-case name -> line
 	std::map<std::string, int> keys;      // of the current section
 	std::string section, line;

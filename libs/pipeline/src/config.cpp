@@ -187,6 +187,13 @@ void ExperimentConfig::loadFromFile(const std::string& given)
 	loadFromConfigFile(*bims::openIniFile(path));
 }
 
+void ExperimentConfig::loadFromText(const std::string& text)
+{
+	checkIniText(text, "<memory>");
+	mrpt::config::CConfigFileMemory mem(text);
+	loadFromConfigFile(mem);
+}
+
 void ExperimentConfig::setVariant(Variant v)
 {
 	pipeline.variant = v;

@@ -82,6 +82,11 @@ void Pipeline::addImu(const mrpt::obs::CObservationIMU& imu)
 	odom_.addImu(imu);
 }
 
+void Pipeline::addImu(const ego::ImuSample& s)
+{
+	odom_.addImu(s);
+}
+
 Pipeline::Observed Pipeline::observe(const cv::Mat& prevGrey,
                                      const cv::Mat& curGrey,
                                      const mrpt::img::TCamera& cam,

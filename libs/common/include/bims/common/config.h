@@ -35,6 +35,8 @@ class ConfigError : public std::runtime_error
  * a key before the first section, a section or a key (within its section)
  * given twice; names compare without case, as MRPT looks them up. */
 void checkIniFile(const std::string& path);
+/** The same checks for .ini text (\a name in the messages). */
+void checkIniText(const std::string& text, const std::string& name);
 
 /** The one way bims opens an .ini: checkIniFile(path), then MRPT's reader;
  * an error of MRPT's (an undefined ${VAR}, ...) becomes a ConfigError

@@ -156,6 +156,8 @@ struct ExperimentConfig
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
 	/** Opens and reads \a path; throws naming the file when missing. */
 	void loadFromFile(const std::string& path);
+	/** Reads .ini text with the same checks ("<memory>" in messages). */
+	void loadFromText(const std::string& text);
 	/** Applies a variant: sets pipeline.variant and, for fused-raycast,
 	 * grids.decay = raycast. */
 	void setVariant(Variant v);

@@ -114,6 +114,8 @@ class Pipeline
 
 	/** Feeds an IMU observation (label filtered by [sensors] imu_label). */
 	void addImu(const mrpt::obs::CObservationIMU& imu);
+	/** Feeds an IMU sample already decoded (no label filter). */
+	void addImu(const ego::ImuSample& s);
 
 	using Next = NextFrame;
 

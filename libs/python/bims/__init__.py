@@ -1,0 +1,84 @@
+"""bims: Bayesian independent motion segmentation from RGB-D + IMU.
+
+The pipeline, its configuration and the rawlog reader of the C++ programs
+on NumPy arrays (docs/python.md)::
+
+    import bims
+    cfg = bims.Config.from_file("config/default.ini")
+    pipe = bims.Pipeline(cfg)
+    for f in bims.read_rawlog("rawlogs/pendulum_slow.rawlog"):
+        r = pipe.process(f.depth, rgb=f.rgb, stamp=f.stamp, imu=f.imu)
+        r.mask   # H x W uint8, 255 = moving
+        r.pose   # 4 x 4 float64, T_WC
+"""
+
+from dataclasses import dataclass
+from typing import Iterator, Optional
+
+import numpy as np
+
+from ._bims import Config, ConfigError, Pipeline, RawlogError, Result
+from ._bims import _RawlogReader
+
+__all__ = [
+    "Config",
+    "ConfigError",
+    "DepthArray",
+    "Frame",
+    "Pipeline",
+    "RawlogError",
+    "Result",
+    "read_rawlog",
+]
+
+
+class DepthArray(np.ndarray):
+    """A depth image (H x W) that carries its camera matrix ``K`` (3 x 3)
+    and its ``units`` (metres per reading of a uint16 image), so that
+    ``Pipeline.process`` needs neither argument. A slice keeps them: crop
+    with care."""
+
+    def __new__(cls, array, K=None, units=None):
+        obj = np.asarray(array).view(cls)
+        obj.K = None if K is None else np.asarray(K, dtype=np.float64)
+        obj.units = units
+        return obj
+
+    def __array_finalize__(self, obj):
+        self.K = getattr(obj, "K", None)
+        self.units = getattr(obj, "units", None)
+
+
+@dataclass
+class Frame:
+    """One RGB-D frame of a recording, with the IMU samples since the
+    previous one."""
+
+    index: int  #: 3D-scan index in the input, from 0
+    stamp: float  #: camera time [s]
+    depth: DepthArray  #: H x W uint16 readings (x depth.units [m])
+    rgb: Optional[np.ndarray]  #: H x W x 3 uint8 RGB, or None (depth only)
+    imu: np.ndarray  #: N x 14 float64: t, gyro, accel, mag, quaternion wxyz (NaN: absent)
+    K: np.ndarray  #: 3 x 3 camera matrix [px]
+
+
+def read_rawlog(path: str, config: Optional[Config] = None) -> Iterator[Frame]:
+    """The frames of an MRPT rawlog, in the order bims-run runs them: the
+    config's [sensors] labels, its IMU checks and depth correction (the
+    built-in defaults without one)."""
+    reader = _RawlogReader(str(path), config if config is not None else Config())
+    for d in reader:
+        if not d["range_is_depth"]:
+            raise ValueError(
+                f"{path}: 3D scan #{d['index']} holds Euclidean ranges, "
+                "not depth: not supported by read_rawlog yet"
+            )
+        depth = DepthArray(d["depth"], K=d["K"], units=d["depth_units"])
+        yield Frame(
+            index=d["index"],
+            stamp=d["stamp"],
+            depth=depth,
+            rgb=d["rgb"],
+            imu=d["imu"],
+            K=d["K"],
+        )

@@ -1,0 +1,64 @@
+"""Type stubs of the C++ module bims._bims (see bims/__init__.py)."""
+
+from typing import Dict, List, Optional
+
+import numpy as np
+import numpy.typing as npt
+
+class ConfigError(ValueError): ...
+class RawlogError(OSError): ...
+
+class Config:
+    """An experiment configuration (.ini), read with the programs' checks."""
+
+    def __init__(self) -> None: ...
+    @staticmethod
+    def from_file(path: str) -> "Config": ...
+    @staticmethod
+    def from_string(text: str) -> "Config": ...
+    def get(self, section: str, key: str) -> str: ...
+    def set(self, section: str, key: str, value: object) -> None: ...
+    def effective(self) -> str: ...
+    @property
+    def source(self) -> str: ...
+
+class Result:
+    """What one frame produced."""
+
+    index: int
+    stamp: float
+    mask: npt.NDArray[np.uint8]
+    mask_tier1: npt.NDArray[np.uint8]
+    mask_tier2: npt.NDArray[np.uint8]
+    mask_flow: npt.NDArray[np.uint8]
+    labels: npt.NDArray[np.int8]
+    pose: npt.NDArray[np.float64]
+    motion: npt.NDArray[np.float64]
+    flags: List[str]
+    flag_bits: int
+    warmup: bool
+    flow_off: bool
+    times: Dict[str, float]
+    moving_voxels: npt.NDArray[np.float64]
+    hit_voxels: int
+
+class Pipeline:
+    """The segmentation pipeline, one frame at a time."""
+
+    def __init__(self, config: Config) -> None: ...
+    def process(
+        self,
+        depth: np.ndarray,
+        rgb: Optional[np.ndarray] = None,
+        stamp: Optional[float] = None,
+        imu: Optional[npt.NDArray[np.float64]] = None,
+        K: Optional[np.ndarray] = None,
+        depth_units: Optional[float] = None,
+    ) -> Result: ...
+    @property
+    def frames_processed(self) -> int: ...
+
+class _RawlogReader:
+    def __init__(self, path: str, config: Config) -> None: ...
+    def __iter__(self) -> "_RawlogReader": ...
+    def __next__(self) -> dict: ...

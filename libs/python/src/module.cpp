@@ -1,0 +1,614 @@
+// The Python module bims._bims (pybind11): the experiment configuration, the
+// pipeline on NumPy arrays and the rawlog reader. The package bims
+// (libs/python/bims/__init__.py) re-exports it with the Python-side helpers;
+// docs/python.md says how to use it.
+#include <bims/common/config.h>
+#include <bims/common/depth_image.h>
+#include <bims/common/rawlog.h>
+#include <bims/ego/attitude_filter.h>
+#include <bims/ego/flags.h>
+#include <bims/ego/rgbd_input.h>
+#include <bims/pipeline/config.h>
+#include <bims/pipeline/pipeline.h>
+#include <bims/source/frame_source.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/system/filesystem.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+namespace py = pybind11;
+using namespace bims;
+
+namespace
+{
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+/** Columns of an IMU array: t, gyro xyz, accel xyz, mag xyz, quaternion
+ * wxyz (R_WI); the first 7 are required, NaN = the channel is absent. */
+constexpr int kImuColumns = 14;
+
+/** Raises FileNotFoundError with \a what. */
+[[noreturn]] void fileNotFound(const std::string& what)
+{
+	PyErr_SetString(PyExc_FileNotFoundError, what.c_str());
+	throw py::error_already_set();
+}
+
+/** A ValueError naming the argument. */
+[[noreturn]] void bad(const std::string& arg, const std::string& what)
+{
+	throw py::value_error(arg + ": " + what);
+}
+
+/** A C-contiguous array of \a dtype with \a ndim dimensions (else a
+ * ValueError or TypeError naming the argument). */
+py::array checked(const py::handle& h, const std::string& arg,
+                  const py::dtype& dtype, int ndim)
+{
+	if (!py::isinstance<py::array>(h))
+		throw py::type_error(arg + ": a numpy array expected, got " +
+		                     std::string(py::str(h.get_type())));
+	py::array a = py::reinterpret_borrow<py::array>(h);
+	if (!a.dtype().is(dtype))
+		throw py::type_error(
+		    arg + ": dtype " + std::string(py::str(py::handle(a.dtype()))) +
+		    ", " + std::string(py::str(py::handle(dtype))) + " expected");
+	if (a.ndim() != ndim)
+		bad(arg, std::to_string(a.ndim()) + " dimensions, " +
+		             std::to_string(ndim) + " expected");
+	if (!(a.flags() & py::array::c_style))
+		bad(arg, "not C-contiguous (numpy.ascontiguousarray(...) first)");
+	return a;
+}
+
+/** A new NumPy array owning a reference to \a m's data (no copy). */
+py::array toNumpy(const cv::Mat& m)
+{
+	if (m.empty()) return py::array_t<uint8_t>(std::vector<py::ssize_t>{0, 0});
+	CV_Assert(m.isContinuous() && m.channels() == 1);
+	auto* keep = new cv::Mat(m);
+	py::capsule owner(keep, [](void* p) { delete static_cast<cv::Mat*>(p); });
+	py::dtype dt;
+	switch (m.depth())
+	{
+		case CV_8U:
+			dt = py::dtype::of<uint8_t>();
+			break;
+		case CV_8S:
+			dt = py::dtype::of<int8_t>();
+			break;
+		case CV_16U:
+			dt = py::dtype::of<uint16_t>();
+			break;
+		case CV_32F:
+			dt = py::dtype::of<float>();
+			break;
+		default:
+			throw std::logic_error("toNumpy: unexpected image type");
+	}
+	return py::array(dt, {m.rows, m.cols},
+	                 {static_cast<py::ssize_t>(m.step[0]),
+	                  static_cast<py::ssize_t>(m.elemSize())},
+	                 m.data, owner);
+}
+
+py::array_t<double> poseMatrix(const mrpt::poses::CPose3D& p)
+{
+	py::array_t<double> out({4, 4});
+	auto o = out.mutable_unchecked<2>();
+	const auto H = p.getHomogeneousMatrixVal<mrpt::math::CMatrixDouble44>();
+	for (int r = 0; r < 4; ++r)
+		for (int c = 0; c < 4; ++c) o(r, c) = H(r, c);
+	return out;
+}
+
+Eigen::Matrix3d intrinsics(const py::handle& h)
+{
+	py::array_t<double> a =
+	    py::array_t<double, py::array::forcecast>::ensure(h);
+	if (!a || a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3)
+		bad("K", "a 3 x 3 camera matrix expected");
+	auto k = a.unchecked<2>();
+	Eigen::Matrix3d K;
+	for (int r = 0; r < 3; ++r)
+		for (int c = 0; c < 3; ++c) K(r, c) = k(r, c);
+	if (!(K(0, 0) > 0 && K(1, 1) > 0) || !K.allFinite() || K(2, 2) != 1 ||
+	    K(1, 0) != 0 || K(2, 0) != 0 || K(2, 1) != 0)
+		bad("K",
+		    "not a pinhole camera matrix [[fx, 0, cx], [0, fy, cy], [0, 0, "
+		    "1]] with finite fx, fy > 0");
+	return K;
+}
+
+/** Configuration: the programs' strict reader (pipeline::ExperimentConfig). */
+struct Config
+{
+	pipeline::ExperimentConfig cfg;
+
+	static Config fromFile(const std::string& path)
+	{
+		Config c;
+		c.cfg.loadFromFile(path);
+		return c;
+	}
+	static Config fromString(const std::string& text)
+	{
+		Config c;
+		c.cfg.loadFromText(text);
+		return c;
+	}
+	std::string get(const std::string& section, const std::string& key) const
+	{
+		mrpt::config::CConfigFileMemory mem(cfg.effectiveIni());
+		if (!mem.keyExists(section, key))
+			throw py::key_error(
+			    "[" + section + "] " + key +
+			    ": no such key (Config.effective() lists them)");
+		return mem.read_string(section, key, "");
+	}
+	void set(const std::string& section, const std::string& key,
+	         const py::object& value)
+	{
+		mrpt::config::CConfigFileMemory mem(cfg.effectiveIni());
+		if (!mem.keyExists(section, key))
+			throw py::key_error(
+			    "[" + section + "] " + key +
+			    ": no such key (Config.effective() lists them)");
+		std::string text = py::isinstance<py::bool_>(value)
+		                       ? (value.cast<bool>() ? "true" : "false")
+		                       : std::string(py::str(value));
+		mem.write(section, key, text);
+		std::string content;
+		mem.getContent(content);
+		pipeline::ExperimentConfig next;
+		next.loadFromText(content);  // the same checks as a file's
+		next.source = cfg.source;
+		cfg = std::move(next);
+	}
+};
+
+/** The result of one frame, as Python sees it. */
+struct Result
+{
+	size_t index = 0;
+	double stamp = 0;
+	py::array mask, maskTier1, maskTier2, maskFlow, labels;
+	py::array_t<double> pose, motion;
+	std::vector<std::string> flags;
+	uint32_t flagBits = 0;
+	bool warmup = false, flowOff = false;
+	py::dict times;
+	py::array_t<double> movingVoxels;
+	size_t hitVoxels = 0;
+};
+
+Result resultOf(const pipeline::FrameResult& r)
+{
+	Result o;
+	o.index = r.index;
+	o.stamp = r.t;
+	o.mask = toNumpy(r.mask);
+	o.maskTier1 = toNumpy(r.maskTier1);
+	o.maskTier2 = toNumpy(r.maskTier2);
+	o.maskFlow = toNumpy(r.maskFlow);
+	o.labels = toNumpy(r.labels);
+	o.pose = poseMatrix(r.T_WC);
+	o.motion = poseMatrix(r.T_CprevC);
+	o.flagBits = r.ego.flags;
+	for (const char* n : ego::flagNames(r.ego.flags)) o.flags.emplace_back(n);
+	o.warmup = r.warmup;
+	o.flowOff = r.flowOff;
+	o.times["input"] = r.ms.input;
+	o.times["egomotion"] = r.ms.egomotion;
+	o.times["flow"] = r.ms.flow;
+	o.times["grids"] = r.ms.grids;
+	o.times["total"] = r.ms.total;
+	o.hitVoxels = r.hitVoxels;
+	py::array_t<double> v(
+	    {static_cast<py::ssize_t>(r.movingVoxelCentres.size()),
+	     py::ssize_t(3)});
+	auto w = v.mutable_unchecked<2>();
+	for (size_t i = 0; i < r.movingVoxelCentres.size(); ++i)
+	{
+		w(i, 0) = r.movingVoxelCentres[i].x;
+		w(i, 1) = r.movingVoxelCentres[i].y;
+		w(i, 2) = r.movingVoxelCentres[i].z;
+	}
+	o.movingVoxels = v;
+	return o;
+}
+
+/** The pipeline on arrays. */
+class PyPipeline
+{
+ public:
+	explicit PyPipeline(const Config& c) : cfg_(c.cfg), pipe_(c.cfg) {}
+
+	Result process(const py::object& depth, const py::object& rgb,
+	               const py::object& stamp, const py::object& imu,
+	               const py::object& K, const py::object& units)
+	{
+		if (stamp.is_none()) bad("stamp", "required (the frame's time [s])");
+		const double t = stamp.cast<double>();
+		if (!std::isfinite(t)) bad("stamp", "not finite");
+		if (haveLast_ && !(t > lastStamp_))
+			bad("stamp", std::to_string(t) +
+			                 " is not after the previous frame's " +
+			                 std::to_string(lastStamp_));
+		ego::RgbdFrame frame = decode(depth, rgb, t, K, units);
+		if (!imu.is_none()) addImu(imu);
+		const pipeline::FrameResult* r = nullptr;
+		{
+			py::gil_scoped_release nogil;
+			r = &pipe_.processFrame(frame, index_);
+		}
+		++index_;
+		lastStamp_ = t;
+		haveLast_ = true;
+		return resultOf(*r);
+	}
+
+	size_t framesProcessed() const { return pipe_.framesProcessed(); }
+
+ private:
+	/** The frame's camera model: \a K, the depth array's K, or [camera]. */
+	Eigen::Matrix3d cameraOf(const py::object& depth, const py::object& K) const
+	{
+		if (!K.is_none()) return intrinsics(K);
+		const py::object attached = py::getattr(depth, "K", py::none());
+		if (!attached.is_none()) return intrinsics(attached);
+		const auto& c = cfg_.ego.camera;
+		if (!c.given)
+			bad("K",
+			    "no camera model: pass K=, give the depth as a "
+			    "bims.DepthArray with one, or set [camera] in the config");
+		Eigen::Matrix3d M;
+		M << c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1;
+		return M;
+	}
+
+	ego::RgbdFrame decode(const py::object& depthObj, const py::object& rgbObj,
+	                      double t, const py::object& K,
+	                      const py::object& unitsObj)
+	{
+		if (!py::isinstance<py::array>(depthObj))
+			throw py::type_error("depth: a numpy array expected");
+		const py::array any = py::reinterpret_borrow<py::array>(depthObj);
+		DepthImage d;
+		cv::Mat quantized;  // float metres -> readings
+		const bool isFloat = any.dtype().is(py::dtype::of<float>());
+		py::array a = checked(
+		    depthObj, "depth",
+		    isFloat ? py::dtype::of<float>() : py::dtype::of<uint16_t>(), 2);
+		const Eigen::Matrix3d Km = cameraOf(depthObj, K);
+		const int H = static_cast<int>(a.shape(0)),
+		          W = static_cast<int>(a.shape(1));
+		if (H == 0 || W == 0) bad("depth", "empty image");
+		const py::object attachedUnits =
+		    py::getattr(depthObj, "units", py::none());
+		if (isFloat)
+		{
+			// Readings of 0.1 mm, or coarser when the farthest reading needs
+			// it (the 16 bits span the frame's range).
+			const cv::Mat m(H, W, CV_32FC1, const_cast<void*>(a.data()));
+			double lo = 0, hi = 0;
+			for (int v = 0; v < H; ++v)
+				for (int u = 0; u < W; ++u)
+				{
+					const float z = m.at<float>(v, u);
+					if (std::isnan(z) || std::isinf(z))
+						bad("depth", "non-finite value at row " +
+						                 std::to_string(v) + ", column " +
+						                 std::to_string(u) +
+						                 " (0 marks a pixel without depth)");
+					lo = std::min(lo, double(z));
+					hi = std::max(hi, double(z));
+				}
+			if (lo < 0) bad("depth", "negative depth (0 marks no reading)");
+			d.units = static_cast<float>(std::max(1e-4, hi / 65535.0));
+			m.convertTo(quantized, CV_16UC1, 1.0 / d.units);
+			d.data = quantized.ptr<uint16_t>(0);
+		}
+		else
+		{
+			double u = 0.001;
+			if (!unitsObj.is_none())
+				u = unitsObj.cast<double>();
+			else if (!attachedUnits.is_none())
+				u = attachedUnits.cast<double>();
+			if (!(u > 0) || !std::isfinite(u))
+				bad("depth_units", "must be a finite value > 0 [m]");
+			d.units = static_cast<float>(u);
+			d.data = static_cast<const uint16_t*>(a.data());
+		}
+		d.width = W;
+		d.height = H;
+		d.stride = static_cast<size_t>(W);
+		d.isDepth = true;
+		d.timestamp = mrpt::Clock::fromDouble(t);
+		d.label = "depth";
+		cv::Mat grey;
+		if (!rgbObj.is_none())
+		{
+			if (!py::isinstance<py::array>(rgbObj))
+				throw py::type_error("rgb: a numpy array expected");
+			const py::array ra = py::reinterpret_borrow<py::array>(rgbObj);
+			const int nd = static_cast<int>(ra.ndim());
+			py::array c = checked(rgbObj, "rgb", py::dtype::of<uint8_t>(),
+			                      nd == 2 ? 2 : 3);
+			if (c.shape(0) != H || c.shape(1) != W)
+				bad("rgb", std::to_string(c.shape(1)) + "x" +
+				               std::to_string(c.shape(0)) +
+				               " differs from the depth's " +
+				               std::to_string(W) + "x" + std::to_string(H) +
+				               " (registered RGB-D expected)");
+			if (nd == 2)
+				grey =
+				    cv::Mat(H, W, CV_8UC1, const_cast<void*>(c.data())).clone();
+			else if (c.shape(2) == 3)
+				cv::cvtColor(
+				    cv::Mat(H, W, CV_8UC3, const_cast<void*>(c.data())), grey,
+				    cv::COLOR_RGB2GRAY);
+			else
+				bad("rgb", "H x W x 3 (RGB) or H x W (grey) expected");
+		}
+		ego::RgbdFrame f;
+		f.t = t;
+		const std::string why = ego::rgbdFrameFrom(d, grey, Km, f);
+		if (!why.empty()) bad("depth", why);
+		return f;
+	}
+
+	void addImu(const py::object& imuObj)
+	{
+		py::array a = checked(imuObj, "imu", py::dtype::of<double>(), 2);
+		const auto cols = a.shape(1);
+		if (cols != 7 && cols != 10 && cols != kImuColumns)
+			bad("imu", std::to_string(cols) +
+			               " columns: 7 (t, gyro xyz, accel xyz), 10 (and mag "
+			               "xyz) or 14 (and the quaternion wxyz) expected");
+		auto m = a.unchecked<double, 2>();
+		auto has = [&](py::ssize_t i, int c0, int n)
+		{
+			if (c0 + n > cols) return false;
+			for (int k = 0; k < n; ++k)
+				if (std::isnan(m(i, c0 + k))) return false;
+			return true;
+		};
+		for (py::ssize_t i = 0; i < a.shape(0); ++i)
+		{
+			const double t = m(i, 0);
+			if (!std::isfinite(t))
+				bad("imu", "row " + std::to_string(i) + ": time not finite");
+			if (haveImu_ && t < lastImu_)
+				bad("imu", "row " + std::to_string(i) + ": time " +
+				               std::to_string(t) +
+				               " is before the previous sample's " +
+				               std::to_string(lastImu_) +
+				               " (samples in time order expected)");
+			ego::ImuSample s;
+			s.t = t;
+			if ((s.hasGyro = has(i, 1, 3)))
+				s.gyro = Eigen::Vector3d(m(i, 1), m(i, 2), m(i, 3));
+			if ((s.hasAcc = has(i, 4, 3)))
+				s.acc = Eigen::Vector3d(m(i, 4), m(i, 5), m(i, 6));
+			if ((s.hasMag = has(i, 7, 3)))
+				s.mag = Eigen::Vector3d(m(i, 7), m(i, 8), m(i, 9));
+			if (has(i, 10, 4))
+				s.q_WI =
+				    Eigen::Quaterniond(m(i, 10), m(i, 11), m(i, 12), m(i, 13))
+				        .normalized();
+			pipe_.addImu(s);
+			lastImu_ = t;
+			haveImu_ = true;
+		}
+	}
+
+	pipeline::ExperimentConfig cfg_;
+	pipeline::Pipeline pipe_;
+	size_t index_ = 0;
+	double lastStamp_ = 0, lastImu_ = 0;
+	bool haveLast_ = false, haveImu_ = false;
+};
+
+/** The IMU samples of a source frame as an N x 14 array. */
+py::array_t<double> imuArray(const source::SourceFrame& f)
+{
+	py::array_t<double> out(
+	    {static_cast<py::ssize_t>(f.imu.size()), py::ssize_t(kImuColumns)});
+	auto o = out.mutable_unchecked<2>();
+	for (size_t i = 0; i < f.imu.size(); ++i)
+	{
+		const ego::ImuSample s = ego::imuSampleFrom(*f.imu[i]);
+		double row[kImuColumns];
+		std::fill(row, row + kImuColumns, kNaN);
+		row[0] = s.t;
+		if (s.hasGyro)
+			for (int k = 0; k < 3; ++k) row[1 + k] = s.gyro[k];
+		if (s.hasAcc)
+			for (int k = 0; k < 3; ++k) row[4 + k] = s.acc[k];
+		if (s.hasMag)
+			for (int k = 0; k < 3; ++k) row[7 + k] = s.mag[k];
+		if (s.q_WI)
+		{
+			row[10] = s.q_WI->w();
+			row[11] = s.q_WI->x();
+			row[12] = s.q_WI->y();
+			row[13] = s.q_WI->z();
+		}
+		for (int k = 0; k < kImuColumns; ++k) o(i, k) = row[k];
+	}
+	return out;
+}
+
+/** A rawlog's frames, one dict each (the package makes them bims.Frame). */
+class PyRawlogReader
+{
+ public:
+	PyRawlogReader(const std::string& path, const Config& c) : cfg_(c.cfg)
+	{
+		if (!mrpt::system::fileExists(path))
+			fileNotFound(path + ": no such rawlog");
+		src_ = std::make_unique<source::RawlogFrameSource>(
+		    std::vector<std::string>{path},
+		    source::FrameOrderParams::of(cfg_.ego, cfg_.pipeline.imu_wait_s,
+		                                 "bims.read_rawlog"),
+		    false);
+	}
+
+	py::dict next()
+	{
+		std::optional<source::SourceFrame> f;
+		{
+			py::gil_scoped_release nogil;
+			f = src_->next();
+		}
+		if (!f)
+		{
+			if (!src_->error().empty()) throw std::runtime_error(src_->error());
+			throw py::stop_iteration();
+		}
+		const auto& scan = *f->scan;
+		py::dict d;
+		d["index"] = f->index;
+		d["stamp"] = f->t;
+		d["imu"] = imuArray(*f);
+		const DepthImage depth = depthImageOf(scan);
+		if (depth.empty())
+			throw std::runtime_error("3D scan #" + std::to_string(f->index) +
+			                         ": no range image");
+		py::array_t<uint16_t> z({depth.height, depth.width});
+		auto zo = z.mutable_unchecked<2>();
+		for (int v = 0; v < depth.height; ++v)
+			for (int u = 0; u < depth.width; ++u) zo(v, u) = depth.row(v)[u];
+		d["depth"] = z;
+		d["depth_units"] = double(depth.units);
+		d["range_is_depth"] = depth.isDepth;
+		Eigen::Matrix3d K;
+		const std::string why = ego::intrinsicsOf(scan, cfg_.ego.camera, K);
+		if (!why.empty())
+			throw std::runtime_error("3D scan #" + std::to_string(f->index) +
+			                         ": " + why);
+		py::array_t<double> k({3, 3});
+		auto ko = k.mutable_unchecked<2>();
+		for (int r = 0; r < 3; ++r)
+			for (int c = 0; c < 3; ++c) ko(r, c) = K(r, c);
+		d["K"] = k;
+		d["rgb"] = py::none();
+		if (scan.hasIntensityImage && !scan.intensityImage.isEmpty())
+		{
+			const cv::Mat img =
+			    scan.intensityImage.asCvMat<cv::Mat>(mrpt::img::SHALLOW_COPY);
+			cv::Mat rgb;
+			if (img.channels() == 3)
+				cv::cvtColor(img, rgb, cv::COLOR_BGR2RGB);
+			else
+				cv::cvtColor(img, rgb, cv::COLOR_GRAY2RGB);
+			py::array_t<uint8_t> a({rgb.rows, rgb.cols, 3});
+			for (int v = 0; v < rgb.rows; ++v)
+				std::copy(rgb.ptr<uint8_t>(v),
+				          rgb.ptr<uint8_t>(v) + 3 * rgb.cols,
+				          a.mutable_data(v, 0, 0));
+			d["rgb"] = a;
+		}
+		return d;
+	}
+
+ private:
+	pipeline::ExperimentConfig cfg_;
+	std::unique_ptr<source::RawlogFrameSource> src_;
+};
+
+}  // namespace
+
+PYBIND11_MODULE(_bims, m)
+{
+	m.doc() = "bims: Bayesian independent motion segmentation (C++ core)";
+	py::register_exception<ConfigError>(m, "ConfigError", PyExc_ValueError);
+	py::register_exception<RawlogError>(m, "RawlogError", PyExc_OSError);
+
+	py::class_<Config>(m, "Config", "An experiment configuration (.ini)")
+	    .def(py::init<>(), "The built-in defaults (config/default.ini's)")
+	    .def_static(
+	        "from_file",
+	        [](const std::string& path)
+	        {
+		        try
+		        {
+			        return Config::fromFile(path);
+		        }
+		        catch (const ConfigError& e)
+		        {
+			        if (std::string(e.what()).find("no such config file") !=
+			            std::string::npos)
+				        fileNotFound(e.what());
+			        throw;
+		        }
+	        },
+	        py::arg("path"),
+	        "Reads an .ini file (or a preset name such as 'bonn.ini') with the "
+	        "programs' checks")
+	    .def_static("from_string", &Config::fromString, py::arg("text"),
+	                "Reads .ini text with the programs' checks")
+	    .def("get", &Config::get, py::arg("section"), py::arg("key"),
+	         "The value in use of [section] key, as text")
+	    .def("set", &Config::set, py::arg("section"), py::arg("key"),
+	         py::arg("value"),
+	         "Sets [section] key (checked as a file's value would be)")
+	    .def(
+	        "effective", [](const Config& c) { return c.cfg.effectiveIni(); },
+	        "Every section and key with the value in use (effective.ini)")
+	    .def_property_readonly("source",
+	                           [](const Config& c) { return c.cfg.source; });
+
+	py::class_<Result>(m, "Result", "What one frame produced")
+	    .def_readonly("index", &Result::index)
+	    .def_readonly("stamp", &Result::stamp)
+	    .def_readonly("mask", &Result::mask,
+	                  "H x W uint8, 255 = moving (bims-run's masks/)")
+	    .def_readonly("mask_tier1", &Result::maskTier1)
+	    .def_readonly("mask_tier2", &Result::maskTier2)
+	    .def_readonly("mask_flow", &Result::maskFlow)
+	    .def_readonly("labels", &Result::labels,
+	                  "H x W int8 flow labels: -1 none, 0 notDiff, 1 Diff")
+	    .def_readonly("pose", &Result::pose, "4 x 4 float64, T_WC")
+	    .def_readonly(
+	        "motion", &Result::motion,
+	        "4 x 4 float64, T_CprevC (relative to the previous frame)")
+	    .def_readonly("flags", &Result::flags, "the egomotion flags' names")
+	    .def_readonly("flag_bits", &Result::flagBits)
+	    .def_readonly("warmup", &Result::warmup)
+	    .def_readonly("flow_off", &Result::flowOff)
+	    .def_readonly("times", &Result::times, "per-stage wall time [ms]")
+	    .def_readonly("moving_voxels", &Result::movingVoxels,
+	                  "N x 3 centres [m] of the voxels labelled moving")
+	    .def_readonly("hit_voxels", &Result::hitVoxels);
+
+	py::class_<PyPipeline>(m, "Pipeline", "The segmentation pipeline")
+	    .def(py::init<const Config&>(), py::arg("config"))
+	    .def(
+	        "process", &PyPipeline::process, py::arg("depth"),
+	        py::arg("rgb") = py::none(), py::arg("stamp") = py::none(),
+	        py::arg("imu") = py::none(), py::arg("K") = py::none(),
+	        py::arg("depth_units") = py::none(),
+	        "Runs one frame: depth H x W uint16 (x depth_units [m], default "
+	        "the array's units or 0.001) or float32 [m]; rgb H x W x 3 uint8 "
+	        "(RGB) or H x W; stamp [s]; imu N x 7/10/14 float64 rows (t, gyro, "
+	        "accel[, mag[, quaternion wxyz]]) up to this frame")
+	    .def_property_readonly("frames_processed",
+	                           &PyPipeline::framesProcessed);
+
+	py::class_<PyRawlogReader>(m, "_RawlogReader")
+	    .def(py::init<const std::string&, const Config&>())
+	    .def("__iter__", [](PyRawlogReader& r) -> PyRawlogReader& { return r; })
+	    .def("__next__", &PyRawlogReader::next);
+}

@@ -1,0 +1,180 @@
+"""The Python module against the programs: the same masks and poses as
+bims-run on the bundled sample, the same strict config reader, and clear
+exceptions naming the argument for bad input."""
+
+import os
+import subprocess
+import tempfile
+import unittest
+
+import numpy as np
+
+import bims
+
+SOURCE = os.environ.get("BIMS_SOURCE_DIR", os.getcwd())
+BIN = os.environ.get("BIMS_BIN_DIR", os.path.join(SOURCE, "build", "bin"))
+SAMPLE = os.path.join(SOURCE, "rawlogs", "pendulum_slow.rawlog")
+CONFIG = os.path.join(SOURCE, "config", "default.ini")
+
+
+def read_png(path):
+    import cv2  # python3-opencv
+
+    img = cv2.imread(path, cv2.IMREAD_UNCHANGED)
+    if img is None:
+        raise FileNotFoundError(path)
+    return img
+
+
+def quat_to_matrix(qx, qy, qz, qw):
+    x, y, z, w = qx, qy, qz, qw
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+class SameAsBimsRun(unittest.TestCase):
+    def test_masks_and_poses_of_the_sample_equal_bims_runs(self):
+        self.assertTrue(os.path.exists(SAMPLE), SAMPLE)
+        with tempfile.TemporaryDirectory() as out:
+            run = subprocess.run(
+                [os.path.join(BIN, "bims-run"), CONFIG, SAMPLE, "-o", out, "-q"],
+                capture_output=True,
+                text=True,
+            )
+            self.assertEqual(run.returncode, 0, run.stderr)
+            traj = {}
+            with open(os.path.join(out, "trajectory.txt")) as f:
+                for line in f:
+                    if line.startswith("#"):
+                        continue
+                    v = [float(x) for x in line.split()]
+                    traj[len(traj)] = v
+            pipe = bims.Pipeline(bims.Config.from_file(CONFIG))
+            n = 0
+            moving = 0
+            for f in bims.read_rawlog(SAMPLE):
+                r = pipe.process(f.depth, rgb=f.rgb, stamp=f.stamp, imu=f.imu)
+                self.assertEqual(r.index, n)
+                self.assertEqual(r.mask.dtype, np.uint8)
+                self.assertEqual(r.mask.shape, f.depth.shape)
+                want = read_png(os.path.join(out, "masks", f"{n:06d}.png"))
+                self.assertTrue(
+                    np.array_equal(r.mask, want), f"mask of frame {n} differs"
+                )
+                moving += int(np.count_nonzero(r.mask))
+                t, tx, ty, tz, qx, qy, qz, qw = traj[n]
+                self.assertAlmostEqual(r.stamp, t, places=5)
+                self.assertEqual(r.pose.shape, (4, 4))
+                np.testing.assert_allclose(
+                    r.pose[:3, 3], [tx, ty, tz], atol=2e-9, err_msg=f"frame {n}"
+                )
+                np.testing.assert_allclose(
+                    r.pose[:3, :3],
+                    quat_to_matrix(qx, qy, qz, qw),
+                    atol=2e-8,
+                    err_msg=f"frame {n}",
+                )
+                self.assertIsInstance(r.flags, list)
+                n += 1
+            self.assertEqual(n, 150)
+            self.assertEqual(pipe.frames_processed, 150)
+            self.assertGreater(moving, 0, "the pendulum is never found")
+
+
+class Config(unittest.TestCase):
+    def test_a_missing_file_is_file_not_found_naming_it(self):
+        with self.assertRaises(FileNotFoundError) as e:
+            bims.Config.from_file("no/such/dir/x.ini")
+        self.assertIn("no/such/dir/x.ini", str(e.exception))
+
+    def test_unknown_keys_and_bad_values_are_value_errors_naming_them(self):
+        with open(CONFIG) as f:
+            text = f.read()
+        self.assertIn("[grids]", text)
+        with self.assertRaises(ValueError) as e:
+            bims.Config.from_string(text.replace("[grids]", "[grids]\nvoxel_sise = 0.05", 1))
+        self.assertIn("voxel_sise", str(e.exception))
+        with self.assertRaises(ValueError) as e:
+            bims.Config.from_string(text + "\n[no_such_section]\nx = 1\n")
+        self.assertIn("no_such_section", str(e.exception))
+        cfg = bims.Config.from_file(CONFIG)
+        with self.assertRaises(ValueError) as e:
+            cfg.set("grids", "voxel_size", -1)
+        self.assertIn("voxel_size", str(e.exception))
+        with self.assertRaises(KeyError):
+            cfg.get("grids", "no_such_key")
+
+    def test_get_set_and_effective(self):
+        cfg = bims.Config.from_file(CONFIG)
+        cfg.set("grids", "voxel_size", 0.08)
+        self.assertAlmostEqual(float(cfg.get("grids", "voxel_size")), 0.08)
+        again = bims.Config.from_string(cfg.effective())
+        self.assertEqual(again.get("grids", "voxel_size"), cfg.get("grids", "voxel_size"))
+        cfg.set("pipeline", "flow_thread", False)
+        self.assertEqual(cfg.get("pipeline", "flow_thread"), "false")
+
+
+class BadInput(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        frames = bims.read_rawlog(SAMPLE)
+        cls.f = next(frames)
+
+    def pipe(self):
+        return bims.Pipeline(bims.Config.from_file(CONFIG))
+
+    def expect(self, error, arg, **kwargs):
+        f = self.f
+        args = dict(depth=f.depth, rgb=f.rgb, stamp=f.stamp, imu=f.imu)
+        args.update(kwargs)
+        p = self.pipe()
+        with self.assertRaises(error) as e:
+            p.process(**args)
+        self.assertTrue(str(e.exception).startswith(arg + ":"), str(e.exception))
+        self.assertEqual(p.frames_processed, 0)
+
+    def test_each_bad_argument_is_named(self):
+        f = self.f
+        self.expect(TypeError, "depth", depth=np.asarray(f.depth, dtype=np.int32))
+        self.expect(ValueError, "depth", depth=bims.DepthArray(f.depth[0], K=f.K))
+        self.expect(
+            ValueError, "depth", depth=bims.DepthArray(f.depth[:, ::2], K=f.K)
+        )
+        nan = bims.DepthArray(f.depth.astype(np.float32) * 0.001, K=f.K)
+        nan[3, 4] = np.nan
+        self.expect(ValueError, "depth", depth=nan)
+        self.expect(ValueError, "rgb", rgb=f.rgb[:-2])
+        self.expect(TypeError, "rgb", rgb=f.rgb.astype(np.float32))
+        self.expect(ValueError, "rgb", rgb=f.rgb[:, ::2])
+        self.expect(ValueError, "K", depth=np.asarray(f.depth))
+        self.expect(ValueError, "stamp", stamp=None)
+        out_of_order = np.zeros((2, 7))
+        out_of_order[:, 0] = [f.stamp - 0.01, f.stamp - 0.02]
+        out_of_order[:, 6] = 9.81
+        self.expect(ValueError, "imu", imu=out_of_order)
+        self.expect(ValueError, "imu", imu=np.zeros((3, 5)))
+
+    def test_stamps_must_increase(self):
+        f = self.f
+        p = self.pipe()
+        p.process(f.depth, rgb=f.rgb, stamp=f.stamp)
+        with self.assertRaises(ValueError) as e:
+            p.process(f.depth, rgb=f.rgb, stamp=f.stamp)
+        self.assertTrue(str(e.exception).startswith("stamp:"))
+
+    def test_float_metres_and_depth_only_frames_run(self):
+        f = self.f
+        p = self.pipe()
+        metres = (f.depth.astype(np.float32) * np.float32(f.depth.units)).copy()
+        r = p.process(metres, stamp=f.stamp, K=f.K)
+        self.assertEqual(r.mask.shape, f.depth.shape)
+        self.assertTrue(r.flow_off)
+
+
+if __name__ == "__main__":
+    unittest.main()
