@@ -10,6 +10,8 @@
 #           against WORK_DIR/prefix, built and run: a grid from an .ini
 #           (bims::maps), a pipeline from share/bims/default.ini.
 # viewer:   the moved tree's bims-viewer finds its share/bims/default.ini.
+# python:   the Python tests (libs/python/tests) with the moved prefix's
+#           package and programs (-DPYTHON=... -DPYTHON_DIR=...).
 cmake_minimum_required(VERSION 3.16)
 
 foreach(v STEP BUILD_DIR SOURCE_DIR WORK_DIR LIBDIR)
@@ -103,6 +105,25 @@ elseif(STEP STREQUAL "consumer")
   endif()
   message(STATUS "${OUT}")
 
+elseif(STEP STREQUAL "python")
+  # The Python tests against the moved prefix: its package, its bims-run.
+  foreach(v PYTHON PYTHON_DIR)
+    if(NOT DEFINED ${v})
+      message(FATAL_ERROR "package_test.cmake: -D${v}=... missing")
+    endif()
+  endforeach()
+  set(site "${prefix}/${PYTHON_DIR}")
+  foreach(f __init__.py _bims.pyi py.typed)
+    if(NOT EXISTS "${site}/bims/${f}")
+      message(FATAL_ERROR "not installed: ${PYTHON_DIR}/bims/${f}")
+    endif()
+  endforeach()
+  run("the Python tests against ${site}"
+      COMMAND "${CMAKE_COMMAND}" -E env "PYTHONPATH=${site}"
+              "BIMS_SOURCE_DIR=${SOURCE_DIR}" "BIMS_BIN_DIR=${prefix}/bin"
+              "BIMS_EXPECT_PACKAGE_DIR=${site}/bims"
+              "${PYTHON}" -m unittest discover
+              -s "${SOURCE_DIR}/libs/python/tests" -p "test_*.py")
 elseif(STEP STREQUAL "viewer")
   # No display: the viewer says which parameters it uses, then fails to
   # open its window (the exit code is not the point here).

@@ -37,6 +37,17 @@ def quat_to_matrix(qx, qy, qz, qw):
     )
 
 
+class Package(unittest.TestCase):
+    def test_the_package_is_the_one_under_test(self):
+        want = os.environ.get("BIMS_EXPECT_PACKAGE_DIR")
+        if want is None:  # the build tree's: PYTHONPATH says which
+            want = os.path.join(os.environ["PYTHONPATH"].split(os.pathsep)[0], "bims")
+        self.assertEqual(
+            os.path.realpath(os.path.dirname(bims.__file__)), os.path.realpath(want)
+        )
+        self.assertTrue(bims._bims.__file__.startswith(os.path.dirname(bims.__file__)))
+
+
 class SameAsBimsRun(unittest.TestCase):
     def test_masks_and_poses_of_the_sample_equal_bims_runs(self):
         self.assertTrue(os.path.exists(SAMPLE), SAMPLE)

@@ -161,7 +161,8 @@ TEST(EndToEnd, ReplayDropsAnImuSampleThatIsNotFiniteAndFlagsItsFrame)
 	// one accelerometer reading 1e300): both samples are not used, counted,
 	// their frames flagged imu_rejected, and every pose stays finite.
 	const std::string in = kDir + "pendulum_slow.rawlog";
-	ASSERT_TRUE(mrpt::system::fileExists(in)) << "bundled sample missing: " << in;
+	ASSERT_TRUE(mrpt::system::fileExists(in))
+	    << "bundled sample missing: " << in;
 	const std::string p =
 	    (std::filesystem::temp_directory_path() / "bims_replay_bad_imu.rawlog")
 	        .string();
