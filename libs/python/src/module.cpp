@@ -101,14 +101,21 @@ py::array toNumpy(const cv::Mat& m)
 	                 m.data, owner);
 }
 
+/** A rows x cols float64 array of \a M (any matrix with M(r, c)). */
+template <class Matrix>
+py::array_t<double> toArray(const Matrix& M, int rows, int cols)
+{
+	py::array_t<double> out({rows, cols});
+	auto o = out.mutable_unchecked<2>();
+	for (int r = 0; r < rows; ++r)
+		for (int c = 0; c < cols; ++c) o(r, c) = M(r, c);
+	return out;
+}
+
 py::array_t<double> poseMatrix(const mrpt::poses::CPose3D& p)
 {
-	py::array_t<double> out({4, 4});
-	auto o = out.mutable_unchecked<2>();
-	const auto H = p.getHomogeneousMatrixVal<mrpt::math::CMatrixDouble44>();
-	for (int r = 0; r < 4; ++r)
-		for (int c = 0; c < 4; ++c) o(r, c) = H(r, c);
-	return out;
+	return toArray(p.getHomogeneousMatrixVal<mrpt::math::CMatrixDouble44>(), 4,
+	               4);
 }
 
 Eigen::Matrix3d intrinsics(const py::handle& h)
@@ -146,23 +153,26 @@ struct Config
 		c.cfg.loadFromText(text);
 		return c;
 	}
-	std::string get(const std::string& section, const std::string& key) const
+	/** KeyError for a key the configuration does not have. */
+	static void requireKey(const mrpt::config::CConfigFileMemory& mem,
+	                       const std::string& section, const std::string& key)
 	{
-		mrpt::config::CConfigFileMemory mem(cfg.effectiveIni());
 		if (!mem.keyExists(section, key))
 			throw py::key_error(
 			    "[" + section + "] " + key +
 			    ": no such key (Config.effective() lists them)");
+	}
+	std::string get(const std::string& section, const std::string& key) const
+	{
+		mrpt::config::CConfigFileMemory mem(cfg.effectiveIni());
+		requireKey(mem, section, key);
 		return mem.read_string(section, key, "");
 	}
 	void set(const std::string& section, const std::string& key,
 	         const py::object& value)
 	{
 		mrpt::config::CConfigFileMemory mem(cfg.effectiveIni());
-		if (!mem.keyExists(section, key))
-			throw py::key_error(
-			    "[" + section + "] " + key +
-			    ": no such key (Config.effective() lists them)");
+		requireKey(mem, section, key);
 		std::string text = py::isinstance<py::bool_>(value)
 		                       ? (value.cast<bool>() ? "true" : "false")
 		                       : std::string(py::str(value));
@@ -300,19 +310,13 @@ class PyPipeline
 			// Readings of 0.1 mm, or coarser when the farthest reading needs
 			// it (the 16 bits span the frame's range).
 			const cv::Mat m(H, W, CV_32FC1, const_cast<void*>(a.data()));
+			cv::Point at;
+			if (!cv::checkRange(m, true, &at))
+				bad("depth", "non-finite value at row " + std::to_string(at.y) +
+				                 ", column " + std::to_string(at.x) +
+				                 " (0 marks a pixel without depth)");
 			double lo = 0, hi = 0;
-			for (int v = 0; v < H; ++v)
-				for (int u = 0; u < W; ++u)
-				{
-					const float z = m.at<float>(v, u);
-					if (std::isnan(z) || std::isinf(z))
-						bad("depth", "non-finite value at row " +
-						                 std::to_string(v) + ", column " +
-						                 std::to_string(u) +
-						                 " (0 marks a pixel without depth)");
-					lo = std::min(lo, double(z));
-					hi = std::max(hi, double(z));
-				}
+			cv::minMaxLoc(m, &lo, &hi);
 			if (lo < 0) bad("depth", "negative depth (0 marks no reading)");
 			d.units = static_cast<float>(std::max(1e-4, hi / 65535.0));
 			m.convertTo(quantized, CV_16UC1, 1.0 / d.units);
@@ -487,9 +491,11 @@ class PyRawlogReader
 			throw std::runtime_error("3D scan #" + std::to_string(f->index) +
 			                         ": no range image");
 		py::array_t<uint16_t> z({depth.height, depth.width});
-		auto zo = z.mutable_unchecked<2>();
-		for (int v = 0; v < depth.height; ++v)
-			for (int u = 0; u < depth.width; ++u) zo(v, u) = depth.row(v)[u];
+		cv::Mat(depth.height, depth.width, CV_16UC1,
+		        const_cast<uint16_t*>(depth.data),
+		        depth.stride * sizeof(uint16_t))
+		    .copyTo(
+		        cv::Mat(depth.height, depth.width, CV_16UC1, z.mutable_data()));
 		d["depth"] = z;
 		d["depth_units"] = double(depth.units);
 		d["range_is_depth"] = depth.isDepth;
@@ -498,26 +504,17 @@ class PyRawlogReader
 		if (!why.empty())
 			throw std::runtime_error("3D scan #" + std::to_string(f->index) +
 			                         ": " + why);
-		py::array_t<double> k({3, 3});
-		auto ko = k.mutable_unchecked<2>();
-		for (int r = 0; r < 3; ++r)
-			for (int c = 0; c < 3; ++c) ko(r, c) = K(r, c);
-		d["K"] = k;
+		d["K"] = toArray(K, 3, 3);
 		d["rgb"] = py::none();
 		if (scan.hasIntensityImage && !scan.intensityImage.isEmpty())
 		{
 			const cv::Mat img =
 			    scan.intensityImage.asCvMat<cv::Mat>(mrpt::img::SHALLOW_COPY);
-			cv::Mat rgb;
-			if (img.channels() == 3)
-				cv::cvtColor(img, rgb, cv::COLOR_BGR2RGB);
-			else
-				cv::cvtColor(img, rgb, cv::COLOR_GRAY2RGB);
-			py::array_t<uint8_t> a({rgb.rows, rgb.cols, 3});
-			for (int v = 0; v < rgb.rows; ++v)
-				std::copy(rgb.ptr<uint8_t>(v),
-				          rgb.ptr<uint8_t>(v) + 3 * rgb.cols,
-				          a.mutable_data(v, 0, 0));
+			py::array_t<uint8_t> a({img.rows, img.cols, 3});
+			cv::Mat rgb(img.rows, img.cols, CV_8UC3, a.mutable_data());
+			cv::cvtColor(
+			    img, rgb,
+			    img.channels() == 3 ? cv::COLOR_BGR2RGB : cv::COLOR_GRAY2RGB);
 			d["rgb"] = a;
 		}
 		return d;
