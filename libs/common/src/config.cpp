@@ -57,10 +57,12 @@ void checkIniFile(const std::string& path)
 {
 	std::error_code ec;
 	if (!std::filesystem::is_regular_file(path, ec))
-		throw ConfigError(
-		    path + (std::filesystem::exists(path, ec)
-		                ? ": not a regular file (a folder?), not a config file"
-		                : ": no such config file"));
+	{
+		if (std::filesystem::exists(path, ec))
+			throw ConfigError(
+			    path + ": not a regular file (a folder?), not a config file");
+		throw ConfigFileMissing(path + ": no such config file");
+	}
 	std::ifstream f(path);
 	if (!f) throw ConfigError(path + ": cannot open config file");
 	checkIniStream(f, path);

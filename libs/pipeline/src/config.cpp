@@ -183,7 +183,8 @@ void ExperimentConfig::loadFromFile(const std::string& given)
 {
 	const std::string path = resolvePreset(given);  // "bonn.ini": a preset
 	if (!mrpt::system::fileExists(path))
-		throw ConfigError(path + ": no such config file" + presetHint(path));
+		throw ConfigFileMissing(path + ": no such config file" +
+		                        presetHint(path));
 	loadFromConfigFile(*bims::openIniFile(path));
 }
 

@@ -543,12 +543,9 @@ PYBIND11_MODULE(_bims, m)
 		        {
 			        return Config::fromFile(path);
 		        }
-		        catch (const ConfigError& e)
+		        catch (const ConfigFileMissing& e)
 		        {
-			        if (std::string(e.what()).find("no such config file") !=
-			            std::string::npos)
-				        fileNotFound(e.what());
-			        throw;
+			        fileNotFound(e.what());
 		        }
 	        },
 	        py::arg("path"),

@@ -25,6 +25,13 @@ class ConfigError : public std::runtime_error
 	using std::runtime_error::runtime_error;
 };
 
+/** A configuration file that does not exist (a ConfigError naming it). */
+class ConfigFileMissing : public ConfigError
+{
+ public:
+	using ConfigError::ConfigError;
+};
+
 /** Checks the syntax of the .ini file \a path before MRPT reads it (MRPT
  * keeps the last of two equal keys or sections and skips malformed lines
  * silently). Throws ConfigError naming the file and the line for: a path
