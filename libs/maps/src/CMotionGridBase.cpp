@@ -219,11 +219,7 @@ bool CMotionGridBase::wasMovingAtLastHit(const VoxelKey& k) const
 
 std::vector<mrpt::math::TPoint3D> CMotionGridBase::movingCells() const
 {
-	std::vector<mrpt::math::TPoint3D> out;
-	const auto& cells = *lastCells_;
-	for (size_t i = 0; i < cells.size(); ++i)
-		if (lastPost_[i] > 0) out.push_back(centerOf(cells[i]));
-	return out;
+	return movingVoxels(*this).centres;
 }
 
 bool CMotionGridBase::internal_insertObservation(

@@ -46,20 +46,47 @@ void writePointsPly(const std::string& path,
 	if (!f) throw std::runtime_error("error writing PLY file '" + path + "'");
 }
 
+VoxelSet staticVoxels(const COccupancyBayesGrid& occ,
+                      const CMotionGridBase* motion, double p)
+{
+	VoxelSet out;
+	const auto keys = staticOccupiedKeys(occ, motion, p);
+	out.centres.reserve(keys.size());
+	out.probabilities.reserve(keys.size());
+	for (const auto& k : keys)
+	{
+		out.centres.push_back(occ.centerOf(k));
+		out.probabilities.push_back(
+		    float(sigmoid(fromFixed(occ.logOddsFixed(k)))));
+	}
+	return out;
+}
+
+VoxelSet occupiedVoxels(const COccupancyBayesGrid& occ, double p)
+{
+	return staticVoxels(occ, nullptr, p);
+}
+
+VoxelSet movingVoxels(const CMotionGridBase& motion)
+{
+	VoxelSet out;
+	const auto& cells = motion.lastCells();
+	const auto& post = motion.lastPosterior();
+	for (size_t i = 0; i < cells.size(); ++i)
+		if (post[i] > 0)  // MAP: P(I) > 1/2 (CMotionGridBase::movingCells)
+		{
+			out.centres.push_back(motion.centerOf(cells[i]));
+			out.probabilities.push_back(float(sigmoid(post[i])));
+		}
+	return out;
+}
+
 size_t writeStaticPly(const std::string& path, const COccupancyBayesGrid& occ,
                       const CMotionGridBase* motion, double p)
 {
-	const auto keys = staticOccupiedKeys(occ, motion, p);
-	std::vector<mrpt::math::TPoint3D> pts;
-	std::vector<float> probs;
-	pts.reserve(keys.size());
-	for (const auto& k : keys)
-	{
-		pts.push_back(occ.centerOf(k));
-		probs.push_back(float(sigmoid(fromFixed(occ.logOddsFixed(k)))));
-	}
-	writePointsPly(path, pts, probs);
-	return pts.size();
+	const VoxelSet v = staticVoxels(occ, motion, p);
+	writePointsPly(path, v.centres, v.probabilities);
+	return v.size();
 }
 
 }  // namespace bims::maps

@@ -71,6 +71,37 @@ TEST(Export, StaticMapExcludesMovingVoxels)
 	}
 }
 
+TEST(Export, VoxelSetsCarryTheirGridsProbabilities)
+{
+	auto& mg = scenario();
+	const auto& occ = *mg.occupancy();
+	const auto* motion = mg.flowConsistency().get();
+	const VoxelSet all = occupiedVoxels(occ, 0.5),
+	               stat = staticVoxels(occ, motion);
+	ASSERT_EQ(all.size(), staticOccupiedKeys(occ, nullptr).size());
+	ASSERT_EQ(stat.size(), staticOccupiedKeys(occ, motion).size());
+	ASSERT_EQ(all.probabilities.size(), all.size());
+	for (size_t i = 0; i < all.size(); ++i)
+	{
+		EXPECT_GT(all.probabilities[i], 0.5f);
+		EXPECT_NEAR(all.probabilities[i], occ.probabilityAt(all.centres[i]),
+		            1e-6);
+	}
+	EXPECT_LT(occupiedVoxels(occ, 0.9).size(), all.size());
+	// the last frame's moving voxels: movingCells() with their P(I)
+	const VoxelSet moving = movingVoxels(*motion);
+	const auto centres = motion->movingCells();
+	ASSERT_GT(moving.size(), 5u);
+	ASSERT_EQ(moving.size(), centres.size());
+	for (size_t i = 0; i < moving.size(); ++i)
+	{
+		EXPECT_EQ(moving.centres[i], centres[i]);
+		EXPECT_GT(moving.probabilities[i], 0.5f);
+		EXPECT_NEAR(moving.probabilities[i],
+		            motion->probabilityAt(centres[i]).value(), 1e-6);
+	}
+}
+
 TEST(Export, PlyHeaderAndSize)
 {
 	auto& mg = scenario();

@@ -201,18 +201,7 @@ size_t OutputWriter::close(const Pipeline& pipe)
 	}
 	size_t nStatic = 0;
 	const auto& g = pipe.grids();
-	const maps::CMotionGridBase* motion = nullptr;
-	switch (maskSource(pipe.config().pipeline.variant))
-	{
-		case MaskSource::Tier1:
-			motion = g.background().get();
-			break;
-		case MaskSource::Tier2:
-			motion = g.flowConsistency().get();
-			break;
-		case MaskSource::FlowLabels:
-			break;  // the flow labels alone: no grid says moving
-	}
+	const maps::CMotionGridBase* motion = pipe.maskGrid();
 	if (p_.static_map && pipe.framesProcessed() > 0)
 	{
 		PartialFile ply(dir_ + "/static_map.ply"), bt(dir_ + "/static_map.bt");

@@ -377,18 +377,17 @@ void Pipeline::runGrids(const maps::PixelLabels* labels, FrameResult& r,
 		case MaskSource::Tier1:
 			r.mask = r.maskTier1;
 			r.movingVoxels = g.movingTier1;
-			r.movingVoxelCentres = grids_.background()->movingCells();
 			break;
 		case MaskSource::Tier2:
 			r.mask = r.maskTier2;
 			r.movingVoxels = g.movingTier2;
-			r.movingVoxelCentres = grids_.flowConsistency()->movingCells();
 			break;
 		case MaskSource::FlowLabels:
 			r.mask = r.maskFlow;
 			r.movingVoxels = 0;
 			break;
 	}
+	if (const auto* m = maskGrid()) r.movingVoxelCentres = m->movingCells();
 	// The tracker of the next frame keeps its features off the tier's own
 	// decision: the fill is for the output (a filled false alarm fed back
 	// would take a whole static surface from the tracker).
@@ -434,6 +433,20 @@ void Pipeline::finishFrame(FrameResult& r)
 	std::swap(prev_, cur_);
 	havePrev_ = true;
 	++nFrames_;
+}
+
+const maps::CMotionGridBase* Pipeline::maskGrid() const
+{
+	switch (maskSource(cfg_.pipeline.variant))
+	{
+		case MaskSource::Tier1:
+			return grids_.background().get();
+		case MaskSource::Tier2:
+			return grids_.flowConsistency().get();
+		case MaskSource::FlowLabels:
+			break;  // the flow labels alone: no grid says moving
+	}
+	return nullptr;
 }
 
 }  // namespace bims::pipeline

@@ -17,7 +17,7 @@ from typing import Iterator, Optional
 
 import numpy as np
 
-from ._bims import Config, ConfigError, Pipeline, RawlogError, Result
+from ._bims import Config, ConfigError, Pipeline, RawlogError, Result, Voxels
 from ._bims import _RawlogReader
 
 __all__ = [
@@ -28,6 +28,7 @@ __all__ = [
     "Pipeline",
     "RawlogError",
     "Result",
+    "Voxels",
     "read_rawlog",
 ]
 

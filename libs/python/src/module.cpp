@@ -8,6 +8,7 @@
 #include <bims/ego/attitude_filter.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/rgbd_input.h>
+#include <bims/maps/export.h>
 #include <bims/pipeline/config.h>
 #include <bims/pipeline/pipeline.h>
 #include <bims/source/frame_source.h>
@@ -201,6 +202,44 @@ struct Result
 	size_t hitVoxels = 0;
 };
 
+/** A rows x 3 float64 array of \a pts. */
+py::array_t<double> centresArray(const std::vector<mrpt::math::TPoint3D>& pts)
+{
+	py::array_t<double> v(
+	    {static_cast<py::ssize_t>(pts.size()), py::ssize_t(3)});
+	auto w = v.mutable_unchecked<2>();
+	for (size_t i = 0; i < pts.size(); ++i)
+	{
+		w(i, 0) = pts[i].x;
+		w(i, 1) = pts[i].y;
+		w(i, 2) = pts[i].z;
+	}
+	return v;
+}
+
+/** Voxels of a grid: centres and their probabilities. */
+struct Voxels
+{
+	py::array_t<double> centres;
+	py::array_t<float> probabilities;
+	size_t size() const { return static_cast<size_t>(probabilities.size()); }
+};
+
+Voxels voxelsOf(const maps::VoxelSet& v)
+{
+	py::array_t<float> p(static_cast<py::ssize_t>(v.size()));
+	std::copy(v.probabilities.begin(), v.probabilities.end(), p.mutable_data());
+	return {centresArray(v.centres), p};
+}
+
+/** \a p, or the config's [output] static_p_occupied when None, checked. */
+double occupiedThreshold(const py::object& p, double fallback)
+{
+	const double v = p.is_none() ? fallback : p.cast<double>();
+	if (!(v >= 0 && v < 1)) bad("p_occupied", "must be in [0, 1)");
+	return v;
+}
+
 Result resultOf(const pipeline::FrameResult& r)
 {
 	Result o;
@@ -223,17 +262,7 @@ Result resultOf(const pipeline::FrameResult& r)
 	o.times["grids"] = r.ms.grids;
 	o.times["total"] = r.ms.total;
 	o.hitVoxels = r.hitVoxels;
-	py::array_t<double> v(
-	    {static_cast<py::ssize_t>(r.movingVoxelCentres.size()),
-	     py::ssize_t(3)});
-	auto w = v.mutable_unchecked<2>();
-	for (size_t i = 0; i < r.movingVoxelCentres.size(); ++i)
-	{
-		w(i, 0) = r.movingVoxelCentres[i].x;
-		w(i, 1) = r.movingVoxelCentres[i].y;
-		w(i, 2) = r.movingVoxelCentres[i].z;
-	}
-	o.movingVoxels = v;
+	o.movingVoxels = centresArray(r.movingVoxelCentres);
 	return o;
 }
 
@@ -268,6 +297,36 @@ class PyPipeline
 	}
 
 	size_t framesProcessed() const { return pipe_.framesProcessed(); }
+
+	Voxels occupiedVoxels(const py::object& p) const
+	{
+		const double th = occupiedThreshold(p, 0.5);
+		return voxelsOf(maps::occupiedVoxels(*pipe_.grids().occupancy(), th));
+	}
+	Voxels movingVoxels() const
+	{
+		const auto* m = pipe_.maskGrid();
+		return voxelsOf(m ? maps::movingVoxels(*m) : maps::VoxelSet{});
+	}
+	Voxels staticVoxels(const py::object& p) const
+	{
+		const double th = occupiedThreshold(p, cfg_.output.static_p_occupied);
+		return voxelsOf(maps::staticVoxels(*pipe_.grids().occupancy(),
+		                                   pipe_.maskGrid(), th));
+	}
+	/** The static map as bims-run writes it: a .ply (centres and
+	 * occupancy) or an OctoMap .bt, by the file's extension. */
+	size_t saveStaticMap(const std::string& path, const py::object& p) const
+	{
+		const double th = occupiedThreshold(p, cfg_.output.static_p_occupied);
+		const std::string ext = mrpt::system::extractFileExtension(path);
+		const auto& occ = *pipe_.grids().occupancy();
+		if (ext == "ply")
+			return maps::writeStaticPly(path, occ, pipe_.maskGrid(), th);
+		if (ext == "bt")
+			return maps::writeStaticOctomap(path, occ, pipe_.maskGrid(), th);
+		bad("path", "'" + path + "': .ply or .bt expected");
+	}
 
  private:
 	/** The frame's camera model: \a K, the depth array's K, or [camera]. */
@@ -587,6 +646,14 @@ PYBIND11_MODULE(_bims, m)
 	                  "N x 3 centres [m] of the voxels labelled moving")
 	    .def_readonly("hit_voxels", &Result::hitVoxels);
 
+	py::class_<Voxels>(m, "Voxels", "Voxels of a grid with a probability each")
+	    .def_readonly("centres", &Voxels::centres, "N x 3 float64 [m], {W}")
+	    .def_readonly("probabilities", &Voxels::probabilities,
+	                  "N float32: occupancy (tier 0) or P(moving)")
+	    .def("__len__", &Voxels::size)
+	    .def("__repr__", [](const Voxels& v)
+	         { return "<bims.Voxels: " + std::to_string(v.size()) + ">"; });
+
 	py::class_<PyPipeline>(m, "Pipeline", "The segmentation pipeline")
 	    .def(py::init<const Config&>(), py::arg("config"))
 	    .def(
@@ -598,8 +665,22 @@ PYBIND11_MODULE(_bims, m)
 	        "the array's units or 0.001) or float32 [m]; rgb H x W x 3 uint8 "
 	        "(RGB) or H x W; stamp [s]; imu N x 7/10/14 float64 rows (t, gyro, "
 	        "accel[, mag[, quaternion wxyz]]) up to this frame")
-	    .def_property_readonly("frames_processed",
-	                           &PyPipeline::framesProcessed);
+	    .def_property_readonly("frames_processed", &PyPipeline::framesProcessed)
+	    .def("occupied_voxels", &PyPipeline::occupiedVoxels,
+	         py::arg("p_occupied") = 0.5,
+	         "Tier 0's voxels with occupancy probability > p_occupied")
+	    .def("moving_voxels", &PyPipeline::movingVoxels,
+	         "The last frame's voxels the variant's tier labels moving, with "
+	         "their P(moving) (empty for flow-only)")
+	    .def("static_voxels", &PyPipeline::staticVoxels,
+	         py::arg("p_occupied") = py::none(),
+	         "The static map: occupied voxels (p > p_occupied, default "
+	         "[output] static_p_occupied) not labelled moving at their last "
+	         "hit")
+	    .def("save_static_map", &PyPipeline::saveStaticMap, py::arg("path"),
+	         py::arg("p_occupied") = py::none(),
+	         "Writes the static map as bims-run does: PATH.ply (binary, x y z "
+	         "value) or PATH.bt (OctoMap); returns the number of voxels");
 
 	py::class_<PyRawlogReader>(m, "_RawlogReader")
 	    .def(py::init<const std::string&, const Config&>())

@@ -95,6 +95,40 @@ class SameAsBimsRun(unittest.TestCase):
             self.assertEqual(n, 150)
             self.assertEqual(pipe.frames_processed, 150)
             self.assertGreater(moving, 0, "the pendulum is never found")
+            self.check_grids_equal_bims_runs(pipe, r, out)
+
+    def check_grids_equal_bims_runs(self, pipe, last, out):
+        """The grids after the run: the last frame's moving voxels and the
+        static map (.ply and .bt) as bims-run wrote them, byte for byte."""
+        moving = pipe.moving_voxels()
+        self.assertGreater(len(moving), 0)
+        self.assertEqual(moving.centres.shape, (len(moving), 3))
+        self.assertEqual(moving.probabilities.dtype, np.float32)
+        self.assertTrue(np.all(moving.probabilities > 0.5))
+        np.testing.assert_array_equal(moving.centres, last.moving_voxels)
+        with open(os.path.join(out, "moving_voxels", "000149.ply")) as f:
+            lines = f.read().split("end_header\n", 1)[1].split()
+        written = np.array(lines, dtype=np.float64).reshape(-1, 3)
+        np.testing.assert_allclose(written, moving.centres, atol=6e-5)  # %.4f
+
+        static = pipe.static_voxels()
+        occupied = pipe.occupied_voxels()
+        self.assertGreater(len(static), 0)
+        self.assertGreaterEqual(len(occupied), len(static))
+        self.assertTrue(np.all(static.probabilities > 0.7))  # static_p_occupied
+        self.assertTrue(np.all(occupied.probabilities > 0.5))
+        self.assertLess(len(pipe.occupied_voxels(0.9)), len(occupied))
+        with tempfile.TemporaryDirectory() as mine:
+            for name in ("static_map.ply", "static_map.bt"):
+                n = pipe.save_static_map(os.path.join(mine, name))
+                self.assertGreater(n, 0)
+                with open(os.path.join(mine, name), "rb") as a, open(
+                    os.path.join(out, name), "rb"
+                ) as b:
+                    self.assertEqual(a.read(), b.read(), name)
+            self.assertEqual(
+                pipe.save_static_map(os.path.join(mine, "s.ply")), len(static)
+            )
 
 
 class Config(unittest.TestCase):
@@ -169,6 +203,21 @@ class BadInput(unittest.TestCase):
         out_of_order[:, 6] = 9.81
         self.expect(ValueError, "imu", imu=out_of_order)
         self.expect(ValueError, "imu", imu=np.zeros((3, 5)))
+
+    def test_bad_grid_queries_are_named(self):
+        p = self.pipe()
+        f = self.f
+        p.process(f.depth, rgb=f.rgb, stamp=f.stamp)
+        with self.assertRaises(ValueError) as e:
+            p.occupied_voxels(1.5)
+        self.assertTrue(str(e.exception).startswith("p_occupied:"))
+        with tempfile.TemporaryDirectory() as d:
+            with self.assertRaises(ValueError) as e:
+                p.save_static_map(os.path.join(d, "map.txt"))
+            self.assertTrue(str(e.exception).startswith("path:"))
+            with self.assertRaises(RuntimeError) as e:
+                p.save_static_map(os.path.join(d, "no", "such", "map.ply"))
+            self.assertIn("map.ply", str(e.exception))
 
     def test_stamps_must_increase(self):
         f = self.f

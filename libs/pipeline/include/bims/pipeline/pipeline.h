@@ -153,6 +153,10 @@ class Pipeline
 		settleDecay();
 		return grids_;
 	}
+	/** The tier whose decision is the variant's mask (tier 1 or 2; nullptr
+	 * when the flow labels alone decide, flow-only): the frame's moving
+	 * voxels are its, and the static map leaves out what it calls moving. */
+	const maps::CMotionGridBase* maskGrid() const;
 	const ego::Odometry& odometry() const { return odom_; }
 	size_t framesProcessed() const { return nFrames_; }
 
