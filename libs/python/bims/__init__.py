@@ -36,18 +36,22 @@ __all__ = [
 class DepthArray(np.ndarray):
     """A depth image (H x W) that carries its camera matrix ``K`` (3 x 3)
     and its ``units`` (metres per reading of a uint16 image), so that
-    ``Pipeline.process`` needs neither argument. A slice keeps them: crop
-    with care."""
+    ``Pipeline.process`` needs neither argument. ``range_is_depth`` False:
+    the readings are Euclidean ranges along each pixel's ray (MRPT's
+    ``range_is_depth``), not depth along the optical axis. A slice keeps
+    them: crop with care."""
 
-    def __new__(cls, array, K=None, units=None):
+    def __new__(cls, array, K=None, units=None, range_is_depth=True):
         obj = np.asarray(array).view(cls)
         obj.K = None if K is None else np.asarray(K, dtype=np.float64)
         obj.units = units
+        obj.range_is_depth = bool(range_is_depth)
         return obj
 
     def __array_finalize__(self, obj):
         self.K = getattr(obj, "K", None)
         self.units = getattr(obj, "units", None)
+        self.range_is_depth = getattr(obj, "range_is_depth", True)
 
 
 @dataclass
@@ -57,7 +61,7 @@ class Frame:
 
     index: int  #: 3D-scan index in the input, from 0
     stamp: float  #: camera time [s]
-    depth: DepthArray  #: H x W uint16 readings (x depth.units [m])
+    depth: DepthArray  #: H x W uint16 readings (x depth.units [m]; ranges if not depth.range_is_depth)
     rgb: Optional[np.ndarray]  #: H x W x 3 uint8 RGB, or None (depth only)
     imu: np.ndarray  #: N x 14 float64: t, gyro, accel, mag, quaternion wxyz (NaN: absent)
     K: np.ndarray  #: 3 x 3 camera matrix [px]
@@ -69,12 +73,12 @@ def read_rawlog(path: str, config: Optional[Config] = None) -> Iterator[Frame]:
     built-in defaults without one)."""
     reader = _RawlogReader(str(path), config if config is not None else Config())
     for d in reader:
-        if not d["range_is_depth"]:
-            raise ValueError(
-                f"{path}: 3D scan #{d['index']} holds Euclidean ranges, "
-                "not depth: not supported by read_rawlog yet"
-            )
-        depth = DepthArray(d["depth"], K=d["K"], units=d["depth_units"])
+        depth = DepthArray(
+            d["depth"],
+            K=d["K"],
+            units=d["depth_units"],
+            range_is_depth=d["range_is_depth"],
+        )
         yield Frame(
             index=d["index"],
             stamp=d["stamp"],

@@ -396,7 +396,11 @@ class PyPipeline
 		d.width = W;
 		d.height = H;
 		d.stride = static_cast<size_t>(W);
-		d.isDepth = true;
+		// Euclidean ranges along each pixel's ray (MRPT's range_is_depth =
+		// false), when the array says so
+		const py::object isDepth =
+		    py::getattr(depthObj, "range_is_depth", py::none());
+		d.isDepth = isDepth.is_none() || isDepth.cast<bool>();
 		d.timestamp = mrpt::Clock::fromDouble(t);
 		d.label = "depth";
 		cv::Mat grey;

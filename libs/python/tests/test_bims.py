@@ -164,6 +164,52 @@ class Config(unittest.TestCase):
         self.assertEqual(cfg.get("pipeline", "flow_thread"), "false")
 
 
+class EuclideanRanges(unittest.TestCase):
+    """A DepthArray of ranges along each pixel's ray (range_is_depth False,
+    as read_rawlog gives such a rawlog's scans) runs as the same depth."""
+
+    def run_frames(self, frames, to_array):
+        pipe = bims.Pipeline(bims.Config.from_file(CONFIG))
+        out = []
+        for f in frames:
+            r = pipe.process(to_array(f), rgb=f.rgb, stamp=f.stamp, imu=f.imu)
+            out.append((r.pose.copy(), r.mask.copy()))
+        return out
+
+    def test_ranges_run_as_their_depth(self):
+        frames = [f for _, f in zip(range(40), bims.read_rawlog(SAMPLE))]
+        K = frames[0].K
+        H, W = frames[0].depth.shape
+        u, v = np.meshgrid(np.arange(W), np.arange(H))
+        ray = np.sqrt(
+            1 + ((u - K[0, 2]) / K[0, 0]) ** 2 + ((v - K[1, 2]) / K[1, 1]) ** 2
+        ).astype(np.float32)
+
+        def metres(f):
+            return f.depth.astype(np.float32) * np.float32(f.depth.units)
+
+        depth = self.run_frames(frames, lambda f: bims.DepthArray(metres(f), K=K))
+        ranges = self.run_frames(
+            frames,
+            lambda f: bims.DepthArray(metres(f) * ray, K=K, range_is_depth=False),
+        )
+        wrong = self.run_frames(  # the ranges taken for depth
+            frames, lambda f: bims.DepthArray(metres(f) * ray, K=K)
+        )
+
+        def worst(a, b):
+            dt = max(np.abs(x[0][:3, 3] - y[0][:3, 3]).max() for x, y in zip(a, b))
+            px = sum(int(np.count_nonzero(x[1] != y[1])) for x, y in zip(a, b))
+            return dt, px
+
+        dt, px = worst(depth, ranges)
+        self.assertLess(dt, 0.002)
+        self.assertLess(px, 0.002 * H * W * len(frames))
+        dt_wrong, px_wrong = worst(depth, wrong)
+        self.assertGreater(px_wrong, 5 * max(px, 1))
+        self.assertGreater(dt_wrong, 5 * dt)
+
+
 class BadInput(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
