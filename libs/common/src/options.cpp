@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <stdexcept>
 
 namespace bims
 {
@@ -97,6 +98,41 @@ bool OptionReader::onGroup(const std::vector<const char*>& keys, bool)
 void OptionReader::onOther(const char* key)
 {
 	s_.allow(key);
+}
+
+// --- OptionChecker ---------------------------------------------------------
+
+void OptionChecker::fail(const char* key, const std::string& what) const
+{
+	throw std::invalid_argument(who_ + ": " + key + " " + what);
+}
+void OptionChecker::onReal(const char* key, double& v, double min, double max,
+                           const char*)
+{
+	if (!(v >= min && v <= max))  // NaN fails too
+		fail(key, "= " + formatReal(v) + ": must be in " + interval(min, max));
+}
+void OptionChecker::onInteger(const char* key, long& v, long min, long max,
+                              const char*)
+{
+	if (v < min || v > max)
+		fail(key, "= " + std::to_string(v) + ": must be in [" +
+		              std::to_string(min) + ", " + std::to_string(max) + "]");
+}
+void OptionChecker::onReals(const char* key, double* v, std::size_t n,
+                            double min, double max, const char* doc)
+{
+	for (std::size_t i = 0; i < n; i++) onReal(key, v[i], min, max, doc);
+}
+void OptionChecker::onChoice(const char* key, std::string& name,
+                             const std::vector<std::string>& names, const char*)
+{
+	if (std::find(names.begin(), names.end(), name) == names.end())
+		fail(key, "= " + name + ": must be one of " + choiceList(names));
+}
+void OptionChecker::onBrokenRule(const char* key, const std::string& what)
+{
+	fail(key, what);
 }
 
 // --- OptionWriter ----------------------------------------------------------

@@ -216,3 +216,42 @@ TEST(Options, TheTableListsEveryKeyWithRangeAndMeaning)
 	EXPECT_EQ(rows[9].key, "fx");
 	EXPECT_EQ(rows[9].value, "(none)");
 }
+
+TEST(Options, TheCheckerRefusesWhatTheDescriptionForbidsNamingTheKey)
+{
+	auto errorOfCheck = [](const Opts& o)
+	{
+		try
+		{
+			bims::checkOptions(o, "Opts");
+		}
+		catch (const std::invalid_argument& e)
+		{
+			return std::string(e.what());
+		}
+		return std::string();
+	};
+	Opts o;
+	EXPECT_EQ(errorOfCheck(o), "");
+	o.gain = 1.5;
+	EXPECT_EQ(errorOfCheck(o), "Opts: gain = 1.5: must be in [0, 1]");
+	o.gain = std::numeric_limits<double>::quiet_NaN();
+	EXPECT_EQ(errorOfCheck(o), "Opts: gain = nan: must be in [0, 1]");
+	o = {};
+	o.count = 0;
+	EXPECT_EQ(errorOfCheck(o), "Opts: count = 0: must be in [1, 10]");
+	o = {};
+	o.v[2] = -11;
+	EXPECT_EQ(errorOfCheck(o), "Opts: v = -11: must be in [-10, 10]");
+	o = {};
+	o.colour = static_cast<Colour>(7);  // not in the table
+	EXPECT_EQ(errorOfCheck(o),
+	          "Opts: colour = ?: must be one of red|green|dark-blue");
+	o = {};
+	o.lo = 3;
+	EXPECT_EQ(errorOfCheck(o), "Opts: hi must be greater than lo");
+	o = {};
+	o.given = true;
+	o.fx = 0;  // a group's keys are checked when it is given
+	EXPECT_EQ(errorOfCheck(o), "Opts: fx = 0: must be in [1, 1e+05]");
+}

@@ -1,6 +1,9 @@
+#include <bims/common/config.h>
+#include <bims/common/options.h>
 #include <bims/maps/CBayesVoxelGridBase.h>
 #include <bims/maps/register.h>
 
+#include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/opengl/COctoMapVoxels.h>
 #include <mrpt/opengl/CSetOfObjects.h>
@@ -97,6 +100,17 @@ void CBayesVoxelGridBase::writeBase(mrpt::serialization::CArchive& out,
                                     uint8_t version) const
 {
 	const auto& p = params_;
+	if (version >= 4)
+	{
+		// The parameters as their describe() names them: a new key needs
+		// no new layout (readBase).
+		const auto rows = optionRows(p);
+		out << uint32_t(rows.size());
+		for (const auto& r : rows) out << r.key << r.value;
+		out << frameCount_
+		    << int64_t(lastTimestamp_.time_since_epoch().count());
+		return;
+	}
 	out << p.voxel_size << uint8_t(p.decay) << p.p_miss << p.reading_lambda
 	    << p.p_min << p.p_max << p.bg_transition_eps << p.flow_transition_tau
 	    << p.flow_lambda << uint8_t(p.flow_evidence) << p.max_range << p.extent
@@ -115,6 +129,59 @@ void CBayesVoxelGridBase::readBase(mrpt::serialization::CArchive& in,
 	// Keys a version does not hold were not options yet: the map was
 	// built with the paper's model there (config/paper.ini), whatever the
 	// defaults are now.
+	GridParams p;
+	if (version >= 4)
+		p = readParamRows(in);
+	else
+		p = readParamsBinary(in, version);
+	setParamsBase(p);  // validates
+	int64_t ts;
+	in >> frameCount_ >> ts;
+	lastTimestamp_ = mrpt::Clock::time_point(mrpt::Clock::duration(ts));
+	totalStats_ = {};
+	badPoseFrames_ = 0;
+}
+
+GridParams CBayesVoxelGridBase::readParamRows(mrpt::serialization::CArchive& in)
+{
+	// key = value rows read as a [grids] section is: unknown keys, values
+	// out of range and bad choices are errors. A key the stream lacks (a map
+	// written before the key existed) keeps its default, which must then
+	// give the model as it was before the key (docs/maps.md).
+	uint32_t n = 0;
+	in >> n;
+	if (n > 1000)
+		throw std::runtime_error("bims::maps: corrupt serialised grid (" +
+		                         std::to_string(n) + " parameters)");
+	std::string ini = "[grids]\n", key, value;
+	for (uint32_t i = 0; i < n; ++i)
+	{
+		in >> key >> value;
+		if (key.empty() || key.find_first_of("=\n\r[]") != std::string::npos ||
+		    value.find_first_of("\n\r") != std::string::npos)
+			throw std::runtime_error(
+			    "bims::maps: corrupt serialised grid (parameter row " +
+			    std::to_string(i) + ")");
+		ini += key + "=" + value + "\n";
+	}
+	GridParams p;
+	try
+	{
+		p.loadFromConfigFile(mrpt::config::CConfigFileMemory(ini), "grids");
+	}
+	catch (const ConfigError& e)
+	{
+		throw std::runtime_error(
+		    std::string("bims::maps: corrupt serialised grid (") + e.what() +
+		    ")");
+	}
+	p.raycast_threads = 1;  // the reading machine's choice, not the map's
+	return p;
+}
+
+GridParams CBayesVoxelGridBase::readParamsBinary(
+    mrpt::serialization::CArchive& in, uint8_t version)
+{
 	GridParams p;
 	p.raycast_margin = 0;
 	p.p_unknown = 0;
@@ -153,12 +220,7 @@ void CBayesVoxelGridBase::readBase(mrpt::serialization::CArchive& in,
 		p.exclude_by = ExcludeBy(xb);
 	}
 	if (version >= 3) in >> p.raycast_margin;
-	setParamsBase(p);  // validates
-	int64_t ts;
-	in >> frameCount_ >> ts;
-	lastTimestamp_ = mrpt::Clock::time_point(mrpt::Clock::duration(ts));
-	totalStats_ = {};
-	badPoseFrames_ = 0;
+	return p;
 }
 
 void CBayesVoxelGridBase::addVoxelsTo(

@@ -283,8 +283,11 @@ void CMotionGridBase::readMotion(mrpt::serialization::CArchive& in,
                                  uint8_t version)
 {
 	grid_.clear();
-	// Version 3 changed the cells, 4 added a parameter (raycast_margin).
-	readBase(in, version >= 4 ? 3 : std::min<uint8_t>(version, 2));
+	// Version 3 changed the cells, 4 added a parameter (raycast_margin), 5
+	// wrote the parameters as key = value rows (readBase's layout 4).
+	readBase(in, version >= 5   ? 4
+	             : version >= 4 ? 3
+	                            : std::min<uint8_t>(version, 2));
 	grid_.setMaxBytes(size_t(params_.max_memory_mb * 1048576.0));
 	uint64_t nb;
 	in >> nb;

@@ -50,7 +50,7 @@ mrpt::maps::CMetricMap* COccupancyBayesGrid::internal_CreateFromMapDefinition(
 
 uint8_t COccupancyBayesGrid::serializeGetVersion() const
 {
-	return 3;
+	return 4;  // = readBase's layout of the parameters (4: key = value rows)
 }
 
 void COccupancyBayesGrid::serializeTo(mrpt::serialization::CArchive& out) const
@@ -80,7 +80,7 @@ void COccupancyBayesGrid::serializeTo(mrpt::serialization::CArchive& out) const
 void COccupancyBayesGrid::serializeFrom(mrpt::serialization::CArchive& in,
                                         uint8_t version)
 {
-	if (version > 3) MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
+	if (version > 4) MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
 	grid_.clear();
 	readBase(in, version);
 	grid_.setMaxBytes(size_t(params_.max_memory_mb * 1048576.0));

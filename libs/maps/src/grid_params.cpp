@@ -7,45 +7,9 @@
 
 namespace bims::maps
 {
-namespace
-{
-void check(bool ok, const char* name, const std::string& what)
-{
-	if (!ok)
-		throw std::invalid_argument(std::string("bims::maps::GridParams: ") +
-		                            name + " " + what);
-}
-}  // namespace
-
 void GridParams::validate() const
 {
-	check(std::isfinite(voxel_size) && voxel_size >= 1e-3 && voxel_size <= 10,
-	      "voxel_size", "must be in [0.001, 10] m");
-	check(p_miss > 0 && p_miss < 1, "p_miss", "must be in (0, 1)");
-	check(std::isfinite(reading_lambda) && reading_lambda >= 1,
-	      "reading_lambda", "must be finite and >= 1");
-	check(p_min > 0 && p_min < 0.5 && p_max > 0.5 && p_max < 1, "p_min/p_max",
-	      "must satisfy 0 < p_min < 0.5 < p_max < 1");
-	check(bg_transition_eps > 0 && bg_transition_eps < 0.5, "bg_transition_eps",
-	      "must be in (0, 0.5)");
-	check(p_unknown >= 0 && p_unknown < 1, "p_unknown",
-	      "must be in [0, 1) (0 = the paper's prior)");
-	check(flow_transition_tau > 0 && flow_transition_tau < 0.5,
-	      "flow_transition_tau", "must be in (0, 0.5)");
-	check(std::isfinite(flow_lambda) && flow_lambda > 1, "flow_lambda",
-	      "must be finite and > 1 (with 1, tier 2 carries no evidence)");
-	check(max_range > 0 && std::isfinite(max_range), "max_range",
-	      "must be > 0");
-	check(extent > 0 && std::isfinite(extent), "extent", "must be > 0");
-	check((extent + max_range) / voxel_size < 0.9 * (1 << 20), "extent",
-	      "+ max_range must be < 943718 voxels (21-bit keys)");
-	check(max_memory_mb >= 1, "max_memory_mb", "must be >= 1");
-	check(raycast_decimation >= 1 && raycast_decimation <= 64,
-	      "raycast_decimation", "must be in [1, 64]");
-	check(raycast_margin >= 0 && std::isfinite(raycast_margin),
-	      "raycast_margin", "must be >= 0");
-	check(raycast_threads >= 1 && raycast_threads <= 64, "raycast_threads",
-	      "must be in [1, 64]");
+	checkOptions(*this, "bims::maps::GridParams");
 }
 
 void GridParams::describe(OptionVisitor& v)
@@ -83,6 +47,8 @@ void GridParams::describe(OptionVisitor& v)
 	       "readings farther than this are skipped [m]");
 	v.real("extent", extent, 1e-2, 1e6,
 	       "readings and rays confined to |x|,|y|,|z| <= extent in {W} [m]");
+	v.rule((extent + max_range) / voxel_size < 0.9 * (1 << 20), "extent",
+	       "+ max_range must be < 943718 voxels (21-bit keys)");
 	v.real("max_memory_mb", max_memory_mb, 1, 1e7,
 	       "memory budget of one grid's voxels [MiB]");
 	v.integer("raycast_decimation", raycast_decimation, 1, 64,
@@ -110,16 +76,8 @@ void GridParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	bims::ConfigSection s(cfg, section);
 	for (const auto& k : alsoAllowed) s.allow(k);
 	OptionReader r(s);
-	describe(r);
+	describe(r);  // ranges, choices and the rule across keys
 	s.finish();
-	try
-	{
-		validate();
-	}
-	catch (const std::invalid_argument& ex)
-	{
-		s.fail("", ex.what());
-	}
 }
 
 void GridParams::dump(std::ostream& o) const

@@ -61,7 +61,7 @@ mrpt::maps::CMetricMap* CFlowConsistencyGrid::internal_CreateFromMapDefinition(
 
 uint8_t CBackgroundSubtractionGrid::serializeGetVersion() const
 {
-	return 4;
+	return kSerializationVersion;
 }
 void CBackgroundSubtractionGrid::serializeTo(
     mrpt::serialization::CArchive& out) const
@@ -71,13 +71,14 @@ void CBackgroundSubtractionGrid::serializeTo(
 void CBackgroundSubtractionGrid::serializeFrom(
     mrpt::serialization::CArchive& in, uint8_t version)
 {
-	if (version > 4) MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
+	if (version > kSerializationVersion)
+		MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
 	readMotion(in, version);
 }
 
 uint8_t CFlowConsistencyGrid::serializeGetVersion() const
 {
-	return 4;
+	return kSerializationVersion;
 }
 void CFlowConsistencyGrid::serializeTo(mrpt::serialization::CArchive& out) const
 {
@@ -86,7 +87,8 @@ void CFlowConsistencyGrid::serializeTo(mrpt::serialization::CArchive& out) const
 void CFlowConsistencyGrid::serializeFrom(mrpt::serialization::CArchive& in,
                                          uint8_t version)
 {
-	if (version > 4) MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
+	if (version > kSerializationVersion)
+		MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
 	readMotion(in, version);
 }
 

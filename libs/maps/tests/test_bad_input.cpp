@@ -1,9 +1,13 @@
 // Bad input: skipped and counted, never a crash or unbounded growth.
+#include <bims/common/options.h>
 #include <bims/maps/motion_grids.h>
 
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <string>
+#include <tuple>
+#include <vector>
 
 #include "scene_raycaster.h"
 #include "test_util.h"
@@ -103,4 +107,63 @@ TEST(BadInput, InvalidParametersAreRejected)
 	p.voxel_size = 0.001;
 	p.extent = 1e5;
 	EXPECT_THROW(p.validate(), std::invalid_argument);
+}
+
+namespace
+{
+/** Sets one real key of a describe() to a value, and lists the real keys
+ * with their ranges. */
+struct RealKeys : bims::OptionVisitor
+{
+	std::string key;
+	double value = 0;
+	std::vector<std::tuple<std::string, double, double>> ranges;
+
+ protected:
+	void onReal(const char* k, double& v, double min, double max,
+	            const char*) override
+	{
+		ranges.emplace_back(k, min, max);
+		if (key == k) v = value;
+	}
+	void onInteger(const char*, long&, long, long, const char*) override {}
+	void onFlag(const char*, bool&, const char*) override {}
+	void onText(const char*, std::string&, const char*) override {}
+	void onReals(const char*, double*, std::size_t, double, double,
+	             const char*) override
+	{
+	}
+	void onChoice(const char*, std::string&, const std::vector<std::string>&,
+	              const char*) override
+	{
+	}
+};
+}  // namespace
+
+TEST(BadInput, ValidateChecksEveryRangeOfTheDescriptionAndNamesTheKey)
+{
+	RealKeys all;
+	GridParams{}.describe(all);
+	ASSERT_GT(all.ranges.size(), 10u);
+	for (const auto& [key, min, max] : all.ranges)
+		for (const double bad :
+		     {max * 2 + 1, min - 1, std::numeric_limits<double>::quiet_NaN()})
+		{
+			if (bad >= min && bad <= max) continue;
+			GridParams p;
+			RealKeys set;
+			set.key = key;
+			set.value = bad;
+			p.describe(set);
+			try
+			{
+				p.validate();
+				ADD_FAILURE() << key << " = " << bad << " passed";
+			}
+			catch (const std::invalid_argument& e)
+			{
+				EXPECT_NE(std::string(e.what()).find(key), std::string::npos)
+				    << e.what();
+			}
+		}
 }

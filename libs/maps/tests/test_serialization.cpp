@@ -233,3 +233,94 @@ TEST(Serialization, CorruptStreamThrows)
 	auto a2 = mrpt::serialization::archiveFrom(half);
 	EXPECT_ANY_THROW(a2.ReadObject());
 }
+
+namespace
+{
+// An empty tier-0 map whose parameters are written as the given key = value
+// rows (the layout of version 4), to test how the rows are read.
+class Tier0WithRows : public COccupancyBayesGrid
+{
+ public:
+	std::vector<std::pair<std::string, std::string>> rows;
+
+ protected:
+	uint8_t serializeGetVersion() const override { return 4; }
+	void serializeTo(mrpt::serialization::CArchive& out) const override
+	{
+		out << uint32_t(rows.size());
+		for (const auto& [k, v] : rows) out << k << v;
+		out << uint32_t(0) << int64_t(0);  // frames, last stamp
+		out << uint64_t(0);                // no blocks
+	}
+};
+
+std::shared_ptr<COccupancyBayesGrid> readRows(
+    std::vector<std::pair<std::string, std::string>> rows)
+{
+	Tier0WithRows w;
+	w.rows = std::move(rows);
+	mrpt::io::CMemoryStream buf;
+	auto arch = mrpt::serialization::archiveFrom(buf);
+	arch << w;
+	buf.Seek(0);
+	return std::dynamic_pointer_cast<COccupancyBayesGrid>(arch.ReadObject());
+}
+
+std::string errorReadingRows(
+    std::vector<std::pair<std::string, std::string>> rows)
+{
+	try
+	{
+		readRows(std::move(rows));
+	}
+	catch (const std::exception& e)
+	{
+		return e.what();
+	}
+	return {};
+}
+}  // namespace
+
+TEST(Serialization, EveryParameterRoundTripsAsItsRow)
+{
+	GridParams p = test::paperGrids();
+	p.voxel_size = 0.1;
+	p.decay = DecayMode::Frustum;
+	p.bg_neighbourhood = BgNeighbourhood::Ray;
+	p.exclude_by = ExcludeBy::Either;
+	p.flow_evidence = FlowEvidence::Veto;
+	p.raycast_target = RayTarget::Points;
+	p.p_unknown = 0.3;
+	p.raycast_margin = 0.07;
+	p.max_memory_mb = 123.5;
+	p.raycast_decimation = 3;
+	MotionGrids mg(p);
+	feed(mg, 2);
+	auto t0 = roundTrip(*mg.occupancy());
+	auto t2 = roundTrip(*mg.flowConsistency());
+	ASSERT_TRUE(t0 && t2);
+	EXPECT_TRUE(t0->params() == p);
+	EXPECT_TRUE(t2->params() == p);
+}
+
+TEST(Serialization, ParameterRowsAreReadAsAGridsSection)
+{
+	// a key the stream lacks (a map written before it existed) keeps its
+	// default
+	const auto m = readRows({{"voxel_size", "0.1"}, {"decay", "frustum"}});
+	ASSERT_TRUE(m);
+	EXPECT_EQ(m->params().voxel_size, 0.1);
+	EXPECT_EQ(m->params().decay, DecayMode::Frustum);
+	EXPECT_EQ(m->params().p_miss, GridParams{}.p_miss);
+	// what a [grids] section may not hold is a corrupt stream, named
+	const std::string unknown = errorReadingRows({{"voxel_sise", "0.1"}});
+	EXPECT_NE(unknown.find("corrupt serialised grid"), std::string::npos)
+	    << unknown;
+	EXPECT_NE(unknown.find("voxel_sise"), std::string::npos) << unknown;
+	const std::string range = errorReadingRows({{"voxel_size", "20"}});
+	EXPECT_NE(range.find("voxel_size"), std::string::npos) << range;
+	const std::string choice = errorReadingRows({{"decay", "sometimes"}});
+	EXPECT_NE(choice.find("sometimes"), std::string::npos) << choice;
+	EXPECT_NE(errorReadingRows({{"decay\n[other]\nx", "all"}}), "");
+	EXPECT_NE(errorReadingRows({{"decay", "all\nx=1"}}), "");
+}

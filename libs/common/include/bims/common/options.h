@@ -146,6 +146,44 @@ void readOptions(Options& opts, const mrpt::config::CConfigFileBase& cfg,
 	s.finish();
 }
 
+/** Checks values set in code (not read from a file) against their declared
+ * ranges, choices and rules: the first that breaks one throws
+ * std::invalid_argument "WHO: KEY = VALUE: must be in [MIN, MAX]" (or
+ * "must be one of a|b", or the rule's text). A params struct's validate()
+ * is checkOptions(*this, "...") and nothing else: its ranges are those of
+ * its describe(), one place. */
+class OptionChecker : public OptionVisitor
+{
+ public:
+	explicit OptionChecker(std::string who) : who_(std::move(who)) {}
+
+ protected:
+	void onReal(const char* key, double& v, double min, double max,
+	            const char*) override;
+	void onInteger(const char* key, long& v, long min, long max,
+	               const char*) override;
+	void onFlag(const char*, bool&, const char*) override {}
+	void onText(const char*, std::string&, const char*) override {}
+	void onReals(const char* key, double* v, std::size_t n, double min,
+	             double max, const char*) override;
+	void onChoice(const char* key, std::string& name,
+	              const std::vector<std::string>& names, const char*) override;
+	void onBrokenRule(const char* key, const std::string& what) override;
+
+ private:
+	[[noreturn]] void fail(const char* key, const std::string& what) const;
+	std::string who_;
+};
+
+/** Throws std::invalid_argument naming \a who and the first key of
+ * \a opts out of its declared range (OptionChecker). */
+template <typename Options>
+void checkOptions(Options opts, const std::string& who)
+{
+	OptionChecker c(who);
+	opts.describe(c);
+}
+
 /** Writes every key with its value into \a section of \a out (MRPT's
  * CConfigFileBase::write, the meaning as a "// " comment, which MRPT
  * strips when it reads the value back; none after an empty value, which

@@ -65,10 +65,12 @@ class CBayesVoxelGridBase : public mrpt::maps::CMetricMap
 	/** Serialises params and counters, the parameters in the layout of
 	 * \a version (readBase(); older ones only to test the readers). */
 	void writeBase(mrpt::serialization::CArchive& out,
-	               uint8_t version = 3) const;
-	/** \a version: of the parameters' serialisation (0: without
-	 * p_unknown, bg_neighbourhood, exclude_moving; 1: without exclude_by;
-	 * 2: without raycast_margin; 3: all). */
+	               uint8_t version = 4) const;
+	/** \a version: of the parameters' serialisation. 4: key = value rows
+	 * of GridParams::describe() (the layout for every key to come); before
+	 * it, a fixed binary layout: 0 without p_unknown, bg_neighbourhood,
+	 * exclude_moving; 1 without exclude_by; 2 without raycast_margin; 3
+	 * all of them then. */
 	void readBase(mrpt::serialization::CArchive& in, uint8_t version);
 
 	/** Appends cubes of side voxel_size at \a centers with \a color to the
@@ -85,6 +87,11 @@ class CBayesVoxelGridBase : public mrpt::maps::CMetricMap
 	mutable size_t badPoseFrames_ = 0;
 	mutable FrameCloudBuilder builder_;
 	mutable unsigned warned_ = 0;
+
+ private:
+	static GridParams readParamRows(mrpt::serialization::CArchive& in);
+	static GridParams readParamsBinary(mrpt::serialization::CArchive& in,
+	                                   uint8_t version);
 };
 
 }  // namespace bims::maps

@@ -24,6 +24,11 @@ class CMotionGridBase : public CBayesVoxelGridBase
 	DEFINE_VIRTUAL_SERIALIZABLE(CMotionGridBase)
 
  public:
+	/** The serialisation version of tiers 1 and 2 (one number for both): 3
+	 * changed the cells, 4 added raycast_margin, 5 writes the parameters
+	 * as key = value rows, so that a new parameter needs no new version. */
+	static constexpr uint8_t kSerializationVersion = 5;
+
 	/** What a voxel keeps between frames: the MAP decision (posterior of
 	 * I > 1/2) at its last hit; 0 for a voxel never hit. The posteriors
 	 * themselves are recomputed every frame (the model has no per-voxel
