@@ -35,10 +35,19 @@ void MotionGrids::clear()
 	tier2_->clear();
 }
 
-void MotionGrids::applyPendingDecay() const
+void MotionGrids::applyPendingDecay()
 {
 	tier0_->applyPendingDecay();
 	decaying_.reset();
+}
+
+std::shared_ptr<const COccupancyBayesGrid> MotionGrids::occupancy() const
+{
+	if (tier0_->decayPending())
+		throw std::logic_error(
+		    "MotionGrids::occupancy() const: the last frame's tier-0 decay is "
+		    "pending (applyPendingDecay() first)");
+	return tier0_;
 }
 
 template <class Build>

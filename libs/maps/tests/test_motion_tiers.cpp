@@ -5,10 +5,12 @@
 #include <bims/maps/motion_grids.h>
 
 #include <gtest/gtest.h>
+
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/serialization/CArchive.h>
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include "scene_raycaster.h"
 #include "test_util.h"
@@ -448,6 +450,11 @@ TEST(MotionGrids, DeferredDecayGivesTheSameMapsAndMasks)
 				}
 				else if (f == 3 && b.decayPending())
 				{
+					// a const query changes nothing: it refuses the map
+					// that lacks the decay
+					EXPECT_THROW(std::as_const(b).occupancy(),
+					             std::logic_error);
+					EXPECT_TRUE(b.decayPending());
 					EXPECT_TRUE(bytesOf(*b.occupancy()) == aBefore);
 					EXPECT_FALSE(b.decayPending());
 				}

@@ -169,7 +169,7 @@ double OutputWriter::writeOther(mrpt::obs::CObservation::Ptr obs)
 	    });
 }
 
-size_t OutputWriter::close(const Pipeline& pipe)
+size_t OutputWriter::close(Pipeline& pipe)
 {
 	std::string err;
 	try

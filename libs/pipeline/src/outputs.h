@@ -36,7 +36,7 @@ class OutputWriter
 	/** Waits for the queued writes, closes the labelled rawlog, writes the
 	 * static map; returns its voxel count. Throws the first write error
 	 * (after closing what is open). */
-	size_t close(const Pipeline& pipe);
+	size_t close(Pipeline& pipe);
 	/** metrics.json. */
 	void writeMetrics(const Pipeline& pipe, const RunSummary& sum);
 	/** Writing time of each frame [ms] (with the observations queued

@@ -72,7 +72,7 @@ Pipeline::~Pipeline()
 	if (decaying_.valid()) decaying_.wait();
 }
 
-double Pipeline::settleDecay() const
+double Pipeline::settleDecay()
 {
 	return decaying_.valid() ? decaying_.get() : 0;
 }

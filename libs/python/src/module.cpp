@@ -298,7 +298,7 @@ class PyPipeline
 
 	size_t framesProcessed() const { return pipe_.framesProcessed(); }
 
-	Voxels occupiedVoxels(const py::object& p) const
+	Voxels occupiedVoxels(const py::object& p)
 	{
 		const double th = occupiedThreshold(p, 0.5);
 		return voxelsOf(maps::occupiedVoxels(*pipe_.grids().occupancy(), th));
@@ -308,7 +308,7 @@ class PyPipeline
 		const auto* m = pipe_.maskGrid();
 		return voxelsOf(m ? maps::movingVoxels(*m) : maps::VoxelSet{});
 	}
-	Voxels staticVoxels(const py::object& p) const
+	Voxels staticVoxels(const py::object& p)
 	{
 		const double th = occupiedThreshold(p, cfg_.output.static_p_occupied);
 		return voxelsOf(maps::staticVoxels(*pipe_.grids().occupancy(),
@@ -316,7 +316,7 @@ class PyPipeline
 	}
 	/** The static map as bims-run writes it: a .ply (centres and
 	 * occupancy) or an OctoMap .bt, by the file's extension. */
-	size_t saveStaticMap(const std::string& path, const py::object& p) const
+	size_t saveStaticMap(const std::string& path, const py::object& p)
 	{
 		const double th = occupiedThreshold(p, cfg_.output.static_p_occupied);
 		const std::string ext = mrpt::system::extractFileExtension(path);

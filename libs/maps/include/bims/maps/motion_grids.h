@@ -78,11 +78,16 @@ class MotionGrids
 
 	/** Tier 0, with a decay left by setDeferDecay() applied first (so not
 	 * while applyPendingDecay() may run on another thread). */
-	std::shared_ptr<COccupancyBayesGrid> occupancy() const
+	std::shared_ptr<COccupancyBayesGrid> occupancy()
 	{
 		applyPendingDecay();
 		return tier0_;
 	}
+	/** Tier 0 as it is: a query that changes nothing. Throws
+	 * std::logic_error while a decay left by setDeferDecay() is pending
+	 * (the map would lack the last frame's misses): applyPendingDecay(),
+	 * or the non-const occupancy(), first. */
+	std::shared_ptr<const COccupancyBayesGrid> occupancy() const;
 	std::shared_ptr<CBackgroundSubtractionGrid> background() const
 	{
 		return tier1_;
@@ -107,7 +112,7 @@ class MotionGrids
 	 * egomotion. A frame not built by buildFrame() is decayed at once. */
 	void setDeferDecay(bool on) { deferDecay_ = on; }
 	bool decayPending() const { return tier0_->decayPending(); }
-	void applyPendingDecay() const;
+	void applyPendingDecay();
 
 	/** Which tier's MAP decides "moving" for exclude_moving (1 or 2;
 	 * default 2). */
@@ -137,7 +142,7 @@ class MotionGrids
 	int decisionTier_ = 2;
 	bool deferDecay_ = false;
 	// The frame whose decay is pending (kept alive for it).
-	mutable std::shared_ptr<const FrameCloud> decaying_;
+	std::shared_ptr<const FrameCloud> decaying_;
 };
 
 }  // namespace bims::maps

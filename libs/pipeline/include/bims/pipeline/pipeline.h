@@ -148,11 +148,15 @@ class Pipeline
 	const ExperimentConfig& config() const { return cfg_; }
 	/** The grids after the last frame (waits for its decay on the decay
 	 * thread; throws what that decay threw). */
-	const maps::MotionGrids& grids() const
+	const maps::MotionGrids& grids()
 	{
 		settleDecay();
 		return grids_;
 	}
+	/** The grids as they are, changing nothing: tiers 1 and 2 after the
+	 * last frame; tier 0 (occupancy() const) only once its decay is settled
+	 * (the non-const grids(); else std::logic_error). */
+	const maps::MotionGrids& grids() const { return grids_; }
 	/** The tier whose decision is the variant's mask (tier 1 or 2; nullptr
 	 * when the flow labels alone decide, flow-only): the frame's moving
 	 * voxels are its, and the static map leaves out what it calls moving. */
@@ -225,8 +229,8 @@ class Pipeline
 	/** The last frame's decay on the decay thread (its result: the decay's
 	 * ms); settleDecay() waits for it and returns those ms (0 if none was
 	 * in flight). */
-	mutable std::future<double> decaying_;
-	double settleDecay() const;
+	std::future<double> decaying_;
+	double settleDecay();
 };
 
 /** maps::PixelMask -> CV_8UC1 (a copy; 0x0 mask -> \a size of zeros). */
