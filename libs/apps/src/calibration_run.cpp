@@ -57,8 +57,7 @@ int runImuCalibration(const ImuCalibrationOptions& o)
 	checkOutputsSpareInputs(
 	    {o.config, o.rawlog, o.calib},
 	    o.out ? std::vector<std::string>{*o.out} : std::vector<std::string>{});
-	ego::EgoConfig ec;
-	ec.loadFromFile(o.config);
+	ego::EgoConfig ec = egoConfigOption(o.config);
 	if (!o.calib.empty()) overrideSensorSectionsFrom(ec, o.calib, "file");
 	const bool haveRef = ec.calibration.has_R_IC;
 	const Eigen::Matrix3d R_ref = ec.calibration.R_IC;
@@ -131,8 +130,7 @@ double largestDepthCorrection(const ego::DepthCorrectionParams& p,
 int runDepthCalibration(const DepthCalibrationOptions& o)
 {
 	checkOutputsSpareInputs({o.config, o.rawlog, o.poses}, {o.out});
-	ego::EgoConfig ec;
-	ec.loadFromFile(o.config);
+	ego::EgoConfig ec = egoConfigOption(o.config);
 	// raw depth, frame-to-frame vision odometry
 	ec.odometry.mode = ego::OdometryMode::Vision;
 	ec.anchor.enable = false;

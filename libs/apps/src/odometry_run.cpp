@@ -32,10 +32,23 @@ void overrideSensorSectionsFrom(ego::EgoConfig& ec, const std::string& calib,
 	ec.overrideSensorSections(*cal);
 }
 
-ego::EgoConfig odometryConfig(const OdometryRunOptions& o)
+ego::EgoConfig egoConfigOption(const std::string& path)
 {
 	ego::EgoConfig ec;
-	ec.loadFromFile(o.config);
+	try
+	{
+		ec.loadFromFile(path);
+	}
+	catch (const ConfigFileMissing& e)
+	{
+		throw UsageError(e.what());
+	}
+	return ec;
+}
+
+ego::EgoConfig odometryConfig(const OdometryRunOptions& o)
+{
+	ego::EgoConfig ec = egoConfigOption(o.config);
 	if (!o.calib.empty())
 		overrideSensorSectionsFrom(ec, o.calib, "calibration file");
 	if (o.mode)

@@ -73,6 +73,24 @@ TEST(OdometryRun, OptionsOverrideTheConfigAndBadValuesAreUsageErrors)
 	}
 }
 
+TEST(OdometryRun, AMissingConfigIsAUsageErrorNamingIt)
+{
+	// the library's error is a ConfigFileMissing; the programs' a usage
+	// error (exit code 2), with the same message
+	const std::string none = kSampleGt + "no_such_config.ini";
+	bims::ego::EgoConfig ec;
+	EXPECT_THROW(ec.loadFromFile(none), bims::ConfigFileMissing);
+	try
+	{
+		egoConfigOption(none);
+		ADD_FAILURE() << "no error for a missing config";
+	}
+	catch (const bims::UsageError& e)
+	{
+		EXPECT_EQ(std::string(e.what()), none + ": no such config file");
+	}
+}
+
 TEST(OdometryRun, ImuModeWithoutRicIsAConfigErrorNamingTheFile)
 {
 	const std::string d = bims::test::freshTmpDir("bims_test_source", "odom");

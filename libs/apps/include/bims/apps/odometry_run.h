@@ -47,6 +47,11 @@ struct OdometryRunOptions
 void overrideSensorSectionsFrom(ego::EgoConfig& ec, const std::string& calib,
                                 const std::string& noSuch);
 
+/** The experiment file \a path of bims-odom, bims-calib-imu and
+ * bims-calib-depth (ego::EgoConfig::loadFromFile); a missing file is a
+ * UsageError naming it (exit code 2). */
+ego::EgoConfig egoConfigOption(const std::string& path);
+
 /** The configuration bims-odom runs: \a o.config, then \a o.calib's sensor
  * sections, --mode and --gyro-aid. Throws UsageError for a missing --calib
  * file or a bad --mode / --gyro-aid value, ConfigError when mode imu has
