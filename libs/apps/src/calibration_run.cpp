@@ -1,4 +1,5 @@
 #include <bims/apps/calibration_run.h>
+#include <bims/apps/frame_range_option.h>
 #include <bims/apps/odometry_run.h>
 #include <bims/common/app.h>
 #include <bims/common/output_paths.h>
@@ -16,7 +17,6 @@
 namespace bims::apps
 {
 using source::FrameRange;
-using source::frameRangeOption;
 using source::ReplayOptions;
 using source::replayRawlog;
 using source::ReplayStats;

@@ -1,4 +1,5 @@
 #include <bims/apps/flow_check.h>
+#include <bims/apps/frame_range_option.h>
 #include <bims/common/app.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
@@ -123,8 +124,8 @@ int runFlowCheck(const FlowCheckOptions& o)
 	pipeline::RunOptions opt;
 	opt.rawlogs = {o.rawlog};
 	opt.progress = o.progress;
-	opt.frames = pipeline::frameRangeOption(o.frames, opt.rawlogs,
-	                                        cfg.ego.sensors.rgbd_label);
+	opt.frames =
+	    frameRangeOption(o.frames, opt.rawlogs, cfg.ego.sensors.rgbd_label);
 	std::unique_ptr<AppendFile> csv;  // each line checked
 	if (o.csv)
 	{

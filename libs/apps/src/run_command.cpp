@@ -1,5 +1,6 @@
 // bims-run's command: the options of its command line into a run
 // (runExperiment) and its report.
+#include <bims/apps/frame_range_option.h>
 #include <bims/apps/run_command.h>
 #include <bims/common/app.h>
 #include <bims/common/choice.h>
@@ -13,7 +14,6 @@
 namespace bims::apps
 {
 using pipeline::formatSummary;
-using pipeline::frameRangeOption;
 using pipeline::runExperiment;
 using pipeline::RunOptions;
 using pipeline::runOutputLayout;

@@ -22,10 +22,9 @@ namespace bims::pipeline
 /** Inclusive range of 3D-scan indices ("A:B", "A:" or ":B"). */
 using source::FrameRange;
 
-/** A program's --frames option and its check against the inputs (one home:
+/** The check of a --frames range against the inputs (one home:
  * bims/source/frame_source.h). */
 using source::checkFrameRangeInInputs;
-using source::frameRangeOption;
 
 /** Median and 95th percentile of a series (bims/common/stats.h). */
 using bims::Percentiles;
