@@ -17,9 +17,6 @@
 namespace bims::apps
 {
 using source::FrameRange;
-using source::ReplayOptions;
-using source::replayRawlog;
-using source::ReplayStats;
 
 void RotationPairCollector::addFrame(const ego::FrameEgomotion& r)
 {

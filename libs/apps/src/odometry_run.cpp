@@ -18,9 +18,6 @@
 
 namespace bims::apps
 {
-using source::ReplayOptions;
-using source::replayRawlog;
-using source::ReplayStats;
 
 void overrideSensorSectionsFrom(ego::EgoConfig& ec, const std::string& calib,
                                 const std::string& noSuch)

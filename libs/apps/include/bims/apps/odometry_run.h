@@ -4,10 +4,10 @@
 // command line into OdometryRunOptions and calls runOdometry.
 #pragma once
 
+#include <bims/apps/odometry_replay.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/odometry.h>
 #include <bims/ego/rgbd_input.h>
-#include <bims/source/odometry_replay.h>
 
 #include <mrpt/poses/CPose3D.h>
 
