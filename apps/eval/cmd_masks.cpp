@@ -1,3 +1,4 @@
+#include <bims/apps/output_checks.h>
 #include <bims/common/app.h>
 #include <bims/common/frame_files.h>
 #include <bims/common/json.h>

@@ -1,6 +1,6 @@
+#include <bims/apps/output_checks.h>
 #include <bims/common/app.h>
 #include <bims/common/json.h>
-#include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
 #include <bims/eval/plots.h>
 #include <bims/eval/trajectory_metrics.h>

@@ -10,8 +10,8 @@
 // same, before any sensor is opened. See docs/grab.md; the logic:
 // bims/apps/grab_run.h.
 #include <bims/apps/grab_run.h>
+#include <bims/apps/output_checks.h>
 #include <bims/common/app.h>
-#include <bims/common/output_paths.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
 #include <cstdio>

@@ -9,6 +9,7 @@
 //
 // Non-interactive use (tests, figures): --max-frames N steps N frames, then
 // --screenshot writes the 3D view as shown in the window and quits.
+#include <bims/apps/output_checks.h>
 #include <bims/common/app.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/share.h>

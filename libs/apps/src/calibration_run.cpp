@@ -1,6 +1,7 @@
 #include <bims/apps/calibration_run.h>
 #include <bims/apps/frame_range_option.h>
 #include <bims/apps/odometry_run.h>
+#include <bims/apps/output_checks.h>
 #include <bims/common/app.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>

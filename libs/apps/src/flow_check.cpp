@@ -1,5 +1,6 @@
 #include <bims/apps/flow_check.h>
 #include <bims/apps/frame_range_option.h>
+#include <bims/apps/output_checks.h>
 #include <bims/common/app.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>

@@ -1,4 +1,5 @@
 #include <bims/apps/flow_labels_run.h>
+#include <bims/apps/output_checks.h>
 #include <bims/common/app.h>
 #include <bims/common/choice.h>
 #include <bims/common/config.h>

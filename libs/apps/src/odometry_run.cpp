@@ -1,4 +1,5 @@
 #include <bims/apps/odometry_run.h>
+#include <bims/apps/output_checks.h>
 #include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>

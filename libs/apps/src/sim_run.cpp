@@ -1,3 +1,4 @@
+#include <bims/apps/output_checks.h>
 #include <bims/apps/sim_run.h>
 #include <bims/common/app.h>
 #include <bims/common/config.h>

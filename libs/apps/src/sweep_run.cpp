@@ -1,6 +1,6 @@
+#include <bims/apps/output_checks.h>
 #include <bims/apps/sweep_run.h>
 #include <bims/common/app.h>
-#include <bims/common/output_paths.h>
 #include <bims/common/progress.h>
 #include <bims/common/share.h>
 #include <bims/sweep/plan.h>

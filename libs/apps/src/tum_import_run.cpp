@@ -1,4 +1,5 @@
 #include <bims/apps/import_options.h>
+#include <bims/apps/output_checks.h>
 #include <bims/apps/tum_import_run.h>
 #include <bims/common/app.h>
 #include <bims/common/config.h>
