@@ -1,9 +1,9 @@
 #include <bims/apps/output_checks.h>
+#include <bims/apps/progress_bar.h>
 #include <bims/common/app.h>
 #include <bims/common/frame_files.h>
 #include <bims/common/json.h>
 #include <bims/common/output_paths.h>
-#include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
 #include <bims/eval/depth_consistency.h>
 #include <bims/eval/mask_labels.h>

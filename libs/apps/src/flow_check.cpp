@@ -1,6 +1,7 @@
 #include <bims/apps/flow_check.h>
 #include <bims/apps/frame_range_option.h>
 #include <bims/apps/output_checks.h>
+#include <bims/apps/progress_bar.h>
 #include <bims/common/app.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
@@ -124,7 +125,8 @@ int runFlowCheck(const FlowCheckOptions& o)
 
 	pipeline::RunOptions opt;
 	opt.rawlogs = {o.rawlog};
-	opt.progress = o.progress;
+	ProgressBar bar("bims-run", 0, o.progress);  // runExperiment's line
+	opt.progress = bar.callback();
 	opt.frames =
 	    frameRangeOption(o.frames, opt.rawlogs, cfg.ego.sensors.rgbd_label);
 	std::unique_ptr<AppendFile> csv;  // each line checked

@@ -1,7 +1,7 @@
 #include <bims/apps/odometry_replay.h>
+#include <bims/apps/progress_bar.h>
 #include <bims/common/frame_files.h>
 #include <bims/common/image_file.h>
-#include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
 #include <bims/ego/flags.h>
 

@@ -161,13 +161,16 @@ ImportSummary importTum(TumFolder tum, const std::string& outRawlog,
 	// half-written rawlog under the final name
 	PartialFile part(outRawlog);
 	RawlogWriter w(part.path(), options.gzLevel);
-	ProgressBar bar("import", tum.frames.size(), options.progress);
+	Progress progress;
+	progress.total = tum.frames.size();
+	reportProgress(options.progress, progress);
 	for (const auto& it : items)
 	{
 		if (it.kind == 2)
 		{
 			w.write(*loadFrame(tum.frames[it.i], params));
-			bar.update(++sum.frames);
+			progress.done = ++sum.frames;
+			reportProgress(options.progress, progress);
 		}
 		else if (it.kind == 1)
 		{
@@ -186,7 +189,8 @@ ImportSummary importTum(TumFolder tum, const std::string& outRawlog,
 	w.close();
 	part.commit();
 	gtPart.commit();
-	bar.finish();
+	progress.finished = true;
+	reportProgress(options.progress, progress);
 	return sum;
 }
 

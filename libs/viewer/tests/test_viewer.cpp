@@ -372,7 +372,6 @@ std::vector<Seen> batchFrames(const std::string& input)
 	std::vector<Seen> batch;
 	pipeline::RunOptions ro;
 	ro.rawlogs = {input};
-	ro.progress = false;
 	ro.onFrame = [&](const pipeline::FrameResult& r, const auto&) {
 		batch.push_back({r.index, r.T_WC, r.mask.clone()});
 	};

@@ -5,7 +5,7 @@
 // installs the stop signals and runs a GrabApp.
 #pragma once
 
-#include <bims/common/progress.h>
+#include <bims/apps/progress_bar.h>
 #include <bims/common/rawlog.h>
 #include <bims/grab/grabber.h>
 #include <bims/pipeline/stepper.h>
