@@ -1,5 +1,5 @@
+#include <bims/apps/app.h>
 #include <bims/apps/output_checks.h>
-#include <bims/common/app.h>
 #include <bims/common/json.h>
 #include <bims/common/trajectory.h>
 #include <bims/eval/attitude_metrics.h>

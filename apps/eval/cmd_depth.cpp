@@ -1,4 +1,4 @@
-#include <bims/common/app.h>
+#include <bims/apps/app.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/eval/depth_consistency.h>

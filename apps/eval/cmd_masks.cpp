@@ -1,6 +1,6 @@
+#include <bims/apps/app.h>
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
-#include <bims/common/app.h>
 #include <bims/common/frame_files.h>
 #include <bims/common/json.h>
 #include <bims/common/output_paths.h>

@@ -9,9 +9,9 @@
 // device: a clear message and exit code 1; --viewer without a display: the
 // same, before any sensor is opened. See docs/grab.md; the logic:
 // bims/apps/grab_run.h.
+#include <bims/apps/app.h>
 #include <bims/apps/grab_run.h>
 #include <bims/apps/output_checks.h>
-#include <bims/common/app.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
 #include <cstdio>

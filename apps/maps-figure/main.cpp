@@ -3,8 +3,8 @@
 //
 //   bims-maps-figure RAWLOG GT_DIR {OUT.png | -o OUT.png} [--max-frames N]
 //                    [--voxel M]
+#include <bims/apps/app.h>
 #include <bims/apps/output_checks.h>
-#include <bims/common/app.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
 #include "figure.h"

@@ -4,8 +4,8 @@
 //   bims-sweep SWEEP.ini -o OUTDIR [-j N] [--jobs-file FILE] [--dry-run] [-q]
 //              [--plot-metric NAME]
 //   bims-sweep --collect OUTDIR [--plot-metric NAME]
+#include <bims/apps/app.h>
 #include <bims/apps/sweep_run.h>
-#include <bims/common/app.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
 int main(int argc, char** argv)

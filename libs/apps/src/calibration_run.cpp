@@ -1,8 +1,8 @@
+#include <bims/apps/app.h>
 #include <bims/apps/calibration_run.h>
 #include <bims/apps/frame_range_option.h>
 #include <bims/apps/odometry_run.h>
 #include <bims/apps/output_checks.h>
-#include <bims/common/app.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>

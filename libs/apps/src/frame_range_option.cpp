@@ -1,5 +1,5 @@
+#include <bims/apps/app.h>
 #include <bims/apps/frame_range_option.h>
-#include <bims/common/app.h>
 
 #include <stdexcept>
 

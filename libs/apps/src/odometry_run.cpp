@@ -1,6 +1,6 @@
+#include <bims/apps/app.h>
 #include <bims/apps/odometry_run.h>
 #include <bims/apps/output_checks.h>
-#include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
 #include <bims/common/output_paths.h>

@@ -1,10 +1,10 @@
 // bims-run's command: the options of its command line into a run
 // (runExperiment) and its report.
+#include <bims/apps/app.h>
 #include <bims/apps/frame_range_option.h>
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
 #include <bims/apps/run_command.h>
-#include <bims/common/app.h>
 #include <bims/common/choice.h>
 #include <bims/common/rawlog.h>
 

@@ -1,7 +1,7 @@
+#include <bims/apps/app.h>
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
 #include <bims/apps/sim_run.h>
-#include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>

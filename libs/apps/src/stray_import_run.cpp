@@ -1,8 +1,8 @@
+#include <bims/apps/app.h>
 #include <bims/apps/import_options.h>
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
 #include <bims/apps/stray_import_run.h>
-#include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/format.h>

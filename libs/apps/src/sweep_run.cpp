@@ -1,7 +1,7 @@
+#include <bims/apps/app.h>
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
 #include <bims/apps/sweep_run.h>
-#include <bims/common/app.h>
 #include <bims/common/share.h>
 #include <bims/sweep/plan.h>
 #include <bims/sweep/processes.h>

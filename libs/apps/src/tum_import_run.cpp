@@ -1,8 +1,8 @@
+#include <bims/apps/app.h>
 #include <bims/apps/import_options.h>
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
 #include <bims/apps/tum_import_run.h>
-#include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/output_paths.h>
 #include <bims/eval/pose_utils.h>

@@ -1,7 +1,7 @@
 // Every program's --frames A:B (frame_range_option.h): the library's plain
 // errors become usage errors with the same message.
+#include <bims/apps/app.h>
 #include <bims/apps/frame_range_option.h>
-#include <bims/common/app.h>
 #include <bims_test/sample.h>
 #include <gtest/gtest.h>
 

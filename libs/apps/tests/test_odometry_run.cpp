@@ -1,8 +1,8 @@
 // bims-odom's run (odometry_run.h): its configuration from the options, the
 // tracker's accuracy against the truth, the CSV and the whole run on the
 // bundled sample.
+#include <bims/apps/app.h>
 #include <bims/apps/odometry_run.h>
-#include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/trajectory.h>
 #include <bims_test/sample.h>

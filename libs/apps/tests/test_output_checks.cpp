@@ -1,8 +1,8 @@
 // The programs' output checks (output_checks.h): outputs never alias
 // inputs, an output folder holding an earlier run is refused unless
 // --overwrite.
+#include <bims/apps/app.h>
 #include <bims/apps/output_checks.h>
-#include <bims/common/app.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 

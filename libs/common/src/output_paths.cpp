@@ -47,6 +47,15 @@ void checkOutputFilesWritable(const std::vector<std::string>& files)
 	}
 }
 
+void makeDirs(const std::string& path)
+{
+	std::error_code ec;
+	std::filesystem::create_directories(path, ec);
+	if (ec)
+		throw std::runtime_error(path +
+		                         ": cannot create directory: " + ec.message());
+}
+
 void replaceSymlink(const std::string& path)
 {
 	std::error_code ec;

@@ -1,4 +1,3 @@
-#include <bims/common/app.h>
 #include <bims/common/image_file.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/progress.h>

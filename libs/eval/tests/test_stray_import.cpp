@@ -2,7 +2,6 @@
 // Stray Scanner capture made by the test itself, imported and checked
 // convention by convention; bad input; the shared real capture (skipped without
 // it); the built program's command line.
-#include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>

@@ -1,4 +1,4 @@
-#include <bims/common/app.h>
+#include <bims/common/errors.h>
 #include <bims/common/imu_check.h>
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>

@@ -1,4 +1,3 @@
-#include <bims/common/app.h>
 #include <bims/common/frame_files.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/pixel_labels.h>

@@ -24,6 +24,9 @@ namespace bims
  * (optional outputs not given) are ignored. */
 void checkOutputFilesWritable(const std::vector<std::string>& files);
 
+/** Creates a directory and its parents; throws naming it on failure. */
+void makeDirs(const std::string& path);
+
 /** Before a program creates the file \a path: a symbolic link there is
  * removed (the link itself, never its target), so the new file replaces the
  * link. Throws naming the path if it is a folder or the link cannot be

@@ -1,5 +1,5 @@
 // The shared command-line plumbing (app.h) of every program.
-#include <bims/common/app.h>
+#include <bims/apps/app.h>
 #include <gtest/gtest.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
@@ -58,13 +58,4 @@ TEST(App, GivenValueTellsAnOptionGivenEmptyFromOneNotGiven)
 	EXPECT_EQ(bims::givenValue(a), std::optional<std::string>(""));
 	EXPECT_EQ(bims::givenValue(b), std::nullopt);
 	EXPECT_EQ(bims::givenValue(n), std::optional<size_t>(7));
-}
-
-TEST(App, AnMrptExceptionIsCutToItsMessage)
-{
-	const std::string mrpt =
-	    "==== MRPT exception ====\nLine 2: Unknown variable `${X}`\nCall "
-	    "stack backtrace:\n[0 ]     0x7f5284debb28\n[1 ]     0x55cc13dc3cf4\n";
-	EXPECT_EQ(bims::withoutBacktrace(mrpt), "Line 2: Unknown variable `${X}`");
-	EXPECT_EQ(bims::withoutBacktrace("a.ini: plain"), "a.ini: plain");
 }
