@@ -52,7 +52,7 @@ SAN_BUILD_DIR ?= build-sanitize
 # those labels, nor the programs only they run (BIMS_SKIP_TEST_LABELS).
 SAN_SKIP_LABELS = cli;sweep;package;e2e;sim;viewer;grab
 SAN_EXCLUDE_LABELS = ^($(subst ;,|,$(SAN_SKIP_LABELS)))$$
-SAN_EXCLUDE_TESTS = ^(Raycast\.SameCellsBlocksAndOrderAsThePerCellWalk|Apps\.HelpExitsCleanlyAndBadOptionsAreUsageErrors)$$
+SAN_EXCLUDE_TESTS = ^(Raycast\.SameCellsBlocksAndOrderAsThePerCellWalk|Apps\.HelpExitsCleanlyAndBadOptionsExitWithCodeTwo)$$
 test-sanitize: deps
 	@if [ ! -f $(SAN_BUILD_DIR)/CMakeCache.txt ]; then \
 	  cmake -S . -B $(SAN_BUILD_DIR) $(TREE_ARGS) -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG=-O1 -DBIMS_SANITIZE=address,undefined \
