@@ -107,7 +107,6 @@ int main(int argc, char** argv)
 			for (int run = 0; run < 3; run++)
 			{
 				bag::BagImportOptions o;
-				o.progress = false;
 				o.gzLevel = gz;
 				const auto t0 = std::chrono::steady_clock::now();
 				const auto sum = bag::importBag({bag}, dir + "/out.rawlog",

@@ -7,8 +7,8 @@
 // needed). Writes a [depth_correction] section to paste into (or include
 // with) the experiment .ini. The run: bims::apps::runDepthCalibration
 // (calibration_run.h).
+#include <bims/apps/app.h>
 #include <bims/apps/calibration_run.h>
-#include <bims/common/app.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 

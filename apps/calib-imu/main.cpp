@@ -5,8 +5,8 @@
 // Log(R_IprevI) = R_IC Log(R_CprevC) robustly (docs/ego.md). When the
 // config already holds an R_IC, the angle between the two is reported.
 // The run: bims::apps::runImuCalibration (calibration_run.h).
+#include <bims/apps/app.h>
 #include <bims/apps/calibration_run.h>
-#include <bims/common/app.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 

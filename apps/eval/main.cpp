@@ -3,7 +3,7 @@
 // bims-eval depth-consistency IN.rawlog GT.txt [options]
 // bims-eval attitude REF.txt EST.txt [--ref-up AXIS] [options]
 // See docs/eval.md for the definitions.
-#include <bims/common/app.h>
+#include <bims/apps/app.h>
 
 #include <cstdio>
 #include <string>

@@ -17,8 +17,8 @@
 // --strip writes a picture: for each listed frame the RGB image with the
 // used pose's Diff pixels in red (docs/journal/pipeline.md). The logic:
 // bims/apps/flow_check.h, bims/flow/pose_check.h.
+#include <bims/apps/app.h>
 #include <bims/apps/flow_check.h>
-#include <bims/common/app.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
 int main(int argc, char** argv)

@@ -8,8 +8,8 @@
 // frame 1's depth and the relative pose T_{C0 C1} (identity by default: a still
 // camera), and the Diff/notDiff labels; writes colour pictures and prints
 // per-stage timings. Useful to tune [flow] on real sensor data.
+#include <bims/apps/app.h>
 #include <bims/apps/flow_labels_run.h>
-#include <bims/common/app.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 

@@ -8,10 +8,10 @@
 // every frame, so a kill or an unplug loses at most the last frame. No
 // device: a clear message and exit code 1; --viewer without a display: the
 // same, before any sensor is opened. See docs/grab.md; the logic:
-// bims/grab/grab_app.h.
-#include <bims/common/app.h>
-#include <bims/common/output_paths.h>
-#include <bims/grab/grab_app.h>
+// bims/apps/grab_run.h.
+#include <bims/apps/app.h>
+#include <bims/apps/grab_run.h>
+#include <bims/apps/output_checks.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
 #include <cstdio>
@@ -57,7 +57,7 @@ int main(int argc, char** argv)
 		                                  {aOut.getValue()});
 		    // Ctrl-C from now on: clean stop
 		    const auto& stop = bims::installStopSignals();
-		    bims::grab::GrabApp app({aCfg.getValue(), aOut.getValue(),
+		    bims::apps::GrabApp app({aCfg.getValue(), aOut.getValue(),
 		                             bims::inRange(aFrames, 0, 100000000,
 		                                           "0 = [global] max_frames"),
 		                             aSeg.getValue(), aExp.getValue(),

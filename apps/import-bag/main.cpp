@@ -2,8 +2,8 @@
 //   [-c CONFIG.ini] [--max-frames N] [--gz L] [--topics] [-q]
 // Converts ROS 1 bags (sensor_msgs/Image depth and colour, CameraInfo, Imu,
 // MagneticField) into a bims rawlog. See docs/import-bag.md.
+#include <bims/apps/app.h>
 #include <bims/apps/bag_import_run.h>
-#include <bims/common/app.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 

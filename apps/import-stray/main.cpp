@@ -3,8 +3,8 @@
 // Converts a Stray Scanner capture (depth/, confidence/, rgb.mp4,
 // camera_matrix.csv, odometry.csv, imu.csv) into a bims rawlog plus ARKit's
 // poses in OUT_arkit_reference.txt. See docs/eval.md.
+#include <bims/apps/app.h>
 #include <bims/apps/stray_import_run.h>
-#include <bims/common/app.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 

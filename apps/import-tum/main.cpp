@@ -2,8 +2,8 @@
 //   [--max-frames N] [--synth-imu [--seed N]] [--gz L]
 // Converts a TUM RGB-D-layout folder into a bims rawlog plus OUT_gt/
 // (groundtruth.txt, calibration.ini). See docs/eval.md.
+#include <bims/apps/app.h>
 #include <bims/apps/tum_import_run.h>
-#include <bims/common/app.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 

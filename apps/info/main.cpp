@@ -2,7 +2,7 @@
 // class, rates, duration, time span, image sizes).
 #include "summary.h"
 
-#include <bims/common/app.h>
+#include <bims/apps/app.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
 #include <iostream>

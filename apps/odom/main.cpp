@@ -4,8 +4,8 @@
 // Egomotion alone: writes the camera trajectory T_WC in the TUM format and a
 // per-stage timing summary. Works with or without IMU data in the rawlog
 // (mode = vision for data without IMU).
+#include <bims/apps/app.h>
 #include <bims/apps/odometry_run.h>
-#include <bims/common/app.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 

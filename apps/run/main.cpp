@@ -12,8 +12,8 @@
 // --print-config prints that effective.ini (of CONFIG.ini, or of the built-in
 // defaults) and exits. See docs/pipeline.md and docs/config.md. The run:
 // bims::apps::runFromCommandLine (bims/apps/run_command.h).
+#include <bims/apps/app.h>
 #include <bims/apps/run_command.h>
-#include <bims/common/app.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
 int main(int argc, char** argv)

@@ -4,8 +4,8 @@
 //   bims-sim --imu-from-tum GT.txt -o IMU.rawlog [--seed N]
 //            [--config imu.ini]
 // See docs/sim.md.
+#include <bims/apps/app.h>
 #include <bims/apps/sim_run.h>
-#include <bims/common/app.h>
 
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 

@@ -4,8 +4,8 @@
 //   bims-sweep SWEEP.ini -o OUTDIR [-j N] [--jobs-file FILE] [--dry-run] [-q]
 //              [--plot-metric NAME]
 //   bims-sweep --collect OUTDIR [--plot-metric NAME]
-#include <bims/common/app.h>
-#include <bims/sweep/sweep.h>
+#include <bims/apps/app.h>
+#include <bims/apps/sweep_run.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
 int main(int argc, char** argv)
@@ -49,7 +49,7 @@ int main(int argc, char** argv)
 		        "gather the results of OUTDIR's runs, done elsewhere", false,
 		        "", "OUTDIR", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
-		    bims::sweep::SweepOptions o;
+		    bims::apps::SweepOptions o;
 		    o.sweepFile = aSweep.getValue();
 		    o.outDir = aOut.getValue();
 		    o.jobs = aJobs.getValue();
@@ -60,6 +60,6 @@ int main(int argc, char** argv)
 		    o.plotMetric = aMetric.getValue();
 		    o.collect = aCollect.getValue();
 		    o.stop = &bims::installStopSignals();
-		    return bims::sweep::runSweep(o);
+		    return bims::apps::runSweep(o);
 	    });
 }

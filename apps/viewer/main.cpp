@@ -9,7 +9,8 @@
 //
 // Non-interactive use (tests, figures): --max-frames N steps N frames, then
 // --screenshot writes the 3D view as shown in the window and quits.
-#include <bims/common/app.h>
+#include <bims/apps/app.h>
+#include <bims/apps/output_checks.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/share.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>

@@ -73,7 +73,6 @@ bims::eval::MaskMetrics score(ExperimentConfig cfg, Variant v, size_t last,
 	RunOptions opt;
 	opt.rawlogs = {rawlog};
 	opt.frames = FrameRange{0, last};
-	opt.progress = false;
 	bims::eval::MaskMetrics m;
 	opt.onFrame = [&](const FrameResult& r,
 	                  const mrpt::obs::CObservation3DRangeScan& scan)
@@ -287,7 +286,6 @@ TEST(EndToEnd, WritesTheContractOutputs)
 	opt.rawlogs = {kSample};
 	opt.frames = FrameRange{10, 14};
 	opt.outDir = tmpDir("outputs");
-	opt.progress = false;
 	const auto sum = runExperiment(cfg, opt);
 	ASSERT_TRUE(sum.error.empty()) << sum.error;
 	EXPECT_EQ(sum.framesProcessed, 5u);
@@ -346,7 +344,6 @@ TEST(EndToEnd, TruncatedRawlogStopsWithAClearErrorAndKeepsPartialOutputs)
 	RunOptions opt;
 	opt.rawlogs = {cut};
 	opt.outDir = dir + "/out";
-	opt.progress = false;
 	const auto sum = runExperiment(cfg, opt);
 	EXPECT_NE(sum.error.find("cut.rawlog: truncated or corrupt"),
 	          std::string::npos)
@@ -374,7 +371,6 @@ TEST(EndToEnd, RawlogWithoutImuRunsVisionOnly)
 	cfg.ego.odometry.mode = bims::ego::OdometryMode::Vision;
 	RunOptions opt;
 	opt.rawlogs = {noImu};
-	opt.progress = false;
 	const auto sum = runExperiment(cfg, opt);
 	EXPECT_TRUE(sum.error.empty()) << sum.error;
 	EXPECT_EQ(sum.framesProcessed, 20u);
@@ -427,7 +423,6 @@ TEST(EndToEnd, UnknownSensorLabelIsAnErrorNamingTheFile)
 	cfg.ego.sensors.rgbd_label = "KINECT";
 	RunOptions opt;
 	opt.rawlogs = {kSample};
-	opt.progress = false;
 	const auto sum = runExperiment(cfg, opt);
 	EXPECT_NE(
 	    sum.error.find("pendulum_slow.rawlog: no CObservation3DRangeScan"),
@@ -534,7 +529,6 @@ TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 		opt.rawlogs = {kSample};
 		opt.frames = FrameRange{0, 19};
 		opt.outDir = tmpDir(name);
-		opt.progress = false;
 		const auto sum = runExperiment(c, opt);
 		EXPECT_TRUE(sum.error.empty()) << sum.error;
 		EXPECT_EQ(sum.framesProcessed, 20u);
@@ -614,7 +608,6 @@ TEST(EndToEnd, LabelledRawlogIsPlainByDefaultAndGzipOnRequest)
 		opt.rawlogs = {kSample};
 		opt.frames = FrameRange{3, 6};
 		opt.outDir = tmpDir("gz" + std::to_string(level));
-		opt.progress = false;
 		const auto sum = runExperiment(c, opt);
 		ASSERT_TRUE(sum.error.empty()) << sum.error;
 		const std::string f = opt.outDir + "/segmented.rawlog";
@@ -644,7 +637,6 @@ TEST(EndToEnd, RawlogEditOpensTheLabelledRawlog)
 	opt.rawlogs = {kSample};
 	opt.frames = FrameRange{0, 4};
 	opt.outDir = tmpDir("rawlogedit");
-	opt.progress = false;
 	ASSERT_TRUE(runExperiment(cfg, opt).error.empty());
 	const std::string log = opt.outDir + "/info.txt";
 	ASSERT_EQ(std::system(("rawlog-edit --info -i '" + opt.outDir +
@@ -672,7 +664,6 @@ TEST(EndToEnd, WriteErrorStopsTheRunNamingTheFileAndKeepsEarlierFrames)
 		opt.frames = FrameRange{0, 29};
 		opt.outDir = tmpDir(threads ? "writeerr_t" : "writeerr_s");
 		fs::create_directories(opt.outDir + "/masks/000003.png/x");
-		opt.progress = false;
 		const auto sum = runExperiment(cfg, opt);
 		EXPECT_NE(sum.error.find("masks/000003.png: is a folder, cannot write"),
 		          std::string::npos)
@@ -706,7 +697,6 @@ TEST(EndToEnd, ARunFromItsEffectiveIniWritesTheSameOutputs)
 		opt.rawlogs = {kSample};
 		opt.frames = FrameRange{0, 14};
 		opt.outDir = tmpDir(name);
-		opt.progress = false;
 		const auto sum = runExperiment(c, opt);
 		EXPECT_TRUE(sum.error.empty()) << sum.error;
 		EXPECT_EQ(sum.framesProcessed, 15u);

@@ -36,7 +36,6 @@ TEST(StrayEndToEnd, DepthAndImuTrackAndSegmentWithoutColour)
 		ip.loadFromConfigFile(f);
 	}
 	ev::StrayImportOptions io;
-	io.progress = false;
 	const auto imp =
 	    ev::importStray(bims::test::kStrayEarly, dir + "/s.rawlog", ip, io);
 	ASSERT_EQ(imp.frames, 331u);
@@ -46,7 +45,6 @@ TEST(StrayEndToEnd, DepthAndImuTrackAndSegmentWithoutColour)
 	cfg.loadFromFile(config);
 	RunOptions opt;
 	opt.rawlogs = {dir + "/s.rawlog"};
-	opt.progress = false;
 	bims::Trajectory est;
 	std::vector<ev::MaskFile> preds;
 	std::vector<cv::Mat> masks;

@@ -1,8 +1,9 @@
+#include <bims/apps/app.h>
 #include <bims/apps/bag_import_run.h>
 #include <bims/apps/import_options.h>
-#include <bims/common/app.h>
+#include <bims/apps/output_checks.h>
+#include <bims/apps/progress_bar.h>
 #include <bims/common/config.h>
-#include <bims/common/output_paths.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/format.h>
 
@@ -125,7 +126,8 @@ int runBagImport(const BagImportRunOptions& o)
 	BagImportOptions opt;
 	opt.maxFrames = o.max_frames;
 	opt.gzLevel = o.gz;
-	opt.progress = o.progress;
+	ProgressBar bar("import", 0, o.progress);
+	opt.progress = bar.callback();
 	const auto sum = importBag(o.bags, o.out, params, opt);
 	std::fputs(bagImportReport(o.out, sum, params).c_str(), stdout);
 	return 0;

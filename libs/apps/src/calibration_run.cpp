@@ -1,6 +1,8 @@
+#include <bims/apps/app.h>
 #include <bims/apps/calibration_run.h>
+#include <bims/apps/frame_range_option.h>
 #include <bims/apps/odometry_run.h>
-#include <bims/common/app.h>
+#include <bims/apps/output_checks.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
@@ -16,10 +18,6 @@
 namespace bims::apps
 {
 using source::FrameRange;
-using source::frameRangeOption;
-using source::ReplayOptions;
-using source::replayRawlog;
-using source::ReplayStats;
 
 void RotationPairCollector::addFrame(const ego::FrameEgomotion& r)
 {
@@ -57,8 +55,7 @@ int runImuCalibration(const ImuCalibrationOptions& o)
 	checkOutputsSpareInputs(
 	    {o.config, o.rawlog, o.calib},
 	    o.out ? std::vector<std::string>{*o.out} : std::vector<std::string>{});
-	ego::EgoConfig ec;
-	ec.loadFromFile(o.config);
+	ego::EgoConfig ec = egoConfigOption(o.config);
 	if (!o.calib.empty()) overrideSensorSectionsFrom(ec, o.calib, "file");
 	const bool haveRef = ec.calibration.has_R_IC;
 	const Eigen::Matrix3d R_ref = ec.calibration.R_IC;
@@ -131,8 +128,7 @@ double largestDepthCorrection(const ego::DepthCorrectionParams& p,
 int runDepthCalibration(const DepthCalibrationOptions& o)
 {
 	checkOutputsSpareInputs({o.config, o.rawlog, o.poses}, {o.out});
-	ego::EgoConfig ec;
-	ec.loadFromFile(o.config);
+	ego::EgoConfig ec = egoConfigOption(o.config);
 	// raw depth, frame-to-frame vision odometry
 	ec.odometry.mode = ego::OdometryMode::Vision;
 	ec.anchor.enable = false;

@@ -1,5 +1,8 @@
+#include <bims/apps/app.h>
 #include <bims/apps/flow_check.h>
-#include <bims/common/app.h>
+#include <bims/apps/frame_range_option.h>
+#include <bims/apps/output_checks.h>
+#include <bims/apps/progress_bar.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/rgbd_input.h>
@@ -122,9 +125,10 @@ int runFlowCheck(const FlowCheckOptions& o)
 
 	pipeline::RunOptions opt;
 	opt.rawlogs = {o.rawlog};
-	opt.progress = o.progress;
-	opt.frames = pipeline::frameRangeOption(o.frames, opt.rawlogs,
-	                                        cfg.ego.sensors.rgbd_label);
+	ProgressBar bar("bims-run", 0, o.progress);  // runExperiment's line
+	opt.progress = bar.callback();
+	opt.frames =
+	    frameRangeOption(o.frames, opt.rawlogs, cfg.ego.sensors.rgbd_label);
 	std::unique_ptr<AppendFile> csv;  // each line checked
 	if (o.csv)
 	{

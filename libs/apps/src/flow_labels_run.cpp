@@ -1,5 +1,6 @@
+#include <bims/apps/app.h>
 #include <bims/apps/flow_labels_run.h>
-#include <bims/common/app.h>
+#include <bims/apps/output_checks.h>
 #include <bims/common/choice.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>

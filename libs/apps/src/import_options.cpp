@@ -1,5 +1,5 @@
+#include <bims/apps/app.h>
 #include <bims/apps/import_options.h>
-#include <bims/common/app.h>
 #include <bims/common/config.h>
 
 #include <filesystem>

@@ -1,5 +1,6 @@
+#include <bims/apps/app.h>
 #include <bims/apps/odometry_run.h>
-#include <bims/common/app.h>
+#include <bims/apps/output_checks.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
 #include <bims/common/output_paths.h>
@@ -18,9 +19,6 @@
 
 namespace bims::apps
 {
-using source::ReplayOptions;
-using source::replayRawlog;
-using source::ReplayStats;
 
 void overrideSensorSectionsFrom(ego::EgoConfig& ec, const std::string& calib,
                                 const std::string& noSuch)
@@ -32,10 +30,23 @@ void overrideSensorSectionsFrom(ego::EgoConfig& ec, const std::string& calib,
 	ec.overrideSensorSections(*cal);
 }
 
-ego::EgoConfig odometryConfig(const OdometryRunOptions& o)
+ego::EgoConfig egoConfigOption(const std::string& path)
 {
 	ego::EgoConfig ec;
-	ec.loadFromFile(o.config);
+	try
+	{
+		ec.loadFromFile(path);
+	}
+	catch (const ConfigFileMissing& e)
+	{
+		throw UsageError(e.what());
+	}
+	return ec;
+}
+
+ego::EgoConfig odometryConfig(const OdometryRunOptions& o)
+{
+	ego::EgoConfig ec = egoConfigOption(o.config);
 	if (!o.calib.empty())
 		overrideSensorSectionsFrom(ec, o.calib, "calibration file");
 	if (o.mode)

@@ -1,9 +1,11 @@
 // bims-run's command: the options of its command line into a run
 // (runExperiment) and its report.
+#include <bims/apps/app.h>
+#include <bims/apps/frame_range_option.h>
+#include <bims/apps/output_checks.h>
+#include <bims/apps/progress_bar.h>
 #include <bims/apps/run_command.h>
-#include <bims/common/app.h>
 #include <bims/common/choice.h>
-#include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
 
 #include <csignal>
@@ -13,7 +15,6 @@
 namespace bims::apps
 {
 using pipeline::formatSummary;
-using pipeline::frameRangeOption;
 using pipeline::runExperiment;
 using pipeline::RunOptions;
 using pipeline::runOutputLayout;
@@ -69,7 +70,8 @@ int runFromCommandLine(const RunCommand& c)
 	RunOptions opt;
 	opt.rawlogs = c.rawlogs;
 	opt.outDir = c.outDir;
-	opt.progress = c.progress;
+	ProgressBar bar("bims-run", 0, c.progress);
+	opt.progress = bar.callback();
 	if (c.installStop) opt.stop = &c.installStop();
 	opt.frames =
 	    frameRangeOption(c.frames, opt.rawlogs, cfg.ego.sensors.rgbd_label);

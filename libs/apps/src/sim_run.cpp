@@ -1,5 +1,7 @@
+#include <bims/apps/app.h>
+#include <bims/apps/output_checks.h>
+#include <bims/apps/progress_bar.h>
 #include <bims/apps/sim_run.h>
-#include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
@@ -124,7 +126,8 @@ int runSim(const SimOptions& o)
 	if (o.config) throw UsageError("--config only applies to --imu-from-tum");
 	const SimConfig cfg = simConfigFor(o);
 	prepareGroundTruthDir();
-	const auto st = runSimulation(cfg, o.out, o.seed, o.progress,
+	ProgressBar bar("bims-sim", 0, o.progress);
+	const auto st = runSimulation(cfg, o.out, o.seed, bar.callback(),
 	                              o.preview.value_or(-1), o.stop);
 	std::fputs(simSummary(st, cfg).c_str(), stderr);
 	if (st.interrupted)

@@ -1,8 +1,9 @@
+#include <bims/apps/app.h>
 #include <bims/apps/import_options.h>
+#include <bims/apps/output_checks.h>
+#include <bims/apps/progress_bar.h>
 #include <bims/apps/stray_import_run.h>
-#include <bims/common/app.h>
 #include <bims/common/config.h>
-#include <bims/common/output_paths.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/format.h>
 
@@ -76,7 +77,8 @@ int runStrayImport(const StrayImportRunOptions& o)
 	StrayImportOptions opt;
 	opt.maxFrames = o.max_frames;
 	opt.gzLevel = o.gz;
-	opt.progress = o.progress;
+	ProgressBar bar("bims-import-stray", 0, o.progress);
+	opt.progress = bar.callback();
 	// the capture's files are inputs too: -o FOLDER/imu.csv is refused
 	const StrayCapture cap = readStrayCapture(o.folder);
 	auto inputs = strayInputFiles(cap);

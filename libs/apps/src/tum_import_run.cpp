@@ -1,6 +1,8 @@
+#include <bims/apps/app.h>
 #include <bims/apps/import_options.h>
+#include <bims/apps/output_checks.h>
+#include <bims/apps/progress_bar.h>
 #include <bims/apps/tum_import_run.h>
-#include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/output_paths.h>
 #include <bims/eval/pose_utils.h>
@@ -86,7 +88,8 @@ int runImport(const ImportRunOptions& o)
 	opt.maxFrames = o.max_frames;
 	opt.bonnGt = o.bonn_gt;
 	opt.gzLevel = o.gz;
-	opt.progress = o.progress;
+	ProgressBar bar("import", 0, o.progress);
+	opt.progress = bar.callback();
 	const bool bonnConverted = opt.bonnGt || params.bonnGt;
 	if (o.synth_imu)
 	{

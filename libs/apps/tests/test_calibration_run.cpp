@@ -1,8 +1,8 @@
 // The calibration programs' runs (calibration_run.h): the gyro/vision
 // rotation pairs, bims-calib-imu's .ini, the size of a depth correction and
 // both runs on the bundled sample.
+#include <bims/apps/app.h>
 #include <bims/apps/calibration_run.h>
-#include <bims/common/app.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/so3.h>
 #include <bims_test/sample.h>

@@ -1,7 +1,7 @@
 // bims-flow-check's logic (flow_check.h): its lines, its summary, a strip
 // tile, and a run over the bundled sample.
+#include <bims/apps/app.h>
 #include <bims/apps/flow_check.h>
-#include <bims/common/app.h>
 #include <bims_test/sample.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>

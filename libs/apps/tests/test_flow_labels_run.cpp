@@ -1,7 +1,7 @@
 // bims-flow-labels' run (flow_labels_run.h): the pose of its command line,
 // the files written, bad inputs named.
+#include <bims/apps/app.h>
 #include <bims/apps/flow_labels_run.h>
-#include <bims/common/app.h>
 #include <bims_test/flow_texture.h>
 #include <bims_test/png_bomb.h>
 #include <bims_test/tmp_dir.h>

@@ -1,8 +1,8 @@
 // bims-odom's run (odometry_run.h): its configuration from the options, the
 // tracker's accuracy against the truth, the CSV and the whole run on the
 // bundled sample.
+#include <bims/apps/app.h>
 #include <bims/apps/odometry_run.h>
-#include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/trajectory.h>
 #include <bims_test/sample.h>
@@ -70,6 +70,24 @@ TEST(OdometryRun, OptionsOverrideTheConfigAndBadValuesAreUsageErrors)
 	{
 		EXPECT_EQ(std::string(e.what()),
 		          bad.calib + ": no such calibration file");
+	}
+}
+
+TEST(OdometryRun, AMissingConfigIsAUsageErrorNamingIt)
+{
+	// the library's error is a ConfigFileMissing; the programs' a usage
+	// error (exit code 2), with the same message
+	const std::string none = kSampleGt + "no_such_config.ini";
+	bims::ego::EgoConfig ec;
+	EXPECT_THROW(ec.loadFromFile(none), bims::ConfigFileMissing);
+	try
+	{
+		egoConfigOption(none);
+		ADD_FAILURE() << "no error for a missing config";
+	}
+	catch (const bims::UsageError& e)
+	{
+		EXPECT_EQ(std::string(e.what()), none + ": no such config file");
 	}
 }
 

@@ -1,7 +1,7 @@
 // bims-run's command (bims/apps/run_command.h): --variant, the exit code,
 // --print-config.
+#include <bims/apps/app.h>
 #include <bims/apps/run_command.h>
-#include <bims/common/app.h>
 #include <gtest/gtest.h>
 
 #include <csignal>

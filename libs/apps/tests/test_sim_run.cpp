@@ -1,8 +1,8 @@
 // bims-sim's run (sim_app.h) called directly: the options' checks, the
 // scene run's configuration, the IMU synthesis from a TUM trajectory and
 // the summary line; the synthetic IMU of bims-import-tum --synth-imu.
+#include <bims/apps/app.h>
 #include <bims/apps/sim_run.h>
-#include <bims/common/app.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/sim/imu.h>

@@ -1,7 +1,7 @@
 // bims-import-tum's run (tum_import_run.h) called directly: the report,
 // the option checks and the synthetic IMU asked of the program's hook.
+#include <bims/apps/app.h>
 #include <bims/apps/tum_import_run.h>
-#include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>

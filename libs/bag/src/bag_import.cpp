@@ -832,7 +832,9 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 
 	PartialFile part(outRawlog);
 	RawlogWriter w(part.path(), options.gzLevel);
-	ProgressBar bar("import", frames.size(), options.progress);
+	Progress progress;
+	progress.total = frames.size();
+	reportProgress(options.progress, progress);
 	for (size_t k = 0; k < items.size(); k++)
 	{
 		const auto next = ahead.pop();
@@ -851,7 +853,8 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 		w.write(*next.obs);
 		if (items[k].kind == 1)
 		{
-			bar.update(++sum.frames);
+			progress.done = ++sum.frames;
+			reportProgress(options.progress, progress);
 			continue;
 		}
 		const auto& s = imu[items[k].i];
@@ -866,7 +869,8 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 	sum.colourEncoding = colourEncoding;
 	w.close();
 	part.commit();
-	bar.finish();
+	progress.finished = true;
+	reportProgress(options.progress, progress);
 	return sum;
 }
 

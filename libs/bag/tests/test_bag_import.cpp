@@ -89,7 +89,6 @@ bag::BagImportSummary import(const std::string& bagPath, const std::string& out,
                              bag::BagImportParams p = {})
 {
 	bag::BagImportOptions o;
-	o.progress = false;
 	o.gzLevel = 0;
 	return bag::importBag({bagPath}, out, p, o);
 }
@@ -371,7 +370,6 @@ TEST(ImportBag, ATumLayoutBagGivesTheRawlogOfTheTumFolderOfTheSameFrames)
 	tp.camera.width = static_cast<int>(f0.cameraParams.ncols);
 	tp.camera.height = static_cast<int>(f0.cameraParams.nrows);
 	eval::ImportOptions to;
-	to.progress = false;
 	to.gzLevel = 0;
 	eval::importTum(d + "/folder", d + "/folder.rawlog", tp, to);
 

@@ -1,5 +1,5 @@
-#include <bims/common/app.h>
 #include <bims/common/config.h>
+#include <bims/common/errors.h>
 #include <mrpt/config/CConfigFile.h>
 
 #include <algorithm>

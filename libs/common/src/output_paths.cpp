@@ -1,4 +1,3 @@
-#include <bims/common/app.h>
 #include <bims/common/output_paths.h>
 #include <fcntl.h>
 #include <unistd.h>
@@ -17,27 +16,6 @@ namespace bims
 {
 namespace
 {
-/** The path with links, `.` and `..` resolved as far as it exists. */
-fs::path resolved(const std::string& p)
-{
-	std::error_code ec;
-	fs::path r = fs::weakly_canonical(p, ec);
-	if (ec) r = fs::absolute(p, ec).lexically_normal();
-	return r;
-}
-
-/** \a inner is \a outer or lies inside it (component by component). */
-bool within(const fs::path& inner, const fs::path& outer)
-{
-	auto i = inner.begin();
-	for (auto o = outer.begin(); o != outer.end(); ++o, ++i)
-	{
-		if (o->empty() && std::next(o) == outer.end()) break;  // trailing '/'
-		if (i == inner.end() || *i != *o) return false;
-	}
-	return true;
-}
-
 std::runtime_error systemError(const std::string& path, const char* what)
 {
 	return std::runtime_error(path + ": " + what + ": " + std::strerror(errno));
@@ -69,37 +47,13 @@ void checkOutputFilesWritable(const std::vector<std::string>& files)
 	}
 }
 
-void checkOutputsSpareInputs(const std::vector<std::string>& inputs,
-                             const std::vector<std::string>& outputs)
+void makeDirs(const std::string& path)
 {
-	std::vector<fs::path> resolvedIn;  // once: a folder may hold thousands
-	for (const auto& in : inputs)
-		resolvedIn.push_back(in.empty() ? fs::path() : resolved(in));
-	for (const auto& out : outputs)
-	{
-		if (out.empty())
-			throw UsageError(
-			    "the output path is empty (nothing would be "
-			    "written)");
-		const fs::path ro = resolved(out);
-		for (size_t k = 0; k < inputs.size(); ++k)
-		{
-			const auto& in = inputs[k];
-			if (in.empty()) continue;
-			const fs::path& ri = resolvedIn[k];
-			if (!within(ri, ro)) continue;
-			const std::string both =
-			    ro == fs::path(out) && ri == fs::path(in)
-			        ? std::string()
-			        : " (" + ro.string() + " and " + ri.string() + ")";
-			if (ri == ro)
-				throw UsageError("output " + out +
-				                 " would overwrite the input " + in + both);
-			throw UsageError("output folder " + out + " contains the input " +
-			                 in + both +
-			                 ": choose an output that holds no input");
-		}
-	}
+	std::error_code ec;
+	std::filesystem::create_directories(path, ec);
+	if (ec)
+		throw std::runtime_error(path +
+		                         ": cannot create directory: " + ec.message());
 }
 
 void replaceSymlink(const std::string& path)
@@ -117,7 +71,7 @@ void replaceSymlink(const std::string& path)
 PartialFile::PartialFile(std::string finalPath)
     : final_(std::move(finalPath)), partial_(final_ + ".partial")
 {
-	if (final_.empty()) throw UsageError("the output path is empty");
+	if (final_.empty()) throw std::invalid_argument("the output path is empty");
 	replaceSymlink(partial_);
 	std::error_code ec;
 	if (fs::is_directory(fs::symlink_status(final_, ec)))
@@ -182,7 +136,7 @@ void PartialDir::commit()
 			                         ": exists and is not a folder (the new "
 			                         "files stay in " +
 			                         partial_ + ")");
-		prepareOutputFolder(final_, layout_, true);  // the earlier run's
+		removeEarlierOutputs(final_, layout_);  // the earlier run's
 		if (fs::is_empty(final_, ec)) fs::remove(final_, ec);
 	}
 	if (!fs::exists(fs::symlink_status(final_, ec)))
@@ -360,6 +314,32 @@ std::vector<std::string> earlierOutputs(const std::string& dir,
 	return found;
 }
 
+size_t removeEarlierOutputs(const std::string& dir,
+                            const OutputFolderLayout& layout,
+                            const std::string& why)
+{
+	const auto found = earlierOutputs(dir, layout);
+	if (found.empty()) return 0;
+	for (const auto& f : found)
+	{
+		std::error_code ec;
+		if (fs::is_directory(fs::symlink_status(f, ec)))
+			throw std::runtime_error(f +
+			                         ": is a folder where the run writes a "
+			                         "file; not removed");
+		if (!fs::remove(f, ec) || ec)
+			throw std::runtime_error(f + ": cannot remove it for " + why +
+			                         ": " + ec.message());
+	}
+	for (const auto& [sub, ext] : layout.frameFolders)
+	{
+		std::error_code ec;
+		if (!sub.empty() && fs::is_empty(fs::path(dir) / sub, ec))
+			fs::remove(fs::path(dir) / sub, ec);
+	}
+	return found.size();
+}
+
 std::vector<std::string> frameFilesIn(const std::string& dir,
                                       const std::string& ext)
 {
@@ -370,50 +350,6 @@ std::vector<std::string> frameFilesIn(const std::string& dir,
 			files.push_back(e.path().string());
 	std::sort(files.begin(), files.end());
 	return files;
-}
-
-size_t prepareOutputFolder(const std::string& dir,
-                           const OutputFolderLayout& layout, bool overwrite,
-                           const std::string& overwriteFlag)
-{
-	namespace fs = std::filesystem;
-	const auto found = earlierOutputs(dir, layout);
-	if (found.empty()) return 0;
-	if (!overwrite)
-		for (const auto& f : found)
-			if (std::error_code ec; fs::is_symlink(f, ec))
-				throw UsageError(
-				    f +
-				    ": a symbolic link where the run writes a folder of its "
-				    "own: remove it, or give " +
-				    overwriteFlag +
-				    " to replace the link (what it points to is never "
-				    "touched)");
-	if (!overwrite)
-		throw UsageError(
-		    dir + ": holds the outputs of an earlier run (" +
-		    std::to_string(found.size()) + " files, e.g. " +
-		    fs::path(found.front()).lexically_relative(dir).string() +
-		    "); give " + overwriteFlag +
-		    " to replace them, or another output folder");
-	for (const auto& f : found)
-	{
-		std::error_code ec;
-		if (fs::is_directory(fs::symlink_status(f, ec)))
-			throw std::runtime_error(f +
-			                         ": is a folder where the run writes a "
-			                         "file; not removed");
-		if (!fs::remove(f, ec) || ec)
-			throw std::runtime_error(f + ": cannot remove it for " +
-			                         overwriteFlag + ": " + ec.message());
-	}
-	for (const auto& [sub, ext] : layout.frameFolders)
-	{
-		std::error_code ec;
-		if (!sub.empty() && fs::is_empty(fs::path(dir) / sub, ec))
-			fs::remove(fs::path(dir) / sub, ec);
-	}
-	return found.size();
 }
 
 }  // namespace bims

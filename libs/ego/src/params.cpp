@@ -1,4 +1,3 @@
-#include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
 #include <bims/common/share.h>
@@ -352,7 +351,8 @@ void EgoConfig::loadFromFile(const std::string& given)
 {
 	const std::string path = resolvePreset(given);  // "stray.ini": a preset
 	if (!mrpt::system::fileExists(path))
-		throw UsageError(path + ": no such config file" + presetHint(path));
+		throw ConfigFileMissing(path + ": no such config file" +
+		                        presetHint(path));
 	const auto cfg = bims::openIniFile(path);
 	checkExperimentSections(*cfg);
 	loadFromConfigFile(*cfg, false);

@@ -173,7 +173,9 @@ StrayImportSummary importStray(const StrayCapture& cap,
 	// OUT.rawlog.partial until complete
 	PartialFile part(outRawlog);
 	RawlogWriter w(part.path(), options.gzLevel);
-	ProgressBar bar("bims-import-stray", frames.size(), options.progress);
+	Progress progress;
+	progress.total = frames.size();
+	reportProgress(options.progress, progress);
 	cv::Mat bgr, small;
 	for (const auto& it : items)
 	{
@@ -243,7 +245,8 @@ StrayImportSummary importStray(const StrayCapture& cap,
 			attachColour(*o, small);
 		}
 		w.write(*o);
-		bar.update(++sum.frames);
+		progress.done = ++sum.frames;
+		reportProgress(options.progress, progress);
 	}
 	// all of the video read: nothing may be left (a container that
 	// counted its frames wrong)
@@ -254,7 +257,8 @@ StrayImportSummary importStray(const StrayCapture& cap,
 		    std::to_string(cap.frames.size()) + " depth frames");
 	w.close();
 	part.commit();
-	bar.finish();
+	progress.finished = true;
+	reportProgress(options.progress, progress);
 
 	// ARKit's poses at the written frames, from the first with a position
 	sum.referencePath = strayReferencePathFor(outRawlog);

@@ -1,4 +1,3 @@
-#include <bims/common/app.h>
 #include <bims/common/image_file.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/progress.h>
@@ -161,13 +160,16 @@ ImportSummary importTum(TumFolder tum, const std::string& outRawlog,
 	// half-written rawlog under the final name
 	PartialFile part(outRawlog);
 	RawlogWriter w(part.path(), options.gzLevel);
-	ProgressBar bar("import", tum.frames.size(), options.progress);
+	Progress progress;
+	progress.total = tum.frames.size();
+	reportProgress(options.progress, progress);
 	for (const auto& it : items)
 	{
 		if (it.kind == 2)
 		{
 			w.write(*loadFrame(tum.frames[it.i], params));
-			bar.update(++sum.frames);
+			progress.done = ++sum.frames;
+			reportProgress(options.progress, progress);
 		}
 		else if (it.kind == 1)
 		{
@@ -186,7 +188,8 @@ ImportSummary importTum(TumFolder tum, const std::string& outRawlog,
 	w.close();
 	part.commit();
 	gtPart.commit();
-	bar.finish();
+	progress.finished = true;
+	reportProgress(options.progress, progress);
 	return sum;
 }
 

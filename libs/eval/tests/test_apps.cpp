@@ -1,7 +1,7 @@
 // End-to-end tests of bims-import-tum and bims-eval (run the built programs).
-#include <bims/common/app.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
+#include <bims/common/version.h>
 #include <bims/eval/tum_import.h>
 #include <bims_test/data.h>
 #include <bims_test/png_bomb.h>
@@ -453,7 +453,7 @@ TEST(ImportParams, BonnIniAndStrictKeys)
 	EXPECT_THROW(q.loadFromConfigFile(range), std::exception);
 }
 
-TEST(Apps, HelpExitsCleanlyAndBadOptionsAreUsageErrors)
+TEST(Apps, HelpExitsCleanlyAndBadOptionsExitWithCodeTwo)
 {
 	// MRPT's TCLAP prints --help and parse errors and returns instead of
 	// exiting: no program may go on with empty arguments after them.

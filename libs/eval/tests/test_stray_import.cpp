@@ -2,7 +2,6 @@
 // Stray Scanner capture made by the test itself, imported and checked
 // convention by convention; bad input; the shared real capture (skipped without
 // it); the built program's command line.
-#include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
@@ -191,7 +190,6 @@ std::string makeCapture(const std::string& name, const CaptureSpec& spec = {})
 ev::StrayImportOptions quiet()
 {
 	ev::StrayImportOptions o;
-	o.progress = false;
 	return o;
 }
 
@@ -443,6 +441,28 @@ TEST(ImportStray, SyntheticCaptureEveryConvention)
 	ASSERT_FALSE(o3.empty());
 	EXPECT_TRUE(std::dynamic_pointer_cast<CObservation3DRangeScan>(o3.back()));
 	EXPECT_NEAR(stampOf(*o3.back()), frameTime(2), 1e-6);
+}
+
+TEST(ImportStray, ProgressIsReportedThroughTheCallbackUpToTheTotal)
+{
+	CaptureSpec spec;
+	spec.video = false;
+	const auto d = makeCapture("progress", spec);
+	std::vector<bims::Progress> seen;
+	ev::StrayImportOptions o;
+	o.progress = [&](const bims::Progress& p) { seen.push_back(p); };
+	const auto sum = ev::importStray(d, d + "/../progress.rawlog", {}, o);
+	ASSERT_GE(seen.size(), 3u);
+	// {0, total} at the start, each frame done, the last one finished
+	EXPECT_EQ(seen.front().done, 0u);
+	for (const auto& p : seen) EXPECT_EQ(p.total, sum.frames);
+	for (size_t k = 1; k < seen.size(); ++k)
+		EXPECT_GE(seen[k].done, seen[k - 1].done);
+	EXPECT_EQ(seen.back().done, sum.frames);
+	EXPECT_TRUE(seen.back().finished);
+	EXPECT_EQ(std::count_if(seen.begin(), seen.end(),
+	                        [](const bims::Progress& p) { return p.finished; }),
+	          1);
 }
 
 TEST(ImportStray, WithoutVideoScansHaveNoColourAndItIsSaidOnce)

@@ -1,6 +1,5 @@
 // The labels of one image pair (pair_labels.h): the camera, the labels of a
 // still and a moved pair, the overlay.
-#include <bims/common/app.h>
 #include <bims/flow/pair_labels.h>
 #include <bims_test/flow_texture.h>
 #include <bims_test/png_bomb.h>

@@ -6,7 +6,6 @@
 
 #include <bims/common/cpu_time.h>
 
-#include <bims/common/app.h>
 #include <bims/common/pixel_labels.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>

@@ -1,4 +1,4 @@
-#include <bims/common/app.h>
+#include <bims/common/errors.h>
 #include <bims/common/imu_check.h>
 #include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
@@ -105,9 +105,9 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	// a bounded range has a known total; otherwise it is estimated from the
 	// share of the input read
 	const bool bounded = opt.frames.bounded();
-	ProgressBar bar("bims-run",
-	                bounded ? opt.frames.last - opt.frames.first + 1 : 0,
-	                opt.progress);
+	Progress progress;
+	progress.total = bounded ? opt.frames.last - opt.frames.first + 1 : 0;
+	reportProgress(opt.progress, progress);
 
 	FrameStepper stepper(pipe);
 	// after a frame ran: its statistics and outputs
@@ -159,12 +159,14 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		if (!bounded && f.inputFraction > 0)
 		{
 			const double scans = (f.index + 1) / f.inputFraction;
-			bar.setTotal(std::max(sum.framesProcessed,
-			                      static_cast<size_t>(scans + 0.5) -
-			                          std::min(opt.frames.first, f.index)),
-			             true);
+			progress.total = std::max(sum.framesProcessed,
+			                          static_cast<size_t>(scans + 0.5) -
+			                              std::min(opt.frames.first, f.index));
+			progress.estimated = true;
 		}
-		bar.update(sum.framesProcessed, "frame " + std::to_string(f.index));
+		progress.done = sum.framesProcessed;
+		progress.note = "frame " + std::to_string(f.index);
+		reportProgress(opt.progress, progress);
 	};
 
 	std::string readError;  ///< the input's, after the frames before it
@@ -213,7 +215,9 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		            (rgbdLabel.empty() ? std::string()
 		                               : " with label '" + rgbdLabel + "'");
 	}
-	bar.finish();
+	progress.finished = true;
+	progress.note.clear();
+	reportProgress(opt.progress, progress);
 
 	// Every output complete (queued frames, static map) before the clock
 	// stops: the frames/s are end to end.

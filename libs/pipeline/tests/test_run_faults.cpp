@@ -68,7 +68,6 @@ RunSummary runOn(const std::vector<std::string>& rawlogs,
 	RunOptions opt;
 	opt.rawlogs = rawlogs;
 	opt.outDir = out;
-	opt.progress = false;
 	return runExperiment(cfg, opt);
 }
 

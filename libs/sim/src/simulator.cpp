@@ -1,4 +1,3 @@
-#include <bims/common/app.h>
 #include <bims/common/frame_files.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/pixel_labels.h>
@@ -161,8 +160,8 @@ const OutputFolderLayout& groundTruthLayout()
 }
 
 SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
-                       uint64_t seed, bool progress, int previewFrame,
-                       const std::atomic<bool>* stop)
+                       uint64_t seed, const ProgressCallback& progress,
+                       int previewFrame, const std::atomic<bool>* stop)
 {
 	const auto tStart = std::chrono::steady_clock::now();
 	const std::clock_t cpuStart = std::clock();
@@ -219,7 +218,9 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 		gtImu.append(lines);
 	};
 
-	ProgressBar bar("bims-sim", size_t(cfg.seq.frames), progress);
+	Progress rendered;
+	rendered.total = size_t(cfg.seq.frames);
+	reportProgress(progress, rendered);
 	RenderedFrame frame;
 	double movingSum = 0;
 	int done = 0;  // frames written
@@ -258,7 +259,8 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 			               tumLine(t0 + tSeq, toPose(R, x)) + "\n";
 		}
 		gtObjects.append(objectLines);
-		bar.update(size_t(j + 1));
+		rendered.done = size_t(j + 1);
+		reportProgress(progress, rendered);
 	}
 	st.interrupted = done < cfg.seq.frames;
 	// IMU a little past the last frame written
@@ -268,7 +270,8 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	for (auto* f : {&gtPoses, &gtImu, &gtObjects}) f->close();
 	part.commit();
 	gtPart.commit();
-	bar.finish();
+	rendered.finished = true;
+	reportProgress(progress, rendered);
 
 	st.frames = size_t(done);
 	st.imuSamples = nextImu;

@@ -1,4 +1,3 @@
-#include <bims/common/app.h>
 #include <bims/common/rawlog.h>
 #include <bims/source/frame_source.h>
 
@@ -67,25 +66,7 @@ void checkFrameRangeInInputs(const FrameRange& range,
 	if (range.first < n)
 		msg +=
 		    "; --frames " + std::to_string(range.first) + ": runs to its end";
-	throw UsageError(msg);
-}
-
-FrameRange frameRangeOption(const std::string& text,
-                            const std::vector<std::string>& rawlogs,
-                            const std::string& rgbdLabel)
-{
-	if (text.empty()) return {};
-	FrameRange r;
-	try
-	{
-		r = FrameRange::parse(text);
-	}
-	catch (const std::invalid_argument& e)
-	{
-		throw UsageError(e.what());
-	}
-	checkFrameRangeInInputs(r, rawlogs, rgbdLabel);
-	return r;
+	throw std::invalid_argument(msg);
 }
 
 }  // namespace bims::source

@@ -1,5 +1,5 @@
 #include "read_ahead.h"
-#include <bims/common/app.h>
+#include <bims/common/errors.h>
 
 #include <bims/common/clock.h>
 #include <bims/common/cpu_time.h>

@@ -2,6 +2,7 @@
 // when a frame is released, with which IMU samples, and which scans are
 // skipped and why.
 #include <bims/source/frame_source.h>
+#include <bims_test/sample.h>
 #include <gtest/gtest.h>
 
 #include <mrpt/core/Clock.h>
@@ -426,4 +427,34 @@ TEST(FrameOrder, WithoutWarningsTheSameFramesAndCountsAndNothingOnStderr)
 	EXPECT_NE(loud.find("a stray timestamp"), std::string::npos);
 	EXPECT_NE(loud.find("sample not used"), std::string::npos);
 	EXPECT_EQ(quiet, "");
+}
+
+TEST(FrameRange, ARangeBeyondTheInputIsAPlainErrorNamingItAndTheCount)
+{
+	// the library's error: std::invalid_argument (bims/apps makes it a
+	// usage error with the same message)
+	const std::string in = bims::test::kSample;
+	EXPECT_NO_THROW(
+	    checkFrameRangeInInputs(FrameRange::parse("0:149"), {in}, "RGBD"));
+	try
+	{
+		checkFrameRangeInInputs(FrameRange::parse("140:160"), {in}, "RGBD");
+		ADD_FAILURE() << "no error for a range beyond the input";
+	}
+	catch (const std::invalid_argument& e)
+	{
+		EXPECT_EQ(std::string(e.what()),
+		          "--frames 140:160: the input (" + in +
+		              ") has 150 3D scans (0 to 149) with label 'RGBD'; "
+		              "--frames 140: runs to its end");
+	}
+	try
+	{
+		FrameRange::parse("7:3");
+		ADD_FAILURE() << "no error for A > B";
+	}
+	catch (const std::invalid_argument& e)
+	{
+		EXPECT_EQ(std::string(e.what()), "--frames '7:3': A > B");
+	}
 }

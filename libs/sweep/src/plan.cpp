@@ -1,4 +1,3 @@
-#include <bims/common/app.h>
 #include <bims/common/config.h>
 #include <bims/common/output_paths.h>
 #include <bims/pipeline/config.h>

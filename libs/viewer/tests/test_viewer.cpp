@@ -1,7 +1,7 @@
 // The viewer's controller, without any GUI: replay order, timeline, play
 // clock, pipeline while replaying, panels, results folders, and an offscreen
 // render of the 3D view in which the three tier colours must appear.
-#include <bims/common/app.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/pipeline/run.h>
@@ -372,7 +372,6 @@ std::vector<Seen> batchFrames(const std::string& input)
 	std::vector<Seen> batch;
 	pipeline::RunOptions ro;
 	ro.rawlogs = {input};
-	ro.progress = false;
 	ro.onFrame = [&](const pipeline::FrameResult& r, const auto&) {
 		batch.push_back({r.index, r.T_WC, r.mask.clone()});
 	};

@@ -4,10 +4,10 @@
 // command line into OdometryRunOptions and calls runOdometry.
 #pragma once
 
+#include <bims/apps/odometry_replay.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/odometry.h>
 #include <bims/ego/rgbd_input.h>
-#include <bims/source/odometry_replay.h>
 
 #include <mrpt/poses/CPose3D.h>
 
@@ -46,6 +46,11 @@ struct OdometryRunOptions
  * noSuch: the NOUN) when it does not exist. bims-odom, bims-calib-imu. */
 void overrideSensorSectionsFrom(ego::EgoConfig& ec, const std::string& calib,
                                 const std::string& noSuch);
+
+/** The experiment file \a path of bims-odom, bims-calib-imu and
+ * bims-calib-depth (ego::EgoConfig::loadFromFile); a missing file is a
+ * UsageError naming it (exit code 2). */
+ego::EgoConfig egoConfigOption(const std::string& path);
 
 /** The configuration bims-odom runs: \a o.config, then \a o.calib's sensor
  * sections, --mode and --gyro-aid. Throws UsageError for a missing --calib

@@ -9,6 +9,7 @@
 
 #include <bims/common/choice.h>
 #include <bims/common/options.h>
+#include <bims/common/progress.h>
 #include <bims/eval/tum_import.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/img/TCamera.h>
@@ -140,7 +141,8 @@ struct BagImportOptions
 {
 	size_t maxFrames = 0;  ///< 0 = all
 	int gzLevel = 1;       ///< 0 = plain rawlog, 1..9 gzip
-	bool progress = true;  ///< progress line on stderr
+	/** The frames written (none: silent). */
+	ProgressCallback progress;
 };
 
 struct BagImportSummary

@@ -1,7 +1,9 @@
-// The one rule of every bims program that writes files: outputs never
-// alias inputs, a file the program creates replaces a symbolic link instead
-// of writing through it, and whole-file outputs appear under their final
-// name only once complete (written as NAME.partial, then renamed).
+// The one rule of every bims program that writes files: a file the program
+// creates replaces a symbolic link instead of writing through it, and
+// whole-file outputs appear under their final name only once complete
+// (written as NAME.partial, then renamed). The programs' checks before any
+// work (outputs never alias inputs, an earlier run's folder refused unless
+// --overwrite) are libs/apps's: bims/apps/output_checks.h.
 #pragma once
 
 #include <string>
@@ -22,17 +24,8 @@ namespace bims
  * (optional outputs not given) are ignored. */
 void checkOutputFilesWritable(const std::vector<std::string>& files);
 
-/** Refuses, before any work, outputs that would destroy an input: an empty
- * output path, an output that is an input, or an output folder that
- * contains an input. Paths are compared after resolving symbolic links, `.`
- * and `..` (std::filesystem::weakly_canonical), so a link or a relative
- * path to an input is the input. \a inputs: every file and folder the
- * program reads: also the files an input folder holds that it reads (a TUM
- * folder's lists and images, the masks of a mask folder: frameFilesIn)
- * and the files its .ini files name; empty strings (optional arguments not
- * given) are ignored. Throws UsageError naming both paths. */
-void checkOutputsSpareInputs(const std::vector<std::string>& inputs,
-                             const std::vector<std::string>& outputs);
+/** Creates a directory and its parents; throws naming it on failure. */
+void makeDirs(const std::string& path);
 
 /** Before a program creates the file \a path: a symbolic link there is
  * removed (the link itself, never its target), so the new file replaces the
@@ -66,16 +59,15 @@ struct OutputFolderLayout
 std::vector<std::string> earlierOutputs(const std::string& dir,
                                         const OutputFolderLayout& layout);
 
-/** Before a program writes into the folder \a dir: when \a dir holds files
- * of \a layout (an earlier run), throws UsageError naming the folder and
- * one of them, and suggesting \a overwriteFlag; with \a overwrite, removes
- * those files (and the per-frame sub-folders left empty) instead, never
- * anything else, and returns how many it removed. A per-frame sub-folder
- * that is a symbolic link is refused (naming it) or, with \a overwrite,
- * the link is removed: what it points to is never emptied. */
-size_t prepareOutputFolder(const std::string& dir,
-                           const OutputFolderLayout& layout, bool overwrite,
-                           const std::string& overwriteFlag = "--overwrite");
+/** Removes the files of \a layout found in \a dir (earlierOutputs) and
+ * the per-frame sub-folders left empty, never anything else; a symbolic
+ * link is removed, what it points to never emptied. Returns how many files
+ * it removed; throws naming a file it cannot remove (\a why: what removes
+ * them, in that message). The programs' --overwrite:
+ * bims/apps/output_checks.h (prepareOutputFolder). */
+size_t removeEarlierOutputs(const std::string& dir,
+                            const OutputFolderLayout& layout,
+                            const std::string& why = "--overwrite");
 
 /** A whole-file output written under PATH.partial and renamed to PATH by
  * commit() (std::rename: atomic, and it replaces a symbolic link at PATH,

@@ -1,57 +1,35 @@
-// The progress of a long command, on stderr (one implementation for every
-// program; -q turns it off):
-//   on a terminal, one line redrawn in place at most every 0.2 s:
-//     "bims-run [#####      ] 45/150 frames 30 % 12.3/s ETA 8.5 s frame 44"
-//   otherwise (a log file, a pipe), a plain line at every tenth of the total
-//   and at least every kLineEverySeconds, never a carriage return:
-//     "bims-run: 45/150 frames (30 %), 12.3 frames/s, 3.7 s, ETA 8.5 s"
-// A total that is an estimate (e.g. from the share of the input read)
-// prints as "~150"; without a total, the count and the rate alone.
+// How a long task of a library tells its progress: through a callback
+// (none: silent), never a line on a terminal of its own. The programs'
+// progress line, which they hand to the libraries as this callback:
+// bims/apps/progress_bar.h.
 #pragma once
 
-#include <chrono>
 #include <cstddef>
+#include <functional>
 #include <string>
 
 namespace bims
 {
-/** "8.5 s", "3 min 05 s", "1 h 02 min". */
-std::string formatDuration(double seconds);
-
-class ProgressBar
+/** One report of a long task. A task reports {0, total} as it starts,
+ * then as its steps get done, and once more with \a finished at its end
+ * (not after an error). */
+struct Progress
 {
- public:
-	/** Seconds between two plain lines at most (not on a terminal). */
-	static constexpr double kLineEverySeconds = 5.0;
-
-	/** \param total number of steps (0 = unknown). \param enabled false =
-	 * silent (-q). \param unit what a step is ("frames"). */
-	ProgressBar(std::string label, size_t total, bool enabled = true,
-	            std::string unit = "frames");
-	/** Sets the total (e.g. once known or estimated); \a estimated prints it
-	 * as "~N". */
-	void setTotal(size_t total, bool estimated = false);
-	/** Sets the number of steps done and draws when due. */
-	void update(size_t done, const std::string& extra = {});
-	/** Final line with the total time. */
-	void finish(const std::string& extra = {});
-
-	/** The text of one line (without "\r" or the end of line): \a done of
-	 * the total after \a seconds, as drawn on a terminal (\a tty) or as a
-	 * plain line. For tests. */
-	std::string text(size_t done, double seconds, bool tty,
-	                 const std::string& extra = {}) const;
-
- private:
-	void draw(size_t done, const std::string& extra, bool final);
-	std::string label_, unit_;
-	size_t total_;
-	bool estimated_ = false;
-	bool enabled_, tty_;
-	size_t lastTenth_ = 0;
-	size_t lastDone_ = 0;
-	std::chrono::steady_clock::time_point start_, last_;
-	bool finished_ = false;
+	size_t done = 0;   ///< steps done
+	size_t total = 0;  ///< steps in all (0: unknown)
+	/** \a total is an estimate (e.g. from the share of the input read). */
+	bool estimated = false;
+	bool finished = false;  ///< the last report: the task is over
+	std::string note;       ///< about the last step, e.g. "frame 44"
 };
+
+/** Receives a task's progress; an empty one: nobody listens. */
+using ProgressCallback = std::function<void(const Progress&)>;
+
+/** Hands \a p to \a cb when there is one. */
+inline void reportProgress(const ProgressCallback& cb, const Progress& p)
+{
+	if (cb) cb(p);
+}
 
 }  // namespace bims

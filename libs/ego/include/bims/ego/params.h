@@ -403,7 +403,7 @@ struct EgoConfig
 
 	/** Opens the experiment file \a path, checks its sections and reads
 	 * it (loadFromConfigFile(cfg, false)); a missing file is a
-	 * bims::UsageError naming it (what the egomotion programs share). */
+	 * bims::ConfigFileMissing naming it. */
 	void loadFromFile(const std::string& path);
 
 	/** Overrides [calibration], [camera] and [sensors] with those present

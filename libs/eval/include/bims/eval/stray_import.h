@@ -8,6 +8,7 @@
 #pragma once
 
 #include <bims/common/options.h>
+#include <bims/common/progress.h>
 #include <bims/common/trajectory.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/img/TCamera.h>
@@ -113,7 +114,8 @@ struct StrayImportOptions
 {
 	size_t maxFrames = 0;  ///< 0 = all
 	int gzLevel = 1;       ///< 0 = plain rawlog, 1..9 gzip
-	bool progress = true;  ///< progress line on stderr
+	/** The frames written (none: silent). */
+	ProgressCallback progress;
 };
 
 struct StrayImportSummary

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <bims/common/choice.h>
+#include <bims/common/progress.h>
 #include <bims/common/trajectory.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/img/TCamera.h>
@@ -140,7 +141,8 @@ struct ImportOptions
 	size_t maxFrames = 0;  ///< 0 = all
 	bool bonnGt = false;   ///< OR-ed with params.bonnGt
 	int gzLevel = 1;       ///< 0 = plain rawlog, 1..9 gzip
-	bool progress = true;  ///< progress line on stderr
+	/** The frames written (none: silent). */
+	ProgressCallback progress;
 	/** Extra observations (e.g. synthetic IMU) merged by timestamp; those
 	 * outside the imported frames' time span are dropped. */
 	std::vector<mrpt::obs::CObservation::Ptr> extra;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <bims/common/output_paths.h>
+#include <bims/common/progress.h>
 #include <bims/common/stats.h>
 #include <bims/pipeline/pipeline.h>
 #include <bims/source/frame_source.h>
@@ -22,10 +23,9 @@ namespace bims::pipeline
 /** Inclusive range of 3D-scan indices ("A:B", "A:" or ":B"). */
 using source::FrameRange;
 
-/** A program's --frames option and its check against the inputs (one home:
+/** The check of a --frames range against the inputs (one home:
  * bims/source/frame_source.h). */
 using source::checkFrameRangeInInputs;
-using source::frameRangeOption;
 
 /** Median and 95th percentile of a series (bims/common/stats.h). */
 using bims::Percentiles;
@@ -96,9 +96,12 @@ struct RunOptions
 	std::vector<std::string> rawlogs;
 	std::string outDir;  ///< empty: write nothing
 	FrameRange frames;
-	bool progress = true;
+	/** The frames processed of the range's or, without a bounded range,
+	 * of an estimate from the share of the input read; each report's note
+	 * "frame N" (the scan index). Empty: none. */
+	ProgressCallback progress;
 	FrameCallback onFrame;
-	/** When it turns true (e.g. bims::installStopSignals), the run stops
+	/** When it turns true (e.g. the programs' stop signals), the run stops
 	 * after the current frame: the frames done are written in full,
 	 * metrics.json says "status": "interrupted". */
 	const std::atomic<bool>* stop = nullptr;

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <bims/common/output_paths.h>
+#include <bims/common/progress.h>
 #include <bims/sim/imu.h>
 #include <bims/sim/motion.h>
 #include <bims/sim/objects.h>
@@ -84,14 +85,14 @@ const bims::OutputFolderLayout& groundTruthLayout();
  * groundTruthDirFor(outRawlog)/: groundtruth.txt (T_WC per frame, TUM), imu.txt
  * (true rates, forces, fields, biases), objects.txt (object poses per frame),
  * masks/NNNNNN.png, calibration.ini. Deterministic in (config, seed). \param
- * progress print a progress bar on stderr. \param previewFrame if >= 0, also
- * writes preview.png (RGB | depth | mask) of that frame into the ground-truth
- * folder. \param stop when it turns true (e.g. bims::installStopSignals), the
- * run ends after the current frame and writes everything for the frames done:
- * a complete, shorter sequence (the IMU up to half a frame past its last
- * frame, as a full run), SimStats::interrupted set. */
+ * progress receives the frames rendered (none: silent). \param previewFrame if
+ * >= 0, also writes preview.png (RGB | depth | mask) of that frame into the
+ * ground-truth folder. \param stop when it turns true (e.g. the program's stop
+ * signals), the run ends after the current frame and writes everything for the
+ * frames done: a complete, shorter sequence (the IMU up to half a frame past
+ * its last frame, as a full run), SimStats::interrupted set. */
 SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
-                       uint64_t seed, bool progress = true,
+                       uint64_t seed, const ProgressCallback& progress = {},
                        int previewFrame = -1,
                        const std::atomic<bool>* stop = nullptr);
 

@@ -78,23 +78,17 @@ struct FrameRange
 	static FrameRange parse(const std::string& s);
 };
 
-/** For --frames A:B, before any work: throws UsageError naming the range
- * and the inputs' 3D-scan count unless \a rawlogs hold the scans A to B
- * (A, when open-ended). Reads them up to that scan (bims::count3DScans),
- * counting the scans with label \a rgbdLabel (all when empty), as
- * the frame sources number them. Nothing to check for the whole input, nor
- * when an input cannot be read that far (missing, truncated): the run
- * reports that as it would without a range. */
+/** For --frames A:B, before any work: throws std::invalid_argument naming
+ * the range and the inputs' 3D-scan count unless \a rawlogs hold the scans
+ * A to B (A, when open-ended). Reads them up to that scan
+ * (bims::count3DScans), counting the scans with label \a rgbdLabel (all
+ * when empty), as the frame sources number them. Nothing to check for the
+ * whole input, nor when an input cannot be read that far (missing,
+ * truncated): the run reports that as it would without a range. (A
+ * program's --frames option: bims/apps/frame_range_option.h.) */
 void checkFrameRangeInInputs(const FrameRange& range,
                              const std::vector<std::string>& rawlogs,
                              const std::string& rgbdLabel);
-
-/** A program's --frames option: \a text "" (not given) is the whole input;
- * otherwise parsed (bad text: UsageError naming it) and checked against
- * the inputs (checkFrameRangeInInputs). */
-FrameRange frameRangeOption(const std::string& text,
-                            const std::vector<std::string>& rawlogs,
-                            const std::string& rgbdLabel);
 
 /** What the rule takes from an experiment's configuration. */
 struct FrameOrderParams

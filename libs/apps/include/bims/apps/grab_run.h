@@ -1,11 +1,11 @@
-// bims-grab's logic (docs/grab.md): the sensors of a grab .ini into a
-// flushed rawlog, each frame optionally segmented as it comes
-// (pipeline::LiveSegmentation) and shown in a window with its moving mask.
-// The program's main reads its command line into GrabOptions, installs the
-// stop signals and runs a GrabApp.
+// bims-grab's run (docs/grab.md): the sensors of a grab .ini (libs/grab's
+// Grabber) into a flushed rawlog, each frame optionally segmented as it
+// comes (pipeline::LiveSegmentation) and shown in a window with its moving
+// mask. The program's main reads its command line into GrabOptions,
+// installs the stop signals and runs a GrabApp.
 #pragma once
 
-#include <bims/common/progress.h>
+#include <bims/apps/progress_bar.h>
 #include <bims/common/rawlog.h>
 #include <bims/grab/grabber.h>
 #include <bims/pipeline/stepper.h>
@@ -24,7 +24,7 @@ namespace mrpt::gui
 class CDisplayWindow;
 }
 
-namespace bims::grab
+namespace bims::apps
 {
 /** The RGB image of \a scan (grey made BGR) with the pixels of \a mask
  * (when of its size) blended half with red; empty without an image. */
@@ -95,9 +95,9 @@ class GrabApp
 	GrabOptions o_;
 	std::shared_ptr<mrpt::gui::CDisplayWindow> win_;
 	std::unique_ptr<mrpt::config::CConfigFile> ini_;
-	std::unique_ptr<Grabber> grabber_;
+	std::unique_ptr<grab::Grabber> grabber_;
 	std::unique_ptr<RawlogWriter> out_;
 	std::unique_ptr<GrabbedFrames> frames_;
 };
 
-}  // namespace bims::grab
+}  // namespace bims::apps

@@ -1,4 +1,5 @@
-#include <bims/common/app.h>
+#include <bims/apps/app.h>
+#include <bims/common/errors.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
 #include <algorithm>
@@ -137,27 +138,6 @@ std::vector<std::string> renameOptions(int argc, char** argv,
 	return args;
 }
 
-const char* version()
-{
-	return BIMS_VERSION;
-}
-
-std::string withoutBacktrace(const std::string& what)
-{
-	if (std::getenv("BIMS_BACKTRACE")) return what;
-	std::string out, line;
-	std::istringstream in(what);
-	while (std::getline(in, line))
-	{
-		if (line.rfind("Call stack backtrace:", 0) == 0) break;
-		if (line.find("==== MRPT exception ====") != std::string::npos)
-			continue;
-		if (line.empty()) continue;
-		out += (out.empty() ? "" : "; ") + line;
-	}
-	return out.empty() ? what : out;
-}
-
 int runApp(const std::string& program, const std::function<int()>& body)
 {
 	try
@@ -213,15 +193,6 @@ const std::atomic<bool>& installStopSignals()
 int stopSignal()
 {
 	return gStopSignal;
-}
-
-void makeDirs(const std::string& path)
-{
-	std::error_code ec;
-	std::filesystem::create_directories(path, ec);
-	if (ec)
-		throw std::runtime_error(path +
-		                         ": cannot create directory: " + ec.message());
 }
 
 std::set<size_t> parseIndexList(const std::string& text,

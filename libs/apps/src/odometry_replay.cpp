@@ -1,21 +1,21 @@
+#include <bims/apps/odometry_replay.h>
+#include <bims/apps/progress_bar.h>
 #include <bims/common/frame_files.h>
 #include <bims/common/image_file.h>
-#include <bims/common/progress.h>
 #include <bims/common/rawlog.h>
 #include <bims/ego/flags.h>
-#include <bims/source/odometry_replay.h>
 
 #include <opencv2/imgcodecs.hpp>
 
 #include <filesystem>
 #include <stdexcept>
 
-namespace bims::source
+namespace bims::apps
 {
 namespace
 {
 /** Scan k-1's mask of \a dir for frame \a k (empty when none). */
-cv::Mat feedbackMask(const std::string& dir, const SourceFrame& f)
+cv::Mat feedbackMask(const std::string& dir, const source::SourceFrame& f)
 {
 	if (dir.empty() || f.index == 0) return {};
 	const std::string p = dir + "/" + frameFileName(f.index - 1);
@@ -37,8 +37,9 @@ ReplayStats replayRawlog(const std::string& path, ego::Odometry& odo,
                          const ImuCallback& onImu)
 {
 	ReplayStats st;
-	RawlogFrameSource src(
-	    {path}, FrameOrderParams::of(odo.config(), opt.imu_wait_s, "bims-odom"),
+	source::RawlogFrameSource src(
+	    {path},
+	    source::FrameOrderParams::of(odo.config(), opt.imu_wait_s, "bims-odom"),
 	    false);
 	ProgressBar bar("bims-odom", opt.max_frames, opt.progress);
 	while (!opt.max_frames || st.frames < opt.max_frames)
@@ -69,9 +70,9 @@ ReplayStats replayRawlog(const std::string& path, ego::Odometry& odo,
 	bar.finish();
 	st.otherLabel = src.stats().otherSkipped;
 	st.imuRejected = src.stats().imuRejected;
-	st.imuNotes = imuNotes(src.stats(), odo.config().sensors.imu_label);
+	st.imuNotes = source::imuNotes(src.stats(), odo.config().sensors.imu_label);
 	if (!src.error().empty()) throw RawlogError(src.error());
 	return st;
 }
 
-}  // namespace bims::source
+}  // namespace bims::apps

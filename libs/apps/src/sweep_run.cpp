@@ -1,11 +1,11 @@
-#include <bims/common/app.h>
-#include <bims/common/output_paths.h>
-#include <bims/common/progress.h>
+#include <bims/apps/app.h>
+#include <bims/apps/output_checks.h>
+#include <bims/apps/progress_bar.h>
+#include <bims/apps/sweep_run.h>
 #include <bims/common/share.h>
 #include <bims/sweep/plan.h>
 #include <bims/sweep/processes.h>
 #include <bims/sweep/results.h>
-#include <bims/sweep/sweep.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -14,8 +14,23 @@
 #include <cstdio>
 #include <thread>
 
-namespace bims::sweep
+namespace bims::apps
 {
+using sweep::collectRun;
+using sweep::Job;
+using sweep::JobOutcome;
+using sweep::PoolOptions;
+using sweep::ResultTable;
+using sweep::runCommand;
+using sweep::runDir;
+using sweep::runJobs;
+using sweep::RunResult;
+using sweep::shellLine;
+using sweep::SweepPlan;
+using sweep::SweepSpec;
+using sweep::writeJobsFile;
+using sweep::writePlan;
+using sweep::writeResults;
 namespace
 {
 /** Writes the results and prints the summary; the exit code. */
@@ -162,4 +177,4 @@ int runSweep(const SweepOptions& opt)
 	return code;
 }
 
-}  // namespace bims::sweep
+}  // namespace bims::apps

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace bims::source
+namespace bims::apps
 {
 struct ReplayOptions
 {
@@ -51,4 +51,4 @@ ReplayStats replayRawlog(const std::string& path, ego::Odometry& odo,
                          const ReplayOptions& opt = {},
                          const ImuCallback& onImu = {});
 
-}  // namespace bims::source
+}  // namespace bims::apps

@@ -1,7 +1,5 @@
-// The shared command-line plumbing (app.h) and the progress line
-// (progress.h) of every program.
-#include <bims/common/app.h>
-#include <bims/common/progress.h>
+// The shared command-line plumbing (app.h) of every program.
+#include <bims/apps/app.h>
 #include <gtest/gtest.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
@@ -60,48 +58,4 @@ TEST(App, GivenValueTellsAnOptionGivenEmptyFromOneNotGiven)
 	EXPECT_EQ(bims::givenValue(a), std::optional<std::string>(""));
 	EXPECT_EQ(bims::givenValue(b), std::nullopt);
 	EXPECT_EQ(bims::givenValue(n), std::optional<size_t>(7));
-}
-
-TEST(Progress, APlainLineHasTotalShareRateAndEta)
-{
-	bims::ProgressBar bar("bims-run", 150, false);
-	EXPECT_EQ(
-	    bar.text(45, 3.0, false),
-	    "bims-run: 45/150 frames (30 %), 15.0 frames/s, 3.0 s, ETA 7.0 s");
-	EXPECT_EQ(bar.text(150, 10.0, false, "frame 149"),
-	          "bims-run: 150/150 frames (100 %), 15.0 frames/s, 10.0 s, "
-	          "frame 149");
-	bar.setTotal(1500, true);  // estimated
-	EXPECT_EQ(bar.text(450, 30.0, false),
-	          "bims-run: 450/~1500 frames (30 %), 15.0 frames/s, 30.0 s, ETA "
-	          "1 min 10 s");
-	bims::ProgressBar open("bims-odom", 0, false);
-	EXPECT_EQ(open.text(20, 2.0, false),
-	          "bims-odom: 20 frames, 10.0 frames/s, 2.0 s");
-}
-
-TEST(Progress, ATerminalLineHasABarAndNoLineEnd)
-{
-	bims::ProgressBar bar("bims-sim", 100, false);
-	const std::string t = bar.text(50, 5.0, true, "x");
-	EXPECT_EQ(t,
-	          "bims-sim [############            ] 50/100 frames 50 % 10.0/s "
-	          "ETA 5.0 s x");
-	EXPECT_EQ(t.find_first_of("\r\n"), std::string::npos);
-}
-
-TEST(Progress, DurationsReadAsMinutesAndHours)
-{
-	EXPECT_EQ(bims::formatDuration(8.46), "8.5 s");
-	EXPECT_EQ(bims::formatDuration(125), "2 min 05 s");
-	EXPECT_EQ(bims::formatDuration(3725), "1 h 02 min");
-}
-
-TEST(App, AnMrptExceptionIsCutToItsMessage)
-{
-	const std::string mrpt =
-	    "==== MRPT exception ====\nLine 2: Unknown variable `${X}`\nCall "
-	    "stack backtrace:\n[0 ]     0x7f5284debb28\n[1 ]     0x55cc13dc3cf4\n";
-	EXPECT_EQ(bims::withoutBacktrace(mrpt), "Line 2: Unknown variable `${X}`");
-	EXPECT_EQ(bims::withoutBacktrace("a.ini: plain"), "a.ini: plain");
 }

@@ -1,12 +1,13 @@
-// bims-sweep (docs/sweep.md): a set of bims-run experiments, configs x
-// [grid] overrides x rawlogs, run a few at a time or written as a jobs file,
-// gathered into one table and a plot.
+// bims-sweep's run (docs/sweep.md): a set of bims-run experiments, configs
+// x [grid] overrides x rawlogs, run a few at a time or written as a jobs
+// file, gathered into one table and a plot. The plan, the processes and the
+// results are libs/sweep's (bims/sweep/plan.h, processes.h, results.h).
 #pragma once
 
 #include <atomic>
 #include <string>
 
-namespace bims::sweep
+namespace bims::apps
 {
 struct SweepOptions
 {
@@ -34,4 +35,4 @@ struct SweepOptions
  * for a bad SWEEP.ini or config, before any run starts. */
 int runSweep(const SweepOptions& opt);
 
-}  // namespace bims::sweep
+}  // namespace bims::apps

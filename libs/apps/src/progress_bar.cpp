@@ -1,4 +1,4 @@
-#include <bims/common/progress.h>
+#include <bims/apps/progress_bar.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -69,6 +69,26 @@ void ProgressBar::finish(const std::string& extra)
 	if (estimated_) total_ = lastDone_;  // the input is read: exact now
 	estimated_ = false;
 	draw(total_ ? std::max(total_, lastDone_) : lastDone_, extra, true);
+}
+
+ProgressCallback ProgressBar::callback()
+{
+	if (!enabled_) return {};
+	return [this](const Progress& p) { report(p); };
+}
+
+void ProgressBar::report(const Progress& p)
+{
+	if (!reported_)
+	{
+		reported_ = true;
+		start_ = last_ = std::chrono::steady_clock::now();
+	}
+	setTotal(p.total, p.estimated);
+	if (p.finished)
+		finish(p.note);
+	else
+		update(p.done, p.note);
 }
 
 std::string ProgressBar::text(size_t done, double secs, bool tty,

@@ -1,8 +1,8 @@
-#include <bims/common/app.h>
+#include <bims/apps/app.h>
+#include <bims/apps/grab_run.h>
+#include <bims/apps/output_checks.h>
 #include <bims/common/config.h>
-#include <bims/common/output_paths.h>
 #include <bims/common/share.h>
-#include <bims/grab/grab_app.h>
 #include <bims/pipeline/mask_overlay.h>
 
 #include <mrpt/gui/CDisplayWindow.h>
@@ -13,7 +13,7 @@
 #include <iostream>
 #include <opencv2/imgproc.hpp>
 
-namespace bims::grab
+namespace bims::apps
 {
 mrpt::img::CImage preview(const mrpt::obs::CObservation3DRangeScan& scan,
                           const cv::Mat& mask)
@@ -103,7 +103,8 @@ GrabApp::GrabApp(const GrabOptions& o) : o_(o)
 		throw std::runtime_error("cannot open '" + o.grabIni + "'");
 
 	ini_ = openIniFile(o.grabIni);
-	grabber_ = std::make_unique<Grabber>(*ini_);  // throws without devices
+	grabber_ =
+	    std::make_unique<grab::Grabber>(*ini_);  // throws without devices
 	// the files its .ini names are inputs too (a replayed IMU rawlog)
 	checkOutputsSpareInputs(grabber_->inputFiles(), {o.out});
 	for (const auto& s : grabber_->describe())
@@ -153,4 +154,4 @@ int GrabApp::run()
 	return clean ? 0 : 1;
 }
 
-}  // namespace bims::grab
+}  // namespace bims::apps

@@ -1,8 +1,8 @@
-// bims-grab's logic without devices (grab_app.h): the preview image and
+// bims-grab's run without devices (grab_run.h): the preview image and
 // what is done with each grabbed frame, fed the bundled sample's
 // observations as a grab hands them over (a scan and the IMU before it).
+#include <bims/apps/grab_run.h>
 #include <bims/common/rawlog.h>
-#include <bims/grab/grab_app.h>
 #include <gtest/gtest.h>
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -10,7 +10,7 @@
 
 #include <regex>
 
-using namespace bims::grab;
+using namespace bims::apps;
 
 namespace
 {

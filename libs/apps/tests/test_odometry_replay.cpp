@@ -2,11 +2,11 @@
 // 150 frames 320x240 with IMU, made by bims-sim): the drift of T_C0C against
 // the ground truth (from frame 30 on) stays below bounds measured when this
 // test was written (docs/journal/egomotion.md, "Egomotion"), in both modes.
+#include <bims/apps/odometry_replay.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/so3.h>
-#include <bims/source/odometry_replay.h>
 #include <gtest/gtest.h>
 
 #include <mrpt/config/CConfigFile.h>
@@ -17,8 +17,8 @@
 #include <filesystem>
 
 using namespace bims::ego;
-using bims::source::ReplayOptions;
-using bims::source::replayRawlog;
+using bims::apps::ReplayOptions;
+using bims::apps::replayRawlog;
 
 namespace
 {

@@ -1,5 +1,20 @@
-// Shared entry-point plumbing for the bims command-line programs.
+// The app base of every bims program (MRPT's mrpt::apps pattern). A
+// program's main declares its command line (TCLAP) and hands the rest to
+// runApp:
+//   parse   parseCommandLine: --help and --version, unknown or mistyped
+//           options, the old spellings still taken (docs/cli.md);
+//   check   the run's own checks of its options (inRange, the output
+//           checks of output_checks.h): a UsageError, before any work;
+//   run     the program's run, one function of libs/apps;
+//   report  an error on stderr as "PROGRAM: error: WHAT" (or "usage
+//           error"), never a call stack;
+//   exit    0 done, 1 error, 2 usage (ExitRequest: a code of its own).
+// The libraries below throw plain errors (std::runtime_error,
+// std::invalid_argument, bims::ConfigError) and report progress through a
+// callback; only this layer speaks of usage.
 #pragma once
+
+#include <bims/common/version.h>
 
 #include <atomic>
 #include <functional>
@@ -12,18 +27,12 @@
 
 namespace bims
 {
-/** Runs \a body, turning any exception into "PROGRAM: error: what" on stderr
- * and exit code 1 (2 for command-line usage errors). Libraries throw; only
- * main() decides to exit. An MRPT exception's text is cut to its message
- * (withoutBacktrace). */
+/** Runs \a body (parse, check, run: its return value is the exit code),
+ * turning any exception into "PROGRAM: error: what" on stderr and exit code
+ * 1 (2 for command-line usage errors). Libraries throw; only main()
+ * decides to exit. An MRPT exception's text is cut to its message
+ * (bims::withoutBacktrace, bims/common/errors.h). */
 int runApp(const std::string& program, const std::function<int()>& body);
-
-/** \a what on one line without MRPT's "==== MRPT exception ====" header and
- * its call stack backtrace (kept when the environment has BIMS_BACKTRACE). */
-std::string withoutBacktrace(const std::string& what);
-
-/** bims's version (the CMake project's), for every program's --version. */
-const char* version();
 
 /** Thrown for wrong command-line usage (exit code 2). */
 struct UsageError : std::runtime_error
@@ -189,8 +198,5 @@ void keepFreedMemoryForReuse();
  * UsageError naming \a flag and the bad item. */
 std::set<size_t> parseIndexList(const std::string& text,
                                 const std::string& flag);
-
-/** Creates a directory and its parents; throws naming it on failure. */
-void makeDirs(const std::string& path);
 
 }  // namespace bims

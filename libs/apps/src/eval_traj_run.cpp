@@ -1,0 +1,112 @@
+// bims-eval traj (eval_run.h).
+#include <bims/apps/eval_run.h>
+#include <bims/apps/output_checks.h>
+#include <bims/common/json.h>
+#include <bims/common/trajectory.h>
+#include <bims/eval/plots.h>
+#include <bims/eval/trajectory_metrics.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+namespace bims::apps
+{
+namespace ev = bims::eval;
+
+namespace
+{
+Trajectory load(const std::string& path)
+{
+	if (!std::filesystem::exists(path))
+		throw std::runtime_error(path + ": file not found");
+	auto t = loadTumTrajectory(path);
+	if (t.empty()) throw std::runtime_error(path + ": trajectory is empty");
+	return t;
+}
+}  // namespace
+
+int runEvalTraj(const EvalTrajOptions& o)
+{
+	std::vector<std::string> outputs;
+	for (const auto* out : {&o.plot, &o.json})
+		if (*out) outputs.push_back(**out);
+	checkOutputsSpareInputs({o.gt, o.est}, outputs);
+
+	ev::TrajectoryReport rep;
+	rep.gtPath = o.gt;
+	rep.estPath = o.est;
+	const auto gt = load(rep.gtPath);
+	const auto est = load(rep.estPath);
+	rep.gtPoses = gt.size();
+	rep.estPoses = est.size();
+	rep.ateOptions.maxTimeDifference = o.maxDt;
+	rep.ateOptions.timeOffset = o.offset;
+	rep.rpeOptions.delta = o.delta;
+	rep.rpeOptions.timeOffset = o.offset;
+	const std::string both = rep.gtPath + " vs " + rep.estPath + ": ";
+	try
+	{
+		rep.ate = ev::computeAte(gt, est, rep.ateOptions);
+	}
+	catch (const std::invalid_argument& e)
+	{
+		throw std::runtime_error(both + e.what());
+	}
+	std::string rpeError;
+	try
+	{
+		rep.rpe = ev::computeRpe(gt, est, rep.rpeOptions);
+	}
+	catch (const std::invalid_argument& e)
+	{
+		rpeError = e.what();
+	}
+
+	std::printf(
+	    "associated %zu of %zu estimated poses with %zu ground-truth poses "
+	    "(max dt %.3f s)\n",
+	    rep.ate.pairs.size(), est.size(), gt.size(), o.maxDt);
+	const auto& a = rep.ate.stats;
+	std::printf("ate_rmse %.4f m (mean %.4f, median %.4f, max %.4f)\n", a.rmse,
+	            a.mean, a.median, a.max);
+	if (rpeError.empty())
+	{
+		std::printf(
+		    "rpe_trans_rmse %.4f m/s (mean %.4f, median %.4f; %zu pairs, "
+		    "delta %.3g s)\n",
+		    rep.rpe.trans.rmse, rep.rpe.trans.mean, rep.rpe.trans.median,
+		    rep.rpe.pairs.size(), o.delta);
+		std::printf("rpe_rot_rmse %.4f deg/s (mean %.4f, median %.4f)\n",
+		            rep.rpe.rot.rmse, rep.rpe.rot.mean, rep.rpe.rot.median);
+	}
+	else
+		std::printf("rpe not available: %s\n", rpeError.c_str());
+
+	if (o.json)
+	{
+		writeJsonFile(*o.json, rep.toJson());
+	}
+	if (!o.noPlot)
+	{
+		std::string path = o.plot.value_or("");
+		if (path.empty())
+			path = std::filesystem::path(rep.estPath)
+			           .replace_extension()
+			           .string() +
+			       "_traj.png";
+		char title[256];
+		std::snprintf(title, sizeof(title), "%s  ATE RMSE %.3f m (%zu poses)",
+		              std::filesystem::path(rep.estPath).filename().c_str(),
+		              a.rmse, rep.ate.pairs.size());
+		ev::writePng(path,
+		             ev::plotTrajectories(
+		                 gt, ev::alignTrajectory(est, rep.ate.T_alignment),
+		                 rep.ate.pairs, title));
+		std::fprintf(stderr, "bims-eval traj: plot written to %s\n",
+		             path.c_str());
+	}
+	return 0;
+}
+
+}  // namespace bims::apps

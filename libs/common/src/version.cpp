@@ -1,0 +1,10 @@
+#include <bims/common/version.h>
+
+namespace bims
+{
+const char* version()
+{
+	return BIMS_VERSION;
+}
+
+}  // namespace bims
