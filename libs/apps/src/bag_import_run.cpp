@@ -97,17 +97,22 @@ std::string bagImportReport(const std::string& out, const BagImportSummary& sum,
 	return r;
 }
 
-int runBagImport(const BagImportRunOptions& o)
+namespace
+{
+/** What every use of the options needs, --topics too. */
+void checkBagsAndGz(const BagImportRunOptions& o)
 {
 	if (o.bags.empty()) throw UsageError("no bag given");
 	checkGzLevel(o.gz);
+}
+}  // namespace
+
+BagImport importBagChecked(const BagImportRunOptions& o,
+                           const ProgressCallback& progress)
+{
+	checkBagsAndGz(o);
 	std::vector<std::string> inputs = o.bags;
 	inputs.push_back(o.config.value_or(""));
-	if (o.listTopics)
-	{
-		std::fputs(describeTopics(bagTopics(o.bags)).c_str(), stdout);
-		return 0;
-	}
 	if (o.out.empty()) throw UsageError("-o OUT.rawlog is required");
 	checkOutputsSpareInputs(inputs, {o.out});
 
@@ -126,10 +131,21 @@ int runBagImport(const BagImportRunOptions& o)
 	BagImportOptions opt;
 	opt.maxFrames = o.max_frames;
 	opt.gzLevel = o.gz;
+	opt.progress = progress;
+	return {importBag(o.bags, o.out, params, opt), params};
+}
+
+int runBagImport(const BagImportRunOptions& o)
+{
+	if (o.listTopics)
+	{
+		checkBagsAndGz(o);
+		std::fputs(describeTopics(bagTopics(o.bags)).c_str(), stdout);
+		return 0;
+	}
 	ProgressBar bar("import", 0, o.progress);
-	opt.progress = bar.callback();
-	const auto sum = importBag(o.bags, o.out, params, opt);
-	std::fputs(bagImportReport(o.out, sum, params).c_str(), stdout);
+	const BagImport r = importBagChecked(o, bar.callback());
+	std::fputs(bagImportReport(o.out, r.summary, r.params).c_str(), stdout);
 	return 0;
 }
 

@@ -58,7 +58,8 @@ std::string strayImportReport(const std::string& out,
 	return r;
 }
 
-int runStrayImport(const StrayImportRunOptions& o)
+StrayImportSummary importStrayChecked(const StrayImportRunOptions& o,
+                                      const ProgressCallback& progress)
 {
 	checkOutputsSpareInputs({o.folder, o.config.value_or("")},
 	                        {o.out, strayReferencePathFor(o.out)});
@@ -77,14 +78,19 @@ int runStrayImport(const StrayImportRunOptions& o)
 	StrayImportOptions opt;
 	opt.maxFrames = o.max_frames;
 	opt.gzLevel = o.gz;
-	ProgressBar bar("bims-import-stray", 0, o.progress);
-	opt.progress = bar.callback();
+	opt.progress = progress;
 	// the capture's files are inputs too: -o FOLDER/imu.csv is refused
 	const StrayCapture cap = readStrayCapture(o.folder);
 	auto inputs = strayInputFiles(cap);
 	inputs.push_back(o.config.value_or(""));
 	checkOutputsSpareInputs(inputs, {o.out, strayReferencePathFor(o.out)});
-	const auto sum = importStray(cap, o.out, params, opt);
+	return importStray(cap, o.out, params, opt);
+}
+
+int runStrayImport(const StrayImportRunOptions& o)
+{
+	ProgressBar bar("bims-import-stray", 0, o.progress);
+	const auto sum = importStrayChecked(o, bar.callback());
 	std::fputs(strayImportReport(o.out, sum).c_str(), stdout);
 	return 0;
 }

@@ -53,7 +53,8 @@ std::string importReport(const std::string& out, const ImportSummary& sum,
 	return r;
 }
 
-int runImport(const ImportRunOptions& o)
+TumImport importTumChecked(const ImportRunOptions& o,
+                           const ProgressCallback& progress)
 {
 	checkOutputsSpareInputs({o.folder, o.config.value_or("")},
 	                        {o.out, groundTruthDirFor(o.out)});
@@ -88,8 +89,7 @@ int runImport(const ImportRunOptions& o)
 	opt.maxFrames = o.max_frames;
 	opt.bonnGt = o.bonn_gt;
 	opt.gzLevel = o.gz;
-	ProgressBar bar("import", 0, o.progress);
-	opt.progress = bar.callback();
+	opt.progress = progress;
 	const bool bonnConverted = opt.bonnGt || params.bonnGt;
 	if (o.synth_imu)
 	{
@@ -107,9 +107,20 @@ int runImport(const ImportRunOptions& o)
 		opt.extra = synthesize(gt, params.imuLabel, cfg.get(), o.seed);
 	}
 
-	const auto sum = importTum(std::move(tum), o.out, params, opt);
+	TumImport r;
+	r.summary = importTum(std::move(tum), o.out, params, opt);
+	r.params = params;
+	r.bonnConverted = bonnConverted;
+	return r;
+}
+
+int runImport(const ImportRunOptions& o)
+{
+	ProgressBar bar("import", 0, o.progress);
+	const TumImport r = importTumChecked(o, bar.callback());
 	std::fputs(
-	    importReport(o.out, sum, o.synth_imu, bonnConverted, params).c_str(),
+	    importReport(o.out, r.summary, o.synth_imu, r.bonnConverted, r.params)
+	        .c_str(),
 	    stdout);
 	return 0;
 }

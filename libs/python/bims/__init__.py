@@ -19,6 +19,12 @@ import numpy as np
 
 from ._bims import Config, ConfigError, Pipeline, RawlogError, Result, Voxels
 from ._bims import _RawlogReader
+from ._bims import UsageError, import_stray, import_tum
+
+try:  # built with the ROS 1 bag libraries (libs/bag)
+    from ._bims import import_bag
+except ImportError:
+    import_bag = None
 
 __all__ = [
     "Config",
@@ -28,9 +34,14 @@ __all__ = [
     "Pipeline",
     "RawlogError",
     "Result",
+    "UsageError",
     "Voxels",
+    "import_stray",
+    "import_tum",
     "read_rawlog",
 ]
+if import_bag is not None:
+    __all__.append("import_bag")
 
 
 class DepthArray(np.ndarray):

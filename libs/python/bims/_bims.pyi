@@ -1,12 +1,44 @@
 """Type stubs of the C++ module bims._bims (see bims/__init__.py)."""
 
-from typing import Dict, List, Optional
+from typing import Any, Callable, Dict, List, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
 
 class ConfigError(ValueError): ...
 class RawlogError(OSError): ...
+class UsageError(ValueError): ...
+
+ProgressFn = Callable[[int, int], None]
+
+def import_tum(
+    folder: str,
+    out: str,
+    config: Optional[str] = None,
+    max_frames: int = 0,
+    gz_level: int = 1,
+    bonn_gt: bool = False,
+    synth_imu: bool = False,
+    seed: int = 1,
+    progress: Optional[ProgressFn] = None,
+) -> Dict[str, Any]: ...
+def import_stray(
+    folder: str,
+    out: str,
+    config: Optional[str] = None,
+    max_frames: int = 0,
+    gz_level: int = 1,
+    progress: Optional[ProgressFn] = None,
+) -> Dict[str, Any]: ...
+def import_bag(
+    bags: Union[str, Sequence[str]],
+    out: str,
+    config: Optional[str] = None,
+    layout: Optional[str] = None,
+    max_frames: int = 0,
+    gz_level: int = 1,
+    progress: Optional[ProgressFn] = None,
+) -> Dict[str, Any]: ...
 
 class Config:
     """An experiment configuration (.ini), read with the programs' checks."""

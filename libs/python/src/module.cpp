@@ -2,6 +2,14 @@
 // pipeline on NumPy arrays and the rawlog reader. The package bims
 // (libs/python/bims/__init__.py) re-exports it with the Python-side helpers;
 // docs/python.md says how to use it.
+#ifdef BIMS_PYTHON_IMPORTERS
+#include <bims/apps/app.h>
+#include <bims/apps/stray_import_run.h>
+#include <bims/apps/tum_import_run.h>
+#ifdef BIMS_PYTHON_BAG
+#include <bims/apps/bag_import_run.h>
+#endif
+#endif
 #include <bims/common/config.h>
 #include <bims/common/depth_image.h>
 #include <bims/common/rawlog.h>
@@ -588,6 +596,120 @@ class PyRawlogReader
 	std::unique_ptr<source::RawlogFrameSource> src_;
 };
 
+#ifdef BIMS_PYTHON_IMPORTERS
+/** \a cb (a Python callable(done, total), or None) as a library's progress
+ * callback: called with the GIL held, at each report. */
+ProgressCallback progressOf(const py::object& cb)
+{
+	if (cb.is_none()) return {};
+	if (!PyCallable_Check(cb.ptr()))
+		throw py::type_error("progress: a callable(done, total) expected");
+	return [cb](const Progress& p)
+	{
+		py::gil_scoped_acquire gil;
+		cb(p.done, p.total);
+	};
+}
+
+/** \a path, or nullopt for None. */
+std::optional<std::string> optionalPath(const py::object& path)
+{
+	if (path.is_none()) return std::nullopt;
+	return py::str(path).cast<std::string>();
+}
+
+/** \a run with the GIL released (the import's own threads and progress
+ * callback take it when they need it). */
+template <class Run>
+auto withoutGil(const Run& run)
+{
+	py::gil_scoped_release nogil;
+	return run();
+}
+
+py::dict importTum(const py::object& folder, const py::object& out,
+                   const py::object& config, size_t maxFrames, int gz,
+                   bool bonnGt, bool synthImu, uint64_t seed,
+                   const py::object& progress)
+{
+	apps::ImportRunOptions o;
+	o.folder = py::str(folder);
+	o.out = py::str(out);
+	o.config = optionalPath(config);
+	o.max_frames = maxFrames;
+	o.gz = gz;
+	o.bonn_gt = bonnGt;
+	o.synth_imu = synthImu;
+	o.seed = seed;
+	const auto cb = progressOf(progress);
+	const apps::TumImport r =
+	    withoutGil([&] { return apps::importTumChecked(o, cb); });
+	const auto& s = r.summary;
+	py::dict d;
+	d["frames"] = s.frames;
+	d["imu"] = s.imu;
+	d["accel"] = s.accel;
+	d["gt_poses"] = s.gtPoses;
+	d["frames_without_gt"] = s.framesWithoutGt;
+	d["gt_dir"] = s.gtDir;
+	d["report"] =
+	    apps::importReport(o.out, s, o.synth_imu, r.bonnConverted, r.params);
+	return d;
+}
+
+py::dict importStray(const py::object& folder, const py::object& out,
+                     const py::object& config, size_t maxFrames, int gz,
+                     const py::object& progress)
+{
+	apps::StrayImportRunOptions o;
+	o.folder = py::str(folder);
+	o.out = py::str(out);
+	o.config = optionalPath(config);
+	o.max_frames = maxFrames;
+	o.gz = gz;
+	const auto cb = progressOf(progress);
+	const auto s = withoutGil([&] { return apps::importStrayChecked(o, cb); });
+	py::dict d;
+	d["frames"] = s.frames;
+	d["imu"] = s.imu;
+	d["width"] = s.width;
+	d["height"] = s.height;
+	d["colour"] = s.colour;
+	d["reference"] = s.referencePath;
+	d["reference_poses"] = s.referencePoses;
+	d["report"] = apps::strayImportReport(o.out, s);
+	return d;
+}
+
+#ifdef BIMS_PYTHON_BAG
+py::dict importBag(const py::object& bags, const py::object& out,
+                   const py::object& config, const py::object& layout,
+                   size_t maxFrames, int gz, const py::object& progress)
+{
+	apps::BagImportRunOptions o;
+	if (py::isinstance<py::str>(bags) || !py::isinstance<py::iterable>(bags))
+		o.bags.push_back(py::str(bags));
+	else
+		for (const auto& b : bags) o.bags.push_back(py::str(b));
+	o.out = py::str(out);
+	o.config = optionalPath(config);
+	o.layout = optionalPath(layout);
+	o.max_frames = maxFrames;
+	o.gz = gz;
+	const auto cb = progressOf(progress);
+	const apps::BagImport r =
+	    withoutGil([&] { return apps::importBagChecked(o, cb); });
+	py::dict d;
+	d["frames"] = r.summary.frames;
+	d["imu"] = r.summary.imu;
+	d["width"] = r.summary.width;
+	d["height"] = r.summary.height;
+	d["report"] = apps::bagImportReport(o.out, r.summary, r.params);
+	return d;
+}
+#endif
+#endif
+
 }  // namespace
 
 PYBIND11_MODULE(_bims, m)
@@ -595,6 +717,32 @@ PYBIND11_MODULE(_bims, m)
 	m.doc() = "bims: Bayesian independent motion segmentation (C++ core)";
 	py::register_exception<ConfigError>(m, "ConfigError", PyExc_ValueError);
 	py::register_exception<RawlogError>(m, "RawlogError", PyExc_OSError);
+#ifdef BIMS_PYTHON_IMPORTERS
+	// the programs' usage errors (options that do not fit)
+	py::register_exception<UsageError>(m, "UsageError", PyExc_ValueError);
+
+	m.def("import_tum", &importTum, py::arg("folder"), py::arg("out"),
+	      py::arg("config") = py::none(), py::arg("max_frames") = 0,
+	      py::arg("gz_level") = 1, py::arg("bonn_gt") = false,
+	      py::arg("synth_imu") = false, py::arg("seed") = 1,
+	      py::arg("progress") = py::none(),
+	      "A TUM RGB-D folder into an MRPT rawlog, as bims-import-tum "
+	      "(OUT_gt/groundtruth.txt beside it); returns its summary, with "
+	      "'report' the lines the program prints");
+	m.def("import_stray", &importStray, py::arg("folder"), py::arg("out"),
+	      py::arg("config") = py::none(), py::arg("max_frames") = 0,
+	      py::arg("gz_level") = 1, py::arg("progress") = py::none(),
+	      "A Stray Scanner capture (LiDAR depth, IMU, ARKit poses) into an "
+	      "MRPT rawlog, as bims-import-stray; returns its summary");
+#ifdef BIMS_PYTHON_BAG
+	m.def("import_bag", &importBag, py::arg("bags"), py::arg("out"),
+	      py::arg("config") = py::none(), py::arg("layout") = py::none(),
+	      py::arg("max_frames") = 0, py::arg("gz_level") = 1,
+	      py::arg("progress") = py::none(),
+	      "ROS 1 bags (one path or a list, read as one recording) into an "
+	      "MRPT rawlog, as bims-import-bag; returns its summary");
+#endif
+#endif
 
 	py::class_<Config>(m, "Config", "An experiment configuration (.ini)")
 	    .def(py::init<>(), "The built-in defaults (config/default.ini's)")

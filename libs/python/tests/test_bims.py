@@ -14,6 +14,9 @@ import bims
 SOURCE = os.environ.get("BIMS_SOURCE_DIR", os.getcwd())
 BIN = os.environ.get("BIMS_BIN_DIR", os.path.join(SOURCE, "build", "bin"))
 SAMPLE = os.path.join(SOURCE, "rawlogs", "pendulum_slow.rawlog")
+SHARED = os.environ.get(
+    "BIMS_SHARED_DATA_DIR", os.path.join(SOURCE, "..", "shared", "data")
+)
 CONFIG = os.path.join(SOURCE, "config", "default.ini")
 
 
@@ -208,6 +211,91 @@ class EuclideanRanges(unittest.TestCase):
         dt_wrong, px_wrong = worst(depth, wrong)
         self.assertGreater(px_wrong, 5 * max(px, 1))
         self.assertGreater(dt_wrong, 5 * dt)
+
+
+class Importers(unittest.TestCase):
+    """bims.import_tum / import_stray: the programs' imports, byte for
+    byte, with their report and their errors."""
+
+    def same_as_program(self, program, args, imported):
+        """Runs PROGRAM ARGS -o A.rawlog and imported(B.rawlog); the rawlogs
+        and the side files are the same bytes, the report is the program's
+        stdout."""
+        with tempfile.TemporaryDirectory() as d:
+            a, b = os.path.join(d, "a.rawlog"), os.path.join(d, "b.rawlog")
+            run = subprocess.run(
+                [os.path.join(BIN, program)] + args + ["-o", a, "-q"],
+                capture_output=True,
+                text=True,
+            )
+            self.assertEqual(run.returncode, 0, run.stderr)
+            seen = []
+            summary = imported(b, lambda done, total: seen.append((done, total)))
+            self.assertEqual(
+                summary["report"],
+                run.stdout.replace(os.path.join(d, "a"), os.path.join(d, "b")),
+            )
+            self.assertGreater(len(seen), 1)
+            self.assertEqual([x[0] for x in seen], sorted(x[0] for x in seen))
+            for name in sorted(os.listdir(d)):
+                if name.startswith("a"):
+                    self.compare(os.path.join(d, name), os.path.join(d, "b" + name[1:]))
+            frames = list(bims.read_rawlog(b))
+            self.assertEqual(len(frames), summary["frames"])
+            return summary
+
+    def compare(self, x, y):
+        if os.path.isdir(x):
+            self.assertEqual(sorted(os.listdir(x)), sorted(os.listdir(y)))
+            for n in os.listdir(x):
+                self.compare(os.path.join(x, n), os.path.join(y, n))
+            return
+        with open(x, "rb") as f, open(y, "rb") as g:
+            self.assertEqual(f.read(), g.read(), os.path.basename(x))
+
+    def test_import_tum_is_bims_import_tum(self):
+        folder = os.path.join(SHARED, "bonn_crowd_f150_349")
+        config = os.path.join(SOURCE, "config", "bonn.ini")
+        self.assertTrue(os.path.isdir(folder), folder)
+        s = self.same_as_program(
+            "bims-import-tum",
+            [folder, "--config", config, "--bonn-gt", "--max-frames", "4"],
+            lambda out, progress: bims.import_tum(
+                folder, out, config=config, bonn_gt=True, max_frames=4,
+                progress=progress,
+            ),
+        )
+        self.assertEqual(s["frames"], 4)
+        self.assertEqual(s["gt_poses"], 4)
+
+    def test_import_stray_is_bims_import_stray(self):
+        folder = os.path.join(SHARED, "stray_early")
+        config = os.path.join(SOURCE, "config", "stray.ini")
+        self.assertTrue(os.path.isdir(folder), folder)
+        s = self.same_as_program(
+            "bims-import-stray",
+            [folder, "--config", config, "--max-frames", "5"],
+            lambda out, progress: bims.import_stray(
+                folder, out, config=config, max_frames=5, progress=progress
+            ),
+        )
+        self.assertEqual(s["frames"], 5)
+        self.assertGreater(s["imu"], 0)
+
+    def test_the_programs_errors(self):
+        folder = os.path.join(SHARED, "stray_early")
+        with tempfile.TemporaryDirectory() as d:
+            with self.assertRaises(ValueError) as e:
+                bims.import_stray(folder, os.path.join(d, "x.rawlog"), gz_level=12)
+            self.assertEqual(str(e.exception), "--gz must be in 0..9")
+            with self.assertRaises(ValueError):  # an output may not be an input
+                bims.import_stray(folder, os.path.join(folder, "imu.csv"))
+            with self.assertRaises(RuntimeError) as e:
+                bims.import_tum(os.path.join(d, "none"), os.path.join(d, "x.rawlog"))
+            self.assertIn("none", str(e.exception))
+            with self.assertRaises(TypeError):
+                bims.import_tum(folder, os.path.join(d, "x.rawlog"), progress=3)
+            self.assertEqual(os.listdir(d), [])
 
 
 class BadInput(unittest.TestCase):

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <bims/bag/bag_import.h>
+#include <bims/common/progress.h>
 
 #include <optional>
 #include <string>
@@ -33,10 +34,22 @@ std::string bagImportReport(const std::string& out,
                             const bag::BagImportSummary& sum,
                             const bag::BagImportParams& params);
 
-/** bims-import-bag: checks the options (UsageError; no output may be an
- * input), reads the config, imports and prints bagImportReport (or, with
- * listTopics, the bags' topics). Returns the program's exit code (0);
- * errors are thrown. */
+/** What an import of bags gave: its summary and the parameters it read. */
+struct BagImport
+{
+	bag::BagImportSummary summary;
+	bag::BagImportParams params;
+};
+
+/** bims-import-bag's import without its terminal: checks the options
+ * (UsageError; no output may be an input), reads the config and imports,
+ * reporting to \a progress (the Python module's import_bag). */
+BagImport importBagChecked(const BagImportRunOptions& o,
+                           const ProgressCallback& progress);
+
+/** bims-import-bag: importBagChecked with the progress line, then prints
+ * bagImportReport (or, with listTopics, the bags' topics). Returns the
+ * program's exit code (0); errors are thrown. */
 int runBagImport(const BagImportRunOptions& o);
 
 }  // namespace bims::apps

@@ -4,6 +4,7 @@
 // StrayImportRunOptions and calls runStrayImport.
 #pragma once
 
+#include <bims/common/progress.h>
 #include <bims/eval/stray_import.h>
 
 #include <optional>
@@ -29,8 +30,14 @@ struct StrayImportRunOptions
 std::string strayImportReport(const std::string& out,
                               const eval::StrayImportSummary& sum);
 
-/** bims-import-stray: checks the options (UsageError; no output may be an
- * input), reads the config (a note on stderr without one), imports and
+/** bims-import-stray's work without its terminal: checks the options
+ * (UsageError; no output may be an input), reads the config (a note on
+ * stderr without one) and imports, reporting to \a progress (the Python
+ * module's import_stray). */
+eval::StrayImportSummary importStrayChecked(const StrayImportRunOptions& o,
+                                            const ProgressCallback& progress);
+
+/** bims-import-stray: importStrayChecked with the progress line, then
  * prints strayImportReport. Returns the program's exit code (0); errors
  * are thrown. */
 int runStrayImport(const StrayImportRunOptions& o);

@@ -5,6 +5,7 @@
 // runImport.
 #pragma once
 
+#include <bims/common/progress.h>
 #include <bims/common/trajectory.h>
 #include <bims/eval/tum_import.h>
 #include <mrpt/config/CConfigFileBase.h>
@@ -50,9 +51,24 @@ std::string importReport(const std::string& out, const eval::ImportSummary& sum,
                          bool synthetic, bool bonnConverted,
                          const eval::ImportParams& params);
 
-/** bims-import-tum: checks the options (UsageError; no output may be an
- * input), reads the config (a note on stderr without one), synthesises the
- * IMU readings if asked, imports and prints importReport. Returns the
+/** What an import into a rawlog gave: its summary, the parameters it
+ * read and whether the ground truth was Bonn's marker pose, converted. */
+struct TumImport
+{
+	eval::ImportSummary summary;
+	eval::ImportParams params;
+	bool bonnConverted = false;
+};
+
+/** bims-import-tum's work without its terminal: checks the options
+ * (UsageError; no output may be an input), reads the config (a note on
+ * stderr without one), synthesises the IMU readings if asked and imports,
+ * reporting to \a progress (the Python module's import_tum). */
+TumImport importTumChecked(const ImportRunOptions& o,
+                           const ProgressCallback& progress);
+
+/** bims-import-tum: importTumChecked with the progress line, then prints
+ * importReport. Returns the
  * program's exit code (0); errors are thrown. */
 int runImport(const ImportRunOptions& o);
 
