@@ -301,7 +301,16 @@ class Importers(unittest.TestCase):
             self.assertIn("none", str(e.exception))
             with self.assertRaises(TypeError):
                 bims.import_tum(folder, os.path.join(d, "x.rawlog"), progress=3)
-            self.assertEqual(os.listdir(d), [])
+
+            def stop(done, total):  # the user stops it from the callback
+                if done >= 2:
+                    raise KeyError("stop here")
+
+            with self.assertRaises(KeyError):
+                bims.import_stray(
+                    folder, os.path.join(d, "x.rawlog"), max_frames=5, progress=stop
+                )
+            self.assertEqual(os.listdir(d), [])  # no partial output
 
 
 class BadInput(unittest.TestCase):
