@@ -93,7 +93,7 @@ TumImport importTumChecked(const ImportRunOptions& o,
 	const bool bonnConverted = opt.bonnGt || params.bonnGt;
 	if (o.synth_imu)
 	{
-		const auto tum = readTumFolder(o.folder, params);
+		// the folder read above (its ground truth)
 		if (!tum.hasGroundTruth)
 			throw std::runtime_error(
 			    o.folder +

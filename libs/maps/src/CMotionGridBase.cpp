@@ -219,7 +219,10 @@ bool CMotionGridBase::wasMovingAtLastHit(const VoxelKey& k) const
 
 std::vector<mrpt::math::TPoint3D> CMotionGridBase::movingCells() const
 {
-	return movingVoxels(*this).centres;
+	std::vector<mrpt::math::TPoint3D> out;
+	forEachMovingCell([&](const VoxelKey& k, float)
+	                  { out.push_back(centerOf(k)); });
+	return out;
 }
 
 bool CMotionGridBase::internal_insertObservation(

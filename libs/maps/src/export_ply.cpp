@@ -70,14 +70,12 @@ VoxelSet occupiedVoxels(const COccupancyBayesGrid& occ, double p)
 VoxelSet movingVoxels(const CMotionGridBase& motion)
 {
 	VoxelSet out;
-	const auto& cells = motion.lastCells();
-	const auto& post = motion.lastPosterior();
-	for (size_t i = 0; i < cells.size(); ++i)
-		if (post[i] > 0)  // MAP: P(I) > 1/2 (CMotionGridBase::movingCells)
-		{
-			out.centres.push_back(motion.centerOf(cells[i]));
-			out.probabilities.push_back(float(sigmoid(post[i])));
-		}
+	motion.forEachMovingCell(
+	    [&](const VoxelKey& k, float post)
+	    {
+		    out.centres.push_back(motion.centerOf(k));
+		    out.probabilities.push_back(float(sigmoid(post)));
+	    });
 	return out;
 }
 

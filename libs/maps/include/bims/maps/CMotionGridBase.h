@@ -90,6 +90,16 @@ class CMotionGridBase : public CBayesVoxelGridBase
 	bool wasMovingAtLastHit(const VoxelKey& k) const;
 	/** Centres [m, {W}] of the last frame's voxels labelled moving. */
 	std::vector<mrpt::math::TPoint3D> movingCells() const;
+	/** Calls \a f(key, posterior log-odds) for each of the last frame's
+	 * voxels labelled moving (MAP: posterior > 1/2), in lastCells() order:
+	 * the one rule of movingCells() and maps::movingVoxels(). */
+	template <class F>
+	void forEachMovingCell(F&& f) const
+	{
+		const auto& cells = *lastCells_;
+		for (size_t i = 0; i < cells.size(); ++i)
+			if (lastPost_[i] > 0) f(cells[i], lastPost_[i]);
+	}
 
 	const Storage& storage() const { return grid_; }
 	size_t memoryBytes() const { return grid_.memoryBytes(); }
