@@ -618,6 +618,19 @@ std::optional<std::string> optionalPath(const py::object& path)
 	return py::str(path).cast<std::string>();
 }
 
+/** The options every importer's run shares (apps/import_options.h). */
+template <class Options>
+Options importOptions(const py::object& out, const py::object& config,
+                      size_t maxFrames, int gz)
+{
+	Options o;
+	o.out = py::str(out);
+	o.config = optionalPath(config);
+	o.max_frames = maxFrames;
+	o.gz = gz;
+	return o;
+}
+
 /** \a run with the GIL released (the import's own threads and progress
  * callback take it when they need it). */
 template <class Run>
@@ -632,12 +645,8 @@ py::dict importTum(const py::object& folder, const py::object& out,
                    bool bonnGt, bool synthImu, uint64_t seed,
                    const py::object& progress)
 {
-	apps::ImportRunOptions o;
+	auto o = importOptions<apps::ImportRunOptions>(out, config, maxFrames, gz);
 	o.folder = py::str(folder);
-	o.out = py::str(out);
-	o.config = optionalPath(config);
-	o.max_frames = maxFrames;
-	o.gz = gz;
 	o.bonn_gt = bonnGt;
 	o.synth_imu = synthImu;
 	o.seed = seed;
@@ -661,12 +670,9 @@ py::dict importStray(const py::object& folder, const py::object& out,
                      const py::object& config, size_t maxFrames, int gz,
                      const py::object& progress)
 {
-	apps::StrayImportRunOptions o;
+	auto o =
+	    importOptions<apps::StrayImportRunOptions>(out, config, maxFrames, gz);
 	o.folder = py::str(folder);
-	o.out = py::str(out);
-	o.config = optionalPath(config);
-	o.max_frames = maxFrames;
-	o.gz = gz;
 	const auto cb = progressOf(progress);
 	const auto s = withoutGil([&] { return apps::importStrayChecked(o, cb); });
 	py::dict d;
@@ -686,16 +692,13 @@ py::dict importBag(const py::object& bags, const py::object& out,
                    const py::object& config, const py::object& layout,
                    size_t maxFrames, int gz, const py::object& progress)
 {
-	apps::BagImportRunOptions o;
+	auto o =
+	    importOptions<apps::BagImportRunOptions>(out, config, maxFrames, gz);
 	if (py::isinstance<py::str>(bags) || !py::isinstance<py::iterable>(bags))
 		o.bags.push_back(py::str(bags));
 	else
 		for (const auto& b : bags) o.bags.push_back(py::str(b));
-	o.out = py::str(out);
-	o.config = optionalPath(config);
 	o.layout = optionalPath(layout);
-	o.max_frames = maxFrames;
-	o.gz = gz;
 	const auto cb = progressOf(progress);
 	const apps::BagImport r =
 	    withoutGil([&] { return apps::importBagChecked(o, cb); });
