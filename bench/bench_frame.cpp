@@ -134,7 +134,7 @@ void loadPair(const std::string& path, int frame)
 	if (!prev || !g_pair.scan)
 		throw std::runtime_error(path + ": fewer than " +
 		                         std::to_string(frame + 1) + " 3D scans");
-	const bims::ego::CameraParams noCam;
+	const bims::sensors::CameraParams noCam;
 	for (auto [o, f] : {std::pair{prev.get(), &g_pair.prev},
 	                    std::pair{g_pair.scan.get(), &g_pair.cur}})
 	{
@@ -147,7 +147,7 @@ void loadPair(const std::string& path, int frame)
 
 void benchDecode(bm::State& st)
 {
-	const bims::ego::CameraParams noCam;
+	const bims::sensors::CameraParams noCam;
 	bims::ego::RgbdFrame f;
 	for (auto _ : st)
 	{

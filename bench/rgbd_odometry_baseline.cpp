@@ -67,7 +67,7 @@ int main(int argc, char** argv)
 		bims::checkExperimentSections(cfg);
 		bims::ego::EgoConfig ec;
 		ec.loadFromConfigFile(cfg, false);
-		bims::ego::DepthCorrection dc(ec.depth_correction);
+		bims::sensors::DepthCorrection dc(ec.depth_correction);
 		bims::RawlogReader reader(in);
 		cv::Ptr<cv::rgbd::Odometry> odo;
 		bims::Trajectory traj;

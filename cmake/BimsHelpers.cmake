@@ -160,3 +160,36 @@ function(bims_add_gtest)
     WORKING_DIRECTORY ${PROJECT_BINARY_DIR}
     PROPERTIES TIMEOUT ${A_TIMEOUT} LABELS "${A_LABELS}")
 endfunction()
+
+# bims_write_module_graph(FILE): one line per library module, "module: the
+# bims modules it links directly" (PUBLIC, PRIVATE and INTERFACE links, the
+# targets' own LINK_LIBRARIES), for scripts/check_layers.py (test
+# Architecture.IncludesFollowTheLinks): the graph the build really has, not a
+# copy of it.
+function(bims_write_module_graph file)
+  set(text "")
+  foreach(module ${ARGN})
+    if(NOT TARGET bims_${module})
+      continue()
+    endif()
+    get_target_property(type bims_${module} TYPE)
+    set(links "")
+    foreach(prop LINK_LIBRARIES INTERFACE_LINK_LIBRARIES)
+      if(type STREQUAL "INTERFACE_LIBRARY" AND prop STREQUAL "LINK_LIBRARIES")
+        continue()
+      endif()
+      get_target_property(l bims_${module} ${prop})
+      if(l)
+        list(APPEND links ${l})
+      endif()
+    endforeach()
+    string(REGEX MATCHALL "bims(::|_)[a-z_]+" deps "${links}")
+    list(TRANSFORM deps REPLACE "^bims(::|_)" "")
+    list(REMOVE_ITEM deps rosbag_deps)
+    list(REMOVE_DUPLICATES deps)
+    list(REMOVE_ITEM deps ${module})
+    list(JOIN deps " " deps)
+    string(APPEND text "${module}: ${deps}\n")
+  endforeach()
+  file(WRITE ${file} "${text}")
+endfunction()

@@ -90,7 +90,7 @@ bims::eval::MaskMetrics scoreAgainstProxy(const ExperimentConfig& cfg,
 	const auto conv = ev::LabelConvention::explicitValues(255, 0, {150, 50});
 	Pipeline pipe(cfg);
 	// the depth correction of config/bonn.ini, as bims-run applies it
-	bims::ego::DepthCorrection depthCorrection(cfg.ego.depth_correction);
+	bims::sensors::DepthCorrection depthCorrection(cfg.ego.depth_correction);
 	std::vector<ev::MaskFile> preds;
 	std::vector<cv::Mat> masks;
 	for (size_t i = 0; i < folder.frames.size(); i++)

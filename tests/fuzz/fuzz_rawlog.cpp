@@ -28,12 +28,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 			        std::dynamic_pointer_cast<CObservation3DRangeScan>(o))
 			{
 				bims::ego::RgbdFrame f;
-				(void)bims::ego::rgbdFrameFrom(*s, bims::ego::CameraParams{},
-				                               f);
+				(void)bims::ego::rgbdFrameFrom(
+				    *s, bims::sensors::CameraParams{}, f);
 			}
 			else if (const auto imu =
 			             std::dynamic_pointer_cast<CObservationIMU>(o))
-				(void)bims::ego::imuSampleFrom(*imu);
+				(void)bims::sensors::imuSampleFrom(*imu);
 		}
 	}
 	catch (const std::exception&)

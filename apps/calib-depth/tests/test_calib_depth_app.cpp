@@ -52,7 +52,7 @@ TEST(CalibDepthApp, AnUndistortedSensorGetsAlmostNoCorrection)
 	          0)
 	    << bims::test::fileText(log);
 	mrpt::config::CConfigFile f(out);
-	bims::ego::DepthCorrectionParams p;
+	bims::sensors::DepthCorrectionParams p;
 	p.loadFromConfigFile(f);
 	EXPECT_TRUE(p.enable);
 	// at the borders and corners of the 320 x 240 sample (fx 270)
@@ -63,7 +63,7 @@ TEST(CalibDepthApp, AnUndistortedSensorGetsAlmostNoCorrection)
 	                           {-0.59, -0.44},
 	                           {0.59, 0.44}})
 	{
-		EXPECT_LT(std::abs(bims::ego::depthCorrectionDelta(p, x, y)), 0.025)
+		EXPECT_LT(std::abs(bims::sensors::depthCorrectionDelta(p, x, y)), 0.025)
 		    << x << " " << y;
 	}
 }

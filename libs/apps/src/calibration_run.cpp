@@ -4,9 +4,9 @@
 #include <bims/apps/odometry_run.h>
 #include <bims/apps/output_checks.h>
 #include <bims/common/output_paths.h>
+#include <bims/common/so3.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
-#include <bims/ego/so3.h>
 #include <bims/source/frame_source.h>
 
 #include <mrpt/system/filesystem.h>
@@ -72,7 +72,7 @@ int runImuCalibration(const ImuCalibrationOptions& o)
 	const auto st = replayRawlog(
 	    o.rawlog, odo,
 	    [&](const ego::FrameEgomotion& r, const auto&) { pairs.addFrame(r); },
-	    ro, [&](const ego::ImuSample& s) { pairs.addImu(s); });
+	    ro, [&](const sensors::ImuSample& s) { pairs.addImu(s); });
 	if (st.imu == 0)
 		throw std::runtime_error(
 		    o.rawlog + ": no IMU observation (check [sensors] imu_label)");
@@ -109,16 +109,16 @@ int runImuCalibration(const ImuCalibrationOptions& o)
 		    res.uncertainty_deg, o.max_uncertainty_deg);
 	if (haveRef)
 		std::printf("bims-calib-imu: angle to the configured R_IC: %.3f deg\n",
-		            ego::angleSO3(R_ref.transpose() * res.R_IC) * 180 / M_PI);
+		            angleSO3(R_ref.transpose() * res.R_IC) * 180 / M_PI);
 	if (o.out)
 		writeFileAtomically(*o.out, imuCalibrationIni(res.R_IC, off, o.rawlog));
 	return 0;
 }
 
-double largestDepthCorrection(const ego::DepthCorrectionParams& p,
+double largestDepthCorrection(const sensors::DepthCorrectionParams& p,
                               const Eigen::Matrix3d& K, cv::Size size)
 {
-	ego::DepthCorrection dc(p);
+	sensors::DepthCorrection dc(p);
 	double worst = 0;
 	cv::Mat fac = dc.factors(K, size);
 	cv::minMaxLoc(cv::abs(fac - 1), nullptr, &worst);

@@ -48,7 +48,7 @@ ReplayStats replayRawlog(const std::string& path, ego::Odometry& odo,
 		if (!f) break;
 		for (const auto& m : f->imu)
 		{
-			const ego::ImuSample s = ego::imuSampleFrom(*m);
+			const sensors::ImuSample s = sensors::imuSampleFrom(*m);
 			odo.addImu(s);
 			if (onImu) onImu(s);
 			++st.imu;

@@ -5,9 +5,9 @@
 #include <bims/common/experiment.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/rawlog.h>
+#include <bims/common/so3.h>
 #include <bims/common/stats.h>
 #include <bims/ego/flags.h>
-#include <bims/ego/so3.h>
 
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/system/filesystem.h>
@@ -83,7 +83,7 @@ TrackerTruth trackerAgainstTruth(const ego::FrameEgomotion& r,
 	TrackerTruth out;
 	const Eigen::Matrix3d R = T_CprevC.getRotationMatrix().asEigen();
 	const Eigen::Vector3d t(T_CprevC.x(), T_CprevC.y(), T_CprevC.z());
-	out.rate_deg_s = ego::angleSO3(R) * 180 / M_PI / dt;
+	out.rate_deg_s = angleSO3(R) * 180 / M_PI / dt;
 	// True position of a previous-image feature.
 	const auto truth = [&](const cv::Point2f& x, Eigen::Vector2d& y)
 	{

@@ -3,8 +3,8 @@
 // both runs on the bundled sample.
 #include <bims/apps/app.h>
 #include <bims/apps/calibration_run.h>
+#include <bims/common/so3.h>
 #include <bims/ego/flags.h>
-#include <bims/ego/so3.h>
 #include <bims_test/sample.h>
 #include <bims_test/text.h>
 #include <bims_test/tmp_dir.h>
@@ -52,7 +52,7 @@ TEST(RotationPairs, GyroOverEachFrameIntervalBesideTheVisualRotation)
 	RotationPairCollector c(0.05);
 	for (int k = 0; k <= 100; k++)
 	{
-		bims::ego::ImuSample s;
+		bims::sensors::ImuSample s;
 		s.t = 0.01 * k;
 		s.hasGyro = true;
 		s.gyro = Eigen::Vector3d(0, 0, s.t < 0.35 ? 1.0 : 2.0);  // rad/s
@@ -63,8 +63,8 @@ TEST(RotationPairs, GyroOverEachFrameIntervalBesideTheVisualRotation)
 	c.addFrame(frame(0.2, 0, aboutZ(0.3)));
 	ASSERT_EQ(c.pairs().size(), 1u);
 	// IMU 0.15 .. 0.25 at 1 rad/s
-	EXPECT_NEAR(bims::ego::angleSO3(c.pairs()[0].R_IprevI), 0.1, 1e-6);
-	EXPECT_NEAR(bims::ego::angleSO3(c.pairs()[0].R_CprevC), 0.3, 1e-9);
+	EXPECT_NEAR(bims::angleSO3(c.pairs()[0].R_IprevI), 0.1, 1e-6);
+	EXPECT_NEAR(bims::angleSO3(c.pairs()[0].R_CprevC), 0.3, 1e-9);
 	// out of order: no pair, and the next interval still starts at 0.2
 	c.addFrame(frame(0.15, bims::ego::kFlagOutOfOrder, aboutZ(0)));
 	EXPECT_EQ(c.pairs().size(), 1u);
@@ -75,7 +75,7 @@ TEST(RotationPairs, GyroOverEachFrameIntervalBesideTheVisualRotation)
 	ASSERT_EQ(c.pairs().size(), 2u);
 	// IMU 0.30 .. 0.45: 0.05 s at 1 rad/s, 0.1 s at 2 rad/s (trapezoid at
 	// the step)
-	EXPECT_NEAR(bims::ego::angleSO3(c.pairs()[1].R_IprevI), 0.255, 0.006);
+	EXPECT_NEAR(bims::angleSO3(c.pairs()[1].R_IprevI), 0.255, 0.006);
 }
 
 TEST(ImuCalibrationIni, ReadsBackAsTheEstimateAndOffset)
@@ -106,7 +106,7 @@ TEST(DepthCalibration, LargestCorrectionIsTheWorstPixel)
 {
 	Eigen::Matrix3d K;
 	K << 100, 0, 160, 0, 100, 120, 0, 0, 1;
-	bims::ego::DepthCorrectionParams p;
+	bims::sensors::DepthCorrectionParams p;
 	p.enable = true;
 	EXPECT_EQ(largestDepthCorrection(p, K, {320, 240}), 0.0);
 	p.coefficients[0] = 0.05;  // delta = 0.05 x: worst at the left border
@@ -131,7 +131,7 @@ TEST(ImuCalibration, EstimatesRICOnTheSampleAndWritesIt)
 	Eigen::Matrix3d Ra, Rb;
 	for (int i = 0; i < 3; i++)
 		for (int j = 0; j < 3; j++) a >> Ra(i, j), b >> Rb(i, j);
-	EXPECT_LT(bims::ego::angleSO3(Rb.transpose() * Ra) * 180 / M_PI, 10.0);
+	EXPECT_LT(bims::angleSO3(Rb.transpose() * Ra) * 180 / M_PI, 10.0);
 	// rotations of 50 degrees between frames: none, nothing to estimate from
 	o.min_angle_deg = 50;
 	o.out = d + "/none.ini";

@@ -4,9 +4,9 @@
 // test was written (docs/journal/egomotion.md, "Egomotion"), in both modes.
 #include <bims/apps/odometry_replay.h>
 #include <bims/common/rawlog.h>
+#include <bims/common/so3.h>
 #include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
-#include <bims/ego/so3.h>
 #include <gtest/gtest.h>
 
 #include <mrpt/config/CConfigFile.h>

@@ -182,7 +182,7 @@ std::vector<Eigen::Quaterniond> attitudes(
 	for (double t : stamps)
 	{
 		for (; i < imu.size() && secondsOf(imu[i]->timestamp) <= t; i++)
-			f.add(ego::imuSampleFrom(*imu[i]));
+			f.add(sensors::imuSampleFrom(*imu[i]));
 		const auto q = f.attitudeAt(t);
 		out.push_back(q ? *q : Eigen::Quaterniond(0, 0, 0, 0));
 	}

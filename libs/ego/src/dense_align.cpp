@@ -1,6 +1,6 @@
+#include <bims/common/so3.h>
 #include <bims/ego/dense_align.h>
 #include <bims/ego/normal_equations.h>
-#include <bims/ego/so3.h>
 
 #include <opencv2/imgproc.hpp>
 

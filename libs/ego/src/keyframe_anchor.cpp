@@ -1,6 +1,6 @@
 #include <bims/common/clock.h>
+#include <bims/common/so3.h>
 #include <bims/ego/keyframe_anchor.h>
-#include <bims/ego/so3.h>
 
 #include <opencv2/imgproc.hpp>
 

@@ -1,8 +1,8 @@
 #include <bims/common/clock.h>
+#include <bims/common/so3.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/moving_prediction.h>
 #include <bims/ego/odometry.h>
-#include <bims/ego/so3.h>
 
 #include <mrpt/math/CMatrixFixed.h>
 

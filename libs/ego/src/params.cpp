@@ -1,8 +1,8 @@
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
 #include <bims/common/share.h>
+#include <bims/common/so3.h>
 #include <bims/ego/params.h>
-#include <bims/ego/so3.h>
 
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/system/filesystem.h>
@@ -14,19 +14,6 @@
 
 namespace bims::ego
 {
-Eigen::Matrix3d orthonormalize(const Eigen::Matrix3d& M)
-{
-	Eigen::JacobiSVD<Eigen::Matrix3d> svd(
-	    M, Eigen::ComputeFullU | Eigen::ComputeFullV);
-	Eigen::Matrix3d R = svd.matrixU() * svd.matrixV().transpose();
-	if (R.determinant() < 0)
-	{
-		Eigen::Matrix3d U = svd.matrixU();
-		U.col(2) *= -1;
-		R = U * svd.matrixV().transpose();
-	}
-	return R;
-}
 
 void AttitudeParams::describe(OptionVisitor& v)
 {
@@ -253,84 +240,6 @@ void AnchorParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	readOptions(*this, cfg, section);
 }
 
-void CalibrationParams::describe(OptionVisitor& v)
-{
-	double r[9];
-	for (int i = 0; i < 9; i++) r[i] = R_IC(i / 3, i % 3);
-	v.reals("R_IC", r, 9, -1.0001, 1.0001,
-	        "camera optical frame in the IMU frame, p_I = R_IC p_C (row "
-	        "major); a file with [odometry] mode = imu must give it");
-	const Eigen::Matrix3d M =
-	    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(r);
-	const double err = (M * M.transpose() - Eigen::Matrix3d::Identity()).norm();
-	std::ostringstream os;
-	os << "not a rotation matrix (|R R^T - I| = " << err
-	   << ", det = " << M.determinant() << ")";
-	// re-orthonormalised, unless it is a rotation to double precision
-	// already (so that an R_IC written out reads back the same)
-	if (v.rule(err <= 1e-3 && M.determinant() >= 0, "R_IC", os.str()))
-		R_IC = err <= 1e-12 ? M : orthonormalize(M);
-	v.real("time_offset_s", time_offset_s, -10, 10,
-	       "IMU stamp = camera stamp + this for the same instant [s]");
-}
-
-void CalibrationParams::loadFromConfigFile(
-    const mrpt::config::CConfigFileBase& cfg, const std::string& section,
-    bool requireR)
-{
-	ConfigSection s(cfg, section);
-	has_R_IC = s.has("R_IC");
-	if (!has_R_IC && requireR)
-		s.fail("R_IC",
-		       "missing: the IMU-to-camera rotation (9 reals, row major, p_I = "
-		       "R_IC p_C) is needed when [odometry] mode = imu");
-	OptionReader r(s);
-	describe(r);
-	s.finish();
-}
-
-void CameraParams::describe(OptionVisitor& v)
-{
-	given = v.group({"fx", "fy", "cx", "cy", "width", "height"}, given);
-	if (given)
-	{
-		v.real("fx", fx, 1, 1e5,
-		       "focal length [px]; fx fy cx cy width height: all or none "
-		       "(none: each observation's own intrinsics)");
-		v.real("fy", fy, 1, 1e5, "focal length [px]");
-		v.real("cx", cx, -1e5, 1e5, "principal point [px]");
-		v.real("cy", cy, -1e5, 1e5, "principal point [px]");
-		v.integer("width", width, 1, 100000, "image width [px]");
-		v.integer("height", height, 1, 100000, "image height [px]");
-	}
-	// Keys bims-import-tum reads from the same section.
-	for (const char* k : {"depth_scale", "max_range", "depth_units", "k1", "k2",
-	                      "p1", "p2", "k3"})
-		v.other(k);
-}
-
-void CameraParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
-                                      const std::string& section)
-{
-	readOptions(*this, cfg, section);
-}
-
-void SensorsParams::describe(OptionVisitor& v)
-{
-	v.text("rgbd_label", rgbd_label,
-	       "sensor label of the 3D scans used (empty: any)");
-	v.text("imu_label", imu_label,
-	       "sensor label of the IMU observations used (empty: any)");
-	v.other("rgbd_rate_hz");  // informative keys written by bims-sim
-	v.other("imu_rate_hz");
-}
-
-void SensorsParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
-                                       const std::string& section)
-{
-	readOptions(*this, cfg, section);
-}
-
 void EgoConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
                                    bool requireCalibration)
 {
@@ -339,12 +248,8 @@ void EgoConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	translation.loadFromConfigFile(cfg);
 	odometry.loadFromConfigFile(cfg);
 	anchor.loadFromConfigFile(cfg);
-	depth_correction.loadFromConfigFile(cfg);
-	calibration.loadFromConfigFile(
-	    cfg, "calibration",
-	    requireCalibration && odometry.mode == OdometryMode::Imu);
-	camera.loadFromConfigFile(cfg);
-	sensors.loadFromConfigFile(cfg);
+	SensorConfig::loadFromConfigFile(
+	    cfg, requireCalibration && odometry.mode == OdometryMode::Imu);
 }
 
 void EgoConfig::loadFromFile(const std::string& given)
@@ -356,15 +261,6 @@ void EgoConfig::loadFromFile(const std::string& given)
 	const auto cfg = bims::openIniFile(path);
 	checkExperimentSections(*cfg);
 	loadFromConfigFile(*cfg, false);
-}
-
-void EgoConfig::overrideSensorSections(const mrpt::config::CConfigFileBase& cal)
-{
-	if (cal.sectionExists("calibration")) calibration.loadFromConfigFile(cal);
-	if (cal.sectionExists("camera")) camera.loadFromConfigFile(cal);
-	if (cal.sectionExists("sensors")) sensors.loadFromConfigFile(cal);
-	if (cal.sectionExists("depth_correction"))
-		depth_correction.loadFromConfigFile(cal);
 }
 
 }  // namespace bims::ego

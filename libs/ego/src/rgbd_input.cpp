@@ -21,7 +21,8 @@ std::string rgbdFrameFrom(const mrpt::obs::CObservation3DRangeScan& obs,
 	if (obs.hasIntensityImage && !obs.intensityImage.isEmpty())
 		image = obs.intensityImage.asCvMat<cv::Mat>(mrpt::img::SHALLOW_COPY);
 	Eigen::Matrix3d K;
-	if (std::string why = intrinsicsOf(obs, cam, K); !why.empty()) return why;
+	if (std::string why = sensors::intrinsicsOf(obs, cam, K); !why.empty())
+		return why;
 	return rgbdFrameFrom(depthImageOf(obs), image, K, out);
 }
 
@@ -110,39 +111,6 @@ mrpt::img::TCamera RgbdFrame::camera() const
 	c.nrows = static_cast<uint32_t>(depth.rows);
 	c.setIntrinsicParamsFromValues(K(0, 0), K(1, 1), K(0, 2), K(1, 2));
 	return c;
-}
-
-std::string intrinsicsOf(const mrpt::obs::CObservation3DRangeScan& obs,
-                         const CameraParams& cam, Eigen::Matrix3d& K)
-{
-	const int H = static_cast<int>(obs.rangeImage.rows());
-	const int W = static_cast<int>(obs.rangeImage.cols());
-	if (cam.given)
-	{
-		if (cam.width != W || cam.height != H)
-		{
-			std::ostringstream os;
-			os << "[camera] says " << cam.width << "x" << cam.height
-			   << " but the images are " << W << "x" << H;
-			return os.str();
-		}
-		K << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1;
-		return {};
-	}
-	const auto& cp = obs.cameraParams;
-	// NaN fails every comparison: require finite, positive focal lengths
-	if (!(cp.fx() > 0) || !(cp.fy() > 0) || !std::isfinite(cp.fx()) ||
-	    !std::isfinite(cp.fy()) || !std::isfinite(cp.cx()) ||
-	    !std::isfinite(cp.cy()))
-	{
-		std::ostringstream os;
-		os << "invalid cameraParams (fx " << cp.fx() << ", fy " << cp.fy()
-		   << ", cx " << cp.cx() << ", cy " << cp.cy()
-		   << "; finite values and fx, fy > 0 expected)";
-		return os.str();
-	}
-	K << cp.fx(), 0, cp.cx(), 0, cp.fy(), cp.cy(), 0, 0, 1;
-	return {};
 }
 
 float depthAt(const cv::Mat& depth, const cv::Point2f& x)

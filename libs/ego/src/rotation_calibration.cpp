@@ -1,5 +1,5 @@
+#include <bims/common/so3.h>
 #include <bims/ego/rotation_calibration.h>
-#include <bims/ego/so3.h>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>

@@ -1,4 +1,4 @@
-#include <bims/ego/so3.h>
+#include <bims/common/so3.h>
 #include <bims/ego/translation_estimator.h>
 
 #include <Eigen/SVD>

@@ -3,9 +3,9 @@
 // ground truth without the simulator. Fixed seeds only.
 #pragma once
 
+#include <bims/common/so3.h>
 #include <bims/ego/attitude_filter.h>
 #include <bims/ego/rgbd_input.h>
-#include <bims/ego/so3.h>
 
 #include <opencv2/core.hpp>
 

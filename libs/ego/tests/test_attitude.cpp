@@ -1,14 +1,15 @@
 // AttitudeFilter: convergence from a wrong state, gating of magnetic
 // disturbances and linear accelerations, interpolation, bad input.
+#include <bims/common/so3.h>
 #include <bims/ego/attitude_filter.h>
 #include <bims/ego/flags.h>
-#include <bims/ego/so3.h>
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "synth_scene.h"
 
+using namespace bims;  // so3.h
 using namespace bims::ego;
 using bims::ego::test::Motion;
 

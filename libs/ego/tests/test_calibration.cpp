@@ -1,10 +1,11 @@
 // R_IC estimation from gyro vs visual relative rotations.
+#include <bims/common/so3.h>
 #include <bims/ego/rotation_calibration.h>
-#include <bims/ego/so3.h>
 #include <gtest/gtest.h>
 
 #include <random>
 
+using namespace bims;  // so3.h
 using namespace bims::ego;
 
 TEST(RotationCalibration, RecoversR_ICWithNoiseAndOutliers)

@@ -15,6 +15,7 @@
 
 #include "synth_scene.h"
 
+using namespace bims;  // so3.h
 using namespace bims::ego;
 
 namespace

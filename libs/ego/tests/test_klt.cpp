@@ -1,7 +1,7 @@
 // GyroAidedKLT: the infinite homography, tracking through fast rotations
 // with and without the gyro aid, forward-backward check and the moving mask.
+#include <bims/common/so3.h>
 #include <bims/ego/gyro_klt.h>
-#include <bims/ego/so3.h>
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
@@ -9,6 +9,7 @@
 
 #include "synth_scene.h"
 
+using namespace bims;  // so3.h
 using namespace bims::ego;
 
 namespace

@@ -1,11 +1,12 @@
 // TranslationEstimator: robustness to 40 % outliers (features on moving
 // objects), vision-only SE(3), analytic vs numeric Jacobians, bad input.
-#include <bims/ego/so3.h>
+#include <bims/common/so3.h>
 #include <bims/ego/translation_estimator.h>
 #include <gtest/gtest.h>
 
 #include <random>
 
+using namespace bims;  // so3.h
 using namespace bims::ego;
 
 namespace

@@ -82,7 +82,7 @@ void Pipeline::addImu(const mrpt::obs::CObservationIMU& imu)
 	odom_.addImu(imu);
 }
 
-void Pipeline::addImu(const ego::ImuSample& s)
+void Pipeline::addImu(const sensors::ImuSample& s)
 {
 	odom_.addImu(s);
 }

@@ -470,7 +470,7 @@ class PyPipeline
 				               " is before the previous sample's " +
 				               std::to_string(lastImu_) +
 				               " (samples in time order expected)");
-			ego::ImuSample s;
+			sensors::ImuSample s;
 			s.t = t;
 			if ((s.hasGyro = has(i, 1, 3)))
 				s.gyro = Eigen::Vector3d(m(i, 1), m(i, 2), m(i, 3));
@@ -503,7 +503,7 @@ py::array_t<double> imuArray(const source::SourceFrame& f)
 	auto o = out.mutable_unchecked<2>();
 	for (size_t i = 0; i < f.imu.size(); ++i)
 	{
-		const ego::ImuSample s = ego::imuSampleFrom(*f.imu[i]);
+		const sensors::ImuSample s = sensors::imuSampleFrom(*f.imu[i]);
 		double row[kImuColumns];
 		std::fill(row, row + kImuColumns, kNaN);
 		row[0] = s.t;
@@ -571,7 +571,7 @@ class PyRawlogReader
 		d["depth_units"] = double(depth.units);
 		d["range_is_depth"] = depth.isDepth;
 		Eigen::Matrix3d K;
-		const std::string why = ego::intrinsicsOf(scan, cfg_.ego.camera, K);
+		const std::string why = sensors::intrinsicsOf(scan, cfg_.ego.camera, K);
 		if (!why.empty())
 			throw std::runtime_error("3D scan #" + std::to_string(f->index) +
 			                         ": " + why);

@@ -1,6 +1,6 @@
 #include <bims/source/frame_source.h>
 
-#include <bims/ego/attitude_filter.h>
+#include <bims/sensors/imu_sample.h>
 
 #include "read_ahead.h"
 
@@ -49,17 +49,17 @@ void add(InputCost& a, const InputCost& b)
 }
 }  // namespace
 
-FrameOrderParams FrameOrderParams::of(const ego::EgoConfig& ego,
+FrameOrderParams FrameOrderParams::of(const sensors::SensorConfig& rig,
                                       double imuWaitS,
                                       const std::string& program)
 {
 	FrameOrderParams p;
 	p.program = program;
-	p.sensors = ego.sensors;
-	p.imuOffsetS = ego.calibration.time_offset_s;
+	p.sensors = rig.sensors;
+	p.imuOffsetS = rig.calibration.time_offset_s;
 	p.imuWaitS = imuWaitS;
-	p.camera = ego.camera;
-	p.depthCorrection = ego.depth_correction;
+	p.camera = rig.camera;
+	p.depthCorrection = rig.depth_correction;
 	return p;
 }
 
@@ -305,8 +305,8 @@ bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
 
 uint8_t imuChannels(const mrpt::obs::CObservationIMU& imu)
 {
-	// what the egomotion reads from it (one home: ego::imuSampleFrom)
-	const ego::ImuSample s = ego::imuSampleFrom(imu);
+	// what the egomotion reads from it (one home: sensors::imuSampleFrom)
+	const sensors::ImuSample s = sensors::imuSampleFrom(imu);
 	return uint8_t((s.hasGyro ? kImuGyro : 0) | (s.hasAcc ? kImuAccel : 0) |
 	               (s.hasMag ? kImuMag : 0));
 }

@@ -44,14 +44,14 @@ class RotationPairCollector
 	explicit RotationPairCollector(double time_offset_s) : off_(time_offset_s)
 	{
 	}
-	void addImu(const ego::ImuSample& s) { imu_.push_back(s); }
+	void addImu(const sensors::ImuSample& s) { imu_.push_back(s); }
 	void addFrame(const ego::FrameEgomotion& r);
 	const std::vector<ego::RotationPair>& pairs() const { return pairs_; }
 
  private:
 	double off_;
 	double tPrev_ = NAN;
-	std::deque<ego::ImuSample> imu_;
+	std::deque<sensors::ImuSample> imu_;
 	std::vector<ego::RotationPair> pairs_;
 };
 
@@ -81,7 +81,7 @@ struct DepthCalibrationOptions
 
 /** The largest |factor - 1| of correction \a p over an image of \a size
  * with intrinsics \a K. */
-double largestDepthCorrection(const ego::DepthCorrectionParams& p,
+double largestDepthCorrection(const sensors::DepthCorrectionParams& p,
                               const Eigen::Matrix3d& K, cv::Size size);
 
 /** bims-calib-depth: checks that no output is an input and the frame

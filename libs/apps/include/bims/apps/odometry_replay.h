@@ -42,7 +42,7 @@ struct ReplayStats
 
 using FrameCallback = std::function<void(
     const ego::FrameEgomotion&, const mrpt::obs::CObservation3DRangeScan&)>;
-using ImuCallback = std::function<void(const ego::ImuSample&)>;
+using ImuCallback = std::function<void(const sensors::ImuSample&)>;
 
 /** Runs \a odo over the rawlog at \a path. Throws RawlogError on a
  * truncated or corrupt file (after the frames before it were processed). */

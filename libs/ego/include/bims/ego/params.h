@@ -1,6 +1,6 @@
 // Parameters of the egomotion stage, one plain struct per .ini section of the
 // experiment file ([attitude], [tracker], [translation], [odometry],
-// [calibration], [camera], [sensors]; see bims/common/experiment.h).
+// and the sensor rig's, bims/sensors/params.h; see bims/common/experiment.h).
 //
 // Each struct has defaults (config/default.ini's values: the built-in
 // defaults are that file's model), describe() naming every key once
@@ -13,6 +13,7 @@
 
 #include <bims/common/choice.h>
 #include <bims/common/options.h>
+#include <bims/sensors/params.h>
 #include <mrpt/config/CConfigFileBase.h>
 
 #include <Eigen/Core>
@@ -311,89 +312,24 @@ struct AnchorParams
 	                        const std::string& section = "anchor");
 };
 
-/** [calibration]: IMU-camera extrinsics. Convention (bims/common/frames.h):
- * R_IC is the camera frame {C} (optical) expressed in the IMU frame {I}:
- * p_I = R_IC p_C, so R_WC = R_WI R_IC. Time: the IMU sample stamped
- * t_cam + time_offset_s was taken at the instant of the camera frame stamped
- * t_cam. */
-struct CalibrationParams
-{
-	/** The simulator's mounting (config/default.ini): IMU x forward, y
-	 * left, z up on the camera's optical axes. */
-	Eigen::Matrix3d R_IC =
-	    (Eigen::Matrix3d() << 0, 0, 1, -1, 0, 0, 0, -1, 0).finished();
-	/** R_IC is known: the built-in one, or read from a file that gives it
-	 * (a file without R_IC leaves it unknown: no IMU rotation). */
-	bool has_R_IC = true;
-	double time_offset_s = 0;  ///< t_imu = t_cam + time_offset_s [s]
+/** The sensor rig's sections (bims/sensors/params.h), used throughout the
+ * egomotion under these names. */
+using sensors::CalibrationParams;
+using sensors::CameraParams;
+using sensors::DepthCorrectionParams;
+using sensors::kDepthCorrectionTerms;
+using sensors::SensorsParams;
 
-	/** Keys: R_IC = 9 reals, row major (checked orthonormal to 1e-3, then
-	 * re-orthonormalised); time_offset_s. */
-	void describe(OptionVisitor& v);
-	/** \param requireR throws ConfigError naming file/section/key when the
-	 * file gives no R_IC. */
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
-	                        const std::string& section = "calibration",
-	                        bool requireR = false);
-};
-
-/** [camera]: intrinsics; when the section has none, those of each
- * observation (cameraParamsIntensity) are used. */
-struct CameraParams
-{
-	bool given = false;                     ///< fx..height present in the file
-	double fx = 0, fy = 0, cx = 0, cy = 0;  ///< [px]
-	int width = 0, height = 0;              ///< [px]
-
-	/** Every key of the section (bims/common/options.h). */
-	void describe(OptionVisitor& v);
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
-	                        const std::string& section = "camera");
-};
-
-/** [sensors]: sensor labels in the rawlog (empty = accept any). */
-struct SensorsParams
-{
-	std::string rgbd_label = "RGBD";
-	std::string imu_label = "IMU";
-
-	/** Every key of the section (bims/common/options.h). */
-	void describe(OptionVisitor& v);
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
-	                        const std::string& section = "sensors");
-};
-
-/** Terms of the depth correction polynomial (bims/ego/depth_correction.h). */
-constexpr int kDepthCorrectionTerms = 12;
-
-/** [depth_correction]: a smooth multiplicative correction of the depth
- * readings, z (1 + delta(x, y)) (bims/ego/depth_correction.h; fitted by
- * bims-calib-depth): enable, coefficients (12 reals). */
-struct DepthCorrectionParams
-{
-	bool enable = false;
-	std::array<double, kDepthCorrectionTerms> coefficients{};
-
-	/** Every key of the section (bims/common/options.h). */
-	void describe(OptionVisitor& v);
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
-	                        const std::string& section = "depth_correction");
-	/** The section as .ini text (what bims-calib-depth writes). */
-	std::string toIni(const std::string& comment = "") const;
-};
-
-/** Everything the egomotion stage reads from one experiment file. */
-struct EgoConfig
+/** Everything the egomotion stage reads from one experiment file: the
+ * sensor rig's sections (depth_correction, calibration, camera, sensors)
+ * and its own. */
+struct EgoConfig : sensors::SensorConfig
 {
 	AttitudeParams attitude;
 	TrackerParams tracker;
 	TranslationParams translation;
 	OdometryParams odometry;
 	AnchorParams anchor;
-	DepthCorrectionParams depth_correction;
-	CalibrationParams calibration;
-	CameraParams camera;
-	SensorsParams sensors;
 
 	/** Reads all sections above (each optional, defaults otherwise);
 	 * R_IC is required when odometry.mode = imu and \a requireCalibration
@@ -405,11 +341,6 @@ struct EgoConfig
 	 * it (loadFromConfigFile(cfg, false)); a missing file is a
 	 * bims::ConfigFileMissing naming it. */
 	void loadFromFile(const std::string& path);
-
-	/** Overrides [calibration], [camera] and [sensors] with those present
-	 * in \a cal (e.g. bims-sim's OUT_gt/calibration.ini); sections absent
-	 * from \a cal are left as they are. */
-	void overrideSensorSections(const mrpt::config::CConfigFileBase& cal);
 };
 
 }  // namespace bims::ego

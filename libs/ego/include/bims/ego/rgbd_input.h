@@ -4,6 +4,7 @@
 
 #include <bims/common/depth_image.h>
 #include <bims/ego/params.h>
+#include <bims/sensors/camera.h>
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
@@ -62,12 +63,6 @@ struct RgbdFrame
                                         const cv::Mat& image,
                                         const Eigen::Matrix3d& K,
                                         RgbdFrame& out);
-
-/** The intrinsics of \a obs's range image: \a cam when given (its size
- * must match), else the observation's cameraParams. \return empty string
- * on success, else what is wrong. */
-std::string intrinsicsOf(const mrpt::obs::CObservation3DRangeScan& obs,
-                         const CameraParams& cam, Eigen::Matrix3d& K);
 
 /** Depth at a sub-pixel position [m]: bilinear over the 4 neighbours if all
  * are valid and within 5 % of each other (no interpolation across depth

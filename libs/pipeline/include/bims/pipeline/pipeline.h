@@ -115,7 +115,7 @@ class Pipeline
 	/** Feeds an IMU observation (label filtered by [sensors] imu_label). */
 	void addImu(const mrpt::obs::CObservationIMU& imu);
 	/** Feeds an IMU sample already decoded (no label filter). */
-	void addImu(const ego::ImuSample& s);
+	void addImu(const sensors::ImuSample& s);
 
 	using Next = NextFrame;
 

@@ -36,8 +36,9 @@
 #pragma once
 
 #include <bims/common/imu_check.h>
-#include <bims/ego/depth_correction.h>
-#include <bims/ego/params.h>
+#include <bims/sensors/depth_correction.h>
+#include <bims/sensors/imu_sample.h>
+#include <bims/sensors/params.h>
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
@@ -98,22 +99,23 @@ struct FrameOrderParams
 	/** Warn on stderr of what is skipped (counted in FrameOrderStats
 	 * either way): off for a pass that only indexes the input. */
 	bool warnings = true;
-	ego::SensorsParams sensors;
+	sensors::SensorsParams sensors;
 	/** IMU stamp = camera stamp + offset for the same instant [s]. */
 	double imuOffsetS = 0;
 	/** A frame waits at most this much newer data for the IMU [s]. */
 	double imuWaitS = 0.2;
 	FrameRange frames;
-	ego::CameraParams camera;  ///< for the depth correction's intrinsics
-	ego::DepthCorrectionParams depthCorrection;
+	sensors::CameraParams camera;  ///< for the depth correction's intrinsics
+	sensors::DepthCorrectionParams depthCorrection;
 	/** Keep the IMU observations to write beside the frames
 	 * (SourceFrame::before, FrameOrder::takeTrailing): a labelled copy of
 	 * the input. */
 	bool keepInput = false;
 
-	/** The rule as \a ego configures it, with \a imuWaitS ([pipeline]). */
-	static FrameOrderParams of(const ego::EgoConfig& ego, double imuWaitS,
-	                           const std::string& program);
+	/** The rule as the sensor rig \a rig configures it (an experiment's
+	 * ego::EgoConfig is one), with \a imuWaitS ([pipeline]). */
+	static FrameOrderParams of(const sensors::SensorConfig& rig,
+	                           double imuWaitS, const std::string& program);
 };
 
 /** Time spent getting the input of a frame (RawlogFrameSource). */
@@ -153,7 +155,7 @@ enum ImuChannel : uint8_t
 	kImuMag = 4
 };
 /** The channels of one sample, as the egomotion reads them
- * (ego::imuSampleFrom: all three axes present and finite). */
+ * (sensors::imuSampleFrom: all three axes present and finite). */
 uint8_t imuChannels(const mrpt::obs::CObservationIMU& imu);
 /** "gyro + accel + mag", "accel", ..., "no gyro, accel or mag". */
 std::string imuChannelNames(uint8_t channels);
@@ -239,7 +241,7 @@ class FrameOrder
 	FrameOrderParams p_;
 	FrameOrderStats st_;
 	RejectedImuSamples rejected_;
-	ego::DepthCorrection depthCorrection_;
+	sensors::DepthCorrection depthCorrection_;
 	std::deque<SourceFrame> waiting_;  ///< accepted, waiting for the IMU
 	std::deque<SourceFrame> released_;
 	std::optional<SourceFrame> held_;  ///< a far stamp, the next scan decides

@@ -1,5 +1,6 @@
 // Small SO(3) helpers (exponential/logarithm maps and their Jacobians) used by
-// the attitude filter, the translation estimator and the R_IC calibration.
+// the attitude filter, the translation estimator, the R_IC calibration and
+// the sensor rig's [calibration] (its R_IC re-orthonormalised).
 // Rotation vectors are in radians; Exp(w) is the rotation by |w| about w/|w|.
 #pragma once
 
@@ -8,7 +9,7 @@
 
 #include <cmath>
 
-namespace bims::ego
+namespace bims
 {
 /** [w]x: the skew-symmetric matrix with [w]x v = w x v. */
 inline Eigen::Matrix3d skew(const Eigen::Vector3d& w)
@@ -64,4 +65,4 @@ inline Eigen::Matrix3d rightJacobianInvSO3(const Eigen::Vector3d& w)
 /** Projects a near-rotation matrix onto SO(3) (SVD). */
 Eigen::Matrix3d orthonormalize(const Eigen::Matrix3d& M);
 
-}  // namespace bims::ego
+}  // namespace bims
