@@ -761,8 +761,8 @@ TEST(EndToEnd, TheGridsUseTheCameraModelAndPoseOfTheEgomotion)
 	Pipeline pipe(cfg);
 	const FrameResult& r = pipe.processFrame(*scan, 0);
 	const auto& f = pipe.grids().lastFrame();
-	EXPECT_EQ(f.K, (bims::maps::Intrinsics{cam.width, cam.height, cam.fx,
-	                                       cam.fy, cam.cx, cam.cy}));
+	EXPECT_EQ(f.K, (bims::sensors::PinholeCamera{cam.width, cam.height, cam.fx,
+	                                             cam.fy, cam.cx, cam.cy}));
 	EXPECT_EQ(f.T_WC, r.T_WC);
 	ASSERT_GT(f.numPoints(), 100u);
 	// every reading is its pixel's depth along [camera]'s ray, at T_WC

@@ -116,7 +116,7 @@ void BagImportParams::loadFromConfigFile(
 	{
 		eval::CameraIntrinsics c;
 		c.loadFromConfigFile(cfg, "camera");
-		camera = c.asTCamera();
+		camera = c.tcamera();
 		cameraFrom = "[camera] of " + cam.file();
 	}
 	else

@@ -104,15 +104,6 @@ DepthImage RgbdFrame::rawDepth() const
 	return d;
 }
 
-mrpt::img::TCamera RgbdFrame::camera() const
-{
-	mrpt::img::TCamera c;
-	c.ncols = static_cast<uint32_t>(depth.cols);
-	c.nrows = static_cast<uint32_t>(depth.rows);
-	c.setIntrinsicParamsFromValues(K(0, 0), K(1, 1), K(0, 2), K(1, 2));
-	return c;
-}
-
 float depthAt(const cv::Mat& depth, const cv::Point2f& x)
 {
 	const int u0 = static_cast<int>(std::floor(x.x));

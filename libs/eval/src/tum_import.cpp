@@ -31,7 +31,7 @@ mrpt::obs::CObservation3DRangeScan::Ptr loadDepthFrame(
 		    depthPath + ": depth image is " + std::to_string(raw.cols) + "x" +
 		    std::to_string(raw.rows) + " but [camera] says " +
 		    std::to_string(cam.width) + "x" + std::to_string(cam.height));
-	return depthObservation(raw, 1.0 / cam.depthScale, cam.asTCamera(),
+	return depthObservation(raw, 1.0 / cam.depthScale, cam.tcamera(),
 	                        params.rgbdLabel, t, params.rangeUnits);
 }
 

@@ -35,16 +35,6 @@ void CameraIntrinsics::loadFromConfigFile(
 	s.finish();
 }
 
-mrpt::img::TCamera CameraIntrinsics::asTCamera() const
-{
-	mrpt::img::TCamera c;
-	c.ncols = static_cast<uint32_t>(width);
-	c.nrows = static_cast<uint32_t>(height);
-	c.setIntrinsicParamsFromValues(fx, fy, cx, cy);
-	c.distortion = mrpt::img::DistortionModel::none;
-	return c;
-}
-
 void ImportParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg)
 {
 	checkExperimentSections(cfg);

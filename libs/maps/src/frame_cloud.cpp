@@ -275,20 +275,18 @@ void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
                               const mrpt::poses::CPose3D& T_WS, FrameCloud& out)
 {
 	const auto& cam = scan.cameraParams;
-	build(scan,
-	      {int(cam.ncols), int(cam.nrows), cam.fx(), cam.fy(), cam.cx(),
-	       cam.cy()},
-	      T_WS + bims::T_SC(), out);
+	build(scan, sensors::PinholeCamera::of(cam), T_WS + bims::T_SC(), out);
 }
 
 void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
-                              const Intrinsics& cam,
+                              const sensors::PinholeCamera& cam,
                               const mrpt::poses::CPose3D& T_WC, FrameCloud& out)
 {
 	build(depthImageOf(scan), cam, T_WC, out);
 }
 
-void FrameCloudBuilder::build(const DepthImage& img, const Intrinsics& cam,
+void FrameCloudBuilder::build(const DepthImage& img,
+                              const sensors::PinholeCamera& cam,
                               const mrpt::poses::CPose3D& T_WC, FrameCloud& out)
 {
 	resetFrame(out, true);
@@ -456,7 +454,7 @@ void FrameCloudBuilder::build(const DepthImage& img, const Intrinsics& cam,
 void FrameCloudBuilder::buildFromPoints(
     const std::vector<mrpt::math::TPoint3Df>& points_W,
     const std::vector<uint32_t>& pixels, const mrpt::math::TPoint3D& origin_W,
-    FrameCloud& out, const Intrinsics& K)
+    FrameCloud& out, const sensors::PinholeCamera& K)
 {
 	resetFrame(out);
 	out.voxel_size = p_.voxel_size;

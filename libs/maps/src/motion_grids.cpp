@@ -68,7 +68,7 @@ const FrameCloud& MotionGrids::buildFrame(
 }
 
 const FrameCloud& MotionGrids::buildFrame(const DepthImage& depth,
-                                          const Intrinsics& K,
+                                          const sensors::PinholeCamera& K,
                                           const mrpt::poses::CPose3D& T_WC)
 {
 	return buildInto([&](FrameCloud& f) { builder_.build(depth, K, T_WC, f); });

@@ -222,7 +222,7 @@ TEST(FlowGrid, PosteriorCountsTheLabelsAsCountLabelsOnBothSidesOf65536)
 				                 float((keys[i].z + 0.5) * p.voxel_size));
 				pix.push_back(uint32_t(pix.size()));
 			}
-		Intrinsics K;
+		bims::sensors::PinholeCamera K;
 		K.width = int(pix.size());
 		K.height = 1;
 		K.fx = K.fy = 1;

@@ -304,9 +304,7 @@ void Pipeline::startNextJobs(const Next& next, FrameResult& r, FrameJobs& jobs)
 	startLookahead(next);
 	// The cloud: this frame's depth with its camera model at its final pose
 	// (its build touches nothing the labels use).
-	const maps::Intrinsics K{cur_.size().width, cur_.size().height,
-	                         cur_.K(0, 0),      cur_.K(1, 1),
-	                         cur_.K(0, 2),      cur_.K(1, 2)};
+	const sensors::PinholeCamera K = cur_.pinhole();
 	jobs.buildHere =
 	    [this, depth = cur_.rawDepth(), K, T_WC = r.T_WC, &ms = r.ms.gridsCloud]
 	{

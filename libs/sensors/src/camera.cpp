@@ -5,6 +5,39 @@
 
 namespace bims::sensors
 {
+Eigen::Matrix3d PinholeCamera::K() const
+{
+	Eigen::Matrix3d k;
+	k << fx, 0, cx, 0, fy, cy, 0, 0, 1;
+	return k;
+}
+
+PinholeCamera PinholeCamera::fromK(const Eigen::Matrix3d& K, int width,
+                                   int height)
+{
+	return {width, height, K(0, 0), K(1, 1), K(0, 2), K(1, 2)};
+}
+
+mrpt::img::TCamera PinholeCamera::tcamera() const
+{
+	mrpt::img::TCamera c;
+	c.ncols = static_cast<uint32_t>(width);
+	c.nrows = static_cast<uint32_t>(height);
+	c.setIntrinsicParamsFromValues(fx, fy, cx, cy);
+	c.distortion = mrpt::img::DistortionModel::none;
+	return c;
+}
+
+PinholeCamera PinholeCamera::of(const mrpt::img::TCamera& c)
+{
+	return {static_cast<int>(c.ncols),
+	        static_cast<int>(c.nrows),
+	        c.fx(),
+	        c.fy(),
+	        c.cx(),
+	        c.cy()};
+}
+
 std::string intrinsicsOf(const mrpt::obs::CObservation3DRangeScan& obs,
                          const CameraParams& cam, Eigen::Matrix3d& K)
 {
@@ -19,7 +52,7 @@ std::string intrinsicsOf(const mrpt::obs::CObservation3DRangeScan& obs,
 			   << " but the images are " << W << "x" << H;
 			return os.str();
 		}
-		K << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1;
+		K = cam.K();
 		return {};
 	}
 	const auto& cp = obs.cameraParams;

@@ -39,9 +39,14 @@ struct RgbdFrame
 	/** The image size: the depth's. */
 	cv::Size size() const { return depth.size(); }
 
-	/** K and the image size as MRPT's camera model (what the flow stage
-	 * takes). */
-	mrpt::img::TCamera camera() const;
+	/** K and the image size: the frame's camera model
+	 * (bims/sensors/params.h). */
+	sensors::PinholeCamera pinhole() const
+	{
+		return sensors::PinholeCamera::fromK(K, depth.cols, depth.rows);
+	}
+	/** The same as MRPT's camera model (what the flow stage takes). */
+	mrpt::img::TCamera camera() const { return pinhole().tcamera(); }
 	/** The raw readings as a view (valid while the frame lives). */
 	DepthImage rawDepth() const;
 };

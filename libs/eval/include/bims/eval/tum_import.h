@@ -6,6 +6,7 @@
 #include <bims/common/choice.h>
 #include <bims/common/progress.h>
 #include <bims/common/trajectory.h>
+#include <bims/sensors/params.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/img/TCamera.h>
 #include <mrpt/obs/CObservation.h>
@@ -21,11 +22,9 @@ namespace bims::eval
 /** Pinhole RGB-D camera, registered depth and colour, no distortion.
  * Section [camera] of an experiment .ini. Defaults: the TUM RGB-D "ROS
  * default" intrinsics. */
-struct CameraIntrinsics
+struct CameraIntrinsics : sensors::PinholeCamera
 {
-	double fx = 525.0, fy = 525.0;  ///< focal lengths [px]
-	double cx = 319.5, cy = 239.5;  ///< principal point [px]
-	int width = 640, height = 480;  ///< image size [px]
+	CameraIntrinsics() : PinholeCamera{640, 480, 525.0, 525.0, 319.5, 239.5} {}
 	/** Depth PNG value per metre (TUM, Bonn: 5000, i.e. 0.2 mm units). */
 	double depthScale = 5000.0;
 
@@ -33,8 +32,6 @@ struct CameraIntrinsics
 	 * unknown keys in the section are errors (bims::ConfigSection). */
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section = "camera");
-	/** As MRPT camera parameters (no distortion). */
-	mrpt::img::TCamera asTCamera() const;
 };
 
 /** Everything bims-import-tum reads from an experiment .ini: sections

@@ -12,6 +12,7 @@
 #include <bims/maps/grid_params.h>
 #include <bims/maps/pixel_maps.h>
 #include <bims/maps/voxel_key.h>
+#include <bims/sensors/params.h>
 
 #include <mrpt/core/Clock.h>
 #include <mrpt/math/TPoint3D.h>
@@ -47,19 +48,6 @@ struct FrameStats
 	std::string asString() const;
 };
 
-/** Pinhole intrinsics of the depth image [px] (distortion ignored, as in
- * MRPT's own unprojection). */
-struct Intrinsics
-{
-	int width = 0, height = 0;
-	double fx = 0, fy = 0, cx = 0, cy = 0;
-	bool operator==(const Intrinsics& o) const
-	{
-		return width == o.width && height == o.height && fx == o.fx &&
-		       fy == o.fy && cx == o.cx && cy == o.cy;
-	}
-};
-
 /** See the file comment. */
 struct FrameCloud
 {
@@ -72,9 +60,9 @@ struct FrameCloud
 	mrpt::poses::CPose3D T_WC;
 	/** Sensor origin in {W} [m]. */
 	mrpt::math::TPoint3D origin_W;
-	/** Intrinsics; width = height = 0 for an unorganised cloud (then
+	/** The camera model; width = height = 0 for an unorganised cloud (then
 	 * decay = frustum has no frustum and masks are empty). */
-	Intrinsics K;
+	sensors::PinholeCamera K;
 	/** Per pixel (row-major) depth used [m] along the optical axis, 0 where
 	 * no valid reading; empty for an unorganised cloud. */
 	std::vector<float> depth;
@@ -113,13 +101,13 @@ class FrameCloudBuilder
 	 * stats.badPose = true. Throws std::invalid_argument if the image is
 	 * empty, \a K's size differs from it or its focal lengths are not
 	 * > 0. */
-	void build(const DepthImage& img, const Intrinsics& K,
+	void build(const DepthImage& img, const sensors::PinholeCamera& K,
 	           const mrpt::poses::CPose3D& T_WC, FrameCloud& out);
 	/** The same from a scan's range image (depthImageOf(scan)): the scan's
 	 * own cameraParams and sensorPose are not read. */
 	void build(const mrpt::obs::CObservation3DRangeScan& scan,
-	           const Intrinsics& K, const mrpt::poses::CPose3D& T_WC,
-	           FrameCloud& out);
+	           const sensors::PinholeCamera& K,
+	           const mrpt::poses::CPose3D& T_WC, FrameCloud& out);
 	/** The same in MRPT's convention (CMetricMap::insertObservation): the
 	 * scan's own cameraParams, and \param T_WS the pose of MRPT's scan
 	 * frame {S} in {W} (the observation's sensorPose is NOT added: pass
@@ -132,7 +120,7 @@ class FrameCloudBuilder
 	void buildFromPoints(const std::vector<mrpt::math::TPoint3Df>& points_W,
 	                     const std::vector<uint32_t>& pixels,
 	                     const mrpt::math::TPoint3D& origin_W, FrameCloud& out,
-	                     const Intrinsics& K = {});
+	                     const sensors::PinholeCamera& K = {});
 
 	/** Keys the points of \a out (points_W, pixel already filled):
 	 * fills cellOfPoint, cells, hits and the extent/range statistics. */

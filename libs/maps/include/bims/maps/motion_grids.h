@@ -63,7 +63,8 @@ class MotionGrids
 	                             const mrpt::poses::CPose3D& T_WS);
 	/** Same from a depth image with the caller's camera model \a K and
 	 * optical-frame pose \a T_WC (FrameCloudBuilder::build). */
-	const FrameCloud& buildFrame(const DepthImage& depth, const Intrinsics& K,
+	const FrameCloud& buildFrame(const DepthImage& depth,
+	                             const sensors::PinholeCamera& K,
 	                             const mrpt::poses::CPose3D& T_WC);
 	/** processFrame() of the frame built last (buildFrame): its cells go
 	 * to tiers 1 and 2 without a copy, and with setDeferDecay() its decay

@@ -3,6 +3,7 @@
 
 #include <bims/sensors/params.h>
 
+#include <mrpt/img/TCamera.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
 #include <Eigen/Core>

@@ -14,6 +14,7 @@
 
 #include <bims/common/options.h>
 #include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/img/TCamera.h>
 
 #include <Eigen/Core>
 
@@ -48,13 +49,36 @@ struct CalibrationParams
 	                        bool requireR = false);
 };
 
+/** The one camera model of bims: pinhole intrinsics of a depth image and
+ * the image registered to it [px] (distortion ignored, as in MRPT's own
+ * unprojection). K() is its matrix form for the egomotion's algebra,
+ * tcamera() MRPT's for the flow tier; width = height = 0: no pinhole model
+ * (an unorganised cloud). */
+struct PinholeCamera
+{
+	int width = 0, height = 0;
+	double fx = 0, fy = 0, cx = 0, cy = 0;
+
+	bool operator==(const PinholeCamera& o) const
+	{
+		return width == o.width && height == o.height && fx == o.fx &&
+		       fy == o.fy && cx == o.cx && cy == o.cy;
+	}
+	/** [fx 0 cx; 0 fy cy; 0 0 1]. */
+	Eigen::Matrix3d K() const;
+	/** The camera of matrix \a K for images of \a width x \a height. */
+	static PinholeCamera fromK(const Eigen::Matrix3d& K, int width, int height);
+	/** MRPT's camera parameters of the same model (no distortion). */
+	mrpt::img::TCamera tcamera() const;
+	/** The pinhole part of MRPT's camera parameters (distortion dropped). */
+	static PinholeCamera of(const mrpt::img::TCamera& c);
+};
+
 /** [camera]: intrinsics; when the section has none, those of each
  * observation (cameraParamsIntensity) are used. */
-struct CameraParams
+struct CameraParams : PinholeCamera
 {
-	bool given = false;                     ///< fx..height present in the file
-	double fx = 0, fy = 0, cx = 0, cy = 0;  ///< [px]
-	int width = 0, height = 0;              ///< [px]
+	bool given = false;  ///< fx..height present in the file
 
 	/** Every key of the section (bims/common/options.h). */
 	void describe(OptionVisitor& v);
