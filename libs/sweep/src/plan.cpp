@@ -7,6 +7,7 @@
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/io/vector_loadsave.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -95,13 +96,39 @@ std::string derive(
 		mem.write(grid[i].section, grid[i].key, overrides[i].second);
 	return mem.getContent();
 }
+
+/** The keys of \a s's section (none when it is absent). */
+std::vector<std::string> keysOf(const mrpt::config::CConfigFileBase& cfg,
+                                const ConfigSection& s)
+{
+	std::vector<std::string> keys;
+	if (s.exists()) cfg.getAllKeys(s.name(), keys);
+	return keys;
+}
+
+/** \a k as an experiment key "section.key" (no values yet). */
+GridAxis experimentKey(const ConfigSection& s, const std::string& k)
+{
+	GridAxis a;
+	a.name = k;
+	const auto dot = k.find('.');
+	if (dot == std::string::npos || dot == 0 || dot + 1 == k.size() ||
+	    k.find('.', dot + 1) != std::string::npos)
+		s.fail(k,
+		       "not an experiment key: write section.key (e.g. "
+		       "grids.voxel_size)");
+	a.section = k.substr(0, dot);
+	a.key = k.substr(dot + 1);
+	return a;
+}
+
 }  // namespace
 
 SweepSpec SweepSpec::load(const std::string& path)
 {
 	const auto file = openIniFile(path);
 	const mrpt::config::CConfigFile& cfg = *file;
-	checkSections(cfg, {"sweep", "grid"});
+	checkSections(cfg, {"sweep", "grid", "set"});
 	SweepSpec spec;
 	spec.file = path;
 	const fs::path folder = fs::path(path).parent_path();
@@ -124,29 +151,37 @@ SweepSpec SweepSpec::load(const std::string& path)
 	s.finish();
 
 	ConfigSection g(cfg, "grid");
-	std::vector<std::string> keys;
-	if (g.exists()) cfg.getAllKeys("grid", keys);
-	for (const auto& k : keys)
+	for (const auto& k : keysOf(cfg, g))
 	{
-		GridAxis a;
-		a.name = k;
-		const auto dot = k.find('.');
-		if (dot == std::string::npos || dot == 0 || dot + 1 == k.size() ||
-		    k.find('.', dot + 1) != std::string::npos)
-			g.fail(k,
-			       "not an experiment key: write section.key (e.g. "
-			       "grids.voxel_size)");
-		a.section = k.substr(0, dot);
-		a.key = k.substr(dot + 1);
+		GridAxis a = experimentKey(g, k);
 		a.values = g.getList(k);
 		if (a.values.empty()) g.fail(k, "no value");
 		std::set<std::string> seen;
 		for (const auto& v : a.values)
 			if (!seen.insert(v).second)
 				g.fail(k, "value '" + v + "' given twice");
-		spec.grid.push_back(std::move(a));
+		// one value: the same for every run, named once, not in run ids
+		a.from = "grid";
+		(a.values.size() > 1 ? spec.grid : spec.constants)
+		    .push_back(std::move(a));
 	}
 	g.finish();
+
+	ConfigSection c(cfg, "set");
+	for (const auto& k : keysOf(cfg, c))
+	{
+		GridAxis a = experimentKey(c, k);
+		if (g.has(k)) c.fail(k, "also in [grid]: give it in one of them");
+		a.values = {c.getString(k, "")};
+		a.from = "set";
+		if (a.values[0].empty()) c.fail(k, "no value");
+		spec.constants.push_back(std::move(a));
+	}
+	c.finish();
+	std::sort(spec.constants.begin(), spec.constants.end(),
+	          [](const GridAxis& a, const GridAxis& b)
+	          { return a.name < b.name; });
+
 	return spec;
 }
 
@@ -157,6 +192,8 @@ SweepPlan SweepPlan::make(const SweepSpec& spec)
 	plan.sweepFile = spec.file;
 	plan.frames = spec.frames;
 	for (const auto& a : spec.grid) plan.gridKeys.push_back(a.name);
+	for (const auto& a : spec.constants)
+		plan.constants.emplace_back(a.name, a.values[0]);
 
 	size_t combos = 1;
 	for (const auto& a : spec.grid) combos *= a.values.size();
@@ -167,8 +204,20 @@ SweepPlan SweepPlan::make(const SweepSpec& spec)
 	for (const auto& config : spec.configs)
 	{
 		checkIniFile(config.path);
-		const std::string base = mrpt::io::file_get_contents(config.path);
+		std::string base = mrpt::io::file_get_contents(config.path);
 		checkWithLoader(base, config.path);
+		// each constant alone, then all: the base of every run
+		for (const auto& a : spec.constants)
+			checkWithLoader(derive(base, {a}, {{a.name, a.values[0]}}),
+			                spec.file + ": [" + a.from + "] " + a.name + " = " +
+			                    a.values[0] + ": on " + config.written);
+		std::vector<std::pair<std::string, std::string>> constants;
+		for (const auto& a : spec.constants)
+			constants.emplace_back(a.name, a.values[0]);
+		base = derive(base, spec.constants, constants);
+		if (constants.size() > 1)
+			checkWithLoader(base, spec.file + ": " + constantsText(plan) +
+			                          ": on " + config.written);
 		// each override alone: the error names the grid key and the value
 		for (const auto& a : spec.grid)
 			for (const auto& v : a.values)
@@ -227,17 +276,20 @@ Json SweepPlan::toJson() const
 	j["sweep_file"] = sweepFile;
 	j["frames"] = frames;
 	j["grid"] = gridKeys;
+	Json& cs = j["constants"] = Json::object();
+	for (const auto& [k, v] : constants) cs[k] = v;
 	Json& rs = j["runs"] = Json::array();
 	for (const auto& r : runs)
 	{
 		Json o;
 		for (const auto& [k, v] : r.overrides) o[k] = v;
-		rs.push_back({{"id", r.id},
-		              {"config", r.config.written},
-		              {"config_path", r.config.path},
-		              {"rawlog", r.rawlog.written},
-		              {"rawlog_path", r.rawlog.path},
-		              {"overrides", o}});
+		Json run = {{"id", r.id},
+		            {"config", r.config.written},
+		            {"config_path", r.config.path},
+		            {"rawlog", r.rawlog.written},
+		            {"rawlog_path", r.rawlog.path},
+		            {"overrides", o}};
+		rs.push_back(std::move(run));
 	}
 	return j;
 }
@@ -257,6 +309,10 @@ SweepPlan SweepPlan::readJson(const std::string& path)
 		p.sweepFile = j.at("sweep_file").get<std::string>();
 		p.frames = j.at("frames").get<std::string>();
 		p.gridKeys = j.at("grid").get<std::vector<std::string>>();
+		// (plans of earlier versions have no constants)
+		const Json constants = j.value("constants", Json::object());
+		for (const auto& [k, v] : constants.items())
+			p.constants.emplace_back(k, v.get<std::string>());
 		for (const auto& o : j.at("runs"))
 		{
 			RunSpec r;
@@ -279,6 +335,14 @@ SweepPlan SweepPlan::readJson(const std::string& path)
 	{
 		throw std::runtime_error(path + ": not a bims-sweep plan: " + e.what());
 	}
+}
+
+std::string constantsText(const SweepPlan& plan)
+{
+	std::string out;
+	for (const auto& [k, v] : plan.constants)
+		out += (out.empty() ? "" : ", ") + k + "=" + v;
+	return out;
 }
 
 std::vector<std::string> shortGridKeys(const std::vector<std::string>& keys)
