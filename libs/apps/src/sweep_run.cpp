@@ -1,4 +1,5 @@
 #include <bims/apps/app.h>
+#include <bims/apps/eval_run.h>
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
 #include <bims/apps/sweep_run.h>
@@ -6,12 +7,14 @@
 #include <bims/sweep/plan.h>
 #include <bims/sweep/processes.h>
 #include <bims/sweep/results.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <thread>
 
 namespace bims::apps
@@ -31,8 +34,68 @@ using sweep::SweepSpec;
 using sweep::writeJobsFile;
 using sweep::writePlan;
 using sweep::writeResults;
+namespace fs = std::filesystem;
 namespace
 {
+/** stdout and stderr into a file while it lives (what bims-eval's runs
+ * print when a sweep scores its runs). */
+class OutputInto
+{
+ public:
+	explicit OutputInto(const std::string& path)
+	{
+		std::fflush(stdout);
+		std::fflush(stderr);
+		const int fd = ::open(path.c_str(),
+		                      O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+		if (fd < 0) throw std::runtime_error(path + ": cannot create");
+		out_ = ::dup(1);
+		err_ = ::dup(2);
+		::dup2(fd, 1);
+		::dup2(fd, 2);
+		::close(fd);
+	}
+	~OutputInto()
+	{
+		std::fflush(stdout);
+		std::fflush(stderr);
+		::dup2(out_, 1);
+		::dup2(err_, 2);
+		::close(out_);
+		::close(err_);
+	}
+	OutputInto(const OutputInto&) = delete;
+	OutputInto& operator=(const OutputInto&) = delete;
+
+ private:
+	int out_ = -1, err_ = -1;
+};
+
+/** Whether \a score exists and is not older than \a source. */
+bool upToDate(const std::string& score, const std::string& source)
+{
+	std::error_code e1, e2;
+	const auto a = fs::last_write_time(score, e1);
+	const auto b = fs::last_write_time(source, e2);
+	return !e1 && !e2 && a >= b;
+}
+
+/** Scores each run (scoreRun) and collects it; a scoring failure makes
+ * the run's status "not scored". */
+sweep::RunResult scoreAndCollect(const SweepPlan& plan, size_t i,
+                                 const std::string& outDir,
+                                 const JobOutcome* outcome)
+{
+	const std::string error = scoreRun(plan, plan.runs[i], outDir);
+	RunResult r = collectRun(plan.runs[i], outDir, outcome);
+	if (!error.empty() && r.ok())
+	{
+		r.status = "not scored";
+		r.error = error;
+	}
+	return r;
+}
+
 /** Writes the results and prints the summary; the exit code. */
 int report(const ResultTable& t, const std::string& outDir,
            const std::string& plotMetric)
@@ -56,6 +119,71 @@ int report(const ResultTable& t, const std::string& outDir,
 }
 }  // namespace
 
+std::string scoreRun(const SweepPlan& plan, const sweep::RunSpec& run,
+                     const std::string& outDir)
+{
+	if (run.truthMasks.empty() && run.truthTrajectory.empty()) return "";
+	const std::string dir = runDir(outDir, run.id);
+	const std::string out = sweep::runOutDir(outDir, run.id);
+	const std::string metrics = out + "/metrics.json";
+	if (collectRun(run, outDir).status != "ok") return "";
+	const bool masks =
+	    !run.truthMasks.empty() && !upToDate(dir + "/masks.json", metrics);
+	const bool traj =
+	    !run.truthTrajectory.empty() && !upToDate(dir + "/traj.json", metrics);
+	if (!masks && !traj) return "";
+	std::string error;
+	OutputInto log(dir + "/eval.txt");
+	if (masks)
+	{
+		try
+		{
+			EvalMasksOptions o;
+			o.gtDir = run.truthMasks;
+			o.predDir = out + "/masks";
+			if (plan.truth.depthValid) o.depthValid = run.rawlog.path;
+			o.noPlots = true;
+			o.quiet = true;
+			o.json = dir + "/masks.json";
+			if (plan.truth.movingValue >= 0)
+				o.movingValue = plan.truth.movingValue;
+			if (plan.truth.staticValue >= 0)
+				o.staticValue = plan.truth.staticValue;
+			if (!plan.truth.ignoreValues.empty())
+				o.ignoreValues = plan.truth.ignoreValues;
+			std::printf("bims-sweep: scoring the masks (bims-eval masks)\n");
+			runEvalMasks(o);
+		}
+		catch (const std::exception& e)
+		{
+			error = std::string("bims-eval masks: ") + e.what();
+			std::fprintf(stderr, "%s\n", error.c_str());
+		}
+	}
+	if (traj)
+	{
+		try
+		{
+			EvalTrajOptions o;
+			o.gt = run.truthTrajectory;
+			o.est = out + "/trajectory.txt";
+			o.json = dir + "/traj.json";
+			o.plot = dir + "/traj.png";
+			std::printf(
+			    "bims-sweep: scoring the trajectory (bims-eval traj)\n");
+			runEvalTraj(o);
+		}
+		catch (const std::exception& e)
+		{
+			const std::string t = std::string("bims-eval traj: ") + e.what();
+			std::fprintf(stderr, "%s\n", t.c_str());
+			error += (error.empty() ? "" : "; ") + t;
+		}
+	}
+	if (!error.empty()) error += " (see " + dir + "/eval.txt)";
+	return error;
+}
+
 int runSweep(const SweepOptions& opt)
 {
 	if (!opt.collect.empty())
@@ -66,8 +194,8 @@ int runSweep(const SweepOptions& opt)
 			    "--collect OUTDIR takes no SWEEP.ini, -o, --jobs-file nor "
 			    "--dry-run");
 		ResultTable t{SweepPlan::readJson(opt.collect + "/sweep.json"), {}};
-		for (const auto& r : t.plan.runs)
-			t.rows.push_back(collectRun(r, opt.collect));
+		for (size_t i = 0; i < t.plan.runs.size(); i++)
+			t.rows.push_back(scoreAndCollect(t.plan, i, opt.collect, nullptr));
 		return report(t, opt.collect, opt.plotMetric);
 	}
 	if (opt.sweepFile.empty())
@@ -143,7 +271,7 @@ int runSweep(const SweepOptions& opt)
 	pool.stopSignal = stopSignal;
 	pool.onDone = [&](size_t i, const JobOutcome& o)
 	{
-		t.rows[i] = collectRun(plan.runs[i], opt.outDir, &o);
+		t.rows[i] = scoreAndCollect(plan, i, opt.outDir, &o);
 		done++;
 		if (opt.quiet) return;
 		char fps[32] = "";

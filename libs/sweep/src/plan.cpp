@@ -122,13 +122,49 @@ GridAxis experimentKey(const ConfigSection& s, const std::string& k)
 	return a;
 }
 
+/** [truth] masks or trajectory: "auto" (each rawlog's RAWLOG_gt/masks or
+ * RAWLOG_gt/groundtruth.txt, the simulator's), or one path per rawlog
+ * (relative ones against SWEEP.ini's folder); each present. One "" per
+ * rawlog when absent. */
+std::vector<std::string> truthPaths(ConfigSection& t, const std::string& key,
+                                    const std::vector<ListedFile>& rawlogs,
+                                    const fs::path& folder)
+{
+	const bool folders = key == "masks";
+	const auto words = t.getWords(key);
+	std::vector<std::string> out(rawlogs.size());
+	if (words.empty()) return out;
+	const bool autoPaths = words.size() == 1 && words[0] == "auto";
+	if (!autoPaths && words.size() != rawlogs.size())
+		t.fail(key, "'auto' or one path per rawlog (" +
+		                std::to_string(rawlogs.size()) + "), not " +
+		                std::to_string(words.size()));
+	for (size_t i = 0; i < rawlogs.size(); i++)
+	{
+		const std::string& w = autoPaths ? "" : words[i];
+		const fs::path p = autoPaths
+		                       ? fs::path(groundTruthDirFor(rawlogs[i].path)) /
+		                             (folders ? "masks" : "groundtruth.txt")
+		                   : fs::path(w).is_absolute() ? fs::path(w)
+		                                               : folder / w;
+		out[i] = fs::absolute(p).lexically_normal().string();
+		std::error_code ec;
+		if (folders ? !fs::is_directory(out[i], ec)
+		            : !fs::is_regular_file(out[i], ec))
+			t.fail(key, (autoPaths ? "auto: " + rawlogs[i].written + "'s "
+			                       : "'" + w + "': ") +
+			                "no such " + (folders ? "folder" : "file") + " (" +
+			                out[i] + ")");
+	}
+	return out;
+}
 }  // namespace
 
 SweepSpec SweepSpec::load(const std::string& path)
 {
 	const auto file = openIniFile(path);
 	const mrpt::config::CConfigFile& cfg = *file;
-	checkSections(cfg, {"sweep", "grid", "set"});
+	checkSections(cfg, {"sweep", "grid", "set", "truth"});
 	SweepSpec spec;
 	spec.file = path;
 	const fs::path folder = fs::path(path).parent_path();
@@ -182,7 +218,25 @@ SweepSpec SweepSpec::load(const std::string& path)
 	          [](const GridAxis& a, const GridAxis& b)
 	          { return a.name < b.name; });
 
+	ConfigSection t(cfg, "truth");
+	spec.truth.masks = truthPaths(t, "masks", spec.rawlogs, folder);
+	spec.truth.trajectories = truthPaths(t, "trajectory", spec.rawlogs, folder);
+	spec.truth.movingValue = t.getInt("moving_value", -1, 0, 255);
+	spec.truth.staticValue = t.getInt("static_value", -1, 0, 255);
+	spec.truth.ignoreValues = t.getString("ignore_values", "");
+	spec.truth.depthValid = t.getBool("depth_valid", true);
+	if (t.exists() && !spec.truth.any())
+		t.fail("masks", "required: masks, trajectory or both");
+	t.finish();
 	return spec;
+}
+
+bool TruthSpec::any() const
+{
+	for (const auto* l : {&masks, &trajectories})
+		for (const auto& p : *l)
+			if (!p.empty()) return true;
+	return false;
 }
 
 SweepPlan SweepPlan::make(const SweepSpec& spec)
@@ -191,6 +245,7 @@ SweepPlan SweepPlan::make(const SweepSpec& spec)
 	plan.name = spec.name;
 	plan.sweepFile = spec.file;
 	plan.frames = spec.frames;
+	plan.truth = spec.truth;
 	for (const auto& a : spec.grid) plan.gridKeys.push_back(a.name);
 	for (const auto& a : spec.constants)
 		plan.constants.emplace_back(a.name, a.values[0]);
@@ -246,11 +301,14 @@ SweepPlan SweepPlan::make(const SweepSpec& spec)
 				checkWithLoader(text, spec.file + ": [grid] " + combo +
 				                          ": on " + config.written);
 			}
-			for (const auto& rawlog : spec.rawlogs)
+			for (size_t k = 0; k < spec.rawlogs.size(); k++)
 			{
+				const ListedFile& rawlog = spec.rawlogs[k];
 				RunSpec r;
 				r.config = config;
 				r.rawlog = rawlog;
+				r.truthMasks = spec.truth.masks[k];
+				r.truthTrajectory = spec.truth.trajectories[k];
 				r.overrides = ov;
 				r.configText = text;
 				std::string num = std::to_string(plan.runs.size() + 1);
@@ -278,6 +336,11 @@ Json SweepPlan::toJson() const
 	j["grid"] = gridKeys;
 	Json& cs = j["constants"] = Json::object();
 	for (const auto& [k, v] : constants) cs[k] = v;
+	if (truth.any())
+		j["truth"] = {{"moving_value", truth.movingValue},
+		              {"static_value", truth.staticValue},
+		              {"ignore_values", truth.ignoreValues},
+		              {"depth_valid", truth.depthValid}};
 	Json& rs = j["runs"] = Json::array();
 	for (const auto& r : runs)
 	{
@@ -289,6 +352,9 @@ Json SweepPlan::toJson() const
 		            {"rawlog", r.rawlog.written},
 		            {"rawlog_path", r.rawlog.path},
 		            {"overrides", o}};
+		if (!r.truthMasks.empty()) run["truth_masks"] = r.truthMasks;
+		if (!r.truthTrajectory.empty())
+			run["truth_trajectory"] = r.truthTrajectory;
 		rs.push_back(std::move(run));
 	}
 	return j;
@@ -309,10 +375,18 @@ SweepPlan SweepPlan::readJson(const std::string& path)
 		p.sweepFile = j.at("sweep_file").get<std::string>();
 		p.frames = j.at("frames").get<std::string>();
 		p.gridKeys = j.at("grid").get<std::vector<std::string>>();
-		// (plans of earlier versions have no constants)
+		// (plans of earlier versions have no constants nor truth)
 		const Json constants = j.value("constants", Json::object());
 		for (const auto& [k, v] : constants.items())
 			p.constants.emplace_back(k, v.get<std::string>());
+		if (j.contains("truth"))
+		{
+			const Json& t = j.at("truth");
+			p.truth.movingValue = t.at("moving_value").get<int>();
+			p.truth.staticValue = t.at("static_value").get<int>();
+			p.truth.ignoreValues = t.at("ignore_values").get<std::string>();
+			p.truth.depthValid = t.at("depth_valid").get<bool>();
+		}
 		for (const auto& o : j.at("runs"))
 		{
 			RunSpec r;
@@ -327,6 +401,10 @@ SweepPlan SweepPlan::readJson(const std::string& path)
 			for (const auto& k : p.gridKeys)
 				r.overrides.emplace_back(
 				    k, o.at("overrides").at(k).get<std::string>());
+			r.truthMasks = o.value("truth_masks", std::string());
+			r.truthTrajectory = o.value("truth_trajectory", std::string());
+			p.truth.masks.push_back(r.truthMasks);
+			p.truth.trajectories.push_back(r.truthTrajectory);
 			p.runs.push_back(std::move(r));
 		}
 		return p;

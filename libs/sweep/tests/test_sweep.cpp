@@ -496,6 +496,54 @@ TEST(SweepSpec, ConstantsAreSetInEveryRunAndNamedInNoRunId)
 	          std::string::npos);
 }
 
+TEST(SweepSpec, TruthNamesEachRawlogsLabelsAndTrajectory)
+{
+	const std::string two =
+	    "[sweep]\nconfigs = a.ini\nrawlogs = x.rawlog "
+	    "y.rawlog\n[truth]\n";
+	// auto: the simulator's RAWLOG_gt/masks and RAWLOG_gt/groundtruth.txt
+	auto d = sweepFolder("truth_auto", two +
+	                                       "masks = auto\ntrajectory = "
+	                                       "auto\nignore_values = 150\n");
+	for (const std::string r : {"x", "y"})
+	{
+		fs::create_directories(d + "/" + r + "_gt/masks");
+		put(d + "/" + r + "_gt/groundtruth.txt", "");
+	}
+	auto plan = sw::SweepPlan::make(sw::SweepSpec::load(d + "/sweep.ini"));
+	ASSERT_EQ(plan.runs.size(), 2u);
+	EXPECT_EQ(plan.runs[1].truthMasks, fs::path(d + "/y_gt/masks").string());
+	EXPECT_EQ(plan.runs[1].truthTrajectory,
+	          fs::path(d + "/y_gt/groundtruth.txt").string());
+	EXPECT_EQ(plan.truth.ignoreValues, "150");
+	EXPECT_TRUE(plan.truth.depthValid);
+	const auto out = tmpDir("truth_out");
+	sw::writePlan(plan, out);
+	const auto back = sw::SweepPlan::readJson(out + "/sweep.json");
+	EXPECT_EQ(back.runs[1].truthMasks, plan.runs[1].truthMasks);
+	EXPECT_EQ(back.runs[0].truthTrajectory, plan.runs[0].truthTrajectory);
+	EXPECT_EQ(back.truth.ignoreValues, "150");
+
+	// one path per rawlog, relative to SWEEP.ini
+	d = sweepFolder("truth_paths", two + "masks = lx ly\n");
+	fs::create_directories(d + "/lx");
+	fs::create_directories(d + "/ly");
+	plan = sw::SweepPlan::make(sw::SweepSpec::load(d + "/sweep.ini"));
+	EXPECT_EQ(plan.runs[0].truthMasks, fs::path(d + "/lx").string());
+	EXPECT_EQ(plan.runs[0].truthTrajectory, "");
+
+	EXPECT_NE(planError(sweepFolder("truth_gone", two + "masks = auto\n"))
+	              .find("[truth] masks: auto: x.rawlog's no such folder"),
+	          std::string::npos);
+	EXPECT_NE(planError(sweepFolder("truth_count", two + "masks = lx\n"))
+	              .find("[truth] masks: 'auto' or one path per rawlog (2), "
+	                    "not 1"),
+	          std::string::npos);
+	EXPECT_NE(planError(sweepFolder("truth_empty", two + "depth_valid = no\n"))
+	              .find("[truth] masks: required: masks, trajectory or both"),
+	          std::string::npos);
+}
+
 TEST(SweepResults, ConstantsAreListedOnceAndLegendsUseFileStems)
 {
 	const auto d = tmpDir("constants_results");

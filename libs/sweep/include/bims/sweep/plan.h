@@ -28,8 +28,25 @@ struct ListedFile
 	std::string written, path;
 };
 
+/** What a sweep's runs are scored against ([truth] of SWEEP.ini): per
+ * rawlog, its moving-pixel labels and/or its trajectory (each "" when
+ * none), and how the labels read (bims-eval masks' options). */
+struct TruthSpec
+{
+	/** One per rawlog, in the rawlogs' order ("": not scored so). */
+	std::vector<std::string> masks, trajectories;
+	/** The labels' values (bims-eval masks --moving-value, --static-value,
+	 * --ignore-values); -1 / "": not given (the labels' contract). */
+	int movingValue = -1, staticValue = -1;
+	std::string ignoreValues;
+	/** Only the pixels with depth in the rawlog's scans are scored
+	 * (bims-eval masks --depth-valid IN.rawlog). */
+	bool depthValid = true;
+	bool any() const;
+};
+
 /** SWEEP.ini as read: [sweep] configs, rawlogs, frames, name; [grid];
- * [set]. */
+ * [set]; [truth]. */
 struct SweepSpec
 {
 	std::string file;  ///< SWEEP.ini
@@ -42,12 +59,15 @@ struct SweepSpec
 	/** The keys set to one value for every run: [set], and the [grid] keys
 	 * given one value; by name. */
 	std::vector<GridAxis> constants;
+	TruthSpec truth;
 
 	/** Reads and checks SWEEP.ini: its syntax (checkIniFile), no section
-	 * but [sweep], [grid] and [set], no unknown key, configs and
+	 * but [sweep], [grid], [set] and [truth], no unknown key, configs and
 	 * rawlogs given and present, frames A:B, grid keys "section.key" with a
 	 * comma-separated list of distinct non-empty values, [set] keys
-	 * "section.key" with one value (not also in [grid]). Throws
+	 * "section.key" with one value (not also in [grid]), [truth] masks and
+	 * trajectory "auto" (the simulator's RAWLOG_gt/masks,
+	 * RAWLOG_gt/groundtruth.txt) or one path per rawlog, present. Throws
 	 * ConfigError naming the file, the section and the key. */
 	static SweepSpec load(const std::string& path);
 };
@@ -68,6 +88,8 @@ struct RunSpec
 	 * overrides set (through MRPT's CConfigFileMemory; comments and the
 	 * other keys kept). */
 	std::string configText;
+	/** The rawlog's labels and trajectory ("": none), from [truth]. */
+	std::string truthMasks, truthTrajectory;
 };
 
 /** Every run of a sweep, checked. */
@@ -79,6 +101,7 @@ struct SweepPlan
 	 * no run id nor legend, listed once. */
 	std::vector<std::pair<std::string, std::string>> constants;
 	std::vector<RunSpec> runs;
+	TruthSpec truth;  ///< masks and trajectories: see the runs'
 
 	/** The runs of \a spec: configs (outer) x grid combinations x rawlogs
 	 * (inner). Every config, every override alone and every combination
