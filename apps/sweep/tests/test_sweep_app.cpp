@@ -291,6 +291,55 @@ TEST(SweepApp, RunsWithGroundTruthAreScoredIntoTheResults)
 	EXPECT_EQ(readCsv(d + "/bad/results.csv")[0].at("status"), "not scored");
 }
 
+TEST(SweepApp, SlurmSubmitsOneArrayJobWhoseTaskIRunsLineI)
+{
+	const auto d = tmpDir("slurm_stub");
+	// a stand-in sbatch: records its arguments, answers a job id
+	fs::create_directories(d + "/bin");
+	std::ofstream(d + "/bin/sbatch")
+	    << "#!/bin/sh\nprintf '%s\\n' \"$@\" > " << q(d + "/args.txt")
+	    << "\necho '4242;cluster'\n";
+	fs::permissions(d + "/bin/sbatch", fs::perms::owner_all);
+	const auto ini = writeSweep(
+	    d, "frames = 0:2\n[grid]\npipeline.variant = fused, bottom-only\n");
+	const std::string out = d + "/out";
+	const std::string path = "PATH=" + q(d + "/bin") + ":\"$PATH\" ";
+	const auto r = bims::test::runCommand(
+	    path + kBin + "/bims-sweep " + q(ini) + " -o " + q(out) +
+	    " --slurm --sbatch '--partition=p --time=5'");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("2 runs submitted as Slurm array job 4242"),
+	          std::string::npos)
+	    << r.out;
+	const std::string args = bims::test::fileText(d + "/args.txt");
+	for (const std::string& a : std::vector<std::string>{
+	         "--parsable\n", "--array=1-2\n", "--partition=p\n", "--time=5\n",
+	         "--output=" + out + "/slurm/%A_%a.out\n", out + "/slurm.sh\n"})
+		EXPECT_NE(args.find(a), std::string::npos) << a << " in " << args;
+	EXPECT_EQ(bims::test::fileText(out + "/jobs.txt").find(kBin + "/bims-run"),
+	          0u);
+	// task 2 runs the second line only
+	const auto t = bims::test::runCommand("SLURM_ARRAY_TASK_ID=2 bash " +
+	                                      q(out + "/slurm.sh"));
+	EXPECT_EQ(t.code, 0) << t.out;
+	EXPECT_FALSE(fs::exists(out + "/runs/1_variant=fused/out/metrics.json"));
+	EXPECT_TRUE(
+	    fs::exists(out + "/runs/2_variant=bottom-only/out/metrics.json"));
+
+	// sbatch failing, or not there: an error naming it
+	std::ofstream(d + "/bin/sbatch")
+	    << "#!/bin/sh\necho 'sbatch: error: invalid partition' >&2\nexit 1\n";
+	const auto f =
+	    bims::test::runCommand(path + kBin + "/bims-sweep " + q(ini) + " -o " +
+	                           q(out) + " --overwrite --slurm");
+	EXPECT_EQ(f.code, 1) << f.out;
+	EXPECT_NE(f.out.find("sbatch failed (exit code 1): sbatch: error: "
+	                     "invalid partition"),
+	          std::string::npos)
+	    << f.out;
+	EXPECT_EQ(sweep(q(ini) + " -o " + q(out) + " --sbatch x").code, 2);
+}
+
 TEST(SweepApp, BadInputIsAnErrorNamingFileAndKeyBeforeAnyRun)
 {
 	const auto d = tmpDir("bad_input");

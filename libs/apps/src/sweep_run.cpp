@@ -3,11 +3,13 @@
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
 #include <bims/apps/sweep_run.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/share.h>
 #include <bims/sweep/plan.h>
 #include <bims/sweep/processes.h>
 #include <bims/sweep/results.h>
 #include <fcntl.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -15,6 +17,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <sstream>
 #include <thread>
 
 namespace bims::apps
@@ -184,15 +187,67 @@ std::string scoreRun(const SweepPlan& plan, const sweep::RunSpec& run,
 	return error;
 }
 
+namespace
+{
+/** Submits the jobs file as one Slurm array job: OUTDIR/slurm.sh runs
+ * line SLURM_ARRAY_TASK_ID of it. Returns sbatch's job id. */
+std::string submitToSlurm(const SweepOptions& opt, const SweepPlan& plan,
+                          const std::string& jobsFile)
+{
+	const std::string dir = fs::absolute(opt.outDir).lexically_normal();
+	const std::string jobs = fs::absolute(jobsFile).lexically_normal();
+	const std::string script = dir + "/slurm.sh";
+	writeFileAtomically(script,
+	                    "#!/bin/bash\n"
+	                    "# bims-sweep " +
+	                        plan.name +
+	                        ": Slurm array task i runs line i of the jobs file "
+	                        "(docs/sweep.md)\n"
+	                        "set -eu\n"
+	                        "line=$(sed -n \"${SLURM_ARRAY_TASK_ID}p\" " +
+	                        shellLine({jobs}) +
+	                        ")\n"
+	                        "exec bash -c \"$line\"\n");
+	makeDirs(dir + "/slurm");
+	std::vector<std::string> argv = {
+	    "sbatch", "--parsable", "--array=1-" + std::to_string(plan.runs.size()),
+	    "--job-name=bims-sweep", "--output=" + dir + "/slurm/%A_%a.out"};
+	std::istringstream more(opt.sbatchArgs);
+	for (std::string w; more >> w;) argv.push_back(w);
+	argv.push_back(script);
+	const std::string line = shellLine(argv);
+	std::printf("bims-sweep: %s\n", line.c_str());
+	std::fflush(stdout);
+	FILE* p = ::popen((line + " 2>&1").c_str(), "r");
+	if (!p) throw std::runtime_error("cannot run sbatch");
+	std::string text;
+	char buf[512];
+	while (std::fgets(buf, sizeof(buf), p)) text += buf;
+	const int status = ::pclose(p);
+	while (!text.empty() && (text.back() == '\n' || text.back() == '\r'))
+		text.pop_back();
+	if (status != 0)
+		throw std::runtime_error(
+		    "sbatch failed (" +
+		    (WIFEXITED(status) && WEXITSTATUS(status) == 127
+		         ? std::string("not found: is Slurm installed here?")
+		         : "exit code " + std::to_string(WEXITSTATUS(status))) +
+		    ")" + (text.empty() ? "" : ": " + text));
+	// --parsable: "JOBID" or "JOBID;CLUSTER"
+	const std::string last = text.substr(text.rfind('\n') + 1);
+	return last.substr(0, last.find(';'));
+}
+}  // namespace
+
 int runSweep(const SweepOptions& opt)
 {
 	if (!opt.collect.empty())
 	{
 		if (!opt.sweepFile.empty() || !opt.outDir.empty() ||
-		    !opt.jobsFile.empty() || opt.dryRun)
+		    !opt.jobsFile.empty() || opt.dryRun || opt.slurm)
 			throw UsageError(
-			    "--collect OUTDIR takes no SWEEP.ini, -o, --jobs-file nor "
-			    "--dry-run");
+			    "--collect OUTDIR takes no SWEEP.ini, -o, --jobs-file, "
+			    "--slurm nor --dry-run");
 		ResultTable t{SweepPlan::readJson(opt.collect + "/sweep.json"), {}};
 		for (size_t i = 0; i < t.plan.runs.size(); i++)
 			t.rows.push_back(scoreAndCollect(t.plan, i, opt.collect, nullptr));
@@ -203,15 +258,21 @@ int runSweep(const SweepOptions& opt)
 	if (opt.outDir.empty())
 		throw UsageError("give the output folder: -o OUTDIR");
 	if (opt.jobs < 0) throw UsageError("-j: a number of runs >= 0");
-	if (opt.dryRun && !opt.jobsFile.empty())
-		throw UsageError("--dry-run writes nothing: no --jobs-file with it");
+	if (opt.dryRun && (!opt.jobsFile.empty() || opt.slurm))
+		throw UsageError(
+		    "--dry-run writes nothing: no --jobs-file nor --slurm with it");
+	if (!opt.sbatchArgs.empty() && !opt.slurm)
+		throw UsageError("--sbatch goes with --slurm");
+	const std::string jobsFile = opt.slurm && opt.jobsFile.empty()
+	                                 ? opt.outDir + "/jobs.txt"
+	                                 : opt.jobsFile;
 
 	const SweepSpec spec = SweepSpec::load(opt.sweepFile);
 	std::vector<std::string> inputs = {spec.file};
 	for (const auto* list : {&spec.configs, &spec.rawlogs})
 		for (const auto& f : *list) inputs.push_back(f.path);
 	checkOutputsSpareInputs(inputs, {opt.outDir});
-	if (!opt.jobsFile.empty()) checkOutputsSpareInputs(inputs, {opt.jobsFile});
+	if (!jobsFile.empty()) checkOutputsSpareInputs(inputs, {jobsFile});
 	const SweepPlan plan = SweepPlan::make(spec);
 
 	const std::string program = executableDir() + "/bims-run";
@@ -242,6 +303,18 @@ int runSweep(const SweepOptions& opt)
 	    {{"sweep.json", "results.csv", "results.md", "results.png"}, {}},
 	    opt.overwrite);
 	writePlan(plan, opt.outDir);
+	if (opt.slurm)
+	{
+		writeJobsFile(jobsFile, program, plan, opt.outDir);
+		const std::string id = submitToSlurm(opt, plan, jobsFile);
+		std::printf(
+		    "bims-sweep: %zu runs submitted as Slurm array job %s (tasks' "
+		    "output in %s/slurm/); when it is done: bims-sweep --collect "
+		    "%s\n",
+		    plan.runs.size(), id.c_str(), opt.outDir.c_str(),
+		    opt.outDir.c_str());
+		return 0;
+	}
 	if (!opt.jobsFile.empty())
 	{
 		writeJobsFile(opt.jobsFile, program, plan, opt.outDir);

@@ -18,8 +18,15 @@ struct SweepOptions
 	/** Runs at once; 0 = one per core. */
 	int jobs = 1;
 	std::string jobsFile;  ///< write the jobs there instead of running them
-	bool dryRun = false;   ///< check and print the runs; write nothing
-	bool quiet = false;    ///< no line per finished run
+	/** Submit the runs as one Slurm array job (sbatch) instead of running
+	 * them: the jobs file (default OUTDIR/jobs.txt), OUTDIR/slurm.sh (task
+	 * i runs line i), the tasks' output in OUTDIR/slurm/. */
+	bool slurm = false;
+	/** More sbatch options, separated by spaces (e.g. "--partition=gpu
+	 * --time=1:00:00"); only with slurm. */
+	std::string sbatchArgs;
+	bool dryRun = false;  ///< check and print the runs; write nothing
+	bool quiet = false;   ///< no line per finished run
 	/** Replace an earlier sweep's plan and results in outDir (its runs'
 	 * outputs are replaced run by run: bims-run --overwrite). */
 	bool overwrite = false;
