@@ -4,6 +4,9 @@
 # locally (-j 2) and once through a cluster tool, then --collect; both
 # results.csv must be the same but for the timing columns.
 #
+#   cluster_sweep.sh local    BIN_DIR SOURCE_DIR WORK_DIR
+#       WORK_DIR/sweep.ini and the reference: bims-sweep -j 2 into
+#       WORK_DIR/local (the fixture of the two below)
 #   cluster_sweep.sh slurm    BIN_DIR SOURCE_DIR WORK_DIR CLUSTER_DIR
 #       bims-sweep --slurm (one sbatch array job) on the single-node Slurm
 #       that tests/cluster/slurm_cluster.sh started in CLUSTER_DIR
@@ -16,6 +19,7 @@ SKIP=77
 mode=$1 bin=$2 src=$3 work=$4 cluster=${5:-}
 
 case "$mode" in
+  local) ;;
   slurm)
     if [ ! -f "$cluster/env" ]; then
       echo "SKIP: no Slurm cluster: $(cat "$cluster/skip" 2>/dev/null || echo "its fixture did not start one (see Slurm.ClusterStarts)")"
@@ -28,12 +32,13 @@ case "$mode" in
       echo "SKIP: GNU parallel is not installed (Debian's parallel: scripts/install-deps.sh)"
       exit $SKIP
     fi ;;
-  *) echo "usage: $0 slurm|parallel BIN_DIR SOURCE_DIR WORK_DIR [CLUSTER_DIR]" >&2; exit 2 ;;
+  *) echo "usage: $0 local|slurm|parallel BIN_DIR SOURCE_DIR WORK_DIR [CLUSTER_DIR]" >&2; exit 2 ;;
 esac
 
-rm -rf "$work"
-mkdir -p "$work"
-cat > "$work/sweep.ini" <<INI
+if [ "$mode" = local ]; then
+  rm -rf "$work"
+  mkdir -p "$work"
+  cat > "$work/sweep.ini" <<INI
 [sweep]
 name = cluster path
 configs = $src/config/default.ini
@@ -49,14 +54,21 @@ masks = auto
 trajectory = auto
 INI
 
-echo "== local: bims-sweep -j 2"
-"$bin/bims-sweep" "$work/sweep.ini" -o "$work/local" -j 2 -q
+  echo "== local: bims-sweep -j 2"
+  "$bin/bims-sweep" "$work/sweep.ini" -o "$work/local" -j 2 -q
+  exit 0
+fi
 
+if [ ! -f "$work/local/results.csv" ]; then
+  echo "FAIL: no reference $work/local/results.csv (see the fixture Sweep.ClusterReferenceRunsLocally)" >&2
+  exit 1
+fi
 remote="$work/$mode"
+rm -rf "$remote"
 if [ "$mode" = parallel ]; then
   echo "== GNU parallel -j 2 over the jobs file"
-  "$bin/bims-sweep" "$work/sweep.ini" -o "$remote" --jobs-file "$work/jobs.txt"
-  parallel -j 2 < "$work/jobs.txt"
+  "$bin/bims-sweep" "$work/sweep.ini" -o "$remote" --jobs-file "$remote.jobs.txt"
+  parallel -j 2 < "$remote.jobs.txt"
 else
   echo "== Slurm: bims-sweep --slurm ($SLURM_CONF)"
   submitted=$("$bin/bims-sweep" "$work/sweep.ini" -o "$remote" --slurm)
