@@ -53,6 +53,7 @@ show_logs() {
 if [ "$cmd" = stop ]; then
   [ -d "$dir" ] || exit 0
   stop_daemons
+  rm -f "$dir/env"  # no cluster to use any more
   echo "slurm_cluster: stopped ($dir)"
   exit 0
 fi
