@@ -16,6 +16,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth imagemagick xdotool x11-apps libgl1-mesa-dri
   python3-dev pybind11-dev python3-numpy python3-opencv
+  slurm-wlm munge parallel
 )
 if [ "${1:-}" = fuzz ]; then
   PACKAGES+=(clang libclang-rt-14-dev)

@@ -2,7 +2,7 @@
 // rawlogs, into one table and a plot (docs/sweep.md).
 //
 //   bims-sweep SWEEP.ini -o OUTDIR [-j N] [--jobs-file FILE] [--dry-run] [-q]
-//              [--plot-metric NAME]
+//              [--plot-metric NAME] [--slurm [--sbatch "ARGS"]]
 //   bims-sweep --collect OUTDIR [--plot-metric NAME]
 #include <bims/apps/app.h>
 #include <bims/apps/sweep_run.h>
@@ -31,6 +31,15 @@ int main(int argc, char** argv)
 		        "write one shell line per run there (and the run folders) "
 		        "instead of running",
 		        false, "", "FILE", cmd);
+		    TCLAP::SwitchArg aSlurm(
+		        "", "slurm",
+		        "submit the runs as one Slurm array job (sbatch) instead of "
+		        "running them; then --collect OUTDIR",
+		        cmd);
+		    TCLAP::ValueArg<std::string> aSbatch(
+		        "", "sbatch",
+		        "more sbatch options for --slurm, separated by spaces", false,
+		        "", "ARGS", cmd);
 		    TCLAP::SwitchArg aDry(
 		        "", "dry-run", "check and list the runs, write nothing", cmd);
 		    TCLAP::SwitchArg aOverwrite(
@@ -55,6 +64,8 @@ int main(int argc, char** argv)
 		    o.jobs = aJobs.getValue();
 		    o.jobsFile = aJobsFile.getValue();
 		    o.dryRun = aDry.getValue();
+		    o.slurm = aSlurm.getValue();
+		    o.sbatchArgs = aSbatch.getValue();
 		    o.quiet = aQuiet.getValue();
 		    o.overwrite = aOverwrite.getValue();
 		    o.plotMetric = aMetric.getValue();

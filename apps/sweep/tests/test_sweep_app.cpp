@@ -237,6 +237,109 @@ TEST(SweepApp, JobsFileLinesRunWithBashAndCollectGathersThem)
 	    << bad.out;
 }
 
+TEST(SweepApp, RunsWithGroundTruthAreScoredIntoTheResults)
+{
+	const auto d = tmpDir("truth");
+	// the sample's pendulum_slow_gt/: masks and trajectory
+	const auto ini = writeSweep(d,
+	                            "frames = 0:4\n[set]\npipeline.variant = "
+	                            "fused\n[truth]\nmasks = auto\ntrajectory = "
+	                            "auto\n");
+	const std::string out = d + "/out";
+	const auto r = sweep(q(ini) + " -o " + q(out) + " -q");
+	ASSERT_EQ(r.code, 0) << r.out;
+	auto rows = readCsv(out + "/results.csv");
+	ASSERT_EQ(rows.size(), 1u);
+	const auto row = rows[0];
+	EXPECT_EQ(row.at("id"), "1");  // a constant is in no run id
+	EXPECT_EQ(row.at("pipeline.variant"), "fused");
+	EXPECT_EQ(row.at("status"), "ok");
+	const double f1 = number(row.at("masks.total.f1"));
+	EXPECT_GT(f1, 0) << row.at("masks.total.f1");  // 5 frames: low
+	EXPECT_LE(f1, 1.0);
+	EXPECT_GE(number(row.at("masks.total.precision")), 0);
+	const double ate = number(row.at("traj.ate.error_m.rmse"));
+	EXPECT_GE(ate, 0) << row.at("traj.ate.error_m.rmse");
+	EXPECT_LT(ate, 0.1);
+	const std::string dir = out + "/runs/1";
+	EXPECT_NE(bims::test::fileText(dir + "/eval.txt").find("total precision"),
+	          std::string::npos);
+	EXPECT_GT(pngSize(dir + "/traj.png").width, 0);
+	const std::string md = bims::test::fileText(out + "/results.md");
+	EXPECT_NE(md.find("Every run: pipeline.variant=fused."), std::string::npos)
+	    << md;
+	EXPECT_NE(md.find("masks.total.f1"), std::string::npos) << md;
+
+	// --collect scores the runs done elsewhere (no masks.json yet)
+	fs::remove(dir + "/masks.json");
+	fs::remove(dir + "/traj.json");
+	ASSERT_EQ(
+	    sweep("--collect " + q(out) + " --plot-metric masks.total.f1").code, 0);
+	rows = readCsv(out + "/results.csv");
+	EXPECT_EQ(rows[0].at("masks.total.f1"), row.at("masks.total.f1"));
+	EXPECT_EQ(rows[0].at("traj.ate.error_m.rmse"),
+	          row.at("traj.ate.error_m.rmse"));
+
+	// labels that cannot be scored: the run is "not scored", exit 1
+	fs::create_directories(d + "/nolabels");
+	const auto bad = writeSweep(d, "frames = 0:4\n[truth]\nmasks = nolabels\n");
+	const auto b = sweep(q(bad) + " -o " + q(d + "/bad") + " -q");
+	EXPECT_EQ(b.code, 1) << b.out;
+	EXPECT_NE(b.out.find("1: not scored, exit 0: bims-eval masks: "),
+	          std::string::npos)
+	    << b.out;
+	EXPECT_EQ(readCsv(d + "/bad/results.csv")[0].at("status"), "not scored");
+}
+
+TEST(SweepApp, SlurmSubmitsOneArrayJobWhoseTaskIRunsLineI)
+{
+	const auto d = tmpDir("slurm_stub");
+	// a stand-in sbatch: records its arguments, answers a job id
+	fs::create_directories(d + "/bin");
+	std::ofstream(d + "/bin/sbatch")
+	    << "#!/bin/sh\nprintf '%s\\n' \"$@\" > " << q(d + "/args.txt")
+	    << "\necho '4242;cluster'\n";
+	fs::permissions(d + "/bin/sbatch", fs::perms::owner_all);
+	const auto ini = writeSweep(
+	    d, "frames = 0:2\n[grid]\npipeline.variant = fused, bottom-only\n");
+	const std::string out = d + "/out";
+	const std::string path = "PATH=" + q(d + "/bin") + ":\"$PATH\" ";
+	const auto r = bims::test::runCommand(
+	    path + kBin + "/bims-sweep " + q(ini) + " -o " + q(out) +
+	    " --slurm --sbatch '--partition=p --time=5'");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("2 runs submitted as Slurm array job 4242"),
+	          std::string::npos)
+	    << r.out;
+	const std::string args = bims::test::fileText(d + "/args.txt");
+	for (const std::string& a : std::vector<std::string>{
+	         "--parsable\n", "--array=1-2\n", "--partition=p\n", "--time=5\n",
+	         "--output=" + out + "/slurm/%A_%a.out\n", out + "/slurm.sh\n"})
+		EXPECT_NE(args.find(a), std::string::npos) << a << " in " << args;
+	EXPECT_EQ(bims::test::fileText(out + "/jobs.txt").find(kBin + "/bims-run"),
+	          0u);
+	// task 2 runs the second line only
+	const auto t = bims::test::runCommand("SLURM_ARRAY_TASK_ID=2 bash " +
+	                                      q(out + "/slurm.sh"));
+	EXPECT_EQ(t.code, 0) << t.out;
+	EXPECT_FALSE(fs::exists(out + "/runs/1_variant=fused/out/metrics.json"));
+	EXPECT_TRUE(
+	    fs::exists(out + "/runs/2_variant=bottom-only/out/metrics.json"));
+
+	// sbatch failing, or not there: an error naming it
+	std::ofstream(d + "/bin/sbatch")
+	    << "#!/bin/sh\necho 'sbatch: error: invalid partition' >&2\nexit 1\n";
+	const auto f =
+	    bims::test::runCommand(path + kBin + "/bims-sweep " + q(ini) + " -o " +
+	                           q(out) + " --overwrite --slurm");
+	EXPECT_EQ(f.code, 1) << f.out;
+	EXPECT_NE(f.out.find("sbatch failed (exit code 1): sbatch: error: "
+	                     "invalid partition"),
+	          std::string::npos)
+	    << f.out;
+	EXPECT_EQ(sweep(q(ini) + " -o " + q(out) + " --sbatch x").code, 2);
+}
+
 TEST(SweepApp, BadInputIsAnErrorNamingFileAndKeyBeforeAnyRun)
 {
 	const auto d = tmpDir("bad_input");

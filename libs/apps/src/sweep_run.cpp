@@ -1,17 +1,23 @@
 #include <bims/apps/app.h>
+#include <bims/apps/eval_run.h>
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
 #include <bims/apps/sweep_run.h>
+#include <bims/common/output_paths.h>
 #include <bims/common/share.h>
 #include <bims/sweep/plan.h>
 #include <bims/sweep/processes.h>
 #include <bims/sweep/results.h>
+#include <fcntl.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
+#include <sstream>
 #include <thread>
 
 namespace bims::apps
@@ -31,8 +37,68 @@ using sweep::SweepSpec;
 using sweep::writeJobsFile;
 using sweep::writePlan;
 using sweep::writeResults;
+namespace fs = std::filesystem;
 namespace
 {
+/** stdout and stderr into a file while it lives (what bims-eval's runs
+ * print when a sweep scores its runs). */
+class OutputInto
+{
+ public:
+	explicit OutputInto(const std::string& path)
+	{
+		std::fflush(stdout);
+		std::fflush(stderr);
+		const int fd = ::open(path.c_str(),
+		                      O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+		if (fd < 0) throw std::runtime_error(path + ": cannot create");
+		out_ = ::dup(1);
+		err_ = ::dup(2);
+		::dup2(fd, 1);
+		::dup2(fd, 2);
+		::close(fd);
+	}
+	~OutputInto()
+	{
+		std::fflush(stdout);
+		std::fflush(stderr);
+		::dup2(out_, 1);
+		::dup2(err_, 2);
+		::close(out_);
+		::close(err_);
+	}
+	OutputInto(const OutputInto&) = delete;
+	OutputInto& operator=(const OutputInto&) = delete;
+
+ private:
+	int out_ = -1, err_ = -1;
+};
+
+/** Whether \a score exists and is not older than \a source. */
+bool upToDate(const std::string& score, const std::string& source)
+{
+	std::error_code e1, e2;
+	const auto a = fs::last_write_time(score, e1);
+	const auto b = fs::last_write_time(source, e2);
+	return !e1 && !e2 && a >= b;
+}
+
+/** Scores each run (scoreRun) and collects it; a scoring failure makes
+ * the run's status "not scored". */
+sweep::RunResult scoreAndCollect(const SweepPlan& plan, size_t i,
+                                 const std::string& outDir,
+                                 const JobOutcome* outcome)
+{
+	const std::string error = scoreRun(plan, plan.runs[i], outDir);
+	RunResult r = collectRun(plan.runs[i], outDir, outcome);
+	if (!error.empty() && r.ok())
+	{
+		r.status = "not scored";
+		r.error = error;
+	}
+	return r;
+}
+
 /** Writes the results and prints the summary; the exit code. */
 int report(const ResultTable& t, const std::string& outDir,
            const std::string& plotMetric)
@@ -56,18 +122,135 @@ int report(const ResultTable& t, const std::string& outDir,
 }
 }  // namespace
 
+std::string scoreRun(const SweepPlan& plan, const sweep::RunSpec& run,
+                     const std::string& outDir)
+{
+	if (run.truthMasks.empty() && run.truthTrajectory.empty()) return "";
+	const std::string dir = runDir(outDir, run.id);
+	const std::string out = sweep::runOutDir(outDir, run.id);
+	const std::string metrics = out + "/metrics.json";
+	if (collectRun(run, outDir).status != "ok") return "";
+	const bool masks =
+	    !run.truthMasks.empty() && !upToDate(dir + "/masks.json", metrics);
+	const bool traj =
+	    !run.truthTrajectory.empty() && !upToDate(dir + "/traj.json", metrics);
+	if (!masks && !traj) return "";
+	std::string error;
+	OutputInto log(dir + "/eval.txt");
+	if (masks)
+	{
+		try
+		{
+			EvalMasksOptions o;
+			o.gtDir = run.truthMasks;
+			o.predDir = out + "/masks";
+			if (plan.truth.depthValid) o.depthValid = run.rawlog.path;
+			o.noPlots = true;
+			o.quiet = true;
+			o.json = dir + "/masks.json";
+			if (plan.truth.movingValue >= 0)
+				o.movingValue = plan.truth.movingValue;
+			if (plan.truth.staticValue >= 0)
+				o.staticValue = plan.truth.staticValue;
+			if (!plan.truth.ignoreValues.empty())
+				o.ignoreValues = plan.truth.ignoreValues;
+			std::printf("bims-sweep: scoring the masks (bims-eval masks)\n");
+			runEvalMasks(o);
+		}
+		catch (const std::exception& e)
+		{
+			error = std::string("bims-eval masks: ") + e.what();
+			std::fprintf(stderr, "%s\n", error.c_str());
+		}
+	}
+	if (traj)
+	{
+		try
+		{
+			EvalTrajOptions o;
+			o.gt = run.truthTrajectory;
+			o.est = out + "/trajectory.txt";
+			o.json = dir + "/traj.json";
+			o.plot = dir + "/traj.png";
+			std::printf(
+			    "bims-sweep: scoring the trajectory (bims-eval traj)\n");
+			runEvalTraj(o);
+		}
+		catch (const std::exception& e)
+		{
+			const std::string t = std::string("bims-eval traj: ") + e.what();
+			std::fprintf(stderr, "%s\n", t.c_str());
+			error += (error.empty() ? "" : "; ") + t;
+		}
+	}
+	if (!error.empty()) error += " (see " + dir + "/eval.txt)";
+	return error;
+}
+
+namespace
+{
+/** Submits the jobs file as one Slurm array job: OUTDIR/slurm.sh runs
+ * line SLURM_ARRAY_TASK_ID of it. Returns sbatch's job id. */
+std::string submitToSlurm(const SweepOptions& opt, const SweepPlan& plan,
+                          const std::string& jobsFile)
+{
+	const std::string dir = fs::absolute(opt.outDir).lexically_normal();
+	const std::string jobs = fs::absolute(jobsFile).lexically_normal();
+	const std::string script = dir + "/slurm.sh";
+	writeFileAtomically(script,
+	                    "#!/bin/bash\n"
+	                    "# bims-sweep " +
+	                        plan.name +
+	                        ": Slurm array task i runs line i of the jobs file "
+	                        "(docs/sweep.md)\n"
+	                        "set -eu\n"
+	                        "line=$(sed -n \"${SLURM_ARRAY_TASK_ID}p\" " +
+	                        shellLine({jobs}) +
+	                        ")\n"
+	                        "exec bash -c \"$line\"\n");
+	makeDirs(dir + "/slurm");
+	std::vector<std::string> argv = {
+	    "sbatch", "--parsable", "--array=1-" + std::to_string(plan.runs.size()),
+	    "--job-name=bims-sweep", "--output=" + dir + "/slurm/%A_%a.out"};
+	std::istringstream more(opt.sbatchArgs);
+	for (std::string w; more >> w;) argv.push_back(w);
+	argv.push_back(script);
+	const std::string line = shellLine(argv);
+	std::printf("bims-sweep: %s\n", line.c_str());
+	std::fflush(stdout);
+	FILE* p = ::popen((line + " 2>&1").c_str(), "r");
+	if (!p) throw std::runtime_error("cannot run sbatch");
+	std::string text;
+	char buf[512];
+	while (std::fgets(buf, sizeof(buf), p)) text += buf;
+	const int status = ::pclose(p);
+	while (!text.empty() && (text.back() == '\n' || text.back() == '\r'))
+		text.pop_back();
+	if (status != 0)
+		throw std::runtime_error(
+		    "sbatch failed (" +
+		    (WIFEXITED(status) && WEXITSTATUS(status) == 127
+		         ? std::string("not found: is Slurm installed here?")
+		         : "exit code " + std::to_string(WEXITSTATUS(status))) +
+		    ")" + (text.empty() ? "" : ": " + text));
+	// --parsable: "JOBID" or "JOBID;CLUSTER"
+	const std::string last = text.substr(text.rfind('\n') + 1);
+	return last.substr(0, last.find(';'));
+}
+}  // namespace
+
 int runSweep(const SweepOptions& opt)
 {
 	if (!opt.collect.empty())
 	{
 		if (!opt.sweepFile.empty() || !opt.outDir.empty() ||
-		    !opt.jobsFile.empty() || opt.dryRun)
+		    !opt.jobsFile.empty() || opt.dryRun || opt.slurm)
 			throw UsageError(
-			    "--collect OUTDIR takes no SWEEP.ini, -o, --jobs-file nor "
-			    "--dry-run");
+			    "--collect OUTDIR takes no SWEEP.ini, -o, --jobs-file, "
+			    "--slurm nor --dry-run");
 		ResultTable t{SweepPlan::readJson(opt.collect + "/sweep.json"), {}};
-		for (const auto& r : t.plan.runs)
-			t.rows.push_back(collectRun(r, opt.collect));
+		for (size_t i = 0; i < t.plan.runs.size(); i++)
+			t.rows.push_back(scoreAndCollect(t.plan, i, opt.collect, nullptr));
 		return report(t, opt.collect, opt.plotMetric);
 	}
 	if (opt.sweepFile.empty())
@@ -75,15 +258,21 @@ int runSweep(const SweepOptions& opt)
 	if (opt.outDir.empty())
 		throw UsageError("give the output folder: -o OUTDIR");
 	if (opt.jobs < 0) throw UsageError("-j: a number of runs >= 0");
-	if (opt.dryRun && !opt.jobsFile.empty())
-		throw UsageError("--dry-run writes nothing: no --jobs-file with it");
+	if (opt.dryRun && (!opt.jobsFile.empty() || opt.slurm))
+		throw UsageError(
+		    "--dry-run writes nothing: no --jobs-file nor --slurm with it");
+	if (!opt.sbatchArgs.empty() && !opt.slurm)
+		throw UsageError("--sbatch goes with --slurm");
+	const std::string jobsFile = opt.slurm && opt.jobsFile.empty()
+	                                 ? opt.outDir + "/jobs.txt"
+	                                 : opt.jobsFile;
 
 	const SweepSpec spec = SweepSpec::load(opt.sweepFile);
 	std::vector<std::string> inputs = {spec.file};
 	for (const auto* list : {&spec.configs, &spec.rawlogs})
 		for (const auto& f : *list) inputs.push_back(f.path);
 	checkOutputsSpareInputs(inputs, {opt.outDir});
-	if (!opt.jobsFile.empty()) checkOutputsSpareInputs(inputs, {opt.jobsFile});
+	if (!jobsFile.empty()) checkOutputsSpareInputs(inputs, {jobsFile});
 	const SweepPlan plan = SweepPlan::make(spec);
 
 	const std::string program = executableDir() + "/bims-run";
@@ -114,6 +303,18 @@ int runSweep(const SweepOptions& opt)
 	    {{"sweep.json", "results.csv", "results.md", "results.png"}, {}},
 	    opt.overwrite);
 	writePlan(plan, opt.outDir);
+	if (opt.slurm)
+	{
+		writeJobsFile(jobsFile, program, plan, opt.outDir);
+		const std::string id = submitToSlurm(opt, plan, jobsFile);
+		std::printf(
+		    "bims-sweep: %zu runs submitted as Slurm array job %s (tasks' "
+		    "output in %s/slurm/); when it is done: bims-sweep --collect "
+		    "%s\n",
+		    plan.runs.size(), id.c_str(), opt.outDir.c_str(),
+		    opt.outDir.c_str());
+		return 0;
+	}
 	if (!opt.jobsFile.empty())
 	{
 		writeJobsFile(opt.jobsFile, program, plan, opt.outDir);
@@ -143,7 +344,7 @@ int runSweep(const SweepOptions& opt)
 	pool.stopSignal = stopSignal;
 	pool.onDone = [&](size_t i, const JobOutcome& o)
 	{
-		t.rows[i] = collectRun(plan.runs[i], opt.outDir, &o);
+		t.rows[i] = scoreAndCollect(plan, i, opt.outDir, &o);
 		done++;
 		if (opt.quiet) return;
 		char fps[32] = "";

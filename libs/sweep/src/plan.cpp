@@ -7,6 +7,7 @@
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/io/vector_loadsave.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -95,13 +96,75 @@ std::string derive(
 		mem.write(grid[i].section, grid[i].key, overrides[i].second);
 	return mem.getContent();
 }
+
+/** The keys of \a s's section (none when it is absent). */
+std::vector<std::string> keysOf(const mrpt::config::CConfigFileBase& cfg,
+                                const ConfigSection& s)
+{
+	std::vector<std::string> keys;
+	if (s.exists()) cfg.getAllKeys(s.name(), keys);
+	return keys;
+}
+
+/** \a k as an experiment key "section.key" (no values yet). */
+GridAxis experimentKey(const ConfigSection& s, const std::string& k)
+{
+	GridAxis a;
+	a.name = k;
+	const auto dot = k.find('.');
+	if (dot == std::string::npos || dot == 0 || dot + 1 == k.size() ||
+	    k.find('.', dot + 1) != std::string::npos)
+		s.fail(k,
+		       "not an experiment key: write section.key (e.g. "
+		       "grids.voxel_size)");
+	a.section = k.substr(0, dot);
+	a.key = k.substr(dot + 1);
+	return a;
+}
+
+/** [truth] masks or trajectory: "auto" (each rawlog's RAWLOG_gt/masks or
+ * RAWLOG_gt/groundtruth.txt, the simulator's), or one path per rawlog
+ * (relative ones against SWEEP.ini's folder); each present. One "" per
+ * rawlog when absent. */
+std::vector<std::string> truthPaths(ConfigSection& t, const std::string& key,
+                                    const std::vector<ListedFile>& rawlogs,
+                                    const fs::path& folder)
+{
+	const bool folders = key == "masks";
+	const auto words = t.getWords(key);
+	std::vector<std::string> out(rawlogs.size());
+	if (words.empty()) return out;
+	const bool autoPaths = words.size() == 1 && words[0] == "auto";
+	if (!autoPaths && words.size() != rawlogs.size())
+		t.fail(key, "'auto' or one path per rawlog (" +
+		                std::to_string(rawlogs.size()) + "), not " +
+		                std::to_string(words.size()));
+	for (size_t i = 0; i < rawlogs.size(); i++)
+	{
+		const std::string& w = autoPaths ? "" : words[i];
+		const fs::path p = autoPaths
+		                       ? fs::path(groundTruthDirFor(rawlogs[i].path)) /
+		                             (folders ? "masks" : "groundtruth.txt")
+		                   : fs::path(w).is_absolute() ? fs::path(w)
+		                                               : folder / w;
+		out[i] = fs::absolute(p).lexically_normal().string();
+		std::error_code ec;
+		if (folders ? !fs::is_directory(out[i], ec)
+		            : !fs::is_regular_file(out[i], ec))
+			t.fail(key, (autoPaths ? "auto: " + rawlogs[i].written + "'s "
+			                       : "'" + w + "': ") +
+			                "no such " + (folders ? "folder" : "file") + " (" +
+			                out[i] + ")");
+	}
+	return out;
+}
 }  // namespace
 
 SweepSpec SweepSpec::load(const std::string& path)
 {
 	const auto file = openIniFile(path);
 	const mrpt::config::CConfigFile& cfg = *file;
-	checkSections(cfg, {"sweep", "grid"});
+	checkSections(cfg, {"sweep", "grid", "set", "truth"});
 	SweepSpec spec;
 	spec.file = path;
 	const fs::path folder = fs::path(path).parent_path();
@@ -124,30 +187,56 @@ SweepSpec SweepSpec::load(const std::string& path)
 	s.finish();
 
 	ConfigSection g(cfg, "grid");
-	std::vector<std::string> keys;
-	if (g.exists()) cfg.getAllKeys("grid", keys);
-	for (const auto& k : keys)
+	for (const auto& k : keysOf(cfg, g))
 	{
-		GridAxis a;
-		a.name = k;
-		const auto dot = k.find('.');
-		if (dot == std::string::npos || dot == 0 || dot + 1 == k.size() ||
-		    k.find('.', dot + 1) != std::string::npos)
-			g.fail(k,
-			       "not an experiment key: write section.key (e.g. "
-			       "grids.voxel_size)");
-		a.section = k.substr(0, dot);
-		a.key = k.substr(dot + 1);
+		GridAxis a = experimentKey(g, k);
 		a.values = g.getList(k);
 		if (a.values.empty()) g.fail(k, "no value");
 		std::set<std::string> seen;
 		for (const auto& v : a.values)
 			if (!seen.insert(v).second)
 				g.fail(k, "value '" + v + "' given twice");
-		spec.grid.push_back(std::move(a));
+		// one value: the same for every run, named once, not in run ids
+		a.from = "grid";
+		(a.values.size() > 1 ? spec.grid : spec.constants)
+		    .push_back(std::move(a));
 	}
 	g.finish();
+
+	ConfigSection c(cfg, "set");
+	for (const auto& k : keysOf(cfg, c))
+	{
+		GridAxis a = experimentKey(c, k);
+		if (g.has(k)) c.fail(k, "also in [grid]: give it in one of them");
+		a.values = {c.getString(k, "")};
+		a.from = "set";
+		if (a.values[0].empty()) c.fail(k, "no value");
+		spec.constants.push_back(std::move(a));
+	}
+	c.finish();
+	std::sort(spec.constants.begin(), spec.constants.end(),
+	          [](const GridAxis& a, const GridAxis& b)
+	          { return a.name < b.name; });
+
+	ConfigSection t(cfg, "truth");
+	spec.truth.masks = truthPaths(t, "masks", spec.rawlogs, folder);
+	spec.truth.trajectories = truthPaths(t, "trajectory", spec.rawlogs, folder);
+	spec.truth.movingValue = t.getInt("moving_value", -1, 0, 255);
+	spec.truth.staticValue = t.getInt("static_value", -1, 0, 255);
+	spec.truth.ignoreValues = t.getString("ignore_values", "");
+	spec.truth.depthValid = t.getBool("depth_valid", true);
+	if (t.exists() && !spec.truth.any())
+		t.fail("masks", "required: masks, trajectory or both");
+	t.finish();
 	return spec;
+}
+
+bool TruthSpec::any() const
+{
+	for (const auto* l : {&masks, &trajectories})
+		for (const auto& p : *l)
+			if (!p.empty()) return true;
+	return false;
 }
 
 SweepPlan SweepPlan::make(const SweepSpec& spec)
@@ -156,7 +245,10 @@ SweepPlan SweepPlan::make(const SweepSpec& spec)
 	plan.name = spec.name;
 	plan.sweepFile = spec.file;
 	plan.frames = spec.frames;
+	plan.truth = spec.truth;
 	for (const auto& a : spec.grid) plan.gridKeys.push_back(a.name);
+	for (const auto& a : spec.constants)
+		plan.constants.emplace_back(a.name, a.values[0]);
 
 	size_t combos = 1;
 	for (const auto& a : spec.grid) combos *= a.values.size();
@@ -167,8 +259,20 @@ SweepPlan SweepPlan::make(const SweepSpec& spec)
 	for (const auto& config : spec.configs)
 	{
 		checkIniFile(config.path);
-		const std::string base = mrpt::io::file_get_contents(config.path);
+		std::string base = mrpt::io::file_get_contents(config.path);
 		checkWithLoader(base, config.path);
+		// each constant alone, then all: the base of every run
+		for (const auto& a : spec.constants)
+			checkWithLoader(derive(base, {a}, {{a.name, a.values[0]}}),
+			                spec.file + ": [" + a.from + "] " + a.name + " = " +
+			                    a.values[0] + ": on " + config.written);
+		std::vector<std::pair<std::string, std::string>> constants;
+		for (const auto& a : spec.constants)
+			constants.emplace_back(a.name, a.values[0]);
+		base = derive(base, spec.constants, constants);
+		if (constants.size() > 1)
+			checkWithLoader(base, spec.file + ": " + constantsText(plan) +
+			                          ": on " + config.written);
 		// each override alone: the error names the grid key and the value
 		for (const auto& a : spec.grid)
 			for (const auto& v : a.values)
@@ -197,11 +301,14 @@ SweepPlan SweepPlan::make(const SweepSpec& spec)
 				checkWithLoader(text, spec.file + ": [grid] " + combo +
 				                          ": on " + config.written);
 			}
-			for (const auto& rawlog : spec.rawlogs)
+			for (size_t k = 0; k < spec.rawlogs.size(); k++)
 			{
+				const ListedFile& rawlog = spec.rawlogs[k];
 				RunSpec r;
 				r.config = config;
 				r.rawlog = rawlog;
+				r.truthMasks = spec.truth.masks[k];
+				r.truthTrajectory = spec.truth.trajectories[k];
 				r.overrides = ov;
 				r.configText = text;
 				std::string num = std::to_string(plan.runs.size() + 1);
@@ -227,17 +334,28 @@ Json SweepPlan::toJson() const
 	j["sweep_file"] = sweepFile;
 	j["frames"] = frames;
 	j["grid"] = gridKeys;
+	Json& cs = j["constants"] = Json::object();
+	for (const auto& [k, v] : constants) cs[k] = v;
+	if (truth.any())
+		j["truth"] = {{"moving_value", truth.movingValue},
+		              {"static_value", truth.staticValue},
+		              {"ignore_values", truth.ignoreValues},
+		              {"depth_valid", truth.depthValid}};
 	Json& rs = j["runs"] = Json::array();
 	for (const auto& r : runs)
 	{
 		Json o;
 		for (const auto& [k, v] : r.overrides) o[k] = v;
-		rs.push_back({{"id", r.id},
-		              {"config", r.config.written},
-		              {"config_path", r.config.path},
-		              {"rawlog", r.rawlog.written},
-		              {"rawlog_path", r.rawlog.path},
-		              {"overrides", o}});
+		Json run = {{"id", r.id},
+		            {"config", r.config.written},
+		            {"config_path", r.config.path},
+		            {"rawlog", r.rawlog.written},
+		            {"rawlog_path", r.rawlog.path},
+		            {"overrides", o}};
+		if (!r.truthMasks.empty()) run["truth_masks"] = r.truthMasks;
+		if (!r.truthTrajectory.empty())
+			run["truth_trajectory"] = r.truthTrajectory;
+		rs.push_back(std::move(run));
 	}
 	return j;
 }
@@ -257,6 +375,18 @@ SweepPlan SweepPlan::readJson(const std::string& path)
 		p.sweepFile = j.at("sweep_file").get<std::string>();
 		p.frames = j.at("frames").get<std::string>();
 		p.gridKeys = j.at("grid").get<std::vector<std::string>>();
+		// (plans of earlier versions have no constants nor truth)
+		const Json constants = j.value("constants", Json::object());
+		for (const auto& [k, v] : constants.items())
+			p.constants.emplace_back(k, v.get<std::string>());
+		if (j.contains("truth"))
+		{
+			const Json& t = j.at("truth");
+			p.truth.movingValue = t.at("moving_value").get<int>();
+			p.truth.staticValue = t.at("static_value").get<int>();
+			p.truth.ignoreValues = t.at("ignore_values").get<std::string>();
+			p.truth.depthValid = t.at("depth_valid").get<bool>();
+		}
 		for (const auto& o : j.at("runs"))
 		{
 			RunSpec r;
@@ -271,6 +401,10 @@ SweepPlan SweepPlan::readJson(const std::string& path)
 			for (const auto& k : p.gridKeys)
 				r.overrides.emplace_back(
 				    k, o.at("overrides").at(k).get<std::string>());
+			r.truthMasks = o.value("truth_masks", std::string());
+			r.truthTrajectory = o.value("truth_trajectory", std::string());
+			p.truth.masks.push_back(r.truthMasks);
+			p.truth.trajectories.push_back(r.truthTrajectory);
 			p.runs.push_back(std::move(r));
 		}
 		return p;
@@ -279,6 +413,14 @@ SweepPlan SweepPlan::readJson(const std::string& path)
 	{
 		throw std::runtime_error(path + ": not a bims-sweep plan: " + e.what());
 	}
+}
+
+std::string constantsText(const SweepPlan& plan)
+{
+	std::string out;
+	for (const auto& [k, v] : plan.constants)
+		out += (out.empty() ? "" : ", ") + k + "=" + v;
+	return out;
 }
 
 std::vector<std::string> shortGridKeys(const std::vector<std::string>& keys)

@@ -87,6 +87,23 @@ bool isScore(const std::string& name)
 	       leaf == "precision" || leaf == "recall";
 }
 
+/** The legend's name of each file: its stem ("pendulum_slow" for
+ * "../rawlogs/pendulum_slow.rawlog"), or the path as written when two
+ * files share a stem. */
+std::map<std::string, std::string> legendNames(
+    const std::set<std::string>& written)
+{
+	std::map<std::string, std::string> name;
+	std::map<std::string, int> uses;
+	for (const auto& w : written) uses[fs::path(w).stem().string()]++;
+	for (const auto& w : written)
+	{
+		const std::string stem = fs::path(w).stem().string();
+		name[w] = uses[stem] > 1 || stem.empty() ? w : stem;
+	}
+	return name;
+}
+
 /** A readable name for the plot's vertical axis. */
 std::string axisName(const std::string& metric)
 {
@@ -186,14 +203,18 @@ size_t ResultTable::failures() const
 namespace
 {
 /** One run's cells of the results table: id, config, rawlog, the override
- * values, status, exit code, seconds and \a metrics (with these digits). */
-std::vector<std::string> rowCells(const RunResult& r,
-                                  const std::vector<std::string>& metrics,
-                                  int secondsDigits, int metricDigits)
+ * values, the \a constants' values, status, exit code, seconds and \a
+ * metrics (with these digits). */
+std::vector<std::string> rowCells(
+    const RunResult& r,
+    const std::vector<std::pair<std::string, std::string>>& constants,
+    const std::vector<std::string>& metrics, int secondsDigits,
+    int metricDigits)
 {
 	std::vector<std::string> c = {r.run.id, r.run.config.written,
 	                              r.run.rawlog.written};
 	for (const auto& [k, v] : r.run.overrides) c.push_back(v);
+	for (const auto& [k, v] : constants) c.push_back(v);
 	c.push_back(r.status);
 	c.push_back(r.exitCode ? std::to_string(*r.exitCode) : "");
 	c.push_back(r.seconds ? number(*r.seconds, secondsDigits) : "");
@@ -208,6 +229,7 @@ std::string csvText(const ResultTable& t)
 	const auto metrics = t.metricNames();
 	std::vector<std::string> head = {"id", "config", "rawlog"};
 	head.insert(head.end(), t.plan.gridKeys.begin(), t.plan.gridKeys.end());
+	for (const auto& [k, v] : t.plan.constants) head.push_back(k);
 	head.insert(head.end(), {"status", "exit_code", "run_seconds"});
 	head.insert(head.end(), metrics.begin(), metrics.end());
 	head.push_back("error");
@@ -221,7 +243,7 @@ std::string csvText(const ResultTable& t)
 	line(head);
 	for (const auto& r : t.rows)
 	{
-		auto c = rowCells(r, metrics, 4, 9);
+		auto c = rowCells(r, t.plan.constants, metrics, 4, 9);
 		c.push_back(r.error);
 		line(c);
 	}
@@ -254,6 +276,8 @@ std::string markdownText(const ResultTable& t, const std::string& plotMetric)
 	       (t.plan.frames.empty() ? "" : ", frames " + t.plan.frames) +
 	       "). Every column in results.csv, " + mdCell(plotMetric) +
 	       " per run in results.png.\n\n";
+	if (!t.plan.constants.empty())
+		out += "Every run: " + mdCell(constantsText(t.plan)) + ".\n\n";
 	std::vector<std::string> head = {"id", "config", "rawlog"};
 	head.insert(head.end(), t.plan.gridKeys.begin(), t.plan.gridKeys.end());
 	head.insert(head.end(), {"status", "exit", "s"});
@@ -267,7 +291,7 @@ std::string markdownText(const ResultTable& t, const std::string& plotMetric)
 	out += "|\n" + rule + "|\n";
 	for (const auto& r : t.rows)
 	{
-		for (const auto& x : rowCells(r, metrics, 3, 4))
+		for (const auto& x : rowCells(r, {}, metrics, 3, 4))
 			out += "| " + mdCell(x) + " ";
 		out += "|\n";
 	}
@@ -284,7 +308,7 @@ std::string markdownText(const ResultTable& t, const std::string& plotMetric)
 	return out;
 }
 
-cv::Mat plotResults(const ResultTable& t, const std::string& metric)
+eval::GroupedBars resultsChart(const ResultTable& t, const std::string& metric)
 {
 	const auto all = t.metricNames();
 	if (!all.empty() && std::find(all.begin(), all.end(), metric) == all.end())
@@ -302,6 +326,8 @@ cv::Mat plotResults(const ResultTable& t, const std::string& metric)
 	c.yLabel = axisName(metric);
 	c.xLabel =
 	    t.plan.gridKeys.empty() ? "(no [grid] overrides)" : "[grid] overrides";
+	if (!t.plan.constants.empty())
+		c.xLabel += "; every run: " + constantsText(t.plan);
 	c.missingLabel = "no value (run not ok)";
 	const auto shortKeys = shortGridKeys(t.plan.gridKeys);
 	std::set<std::string> configs, rawlogs;
@@ -310,6 +336,8 @@ cv::Mat plotResults(const ResultTable& t, const std::string& metric)
 		configs.insert(r.run.config.written);
 		rawlogs.insert(r.run.rawlog.written);
 	}
+	const auto configName = legendNames(configs);
+	const auto rawlogName = legendNames(rawlogs);
 	// each row's group (its grid values) and series (config, rawlog)
 	std::map<std::string, size_t> group, series;
 	std::vector<std::pair<size_t, size_t>> cell;
@@ -319,9 +347,10 @@ cv::Mat plotResults(const ResultTable& t, const std::string& metric)
 		for (size_t i = 0; i < r.run.overrides.size(); i++)
 			g += (i ? "\n" : "") + shortKeys[i] + "=" +
 			     r.run.overrides[i].second;
-		std::string s = configs.size() > 1 ? r.run.config.written : "";
+		std::string s =
+		    configs.size() > 1 ? configName.at(r.run.config.written) : "";
 		if (rawlogs.size() > 1 || s.empty())
-			s += (s.empty() ? "" : ", ") + r.run.rawlog.written;
+			s += (s.empty() ? "" : ", ") + rawlogName.at(r.run.rawlog.written);
 		if (group.emplace(g, c.groups.size()).second) c.groups.push_back(g);
 		if (series.emplace(s, c.series.size()).second) c.series.push_back(s);
 		cell.emplace_back(group[g], series[s]);
@@ -331,7 +360,12 @@ cv::Mat plotResults(const ResultTable& t, const std::string& metric)
 	for (size_t i = 0; i < t.rows.size(); i++)
 		if (t.rows[i].ok())
 			c.values[cell[i].first][cell[i].second] = t.rows[i].metric(metric);
-	return eval::plotGroupedBars(c);
+	return c;
+}
+
+cv::Mat plotResults(const ResultTable& t, const std::string& metric)
+{
+	return eval::plotGroupedBars(resultsChart(t, metric));
 }
 
 void writeResults(const ResultTable& t, const std::string& outDir,

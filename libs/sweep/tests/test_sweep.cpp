@@ -448,3 +448,138 @@ TEST(SweepPlan, TheBundledExamplePlansFourRuns)
 	EXPECT_EQ(plan.runs[3].id, "4_voxel_size=0.1_variant=flow-only");
 	EXPECT_TRUE(fs::exists(plan.runs[0].rawlog.path));
 }
+
+TEST(SweepSpec, ConstantsAreSetInEveryRunAndNamedInNoRunId)
+{
+	// [set] and a [grid] key of one value: the same in every run
+	const auto d =
+	    sweepFolder("constants",
+	                "[sweep]\nconfigs = a.ini\nrawlogs = x.rawlog\n[grid]\n"
+	                "grids.voxel_size = 0.05, 0.1\nflow.method = farneback\n"
+	                "[set]\npipeline.variant = fused-raycast\n");
+	const auto spec = sw::SweepSpec::load(d + "/sweep.ini");
+	ASSERT_EQ(spec.grid.size(), 1u);
+	const auto plan = sw::SweepPlan::make(spec);
+	EXPECT_EQ(plan.gridKeys, std::vector<std::string>{"grids.voxel_size"});
+	EXPECT_EQ(sw::constantsText(plan),
+	          "flow.method=farneback, pipeline.variant=fused-raycast");
+	ASSERT_EQ(plan.runs.size(), 2u);
+	EXPECT_EQ(plan.runs[0].id, "1_voxel_size=0.05");
+	EXPECT_EQ(plan.runs[1].id, "2_voxel_size=0.1");
+	for (const auto& r : plan.runs)
+	{
+		mrpt::config::CConfigFileMemory mem(r.configText);
+		EXPECT_EQ(mem.read_string("pipeline", "variant", ""), "fused-raycast");
+		EXPECT_EQ(mem.read_string("flow", "method", ""), "farneback");
+	}
+	// kept in sweep.json for --collect
+	const auto out = tmpDir("constants_out");
+	sw::writePlan(plan, out);
+	const auto back = sw::SweepPlan::readJson(out + "/sweep.json");
+	EXPECT_EQ(back.constants, plan.constants);
+
+	const std::string ok = "[sweep]\nconfigs = a.ini\nrawlogs = x.rawlog\n";
+	EXPECT_NE(planError(sweepFolder("constants_bad",
+	                                ok + "[set]\npipeline.variant = fsued\n"))
+	              .find("[set] pipeline.variant = fsued: on a.ini: [pipeline] "
+	                    "variant: 'fsued' is not one of"),
+	          std::string::npos);
+	EXPECT_NE(planError(sweepFolder("constants_twice",
+	                                ok + "[grid]\npipeline.variant = fused, "
+	                                     "flow-only\n[set]\npipeline.variant "
+	                                     "= fused\n"))
+	              .find("[set] pipeline.variant: also in [grid]"),
+	          std::string::npos);
+	EXPECT_NE(planError(sweepFolder("constants_key", ok + "[set]\nvariant = "
+	                                                      "fused\n"))
+	              .find("[set] variant: not an experiment key"),
+	          std::string::npos);
+}
+
+TEST(SweepSpec, TruthNamesEachRawlogsLabelsAndTrajectory)
+{
+	const std::string two =
+	    "[sweep]\nconfigs = a.ini\nrawlogs = x.rawlog "
+	    "y.rawlog\n[truth]\n";
+	// auto: the simulator's RAWLOG_gt/masks and RAWLOG_gt/groundtruth.txt
+	auto d = sweepFolder("truth_auto", two +
+	                                       "masks = auto\ntrajectory = "
+	                                       "auto\nignore_values = 150\n");
+	for (const std::string r : {"x", "y"})
+	{
+		fs::create_directories(d + "/" + r + "_gt/masks");
+		put(d + "/" + r + "_gt/groundtruth.txt", "");
+	}
+	auto plan = sw::SweepPlan::make(sw::SweepSpec::load(d + "/sweep.ini"));
+	ASSERT_EQ(plan.runs.size(), 2u);
+	EXPECT_EQ(plan.runs[1].truthMasks, fs::path(d + "/y_gt/masks").string());
+	EXPECT_EQ(plan.runs[1].truthTrajectory,
+	          fs::path(d + "/y_gt/groundtruth.txt").string());
+	EXPECT_EQ(plan.truth.ignoreValues, "150");
+	EXPECT_TRUE(plan.truth.depthValid);
+	const auto out = tmpDir("truth_out");
+	sw::writePlan(plan, out);
+	const auto back = sw::SweepPlan::readJson(out + "/sweep.json");
+	EXPECT_EQ(back.runs[1].truthMasks, plan.runs[1].truthMasks);
+	EXPECT_EQ(back.runs[0].truthTrajectory, plan.runs[0].truthTrajectory);
+	EXPECT_EQ(back.truth.ignoreValues, "150");
+
+	// one path per rawlog, relative to SWEEP.ini
+	d = sweepFolder("truth_paths", two + "masks = lx ly\n");
+	fs::create_directories(d + "/lx");
+	fs::create_directories(d + "/ly");
+	plan = sw::SweepPlan::make(sw::SweepSpec::load(d + "/sweep.ini"));
+	EXPECT_EQ(plan.runs[0].truthMasks, fs::path(d + "/lx").string());
+	EXPECT_EQ(plan.runs[0].truthTrajectory, "");
+
+	EXPECT_NE(planError(sweepFolder("truth_gone", two + "masks = auto\n"))
+	              .find("[truth] masks: auto: x.rawlog's no such folder"),
+	          std::string::npos);
+	EXPECT_NE(planError(sweepFolder("truth_count", two + "masks = lx\n"))
+	              .find("[truth] masks: 'auto' or one path per rawlog (2), "
+	                    "not 1"),
+	          std::string::npos);
+	EXPECT_NE(planError(sweepFolder("truth_empty", two + "depth_valid = no\n"))
+	              .find("[truth] masks: required: masks, trajectory or both"),
+	          std::string::npos);
+}
+
+TEST(SweepResults, ConstantsAreListedOnceAndLegendsUseFileStems)
+{
+	const auto d = tmpDir("constants_results");
+	auto t = table(d);
+	t.plan.constants = {{"flow.method", "farneback"}};
+	for (auto& r : t.plan.runs) r.rawlog.written = "../data/x.rawlog";
+	for (auto& row : t.rows) row.run.rawlog.written = "../data/x.rawlog";
+	std::istringstream csv(sw::csvText(t));
+	std::string head, row;
+	std::getline(csv, head);
+	std::getline(csv, row);
+	EXPECT_EQ(head.rfind("id,config,rawlog,grids.voxel_size,pipeline.variant,"
+	                     "flow.method,status,",
+	                     0),
+	          0u)
+	    << head;
+	EXPECT_EQ(row.rfind("1,a.ini,../data/x.rawlog,0.05,fused,farneback,ok,", 0),
+	          0u)
+	    << row;
+	const std::string md = sw::markdownText(t, "fps");
+	EXPECT_NE(md.find("Every run: flow.method=farneback."), std::string::npos)
+	    << md;
+	EXPECT_EQ(md.find("farneback"), md.rfind("farneback")) << md;
+
+	const auto c = sw::resultsChart(t, "fps");
+	EXPECT_EQ(c.series, std::vector<std::string>{"x"});
+	EXPECT_NE(c.xLabel.find("every run: flow.method=farneback"),
+	          std::string::npos)
+	    << c.xLabel;
+	for (const auto& g : c.groups)
+		EXPECT_EQ(g.find("method"), std::string::npos) << g;
+	EXPECT_EQ(c.groups.front(), "voxel_size=0.05\nvariant=fused");
+
+	// two rawlogs of one stem keep their paths as written
+	t.rows[1].run.rawlog.written = "../other/x.rawlog";
+	EXPECT_EQ(
+	    sw::resultsChart(t, "fps").series,
+	    (std::vector<std::string>{"../data/x.rawlog", "../other/x.rawlog"}));
+}

@@ -18,6 +18,7 @@ struct GridAxis
 	std::string name;  ///< "section.key" as written, e.g. grids.voxel_size
 	std::string section, key;
 	std::vector<std::string> values;  ///< in the order written
+	std::string from = "grid";        ///< its section of SWEEP.ini (or "set")
 };
 
 /** A file listed in SWEEP.ini: as written, and its path (relative ones
@@ -27,20 +28,47 @@ struct ListedFile
 	std::string written, path;
 };
 
-/** SWEEP.ini as read: [sweep] configs, rawlogs, frames, name; [grid]. */
+/** What a sweep's runs are scored against ([truth] of SWEEP.ini): per
+ * rawlog, its moving-pixel labels and/or its trajectory (each "" when
+ * none), and how the labels read (bims-eval masks' options). */
+struct TruthSpec
+{
+	/** One per rawlog, in the rawlogs' order ("": not scored so). */
+	std::vector<std::string> masks, trajectories;
+	/** The labels' values (bims-eval masks --moving-value, --static-value,
+	 * --ignore-values); -1 / "": not given (the labels' contract). */
+	int movingValue = -1, staticValue = -1;
+	std::string ignoreValues;
+	/** Only the pixels with depth in the rawlog's scans are scored
+	 * (bims-eval masks --depth-valid IN.rawlog). */
+	bool depthValid = true;
+	bool any() const;
+};
+
+/** SWEEP.ini as read: [sweep] configs, rawlogs, frames, name; [grid];
+ * [set]; [truth]. */
 struct SweepSpec
 {
 	std::string file;  ///< SWEEP.ini
 	std::string name;  ///< [sweep] name (default: the file's stem)
 	std::vector<ListedFile> configs, rawlogs;
-	std::string frames;          ///< bims-run --frames A:B ("": every frame)
-	std::vector<GridAxis> grid;  ///< keys in MRPT's order (by name)
+	std::string frames;  ///< bims-run --frames A:B ("": every frame)
+	/** The keys that vary: two or more values ([grid]), in MRPT's order
+	 * (by name). */
+	std::vector<GridAxis> grid;
+	/** The keys set to one value for every run: [set], and the [grid] keys
+	 * given one value; by name. */
+	std::vector<GridAxis> constants;
+	TruthSpec truth;
 
 	/** Reads and checks SWEEP.ini: its syntax (checkIniFile), no section
-	 * but [sweep] and [grid], no unknown key, configs and rawlogs given and
-	 * present, frames A:B, grid keys "section.key" with a comma-separated
-	 * list of distinct non-empty values. Throws ConfigError naming the
-	 * file, the section and the key. */
+	 * but [sweep], [grid], [set] and [truth], no unknown key, configs and
+	 * rawlogs given and present, frames A:B, grid keys "section.key" with a
+	 * comma-separated list of distinct non-empty values, [set] keys
+	 * "section.key" with one value (not also in [grid]), [truth] masks and
+	 * trajectory "auto" (the simulator's RAWLOG_gt/masks,
+	 * RAWLOG_gt/groundtruth.txt) or one path per rawlog, present. Throws
+	 * ConfigError naming the file, the section and the key. */
 	static SweepSpec load(const std::string& path);
 };
 
@@ -56,9 +84,12 @@ struct RunSpec
 	ListedFile config, rawlog;
 	/** (grid key name, value), one per grid key, in the grid's order. */
 	std::vector<std::pair<std::string, std::string>> overrides;
-	/** The derived config.ini: the config with the overrides set (through
-	 * MRPT's CConfigFileMemory; comments and the other keys kept). */
+	/** The derived config.ini: the config with the constants and the
+	 * overrides set (through MRPT's CConfigFileMemory; comments and the
+	 * other keys kept). */
 	std::string configText;
+	/** The rawlog's labels and trajectory ("": none), from [truth]. */
+	std::string truthMasks, truthTrajectory;
 };
 
 /** Every run of a sweep, checked. */
@@ -66,7 +97,11 @@ struct SweepPlan
 {
 	std::string name, sweepFile, frames;
 	std::vector<std::string> gridKeys;
+	/** (key, value) set for every run ([set], one-value [grid] keys): in
+	 * no run id nor legend, listed once. */
+	std::vector<std::pair<std::string, std::string>> constants;
 	std::vector<RunSpec> runs;
+	TruthSpec truth;  ///< masks and trajectories: see the runs'
 
 	/** The runs of \a spec: configs (outer) x grid combinations x rawlogs
 	 * (inner). Every config, every override alone and every combination
@@ -81,6 +116,9 @@ struct SweepPlan
 	/** Reads \a path (a sweep.json); throws naming it. */
 	static SweepPlan readJson(const std::string& path);
 };
+
+/** "grids.decay=raycast, pipeline.variant=fused" (empty without). */
+std::string constantsText(const SweepPlan& plan);
 
 /** The names run ids and plot labels give the grid keys: the key alone
  * ("voxel_size") unless two sections share it ("grids.voxel_size"). */

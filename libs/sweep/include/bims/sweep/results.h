@@ -3,6 +3,7 @@
 // results.md and the plot results.png.
 #pragma once
 
+#include <bims/eval/plots.h>
 #include <bims/sweep/plan.h>
 #include <bims/sweep/processes.h>
 
@@ -53,21 +54,27 @@ struct ResultTable
 	size_t failures() const;
 };
 
-/** One row per run: id, config, rawlog, each grid key, status, exit_code,
- * run_seconds, every metric, error (RFC 4180 quoting). */
+/** One row per run: id, config, rawlog, each grid key, each constant,
+ * status, exit_code, run_seconds, every metric, error (RFC 4180 quoting). */
 std::string csvText(const ResultTable& t);
 
-/** A markdown table of the runs with the main columns: id, config, rawlog,
- * the grid keys, status, exit code, seconds, frames, fps, wall and CPU
- * seconds, peak memory, the pipeline's median ms per frame, \a plotMetric,
- * and the scores of other JSON files (names ending in rmse, f1, iou,
- * precision, recall); then the failed runs with their errors. */
+/** A markdown table of the runs (after a line listing the constants once)
+ * with the main columns: id, config, rawlog, the grid keys, status, exit code,
+ * seconds, frames, fps, wall and CPU seconds, peak memory, the pipeline's
+ * median ms per frame, \a plotMetric, and the scores of other JSON files (names
+ * ending in rmse, f1, iou, precision, recall); then the failed runs with their
+ * errors. */
 std::string markdownText(const ResultTable& t, const std::string& plotMetric);
 
-/** \a metric per run (eval::plotGroupedBars): one group per combination
- * of the grid's values, one bar per config and rawlog; runs that are not
- * ok have no bar. Throws std::invalid_argument naming the metrics there
- * are when no run has \a metric but some have others. */
+/** The chart of \a metric per run: one group per combination of the
+ * grid's values, one bar per config and rawlog (named by the file's stem,
+ * or as written when two share it); the constants listed once under the
+ * axis; runs that are not ok have no value. Throws std::invalid_argument
+ * naming the metrics there are when no run has \a metric but some have
+ * others. */
+eval::GroupedBars resultsChart(const ResultTable& t, const std::string& metric);
+
+/** resultsChart drawn (eval::plotGroupedBars). */
 cv::Mat plotResults(const ResultTable& t, const std::string& metric);
 
 /** Writes OUTDIR/results.csv, results.md, then results.png. */
