@@ -228,10 +228,12 @@ cv::Mat plotGroupedBars(const GroupedBars& c)
 	for (const auto& row : c.values)
 		for (double v : row)
 			if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+	if (c.yMax && *c.yMax > lo) hi = std::max(hi, *c.yMax);
 	if (!(hi > lo)) hi = lo + 1;
 	const double step = niceLength((hi - lo) / 5);
 	lo = std::floor(lo / step) * step;
-	hi = std::ceil(hi * 1.06 / step) * step;  // room for the value labels
+	if (!(c.yMax && hi == *c.yMax))
+		hi = std::ceil(hi * 1.06 / step) * step;  // room for the value labels
 	auto py = [&](double v)
 	{
 		return static_cast<int>(

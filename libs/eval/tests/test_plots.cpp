@@ -69,6 +69,27 @@ TEST(GroupedBars, ManyGroupsWidenTheChartAndAMissingValueIsNoBar)
 	EXPECT_GT(countColour(img, kFirstSeries, g0End + 2, img.cols), 0);
 }
 
+TEST(GroupedBars, AScoresAxisEndsAtItsTop)
+{
+	// F1 0.5: without a top the axis ends a step above the value (0.6),
+	// with yMax = 1 at 1: the same bar is 0.6 times as tall
+	ev::GroupedBars c;
+	c.title = "F1 per run";
+	c.groups = {"a=1"};
+	c.series = {"x"};
+	c.values = {{0.5}};
+	const int free =
+	    countColour(ev::plotGroupedBars(c), kFirstSeries, 96, 1024);
+	c.yMax = 1.0;
+	const int scored =
+	    countColour(ev::plotGroupedBars(c), kFirstSeries, 96, 1024);
+	ASSERT_GT(free, 100);
+	EXPECT_NEAR(static_cast<double>(scored) / free, 0.6, 0.03);
+	// a value above the top keeps the axis over it
+	c.values = {{1.4}};
+	EXPECT_GT(countColour(ev::plotGroupedBars(c), kFirstSeries, 96, 1024), 0);
+}
+
 TEST(GroupedBars, ValuesNotOnePerGroupAndSeriesAreRefused)
 {
 	ev::GroupedBars c;

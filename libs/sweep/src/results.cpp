@@ -329,6 +329,7 @@ eval::GroupedBars resultsChart(const ResultTable& t, const std::string& metric)
 	if (!t.plan.constants.empty())
 		c.xLabel += "; every run: " + constantsText(t.plan);
 	c.missingLabel = "no value (run not ok)";
+	c.yMax = metricAxisTop(metric);
 	const auto shortKeys = shortGridKeys(t.plan.gridKeys);
 	std::set<std::string> configs, rawlogs;
 	for (const auto& r : t.rows)
@@ -361,6 +362,21 @@ eval::GroupedBars resultsChart(const ResultTable& t, const std::string& metric)
 		if (t.rows[i].ok())
 			c.values[cell[i].first][cell[i].second] = t.rows[i].metric(metric);
 	return c;
+}
+
+std::optional<double> metricAxisTop(const std::string& metric)
+{
+	const std::string last = metric.substr(metric.rfind('.') + 1);
+	const auto endsWith = [&](const char* e)
+	{
+		const std::string x(e);
+		return last.size() >= x.size() &&
+		       last.compare(last.size() - x.size(), x.size(), x) == 0;
+	};
+	for (const char* score : {"f1", "precision", "recall", "iou"})
+		if (last == score) return 1.0;
+	if (endsWith("_fraction")) return 1.0;
+	return std::nullopt;
 }
 
 cv::Mat plotResults(const ResultTable& t, const std::string& metric)

@@ -583,3 +583,14 @@ TEST(SweepResults, ConstantsAreListedOnceAndLegendsUseFileStems)
 	    sw::resultsChart(t, "fps").series,
 	    (std::vector<std::string>{"../data/x.rawlog", "../other/x.rawlog"}));
 }
+
+TEST(SweepResults, ScoresAndSharesHaveTheirAxisEndAtOne)
+{
+	EXPECT_EQ(sw::metricAxisTop("masks.total.f1"), 1.0);
+	EXPECT_EQ(sw::metricAxisTop("masks.total.precision"), 1.0);
+	EXPECT_EQ(sw::metricAxisTop("masks.total.recall"), 1.0);
+	EXPECT_EQ(sw::metricAxisTop("static_called_moving_fraction"), 1.0);
+	EXPECT_FALSE(sw::metricAxisTop("fps"));
+	EXPECT_FALSE(sw::metricAxisTop("traj.ate.error_m.rmse"));
+	EXPECT_FALSE(sw::metricAxisTop("f1_count"));
+}

@@ -6,6 +6,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,10 +39,14 @@ struct GroupedBars
 	 * explained in the legend by missingLabel). */
 	std::vector<std::vector<double>> values;
 	std::string missingLabel = "no value";
+	/** The top of the vertical axis when the values have one (a score or
+	 * a share: 1); none: from the values. */
+	std::optional<double> yMax;
 };
 
 /** Bar chart of \a c: white background, y axis from 0 (or the lowest
- * value, when negative) with ticks at 1, 2 or 5 times a power of ten, the
+ * value, when negative) to c.yMax or a little above the highest value, with
+ * ticks at 1, 2 or 5 times a power of ten, the
  * value above each bar, the group labels under the axis, legend top right.
  * 1024 x 640 pixels, wider (never narrower) when the groups and their
  * labels need more room. Throws std::invalid_argument when values does not

@@ -74,6 +74,11 @@ std::string markdownText(const ResultTable& t, const std::string& plotMetric);
  * others. */
 eval::GroupedBars resultsChart(const ResultTable& t, const std::string& metric);
 
+/** The top of a metric's axis when its values have one: 1 for a score or a
+ * share (a name whose last part is f1, precision, recall, iou or
+ * ends in _fraction); none otherwise. */
+std::optional<double> metricAxisTop(const std::string& metric);
+
 /** resultsChart drawn (eval::plotGroupedBars). */
 cv::Mat plotResults(const ResultTable& t, const std::string& metric);
 
