@@ -113,6 +113,15 @@ int runSweep(const SweepOptions& opt)
 	    opt.outDir,
 	    {{"sweep.json", "results.csv", "results.md", "results.png"}, {}},
 	    opt.overwrite);
+	makeDirs(opt.outDir);
+	// what the sweep writes into OUTDIR (each run's out/ has bims-run's)
+	OutputManifest manifest(opt.outDir, "bims-sweep");
+	for (const char* f :
+	     {"sweep.json", "results.csv", "results.md", "results.png"})
+		manifest.file(f);
+	for (const auto& r : plan.runs)
+		for (const char* f : {"config.ini", "log.txt"})
+			manifest.file("runs/" + r.id + "/" + f);
 	writePlan(plan, opt.outDir);
 	if (!opt.jobsFile.empty())
 	{

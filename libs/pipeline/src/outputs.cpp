@@ -65,6 +65,8 @@ const OutputFolderLayout& runOutputLayout()
 OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
     : dir_(dir), p_(p), worker_(kQueuedWrites, p.writer_thread)
 {
+	makeDirs(dir_);
+	manifest_ = std::make_unique<OutputManifest>(dir_, "bims-run");
 	makeDirs(dir_ + "/masks");
 	// written last: a folder without it is partial (an earlier run's would
 	// say otherwise)
@@ -74,8 +76,8 @@ OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
 	if (p_.moving_ply) makeDirs(dir_ + "/moving_voxels");
 	if (p_.flow_labels) makeDirs(dir_ + "/flow_labels");
 	// grown line by line, each line checked and whole
-	traj_ = std::make_unique<AppendFile>(dir_ + "/trajectory.txt");
-	csv_ = std::make_unique<AppendFile>(dir_ + "/frames.csv");
+	traj_ = std::make_unique<AppendFile>(file("trajectory.txt"));
+	csv_ = std::make_unique<AppendFile>(file("frames.csv"));
 	traj_->append(
 	    tumHeader("bims-run estimated camera trajectory T_WC (optical frame)"));
 	csv_->append(
@@ -83,7 +85,7 @@ OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
 	    "moving_voxels,moving_px,diff_px,notdiff_px,"
 	    "ms_input,ms_ego,ms_flow,ms_grids,ms_total,filled_px,ego_flag_names\n");
 	if (p_.labelled_rawlog)
-		rawlog_ = std::make_unique<RawlogWriter>(dir_ + "/segmented.rawlog",
+		rawlog_ = std::make_unique<RawlogWriter>(file("segmented.rawlog"),
 		                                         p_.labelled_rawlog_gz_level);
 }
 
@@ -114,17 +116,17 @@ double OutputWriter::writeFrame(const FrameResult& r,
 void OutputWriter::doWriteFrame(const FrameResult& r,
                                 mrpt::obs::CObservation3DRangeScan& scan)
 {
-	writeImageFile(dir_ + "/masks/" + frameFileName(long(r.index)), r.mask);
+	writeImageFile(file("masks/" + frameFileName(long(r.index))), r.mask);
 	if (p_.moving_ply)
 		writePointsPly(
-		    dir_ + "/moving_voxels/" + frameFileName(long(r.index), "ply"),
+		    file("moving_voxels/" + frameFileName(long(r.index), "ply")),
 		    r.movingVoxelCentres);
 	if (p_.flow_labels && !r.labels.empty())
 	{
 		cv::Mat vis(r.labels.size(), CV_8UC1, cv::Scalar(0));
 		vis.setTo(128, r.labels == 0);
 		vis.setTo(255, r.labels == 1);
-		writeImageFile(dir_ + "/flow_labels/" + frameFileName(long(r.index)),
+		writeImageFile(file("flow_labels/" + frameFileName(long(r.index))),
 		               vis);
 	}
 	if (rawlog_)
@@ -203,7 +205,7 @@ size_t OutputWriter::close(Pipeline& pipe)
 	const maps::CMotionGridBase* motion = pipe.maskGrid();
 	if (p_.static_map && pipe.framesProcessed() > 0)
 	{
-		PartialFile ply(dir_ + "/static_map.ply"), bt(dir_ + "/static_map.bt");
+		PartialFile ply(file("static_map.ply")), bt(file("static_map.bt"));
 		nStatic = maps::writeStaticPly(ply.path(), *g.occupancy(), motion,
 		                               p_.static_p_occupied);
 		maps::writeStaticOctomap(bt.path(), *g.occupancy(), motion,
@@ -253,7 +255,7 @@ void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
 		                {"mean", jsonNumber(p.mean, 3)},
 		                {"n", p.n}};
 	j["error"] = sum.error;
-	writeJsonFile(dir_ + "/metrics.json", j);
+	writeJsonFile(file("metrics.json"), j);
 }
 
 }  // namespace bims::pipeline

@@ -95,7 +95,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	if (!opt.outDir.empty())
 	{
 		out = std::make_unique<OutputWriter>(opt.outDir, cfg.output);
-		writeFileAtomically(opt.outDir + "/effective.ini", cfg.effectiveIni());
+		writeFileAtomically(out->file("effective.ini"), cfg.effectiveIni());
 	}
 
 	const std::string& rgbdLabel = cfg.ego.sensors.rgbd_label;
