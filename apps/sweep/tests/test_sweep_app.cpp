@@ -286,6 +286,26 @@ TEST(SweepApp, BadInputIsAnErrorNamingFileAndKeyBeforeAnyRun)
 	EXPECT_FALSE(fs::exists(d + "/runs"));
 	EXPECT_EQ(sweep(q(ini)).code, 2);  // no -o
 	EXPECT_EQ(sweep(q(ini) + " -o " + q(out) + " -j -1").code, 2);
+	// Issue 39: --plot-metric nope passed --dry-run and failed after every
+	// run; it is refused first, listing the names metrics.json has
+	for (const char* more : {" --dry-run", ""})
+	{
+		const auto metric =
+		    sweep(q(ini) + " -o " + q(out) + " --plot-metric nope" + more);
+		EXPECT_EQ(metric.code, 2) << metric.out;
+		EXPECT_NE(metric.out.find("--plot-metric nope: not a number bims-run "
+		                          "writes in metrics.json; one of: "
+		                          "frames_processed, "),
+		          std::string::npos)
+		    << metric.out;
+		for (const char* name :
+		     {", fps,", "frames_flagged_by.{imu_missing,imu_gap,",
+		      "stage_ms.{read,read_cpu,wait_input,input,",
+		      "}.{median,p95,mean,n}"})
+			EXPECT_NE(metric.out.find(name), std::string::npos)
+			    << name << " in " << metric.out;
+		EXPECT_FALSE(fs::exists(out));
+	}
 	// --dry-run: the runs listed, nothing written
 	const auto dry = sweep(q(ini) + " -o " + q(out) + " --dry-run");
 	EXPECT_EQ(dry.code, 0) << dry.out;

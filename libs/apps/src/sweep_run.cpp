@@ -3,15 +3,18 @@
 #include <bims/apps/progress_bar.h>
 #include <bims/apps/sweep_run.h>
 #include <bims/common/share.h>
+#include <bims/pipeline/run.h>
 #include <bims/sweep/plan.h>
 #include <bims/sweep/processes.h>
 #include <bims/sweep/results.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <sstream>
 #include <thread>
 
 namespace bims::apps
@@ -54,6 +57,59 @@ int report(const ResultTable& t, const std::string& outDir,
 			    r.error.empty() ? "" : ": ", r.error.c_str());
 	return 1;
 }
+
+/** \a names in short: the plain ones, then each dotted family as
+ * "stage_ms.{input,...}.{median,...}". */
+std::string namesText(const std::vector<std::string>& names)
+{
+	std::string plain;
+	std::vector<std::pair<std::string, std::vector<std::vector<std::string>>>>
+	    families;
+	for (const auto& n : names)
+	{
+		std::vector<std::string> parts;
+		std::istringstream in(n);
+		for (std::string part; std::getline(in, part, '.');)
+			parts.push_back(part);
+		if (parts.size() == 1)
+		{
+			plain += (plain.empty() ? "" : ", ") + n;
+			continue;
+		}
+		if (families.empty() || families.back().first != parts[0])
+			families.push_back({parts[0], {}});
+		auto& levels = families.back().second;
+		levels.resize(std::max(levels.size(), parts.size() - 1));
+		for (size_t k = 1; k < parts.size(); ++k)
+			if (std::find(levels[k - 1].begin(), levels[k - 1].end(),
+			              parts[k]) == levels[k - 1].end())
+				levels[k - 1].push_back(parts[k]);
+	}
+	for (const auto& [first, levels] : families)
+	{
+		plain += ", " + first;
+		for (const auto& level : levels)
+		{
+			plain += ".{";
+			for (size_t k = 0; k < level.size(); ++k)
+				plain += (k ? "," : "") + level[k];
+			plain += "}";
+		}
+	}
+	return plain;
+}
+
+/** --plot-metric, before any run: a number bims-run writes in
+ * metrics.json (pipeline::metricNames). */
+void checkPlotMetric(const std::string& metric)
+{
+	const auto names = pipeline::metricNames();
+	if (std::find(names.begin(), names.end(), metric) == names.end())
+		throw UsageError("--plot-metric " + metric +
+		                 ": not a number bims-run writes in metrics.json; "
+		                 "one of: " +
+		                 namesText(names));
+}
 }  // namespace
 
 int runSweep(const SweepOptions& opt)
@@ -77,6 +133,7 @@ int runSweep(const SweepOptions& opt)
 	if (opt.jobs < 0) throw UsageError("-j: a number of runs >= 0");
 	if (opt.dryRun && !opt.jobsFile.empty())
 		throw UsageError("--dry-run writes nothing: no --jobs-file with it");
+	checkPlotMetric(opt.plotMetric);
 
 	const SweepSpec spec = SweepSpec::load(opt.sweepFile);
 	std::vector<std::string> inputs = {spec.file};

@@ -262,7 +262,14 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		    std::to_string(sum.framesSurfaceFilled) +
 		    " frames: the rest of depth surfaces the tiers called mostly "
 		    "moving (frames.csv filled_px)");
-	for (auto& [name, v] : stage) sum.stageMs[name] = Percentiles::of(v);
+	for (auto& [name, v] : stage)
+	{
+		const auto& known = stageNames();
+		if (std::find(known.begin(), known.end(), name) == known.end())
+			throw std::logic_error("stage " + name +
+			                       " is not one of stageNames()");
+		sum.stageMs[name] = Percentiles::of(v);
+	}
 	sum.dataSeconds = std::isnan(firstT) ? 0 : lastT - firstT;
 	sum.meanMovingPixelFraction =
 	    sum.framesProcessed ? movingFracSum / sum.framesProcessed : 0;
@@ -303,14 +310,11 @@ std::string formatSummary(const RunSummary& s)
 	              100.0 * s.meanMovingPixelFraction);
 	o << buf;
 	o << "stage        median ms   p95 ms   mean ms\n";
-	for (const char* k :
-	     {"read", "read_cpu", "wait_input", "input", "egomotion", "flow",
-	      "flow_observed", "grids", "grids_cloud", "grids_decay", "total",
-	      "total_cpu", "outputs", "outputs_cpu", "wait_output"})
+	for (const auto& k : stageNames())
 	{
 		const auto it = s.stageMs.find(k);
 		if (it == s.stageMs.end()) continue;
-		std::snprintf(buf, sizeof(buf), "%-12s %9.2f %8.2f %9.2f\n", k,
+		std::snprintf(buf, sizeof(buf), "%-12s %9.2f %8.2f %9.2f\n", k.c_str(),
 		              it->second.median, it->second.p95, it->second.mean);
 		o << buf;
 	}

@@ -112,6 +112,15 @@ struct RunOptions
  * voxels. */
 void checkFiniteOutputs(const FrameResult& r);
 
+/** metrics.json's stages (its stage_ms keys; RunSummary::stageMs). */
+const std::vector<std::string>& stageNames();
+
+/** Every number runExperiment writes into metrics.json, by its path as
+ * bims-sweep reads it ("fps", "frames_flagged_by.imu_gap",
+ * "stage_ms.total.median"): the names a run's metric can have, from the
+ * one list of metrics.json's fields. */
+std::vector<std::string> metricNames();
+
 /** What runExperiment writes into RunOptions::outDir (bims-run's output
  * folder), for bims::prepareOutputFolder: the files refused as an earlier
  * run's and cleared by --overwrite. */
