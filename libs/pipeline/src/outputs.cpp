@@ -290,6 +290,8 @@ const std::vector<MetricField>& metricFields()
 	     [](M m) { return Json(m.sum.framesSurfaceFilled); }},
 	    {"pixels_surface_filled", K::Number,
 	     [](M m) { return Json(m.sum.pixelsSurfaceFilled); }},
+	    {"frames_without_imu", K::Number,
+	     [](M m) { return Json(m.sum.framesWithoutImu); }},
 	    {"imu_rejected", K::Number,
 	     [](M m) { return Json(m.sum.imuRejected); }},
 	    {"imu_out_of_order", K::Number,

@@ -132,6 +132,8 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 			sum.framesNotMeasured++;
 		for (const char* name : ego::flagNames(counted))
 			sum.framesFlaggedBy[name]++;
+		if (flags & (ego::kFlagImuMissing | ego::kFlagImuGap))
+			sum.framesWithoutImu++;
 		stage["read"].push_back(f.cost.readMs);
 		stage["read_cpu"].push_back(f.cost.readCpuMs);
 		stage["wait_input"].push_back(f.cost.waitMs);
@@ -236,6 +238,16 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	}
 	for (auto& n : source::imuNotes(sum, imuLabel))
 		sum.notes.push_back(std::move(n));
+	sum.imuUnusable = imuMostlyUnusable(sum);
+	if (sum.imuUnusable && !source::imuMostlySkipped(sum))
+		sum.notes.push_back(
+		    "the IMU was mostly unusable: " +
+		    std::to_string(sum.framesWithoutImu) + " of " +
+		    std::to_string(sum.framesProcessed) +
+		    " frames had no IMU data for their interval (imu_missing, "
+		    "imu_gap) though the input holds " +
+		    std::to_string(sum.imuRead) +
+		    " IMU samples: are its stamps on the camera's clock?");
 	if (sum.framesProcessed > 0 && sum.imuRead == 0 &&
 	    cfg.ego.odometry.mode == ego::OdometryMode::Imu)
 		sum.notes.push_back(
@@ -292,6 +304,12 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	return sum;
 }
 
+bool imuMostlyUnusable(const RunSummary& s)
+{
+	return s.imuRead > 0 && (source::imuMostlySkipped(s) ||
+	                         2 * s.framesWithoutImu > s.framesProcessed);
+}
+
 std::string formatSummary(const RunSummary& s)
 {
 	std::ostringstream o;
@@ -302,6 +320,9 @@ std::string formatSummary(const RunSummary& s)
 	              s.variant.c_str(), s.framesProcessed, s.framesNotMeasured,
 	              s.scansRead, s.imuRead, s.dataSeconds);
 	o << buf;
+	if (s.imuUnusable)
+		o << "status imu_unusable: the IMU was mostly unusable (see the "
+		     "note)\n";
 	std::snprintf(buf, sizeof(buf),
 	              "wall time %.1f s, %.1f frames/s end to end (CPU %.1f s, all "
 	              "threads; peak memory %.0f MiB); mean moving-pixel fraction "
