@@ -390,7 +390,10 @@ TEST(Cli, NumericOptionsOutOfTheirRangeAreUsageErrors)
 	          "--depth-scale 0: out of range"},
 	         {"bims-flow-labels " + png + " " + png + " " + png + " -o " + d +
 	              "/f --fx -542",
-	          "--fx -542: out of range"}})
+	          "--fx -542: out of range"},
+	         {"bims-flow-labels " + png + " " + png + " " + png + " -o " + d +
+	              "/f --fx 0",
+	          "--fx 0: out of range"}})
 	{
 		const auto r = bims::test::runCommand(kBin + "/" + args);
 		EXPECT_EQ(r.code, 2) << args << "\n" << r.out;
