@@ -6,6 +6,7 @@
 #include <bims/common/image_file.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
+#include <bims/eval/association.h>
 #include <bims/maps/export.h>
 #include <bims/maps/motion_grids.h>
 #include <filesystem>
@@ -21,25 +22,76 @@
 
 #include <cstdio>
 #include <iostream>
+#include <stdexcept>
+#include <vector>
+
+namespace
+{
+/** A scan and its ground-truth pose at most this far apart [s] (TUM's
+ * associate.py default). */
+constexpr double kMaxPoseDifference = 0.02;
+}  // namespace
 
 int renderGridsFigure(const FigureOptions& o)
 {
 	const std::string& gt = o.gt;
-	const auto traj = bims::loadTumTrajectory(gt + "/groundtruth.txt");
+	const std::string gtFile = gt + "/groundtruth.txt";
+	const auto traj = bims::loadTumTrajectory(gtFile);
+	// The poses paired with the scans by time stamp (eval's association),
+	// never by line: another recording's ground truth is an error.
+	std::vector<double> scanT, gtT;
+	{
+		bims::RawlogReader first(o.rawlog);
+		while (auto obs = first.next())
+			if (IS_CLASS(*obs, mrpt::obs::CObservation3DRangeScan))
+			{
+				scanT.push_back(mrpt::Clock::toDouble(obs->timestamp));
+				if (int(scanT.size()) >= o.frames) break;
+			}
+	}
+	for (const auto& p : traj) gtT.push_back(p.t);
+	const auto pairs =
+	    bims::eval::associateGreedy(scanT, gtT, kMaxPoseDifference);
+	if (pairs.empty())
+	{
+		char span[160] = "no 3D scan";
+		if (!scanT.empty() && !gtT.empty())
+			std::snprintf(span, sizeof(span),
+			              "its scans at %.3f..%.3f s, the poses at %.3f..%.3f "
+			              "s",
+			              scanT.front(), scanT.back(), gtT.front(), gtT.back());
+		char within[32];
+		std::snprintf(within, sizeof(within), "%g", kMaxPoseDifference);
+		throw std::runtime_error(
+		    gtFile + ": no pose within " + within + " s of any of the first " +
+		    std::to_string(scanT.size()) + " 3D scans of " + o.rawlog + " (" +
+		    span + "): the ground truth of another recording?");
+	}
+	std::vector<long> poseOf(scanT.size(), -1);
+	for (const auto& [i, j] : pairs) poseOf[i] = long(j);
+
 	bims::maps::GridParams p;
 	p.voxel_size = o.voxel;
 	p.decay = bims::maps::DecayMode::Raycast;
 	p.raycast_target = bims::maps::RayTarget::Voxels;
 	bims::maps::MotionGrids grids(p);
 	bims::RawlogReader r(o.rawlog);
-	int k = 0;
+	int k = 0, used = 0;
+	long lastPose = 0;
 	while (auto obs = r.next())
 	{
 		auto scan =
 		    std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(obs);
 		if (!scan) continue;
-		if (k >= o.frames || k >= int(traj.size())) break;
-		const auto T_WS = traj[k].T_WC + (-bims::T_SC());
+		if (k >= int(scanT.size())) break;
+		const long pose = poseOf[size_t(k)];
+		if (pose < 0)
+		{
+			++k;  // no pose at its time
+			continue;
+		}
+		lastPose = pose;
+		const auto T_WS = traj[size_t(pose)].T_WC + (-bims::T_SC());
 		const std::string name = "/masks/" + bims::frameFileName(k);
 		const cv::Mat m =
 		    std::filesystem::exists(gt + name)
@@ -56,7 +108,12 @@ int renderGridsFigure(const FigureOptions& o)
 		grids.processFrame(*scan, T_WS,
 		                   labels.label.empty() ? nullptr : &labels);
 		++k;
+		++used;
 	}
+	if (used < k)
+		std::cout << k - used << " of the first " << k
+		          << " 3D scans have no ground-truth pose within "
+		          << kMaxPoseDifference << " s: skipped\n";
 	mrpt::opengl::COpenGLScene scene;
 	auto all = mrpt::opengl::CSetOfObjects::Create();
 	// Tier 0 without the voxels tier 1/2 flag (they coincide and would
@@ -96,7 +153,7 @@ int renderGridsFigure(const FigureOptions& o)
 	scene.insert(all);
 	mrpt::opengl::CFBORender fbo(1000, 750);
 	auto& cam = fbo.getCamera(scene);
-	const auto at = traj[std::max(0, k - 1)].T_WC.translation();
+	const auto at = traj[size_t(lastPose)].T_WC.translation();
 	cam.setPointingAt(float(at.x + 2.0), float(at.y), float(at.z - 0.3));
 	cam.setZoomDistance(5);
 	cam.setAzimuthDegrees(180);
@@ -104,7 +161,7 @@ int renderGridsFigure(const FigureOptions& o)
 	mrpt::img::CImage img;
 	fbo.render_RGB(scene, img);
 	img.saveToFile(o.out);
-	std::cout << k << " frames; " << grids.occupancy()->asString() << "\n"
+	std::cout << used << " frames; " << grids.occupancy()->asString() << "\n"
 	          << grids.flowConsistency()->asString() << "\nwrote " << o.out
 	          << "\n";
 	return 0;

@@ -16,6 +16,9 @@ struct FigureOptions
 	double voxel = 0.05;  ///< voxel size [m]
 };
 
-/** Integrates the first \a o.frames frames and writes the picture; prints
- * what it drew. Returns the program's exit code (0). */
+/** Integrates the first \a o.frames 3D scans, each at the ground-truth
+ * pose paired with it by time stamp (eval::associateGreedy, at most 0.02 s
+ * apart; a scan without one is skipped), and writes the picture; prints
+ * what it drew. Throws naming both files when no scan has a pose (the
+ * ground truth of another recording). Returns the exit code (0). */
 int renderGridsFigure(const FigureOptions& o);

@@ -7,6 +7,7 @@
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -389,7 +390,10 @@ TEST(Cli, NumericOptionsOutOfTheirRangeAreUsageErrors)
 	          "--depth-scale 0: out of range"},
 	         {"bims-flow-labels " + png + " " + png + " " + png + " -o " + d +
 	              "/f --fx -542",
-	          "--fx -542: out of range"}})
+	          "--fx -542: out of range"},
+	         {"bims-flow-labels " + png + " " + png + " " + png + " -o " + d +
+	              "/f --fx 0",
+	          "--fx 0: out of range"}})
 	{
 		const auto r = bims::test::runCommand(kBin + "/" + args);
 		EXPECT_EQ(r.code, 2) << args << "\n" << r.out;
@@ -415,6 +419,73 @@ TEST(Cli, MapsFigureTakesItsOutputAsOOrAsTheThirdWordOnce)
 		    << r.out;
 	}
 	EXPECT_FALSE(fs::exists(d + "/a.png") || fs::exists(d + "/b.png"));
+}
+
+// Issue 39: bims-maps-figure paired the poses with the scans by line, so
+// another recording's ground truth gave a picture. Pairs are by time stamp:
+// a ground truth without a pose at any scan's time is an error naming it,
+// and a pose missing at the start shifts nothing.
+TEST(Cli, MapsFigurePairsPosesByTimeAndRefusesAnotherRecordingsGroundTruth)
+{
+	if (!built("bims-maps-figure")) GTEST_SKIP() << "not built";
+	const std::string d =
+	    bims::test::freshTmpDir("bims_test_cli", "figure_time");
+	const std::string gtText = bims::test::fileText(
+	    kSrc + "/rawlogs/pendulum_slow_gt/groundtruth.txt");
+	// another recording: the same poses 1000 s later
+	fs::create_directories(d + "/other");
+	{
+		std::istringstream in(gtText);
+		std::ofstream out(d + "/other/groundtruth.txt");
+		for (std::string line; std::getline(in, line);)
+		{
+			if (line.empty() || line[0] == '#')
+			{
+				out << line << "\n";
+				continue;
+			}
+			const size_t sp = line.find(' ');
+			char t[64];
+			std::snprintf(t, sizeof(t), "%.6f",
+			              std::stod(line.substr(0, sp)) + 1000);
+			out << t << line.substr(sp) << "\n";
+		}
+	}
+	const auto r =
+	    bims::test::runCommand(kBin + "/bims-maps-figure " + kSample + " " + d +
+	                           "/other -o " + d + "/other.png --max-frames 10");
+	EXPECT_EQ(r.code, 1) << r.out;
+	EXPECT_NE(r.out.find(d + "/other/groundtruth.txt: no pose within 0.02"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("of any of the first 10 3D scans of " + kSample),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("the ground truth of another recording?"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_FALSE(fs::exists(d + "/other.png"));
+	// the first 4 poses missing: scans 0-3 skipped, 4-9 at their own poses
+	fs::create_directories(d + "/late");
+	{
+		std::istringstream in(gtText);
+		std::ofstream out(d + "/late/groundtruth.txt");
+		int poses = 0;
+		for (std::string line; std::getline(in, line);)
+			if (line.empty() || line[0] == '#' || poses++ >= 4)
+				out << line << "\n";
+	}
+	const auto late =
+	    bims::test::runCommand(kBin + "/bims-maps-figure " + kSample + " " + d +
+	                           "/late -o " + d + "/late.png --max-frames 10");
+	EXPECT_NE(late.out.find("4 of the first 10 3D scans have no "
+	                        "ground-truth pose within 0.02 s: skipped"),
+	          std::string::npos)
+	    << late.out;
+	if (late.code == 0)  // drawn where OpenGL renders off screen
+	{
+		EXPECT_NE(late.out.find("\n6 frames; "), std::string::npos) << late.out;
+	}
 }
 
 // Issue 37: a program without its arguments said only TCLAP's "One or

@@ -278,6 +278,85 @@ TEST(EndToEnd, OneStrayImuStampIsSkippedAndTheRunHolds)
 	EXPECT_NE(text.find("1 with a stray timestamp"), std::string::npos) << text;
 }
 
+// Issue 39: an IMU that was mostly unusable was only a note; the status
+// said "ok". Most stamps out of order (skipped), or the IMU on another
+// clock (most frames without IMU data): status "imu_unusable" in
+// metrics.json and the summary.
+TEST(EndToEnd, AMostlyUnusableImuIsTheRunsStatus)
+{
+	const std::string dir = tmpDir("unusable_imu");
+	ExperimentConfig cfg;
+	cfg.loadFromFile(kConfig);
+	auto runOn = [&](const std::string& rawlog, const std::string& out)
+	{
+		RunOptions opt;
+		opt.rawlogs = {rawlog};
+		opt.frames = FrameRange{0, 19};
+		opt.outDir = dir + "/" + out;
+		const auto sum = runExperiment(cfg, opt);
+		EXPECT_EQ(sum.error, "");
+		EXPECT_EQ(sum.framesProcessed, 20u);
+		return sum;
+	};
+	auto status = [&](const std::string& out)
+	{
+		return bims::Json::parse(
+		    bims::test::fileText(dir + "/" + out + "/metrics.json"))["status"];
+	};
+	// the sample as it is: ok
+	const auto plain = runOn(kSample, "plain");
+	EXPECT_FALSE(plain.imuUnusable);
+	EXPECT_EQ(status("plain"), "ok");
+	EXPECT_LE(2 * plain.framesWithoutImu, plain.framesProcessed);
+
+	// every IMU stamp after the first ten going backwards
+	const std::string backwards = dir + "/backwards.rawlog";
+	size_t imu = 0;
+	double t0 = 0;
+	rewriteSample(backwards,
+	              [&](mrpt::obs::CObservation& o)
+	              {
+		              if (!dynamic_cast<mrpt::obs::CObservationIMU*>(&o))
+			              return true;
+		              if (imu == 10) t0 = mrpt::Clock::toDouble(o.timestamp);
+		              if (imu >= 10)
+			              o.timestamp = mrpt::Clock::fromDouble(
+			                  t0 - 1e-3 * double(imu - 10));
+		              ++imu;
+		              return true;
+	              });
+	const auto b = runOn(backwards, "backwards");
+	EXPECT_GT(2 * b.imuOutOfOrder, b.imuRead);
+	EXPECT_TRUE(b.imuUnusable);
+	EXPECT_EQ(status("backwards"), "imu_unusable");
+	EXPECT_NE(formatSummary(b).find("status imu_unusable: the IMU was mostly "
+	                                "unusable"),
+	          std::string::npos)
+	    << formatSummary(b);
+
+	// the IMU's clock 100 s behind the camera's: its samples are all used,
+	// but no frame has any in its interval
+	const std::string behind = dir + "/behind.rawlog";
+	rewriteSample(behind,
+	              [&](mrpt::obs::CObservation& o)
+	              {
+		              if (dynamic_cast<mrpt::obs::CObservationIMU*>(&o))
+			              o.timestamp = mrpt::Clock::fromDouble(
+			                  mrpt::Clock::toDouble(o.timestamp) - 100);
+		              return true;
+	              });
+	const auto h = runOn(behind, "behind");
+	EXPECT_EQ(h.imuOutOfOrder + h.imuBadStamp, 0u);
+	EXPECT_GT(2 * h.framesWithoutImu, h.framesProcessed);
+	EXPECT_TRUE(h.imuUnusable);
+	EXPECT_EQ(status("behind"), "imu_unusable");
+	bool said = false;
+	for (const auto& n : h.notes)
+		said |= n.find("frames had no IMU data for their interval") !=
+		        std::string::npos;
+	EXPECT_TRUE(said) << formatSummary(h);
+}
+
 TEST(EndToEnd, WritesTheContractOutputs)
 {
 	ExperimentConfig cfg;

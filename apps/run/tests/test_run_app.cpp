@@ -219,6 +219,24 @@ TEST(RunApp, AnEarlierRunIsRefusedAndOverwriteClearsItsFilesOnly)
 	EXPECT_EQ(bims::Json::parse(bims::test::fileText(
 	              out + "/metrics.json"))["frames_processed"],
 	          2);
+	// Issue 39: --overwrite removes only what the earlier run's manifest
+	// lists; a file at an output name it does not list is kept, the run
+	// refused, nothing removed
+	const std::string manifest =
+	    bims::test::fileText(out + "/bims-manifest.txt");
+	for (const char* f : {"\nmasks/000001.png\n", "\nmetrics.json\n",
+	                      "\neffective.ini\n", "\ntrajectory.txt\n"})
+		EXPECT_NE(manifest.find(f), std::string::npos) << f << manifest;
+	std::ofstream(out + "/masks/000007.png") << "mine";
+	const auto before2 = filesBelow(out);
+	const auto kept = run(q(kConfig) + " " + q(kSample) + " -o " + q(out) +
+	                      " --frames 0:1 --overwrite -q");
+	EXPECT_EQ(kept.code, 2) << kept.out;
+	EXPECT_NE(kept.out.find("these are not in it and are kept: "
+	                        "masks/000007.png"),
+	          std::string::npos)
+	    << kept.out;
+	EXPECT_EQ(filesBelow(out), before2);
 }
 
 namespace
@@ -366,7 +384,8 @@ TEST(RunApp, AfterSigkillEveryFileIsWholeAndNoMetricsSaysDone)
 	const auto d = tmpDir("sigkill");
 	fs::create_directories(d + "/out");
 	std::ofstream(d + "/out/metrics.json")
-	    << "{\"status\": \"ok\"}\n";  // stale
+	    << "{\"status\": \"ok\"}\n";  // stale, an earlier run's
+	std::ofstream(d + "/out/bims-manifest.txt") << "metrics.json\n";
 	EXPECT_EQ(interruptedRun(d, SIGKILL), -SIGKILL);
 	EXPECT_FALSE(fs::exists(d + "/out/metrics.json"));
 	const std::string csv = bims::test::fileText(d + "/out/frames.csv");

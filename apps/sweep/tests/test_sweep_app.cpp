@@ -246,6 +246,17 @@ TEST(SweepApp, RunsWithGroundTruthAreScoredIntoTheResults)
 	                            "fused\n[truth]\nmasks = auto\ntrajectory = "
 	                            "auto\n");
 	const std::string out = d + "/out";
+	// a score is a metric to plot when the runs are scored, not otherwise
+	EXPECT_EQ(sweep(q(ini) + " -o " + q(out) +
+	                " --dry-run --plot-metric masks.total.f1")
+	              .code,
+	          0);
+	fs::create_directories(d + "/u");
+	const auto unscored = writeSweep(d + "/u", "frames = 0:4\n");
+	const auto refused = sweep(q(unscored) + " -o " + q(d + "/u/out") +
+	                           " --dry-run --plot-metric masks.total.f1");
+	EXPECT_EQ(refused.code, 2) << refused.out;
+	EXPECT_EQ(refused.out.find("masks.*"), std::string::npos) << refused.out;
 	const auto r = sweep(q(ini) + " -o " + q(out) + " -q");
 	ASSERT_EQ(r.code, 0) << r.out;
 	auto rows = readCsv(out + "/results.csv");
@@ -389,6 +400,26 @@ TEST(SweepApp, BadInputIsAnErrorNamingFileAndKeyBeforeAnyRun)
 	EXPECT_FALSE(fs::exists(d + "/runs"));
 	EXPECT_EQ(sweep(q(ini)).code, 2);  // no -o
 	EXPECT_EQ(sweep(q(ini) + " -o " + q(out) + " -j -1").code, 2);
+	// Issue 39: --plot-metric nope passed --dry-run and failed after every
+	// run; it is refused first, listing the names metrics.json has
+	for (const char* more : {" --dry-run", ""})
+	{
+		const auto metric =
+		    sweep(q(ini) + " -o " + q(out) + " --plot-metric nope" + more);
+		EXPECT_EQ(metric.code, 2) << metric.out;
+		EXPECT_NE(metric.out.find("--plot-metric nope: not a number bims-run "
+		                          "writes in metrics.json; one of: "
+		                          "frames_processed, "),
+		          std::string::npos)
+		    << metric.out;
+		for (const char* name :
+		     {", fps,", "frames_flagged_by.{imu_missing,imu_gap,",
+		      "stage_ms.{read,read_cpu,wait_input,input,",
+		      "}.{median,p95,mean,n}"})
+			EXPECT_NE(metric.out.find(name), std::string::npos)
+			    << name << " in " << metric.out;
+		EXPECT_FALSE(fs::exists(out));
+	}
 	// --dry-run: the runs listed, nothing written
 	const auto dry = sweep(q(ini) + " -o " + q(out) + " --dry-run");
 	EXPECT_EQ(dry.code, 0) << dry.out;

@@ -251,10 +251,11 @@ FrameDepth frameDepth(ScanStream& scans, const ev::MaskFile& f,
 }
 
 /** Scores one pair: its line on stdout (unless quiet), its overlay (in
- * \a outDir, and kept for the strip), its JSON record; adds it to \a t. */
+ * \a overlays' folder, and kept for the strip), its JSON record; adds it to \a
+ * t. */
 void scorePair(const EvalMasksOptions& o, const ev::MaskPair& pair,
                const ev::LabelConvention& labels, ScanStream* scans,
-               const std::string& outDir, const std::set<size_t>& stripSet,
+               OutputManifest* overlays, const std::set<size_t>& stripSet,
                MaskTotals& t)
 {
 	const ev::MaskFile& f = *pair.pred;
@@ -299,12 +300,12 @@ void scorePair(const EvalMasksOptions& o, const ev::MaskPair& pair,
 	                         std::to_string(m.fn) + " " + m.scoresLine();
 	if (!o.quiet) std::printf("%s\n", line.c_str());
 	const bool inStrip = stripSet.count(static_cast<size_t>(f.index)) > 0;
-	if (!outDir.empty() || inStrip)
+	if (overlays || inStrip)
 	{
 		const cv::Mat overlay =
 		    ev::maskOverlay(gMoving, pm, d.valid, d.background,
 		                    "frame " + frame + "  " + m.scoresLine());
-		if (!outDir.empty()) ev::writePng(outDir + "/" + f.name, overlay);
+		if (overlays) ev::writePng(overlays->file(f.name), overlay);
 		if (inStrip) t.tiles[f.index] = overlay;
 	}
 	t.jsonFrames.push_back({{"frame", f.byTime() ? Json(frame) : Json(f.index)},
@@ -406,6 +407,9 @@ int runEvalMasks(const EvalMasksOptions& o)
 	const ev::LabelConvention labels = labelConvention(o);
 	const auto pairing = pairMasks(o);
 	const std::string outDir = prepareOverlayFolder(o, inputs);
+	std::unique_ptr<OutputManifest> overlays;
+	if (!outDir.empty())
+		overlays = std::make_unique<OutputManifest>(outDir, "bims-eval masks");
 	std::unique_ptr<ScanStream> scans;
 	if (o.depthValid) scans = std::make_unique<ScanStream>(*o.depthValid);
 
@@ -416,7 +420,7 @@ int runEvalMasks(const EvalMasksOptions& o)
 	for (const ev::MaskPair& pair : pairs)
 	{
 		bar.update(done++);  // the pairs scored before this one
-		scorePair(o, pair, labels, scans.get(), outDir, stripSet, t);
+		scorePair(o, pair, labels, scans.get(), overlays.get(), stripSet, t);
 	}
 	bar.finish();
 	printUnpaired(o, *pairing);

@@ -2,6 +2,7 @@
 #include <bims/apps/output_checks.h>
 
 #include <filesystem>
+#include <set>
 #include <stdexcept>
 
 namespace fs = std::filesystem;
@@ -81,14 +82,62 @@ size_t prepareOutputFolder(const std::string& dir,
 				    overwriteFlag +
 				    " to replace the link (what it points to is never "
 				    "touched)");
+	// the outputs, the manifest aside (unless it is all there is)
+	std::vector<std::string> outputs;
+	for (const auto& f : found)
+		if (fs::path(f).filename() != kOutputManifest) outputs.push_back(f);
+	if (outputs.empty()) outputs = found;
 	if (!overwrite)
 		throw UsageError(
 		    dir + ": holds the outputs of an earlier run (" +
-		    std::to_string(found.size()) + " files, e.g. " +
-		    fs::path(found.front()).lexically_relative(dir).string() +
+		    std::to_string(outputs.size()) + " files, e.g. " +
+		    fs::path(outputs.front()).lexically_relative(dir).string() +
 		    "); give " + overwriteFlag +
 		    " to replace them, or another output folder");
-	return removeEarlierOutputs(dir, layout, overwriteFlag);
+	// --overwrite: links at output names are replaced (never followed);
+	// of the files, only those the earlier run's manifest lists go
+	std::set<std::string> listed;
+	try
+	{
+		for (const auto& f : manifestFiles(dir))
+		{
+			listed.insert(f);
+			listed.insert(f + ".partial");
+		}
+	}
+	catch (const std::runtime_error& e)
+	{
+		throw UsageError(e.what());
+	}
+	std::vector<std::string> links, kept;
+	for (const auto& f : found)
+	{
+		const std::string rel = fs::path(f).lexically_relative(dir).string();
+		if (std::error_code ec; fs::is_symlink(f, ec))
+			links.push_back(f);
+		else if (rel != kOutputManifest && !listed.count(rel))
+			kept.push_back(rel);
+	}
+	if (!kept.empty())
+	{
+		std::string names;
+		for (size_t k = 0; k < kept.size() && k < 5; ++k)
+			names += (k ? ", " : "") + kept[k];
+		if (kept.size() > 5)
+			names += " and " + std::to_string(kept.size() - 5) + " more";
+		throw UsageError(
+		    dir + ": " + overwriteFlag +
+		    " removes only the files an earlier run's manifest (" +
+		    kOutputManifest + ") lists; these are not in " +
+		    (listed.empty() ? "one (there is none)" : "it") +
+		    " and are kept: " + names +
+		    "; remove them yourself, or give another output folder");
+	}
+	for (const auto& l : links)
+		if (std::error_code ec; !fs::remove(l, ec) || ec)
+			throw std::runtime_error(l + ": cannot remove the link for " +
+			                         overwriteFlag + ": " + ec.message());
+	return links.size() + removeListedOutputs(dir, overwriteFlag);
 }
 
 }  // namespace bims

@@ -5,6 +5,7 @@
 #include <bims/apps/sweep_run.h>
 #include <bims/common/output_paths.h>
 #include <bims/common/share.h>
+#include <bims/pipeline/run.h>
 #include <bims/sweep/plan.h>
 #include <bims/sweep/processes.h>
 #include <bims/sweep/results.h>
@@ -12,6 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -119,6 +121,71 @@ int report(const ResultTable& t, const std::string& outDir,
 			               : "",
 			    r.error.empty() ? "" : ": ", r.error.c_str());
 	return 1;
+}
+
+/** \a names in short: the plain ones, then each dotted family as
+ * "stage_ms.{input,...}.{median,...}". */
+std::string namesText(const std::vector<std::string>& names)
+{
+	std::string plain;
+	std::vector<std::pair<std::string, std::vector<std::vector<std::string>>>>
+	    families;
+	for (const auto& n : names)
+	{
+		std::vector<std::string> parts;
+		std::istringstream in(n);
+		for (std::string part; std::getline(in, part, '.');)
+			parts.push_back(part);
+		if (parts.size() == 1)
+		{
+			plain += (plain.empty() ? "" : ", ") + n;
+			continue;
+		}
+		if (families.empty() || families.back().first != parts[0])
+			families.push_back({parts[0], {}});
+		auto& levels = families.back().second;
+		levels.resize(std::max(levels.size(), parts.size() - 1));
+		for (size_t k = 1; k < parts.size(); ++k)
+			if (std::find(levels[k - 1].begin(), levels[k - 1].end(),
+			              parts[k]) == levels[k - 1].end())
+				levels[k - 1].push_back(parts[k]);
+	}
+	for (const auto& [first, levels] : families)
+	{
+		plain += ", " + first;
+		for (const auto& level : levels)
+		{
+			plain += ".{";
+			for (size_t k = 0; k < level.size(); ++k)
+				plain += (k ? "," : "") + level[k];
+			plain += "}";
+		}
+	}
+	return plain;
+}
+
+/** --plot-metric, before any run: a number bims-run writes in
+ * metrics.json (pipeline::metricNames), or, when the runs are scored
+ * ([truth]), one of their scores (masks.* of the labels, traj.* of the
+ * trajectory; their fields are checked when the results are collected). */
+void checkPlotMetric(const std::string& metric, const sweep::TruthSpec& truth)
+{
+	const auto names = pipeline::metricNames();
+	if (std::find(names.begin(), names.end(), metric) != names.end()) return;
+	const auto given = [](const std::vector<std::string>& v) {
+		return std::any_of(v.begin(), v.end(),
+		                   [](auto& x) { return !x.empty(); });
+	};
+	const bool masks = given(truth.masks), traj = given(truth.trajectories);
+	if ((masks && metric.rfind("masks.", 0) == 0) ||
+	    (traj && metric.rfind("traj.", 0) == 0))
+		return;
+	throw UsageError(
+	    "--plot-metric " + metric +
+	    ": not a number bims-run writes in metrics.json; one of: " +
+	    namesText(names) +
+	    (masks ? "; or a score of the labels, masks.*" : "") +
+	    (traj ? "; or a score of the trajectory, traj.*" : ""));
 }
 }  // namespace
 
@@ -268,6 +335,7 @@ int runSweep(const SweepOptions& opt)
 	                                 : opt.jobsFile;
 
 	const SweepSpec spec = SweepSpec::load(opt.sweepFile);
+	checkPlotMetric(opt.plotMetric, spec.truth);
 	std::vector<std::string> inputs = {spec.file};
 	for (const auto* list : {&spec.configs, &spec.rawlogs})
 		for (const auto& f : *list) inputs.push_back(f.path);
@@ -302,6 +370,15 @@ int runSweep(const SweepOptions& opt)
 	    opt.outDir,
 	    {{"sweep.json", "results.csv", "results.md", "results.png"}, {}},
 	    opt.overwrite);
+	makeDirs(opt.outDir);
+	// what the sweep writes into OUTDIR (each run's out/ has bims-run's)
+	OutputManifest manifest(opt.outDir, "bims-sweep");
+	for (const char* f :
+	     {"sweep.json", "results.csv", "results.md", "results.png"})
+		manifest.file(f);
+	for (const auto& r : plan.runs)
+		for (const char* f : {"config.ini", "log.txt"})
+			manifest.file("runs/" + r.id + "/" + f);
 	writePlan(plan, opt.outDir);
 	if (opt.slurm)
 	{

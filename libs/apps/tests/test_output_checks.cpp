@@ -3,6 +3,7 @@
 // --overwrite.
 #include <bims/apps/app.h>
 #include <bims/apps/output_checks.h>
+#include <bims_test/text.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 
@@ -126,18 +127,102 @@ TEST(OutputChecks, AFolderOfAnEarlierRunIsRefusedThenClearedOfItsFilesOnly)
 		    << m;
 	}
 	EXPECT_TRUE(fs::exists(d + "/out/metrics.json"));
-	// --overwrite: those five go, everything else stays
+	// --overwrite: those five go (the earlier run's manifest lists them),
+	// everything else stays
+	{
+		bims::OutputManifest m(d + "/out", "test");
+		for (const char* f :
+		     {"metrics.json", "trajectory.txt", "masks/000001.png",
+		      "masks/000002.png", "1548339824.89375.png"})
+			m.file(f);
+	}
+	EXPECT_EQ(bims::earlierOutputs(d + "/out", layout).size(), 6u);
 	EXPECT_EQ(bims::prepareOutputFolder(d + "/out", layout, true), 5u);
 	EXPECT_TRUE(bims::earlierOutputs(d + "/out", layout).empty());
+	EXPECT_FALSE(fs::exists(d + "/out/" + bims::kOutputManifest));
 	for (const char* f : {"notes.txt", "masks/readme.txt", "masks/x000001.png",
 	                      "plot.png", "other/000001.png"})
 		EXPECT_TRUE(fs::exists(d + "/out/" + f)) << f;
-	// a per-frame folder left empty is removed
+	// a sub-folder its files leave empty is removed
 	fs::remove(d + "/out/masks/readme.txt");
 	fs::remove(d + "/out/masks/x000001.png");
+	bims::OutputManifest(d + "/out", "test").file("masks/000003.png");
 	std::ofstream(d + "/out/masks/000003.png") << "";
 	EXPECT_EQ(bims::prepareOutputFolder(d + "/out", layout, true), 1u);
 	EXPECT_FALSE(fs::exists(d + "/out/masks"));
+}
+
+// Issue 39: --overwrite deleted whatever had an output's name. It removes
+// what the earlier run's manifest lists, and refuses, keeping everything,
+// when a file at an output name is not in it (a user's, another program's,
+// or a folder without a manifest).
+TEST(OutputChecks, OverwriteRemovesOnlyWhatTheEarlierRunsManifestLists)
+{
+	const std::string d = fresh("manifest");
+	const bims::OutputFolderLayout layout{{"metrics.json", "trajectory.txt"},
+	                                      {{"masks", ".png"}}};
+	fs::create_directories(d + "/out/masks");
+	{
+		bims::OutputManifest m(d + "/out", "test");
+		std::ofstream(m.file("metrics.json")) << "{}";
+		std::ofstream(m.file("masks/000000.png")) << "run";
+		m.file("masks/000000.png");  // listed once
+		m.file("trajectory.txt");    // listed, never written (killed)
+	}
+	EXPECT_EQ(bims::manifestFiles(d + "/out"),
+	          (std::vector<std::string>{"metrics.json", "masks/000000.png",
+	                                    "trajectory.txt"}));
+	std::ofstream(d + "/out/masks/000001.png") << "mine";
+	const auto e = usageError(
+	    [&] { bims::prepareOutputFolder(d + "/out", layout, true); });
+	EXPECT_NE(e.find(d + "/out: --overwrite removes only the files an "
+	                     "earlier run's manifest (bims-manifest.txt) lists; "
+	                     "these are not in it and are kept: masks/000001.png; "
+	                     "remove them yourself"),
+	          std::string::npos)
+	    << e;
+	for (const char* f : {"metrics.json", "masks/000000.png",
+	                      "masks/000001.png", "bims-manifest.txt"})
+		EXPECT_TRUE(fs::exists(d + "/out/" + f)) << f;  // nothing removed
+	fs::remove(d + "/out/masks/000001.png");
+	EXPECT_EQ(bims::prepareOutputFolder(d + "/out", layout, true), 2u);
+	EXPECT_FALSE(fs::exists(d + "/out/masks"));
+	EXPECT_FALSE(fs::exists(d + "/out/bims-manifest.txt"));
+	// no manifest: nothing is the earlier run's
+	std::ofstream(d + "/out/metrics.json") << "{}";
+	const auto none = usageError(
+	    [&] { bims::prepareOutputFolder(d + "/out", layout, true); });
+	EXPECT_NE(none.find("these are not in one (there is none) and are kept: "
+	                    "metrics.json"),
+	          std::string::npos)
+	    << none;
+	EXPECT_TRUE(fs::exists(d + "/out/metrics.json"));
+	// a manifest naming a path out of the folder is no manifest of bims's
+	std::ofstream(d + "/out/bims-manifest.txt") << "metrics.json\n../x\n";
+	std::ofstream(d + "/x") << "precious";
+	const auto out = usageError(
+	    [&] { bims::prepareOutputFolder(d + "/out", layout, true); });
+	EXPECT_NE(out.find("bims-manifest.txt:2: ../x is outside the folder"),
+	          std::string::npos)
+	    << out;
+	EXPECT_TRUE(fs::exists(d + "/x"));
+	EXPECT_TRUE(fs::exists(d + "/out/metrics.json"));
+}
+
+// A manifest's file below a folder that is now a link to elsewhere is
+// never reached through the link: the link goes, its target stays whole.
+TEST(OutputChecks, AManifestIsNeverFollowedThroughALinkedFolder)
+{
+	const std::string d = fresh("manifest_link");
+	fs::create_directories(d + "/keep");
+	fs::create_directories(d + "/out");
+	std::ofstream(d + "/keep/000000.png") << "x";
+	bims::OutputManifest(d + "/out", "test").file("masks/000000.png");
+	fs::create_directory_symlink(d + "/keep", d + "/out/masks");
+	const bims::OutputFolderLayout layout{{}, {{"masks", ".png"}}};
+	EXPECT_EQ(bims::prepareOutputFolder(d + "/out", layout, true), 1u);
+	EXPECT_FALSE(fs::exists(fs::symlink_status(d + "/out/masks")));
+	EXPECT_EQ(bims::test::fileText(d + "/keep/000000.png"), "x");
 }
 
 TEST(OutputChecks, OverwriteRemovesALinkOfTheLayoutNotItsTarget)

@@ -101,6 +101,42 @@ TEST(ImportRun, BadOptionsAreErrorsBeforeAnyOutput)
 	EXPECT_FALSE(fs::exists(o.out));
 }
 
+// Issue 39: the guarded image reader's limits are [input] keys of the
+// importer's -c CONFIG.ini: a folder's image beyond them is refused naming
+// the file, the size and the keys, before it is decoded.
+TEST(ImportRun, TheImageLimitsOfTheConfigApplyToTheFoldersImages)
+{
+	const auto d = tumFolder("limits", false);
+	bims::apps::ImportRunOptions o;
+	o.folder = d;
+	o.out = d + "/x.rawlog";
+	o.progress = false;
+	o.config = d + "/small.ini";
+	std::ofstream(*o.config) << "[input]\nimage_max_side = 600\n";
+	const std::string e = errorOf<std::runtime_error>(o);
+	EXPECT_NE(e.find(d + "/depth/a.png: cannot read depth image: declares "
+	                     "640 x 480 pixels in its PNG header, beyond the 600 "
+	                     "per side"),
+	          std::string::npos)
+	    << e;
+	EXPECT_NE(e.find("[input] image_max_side, image_max_pixels"),
+	          std::string::npos)
+	    << e;
+	EXPECT_FALSE(fs::exists(o.out));
+	std::ofstream(*o.config) << "[input]\nimage_max_pixels = 307199\n";
+	EXPECT_NE(errorOf<std::runtime_error>(o).find("beyond the 16384 per side "
+	                                              "and 307199 pixels"),
+	          std::string::npos);
+	// out of range: an error naming the file, section and key
+	std::ofstream(*o.config) << "[input]\nimage_max_side = 0\n";
+	EXPECT_NE(errorOf<std::runtime_error>(o).find("[input] image_max_side"),
+	          std::string::npos);
+	// within them (the defaults: today's), the import runs
+	std::ofstream(*o.config) << "[input]\nimage_max_pixels = 307200\n";
+	EXPECT_EQ(errorOf<std::exception>(o), "");
+	EXPECT_TRUE(fs::exists(o.out));
+}
+
 TEST(ImportRun, SynthImuTakesTheConvertedTruthLabelCalibrationAndSeed)
 {
 	const auto d = tumFolder("synth", true);

@@ -22,6 +22,7 @@ const std::vector<std::string>& experimentSections()
 	    "flow",              // flow: observed / expected flow, Diff labels
 	    "pipeline",          // pipeline: orchestration, variants
 	    "output",            // what bims-run writes
+	    "input",             // size limits of input image files
 	};
 	return s;
 }

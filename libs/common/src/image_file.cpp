@@ -1,4 +1,5 @@
 #include <bims/common/image_file.h>
+#include <bims/common/options.h>
 
 #include <filesystem>
 #include <fstream>
@@ -118,14 +119,32 @@ std::optional<ImageHeader> imageHeader(const uint8_t* p, size_t n)
 	return std::nullopt;
 }
 
-bool imageSizeWithinLimits(uint64_t rows, uint64_t cols)
+void ImageLimits::describe(OptionVisitor& v)
 {
-	return rows <= kMaxImageSide && cols <= kMaxImageSide &&
-	       rows * cols <= kMaxImagePixels;
+	v.integer("image_max_side", max_side, 1, 65535,
+	          "an input image file (TUM folder, Stray capture, labels) "
+	          "declaring more pixels per side is refused before decoding");
+	v.integer("image_max_pixels", max_pixels, 1, 1L << 31,
+	          "an input image file declaring more pixels (width x height) "
+	          "is refused before decoding");
+}
+
+void ImageLimits::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+                                     const std::string& section)
+{
+	readOptions(*this, cfg, section);
+}
+
+bool imageSizeWithinLimits(uint64_t rows, uint64_t cols,
+                           const ImageLimits& limits)
+{
+	const auto side = static_cast<uint64_t>(limits.max_side);
+	return rows <= side && cols <= side &&
+	       rows * cols <= static_cast<uint64_t>(limits.max_pixels);
 }
 
 cv::Mat readImageFile(const std::string& path, int flags,
-                      const std::string& what)
+                      const std::string& what, const ImageLimits& limits)
 {
 	namespace fs = std::filesystem;
 	const auto fail = [&](const std::string& why)
@@ -138,7 +157,7 @@ cv::Mat readImageFile(const std::string& path, int flags,
 	if (!f) throw fail("cannot open the file");
 	// a compressed image is never larger than its pixels (at 8 bytes each)
 	const uint64_t size = fs::file_size(path, ec);
-	if (ec || size > kMaxImagePixels * 8)
+	if (ec || size > static_cast<uint64_t>(limits.max_pixels) * 8)
 		throw fail("larger than any image bims reads (" + std::to_string(size) +
 		           " bytes)");
 	std::vector<uint8_t> bytes(static_cast<size_t>(size));
@@ -150,12 +169,13 @@ cv::Mat readImageFile(const std::string& path, int flags,
 		throw fail(bytes.empty() ? std::string("the file is empty")
 		                         : std::string("not a PNG, JPEG, TIFF or BMP "
 		                                       "image (no header of one)"));
-	if (!imageSizeWithinLimits(h->height, h->width))
+	if (!imageSizeWithinLimits(h->height, h->width, limits))
 		throw fail("declares " + std::to_string(h->width) + " x " +
 		           std::to_string(h->height) + " pixels in its " + h->format +
-		           " header, beyond the " + std::to_string(kMaxImageSide) +
-		           " per side and " + std::to_string(kMaxImagePixels) +
-		           " pixels bims reads (not decoded)");
+		           " header, beyond the " + std::to_string(limits.max_side) +
+		           " per side and " + std::to_string(limits.max_pixels) +
+		           " pixels bims reads ([input] image_max_side, "
+		           "image_max_pixels; not decoded)");
 	if (h->width == 0 || h->height == 0)
 		throw fail(std::string("declares an empty image in its ") + h->format +
 		           " header");

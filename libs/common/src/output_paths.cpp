@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
@@ -20,6 +21,8 @@ std::runtime_error systemError(const std::string& path, const char* what)
 {
 	return std::runtime_error(path + ": " + what + ": " + std::strerror(errno));
 }
+void removeLayoutFiles(const std::string& dir,
+                       const OutputFolderLayout& layout);
 }  // namespace
 
 void checkOutputFilesWritable(const std::vector<std::string>& files)
@@ -136,7 +139,7 @@ void PartialDir::commit()
 			                         ": exists and is not a folder (the new "
 			                         "files stay in " +
 			                         partial_ + ")");
-		removeEarlierOutputs(final_, layout_);  // the earlier run's
+		removeLayoutFiles(final_, layout_);  // the earlier run's
 		if (fs::is_empty(final_, ec)) fs::remove(final_, ec);
 	}
 	if (!fs::exists(fs::symlink_status(final_, ec)))
@@ -283,6 +286,9 @@ std::vector<std::string> earlierOutputs(const std::string& dir,
 	std::vector<std::string> found;
 	std::error_code ec;
 	if (!fs::is_directory(dir, ec)) return found;
+	if (const fs::path m = fs::path(dir) / kOutputManifest;
+	    fs::is_symlink(m, ec) || fs::exists(m, ec))
+		found.push_back(m.string());
 	for (const auto& f : layout.files)
 		for (const std::string& name : {f, f + ".partial"})
 		{
@@ -314,13 +320,13 @@ std::vector<std::string> earlierOutputs(const std::string& dir,
 	return found;
 }
 
-size_t removeEarlierOutputs(const std::string& dir,
-                            const OutputFolderLayout& layout,
-                            const std::string& why)
+namespace
 {
-	const auto found = earlierOutputs(dir, layout);
-	if (found.empty()) return 0;
-	for (const auto& f : found)
+/** PartialDir's: the files of \a layout in \a dir (a folder bims names
+ * after its rawlog) and the per-frame sub-folders left empty. */
+void removeLayoutFiles(const std::string& dir, const OutputFolderLayout& layout)
+{
+	for (const auto& f : earlierOutputs(dir, layout))
 	{
 		std::error_code ec;
 		if (fs::is_directory(fs::symlink_status(f, ec)))
@@ -328,8 +334,7 @@ size_t removeEarlierOutputs(const std::string& dir,
 			                         ": is a folder where the run writes a "
 			                         "file; not removed");
 		if (!fs::remove(f, ec) || ec)
-			throw std::runtime_error(f + ": cannot remove it for " + why +
-			                         ": " + ec.message());
+			throw std::runtime_error(f + ": cannot remove it: " + ec.message());
 	}
 	for (const auto& [sub, ext] : layout.frameFolders)
 	{
@@ -337,7 +342,101 @@ size_t removeEarlierOutputs(const std::string& dir,
 		if (!sub.empty() && fs::is_empty(fs::path(dir) / sub, ec))
 			fs::remove(fs::path(dir) / sub, ec);
 	}
-	return found.size();
+}
+
+/** \a rel's folders below \a dir are real folders (no link on the way). */
+bool reachedWithoutLinks(const fs::path& dir, const fs::path& rel)
+{
+	fs::path p = dir;
+	std::error_code ec;
+	for (auto it = rel.begin(); std::next(it) != rel.end(); ++it)
+	{
+		p /= *it;
+		if (!fs::is_directory(fs::symlink_status(p, ec))) return false;
+	}
+	return true;
+}
+}  // namespace
+
+OutputManifest::OutputManifest(std::string dir, const std::string& program)
+    : dir_(std::move(dir)), file_(dir_ + "/" + kOutputManifest)
+{
+	file_.append("# " + program +
+	             ": the files it wrote into this folder, one a line; "
+	             "--overwrite removes only these\n");
+}
+
+std::string OutputManifest::file(const std::string& rel)
+{
+	{
+		std::lock_guard<std::mutex> lock(mutex_);
+		if (listed_.insert(rel).second) file_.append(rel + "\n");
+	}
+	return dir_ + "/" + rel;
+}
+
+std::vector<std::string> manifestFiles(const std::string& dir)
+{
+	const std::string path = dir + "/" + kOutputManifest;
+	std::vector<std::string> files;
+	std::ifstream in(path);
+	if (!in) return files;
+	std::string line;
+	for (size_t n = 1; std::getline(in, line); ++n)
+	{
+		if (line.empty() || line[0] == '#') continue;
+		const fs::path rel(line);
+		bool leaves = rel.is_absolute();
+		for (const auto& part : rel) leaves = leaves || part == "..";
+		if (leaves)
+			throw std::runtime_error(
+			    path + ":" + std::to_string(n) + ": " + line +
+			    " is outside the folder: not a manifest bims wrote (remove "
+			    "the earlier outputs yourself)");
+		files.push_back(line);
+	}
+	return files;
+}
+
+size_t removeListedOutputs(const std::string& dir, const std::string& why)
+{
+	const auto listed = manifestFiles(dir);
+	size_t removed = 0;
+	std::set<fs::path> folders;
+	for (const auto& rel : listed)
+	{
+		if (!reachedWithoutLinks(dir, rel)) continue;  // never followed
+		for (const std::string& name : {rel, rel + ".partial"})
+		{
+			const fs::path p = fs::path(dir) / name;
+			std::error_code ec;
+			const auto st = fs::symlink_status(p, ec);
+			if (!fs::exists(st) && !fs::is_symlink(st)) continue;
+			if (fs::is_directory(st))
+				throw std::runtime_error(p.string() +
+				                         ": is a folder where the run wrote a "
+				                         "file; not removed");
+			if (!fs::remove(p, ec) || ec)
+				throw std::runtime_error(p.string() +
+				                         ": cannot remove it for " + why +
+				                         ": " + ec.message());
+			++removed;
+		}
+		for (fs::path f = fs::path(rel).parent_path(); !f.empty();
+		     f = f.parent_path())
+			folders.insert(f);
+	}
+	// the deepest first
+	for (auto it = folders.rbegin(); it != folders.rend(); ++it)
+	{
+		const fs::path p = fs::path(dir) / *it;
+		std::error_code ec;
+		if (fs::is_directory(fs::symlink_status(p, ec)) && fs::is_empty(p, ec))
+			fs::remove(p, ec);
+	}
+	std::error_code ec;
+	fs::remove(fs::path(dir) / kOutputManifest, ec);
+	return removed;
 }
 
 std::vector<std::string> frameFilesIn(const std::string& dir,

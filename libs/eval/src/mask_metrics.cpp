@@ -218,9 +218,10 @@ MaskMetrics voxelMaskMetrics(const cv::Mat& gt, const cv::Mat& pred,
 	return m;
 }
 
-cv::Mat loadMask(const std::string& path)
+cv::Mat loadMask(const std::string& path, const ImageLimits& limits)
 {
-	const cv::Mat m = readImageFile(path, cv::IMREAD_UNCHANGED, "mask image");
+	const cv::Mat m =
+	    readImageFile(path, cv::IMREAD_UNCHANGED, "mask image", limits);
 	if (m.type() != CV_8UC1)
 		throw std::runtime_error(
 		    path + ": mask must be an 8-bit single-channel PNG (got " +

@@ -11,9 +11,10 @@ namespace bims::eval
 {
 using mrpt::obs::CObservation3DRangeScan;
 
-cv::Mat readDepthPng(const std::string& path)
+cv::Mat readDepthPng(const std::string& path, const ImageLimits& limits)
 {
-	cv::Mat raw = readImageFile(path, cv::IMREAD_UNCHANGED, "depth image");
+	cv::Mat raw =
+	    readImageFile(path, cv::IMREAD_UNCHANGED, "depth image", limits);
 	if (raw.type() != CV_16UC1)
 		throw std::runtime_error(path +
 		                         ": depth must be a 16-bit single-channel PNG");

@@ -96,7 +96,7 @@ StrayImportSummary importStray(const StrayCapture& cap,
 	// the depth grid: the first image's size, every image's
 	const std::string firstDepth = frames.front().depthPath;
 	{
-		const cv::Mat d = readDepthPng(firstDepth);
+		const cv::Mat d = readDepthPng(firstDepth, params.images);
 		sum.width = d.cols;
 		sum.height = d.rows;
 	}
@@ -186,7 +186,7 @@ StrayImportSummary importStray(const StrayCapture& cap,
 			continue;
 		}
 		const StrayFrame& f = frames[it.i];
-		cv::Mat depth = readDepthPng(f.depthPath);
+		cv::Mat depth = readDepthPng(f.depthPath, params.images);
 		if (depth.cols != sum.width || depth.rows != sum.height)
 			throw std::runtime_error(f.depthPath + ": depth image is " +
 			                         sizeText(depth.cols, depth.rows) +
@@ -196,7 +196,7 @@ StrayImportSummary importStray(const StrayCapture& cap,
 		if (cap.hasConfidence)
 		{
 			conf = readImageFile(f.confidencePath, cv::IMREAD_UNCHANGED,
-			                     "confidence image");
+			                     "confidence image", params.images);
 			if (conf.type() != CV_8UC1)
 				throw std::runtime_error(
 				    f.confidencePath +

@@ -21,6 +21,7 @@ void StrayImportParams::loadFromConfigFile(
 	checkExperimentSections(cfg);
 	readOptions(*this, cfg, "import_stray");
 	loadImportLabels(cfg, rgbd_label, imu_label);
+	images.loadFromConfigFile(cfg, "input");
 }
 
 }  // namespace bims::eval

@@ -25,7 +25,7 @@ mrpt::obs::CObservation3DRangeScan::Ptr loadDepthFrame(
     const std::string& depthPath, double t, const ImportParams& params)
 {
 	const auto& cam = params.camera;
-	const cv::Mat raw = readDepthPng(depthPath);
+	const cv::Mat raw = readDepthPng(depthPath, params.images);
 	if (raw.cols != cam.width || raw.rows != cam.height)
 		throw std::runtime_error(
 		    depthPath + ": depth image is " + std::to_string(raw.cols) + "x" +
@@ -40,8 +40,8 @@ mrpt::obs::CObservation3DRangeScan::Ptr loadFrame(const TumFrame& frame,
 {
 	const auto& cam = params.camera;
 	auto o = loadDepthFrame(frame.depthPath, frame.t, params);
-	const cv::Mat rgb =
-	    readImageFile(frame.rgbPath, cv::IMREAD_COLOR, "colour image");
+	const cv::Mat rgb = readImageFile(frame.rgbPath, cv::IMREAD_COLOR,
+	                                  "colour image", params.images);
 	if (rgb.cols != cam.width || rgb.rows != cam.height)
 		throw std::runtime_error(
 		    frame.rgbPath + ": colour image is " + std::to_string(rgb.cols) +

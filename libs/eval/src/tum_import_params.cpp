@@ -56,6 +56,7 @@ void ImportParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg)
 	im.finish();
 
 	loadImportLabels(cfg, rgbdLabel, imuLabel);
+	images.loadFromConfigFile(cfg, "input");
 }
 
 }  // namespace bims::eval

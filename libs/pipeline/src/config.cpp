@@ -100,6 +100,7 @@ void forEachSection(Config& c, F&& f)
 	f("grids", "the three Bayesian grids", c.grids);
 	f("pipeline", "orchestration, variant", c.pipeline);
 	f("output", "what bims-run writes", c.output);
+	f("input", "size limits of input image files", c.input);
 }
 
 /** A table cell: no line breaks, '|' escaped. */
@@ -146,7 +147,8 @@ std::string configReference()
 	    "`[import]`, `[import_stray]` and `[import_bag]` (read by "
 	    "`bims-import-tum`,\n`bims-import-stray` and `bims-import-bag` "
 	    "only: `docs/eval.md`, `docs/import-bag.md`)\nand MRPT map "
-	    "definitions (`[map...]`) are not listed.\n";
+	    "definitions (`[map...]`) are not listed. `[input]` is read by "
+	    "`bims-import-tum`\nand `bims-import-stray` (their `-c`) too.\n";
 	const ExperimentConfig defaults;
 	forEachSection(defaults,
 	               [&](const char* section, const char* title, const auto& opts)
@@ -172,6 +174,7 @@ void ExperimentConfig::loadFromConfigFile(
 	grids.loadFromConfigFile(cfg, "grids");
 	pipeline.loadFromConfigFile(cfg, "pipeline");
 	output.loadFromConfigFile(cfg, "output");
+	input.loadFromConfigFile(cfg, "input");
 	// import settings live in the same file (config/bonn.ini,
 	// config/stray.ini, config/realsense.ini) but are read by the importers
 	// only.

@@ -65,6 +65,8 @@ const OutputFolderLayout& runOutputLayout()
 OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
     : dir_(dir), p_(p), worker_(kQueuedWrites, p.writer_thread)
 {
+	makeDirs(dir_);
+	manifest_ = std::make_unique<OutputManifest>(dir_, "bims-run");
 	makeDirs(dir_ + "/masks");
 	// written last: a folder without it is partial (an earlier run's would
 	// say otherwise)
@@ -74,8 +76,8 @@ OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
 	if (p_.moving_ply) makeDirs(dir_ + "/moving_voxels");
 	if (p_.flow_labels) makeDirs(dir_ + "/flow_labels");
 	// grown line by line, each line checked and whole
-	traj_ = std::make_unique<AppendFile>(dir_ + "/trajectory.txt");
-	csv_ = std::make_unique<AppendFile>(dir_ + "/frames.csv");
+	traj_ = std::make_unique<AppendFile>(file("trajectory.txt"));
+	csv_ = std::make_unique<AppendFile>(file("frames.csv"));
 	traj_->append(
 	    tumHeader("bims-run estimated camera trajectory T_WC (optical frame)"));
 	csv_->append(
@@ -83,7 +85,7 @@ OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
 	    "moving_voxels,moving_px,diff_px,notdiff_px,"
 	    "ms_input,ms_ego,ms_flow,ms_grids,ms_total,filled_px,ego_flag_names\n");
 	if (p_.labelled_rawlog)
-		rawlog_ = std::make_unique<RawlogWriter>(dir_ + "/segmented.rawlog",
+		rawlog_ = std::make_unique<RawlogWriter>(file("segmented.rawlog"),
 		                                         p_.labelled_rawlog_gz_level);
 }
 
@@ -114,17 +116,17 @@ double OutputWriter::writeFrame(const FrameResult& r,
 void OutputWriter::doWriteFrame(const FrameResult& r,
                                 mrpt::obs::CObservation3DRangeScan& scan)
 {
-	writeImageFile(dir_ + "/masks/" + frameFileName(long(r.index)), r.mask);
+	writeImageFile(file("masks/" + frameFileName(long(r.index))), r.mask);
 	if (p_.moving_ply)
 		writePointsPly(
-		    dir_ + "/moving_voxels/" + frameFileName(long(r.index), "ply"),
+		    file("moving_voxels/" + frameFileName(long(r.index), "ply")),
 		    r.movingVoxelCentres);
 	if (p_.flow_labels && !r.labels.empty())
 	{
 		cv::Mat vis(r.labels.size(), CV_8UC1, cv::Scalar(0));
 		vis.setTo(128, r.labels == 0);
 		vis.setTo(255, r.labels == 1);
-		writeImageFile(dir_ + "/flow_labels/" + frameFileName(long(r.index)),
+		writeImageFile(file("flow_labels/" + frameFileName(long(r.index))),
 		               vis);
 	}
 	if (rawlog_)
@@ -203,7 +205,7 @@ size_t OutputWriter::close(Pipeline& pipe)
 	const maps::CMotionGridBase* motion = pipe.maskGrid();
 	if (p_.static_map && pipe.framesProcessed() > 0)
 	{
-		PartialFile ply(dir_ + "/static_map.ply"), bt(dir_ + "/static_map.bt");
+		PartialFile ply(file("static_map.ply")), bt(file("static_map.bt"));
 		nStatic = maps::writeStaticPly(ply.path(), *g.occupancy(), motion,
 		                               p_.static_p_occupied);
 		maps::writeStaticOctomap(bt.path(), *g.occupancy(), motion,
@@ -216,44 +218,138 @@ size_t OutputWriter::close(Pipeline& pipe)
 	return nStatic;
 }
 
+namespace
+{
+/** What a field of metrics.json is made from. */
+struct MetricInputs
+{
+	const Pipeline& pipe;
+	const RunSummary& sum;
+	size_t staticVoxels;
+};
+
+/** What a field holds: a number (a metric), text, one number per stage
+ * (median, p95, mean, n) or per egomotion flag, or a list. */
+enum class MetricKind
+{
+	Number,
+	Text,
+	PerStage,
+	PerFlag,
+	List
+};
+
+struct MetricField
+{
+	const char* key;
+	MetricKind kind;
+	Json (*value)(const MetricInputs&);
+};
+
+/** metrics.json's fields in their order: the one list of its keys, which
+ * the writer writes and metricNames() names. */
+const std::vector<MetricField>& metricFields()
+{
+	using K = MetricKind;
+	using M = const MetricInputs&;
+	static const std::vector<MetricField> fields = {
+	    {"status", K::Text, [](M m) { return Json(m.sum.status()); }},
+	    {"variant", K::Text, [](M m) { return Json(m.sum.variant); }},
+	    {"config", K::Text, [](M m) { return Json(m.pipe.config().source); }},
+	    {"frames_processed", K::Number,
+	     [](M m) { return Json(m.sum.framesProcessed); }},
+	    {"frames_flagged", K::Number,
+	     [](M m) { return Json(m.sum.framesFlagged); }},
+	    {"frames_not_measured", K::Number,
+	     [](M m) { return Json(m.sum.framesNotMeasured); }},
+	    {"frames_flagged_by", K::PerFlag,
+	     [](M m) { return Json(m.sum.framesFlaggedBy); }},
+	    {"notes", K::List, [](M m) { return Json(m.sum.notes); }},
+	    {"scans_read", K::Number, [](M m) { return Json(m.sum.scansRead); }},
+	    {"imu_read", K::Number, [](M m) { return Json(m.sum.imuRead); }},
+	    {"scans_out_of_order", K::Number,
+	     [](M m) { return Json(m.sum.scansOutOfOrder); }},
+	    {"wall_seconds", K::Number,
+	     [](M m) { return jsonNumber(m.sum.seconds, 3); }},
+	    {"cpu_seconds", K::Number,
+	     [](M m) { return jsonNumber(m.sum.cpuSeconds, 3); }},
+	    {"peak_resident_mib", K::Number,
+	     [](M m) { return jsonNumber(m.sum.peakResidentMiB, 1); }},
+	    {"fps", K::Number, [](M m) { return jsonNumber(m.sum.fps(), 3); }},
+	    {"data_seconds", K::Number,
+	     [](M m) { return jsonNumber(m.sum.dataSeconds, 3); }},
+	    {"mean_moving_pixel_fraction", K::Number,
+	     [](M m) { return jsonNumber(m.sum.meanMovingPixelFraction, 6); }},
+	    {"static_map_voxels", K::Number,
+	     [](M m) { return Json(m.staticVoxels); }},
+	    {"frames_flow_ahead", K::Number,
+	     [](M m) { return Json(m.sum.framesFlowAhead); }},
+	    {"frames_without_flow", K::Number,
+	     [](M m) { return Json(m.sum.framesWithoutFlow); }},
+	    {"frames_surface_filled", K::Number,
+	     [](M m) { return Json(m.sum.framesSurfaceFilled); }},
+	    {"pixels_surface_filled", K::Number,
+	     [](M m) { return Json(m.sum.pixelsSurfaceFilled); }},
+	    {"frames_without_imu", K::Number,
+	     [](M m) { return Json(m.sum.framesWithoutImu); }},
+	    {"imu_rejected", K::Number,
+	     [](M m) { return Json(m.sum.imuRejected); }},
+	    {"imu_out_of_order", K::Number,
+	     [](M m) { return Json(m.sum.imuOutOfOrder); }},
+	    {"imu_bad_stamp", K::Number,
+	     [](M m) { return Json(m.sum.imuBadStamp); }},
+	    {"scans_bad_stamp", K::Number,
+	     [](M m) { return Json(m.sum.scansBadStamp); }},
+	    {"stage_ms", K::PerStage,
+	     [](M m)
+	     {
+		     Json stages = Json::object();
+		     for (const auto& [name, p] : m.sum.stageMs)
+			     stages[name] = {{"median", jsonNumber(p.median, 3)},
+			                     {"p95", jsonNumber(p.p95, 3)},
+			                     {"mean", jsonNumber(p.mean, 3)},
+			                     {"n", p.n}};
+		     return stages;
+	     }},
+	    {"error", K::Text, [](M m) { return Json(m.sum.error); }}};
+	return fields;
+}
+}  // namespace
+
+const std::vector<std::string>& stageNames()
+{
+	// in the summary's order
+	static const std::vector<std::string> names = {
+	    "read",  "read_cpu",      "wait_input", "input",       "egomotion",
+	    "flow",  "flow_observed", "grids",      "grids_cloud", "grids_decay",
+	    "total", "total_cpu",     "outputs",    "outputs_cpu", "wait_output"};
+	return names;
+}
+
+std::vector<std::string> metricNames()
+{
+	std::vector<std::string> names;
+	for (const auto& f : metricFields())
+		if (f.kind == MetricKind::Number)
+			names.push_back(f.key);
+		else if (f.kind == MetricKind::PerFlag)
+			for (const char* flag :
+			     ego::flagNames(~uint32_t(ego::kFlagFirstFrame)))
+				names.push_back(std::string(f.key) + "." + flag);
+		else if (f.kind == MetricKind::PerStage)
+			for (const auto& stage : stageNames())
+				for (const char* stat : {"median", "p95", "mean", "n"})
+					names.push_back(std::string(f.key) + "." + stage + "." +
+					                stat);
+	return names;
+}
+
 void OutputWriter::writeMetrics(const Pipeline& pipe, const RunSummary& sum)
 {
 	Json j;
-	j["status"] = sum.status();
-	j["variant"] = sum.variant;
-	j["config"] = pipe.config().source;
-	j["frames_processed"] = sum.framesProcessed;
-	j["frames_flagged"] = sum.framesFlagged;
-	j["frames_not_measured"] = sum.framesNotMeasured;
-	j["frames_flagged_by"] = sum.framesFlaggedBy;
-	j["notes"] = sum.notes;
-	j["scans_read"] = sum.scansRead;
-	j["imu_read"] = sum.imuRead;
-	j["scans_out_of_order"] = sum.scansOutOfOrder;
-	j["wall_seconds"] = jsonNumber(sum.seconds, 3);
-	j["cpu_seconds"] = jsonNumber(sum.cpuSeconds, 3);
-	j["peak_resident_mib"] = jsonNumber(sum.peakResidentMiB, 1);
-	j["fps"] = jsonNumber(sum.fps(), 3);
-	j["data_seconds"] = jsonNumber(sum.dataSeconds, 3);
-	j["mean_moving_pixel_fraction"] =
-	    jsonNumber(sum.meanMovingPixelFraction, 6);
-	j["static_map_voxels"] = staticVoxels_;
-	j["frames_flow_ahead"] = sum.framesFlowAhead;
-	j["frames_without_flow"] = sum.framesWithoutFlow;
-	j["frames_surface_filled"] = sum.framesSurfaceFilled;
-	j["pixels_surface_filled"] = sum.pixelsSurfaceFilled;
-	j["imu_rejected"] = sum.imuRejected;
-	j["imu_out_of_order"] = sum.imuOutOfOrder;
-	j["imu_bad_stamp"] = sum.imuBadStamp;
-	j["scans_bad_stamp"] = sum.scansBadStamp;
-	Json& stages = j["stage_ms"] = Json::object();
-	for (const auto& [name, p] : sum.stageMs)
-		stages[name] = {{"median", jsonNumber(p.median, 3)},
-		                {"p95", jsonNumber(p.p95, 3)},
-		                {"mean", jsonNumber(p.mean, 3)},
-		                {"n", p.n}};
-	j["error"] = sum.error;
-	writeJsonFile(dir_ + "/metrics.json", j);
+	const MetricInputs in{pipe, sum, staticVoxels_};
+	for (const auto& f : metricFields()) j[f.key] = f.value(in);
+	writeJsonFile(file("metrics.json"), j);
 }
 
 }  // namespace bims::pipeline

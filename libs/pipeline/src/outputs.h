@@ -39,6 +39,8 @@ class OutputWriter
 	size_t close(Pipeline& pipe);
 	/** metrics.json. */
 	void writeMetrics(const Pipeline& pipe, const RunSummary& sum);
+	/** DIR/REL for a file the run writes, listed in its manifest first. */
+	std::string file(const std::string& rel) { return manifest_->file(rel); }
 	/** Writing time of each frame [ms] (with the observations queued
 	 * before it); complete after close(). */
 	const std::vector<double>& frameMs() const { return frameMs_; }
@@ -51,6 +53,7 @@ class OutputWriter
 
 	std::string dir_;
 	OutputParams p_;
+	std::unique_ptr<OutputManifest> manifest_;
 	std::unique_ptr<AppendFile> traj_, csv_;
 	std::unique_ptr<RawlogWriter> rawlog_;
 	size_t staticVoxels_ = 0;

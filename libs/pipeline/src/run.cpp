@@ -95,7 +95,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	if (!opt.outDir.empty())
 	{
 		out = std::make_unique<OutputWriter>(opt.outDir, cfg.output);
-		writeFileAtomically(opt.outDir + "/effective.ini", cfg.effectiveIni());
+		writeFileAtomically(out->file("effective.ini"), cfg.effectiveIni());
 	}
 
 	const std::string& rgbdLabel = cfg.ego.sensors.rgbd_label;
@@ -132,6 +132,8 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 			sum.framesNotMeasured++;
 		for (const char* name : ego::flagNames(counted))
 			sum.framesFlaggedBy[name]++;
+		if (flags & (ego::kFlagImuMissing | ego::kFlagImuGap))
+			sum.framesWithoutImu++;
 		stage["read"].push_back(f.cost.readMs);
 		stage["read_cpu"].push_back(f.cost.readCpuMs);
 		stage["wait_input"].push_back(f.cost.waitMs);
@@ -236,6 +238,16 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	}
 	for (auto& n : source::imuNotes(sum, imuLabel))
 		sum.notes.push_back(std::move(n));
+	sum.imuUnusable = imuMostlyUnusable(sum);
+	if (sum.imuUnusable && !source::imuMostlySkipped(sum))
+		sum.notes.push_back(
+		    "the IMU was mostly unusable: " +
+		    std::to_string(sum.framesWithoutImu) + " of " +
+		    std::to_string(sum.framesProcessed) +
+		    " frames had no IMU data for their interval (imu_missing, "
+		    "imu_gap) though the input holds " +
+		    std::to_string(sum.imuRead) +
+		    " IMU samples: are its stamps on the camera's clock?");
 	if (sum.framesProcessed > 0 && sum.imuRead == 0 &&
 	    cfg.ego.odometry.mode == ego::OdometryMode::Imu)
 		sum.notes.push_back(
@@ -262,7 +274,14 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		    std::to_string(sum.framesSurfaceFilled) +
 		    " frames: the rest of depth surfaces the tiers called mostly "
 		    "moving (frames.csv filled_px)");
-	for (auto& [name, v] : stage) sum.stageMs[name] = Percentiles::of(v);
+	for (auto& [name, v] : stage)
+	{
+		const auto& known = stageNames();
+		if (std::find(known.begin(), known.end(), name) == known.end())
+			throw std::logic_error("stage " + name +
+			                       " is not one of stageNames()");
+		sum.stageMs[name] = Percentiles::of(v);
+	}
 	sum.dataSeconds = std::isnan(firstT) ? 0 : lastT - firstT;
 	sum.meanMovingPixelFraction =
 	    sum.framesProcessed ? movingFracSum / sum.framesProcessed : 0;
@@ -285,6 +304,12 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	return sum;
 }
 
+bool imuMostlyUnusable(const RunSummary& s)
+{
+	return s.imuRead > 0 && (source::imuMostlySkipped(s) ||
+	                         2 * s.framesWithoutImu > s.framesProcessed);
+}
+
 std::string formatSummary(const RunSummary& s)
 {
 	std::ostringstream o;
@@ -295,6 +320,9 @@ std::string formatSummary(const RunSummary& s)
 	              s.variant.c_str(), s.framesProcessed, s.framesNotMeasured,
 	              s.scansRead, s.imuRead, s.dataSeconds);
 	o << buf;
+	if (s.imuUnusable)
+		o << "status imu_unusable: the IMU was mostly unusable (see the "
+		     "note)\n";
 	std::snprintf(buf, sizeof(buf),
 	              "wall time %.1f s, %.1f frames/s end to end (CPU %.1f s, all "
 	              "threads; peak memory %.0f MiB); mean moving-pixel fraction "
@@ -303,14 +331,11 @@ std::string formatSummary(const RunSummary& s)
 	              100.0 * s.meanMovingPixelFraction);
 	o << buf;
 	o << "stage        median ms   p95 ms   mean ms\n";
-	for (const char* k :
-	     {"read", "read_cpu", "wait_input", "input", "egomotion", "flow",
-	      "flow_observed", "grids", "grids_cloud", "grids_decay", "total",
-	      "total_cpu", "outputs", "outputs_cpu", "wait_output"})
+	for (const auto& k : stageNames())
 	{
 		const auto it = s.stageMs.find(k);
 		if (it == s.stageMs.end()) continue;
-		std::snprintf(buf, sizeof(buf), "%-12s %9.2f %8.2f %9.2f\n", k,
+		std::snprintf(buf, sizeof(buf), "%-12s %9.2f %8.2f %9.2f\n", k.c_str(),
 		              it->second.median, it->second.p95, it->second.mean);
 		o << buf;
 	}

@@ -298,6 +298,27 @@ TEST(RunOutputs, TheLayoutNamesEveryFileARunWrites)
 		if (!e.is_directory()) written.push_back(e.path().string());
 	std::sort(written.begin(), written.end());
 	EXPECT_EQ(bims::earlierOutputs(d + "/out", runOutputLayout()), written);
+	// every number of metrics.json is one metricNames() names (bims-sweep
+	// --plot-metric checks against it before any run)
+	const auto names = bims::pipeline::metricNames();
+	std::function<void(const bims::Json&, const std::string&)> check =
+	    [&](const bims::Json& j, const std::string& path)
+	{
+		if (j.is_object())
+		{
+			for (const auto& [k, v] : j.items())
+				check(v, path.empty() ? k : path + "." + k);
+		}
+		else if (j.is_number())
+		{
+			EXPECT_NE(std::find(names.begin(), names.end(), path), names.end())
+			    << path;
+		}
+	};
+	const auto metrics =
+	    bims::Json::parse(std::ifstream(d + "/out/metrics.json"));
+	check(metrics, "");
+	EXPECT_GT(metrics["stage_ms"].size(), 10u);
 	// the files, the masks and flow labels of every frame (a PLY only for
 	// a frame with moving voxels)
 	EXPECT_GE(written.size(), 6u + 2 * 4u);

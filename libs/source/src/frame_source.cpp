@@ -320,6 +320,12 @@ std::string imuChannelNames(uint8_t c)
 	return s.empty() ? "no gyro, accel or mag" : s;
 }
 
+bool imuMostlySkipped(const FrameOrderStats& s)
+{
+	const size_t unusable = s.imuRejected + s.imuOutOfOrder + s.imuBadStamp;
+	return s.imuRead > 0 && 2 * unusable > s.imuRead;
+}
+
 std::vector<std::string> imuNotes(const FrameOrderStats& s,
                                   const std::string& label)
 {
@@ -327,7 +333,7 @@ std::vector<std::string> imuNotes(const FrameOrderStats& s,
 	// Samples whose stamp or values could not be used: most of them, and
 	// the IMU was in effect absent.
 	const size_t unusable = s.imuRejected + s.imuOutOfOrder + s.imuBadStamp;
-	if (s.imuRead > 0 && 2 * unusable > s.imuRead)
+	if (imuMostlySkipped(s))
 		notes.push_back(
 		    "the IMU was mostly unusable: " + std::to_string(unusable) +
 		    " of its " + std::to_string(s.imuRead) + " samples skipped (" +

@@ -135,7 +135,8 @@ void ReplayController::loadResultsFrame()
 	const std::string p =
 	    opt_.resultsDir + "/masks/" + frameFileName(frame_->index);
 	if (mrpt::system::fileExists(p))
-		resultsMask_ = readImageFile(p, cv::IMREAD_GRAYSCALE, "mask");
+		resultsMask_ =
+		    readImageFile(p, cv::IMREAD_GRAYSCALE, "mask", cfg_.input);
 }
 
 void ReplayController::seek(size_t i)

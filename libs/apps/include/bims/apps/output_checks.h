@@ -24,12 +24,16 @@ void checkOutputsSpareInputs(const std::vector<std::string>& inputs,
                              const std::vector<std::string>& outputs);
 
 /** Before a program writes into the folder \a dir: when \a dir holds files
- * of \a layout (an earlier run), throws UsageError naming the folder and
- * one of them, and suggesting \a overwriteFlag; with \a overwrite, removes
- * those files (and the per-frame sub-folders left empty) instead, never
- * anything else, and returns how many it removed. A per-frame sub-folder
- * that is a symbolic link is refused (naming it) or, with \a overwrite,
- * the link is removed: what it points to is never emptied. */
+ * of \a layout or a manifest (an earlier run), throws UsageError naming the
+ * folder and one of them, and suggesting \a overwriteFlag. With
+ * \a overwrite, removes what the earlier run's manifest lists (OutputManifest,
+ * bims/common/output_paths.h: removeListedOutputs) and returns how many
+ * files it removed; a file of \a layout the manifest does not list (no
+ * manifest: any) is kept and refused (UsageError naming it), before
+ * anything is removed. A symbolic link at an output name (a per-frame
+ * sub-folder too) is refused (naming it) or, with \a overwrite, removed:
+ * what it points to is never followed nor emptied. The program then starts
+ * its own OutputManifest. */
 size_t prepareOutputFolder(const std::string& dir,
                            const OutputFolderLayout& layout, bool overwrite,
                            const std::string& overwriteFlag = "--overwrite");

@@ -15,12 +15,32 @@ namespace cv
 {
 class Mat;
 }
+namespace mrpt::config
+{
+class CConfigFileBase;
+}
 
 namespace bims
 {
-/** Largest image a bims input may hold: per side, and in pixels. */
+class OptionVisitor;
+
+/** Largest image a bims input may hold by default: per side, and in
+ * pixels (ImageLimits' defaults; the rawlog reader's limits). */
 constexpr uint32_t kMaxImageSide = 16384;
 constexpr uint64_t kMaxImagePixels = uint64_t{1} << 26;  // 67 Mpx
+
+/** The limits an image file's declared size is checked against before it
+ * is decoded: [input] of an experiment .ini (the importers read it from
+ * their -c CONFIG.ini), the defaults without one. */
+struct ImageLimits
+{
+	long max_side = kMaxImageSide;      ///< [input] image_max_side
+	long max_pixels = kMaxImagePixels;  ///< [input] image_max_pixels
+
+	void describe(OptionVisitor& v);
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+	                        const std::string& section);
+};
 
 /** What an image file's header declares. */
 struct ImageHeader
@@ -34,17 +54,19 @@ struct ImageHeader
  * they are none of these formats or end before the size. */
 std::optional<ImageHeader> imageHeader(const uint8_t* p, size_t n);
 
-/** Whether a rows x cols image is within kMaxImageSide / kMaxImagePixels. */
-bool imageSizeWithinLimits(uint64_t rows, uint64_t cols);
+/** Whether a rows x cols image is within \a limits. */
+bool imageSizeWithinLimits(uint64_t rows, uint64_t cols,
+                           const ImageLimits& limits = {});
 
 /** Reads the image file \a path as cv::imread(path, \a flags) does, but
  * first checks that it is a readable file in one of the formats of
- * imageHeader() whose declared size is within the limits; decodes only
+ * imageHeader() whose declared size is within \a limits; decodes only
  * then. Throws std::runtime_error "PATH: cannot read WHAT: why" (\a what:
  * e.g. "depth image", "label"; why: no such file, a folder, empty, not an
  * image of those formats, a size beyond the limits (with the size and the
  * format), or bytes that do not decode). */
 cv::Mat readImageFile(const std::string& path, int flags,
-                      const std::string& what = "image");
+                      const std::string& what = "image",
+                      const ImageLimits& limits = {});
 
 }  // namespace bims

@@ -6,6 +6,8 @@
 // --overwrite) are libs/apps's: bims/apps/output_checks.h.
 #pragma once
 
+#include <mutex>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -39,7 +41,8 @@ std::vector<std::string> frameFilesIn(const std::string& dir,
                                       const std::string& ext = ".png");
 
 /** What a program writes into an output folder, for refusing a folder that
- * holds an earlier run and for clearing exactly that run with --overwrite. */
+ * holds an earlier run (--overwrite clears only what that run's manifest
+ * lists: OutputManifest). */
 struct OutputFolderLayout
 {
 	/** Files by name (e.g. "metrics.json"); PATH.partial files of them
@@ -52,22 +55,12 @@ struct OutputFolderLayout
 	std::vector<std::pair<std::string, std::string>> frameFolders;
 };
 
-/** The files of \a layout found in \a dir (paths inside it, sorted); none
- * when \a dir does not exist. Anything else in \a dir is not listed. A
- * per-frame sub-folder that is a symbolic link is listed as itself (the
- * link), never followed. */
+/** The files of \a layout found in \a dir (paths inside it, sorted), and
+ * its manifest (kOutputManifest) when there is one; none when \a dir does
+ * not exist. Anything else in \a dir is not listed. A per-frame sub-folder
+ * that is a symbolic link is listed as itself (the link), never followed. */
 std::vector<std::string> earlierOutputs(const std::string& dir,
                                         const OutputFolderLayout& layout);
-
-/** Removes the files of \a layout found in \a dir (earlierOutputs) and
- * the per-frame sub-folders left empty, never anything else; a symbolic
- * link is removed, what it points to never emptied. Returns how many files
- * it removed; throws naming a file it cannot remove (\a why: what removes
- * them, in that message). The programs' --overwrite:
- * bims/apps/output_checks.h (prepareOutputFolder). */
-size_t removeEarlierOutputs(const std::string& dir,
-                            const OutputFolderLayout& layout,
-                            const std::string& why = "--overwrite");
 
 /** A whole-file output written under PATH.partial and renamed to PATH by
  * commit() (std::rename: atomic, and it replaces a symbolic link at PATH,
@@ -152,6 +145,46 @@ class AppendFile
 	int fd_ = -1;
 	size_t size_ = 0;
 };
+
+/** The manifest of an output folder: the files a run wrote into it, one
+ * path relative to the folder a line ('#': a comment). --overwrite removes
+ * only what it lists (bims/apps/output_checks.h: prepareOutputFolder). */
+inline constexpr const char* kOutputManifest = "bims-manifest.txt";
+
+/** A run's manifest, DIR/bims-manifest.txt, created (an earlier one
+ * replaced: clear the earlier run's files first) before the run writes
+ * anything into DIR. Each file is added before it is created and the line
+ * reaches the OS at once, so a killed run's manifest still lists every
+ * file it left. Thread-safe. */
+class OutputManifest
+{
+ public:
+	/** \a program: named in the manifest's first line. */
+	OutputManifest(std::string dir, const std::string& program);
+	/** DIR/REL, with REL added to the manifest (once). */
+	std::string file(const std::string& rel);
+	const std::string& dir() const { return dir_; }
+
+ private:
+	std::string dir_;
+	std::mutex mutex_;
+	std::set<std::string> listed_;
+	AppendFile file_;
+};
+
+/** The paths the manifest of \a dir lists (relative to it, in order);
+ * empty when it has none. Throws naming the manifest and the line when a
+ * path is absolute or leaves the folder (`..`): no manifest bims wrote. */
+std::vector<std::string> manifestFiles(const std::string& dir);
+
+/** Removes what the manifest of \a dir lists (each file and its .partial;
+ * a symbolic link removed, never followed, and a path through a linked
+ * folder skipped), then the sub-folders that leaves empty, then the
+ * manifest; never anything else. Returns how many files it removed; throws
+ * naming a file it cannot remove (\a why: what removes them, in that
+ * message). */
+size_t removeListedOutputs(const std::string& dir,
+                           const std::string& why = "--overwrite");
 
 /** Writes \a bytes to \a path through a PartialFile: every write and the
  * close checked (a full disk is an error naming the file, never a short

@@ -2,6 +2,7 @@
 // ground-truth mask, counted over the pixels with valid depth.
 #pragma once
 
+#include <bims/common/image_file.h>
 #include <bims/common/json.h>
 #include <bims/eval/mask_labels.h>
 #include <opencv2/core.hpp>
@@ -68,9 +69,10 @@ MaskMetrics voxelMaskMetrics(const cv::Mat& gt, const cv::Mat& pred,
                              const cv::Mat& depthM, double fx, double fy,
                              double cx, double cy, double voxelM);
 
-/** Reads an 8-bit single-channel mask PNG; throws std::runtime_error naming
- * the file if it is missing, unreadable or of another type. */
-cv::Mat loadMask(const std::string& path);
+/** Reads an 8-bit single-channel mask PNG (its size checked against
+ * \a limits first); throws std::runtime_error naming the file if it is
+ * missing, unreadable, too large or of another type. */
+cv::Mat loadMask(const std::string& path, const ImageLimits& limits = {});
 
 /** Colour overlay of one frame (BGR): TP green, FP red, FN blue (blended
  * 60 % over the \a background when one is given), invalid pixels dark grey,

@@ -5,6 +5,7 @@
 // stamps come from.
 #pragma once
 
+#include <bims/common/image_file.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/img/TCamera.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -19,7 +20,7 @@ namespace bims::eval
 /** Reads the depth PNG \a path as it is stored: throws std::runtime_error
  * naming the file when it cannot be read or is not a 16-bit single-channel
  * image. */
-cv::Mat readDepthPng(const std::string& path);
+cv::Mat readDepthPng(const std::string& path, const ImageLimits& limits = {});
 
 /** The observation of one registered depth image:
  * \a depth (CV_16UC1, 0 = no reading; or CV_32FC1, where 0, negative and

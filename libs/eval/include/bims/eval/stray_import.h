@@ -7,6 +7,7 @@
 // (docs/eval.md, "Import of a Stray Scanner capture").
 #pragma once
 
+#include <bims/common/image_file.h>
 #include <bims/common/options.h>
 #include <bims/common/progress.h>
 #include <bims/common/trajectory.h>
@@ -32,12 +33,15 @@ struct StrayImportParams
 	int colour_width = 1920, colour_height = 1440;
 	/** [sensors] rgbd_label, imu_label: the labels written. */
 	std::string rgbd_label = "RGBD", imu_label = "IMU";
+	/** [input]: the size limits of the capture's depth and confidence
+	 * images. */
+	ImageLimits images;
 
 	/** The keys of [import_stray] (bims/common/options.h). */
 	void describe(OptionVisitor& v);
 	/** Checks the file's sections (bims::checkExperimentSections), reads
-	 * [import_stray] and [sensors] strictly: unknown keys and values out of
-	 * range are errors naming file, section and key. */
+	 * [import_stray], [sensors] and [input] strictly: unknown keys and values
+	 * out of range are errors naming file, section and key. */
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
 };
 

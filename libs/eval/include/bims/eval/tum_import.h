@@ -4,6 +4,7 @@
 #pragma once
 
 #include <bims/common/choice.h>
+#include <bims/common/image_file.h>
 #include <bims/common/progress.h>
 #include <bims/common/trajectory.h>
 #include <bims/sensors/params.h>
@@ -74,9 +75,11 @@ struct ImportParams
 	 * samples, a real sensor of its own (accelerometer only): never a
 	 * synthetic IMU's label (one with "SYNTH" is refused). */
 	std::string accelLabel = "ACCEL";
+	/** [input]: the size limits of the folder's image files. */
+	ImageLimits images;
 
 	/** Checks the file's sections (bims::checkExperimentSections) and reads
-	 * [camera], [import], [sensors] strictly. */
+	 * [camera], [import], [sensors], [input] strictly. */
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
 };
 

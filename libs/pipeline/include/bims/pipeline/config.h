@@ -7,6 +7,7 @@
 #pragma once
 
 #include <bims/common/choice.h>
+#include <bims/common/image_file.h>
 #include <bims/common/options.h>
 #include <bims/ego/params.h>
 #include <bims/flow/params.h>
@@ -151,6 +152,9 @@ struct ExperimentConfig
 	maps::GridParams grids;
 	PipelineParams pipeline;
 	OutputParams output;
+	/** [input]: the size limits of input image files (the importers',
+	 * the labels' and masks' readers). */
+	ImageLimits input;
 
 	/** Reads every section (checkExperimentSections first). */
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);

@@ -56,6 +56,12 @@ struct RunSummary : source::FrameOrderStats
 	 * surface_fill), and the pixels it added over the run */
 	size_t framesSurfaceFilled = 0;
 	size_t pixelsSurfaceFilled = 0;
+	/** frames flagged imu_missing or imu_gap: no IMU data for their
+	 * interval */
+	size_t framesWithoutImu = 0;
+	/** The input held IMU samples with the label but the run could mostly
+	 * not use them (imuMostlyUnusable): status "imu_unusable". */
+	bool imuUnusable = false;
 	/** Wall time of the whole run: reading, every frame, every output
 	 * (static map included; metrics.json excepted). */
 	double seconds = 0;
@@ -77,13 +83,23 @@ struct RunSummary : source::FrameOrderStats
 	std::string error;
 	/** Stopped on request (RunOptions::stop) before the end of the input. */
 	bool interrupted = false;
-	/** "interrupted", "error" or "ok" (metrics.json's "status"). */
+	/** "interrupted", "error", "imu_unusable" or "ok" (metrics.json's
+	 * "status", in that order of precedence). */
 	const char* status() const
 	{
-		return interrupted ? "interrupted" : error.empty() ? "ok" : "error";
+		return interrupted      ? "interrupted"
+		       : !error.empty() ? "error"
+		       : imuUnusable    ? "imu_unusable"
+		                        : "ok";
 	}
 	double fps() const { return seconds > 0 ? framesProcessed / seconds : 0; }
 };
+
+/** The rule of status "imu_unusable": the input held IMU samples with the
+ * label (imuRead > 0) and more than half of them were skipped
+ * (source::imuMostlySkipped) or more than half of the processed frames had
+ * no IMU data (framesWithoutImu: imu_missing or imu_gap). */
+bool imuMostlyUnusable(const RunSummary& s);
 
 /** Called after each processed frame (e.g. a viewer), on the run's thread,
  * before the frame is queued for writing (the scan's pixelLabels are still
@@ -111,6 +127,15 @@ struct RunOptions
  * anything bims-run writes of it is not finite: the pose, the moving
  * voxels. */
 void checkFiniteOutputs(const FrameResult& r);
+
+/** metrics.json's stages (its stage_ms keys; RunSummary::stageMs). */
+const std::vector<std::string>& stageNames();
+
+/** Every number runExperiment writes into metrics.json, by its path as
+ * bims-sweep reads it ("fps", "frames_flagged_by.imu_gap",
+ * "stage_ms.total.median"): the names a run's metric can have, from the
+ * one list of metrics.json's fields. */
+std::vector<std::string> metricNames();
 
 /** What runExperiment writes into RunOptions::outDir (bims-run's output
  * folder), for bims::prepareOutputFolder: the files refused as an earlier

@@ -184,6 +184,10 @@ struct FrameOrderStats
 	std::map<std::string, ImuLabelStats> imuOtherLabels;
 };
 
+/** More than half of the IMU's samples were skipped (stamp out of order,
+ * repeated or stray, or a value rejected). */
+bool imuMostlySkipped(const FrameOrderStats& s);
+
 /** What a run should say about its IMU (bims-run's and bims-odom's
  * summaries): the label used, its samples and channels, a gyro-less IMU
  * the egomotion cannot use, and the IMU samples left unused under other
