@@ -41,9 +41,10 @@ int cmdMasks(int argc, char** argv)
 	    false, 0.05, "M", cmd);
 	TCLAP::ValueArg<int> movingValue(
 	    "", "moving-value",
-	    "label value meaning moving (with it, or with --static-value or "
-	    "--ignore-values, labels may hold only the values given; default: "
-	    ">= 128 is moving)",
+	    "label value meaning moving (labels may hold only the values declared "
+	    "here or in the label folder's labels.ini; without either, only 0 "
+	    "static and 255 moving: any other value is refused, listing the "
+	    "values found)",
 	    false, -1, "V", cmd);
 	TCLAP::ValueArg<int> staticValue("", "static-value",
 	                                 "label value meaning static (default 0 "

@@ -101,21 +101,72 @@ std::set<size_t> checkMasksOptions(const EvalMasksOptions& o,
 	return stripSet;
 }
 
-/** The labels' values: the contract's (>= 128 moving) unless a value is
- * given. */
-ev::LabelConvention labelConvention(const EvalMasksOptions& o)
+/** The labels' values and where they were declared: the options, else
+ * the label folder's labels.ini, else bims's own 0 static and 255 moving
+ * (what bims-sim and bims-run write); any other value is refused by
+ * checkLabelValues, never guessed. */
+struct DeclaredLabels
 {
-	if (!o.movingValue && !o.staticValue && !o.ignoreValues) return {};
-	try
+	ev::LabelConvention convention;
+	std::string source;  ///< "the options", the labels.ini, "bims's own"
+};
+
+DeclaredLabels labelConvention(const EvalMasksOptions& o)
+{
+	DeclaredLabels d;
+	if (o.movingValue || o.staticValue || o.ignoreValues)
 	{
-		return ev::LabelConvention::explicitValues(
-		    o.movingValue.value_or(-1), o.staticValue.value_or(-1),
-		    ev::parseLabelValues(o.ignoreValues.value_or("")));
+		try
+		{
+			d.convention = ev::LabelConvention::explicitValues(
+			    o.movingValue.value_or(-1), o.staticValue.value_or(-1),
+			    ev::parseLabelValues(o.ignoreValues.value_or("")));
+		}
+		catch (const std::invalid_argument& e)
+		{
+			throw UsageError(std::string("label values: ") + e.what());
+		}
+		d.source = "the options";
+		return d;
 	}
-	catch (const std::invalid_argument& e)
+	if (auto c = ev::readLabelConventionFile(o.gtDir))
 	{
-		throw UsageError(std::string("label values: ") + e.what());
+		d.convention = *c;
+		d.source = (fs::path(o.gtDir) / ev::kLabelConventionFile).string();
+		return d;
 	}
+	d.convention = ev::LabelConvention::explicitValues(255, 0, {});
+	d.source = "bims's own, no other declared";
+	return d;
+}
+
+/** Every value of the paired labels known to the convention, before any
+ * output: else a usage error listing the values found, their counts and
+ * how to declare them. */
+void checkLabelValues(const EvalMasksOptions& o, const ev::MaskMatch& match,
+                      const DeclaredLabels& labels)
+{
+	ev::LabelValueCounts counts;
+	for (const ev::MaskPair& pair : match.pairs)
+		counts.add(ev::loadMask(o.gtDir + "/" + pair.label->name));
+	const std::vector<int> unknown = counts.unknown(labels.convention);
+	if (unknown.empty()) return;
+	std::string values;
+	for (int v : unknown)
+		values += (values.empty() ? "" : ",") + std::to_string(v) +
+		          " (first in " +
+		          match.pairs[counts.firstImage[v]].label->name + ")";
+	throw UsageError(
+	    o.gtDir + ": label values " + values + " are neither moving, static " +
+	    "nor not scored under " + labels.convention.describe() + " (" +
+	    labels.source + "); a value is never guessed. The values found: " +
+	    counts.describe(labels.convention) +
+	    ". Declare every value: --moving-value V --static-value V "
+	    "--ignore-values LIST (e.g. --moving-value 255 --static-value 0 "
+	    "--ignore-values 150,50 for the Bonn and Stray labels of the shared "
+	    "data), or a " +
+	    ev::kLabelConventionFile + " in " + o.gtDir +
+	    " ([labels] moving = 255, static = 0, not_scored = 150 50)");
 }
 
 /** The labels and predictions and which pairs with which (by index, or by
@@ -296,14 +347,14 @@ void scorePair(const EvalMasksOptions& o, const ev::MaskPair& pair,
 	}
 	const std::string line = "frame " + frame + " tp " + std::to_string(m.tp) +
 	                         " fp " + std::to_string(m.fp) + " fn " +
-	                         std::to_string(m.fn) + " " + m.scoresLine();
+	                         std::to_string(m.fn) + " " + m.frameScoresLine();
 	if (!o.quiet) std::printf("%s\n", line.c_str());
 	const bool inStrip = stripSet.count(static_cast<size_t>(f.index)) > 0;
 	if (!outDir.empty() || inStrip)
 	{
 		const cv::Mat overlay =
 		    ev::maskOverlay(gMoving, pm, d.valid, d.background,
-		                    "frame " + frame + "  " + m.scoresLine());
+		                    "frame " + frame + "  " + m.frameScoresLine());
 		if (!outDir.empty()) ev::writePng(outDir + "/" + f.name, overlay);
 		if (inStrip) t.tiles[f.index] = overlay;
 	}
@@ -403,8 +454,13 @@ int runEvalMasks(const EvalMasksOptions& o)
 {
 	const std::vector<std::string> inputs = masksInputs(o);
 	const std::set<size_t> stripSet = checkMasksOptions(o, inputs);
-	const ev::LabelConvention labels = labelConvention(o);
+	const DeclaredLabels declared = labelConvention(o);
+	const ev::LabelConvention& labels = declared.convention;
 	const auto pairing = pairMasks(o);
+	checkLabelValues(o, pairing->match, declared);
+	if (!o.quiet)
+		std::fprintf(stderr, "bims-eval masks: labels: %s (%s)\n",
+		             labels.describe().c_str(), declared.source.c_str());
 	const std::string outDir = prepareOverlayFolder(o, inputs);
 	std::unique_ptr<ScanStream> scans;
 	if (o.depthValid) scans = std::make_unique<ScanStream>(*o.depthValid);

@@ -295,15 +295,20 @@ TEST(EvalMasks, LabelsByTimestampWithIgnoredValues)
 	EXPECT_NE(r.out.find("ignored 12"), std::string::npos) << r.out;
 	EXPECT_NE(r.out.find("1 of 4 labels have no prediction"), std::string::npos)
 	    << r.out;
-	// A label value outside the convention: an error naming the file.
+	// A label value outside the convention: a usage error before any
+	// output, naming the value, the first label holding it and the counts.
 	cv::Mat bad(2, 8, CV_8UC1, cv::Scalar(0));
 	bad.at<uint8_t>(1, 5) = 77;
 	cv::imwrite(d + "/labels/100.06600.png", bad);
 	r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
 	        "/run/masks --no-plots" + conv);
-	EXPECT_EQ(r.code, 1);
-	EXPECT_NE(r.out.find("100.06600.png vs"), std::string::npos) << r.out;
-	EXPECT_NE(r.out.find("label value 77 at pixel (5, 1)"), std::string::npos)
+	EXPECT_EQ(r.code, 2);
+	EXPECT_NE(r.out.find("label values 77 (first in 100.06600.png) are "
+	                     "neither moving"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("77: 1 px in 1 of 3 labels (UNKNOWN)"),
+	          std::string::npos)
 	    << r.out;
 	// A label of another size.
 	cv::imwrite(d + "/labels/100.06600.png",
@@ -344,6 +349,74 @@ TEST(EvalMasks, LabelsByTimestampWithIgnoredValues)
 	EXPECT_NE(r.code, 0);
 	EXPECT_NE(r.out.find("'x' is not a label value"), std::string::npos)
 	    << r.out;
+}
+
+TEST(EvalMasks, UndeclaredLabelValuesAreRefusedNotGuessed)
+{
+	// Bonn-proxy-style labels (255 moving, 0 static, 150 ambiguous, 50 no
+	// depth) given without their convention: 150 must not be scored as
+	// moving (it once was: >= 128). The evaluation refuses before any
+	// output, listing each value and its counts; a labels.ini in the label
+	// folder, or the options, declare them.
+	const auto d = tmpDir("masks_undeclared");
+	fs::create_directories(d + "/labels");
+	fs::create_directories(d + "/pred");
+	for (int k = 0; k < 2; k++)
+	{
+		// cols 0-1 moving (frame 1 only), 2 ambiguous, 3 no depth, 4-7 static
+		cv::Mat l(2, 8, CV_8UC1, cv::Scalar(0));
+		if (k == 1) l.colRange(0, 2) = 255;
+		l.col(2) = 150;
+		l.col(3) = 50;
+		cv::imwrite(d + "/labels/00000" + std::to_string(k) + ".png", l);
+		// prediction: cols 0-2 and 7 moving
+		cv::Mat p(2, 8, CV_8UC1, cv::Scalar(0));
+		p.colRange(0, 3) = 255;
+		p.col(7) = 255;
+		cv::imwrite(d + "/pred/00000" + std::to_string(k) + ".png", p);
+	}
+	auto r = run(kBin + "/bims-eval masks " + d + "/labels " + d + "/pred");
+	EXPECT_EQ(r.code, 2) << r.out;
+	EXPECT_NE(r.out.find("label values 50 (first in 000000.png),150 (first in "
+	                     "000000.png) are neither moving, static nor not "
+	                     "scored"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("150: 4 px in 2 of 2 labels (UNKNOWN)"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("255: 4 px in 1 of 2 labels (moving)"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("--ignore-values"), std::string::npos) << r.out;
+	EXPECT_EQ(r.out.find("total precision"), std::string::npos) << r.out;
+	EXPECT_FALSE(fs::exists(d + "/pred_eval")) << "no output before the check";
+	// Declared in the folder: frame 0 has no moving label and reports its
+	// false positives (cols 0, 1 and 7 of 2 rows), not F1 0; frame 1: TP 4,
+	// FP 2 (col 7), FN 0.
+	std::ofstream(d + "/labels/labels.ini")
+	    << "[labels]\nmoving = 255\nstatic = 0\nnot_scored = 150 50\n";
+	r = run(kBin + "/bims-eval masks " + d + "/labels " + d + "/pred");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("frame 000000 tp 0 fp 6 fn 0 no moving label: fp 6, "
+	                     "static as moving 0.5000"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("labels: moving 255, static 0, not scored 150 50 (" +
+	                     d + "/labels/labels.ini)"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_EQ(lastLine(r.out),
+	          "total precision 0.3333 recall 1.0000 F1 0.5000 IoU 0.3333")
+	    << r.out;
+	// A bad convention file is an error naming it.
+	std::ofstream(d + "/labels/labels.ini")
+	    << "[labels]\nmoving = 255\nstatic = 0\nnotscored = 150 50\n";
+	r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	        "/pred --overwrite");
+	EXPECT_NE(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("labels.ini"), std::string::npos) << r.out;
+	EXPECT_NE(r.out.find("notscored"), std::string::npos) << r.out;
 }
 
 TEST(EvalTraj, BadInputIsAClearError)
