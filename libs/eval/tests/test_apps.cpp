@@ -2,6 +2,7 @@
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/common/version.h>
+#include <bims/eval/pose_utils.h>
 #include <bims/eval/tum_import.h>
 #include <bims_test/data.h>
 #include <bims_test/png_bomb.h>
@@ -417,6 +418,49 @@ TEST(EvalMasks, UndeclaredLabelValuesAreRefusedNotGuessed)
 	EXPECT_NE(r.code, 0) << r.out;
 	EXPECT_NE(r.out.find("labels.ini"), std::string::npos) << r.out;
 	EXPECT_NE(r.out.find("notscored"), std::string::npos) << r.out;
+}
+
+TEST(EvalTraj, BonnMarkerPosesAreWarnedAboutAndTheImportSaysSo)
+{
+	if (!fs::exists(bims::test::kBonnCrowd + "/depth.txt"))
+		GTEST_SKIP() << "no Bonn sample";
+	// Imported without -c: the marker's poses are kept, with a note.
+	const auto d = tmpDir("bonn_marker");
+	auto r = run(kBin + "/bims-import-tum " + bims::test::kBonnCrowd + " -o " +
+	             d + "/m.rawlog --max-frames 80 -q");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("looks like a Bonn RGB-D Dynamic folder"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("-c bonn.ini or --bonn-gt"), std::string::npos)
+	    << r.out;
+	// The camera's poses as the estimate, the marker's as the "ground
+	// truth": a small ATE, an RPE ten times too large: a warning naming
+	// the cause and the fix.
+	auto marker = bims::loadTumTrajectory(d + "/m_gt/groundtruth.txt");
+	auto cam = marker;
+	for (auto& p : cam) p.T_WC = bims::eval::bonnMarkerToCamera(p.T_WC);
+	bims::saveTumTrajectory(d + "/cam.txt", cam);
+	r = run(kBin + "/bims-eval traj " + d + "/m_gt/groundtruth.txt " + d +
+	        "/cam.txt --no-plot");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("warning: the RPE"), std::string::npos) << r.out;
+	EXPECT_NE(r.out.find("motion-capture marker"), std::string::npos) << r.out;
+	EXPECT_NE(r.out.find("--bonn-gt"), std::string::npos) << r.out;
+	// The camera's poses against themselves shifted by 2 ms: no warning.
+	auto shifted = cam;
+	for (auto& p : shifted) p.t += 0.002;
+	bims::saveTumTrajectory(d + "/shifted.txt", shifted);
+	r = run(kBin + "/bims-eval traj " + d + "/cam.txt " + d +
+	        "/shifted.txt --no-plot");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_EQ(r.out.find("warning"), std::string::npos) << r.out;
+	// Imported with the Bonn preset: no note.
+	r = run(kBin + "/bims-import-tum " + bims::test::kBonnCrowd + " -o " + d +
+	        "/c.rawlog --max-frames 10 -q -c " + BIMS_SOURCE_DIR +
+	        "/config/bonn.ini");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_EQ(r.out.find("looks like a Bonn"), std::string::npos) << r.out;
 }
 
 TEST(EvalTraj, BadInputIsAClearError)
