@@ -67,6 +67,13 @@ int cmdMasks(int argc, char** argv)
 	    "labels are a subset of the frames: a prediction inside the labels' "
 	    "time span without a label is accepted (not scored)",
 	    cmd);
+	TCLAP::ValueArg<std::string> span(
+	    "", "span",
+	    "run: score the labels of the run's frames only (a run of --frames "
+	    "A:B against a whole recording's labels; the others are left out "
+	    "with a note); labels: every label must have a prediction (default: "
+	    "run)",
+	    false, "run", "run|labels", cmd);
 	TCLAP::ValueArg<std::string> strip(
 	    "", "strip",
 	    "also write the overlays of --strip-frames side by side (half size) "
@@ -98,6 +105,7 @@ int cmdMasks(int argc, char** argv)
 	o.framesCsv = bims::givenValue(framesCsv);
 	o.maxDt = maxDt.getValue();
 	o.sparseLabels = sparse.getValue();
+	o.span = span.getValue();
 	o.strip = bims::givenValue(strip);
 	o.stripFrames = stripFrames.getValue();
 	o.overwrite = overwrite.getValue();

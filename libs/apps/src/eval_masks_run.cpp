@@ -16,6 +16,7 @@
 #include <bims/eval/plots.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -98,6 +99,8 @@ std::set<size_t> checkMasksOptions(const EvalMasksOptions& o,
 		throw UsageError("--strip and --strip-frames go together");
 	if (!(o.maxDt > 0) || !std::isfinite(o.maxDt))
 		throw UsageError("--max-dt must be > 0");
+	if (o.span != "run" && o.span != "labels")
+		throw UsageError("--span is run or labels, not '" + o.span + "'");
 	return stripSet;
 }
 
@@ -211,7 +214,11 @@ std::unique_ptr<MaskPairing> pairMasks(const EvalMasksOptions& o)
 		p.stamps = ev::readFrameStamps(csv);
 	}
 	p.match = ev::matchMasks(p.gtFiles, p.predFiles, p.stamps, o.maxDt);
-	const size_t nLabels = p.gtFiles.size(), nPairs = p.match.pairs.size();
+	if (o.span == "labels") p.match.labelsOutsidePredictions.clear();
+	// the labels of the run's frames (--span run) or all of them
+	const size_t nLabels =
+	    p.gtFiles.size() - p.match.labelsOutsidePredictions.size();
+	const size_t nPairs = p.match.pairs.size();
 	if (nPairs == 0)
 		throw std::runtime_error(
 		    predDir + ": none of the " + std::to_string(nLabels) +
@@ -223,6 +230,7 @@ std::unique_ptr<MaskPairing> pairMasks(const EvalMasksOptions& o)
 		throw std::runtime_error(
 		    predDir + ": only " + std::to_string(nPairs) + " of the " +
 		    std::to_string(nLabels) + " labels of " + gtDir +
+		    (o.span == "run" ? " inside the run's span" : "") +
 		    " have a prediction within " + std::to_string(o.maxDt) +
 		    " s: the predictions are not of these frames (another run?)");
 	if (!p.match.predictionsWithoutLabel.empty() && !o.sparseLabels)
@@ -364,18 +372,32 @@ void scorePair(const EvalMasksOptions& o, const ev::MaskPair& pair,
 	                        {"metrics", m.toJson()}});
 }
 
-/** The labels without a prediction, the predictions without a label. */
+/** The labels without a prediction of the run's frames (those outside,
+ * with --span run, in a note), the predictions without a label. */
 void printUnpaired(const EvalMasksOptions& o, const MaskPairing& p)
 {
 	const ev::MaskMatch& match = p.match;
-	if (!match.labelsWithoutPrediction.empty())
+	const auto& outside = match.labelsOutsidePredictions;
+	std::vector<const ev::MaskFile*> inside;
+	for (const ev::MaskFile* f : match.labelsWithoutPrediction)
+		if (std::find(outside.begin(), outside.end(), f) == outside.end())
+			inside.push_back(f);
+	if (!outside.empty())
+		std::fprintf(stderr,
+		             "bims-eval masks: note: %zu of %zu labels lie outside the "
+		             "run's frames (%s to %s), not scored: the run covers "
+		             "part of the labelled frames (--span run; --span labels "
+		             "requires a prediction for every label)\n",
+		             outside.size(), p.gtFiles.size(),
+		             p.match.pairs.front().label->name.c_str(),
+		             p.match.pairs.back().label->name.c_str());
+	if (!inside.empty())
 		std::fprintf(
 		    stderr,
 		    "bims-eval masks: warning: %zu of %zu labels have no prediction in "
 		    "%s (not counted; first: %s)\n",
-		    match.labelsWithoutPrediction.size(), p.gtFiles.size(),
-		    o.predDir.c_str(),
-		    match.labelsWithoutPrediction.front()->name.c_str());
+		    inside.size(), p.gtFiles.size() - outside.size(), o.predDir.c_str(),
+		    inside.front()->name.c_str());
 	if (match.predictionsOutside > 0 || !match.predictionsWithoutLabel.empty())
 		std::fprintf(stderr,
 		             "bims-eval masks: %zu predictions without a label (%d "
@@ -411,7 +433,9 @@ void writeMasksJson(const EvalMasksOptions& o, const MaskPairing& p,
 	jf["pred"] = o.predDir;
 	jf["labels"] = labels.describe();
 	jf["frames_compared"] = p.match.pairs.size();
-	jf["frames_missing"] = p.match.labelsWithoutPrediction.size();
+	jf["frames_missing"] = p.match.labelsWithoutPrediction.size() -
+	                       p.match.labelsOutsidePredictions.size();
+	jf["labels_outside_run"] = p.match.labelsOutsidePredictions.size();
 	jf["depth_valid_only"] = depthValidOnly;
 	jf["total"] = t.total.toJson();
 	jf["frames_nothing_moving"] = t.nPeopleFree;

@@ -312,7 +312,12 @@ MaskMatch matchMasks(const std::vector<MaskFile>& labels,
 			if (j < preds.size() && preds[j].index == l.index)
 				m.pairs.push_back({&l, &preds[j], 0});
 			else
+			{
 				m.labelsWithoutPrediction.push_back(&l);
+				if (l.index < preds.front().index ||
+				    l.index > preds.back().index)
+					m.labelsOutsidePredictions.push_back(&l);
+			}
 		}
 		return m;
 	}
@@ -349,7 +354,12 @@ MaskMatch matchMasks(const std::vector<MaskFile>& labels,
 		labelUsed[i] = predUsed[j] = true;
 	}
 	for (size_t i = 0; i < tl.size(); i++)
-		if (!labelUsed[i]) m.labelsWithoutPrediction.push_back(&labels[i]);
+	{
+		if (labelUsed[i]) continue;
+		m.labelsWithoutPrediction.push_back(&labels[i]);
+		if (tl[i] < tps.front() - maxDt || tl[i] > tps.back() + maxDt)
+			m.labelsOutsidePredictions.push_back(&labels[i]);
+	}
 	for (size_t j = 0; j < tps.size(); j++)
 	{
 		if (predUsed[j]) continue;

@@ -1,4 +1,5 @@
 // End-to-end tests of bims-import-tum and bims-eval (run the built programs).
+#include <bims/common/frame_files.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/common/version.h>
@@ -294,7 +295,9 @@ TEST(EvalMasks, LabelsByTimestampWithIgnoredValues)
 	EXPECT_NE(r.out.find("total_static_as_moving 0.2500"), std::string::npos)
 	    << r.out;
 	EXPECT_NE(r.out.find("ignored 12"), std::string::npos) << r.out;
-	EXPECT_NE(r.out.find("1 of 4 labels have no prediction"), std::string::npos)
+	// (label 0 lies before the run's first frame: left out with a note)
+	EXPECT_NE(r.out.find("note: 1 of 4 labels lie outside the run's frames"),
+	          std::string::npos)
 	    << r.out;
 	// A label value outside the convention: a usage error before any
 	// output, naming the value, the first label holding it and the counts.
@@ -461,6 +464,53 @@ TEST(EvalTraj, BonnMarkerPosesAreWarnedAboutAndTheImportSaysSo)
 	        "/config/bonn.ini");
 	ASSERT_EQ(r.code, 0) << r.out;
 	EXPECT_EQ(r.out.find("looks like a Bonn"), std::string::npos) << r.out;
+}
+
+TEST(EvalMasks, APartialRunIsScoredAgainstTheLabelsOfItsFrames)
+{
+	// 20 labels named by time; a run of frames 5-12 of them (bims-run
+	// --frames 5:12 numbers its masks by scan index, frames.csv gives
+	// their stamps): scored against those 8 labels, the 12 others left out
+	// with a note, not refused as "only 8 of the 20 labels".
+	const auto d = tmpDir("masks_span");
+	fs::create_directories(d + "/labels");
+	fs::create_directories(d + "/run/masks");
+	std::ofstream csv(d + "/run/frames.csv");
+	csv << "index,t\n";
+	for (int k = 0; k < 20; k++)
+	{
+		cv::Mat l(2, 4, CV_8UC1, cv::Scalar(0));
+		l.col(0) = 255;
+		char name[64];
+		std::snprintf(name, sizeof name, "%.5f", 100 + 0.03 * k);
+		cv::imwrite(d + "/labels/" + name + ".png", l);
+		if (k < 5 || k > 12) continue;
+		cv::Mat p(2, 4, CV_8UC1, cv::Scalar(0));
+		p.colRange(0, 2) = 255;  // TP 2, FP 2
+		cv::imwrite(d + "/run/masks/" + bims::frameFileName(k), p);
+		csv << k << "," << name << "\n";
+	}
+	csv.close();
+	auto r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	             "/run/masks --no-plots");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("note: 12 of 20 labels lie outside the run's frames "
+	                     "(100.15000.png to 100.36000.png), not scored"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("total_counts frames 8 tp 16 fp 16 fn 0"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_EQ(r.out.find("warning"), std::string::npos) << r.out;
+	// --span labels: every label must have a prediction.
+	r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	        "/run/masks --no-plots --span labels");
+	EXPECT_EQ(r.code, 1) << r.out;
+	EXPECT_NE(r.out.find("only 8 of the 20 labels"), std::string::npos)
+	    << r.out;
+	r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	        "/run/masks --no-plots --span all");
+	EXPECT_EQ(r.code, 2) << r.out;
 }
 
 TEST(EvalTraj, BadInputIsAClearError)

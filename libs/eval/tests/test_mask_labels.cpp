@@ -209,6 +209,8 @@ TEST(MatchMasks, ByTimeOneToOneWithinTheTolerance)
 	EXPECT_NEAR(m.pairs[0].dt, 0.002, 1e-9);
 	ASSERT_EQ(m.labelsWithoutPrediction.size(), 1u);
 	EXPECT_EQ(m.labelsWithoutPrediction[0], &labels[0]);
+	// (before the first prediction: outside the run's span)
+	ASSERT_EQ(m.labelsOutsidePredictions.size(), 1u);
 	EXPECT_EQ(m.predictionsOutside, 2);
 	EXPECT_TRUE(m.predictionsWithoutLabel.empty());
 	// a label missing inside the span is reported
@@ -234,6 +236,7 @@ TEST(MatchMasks, ByIndexPairsEqualNames)
 	EXPECT_EQ(m.pairs[0].label->index, 0);
 	ASSERT_EQ(m.labelsWithoutPrediction.size(), 1u);
 	EXPECT_EQ(m.labelsWithoutPrediction[0]->index, 2);
+	EXPECT_EQ(m.labelsOutsidePredictions.size(), 1u);  // after the last
 	// labels by index, predictions by time: an error
 	EXPECT_THROW(ev::matchMasks(labels, {byTime(1.0)}, {}, 0.01),
 	             std::runtime_error);

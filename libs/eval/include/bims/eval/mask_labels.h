@@ -116,6 +116,10 @@ struct MaskMatch
 	std::vector<MaskPair> pairs;  ///< sorted by label
 	/** Labels without a prediction (e.g. frames the importer dropped). */
 	std::vector<const MaskFile*> labelsWithoutPrediction;
+	/** Those of them outside the predictions' span (before the first or
+	 * after the last, by index, or by time beyond the tolerance): a run of
+	 * part of the labelled frames (bims-run --frames A:B). */
+	std::vector<const MaskFile*> labelsOutsidePredictions;
 	/** Predictions inside the labels' time span without a label within
 	 * the tolerance: a label folder with a missing frame (by time only). */
 	std::vector<const MaskFile*> predictionsWithoutLabel;
