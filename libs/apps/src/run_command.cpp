@@ -2,6 +2,7 @@
 // (runExperiment) and its report.
 #include <bims/apps/app.h>
 #include <bims/apps/frame_range_option.h>
+#include <bims/apps/input_kind.h>
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
 #include <bims/apps/run_command.h>
@@ -58,7 +59,9 @@ int runExitCode(const RunSummary& s, int signal)
 int runFromCommandLine(const RunCommand& c)
 {
 	// every input before any output: a typo in the second rawlog is an
-	// error before the first is run and before OUTDIR is made
+	// error before the first is run and before OUTDIR is made; an input of
+	// the wrong kind names the command to use
+	checkRunInputKinds(c.config, c.rawlogs);
 	for (const auto& r : c.rawlogs) checkRawlogPath(r);
 	auto inputs = c.rawlogs;
 	inputs.push_back(c.config);
