@@ -55,7 +55,8 @@ const OutputFolderLayout& runOutputLayout()
 	// bims-run's --overwrite checks that a run leaves nothing else)
 	static const OutputFolderLayout layout{
 	    {"trajectory.txt", "frames.csv", "metrics.json", "effective.ini",
-	     "segmented.rawlog", "static_map.ply", "static_map.bt"},
+	     "segmented.rawlog", "static_map.ply", "static_map.bt",
+	     "report.md"},  // (report.md: bims-run's, bims/apps/run_report.h)
 	    {{"masks", ".png"},
 	     {"moving_voxels", ".ply"},
 	     {"flow_labels", ".png"}}};
