@@ -76,6 +76,20 @@ find_program(BIMS_HELP2MAN help2man)
 if(BIMS_HELP2MAN AND NOT BIMS_SANITIZE)
   set(BIMS_MAN_DIR "${PROJECT_BINARY_DIR}/share/man/man1")
   file(MAKE_DIRECTORY "${BIMS_MAN_DIR}")
+  # Every page's FILES (share/bims) and SEE ALSO (the other programs):
+  # docs/man/common.h2m.in; each program's EXAMPLES: docs/man/PROGRAM.h2m.
+  set(BIMS_MAN_SOURCE_DIR "${PROJECT_SOURCE_DIR}/docs/man")
+  file(GLOB _bims_man_includes "${BIMS_MAN_SOURCE_DIR}/bims-*.h2m")
+  set(BIMS_MAN_SEE_ALSO "")
+  foreach(_inc IN LISTS _bims_man_includes)
+    get_filename_component(_prog "${_inc}" NAME_WE)
+    string(REPLACE "-" "\\-" _prog "${_prog}")
+    list(APPEND BIMS_MAN_SEE_ALSO "\\fB${_prog}\\fR(1)")
+  endforeach()
+  list(JOIN BIMS_MAN_SEE_ALSO ", " BIMS_MAN_SEE_ALSO)
+  set(BIMS_MAN_DATADIR "${CMAKE_INSTALL_FULL_DATADIR}")
+  configure_file("${BIMS_MAN_SOURCE_DIR}/common.h2m.in"
+                 "${PROJECT_BINARY_DIR}/share/man/common.h2m" @ONLY)
 else()
   set(BIMS_MAN_DIR "")
   message(STATUS "bims: no man pages (help2man not found, or a sanitizer build)")
@@ -92,14 +106,21 @@ function(bims_add_man_page program summary)
     set(summary "a bims program")
   endif()
   set(page "${BIMS_MAN_DIR}/${program}.1")
+  set(common "${PROJECT_BINARY_DIR}/share/man/common.h2m")
+  set(examples "${BIMS_MAN_SOURCE_DIR}/${program}.h2m")
+  if(NOT EXISTS "${examples}")
+    message(FATAL_ERROR "${program}: no docs/man/${program}.h2m (its man "
+                        "page's EXAMPLES)")
+  endif()
   # run by its name (PATH), so that the page's usage line has no build path
   add_custom_command(OUTPUT "${page}"
     COMMAND ${CMAKE_COMMAND} -E env
             "PATH=$<TARGET_FILE_DIR:${program}>:$ENV{PATH}"
             "${BIMS_HELP2MAN}" --no-info --no-discard-stderr
             "--version-string=${PROJECT_VERSION}" "--name=${summary}"
+            "--include=${examples}" "--include=${common}"
             "--output=${page}" ${program}
-    DEPENDS ${program}
+    DEPENDS ${program} "${examples}" "${common}"
     COMMENT "man page ${program}.1 (help2man)"
     VERBATIM)
   add_custom_target(${program}-man ALL DEPENDS "${page}")

@@ -41,9 +41,10 @@ int cmdMasks(int argc, char** argv)
 	    false, 0.05, "M", cmd);
 	TCLAP::ValueArg<int> movingValue(
 	    "", "moving-value",
-	    "label value meaning moving (with it, or with --static-value or "
-	    "--ignore-values, labels may hold only the values given; default: "
-	    ">= 128 is moving)",
+	    "label value meaning moving (labels may hold only the values declared "
+	    "here or in the label folder's labels.ini; without either, only 0 "
+	    "static and 255 moving: any other value is refused, listing the "
+	    "values found)",
 	    false, -1, "V", cmd);
 	TCLAP::ValueArg<int> staticValue("", "static-value",
 	                                 "label value meaning static (default 0 "
@@ -66,6 +67,13 @@ int cmdMasks(int argc, char** argv)
 	    "labels are a subset of the frames: a prediction inside the labels' "
 	    "time span without a label is accepted (not scored)",
 	    cmd);
+	TCLAP::ValueArg<std::string> span(
+	    "", "span",
+	    "run: score the labels of the run's frames only (a run of --frames "
+	    "A:B against a whole recording's labels; the others are left out "
+	    "with a note); labels: every label must have a prediction (default: "
+	    "run)",
+	    false, "run", "run|labels", cmd);
 	TCLAP::ValueArg<std::string> strip(
 	    "", "strip",
 	    "also write the overlays of --strip-frames side by side (half size) "
@@ -97,6 +105,7 @@ int cmdMasks(int argc, char** argv)
 	o.framesCsv = bims::givenValue(framesCsv);
 	o.maxDt = maxDt.getValue();
 	o.sparseLabels = sparse.getValue();
+	o.span = span.getValue();
 	o.strip = bims::givenValue(strip);
 	o.stripFrames = stripFrames.getValue();
 	o.overwrite = overwrite.getValue();

@@ -35,7 +35,7 @@ int main(int argc, char** argv)
 		        "c", "config",
 		        "experiment .ini: [import_bag] topics and pairing, [camera] "
 		        "intrinsics over the bag's CameraInfo, [sensors] labels (e.g. "
-		        "config/realsense.ini)",
+		        "the preset realsense.ini of share/bims)",
 		        false, "", "CONFIG.ini", cmd);
 		    TCLAP::ValueArg<long> maxFrames(
 		        "", "max-frames", "import only the first N frames (0 = all)",

@@ -31,7 +31,7 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<std::string> config(
 		        "c", "config",
 		        "experiment .ini: [import_stray] (min_confidence, colour "
-		        "size), [sensors] labels (e.g. config/stray.ini)",
+		        "size), [sensors] labels (e.g. the preset stray.ini)",
 		        false, "", "stray.ini", cmd);
 		    TCLAP::ValueArg<long> maxFrames(
 		        "", "max-frames", "import only the first N frames (0 = all)",

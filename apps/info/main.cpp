@@ -3,6 +3,7 @@
 #include "summary.h"
 
 #include <bims/apps/app.h>
+#include <bims/apps/input_kind.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
 #include <iostream>
@@ -18,6 +19,8 @@ int main(int argc, char** argv)
 		    TCLAP::UnlabeledValueArg<std::string> in(
 		        "rawlog", "Input rawlog", true, "", "IN.rawlog", cmd);
 		    bims::parseCommandLine(cmd, argc, argv);
+		    bims::apps::checkRawlogInputKind(in.getValue(),
+		                                     "bims-info IN.rawlog");
 		    const auto s = bims::info::summarizeRawlog(in.getValue());
 		    bims::info::printSummary(s, std::cout);
 		    return 0;

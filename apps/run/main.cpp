@@ -30,8 +30,10 @@ int main(int argc, char** argv)
 		        "rawlogs",
 		        ' ', bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> aCfg(
-		        "config", "experiment .ini (config/default.ini)", true, "",
-		        "CONFIG.ini", cmd);
+		        "config",
+		        "experiment .ini: a file, or a preset of share/bims by name "
+		        "(default.ini, paper.ini, bonn.ini, stray.ini, realsense.ini)",
+		        true, "", "CONFIG.ini", cmd);
 		    TCLAP::UnlabeledMultiArg<std::string> aIn(
 		        "rawlogs", "input rawlog(s), read one after the other", true,
 		        "IN.rawlog", cmd);

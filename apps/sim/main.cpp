@@ -20,8 +20,10 @@ int main(int argc, char** argv)
 		        "OUT_gt/).",
 		        ' ', bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> scene(
-		        "scene", "Scene .ini (see config/sim/)", false, "", "SCENE.ini",
-		        cmd);
+		        "scene",
+		        "Scene .ini: a file, or a preset of share/bims by name "
+		        "(sim/crowded.ini, sim/pendulum_slow.ini, ...)",
+		        false, "", "SCENE.ini", cmd);
 		    TCLAP::ValueArg<std::string> out("o", "out", "Output rawlog", true,
 		                                     "", "OUT.rawlog", cmd);
 		    TCLAP::ValueArg<uint64_t> seed(

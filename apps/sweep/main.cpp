@@ -18,7 +18,7 @@ int main(int argc, char** argv)
 		        "bims: run a sweep of bims-run experiments (docs/sweep.md)",
 		        ' ', bims::version());
 		    TCLAP::UnlabeledValueArg<std::string> aSweep(
-		        "sweep", "sweep description (config/sweep_example.ini)", false,
+		        "sweep", "sweep description (an example: docs/sweep.md)", false,
 		        "", "SWEEP.ini", cmd);
 		    TCLAP::ValueArg<std::string> aOut(
 		        "o", "out", "output folder (runs/, results.*)", false, "",

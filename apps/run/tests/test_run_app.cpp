@@ -124,13 +124,50 @@ TEST(RunApp, EveryInputRawlogIsCheckedBeforeAnyOutput)
 	    << missing.out;
 	const auto folder =
 	    run(q(kConfig) + " " + q(d + "/tum") + " -o " + q(d + "/out") + " -q");
-	EXPECT_EQ(folder.code, 1) << folder.out;
-	EXPECT_NE(folder.out.find("a TUM RGB-D folder; import it first: "
-	                          "bims-import-tum"),
+	EXPECT_EQ(folder.code, 2) << folder.out;
+	EXPECT_NE(folder.out.find("a TUM RGB-D folder, not a rawlog; import it "
+	                          "first: bims-import-tum"),
 	          std::string::npos)
 	    << folder.out;
 	EXPECT_EQ(folder.out.find("backtrace"), std::string::npos) << folder.out;
 	EXPECT_FALSE(fs::exists(d + "/out"));  // nothing made
+}
+
+TEST(RunApp, SwappedArgumentsAndWrongKindsNameTheCommandBeforeAnyOutput)
+{
+	const auto d = tmpDir("kinds");
+	// bims-run IN.rawlog CFG.ini: no binary garbage as an .ini error
+	auto r =
+	    run(q(kSample) + " " + q(kConfig) + " -o " + q(d + "/out") + " -q");
+	EXPECT_EQ(r.code, 2) << r.out;
+	EXPECT_NE(r.out.find("the arguments are swapped"), std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("bims-run " + kConfig + " " + kSample),
+	          std::string::npos)
+	    << r.out;
+	// an .ini where the rawlog belongs
+	r = run(q(kConfig) + " " + q(kConfig) + " -o " + q(d + "/out") + " -q");
+	EXPECT_EQ(r.code, 2) << r.out;
+	EXPECT_NE(r.out.find("an .ini where a rawlog belongs"), std::string::npos)
+	    << r.out;
+	// a folder
+	r = run(q(kConfig) + " " + q(d) + " -o " + q(d + "/out") + " -q");
+	EXPECT_EQ(r.code, 2) << r.out;
+	EXPECT_NE(r.out.find("a folder, not a rawlog file"), std::string::npos)
+	    << r.out;
+	// a typo in the input: no output folder made
+	r = run(q(kConfig) + " " + q(d + "/bonn.rawlg") + " -o " + q(d + "/out") +
+	        " -q");
+	EXPECT_EQ(r.code, 1) << r.out;
+	EXPECT_NE(r.out.find("bonn.rawlg: no such rawlog file"), std::string::npos)
+	    << r.out;
+	EXPECT_FALSE(fs::exists(d + "/out"));  // nothing made
+	// bims-info recognises an .ini too
+	r = bims::test::runCommand(kBin + "/bims-info " + q(kConfig));
+	EXPECT_EQ(r.code, 2) << r.out;
+	EXPECT_NE(r.out.find("an .ini where a rawlog belongs: bims-info IN.rawlog"),
+	          std::string::npos)
+	    << r.out;
 }
 
 // Issue 39's reproduction: a symbolic link at masks/ was followed: the

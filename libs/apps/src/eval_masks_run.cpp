@@ -16,6 +16,7 @@
 #include <bims/eval/plots.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -98,24 +99,77 @@ std::set<size_t> checkMasksOptions(const EvalMasksOptions& o,
 		throw UsageError("--strip and --strip-frames go together");
 	if (!(o.maxDt > 0) || !std::isfinite(o.maxDt))
 		throw UsageError("--max-dt must be > 0");
+	if (o.span != "run" && o.span != "labels")
+		throw UsageError("--span is run or labels, not '" + o.span + "'");
 	return stripSet;
 }
 
-/** The labels' values: the contract's (>= 128 moving) unless a value is
- * given. */
-ev::LabelConvention labelConvention(const EvalMasksOptions& o)
+/** The labels' values and where they were declared: the options, else
+ * the label folder's labels.ini, else bims's own 0 static and 255 moving
+ * (what bims-sim and bims-run write); any other value is refused by
+ * checkLabelValues, never guessed. */
+struct DeclaredLabels
 {
-	if (!o.movingValue && !o.staticValue && !o.ignoreValues) return {};
-	try
+	ev::LabelConvention convention;
+	std::string source;  ///< "the options", the labels.ini, "bims's own"
+};
+
+DeclaredLabels labelConvention(const EvalMasksOptions& o)
+{
+	DeclaredLabels d;
+	if (o.movingValue || o.staticValue || o.ignoreValues)
 	{
-		return ev::LabelConvention::explicitValues(
-		    o.movingValue.value_or(-1), o.staticValue.value_or(-1),
-		    ev::parseLabelValues(o.ignoreValues.value_or("")));
+		try
+		{
+			d.convention = ev::LabelConvention::explicitValues(
+			    o.movingValue.value_or(-1), o.staticValue.value_or(-1),
+			    ev::parseLabelValues(o.ignoreValues.value_or("")));
+		}
+		catch (const std::invalid_argument& e)
+		{
+			throw UsageError(std::string("label values: ") + e.what());
+		}
+		d.source = "the options";
+		return d;
 	}
-	catch (const std::invalid_argument& e)
+	if (auto c = ev::readLabelConventionFile(o.gtDir))
 	{
-		throw UsageError(std::string("label values: ") + e.what());
+		d.convention = *c;
+		d.source = (fs::path(o.gtDir) / ev::kLabelConventionFile).string();
+		return d;
 	}
+	d.convention = ev::LabelConvention::explicitValues(255, 0, {});
+	d.source = "bims's own, no other declared";
+	return d;
+}
+
+/** Every value of the paired labels known to the convention, before any
+ * output: else a usage error listing the values found, their counts and
+ * how to declare them. */
+void checkLabelValues(const EvalMasksOptions& o, const ev::MaskMatch& match,
+                      const DeclaredLabels& labels)
+{
+	ev::LabelValueCounts counts;
+	for (const ev::MaskPair& pair : match.pairs)
+		counts.add(ev::loadMask(o.gtDir + "/" + pair.label->name));
+	const std::vector<int> unknown = counts.unknown(labels.convention);
+	if (unknown.empty()) return;
+	std::string values;
+	for (int v : unknown)
+		values += (values.empty() ? "" : ",") + std::to_string(v) +
+		          " (first in " +
+		          match.pairs[counts.firstImage[v]].label->name + ")";
+	throw UsageError(
+	    o.gtDir + ": label values " + values + " are neither moving, static " +
+	    "nor not scored under " + labels.convention.describe() + " (" +
+	    labels.source + "); a value is never guessed. The values found: " +
+	    counts.describe(labels.convention) +
+	    ". Declare every value: --moving-value V --static-value V "
+	    "--ignore-values LIST (e.g. --moving-value 255 --static-value 0 "
+	    "--ignore-values 150,50 for the Bonn and Stray labels of the shared "
+	    "data), or a " +
+	    ev::kLabelConventionFile + " in " + o.gtDir +
+	    " ([labels] moving = 255, static = 0, not_scored = 150 50)");
 }
 
 /** The labels and predictions and which pairs with which (by index, or by
@@ -160,7 +214,11 @@ std::unique_ptr<MaskPairing> pairMasks(const EvalMasksOptions& o)
 		p.stamps = ev::readFrameStamps(csv);
 	}
 	p.match = ev::matchMasks(p.gtFiles, p.predFiles, p.stamps, o.maxDt);
-	const size_t nLabels = p.gtFiles.size(), nPairs = p.match.pairs.size();
+	if (o.span == "labels") p.match.labelsOutsidePredictions.clear();
+	// the labels of the run's frames (--span run) or all of them
+	const size_t nLabels =
+	    p.gtFiles.size() - p.match.labelsOutsidePredictions.size();
+	const size_t nPairs = p.match.pairs.size();
 	if (nPairs == 0)
 		throw std::runtime_error(
 		    predDir + ": none of the " + std::to_string(nLabels) +
@@ -172,6 +230,7 @@ std::unique_ptr<MaskPairing> pairMasks(const EvalMasksOptions& o)
 		throw std::runtime_error(
 		    predDir + ": only " + std::to_string(nPairs) + " of the " +
 		    std::to_string(nLabels) + " labels of " + gtDir +
+		    (o.span == "run" ? " inside the run's span" : "") +
 		    " have a prediction within " + std::to_string(o.maxDt) +
 		    " s: the predictions are not of these frames (another run?)");
 	if (!p.match.predictionsWithoutLabel.empty() && !o.sparseLabels)
@@ -297,14 +356,14 @@ void scorePair(const EvalMasksOptions& o, const ev::MaskPair& pair,
 	}
 	const std::string line = "frame " + frame + " tp " + std::to_string(m.tp) +
 	                         " fp " + std::to_string(m.fp) + " fn " +
-	                         std::to_string(m.fn) + " " + m.scoresLine();
+	                         std::to_string(m.fn) + " " + m.frameScoresLine();
 	if (!o.quiet) std::printf("%s\n", line.c_str());
 	const bool inStrip = stripSet.count(static_cast<size_t>(f.index)) > 0;
 	if (overlays || inStrip)
 	{
 		const cv::Mat overlay =
 		    ev::maskOverlay(gMoving, pm, d.valid, d.background,
-		                    "frame " + frame + "  " + m.scoresLine());
+		                    "frame " + frame + "  " + m.frameScoresLine());
 		if (overlays) ev::writePng(overlays->file(f.name), overlay);
 		if (inStrip) t.tiles[f.index] = overlay;
 	}
@@ -314,18 +373,32 @@ void scorePair(const EvalMasksOptions& o, const ev::MaskPair& pair,
 	                        {"metrics", m.toJson()}});
 }
 
-/** The labels without a prediction, the predictions without a label. */
+/** The labels without a prediction of the run's frames (those outside,
+ * with --span run, in a note), the predictions without a label. */
 void printUnpaired(const EvalMasksOptions& o, const MaskPairing& p)
 {
 	const ev::MaskMatch& match = p.match;
-	if (!match.labelsWithoutPrediction.empty())
+	const auto& outside = match.labelsOutsidePredictions;
+	std::vector<const ev::MaskFile*> inside;
+	for (const ev::MaskFile* f : match.labelsWithoutPrediction)
+		if (std::find(outside.begin(), outside.end(), f) == outside.end())
+			inside.push_back(f);
+	if (!outside.empty())
+		std::fprintf(stderr,
+		             "bims-eval masks: note: %zu of %zu labels lie outside the "
+		             "run's frames (%s to %s), not scored: the run covers "
+		             "part of the labelled frames (--span run; --span labels "
+		             "requires a prediction for every label)\n",
+		             outside.size(), p.gtFiles.size(),
+		             p.match.pairs.front().label->name.c_str(),
+		             p.match.pairs.back().label->name.c_str());
+	if (!inside.empty())
 		std::fprintf(
 		    stderr,
 		    "bims-eval masks: warning: %zu of %zu labels have no prediction in "
 		    "%s (not counted; first: %s)\n",
-		    match.labelsWithoutPrediction.size(), p.gtFiles.size(),
-		    o.predDir.c_str(),
-		    match.labelsWithoutPrediction.front()->name.c_str());
+		    inside.size(), p.gtFiles.size() - outside.size(), o.predDir.c_str(),
+		    inside.front()->name.c_str());
 	if (match.predictionsOutside > 0 || !match.predictionsWithoutLabel.empty())
 		std::fprintf(stderr,
 		             "bims-eval masks: %zu predictions without a label (%d "
@@ -361,7 +434,9 @@ void writeMasksJson(const EvalMasksOptions& o, const MaskPairing& p,
 	jf["pred"] = o.predDir;
 	jf["labels"] = labels.describe();
 	jf["frames_compared"] = p.match.pairs.size();
-	jf["frames_missing"] = p.match.labelsWithoutPrediction.size();
+	jf["frames_missing"] = p.match.labelsWithoutPrediction.size() -
+	                       p.match.labelsOutsidePredictions.size();
+	jf["labels_outside_run"] = p.match.labelsOutsidePredictions.size();
 	jf["depth_valid_only"] = depthValidOnly;
 	jf["total"] = t.total.toJson();
 	jf["frames_nothing_moving"] = t.nPeopleFree;
@@ -404,8 +479,13 @@ int runEvalMasks(const EvalMasksOptions& o)
 {
 	const std::vector<std::string> inputs = masksInputs(o);
 	const std::set<size_t> stripSet = checkMasksOptions(o, inputs);
-	const ev::LabelConvention labels = labelConvention(o);
+	const DeclaredLabels declared = labelConvention(o);
+	const ev::LabelConvention& labels = declared.convention;
 	const auto pairing = pairMasks(o);
+	checkLabelValues(o, pairing->match, declared);
+	if (!o.quiet)
+		std::fprintf(stderr, "bims-eval masks: labels: %s (%s)\n",
+		             labels.describe().c_str(), declared.source.c_str());
 	const std::string outDir = prepareOverlayFolder(o, inputs);
 	std::unique_ptr<OutputManifest> overlays;
 	if (!outDir.empty())

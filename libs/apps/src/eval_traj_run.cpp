@@ -6,6 +6,7 @@
 #include <bims/eval/plots.h>
 #include <bims/eval/trajectory_metrics.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -23,6 +24,31 @@ Trajectory load(const std::string& path)
 	auto t = loadTumTrajectory(path);
 	if (t.empty()) throw std::runtime_error(path + ": trajectory is empty");
 	return t;
+}
+/** The body-frame rule (eval::orientationsDisagreeWithPositions): the
+ * warning names the likely cause and the fix. */
+void warnIfOrientationsDisagree(const EvalTrajOptions& o,
+                                const ev::TrajectoryReport& rep,
+                                const Trajectory& gt, const Trajectory& est)
+{
+	const ev::ErrorStats disp =
+	    ev::displacementErrors(gt, est, rep.rpe, rep.ate, rep.rpeOptions);
+	if (!ev::orientationsDisagreeWithPositions(rep.rpe.trans, disp,
+	                                           rep.ate.stats, o.delta))
+		return;
+	std::fprintf(
+	    stderr,
+	    "bims-eval traj: warning: the RPE (%.4f m/s, %.2f deg/s) is %.1fx what "
+	    "the positions alone give for the same pairs (%.4f m/s) while the ATE "
+	    "is %.4f m: the orientations of %s and %s are not of the same body. "
+	    "Likely cause: the ground truth holds the poses of another body than "
+	    "the camera, e.g. a Bonn RGB-D Dynamic folder's groundtruth.txt (the "
+	    "motion-capture marker's). Fix: import the folder with "
+	    "`bims-import-tum FOLDER -o OUT.rawlog -c bonn.ini` (or --bonn-gt) "
+	    "and score against OUT_gt/groundtruth.txt, the camera's poses\n",
+	    rep.rpe.trans.rmse, rep.rpe.rot.rmse,
+	    disp.rmse > 0 ? rep.rpe.trans.rmse / disp.rmse : INFINITY, disp.rmse,
+	    rep.ate.stats.rmse, o.gt.c_str(), o.est.c_str());
 }
 }  // namespace
 
@@ -79,6 +105,7 @@ int runEvalTraj(const EvalTrajOptions& o)
 		    rep.rpe.pairs.size(), o.delta);
 		std::printf("rpe_rot_rmse %.4f deg/s (mean %.4f, median %.4f)\n",
 		            rep.rpe.rot.rmse, rep.rpe.rot.mean, rep.rpe.rot.median);
+		warnIfOrientationsDisagree(o, rep, gt, est);
 	}
 	else
 		std::printf("rpe not available: %s\n", rpeError.c_str());

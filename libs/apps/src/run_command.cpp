@@ -2,14 +2,17 @@
 // (runExperiment) and its report.
 #include <bims/apps/app.h>
 #include <bims/apps/frame_range_option.h>
+#include <bims/apps/input_kind.h>
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
 #include <bims/apps/run_command.h>
+#include <bims/apps/run_report.h>
 #include <bims/common/choice.h>
 #include <bims/common/rawlog.h>
 
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <stdexcept>
 
 namespace bims::apps
@@ -58,7 +61,9 @@ int runExitCode(const RunSummary& s, int signal)
 int runFromCommandLine(const RunCommand& c)
 {
 	// every input before any output: a typo in the second rawlog is an
-	// error before the first is run and before OUTDIR is made
+	// error before the first is run and before OUTDIR is made; an input of
+	// the wrong kind names the command to use
+	checkRunInputKinds(c.config, c.rawlogs);
 	for (const auto& r : c.rawlogs) checkRawlogPath(r);
 	auto inputs = c.rawlogs;
 	inputs.push_back(c.config);
@@ -84,8 +89,26 @@ int runFromCommandLine(const RunCommand& c)
 		             cleared, opt.outDir.c_str());
 	const auto sum = runExperiment(cfg, opt);
 	std::printf("%s", formatSummary(sum).c_str());
-	std::printf("outputs in %s/ (trajectory.txt, masks/, metrics.json, ...)\n",
-	            opt.outDir.c_str());
+	// the one page to read first (a run stopped before metrics.json has
+	// none)
+	bool report = false;
+	if (std::filesystem::exists(opt.outDir + "/metrics.json"))
+	{
+		try
+		{
+			writeRunReport({opt.outDir, opt.rawlogs, c.config,
+			                choiceName(cfg.ego.odometry.mode)});
+			report = true;
+		}
+		catch (const std::exception& e)
+		{
+			std::fprintf(stderr, "bims-run: warning: no report.md: %s\n",
+			             e.what());
+		}
+	}
+	std::printf(
+	    "outputs in %s/ (%strajectory.txt, masks/, metrics.json, ...)\n",
+	    opt.outDir.c_str(), report ? "report.md, " : "");
 	if (!sum.error.empty())
 		std::fprintf(stderr, "bims-run: error: %s\n", sum.error.c_str());
 	const int sig = stopSignal();

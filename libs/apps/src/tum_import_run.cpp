@@ -10,6 +10,8 @@
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/format.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -114,6 +116,23 @@ TumImport importTumChecked(const ImportRunOptions& o,
 	return r;
 }
 
+namespace
+{
+/** A folder of the Bonn RGB-D Dynamic dataset, by its name (rgbd_bonn_*,
+ * or any name with "bonn"): its ground truth is of the motion-capture
+ * marker, not of the camera. */
+bool looksLikeBonnFolder(const std::string& folder)
+{
+	std::filesystem::path a =
+	    std::filesystem::absolute(folder).lexically_normal();
+	if (a.filename().empty()) a = a.parent_path();  // "FOLDER/"
+	std::string p = a.filename().string();
+	std::transform(p.begin(), p.end(), p.begin(),
+	               [](unsigned char c) { return std::tolower(c); });
+	return p.find("bonn") != std::string::npos;
+}
+}  // namespace
+
 int runImport(const ImportRunOptions& o)
 {
 	ProgressBar bar("import", 0, o.progress);
@@ -122,6 +141,16 @@ int runImport(const ImportRunOptions& o)
 	    importReport(o.out, r.summary, o.synth_imu, r.bonnConverted, r.params)
 	        .c_str(),
 	    stdout);
+	if (r.summary.gtPoses > 0 && !r.bonnConverted &&
+	    looksLikeBonnFolder(o.folder))
+		std::fprintf(
+		    stderr,
+		    "bims-import-tum: note: %s looks like a Bonn RGB-D Dynamic folder "
+		    "(its name): its groundtruth.txt holds the motion-capture marker's "
+		    "poses, kept as they are in %s/groundtruth.txt. For the camera's "
+		    "poses (what bims-eval traj compares an estimate with), import "
+		    "with -c bonn.ini or --bonn-gt\n",
+		    o.folder.c_str(), r.summary.gtDir.c_str());
 	return 0;
 }
 

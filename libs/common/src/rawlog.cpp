@@ -212,7 +212,7 @@ void checkRawlogPath(const std::string& path)
 			hint =
 			    ": a Stray Scanner capture; import it first: "
 			    "bims-import-stray " +
-			    path + " -o OUT.rawlog -c config/stray.ini";
+			    path + " -o OUT.rawlog -c stray.ini";
 		throw RawlogError(path + ": a folder, not a rawlog file" + hint);
 	}
 	if (!fs::is_regular_file(st))

@@ -1,5 +1,7 @@
+#include <bims/common/config.h>
 #include <bims/eval/association.h>
 #include <bims/eval/mask_labels.h>
+#include <mrpt/config/CConfigFile.h>
 
 #include <algorithm>
 #include <cctype>
@@ -111,6 +113,75 @@ std::vector<int> parseLabelValues(const std::string& text)
 		out.push_back(v);
 	}
 	return out;
+}
+
+std::optional<LabelConvention> readLabelConventionFile(const std::string& dir)
+{
+	const std::string path = (fs::path(dir) / kLabelConventionFile).string();
+	if (!fs::exists(path)) return std::nullopt;
+	const auto cfg = openIniFile(path);
+	checkSections(*cfg, {"labels"});
+	ConfigSection s(*cfg, "labels", true);
+	const int moving = static_cast<int>(s.requireInt("moving", 0, 255));
+	const int staticValue = static_cast<int>(s.requireInt("static", 0, 255));
+	const std::string notScored = s.getString("not_scored", "");
+	s.finish();
+	try
+	{
+		return LabelConvention::explicitValues(moving, staticValue,
+		                                       parseLabelValues(notScored));
+	}
+	catch (const std::invalid_argument& e)
+	{
+		s.fail("not_scored", e.what());
+	}
+}
+
+void LabelValueCounts::add(const cv::Mat& labels)
+{
+	if (labels.type() != CV_8UC1)
+		throw std::invalid_argument("a label image is 8-bit single-channel");
+	std::array<uint64_t, 256> n{};
+	for (int v = 0; v < labels.rows; v++)
+	{
+		const uint8_t* row = labels.ptr<uint8_t>(v);
+		for (int u = 0; u < labels.cols; u++) n[row[u]]++;
+	}
+	for (int i = 0; i < 256; i++)
+		if (n[i])
+		{
+			if (!pixels[i]) firstImage[i] = nImages;
+			pixels[i] += n[i];
+			images[i]++;
+		}
+	nImages++;
+}
+
+std::vector<int> LabelValueCounts::unknown(const LabelConvention& c) const
+{
+	std::vector<int> out;
+	for (int i = 0; i < 256; i++)
+		if (pixels[i] && c.classOf(i) == LabelClass::Unknown) out.push_back(i);
+	return out;
+}
+
+std::string LabelValueCounts::describe(const LabelConvention& c) const
+{
+	std::string s;
+	for (int i = 0; i < 256; i++)
+	{
+		if (!pixels[i]) continue;
+		const LabelClass k = c.classOf(i);
+		s += std::string(s.empty() ? "" : ", ") + std::to_string(i) + ": " +
+		     std::to_string(pixels[i]) + " px in " + std::to_string(images[i]) +
+		     " of " + std::to_string(nImages) + " labels (" +
+		     (k == LabelClass::Moving      ? "moving"
+		      : k == LabelClass::Static    ? "static"
+		      : k == LabelClass::NotScored ? "not scored"
+		                                   : "UNKNOWN") +
+		     ")";
+	}
+	return s;
 }
 
 namespace
@@ -241,7 +312,12 @@ MaskMatch matchMasks(const std::vector<MaskFile>& labels,
 			if (j < preds.size() && preds[j].index == l.index)
 				m.pairs.push_back({&l, &preds[j], 0});
 			else
+			{
 				m.labelsWithoutPrediction.push_back(&l);
+				if (l.index < preds.front().index ||
+				    l.index > preds.back().index)
+					m.labelsOutsidePredictions.push_back(&l);
+			}
 		}
 		return m;
 	}
@@ -278,7 +354,12 @@ MaskMatch matchMasks(const std::vector<MaskFile>& labels,
 		labelUsed[i] = predUsed[j] = true;
 	}
 	for (size_t i = 0; i < tl.size(); i++)
-		if (!labelUsed[i]) m.labelsWithoutPrediction.push_back(&labels[i]);
+	{
+		if (labelUsed[i]) continue;
+		m.labelsWithoutPrediction.push_back(&labels[i]);
+		if (tl[i] < tps.front() - maxDt || tl[i] > tps.back() + maxDt)
+			m.labelsOutsidePredictions.push_back(&labels[i]);
+	}
 	for (size_t j = 0; j < tps.size(); j++)
 	{
 		if (predUsed[j]) continue;

@@ -147,6 +147,13 @@ std::string MaskMetrics::scoresLine() const
 	       " F1 " + fmt4(f1()) + " IoU " + fmt4(iou());
 }
 
+std::string MaskMetrics::frameScoresLine() const
+{
+	if (tp + fn > 0) return scoresLine();
+	return "no moving label: fp " + std::to_string(fp) + ", static as moving " +
+	       fmt4(staticAsMoving());
+}
+
 Json MaskMetrics::toJson() const
 {
 	return {{"tp", tp},

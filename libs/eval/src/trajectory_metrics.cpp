@@ -148,6 +148,7 @@ RpeResult computeRpe(const Trajectory& gt, const Trajectory& est,
 		const Eigen::Isometry3d E = dG.inverse() * dE;
 		const double c = std::clamp((E.linear().trace() - 1) / 2, -1.0, 1.0);
 		r.pairs.emplace_back(i, j);
+		r.gtPairs.emplace_back(g0, g1);
 		r.transErrors.push_back(E.translation().norm() / opt.delta);
 		r.rotErrors.push_back(std::acos(c) * 180.0 / M_PI / opt.delta);
 	}
@@ -163,6 +164,34 @@ RpeResult computeRpe(const Trajectory& gt, const Trajectory& est,
 	r.trans = ErrorStats::of(r.transErrors);
 	r.rot = ErrorStats::of(r.rotErrors);
 	return r;
+}
+
+ErrorStats displacementErrors(const Trajectory& gt, const Trajectory& est,
+                              const RpeResult& rpe, const AteResult& ate,
+                              const RpeOptions& opt)
+{
+	const Eigen::Matrix3d R = toIso(ate.T_alignment).linear();
+	std::vector<double> e;
+	for (size_t k = 0; k < rpe.pairs.size() && k < rpe.gtPairs.size(); k++)
+	{
+		const auto [i, j] = rpe.pairs[k];
+		const auto [g0, g1] = rpe.gtPairs[k];
+		const Eigen::Vector3d dG =
+		    toIso(gt[g1].T_WC).translation() - toIso(gt[g0].T_WC).translation();
+		const Eigen::Vector3d dE =
+		    toIso(est[j].T_WC).translation() - toIso(est[i].T_WC).translation();
+		e.push_back((dG - R * dE).norm() / opt.delta);
+	}
+	return ErrorStats::of(e);
+}
+
+bool orientationsDisagreeWithPositions(const ErrorStats& rpeTrans,
+                                       const ErrorStats& displacement,
+                                       const ErrorStats& ate, double delta)
+{
+	return rpeTrans.count > 0 && rpeTrans.rmse >= kBodyFrameMinRpe &&
+	       rpeTrans.rmse >= kBodyFrameRatio * displacement.rmse &&
+	       rpeTrans.rmse * delta >= 2 * ate.rmse;
 }
 
 Trajectory alignTrajectory(const Trajectory& est, const mrpt::poses::CPose3D& T)

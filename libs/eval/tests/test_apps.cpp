@@ -1,7 +1,9 @@
 // End-to-end tests of bims-import-tum and bims-eval (run the built programs).
+#include <bims/common/frame_files.h>
 #include <bims/common/rawlog.h>
 #include <bims/common/trajectory.h>
 #include <bims/common/version.h>
+#include <bims/eval/pose_utils.h>
 #include <bims/eval/tum_import.h>
 #include <bims_test/data.h>
 #include <bims_test/png_bomb.h>
@@ -293,17 +295,24 @@ TEST(EvalMasks, LabelsByTimestampWithIgnoredValues)
 	EXPECT_NE(r.out.find("total_static_as_moving 0.2500"), std::string::npos)
 	    << r.out;
 	EXPECT_NE(r.out.find("ignored 12"), std::string::npos) << r.out;
-	EXPECT_NE(r.out.find("1 of 4 labels have no prediction"), std::string::npos)
+	// (label 0 lies before the run's first frame: left out with a note)
+	EXPECT_NE(r.out.find("note: 1 of 4 labels lie outside the run's frames"),
+	          std::string::npos)
 	    << r.out;
-	// A label value outside the convention: an error naming the file.
+	// A label value outside the convention: a usage error before any
+	// output, naming the value, the first label holding it and the counts.
 	cv::Mat bad(2, 8, CV_8UC1, cv::Scalar(0));
 	bad.at<uint8_t>(1, 5) = 77;
 	cv::imwrite(d + "/labels/100.06600.png", bad);
 	r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
 	        "/run/masks --no-plots" + conv);
-	EXPECT_EQ(r.code, 1);
-	EXPECT_NE(r.out.find("100.06600.png vs"), std::string::npos) << r.out;
-	EXPECT_NE(r.out.find("label value 77 at pixel (5, 1)"), std::string::npos)
+	EXPECT_EQ(r.code, 2);
+	EXPECT_NE(r.out.find("label values 77 (first in 100.06600.png) are "
+	                     "neither moving"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("77: 1 px in 1 of 3 labels (UNKNOWN)"),
+	          std::string::npos)
 	    << r.out;
 	// A label of another size.
 	cv::imwrite(d + "/labels/100.06600.png",
@@ -344,6 +353,164 @@ TEST(EvalMasks, LabelsByTimestampWithIgnoredValues)
 	EXPECT_NE(r.code, 0);
 	EXPECT_NE(r.out.find("'x' is not a label value"), std::string::npos)
 	    << r.out;
+}
+
+TEST(EvalMasks, UndeclaredLabelValuesAreRefusedNotGuessed)
+{
+	// Bonn-proxy-style labels (255 moving, 0 static, 150 ambiguous, 50 no
+	// depth) given without their convention: 150 must not be scored as
+	// moving (it once was: >= 128). The evaluation refuses before any
+	// output, listing each value and its counts; a labels.ini in the label
+	// folder, or the options, declare them.
+	const auto d = tmpDir("masks_undeclared");
+	fs::create_directories(d + "/labels");
+	fs::create_directories(d + "/pred");
+	for (int k = 0; k < 2; k++)
+	{
+		// cols 0-1 moving (frame 1 only), 2 ambiguous, 3 no depth, 4-7 static
+		cv::Mat l(2, 8, CV_8UC1, cv::Scalar(0));
+		if (k == 1) l.colRange(0, 2) = 255;
+		l.col(2) = 150;
+		l.col(3) = 50;
+		cv::imwrite(d + "/labels/00000" + std::to_string(k) + ".png", l);
+		// prediction: cols 0-2 and 7 moving
+		cv::Mat p(2, 8, CV_8UC1, cv::Scalar(0));
+		p.colRange(0, 3) = 255;
+		p.col(7) = 255;
+		cv::imwrite(d + "/pred/00000" + std::to_string(k) + ".png", p);
+	}
+	auto r = run(kBin + "/bims-eval masks " + d + "/labels " + d + "/pred");
+	EXPECT_EQ(r.code, 2) << r.out;
+	EXPECT_NE(r.out.find("label values 50 (first in 000000.png),150 (first in "
+	                     "000000.png) are neither moving, static nor not "
+	                     "scored"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("150: 4 px in 2 of 2 labels (UNKNOWN)"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("255: 4 px in 1 of 2 labels (moving)"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("--ignore-values"), std::string::npos) << r.out;
+	EXPECT_EQ(r.out.find("total precision"), std::string::npos) << r.out;
+	EXPECT_FALSE(fs::exists(d + "/pred_eval")) << "no output before the check";
+	// Declared in the folder: frame 0 has no moving label and reports its
+	// false positives (cols 0, 1 and 7 of 2 rows), not F1 0; frame 1: TP 4,
+	// FP 2 (col 7), FN 0.
+	std::ofstream(d + "/labels/labels.ini")
+	    << "[labels]\nmoving = 255\nstatic = 0\nnot_scored = 150 50\n";
+	r = run(kBin + "/bims-eval masks " + d + "/labels " + d + "/pred");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("frame 000000 tp 0 fp 6 fn 0 no moving label: fp 6, "
+	                     "static as moving 0.5000"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("labels: moving 255, static 0, not scored 150 50 (" +
+	                     d + "/labels/labels.ini)"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_EQ(lastLine(r.out),
+	          "total precision 0.3333 recall 1.0000 F1 0.5000 IoU 0.3333")
+	    << r.out;
+	// A bad convention file is an error naming it.
+	std::ofstream(d + "/labels/labels.ini")
+	    << "[labels]\nmoving = 255\nstatic = 0\nnotscored = 150 50\n";
+	r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	        "/pred --overwrite");
+	EXPECT_NE(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("labels.ini"), std::string::npos) << r.out;
+	EXPECT_NE(r.out.find("notscored"), std::string::npos) << r.out;
+}
+
+TEST(EvalTraj, BonnMarkerPosesAreWarnedAboutAndTheImportSaysSo)
+{
+	if (!fs::exists(bims::test::kBonnCrowd + "/depth.txt"))
+		GTEST_SKIP() << "no Bonn sample";
+	// Imported without -c: the marker's poses are kept, with a note.
+	const auto d = tmpDir("bonn_marker");
+	auto r = run(kBin + "/bims-import-tum " + bims::test::kBonnCrowd + " -o " +
+	             d + "/m.rawlog --max-frames 80 -q");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("looks like a Bonn RGB-D Dynamic folder"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("-c bonn.ini or --bonn-gt"), std::string::npos)
+	    << r.out;
+	// The camera's poses as the estimate, the marker's as the "ground
+	// truth": a small ATE, an RPE ten times too large: a warning naming
+	// the cause and the fix.
+	auto marker = bims::loadTumTrajectory(d + "/m_gt/groundtruth.txt");
+	auto cam = marker;
+	for (auto& p : cam) p.T_WC = bims::eval::bonnMarkerToCamera(p.T_WC);
+	bims::saveTumTrajectory(d + "/cam.txt", cam);
+	r = run(kBin + "/bims-eval traj " + d + "/m_gt/groundtruth.txt " + d +
+	        "/cam.txt --no-plot");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("warning: the RPE"), std::string::npos) << r.out;
+	EXPECT_NE(r.out.find("motion-capture marker"), std::string::npos) << r.out;
+	EXPECT_NE(r.out.find("--bonn-gt"), std::string::npos) << r.out;
+	// The camera's poses against themselves shifted by 2 ms: no warning.
+	auto shifted = cam;
+	for (auto& p : shifted) p.t += 0.002;
+	bims::saveTumTrajectory(d + "/shifted.txt", shifted);
+	r = run(kBin + "/bims-eval traj " + d + "/cam.txt " + d +
+	        "/shifted.txt --no-plot");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_EQ(r.out.find("warning"), std::string::npos) << r.out;
+	// Imported with the Bonn preset: no note.
+	r = run(kBin + "/bims-import-tum " + bims::test::kBonnCrowd + " -o " + d +
+	        "/c.rawlog --max-frames 10 -q -c " + BIMS_SOURCE_DIR +
+	        "/config/bonn.ini");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_EQ(r.out.find("looks like a Bonn"), std::string::npos) << r.out;
+}
+
+TEST(EvalMasks, APartialRunIsScoredAgainstTheLabelsOfItsFrames)
+{
+	// 20 labels named by time; a run of frames 5-12 of them (bims-run
+	// --frames 5:12 numbers its masks by scan index, frames.csv gives
+	// their stamps): scored against those 8 labels, the 12 others left out
+	// with a note, not refused as "only 8 of the 20 labels".
+	const auto d = tmpDir("masks_span");
+	fs::create_directories(d + "/labels");
+	fs::create_directories(d + "/run/masks");
+	std::ofstream csv(d + "/run/frames.csv");
+	csv << "index,t\n";
+	for (int k = 0; k < 20; k++)
+	{
+		cv::Mat l(2, 4, CV_8UC1, cv::Scalar(0));
+		l.col(0) = 255;
+		char name[64];
+		std::snprintf(name, sizeof name, "%.5f", 100 + 0.03 * k);
+		cv::imwrite(d + "/labels/" + name + ".png", l);
+		if (k < 5 || k > 12) continue;
+		cv::Mat p(2, 4, CV_8UC1, cv::Scalar(0));
+		p.colRange(0, 2) = 255;  // TP 2, FP 2
+		cv::imwrite(d + "/run/masks/" + bims::frameFileName(k), p);
+		csv << k << "," << name << "\n";
+	}
+	csv.close();
+	auto r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	             "/run/masks --no-plots");
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("note: 12 of 20 labels lie outside the run's frames "
+	                     "(100.15000.png to 100.36000.png), not scored"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("total_counts frames 8 tp 16 fp 16 fn 0"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_EQ(r.out.find("warning"), std::string::npos) << r.out;
+	// --span labels: every label must have a prediction.
+	r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	        "/run/masks --no-plots --span labels");
+	EXPECT_EQ(r.code, 1) << r.out;
+	EXPECT_NE(r.out.find("only 8 of the 20 labels"), std::string::npos)
+	    << r.out;
+	r = run(kBin + "/bims-eval masks " + d + "/labels " + d +
+	        "/run/masks --no-plots --span all");
+	EXPECT_EQ(r.code, 2) << r.out;
 }
 
 TEST(EvalTraj, BadInputIsAClearError)

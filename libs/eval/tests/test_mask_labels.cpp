@@ -101,6 +101,46 @@ TEST(LabelConvention, IgnoredPixelsAreNotScoredAndOtherValuesThrow)
 	}
 }
 
+TEST(LabelConvention, ValueCountsNameTheUnknownValues)
+{
+	const auto c = ev::LabelConvention::explicitValues(255, 0, {});
+	ev::LabelValueCounts n;
+	n.add((cv::Mat_<uint8_t>(1, 4) << 255, 0, 150, 150));
+	n.add((cv::Mat_<uint8_t>(1, 2) << 0, 50));
+	EXPECT_EQ(n.unknown(c), (std::vector<int>{50, 150}));
+	EXPECT_EQ(n.firstImage[150], 0u);
+	EXPECT_EQ(n.firstImage[50], 1u);
+	EXPECT_EQ(n.describe(c),
+	          "0: 2 px in 2 of 2 labels (static), 50: 1 px in 1 of 2 labels "
+	          "(UNKNOWN), 150: 2 px in 1 of 2 labels (UNKNOWN), 255: 1 px in 1 "
+	          "of 2 labels (moving)");
+	EXPECT_TRUE(
+	    n.unknown(ev::LabelConvention::explicitValues(255, 0, {150, 50}))
+	        .empty());
+	// a label folder's own declaration
+	const auto d = freshDir("conv");
+	EXPECT_FALSE(ev::readLabelConventionFile(d).has_value());
+	std::ofstream(d + "/labels.ini")
+	    << "[labels]\nmoving = 255\nstatic = 0\nnot_scored = 150, 50\n";
+	const auto f = ev::readLabelConventionFile(d);
+	ASSERT_TRUE(f.has_value());
+	EXPECT_EQ(f->describe(), "moving 255, static 0, not scored 150 50");
+	std::ofstream(d + "/labels.ini") << "[labels]\nmoving = 255\n";
+	EXPECT_THROW(ev::readLabelConventionFile(d), std::runtime_error);
+}
+
+TEST(MaskMetrics, AFrameWithoutMovingLabelReportsItsFalsePositivesNotF1)
+{
+	const cv::Mat gt(1, 4, CV_8UC1, cv::Scalar(0));
+	const cv::Mat pred = (cv::Mat_<uint8_t>(1, 4) << 255, 0, 0, 0);
+	const auto m = ev::MaskMetrics::compute(gt, pred);
+	EXPECT_EQ(m.frameScoresLine(),
+	          "no moving label: fp 1, static as moving 0.2500");
+	const cv::Mat gt2 = (cv::Mat_<uint8_t>(1, 4) << 255, 0, 0, 0);
+	const auto m2 = ev::MaskMetrics::compute(gt2, pred);
+	EXPECT_EQ(m2.frameScoresLine(), m2.scoresLine());
+}
+
 TEST(MaskFiles, NamedByIndexOrByTimeNotBoth)
 {
 	const auto d = freshDir("names");
@@ -169,6 +209,8 @@ TEST(MatchMasks, ByTimeOneToOneWithinTheTolerance)
 	EXPECT_NEAR(m.pairs[0].dt, 0.002, 1e-9);
 	ASSERT_EQ(m.labelsWithoutPrediction.size(), 1u);
 	EXPECT_EQ(m.labelsWithoutPrediction[0], &labels[0]);
+	// (before the first prediction: outside the run's span)
+	ASSERT_EQ(m.labelsOutsidePredictions.size(), 1u);
 	EXPECT_EQ(m.predictionsOutside, 2);
 	EXPECT_TRUE(m.predictionsWithoutLabel.empty());
 	// a label missing inside the span is reported
@@ -194,6 +236,7 @@ TEST(MatchMasks, ByIndexPairsEqualNames)
 	EXPECT_EQ(m.pairs[0].label->index, 0);
 	ASSERT_EQ(m.labelsWithoutPrediction.size(), 1u);
 	EXPECT_EQ(m.labelsWithoutPrediction[0]->index, 2);
+	EXPECT_EQ(m.labelsOutsidePredictions.size(), 1u);  // after the last
 	// labels by index, predictions by time: an error
 	EXPECT_THROW(ev::matchMasks(labels, {byTime(1.0)}, {}, 0.01),
 	             std::runtime_error);

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include <cmath>
+#include <tuple>
 
 using bims::StampedPose;
 using bims::Trajectory;
@@ -167,6 +168,47 @@ TEST(Rpe, RotationRateErrorInDegreesPerSecond)
 	EXPECT_NEAR(r.rot.rmse, 10.0, 1e-6);
 	EXPECT_NEAR(r.rot.max, 10.0, 1e-6);
 	EXPECT_NEAR(r.trans.rmse, 0.0, 1e-9);
+}
+
+TEST(Rpe, PosesOfAnotherBodyAreFlaggedByTheirDisplacements)
+{
+	// A camera walking a circle of 1 m radius in 8 s while turning; the
+	// "ground truth" is that of a body rigidly attached to it with a large
+	// rotation and a small lever (as Bonn's motion-capture marker is), and
+	// once the camera's own.
+	Trajectory cam, marker;
+	const CPose3D X(0.011, -0.01, 0.011, mrpt::DEG2RAD(100.0),
+	                mrpt::DEG2RAD(30.0), mrpt::DEG2RAD(-40.0));
+	for (int k = 0; k <= 240; k++)
+	{
+		const double t = k / 30.0, a = 2 * M_PI * t / 8;
+		const CPose3D T(std::cos(a), std::sin(a), 0.1 * std::sin(3 * a),
+		                a + 0.3 * std::sin(2 * a), 0.1 * std::cos(a), 0);
+		cam.push_back({t, T});
+		marker.push_back({t, T + X});
+	}
+	const auto judge = [](const Trajectory& gt, const Trajectory& est)
+	{
+		const auto ate = ev::computeAte(gt, est);
+		const auto rpe = ev::computeRpe(gt, est);
+		const auto disp = ev::displacementErrors(gt, est, rpe, ate);
+		return std::make_tuple(ev::orientationsDisagreeWithPositions(
+		                           rpe.trans, disp, ate.stats, 1.0),
+		                       ate.stats.rmse, rpe.trans.rmse, disp.rmse);
+	};
+	const auto [flagged, ate, rpe, disp] = judge(marker, cam);
+	EXPECT_TRUE(flagged) << "ate " << ate << " rpe " << rpe << " disp " << disp;
+	EXPECT_LT(ate, 0.02);
+	EXPECT_GT(rpe, 10 * disp);
+	// the camera's own poses, with 5 mm of noise: not flagged
+	Trajectory noisy = cam;
+	for (size_t k = 0; k < noisy.size(); k++)
+		noisy[k].T_WC =
+		    noisy[k].T_WC + CPose3D(0.005 * std::sin(7.0 * k),
+		                            0.005 * std::cos(3.0 * k), 0,
+		                            0.002 * std::sin(5.0 * k), 0, 0);
+	EXPECT_FALSE(std::get<0>(judge(cam, noisy)));
+	EXPECT_FALSE(std::get<0>(judge(cam, cam)));
 }
 
 TEST(Rpe, NoOverlapIsAnError)

@@ -64,6 +64,9 @@ void OutputParams::describe(OptionVisitor& v)
 	       "static_map.ply and static_map.bt at the end");
 	v.flag("labelled_rawlog", labelled_rawlog,
 	       "segmented.rawlog with the masks as pixel labels");
+	v.flag("labelled_rawlog_images", labelled_rawlog_images,
+	       "segmented.rawlog copies the input's images too (false: each scan's "
+	       "stamp, sensor label, camera and labels only)");
 	v.integer("labelled_rawlog_gz_level", labelled_rawlog_gz_level, 0, 9,
 	          "0 = plain, 1..9 = gzip");
 	v.flag("flow_labels", flow_labels, "flow_labels/NNNNNN.png (Diff red)");

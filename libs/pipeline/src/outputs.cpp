@@ -55,7 +55,8 @@ const OutputFolderLayout& runOutputLayout()
 	// bims-run's --overwrite checks that a run leaves nothing else)
 	static const OutputFolderLayout layout{
 	    {"trajectory.txt", "frames.csv", "metrics.json", "effective.ini",
-	     "segmented.rawlog", "static_map.ply", "static_map.bt"},
+	     "segmented.rawlog", "static_map.ply", "static_map.bt",
+	     "report.md"},  // (report.md: bims-run's, bims/apps/run_report.h)
 	    {{"masks", ".png"},
 	     {"moving_voxels", ".ply"},
 	     {"flow_labels", ".png"}}};
@@ -133,10 +134,32 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 	{
 		// Label 0 ("moving"), bit 0 of each pixel's byte; written in one
 		// buffer (MRPT's TPixelLabelInfo<1> bytes, ~3 ms less per VGA frame).
-		scan.pixelLabels = bims::BulkPixelLabels::fromMask(
-		    r.mask.ptr<uint8_t>(0), r.mask.rows, r.mask.cols, r.mask.step[0],
-		    "moving");  // no copy of the images
-		rawlog_->write(scan);
+		auto labels = bims::BulkPixelLabels::fromMask(r.mask.ptr<uint8_t>(0),
+		                                              r.mask.rows, r.mask.cols,
+		                                              r.mask.step[0], "moving");
+		if (p_.labelled_rawlog_images)
+		{
+			scan.pixelLabels = labels;  // no copy of the images
+			rawlog_->write(scan);
+		}
+		else
+		{
+			// the scan without its images: what finds it in the input (stamp,
+			// sensor label) and reads its pixels (cameras, poses), the labels
+			mrpt::obs::CObservation3DRangeScan lab;
+			lab.timestamp = scan.timestamp;
+			lab.sensorLabel = scan.sensorLabel;
+			lab.sensorPose = scan.sensorPose;
+			lab.cameraParams = scan.cameraParams;
+			lab.cameraParamsIntensity = scan.cameraParamsIntensity;
+			lab.relativePoseIntensityWRTDepth =
+			    scan.relativePoseIntensityWRTDepth;
+			lab.rangeUnits = scan.rangeUnits;
+			lab.maxRange = scan.maxRange;
+			lab.stdError = scan.stdError;
+			lab.pixelLabels = labels;
+			rawlog_->write(lab);
+		}
 		// a killed run leaves it readable up to the last whole frame
 		rawlog_->flush();
 	}

@@ -43,8 +43,11 @@ struct EvalMasksOptions
 	std::optional<std::string> ignoreValues;  ///< label values not scored
 	/** the predictions' stamps when labels are named by time */
 	std::optional<std::string> framesCsv;
-	double maxDt = 0.01;               ///< largest |t_label - t_prediction| [s]
-	bool sparseLabels = false;         ///< labels are a subset of the frames
+	double maxDt = 0.01;        ///< largest |t_label - t_prediction| [s]
+	bool sparseLabels = false;  ///< labels are a subset of the frames
+	/** "run": the labels outside the predictions' span are left out (a
+	 * partial run); "labels": every label must have a prediction */
+	std::string span = "run";
 	std::optional<std::string> strip;  ///< the strip of --strip-frames
 	std::string stripFrames;           ///< "i,j,..": scan indices
 	bool overwrite = false;  ///< replace an earlier evaluation's overlays

@@ -6,7 +6,10 @@
 
 #include <opencv2/core.hpp>
 
+#include <array>
+#include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -51,6 +54,32 @@ struct LabelConvention
  * std::invalid_argument naming the bad item. */
 std::vector<int> parseLabelValues(const std::string& text);
 
+/** The file in a label folder that declares its values: "labels.ini",
+ * section [labels], keys moving, static (0-255) and not_scored (a list). */
+inline constexpr const char* kLabelConventionFile = "labels.ini";
+
+/** The convention \a dir declares in its labels.ini; nullopt when it has
+ * none. The file is read strictly (unknown keys, bad values: ConfigError or
+ * std::invalid_argument naming the file). */
+std::optional<LabelConvention> readLabelConventionFile(const std::string& dir);
+
+/** How many pixels (and label images) hold each value. */
+struct LabelValueCounts
+{
+	std::array<uint64_t, 256> pixels{};  ///< pixels of each value
+	std::array<size_t, 256> images{};    ///< label images holding it
+	/** The first image (0: the first added) holding each value. */
+	std::array<size_t, 256> firstImage{};
+	size_t nImages = 0;               ///< label images counted
+	void add(const cv::Mat& labels);  ///< CV_8UC1
+	/** The values present that \a c classes as unknown, ascending. */
+	std::vector<int> unknown(const LabelConvention& c) const;
+	/** "0: 1234 px in 3 labels, 255: ..." over the values present, each
+	 * with its class under \a c ("moving", "static", "not scored" or
+	 * "unknown"). */
+	std::string describe(const LabelConvention& c) const;
+};
+
 /** A mask file: named NNNNNN.png (index of the 3D scan, from 0) or
  * SECONDS.png (a timestamp, as TUM-style folders name their images). */
 struct MaskFile
@@ -87,6 +116,10 @@ struct MaskMatch
 	std::vector<MaskPair> pairs;  ///< sorted by label
 	/** Labels without a prediction (e.g. frames the importer dropped). */
 	std::vector<const MaskFile*> labelsWithoutPrediction;
+	/** Those of them outside the predictions' span (before the first or
+	 * after the last, by index, or by time beyond the tolerance): a run of
+	 * part of the labelled frames (bims-run --frames A:B). */
+	std::vector<const MaskFile*> labelsOutsidePredictions;
 	/** Predictions inside the labels' time span without a label within
 	 * the tolerance: a label folder with a missing frame (by time only). */
 	std::vector<const MaskFile*> predictionsWithoutLabel;

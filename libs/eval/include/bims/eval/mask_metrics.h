@@ -53,6 +53,11 @@ struct MaskMetrics
 	/** "precision P recall R F1 F IoU I" with 4 decimals ("nan" if
 	 * undefined). */
 	std::string scoresLine() const;
+	/** One frame's figures: scoresLine(), or for a frame without a moving
+	 * label (where precision and F1 are 0 or undefined whatever the
+	 * segmentation does) its false positives, "no moving label: fp N,
+	 * static as moving S". */
+	std::string frameScoresLine() const;
 	/** JSON object with counts and scores. */
 	Json toJson() const;
 };

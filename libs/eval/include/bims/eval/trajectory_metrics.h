@@ -68,6 +68,8 @@ struct RpeResult
 {
 	/** (est index i, est index j) pairs used. */
 	IndexPairs pairs;
+	/** The ground-truth poses of each pair (gt index at i, at j). */
+	IndexPairs gtPairs;
 	/** Per pair, |translation of E| / delta [m/s] where
 	 * E = (G_i^-1 G_j)^-1 (E_i^-1 E_j). */
 	std::vector<double> transErrors;
@@ -85,6 +87,30 @@ struct RpeResult
  * (e.g. no time overlap, or the estimate spans less than delta). */
 RpeResult computeRpe(const Trajectory& gt, const Trajectory& est,
                      const RpeOptions& opt = {});
+
+/** What the positions alone say of the RPE's pairs: per pair, the
+ * ground truth's displacement against the estimate's, both in the ground
+ * truth's world (the estimate's rotated by the ATE's alignment),
+ * |dp_gt - R dp_est| / delta [m/s]. When both trajectories' orientations
+ * are of the same body frame this equals the RPE's translation error
+ * (|t(E)| = |R_Gi^T dp_gt - R_Ei^T dp_est|); far below it, the
+ * orientations disagree with the positions. */
+ErrorStats displacementErrors(const Trajectory& gt, const Trajectory& est,
+                              const RpeResult& rpe, const AteResult& ate,
+                              const RpeOptions& opt = {});
+
+/** The rule of bims-eval traj's body-frame warning: the RPE's translation
+ * RMSE at least kBodyFrameMinRpe, at least kBodyFrameRatio times the
+ * displacements' (the same pairs compared in the aligned world) and, per
+ * delta, at least twice the ATE RMSE: the positions agree but the relative
+ * motions, read in each trajectory's own body frame, do not. The likely
+ * cause: poses of another body than the camera (Bonn's groundtruth.txt is
+ * the motion-capture marker's). */
+inline constexpr double kBodyFrameRatio = 3.0;
+inline constexpr double kBodyFrameMinRpe = 0.01;  ///< [m/s]
+bool orientationsDisagreeWithPositions(const ErrorStats& rpeTrans,
+                                       const ErrorStats& displacement,
+                                       const ErrorStats& ate, double delta);
 
 /** Both metrics plus the inputs' sizes, for reports. */
 struct TrajectoryReport

@@ -127,6 +127,10 @@ struct OutputParams
 	bool moving_ply = true;  ///< moving_voxels/NNNNNN.ply per frame
 	bool static_map = true;  ///< static_map.ply and static_map.bt at the end
 	bool labelled_rawlog = true;  ///< segmented.rawlog with pixel labels
+	/** segmented.rawlog holds the input's images too (a whole copy: 2.9x the
+	 * input on the Bonn slice); false: each 3D scan with its stamp, sensor
+	 * label, camera and the labels only, read beside the input. */
+	bool labelled_rawlog_images = false;
 	/** gzip level of segmented.rawlog: 0 = plain (default: gzip costs more
 	 * than the whole pipeline at 640x480), 1..9 = gzip. */
 	int labelled_rawlog_gz_level = 0;
