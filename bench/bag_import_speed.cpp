@@ -5,7 +5,7 @@
 // Prints the frames per second of each, the best of 3 runs.
 //   build/bin/bag_import_speed [N=300] [WORK_DIR=/tmp/bims_bag_bench]
 #include <bims/bag/bag_import.h>
-#include <bims/common/rawlog.h>
+#include <bims/io/rawlog.h>
 #include <bims_test/bag_writer.h>
 
 #include <chrono>

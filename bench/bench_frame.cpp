@@ -21,14 +21,14 @@
 // dense alignment (ego/dense_*) uses the experiment's [anchor] section, the
 // earlier frame as the keyframe, and two initial guesses (no motion, and the
 // pair's pose), as KeyframeAnchor::track gives it.
-#include <bims/common/rawlog.h>
-#include <bims/common/trajectory.h>
 #include <bims/ego/dense_align.h>
 #include <bims/ego/gyro_klt.h>
 #include <bims/ego/rgbd_input.h>
 #include <bims/flow/consistency.h>
 #include <bims/flow/expected_flow.h>
 #include <bims/flow/observed_flow.h>
+#include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
 #include <bims/pipeline/surface_fill.h>
 
 #include <mrpt/config/CConfigFile.h>

@@ -10,9 +10,9 @@
 //
 //   bench_maps [--bonn_depth=PNG] [--sim_rawlog=RAWLOG] [--sim_frame=N]
 //              [--voxels=0.02,0.05] [benchmark flags]
-#include <bims/common/json.h>
-#include <bims/common/rawlog.h>
 #include <bims/eval/tum_import.h>
+#include <bims/io/json.h>
+#include <bims/io/rawlog.h>
 #include <bims/maps/dda.h>
 #include <bims/maps/motion_grids.h>
 #include <bims/maps/ray_marks.h>

@@ -1,6 +1,6 @@
 #include "json_reporter.h"
 
-#include <bims/common/json.h>
+#include <bims/io/json.h>
 
 #include <cmath>
 #include <cstdio>

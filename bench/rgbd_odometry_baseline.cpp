@@ -11,11 +11,11 @@
 // --no-depth-correction. Prints the median and p95 ms per frame of compute().
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
-#include <bims/common/rawlog.h>
-#include <bims/common/trajectory.h>
 #include <bims/ego/depth_correction.h>
 #include <bims/ego/odometry.h>
 #include <bims/ego/rgbd_input.h>
+#include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
 #include <bims/pipeline/run.h>
 
 #include <mrpt/config/CConfigFile.h>

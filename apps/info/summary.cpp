@@ -1,6 +1,6 @@
 #include "summary.h"
 
-#include <bims/common/rawlog.h>
+#include <bims/io/rawlog.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationImage.h>
 #include <mrpt/system/datetime.h>

@@ -1,12 +1,12 @@
 // bims-maps-figure's picture (figure.h).
 #include "figure.h"
 
-#include <bims/common/frame_files.h>
 #include <bims/common/frames.h>
-#include <bims/common/image_file.h>
-#include <bims/common/rawlog.h>
-#include <bims/common/trajectory.h>
 #include <bims/eval/association.h>
+#include <bims/io/frame_files.h>
+#include <bims/io/image_file.h>
+#include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
 #include <bims/maps/export.h>
 #include <bims/maps/motion_grids.h>
 #include <filesystem>

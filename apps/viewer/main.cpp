@@ -11,8 +11,8 @@
 // --screenshot writes the 3D view as shown in the window and quits.
 #include <bims/apps/app.h>
 #include <bims/apps/output_checks.h>
-#include <bims/common/output_paths.h>
 #include <bims/common/share.h>
+#include <bims/io/output_paths.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
 #include <cmath>

@@ -1,7 +1,7 @@
 #include "scene_canvas.h"
 
 #include <GL/gl.h>
-#include <bims/common/output_paths.h>
+#include <bims/io/output_paths.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>

@@ -1,8 +1,8 @@
 #include "viewer_frame.h"
 
-#include <bims/common/frame_files.h>
-#include <bims/common/json.h>
-#include <bims/common/output_paths.h>
+#include <bims/io/frame_files.h>
+#include <bims/io/json.h>
+#include <bims/io/output_paths.h>
 
 #include <wx/aboutdlg.h>
 #include <wx/dirdlg.h>

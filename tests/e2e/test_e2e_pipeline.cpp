@@ -1,11 +1,11 @@
 // End-to-end: the whole pipeline on the bundled simulator sample, scored
 // against its exact ground-truth masks; and the pipeline's behaviour on bad
 // input (truncated rawlog, no IMU, wrong sensor label).
-#include <bims/common/json.h>
-#include <bims/common/rawlog.h>
 #include <bims/ego/flags.h>
 #include <bims/eval/mask_metrics.h>
 #include <bims/eval/trajectory_metrics.h>
+#include <bims/io/json.h>
+#include <bims/io/rawlog.h>
 #include <bims/pipeline/pipeline.h>
 #include <bims/pipeline/run.h>
 #include <gtest/gtest.h>

@@ -4,12 +4,12 @@
 // same preset, its trajectory against ARKit's poses and its masks against the
 // capture's proxy labels. Regression floors of the figures of
 // bench/stray_real.sh (docs/journal/phone-lidar-imu.md).
-#include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
 #include <bims/eval/mask_labels.h>
 #include <bims/eval/mask_metrics.h>
 #include <bims/eval/stray_import.h>
 #include <bims/eval/trajectory_metrics.h>
+#include <bims/io/trajectory.h>
 #include <bims/pipeline/run.h>
 #include <bims_test/data.h>
 #include <bims_test/tmp_dir.h>

@@ -1,8 +1,8 @@
 // Fuzz target: an image file as every importer and bims-eval read it
-// (bims/common/image_file.h): the header check (PNG, JPEG, TIFF, BMP; the
+// (bims/io/image_file.h): the header check (PNG, JPEG, TIFF, BMP; the
 // declared size against the limits before anything is decoded), then the
 // decoding, as stored (depth, labels) and as colour.
-#include <bims/common/image_file.h>
+#include <bims/io/image_file.h>
 
 #include <exception>
 #include <opencv2/imgcodecs.hpp>

@@ -1,9 +1,9 @@
 // Fuzz target: the rawlog reader (every program reads rawlogs through it,
 // with the scan-size guard before MRPT allocates) and the checks a frame
 // passes before use (rgbdFrameFrom, the IMU sample conversion).
-#include <bims/common/rawlog.h>
 #include <bims/ego/attitude_filter.h>
 #include <bims/ego/rgbd_input.h>
+#include <bims/io/rawlog.h>
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>

@@ -1,8 +1,8 @@
 // Fuzz target: the TUM / Bonn folder index (rgb.txt, depth.txt,
 // groundtruth.txt, accelerometer.txt: the input's parts, separated by lines
 // "--"; an empty part is a missing file) and the TUM trajectory reader.
-#include <bims/common/trajectory.h>
 #include <bims/eval/tum_import.h>
+#include <bims/io/trajectory.h>
 
 #include <cstdio>
 #include <exception>

@@ -3,7 +3,7 @@
 // OUT_DIR/rawlog: the sample's first scans shrunk to 32 x 24 (depth,
 // intensity, camera models) with the IMU samples between them, plain;
 // OUT_DIR/labels and OUT_DIR/tum: small hand-made inputs of each kind.
-#include <bims/common/rawlog.h>
+#include <bims/io/rawlog.h>
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>

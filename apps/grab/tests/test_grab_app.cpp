@@ -1,6 +1,6 @@
 // bims-grab end to end without hardware: OpenNI2's Dummy device + the
 // simulated IMU of the bundled sample replayed in real time.
-#include <bims/common/rawlog.h>
+#include <bims/io/rawlog.h>
 #include <bims_test/text.h>
 #include <gtest/gtest.h>
 

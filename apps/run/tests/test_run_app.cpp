@@ -1,7 +1,7 @@
 // bims-run as a program: what it refuses before any work, and what it never
 // does to files it did not create.
-#include <bims/common/frame_files.h>
-#include <bims/common/json.h>
+#include <bims/io/frame_files.h>
+#include <bims/io/json.h>
 #include <bims_test/run_command.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // bims-sweep as a program, over the bundled sample (10 frames a run): the
 // runs, their table and plot, a failed run, the jobs file and --collect,
 // bad input refused before any run, Ctrl-C.
-#include <bims/common/json.h>
+#include <bims/io/json.h>
 #include <bims_test/run_command.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>

@@ -1,9 +1,9 @@
 // bims-viewer under Xvfb: the real wx window with MRPT's GL canvas opens the
 // bundled rawlog, steps frames with the pipeline, and the 3D view it drew
 // (read back from the canvas) shows the three tier colours.
-#include <bims/common/frame_files.h>
-#include <bims/common/json.h>
-#include <bims/common/rawlog.h>
+#include <bims/io/frame_files.h>
+#include <bims/io/json.h>
+#include <bims/io/rawlog.h>
 #include <bims/viewer/panels.h>
 #include <bims_test/data.h>
 #include <bims_test/text.h>

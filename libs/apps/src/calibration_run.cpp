@@ -3,10 +3,10 @@
 #include <bims/apps/frame_range_option.h>
 #include <bims/apps/odometry_run.h>
 #include <bims/apps/output_checks.h>
-#include <bims/common/output_paths.h>
 #include <bims/common/so3.h>
-#include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
+#include <bims/io/output_paths.h>
+#include <bims/io/trajectory.h>
 #include <bims/source/frame_source.h>
 
 #include <mrpt/system/filesystem.h>

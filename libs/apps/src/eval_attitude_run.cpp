@@ -2,9 +2,9 @@
 #include <bims/apps/app.h>
 #include <bims/apps/eval_run.h>
 #include <bims/apps/output_checks.h>
-#include <bims/common/json.h>
-#include <bims/common/trajectory.h>
 #include <bims/eval/attitude_metrics.h>
+#include <bims/io/json.h>
+#include <bims/io/trajectory.h>
 
 #include <cstdio>
 #include <filesystem>

@@ -1,9 +1,9 @@
 // bims-eval depth-consistency (eval_run.h).
 #include <bims/apps/eval_run.h>
-#include <bims/common/rawlog.h>
-#include <bims/common/trajectory.h>
 #include <bims/eval/depth_consistency.h>
 #include <bims/eval/pose_utils.h>
+#include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
 #include <algorithm>

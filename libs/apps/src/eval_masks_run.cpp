@@ -6,14 +6,14 @@
 #include <bims/apps/eval_run.h>
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
-#include <bims/common/frame_files.h>
-#include <bims/common/json.h>
-#include <bims/common/output_paths.h>
-#include <bims/common/rawlog.h>
 #include <bims/eval/depth_consistency.h>
 #include <bims/eval/mask_labels.h>
 #include <bims/eval/mask_metrics.h>
 #include <bims/eval/plots.h>
+#include <bims/io/frame_files.h>
+#include <bims/io/json.h>
+#include <bims/io/output_paths.h>
+#include <bims/io/rawlog.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
 #include <algorithm>

@@ -1,10 +1,10 @@
 // bims-eval traj (eval_run.h).
 #include <bims/apps/eval_run.h>
 #include <bims/apps/output_checks.h>
-#include <bims/common/json.h>
-#include <bims/common/trajectory.h>
 #include <bims/eval/plots.h>
 #include <bims/eval/trajectory_metrics.h>
+#include <bims/io/json.h>
+#include <bims/io/trajectory.h>
 
 #include <cmath>
 #include <cstdio>

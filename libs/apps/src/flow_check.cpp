@@ -3,11 +3,11 @@
 #include <bims/apps/frame_range_option.h>
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
-#include <bims/common/output_paths.h>
-#include <bims/common/trajectory.h>
 #include <bims/ego/rgbd_input.h>
 #include <bims/eval/plots.h>
 #include <bims/eval/pose_utils.h>
+#include <bims/io/output_paths.h>
+#include <bims/io/trajectory.h>
 #include <bims/pipeline/mask_overlay.h>
 #include <bims/pipeline/run.h>
 

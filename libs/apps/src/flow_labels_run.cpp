@@ -4,9 +4,9 @@
 #include <bims/common/choice.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
-#include <bims/common/image_file.h>
-#include <bims/common/output_paths.h>
 #include <bims/flow/observed_flow.h>
+#include <bims/io/image_file.h>
+#include <bims/io/output_paths.h>
 #include <mrpt/core/bits_math.h>
 #include <mrpt/system/filesystem.h>
 

@@ -1,9 +1,9 @@
 #include <bims/apps/odometry_replay.h>
 #include <bims/apps/progress_bar.h>
-#include <bims/common/frame_files.h>
-#include <bims/common/image_file.h>
-#include <bims/common/rawlog.h>
 #include <bims/ego/flags.h>
+#include <bims/io/frame_files.h>
+#include <bims/io/image_file.h>
+#include <bims/io/rawlog.h>
 
 #include <opencv2/imgcodecs.hpp>
 

@@ -3,11 +3,11 @@
 #include <bims/apps/output_checks.h>
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
-#include <bims/common/output_paths.h>
-#include <bims/common/rawlog.h>
 #include <bims/common/so3.h>
 #include <bims/common/stats.h>
 #include <bims/ego/flags.h>
+#include <bims/io/output_paths.h>
+#include <bims/io/rawlog.h>
 
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/system/filesystem.h>

@@ -8,7 +8,7 @@
 #include <bims/apps/run_command.h>
 #include <bims/apps/run_report.h>
 #include <bims/common/choice.h>
-#include <bims/common/rawlog.h>
+#include <bims/io/rawlog.h>
 
 #include <csignal>
 #include <cstdio>
@@ -75,6 +75,7 @@ int runFromCommandLine(const RunCommand& c)
 	RunOptions opt;
 	opt.rawlogs = c.rawlogs;
 	opt.outDir = c.outDir;
+	opt.laterFiles = {"report.md"};  // writeRunReport, after the run
 	ProgressBar bar("bims-run", 0, c.progress);
 	opt.progress = bar.callback();
 	if (c.installStop) opt.stop = &c.installStop();

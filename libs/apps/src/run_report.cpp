@@ -1,11 +1,11 @@
 #include <bims/apps/run_report.h>
-#include <bims/common/frame_files.h>
-#include <bims/common/json.h>
-#include <bims/common/output_paths.h>
-#include <bims/common/trajectory.h>
 #include <bims/eval/mask_labels.h>
 #include <bims/eval/mask_metrics.h>
 #include <bims/eval/trajectory_metrics.h>
+#include <bims/io/frame_files.h>
+#include <bims/io/json.h>
+#include <bims/io/output_paths.h>
+#include <bims/io/trajectory.h>
 #include <opencv2/core.hpp>
 
 #include <algorithm>

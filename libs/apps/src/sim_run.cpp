@@ -3,9 +3,9 @@
 #include <bims/apps/progress_bar.h>
 #include <bims/apps/sim_run.h>
 #include <bims/common/config.h>
-#include <bims/common/output_paths.h>
-#include <bims/common/rawlog.h>
-#include <bims/common/trajectory.h>
+#include <bims/io/output_paths.h>
+#include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
 #include <bims/sim/imu.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/format.h>

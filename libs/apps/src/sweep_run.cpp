@@ -3,8 +3,8 @@
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
 #include <bims/apps/sweep_run.h>
-#include <bims/common/output_paths.h>
 #include <bims/common/share.h>
+#include <bims/io/output_paths.h>
 #include <bims/pipeline/run.h>
 #include <bims/sweep/plan.h>
 #include <bims/sweep/processes.h>

@@ -4,8 +4,8 @@
 #include <bims/apps/progress_bar.h>
 #include <bims/apps/tum_import_run.h>
 #include <bims/common/config.h>
-#include <bims/common/output_paths.h>
 #include <bims/eval/pose_utils.h>
+#include <bims/io/output_paths.h>
 #include <bims/sim/imu.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/format.h>

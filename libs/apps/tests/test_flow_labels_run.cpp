@@ -80,7 +80,7 @@ TEST(FlowLabelsRun, TheRunWritesFourPicturesAndNamesBadInputs)
 	bad = o;
 	bad.rgb1 = d + "/none.png";
 	EXPECT_EQ(errorOf(bad), d + "/none.png: cannot read image: no such file");
-	// a decompression bomb: refused from its header (bims/common/image_file.h)
+	// a decompression bomb: refused from its header (bims/io/image_file.h)
 	bad = o;
 	bims::test::writePngBomb(d + "/bomb.png");
 	bad.rgb0 = d + "/bomb.png";

@@ -2,7 +2,7 @@
 // what is done with each grabbed frame, fed the bundled sample's
 // observations as a grab hands them over (a scan and the IMU before it).
 #include <bims/apps/grab_run.h>
-#include <bims/common/rawlog.h>
+#include <bims/io/rawlog.h>
 #include <gtest/gtest.h>
 
 #include <mrpt/obs/CObservation3DRangeScan.h>

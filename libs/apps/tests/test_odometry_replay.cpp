@@ -3,10 +3,10 @@
 // the ground truth (from frame 30 on) stays below bounds measured when this
 // test was written (docs/journal/egomotion.md, "Egomotion"), in both modes.
 #include <bims/apps/odometry_replay.h>
-#include <bims/common/rawlog.h>
 #include <bims/common/so3.h>
-#include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
+#include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
 #include <gtest/gtest.h>
 
 #include <mrpt/config/CConfigFile.h>

@@ -4,7 +4,7 @@
 #include <bims/apps/app.h>
 #include <bims/apps/odometry_run.h>
 #include <bims/common/config.h>
-#include <bims/common/trajectory.h>
+#include <bims/io/trajectory.h>
 #include <bims_test/sample.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>

@@ -3,7 +3,7 @@
 // links to its outputs.
 #include <bims/apps/run_command.h>
 #include <bims/apps/run_report.h>
-#include <bims/common/trajectory.h>
+#include <bims/io/trajectory.h>
 #include <bims_test/sample.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>

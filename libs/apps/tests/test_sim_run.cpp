@@ -3,8 +3,8 @@
 // the summary line; the synthetic IMU of bims-import-tum --synth-imu.
 #include <bims/apps/app.h>
 #include <bims/apps/sim_run.h>
-#include <bims/common/rawlog.h>
-#include <bims/common/trajectory.h>
+#include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
 #include <bims/sim/imu.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>

@@ -3,9 +3,9 @@
 #include <bims/apps/app.h>
 #include <bims/apps/tum_import_run.h>
 #include <bims/common/config.h>
-#include <bims/common/rawlog.h>
-#include <bims/common/trajectory.h>
 #include <bims/eval/pose_utils.h>
+#include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 #include <mrpt/obs/CObservationIMU.h>

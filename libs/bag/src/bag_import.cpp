@@ -1,9 +1,9 @@
 #include <bims/bag/bag_import.h>
-#include <bims/common/output_paths.h>
 #include <bims/common/progress.h>
-#include <bims/common/rawlog.h>
 #include <bims/eval/association.h>
 #include <bims/eval/rgbd_frame.h>
+#include <bims/io/output_paths.h>
+#include <bims/io/rawlog.h>
 #include <cv_bridge/cv_bridge.h>
 #include <mrpt/core/format.h>
 #include <rosbag/bag.h>

@@ -5,10 +5,11 @@
 // the TUM folder of the same frames; and the bad bags users meet.
 #include <bims/bag/bag_import.h>
 #include <bims/common/config.h>
-#include <bims/common/rawlog.h>
 #include <bims/ego/attitude_filter.h>
 #include <bims/eval/tum_import.h>
+#include <bims/io/rawlog.h>
 #include <bims_test/bag_writer.h>
+#include <bims_test/error_of.h>
 #include <bims_test/run_command.h>
 #include <bims_test/sample.h>
 #include <bims_test/text.h>
@@ -95,15 +96,7 @@ bag::BagImportSummary import(const std::string& bagPath, const std::string& out,
 
 std::string errorOf(const std::function<void()>& f)
 {
-	try
-	{
-		f();
-	}
-	catch (const std::exception& e)
-	{
-		return e.what();
-	}
-	return "(no error)";
+	return bims::test::errorOf(f, "(no error)");
 }
 
 /** Every frame of \a got equals the sample's: range image, colour, stamp

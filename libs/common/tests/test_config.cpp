@@ -1,8 +1,9 @@
 #include <bims/common/config.h>
+#include <bims_test/error_of.h>
 #include <gtest/gtest.h>
 
+#include <bims_test/tmp_dir.h>
 #include <mrpt/config/CConfigFileMemory.h>
-#include "tmp_path.h"
 
 #include <filesystem>
 #include <fstream>
@@ -11,20 +12,10 @@
 using bims::ConfigError;
 using bims::ConfigSection;
 
+using bims::test::errorOf;
+
 namespace
 {
-std::string errorOf(const std::function<void()>& f)
-{
-	try
-	{
-		f();
-	}
-	catch (const ConfigError& e)
-	{
-		return e.what();
-	}
-	return {};
-}
 }  // namespace
 
 TEST(ConfigSection, ReadsTypedValuesAndDefaults)
@@ -57,7 +48,7 @@ TEST(ConfigSection, ListsOfWordsAndOfCommaSeparatedItems)
 	EXPECT_TRUE(s.getWords("absent").empty());
 	EXPECT_TRUE(s.getList("absent2").empty());
 	for (const char* k : {"gap", "end", "blank"})
-		EXPECT_NE(errorOf([&] { s.getList(k); })
+		EXPECT_NE(errorOf<bims::ConfigError>([&] { s.getList(k); })
 		              .find(std::string("[a] ") + k + ": '"),
 		          std::string::npos)
 		    << k;
@@ -69,7 +60,7 @@ TEST(ConfigSection, UnknownKeyIsAnErrorNamingSectionAndKey)
 	mrpt::config::CConfigFileMemory cfg("[a]\nx = 1\nxx = 2\n");
 	ConfigSection s(cfg, "a");
 	s.getDouble("x", 0, 0, 10);
-	const auto msg = errorOf([&] { s.finish(); });
+	const auto msg = errorOf<bims::ConfigError>([&] { s.finish(); });
 	EXPECT_NE(msg.find("[a] xx: unknown key"), std::string::npos) << msg;
 	EXPECT_NE(msg.find("<memory>"), std::string::npos) << msg;
 }
@@ -79,33 +70,39 @@ TEST(ConfigSection, OutOfRangeAndMalformedValuesAreErrors)
 	mrpt::config::CConfigFileMemory cfg(
 	    "[a]\nx = 11\ny = abc\nn = 2.5\nb = maybe\nm = other\nv = 1 2\n");
 	ConfigSection s(cfg, "a");
-	EXPECT_NE(errorOf([&] { s.getDouble("x", 0, 0, 10); }).find("out of range"),
+	EXPECT_NE(errorOf<bims::ConfigError>([&] { s.getDouble("x", 0, 0, 10); })
+	              .find("out of range"),
 	          std::string::npos);
-	EXPECT_NE(errorOf([&] { s.getDouble("y", 0, 0, 10); }).find("[a] y:"),
+	EXPECT_NE(errorOf<bims::ConfigError>([&] { s.getDouble("y", 0, 0, 10); })
+	              .find("[a] y:"),
 	          std::string::npos);
-	EXPECT_NE(errorOf([&] { s.getInt("n", 0, 0, 10); }).find("not an integer"),
+	EXPECT_NE(errorOf<bims::ConfigError>([&] { s.getInt("n", 0, 0, 10); })
+	              .find("not an integer"),
 	          std::string::npos);
-	EXPECT_NE(errorOf([&] { s.getBool("b", false); }).find("not a boolean"),
+	EXPECT_NE(errorOf<bims::ConfigError>([&] { s.getBool("b", false); })
+	              .find("not a boolean"),
 	          std::string::npos);
-	EXPECT_NE(errorOf(
+	EXPECT_NE(errorOf<bims::ConfigError>(
 	              [&] {
 		              s.getChoice("m", "a", {"a", "b"});
 	              })
 	              .find("a|b"),
 	          std::string::npos);
 	EXPECT_NE(
-	    errorOf([&] { s.getDoubles("v", {}, 3, 0, 9); }).find("expected 3"),
+	    errorOf<bims::ConfigError>([&] { s.getDoubles("v", {}, 3, 0, 9); })
+	        .find("expected 3"),
 	    std::string::npos);
 }
 
 TEST(ConfigSection, RequiredKeysAndSections)
 {
 	mrpt::config::CConfigFileMemory cfg("[a]\nx = 1\n");
-	EXPECT_NE(errorOf([&] { ConfigSection(cfg, "b", true); })
+	EXPECT_NE(errorOf<bims::ConfigError>([&] { ConfigSection(cfg, "b", true); })
 	              .find("missing required section [b]"),
 	          std::string::npos);
 	ConfigSection s(cfg, "a");
-	EXPECT_NE(errorOf([&] { s.requireDouble("y", 0, 1); }).find("required key"),
+	EXPECT_NE(errorOf<bims::ConfigError>([&] { s.requireDouble("y", 0, 1); })
+	              .find("required key"),
 	          std::string::npos);
 	EXPECT_DOUBLE_EQ(s.requireDouble("x", 0, 1), 1.0);
 }
@@ -114,8 +111,8 @@ TEST(ConfigSection, UnknownSectionsAreErrors)
 {
 	mrpt::config::CConfigFileMemory cfg(
 	    "[a]\nx=1\n[map_voxel_00]\ny=2\n[oops]\nz=3\n");
-	const auto msg =
-	    errorOf([&] { bims::checkSections(cfg, {"a"}, {"map_"}); });
+	const auto msg = errorOf<bims::ConfigError>(
+	    [&] { bims::checkSections(cfg, {"a"}, {"map_"}); });
 	EXPECT_NE(msg.find("[oops]: unknown section"), std::string::npos) << msg;
 }
 
@@ -124,9 +121,9 @@ namespace
 /** The ConfigError of checking an .ini file holding \a text ("" if none). */
 std::string iniError(const std::string& text, const std::string& name)
 {
-	const auto p = bims::test::tmpPath(name);
+	const auto p = bims::test::tmpPath("bims_test_common", name);
 	std::ofstream(p) << text;
-	return errorOf([&] { bims::checkIniFile(p); });
+	return errorOf<bims::ConfigError>([&] { bims::checkIniFile(p); });
 }
 }  // namespace
 
@@ -168,14 +165,14 @@ TEST(IniSyntax, AFolderOrAMissingFileIsNamed)
 	const auto dir =
 	    std::filesystem::temp_directory_path() / "bims_test_common";
 	std::filesystem::create_directories(dir / "a_folder.ini");
-	EXPECT_NE(
-	    errorOf([&] { bims::checkIniFile((dir / "a_folder.ini").string()); })
-	        .find("a_folder.ini: not a regular file"),
-	    std::string::npos);
-	EXPECT_NE(
-	    errorOf([&] { bims::checkIniFile((dir / "missing.ini").string()); })
-	        .find("missing.ini: no such config file"),
-	    std::string::npos);
+	EXPECT_NE(errorOf<bims::ConfigError>(
+	              [&] { bims::checkIniFile((dir / "a_folder.ini").string()); })
+	              .find("a_folder.ini: not a regular file"),
+	          std::string::npos);
+	EXPECT_NE(errorOf<bims::ConfigError>(
+	              [&] { bims::checkIniFile((dir / "missing.ini").string()); })
+	              .find("missing.ini: no such config file"),
+	          std::string::npos);
 }
 
 TEST(IniSyntax, EveryBundledIniPasses)
@@ -188,8 +185,9 @@ TEST(IniSyntax, EveryBundledIniPasses)
 		for (const auto& e : std::filesystem::recursive_directory_iterator(d))
 			if (e.path().extension() == ".ini")
 			{
-				EXPECT_EQ(
-				    errorOf([&] { bims::checkIniFile(e.path().string()); }), "")
+				EXPECT_EQ(errorOf<bims::ConfigError>(
+				              [&] { bims::checkIniFile(e.path().string()); }),
+				          "")
 				    << e.path();
 				n++;
 			}
@@ -222,15 +220,15 @@ TEST(IniSyntax, BomIncludeAndBinaryBytesAreRefused)
 
 TEST(IniSyntax, OpenIniFileTurnsMrptErrorsIntoOneLine)
 {
-	const auto p = bims::test::tmpPath("undefined_var.ini");
+	const auto p = bims::test::tmpPath("bims_test_common", "undefined_var.ini");
 	std::ofstream(p) << "[a]\nx = ${UNDEFINED_BIMS_VAR}\n";
-	const auto e = errorOf([&] { bims::openIniFile(p); });
+	const auto e = errorOf<bims::ConfigError>([&] { bims::openIniFile(p); });
 	EXPECT_EQ(e.rfind(p + ": ", 0), 0u) << e;
 	EXPECT_NE(e.find("UNDEFINED_BIMS_VAR"), std::string::npos) << e;
 	EXPECT_EQ(e.find("backtrace"), std::string::npos) << e;
 	EXPECT_EQ(e.find('\n'), std::string::npos) << e;
 	// @define works as MRPT reads it
-	const auto q = bims::test::tmpPath("define_var.ini");
+	const auto q = bims::test::tmpPath("bims_test_common", "define_var.ini");
 	std::ofstream(q) << "@define V 0.25\n[a]\nx = ${V}\n";
 	const auto cfg = bims::openIniFile(q);
 	EXPECT_DOUBLE_EQ(cfg->read_double("a", "x", 0), 0.25);

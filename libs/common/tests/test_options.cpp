@@ -3,12 +3,15 @@
 #include <bims/common/choice.h>
 #include <bims/common/config.h>
 #include <bims/common/options.h>
+#include <bims_test/error_of.h>
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
 
 #include <cmath>
 #include <functional>
 #include <limits>
+
+using bims::test::errorOf;
 
 namespace
 {
@@ -59,19 +62,6 @@ struct Opts
 	}
 };
 
-std::string errorOf(const std::function<void()>& f)
-{
-	try
-	{
-		f();
-	}
-	catch (const bims::ConfigError& e)
-	{
-		return e.what();
-	}
-	return {};
-}
-
 Opts read(const std::string& ini)
 {
 	mrpt::config::CConfigFileMemory cfg(ini);
@@ -110,9 +100,10 @@ TEST(Choice, AnIniValueOutsideTheTableNamesFileSectionKeyValueAndChoices)
 	bims::ConfigSection s(cfg, "paint");
 	EXPECT_EQ(s.getChoice("other", Colour::Green), Colour::Red);
 	EXPECT_EQ(s.getChoice("absent", Colour::DarkBlue), Colour::DarkBlue);
-	EXPECT_EQ(errorOf([&] { s.getChoice("colour", Colour::Red); }),
-	          "<memory>: [paint] colour: 'blue' is not one of "
-	          "red|green|dark-blue");
+	EXPECT_EQ(
+	    errorOf<bims::ConfigError>([&] { s.getChoice("colour", Colour::Red); }),
+	    "<memory>: [paint] colour: 'blue' is not one of "
+	    "red|green|dark-blue");
 }
 
 TEST(Options, ReadsEveryKindOfKeyAndRejectsWhatTheDescriptionForbids)
@@ -133,14 +124,14 @@ TEST(Options, ReadsEveryKindOfKeyAndRejectsWhatTheDescriptionForbids)
 	EXPECT_EQ(read("[s]\n").label, "RGBD");
 	EXPECT_FALSE(read("[s]\n").given);
 
-	EXPECT_EQ(errorOf([] { read("[s]\ngain = 2\n"); }),
+	EXPECT_EQ(errorOf<bims::ConfigError>([] { read("[s]\ngain = 2\n"); }),
 	          "<memory>: [s] gain: value 2 out of range [0, 1]");
-	EXPECT_EQ(errorOf([] { read("[s]\nlo = 3\n"); }),
+	EXPECT_EQ(errorOf<bims::ConfigError>([] { read("[s]\nlo = 3\n"); }),
 	          "<memory>: [s] hi: must be greater than lo");
-	EXPECT_NE(errorOf([] { read("[s]\ncolor = red\n"); })
+	EXPECT_NE(errorOf<bims::ConfigError>([] { read("[s]\ncolor = red\n"); })
 	              .find("[s] color: unknown key"),
 	          std::string::npos);
-	EXPECT_NE(errorOf([] { read("[s]\ncolour = blue\n"); })
+	EXPECT_NE(errorOf<bims::ConfigError>([] { read("[s]\ncolour = blue\n"); })
 	              .find("'blue' is not one of red|green|dark-blue"),
 	          std::string::npos);
 }
@@ -161,8 +152,9 @@ TEST(Options, AGroupIsAllOrNothing)
 	};
 	mrpt::config::CConfigFileMemory half(std::string("[s]\na = 1\n"));
 	Pair p;
-	EXPECT_EQ(errorOf([&] { bims::readOptions(p, half, "s"); }),
-	          "<memory>: [s] b: missing: give all of a b or none");
+	EXPECT_EQ(
+	    errorOf<bims::ConfigError>([&] { bims::readOptions(p, half, "s"); }),
+	    "<memory>: [s] b: missing: give all of a b or none");
 }
 
 TEST(Options, WrittenValuesReadBackToTheSameOptions)

@@ -8,8 +8,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <bims_test/tmp_dir.h>
 #include "bims_test/text.h"
-#include "tmp_path.h"
 
 namespace fs = std::filesystem;
 
@@ -56,7 +56,8 @@ TEST(Share, AnyPrefixIsFoundFromItsBinFolderAndMayBeMoved)
 {
 	// An install prefix anywhere (not the one compiled in): found from its
 	// bin/ folder, and only from there.
-	const fs::path prefix = bims::test::tmpPath("share_prefix");
+	const fs::path prefix =
+	    bims::test::tmpPath("bims_test_common", "share_prefix");
 	fs::remove_all(prefix);
 	fs::create_directories(prefix / "bin");
 	fs::create_directories(prefix / "share" / "bims" / "sim");
@@ -67,7 +68,8 @@ TEST(Share, AnyPrefixIsFoundFromItsBinFolderAndMayBeMoved)
 	EXPECT_EQ(found,
 	          (prefix / "share" / "bims" / "sim" / "only_here.ini").string());
 	// Moved: the program's new folder finds it there.
-	const fs::path moved = bims::test::tmpPath("share_prefix_moved");
+	const fs::path moved =
+	    bims::test::tmpPath("bims_test_common", "share_prefix_moved");
 	fs::remove_all(moved);
 	fs::rename(prefix, moved);
 	EXPECT_EQ(

@@ -1,5 +1,5 @@
-#include <bims/common/image_file.h>
 #include <bims/eval/mask_metrics.h>
+#include <bims/io/image_file.h>
 #include <map>
 #include <tuple>
 

@@ -1,5 +1,5 @@
-#include <bims/common/output_paths.h>
 #include <bims/eval/plots.h>
+#include <bims/io/output_paths.h>
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 #include <bims/common/config.h>
-#include <bims/common/image_file.h>
 #include <bims/eval/rgbd_frame.h>
+#include <bims/io/image_file.h>
 #include <mrpt/core/Clock.h>
 
 #include <cmath>

@@ -1,10 +1,10 @@
-#include <bims/common/image_file.h>
-#include <bims/common/output_paths.h>
 #include <bims/common/progress.h>
-#include <bims/common/rawlog.h>
 #include <bims/eval/pose_utils.h>
 #include <bims/eval/rgbd_frame.h>
 #include <bims/eval/tum_import.h>
+#include <bims/io/image_file.h>
+#include <bims/io/output_paths.h>
+#include <bims/io/rawlog.h>
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/system/datetime.h>
 

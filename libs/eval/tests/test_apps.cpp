@@ -1,10 +1,10 @@
 // End-to-end tests of bims-import-tum and bims-eval (run the built programs).
-#include <bims/common/frame_files.h>
-#include <bims/common/rawlog.h>
-#include <bims/common/trajectory.h>
 #include <bims/common/version.h>
 #include <bims/eval/pose_utils.h>
 #include <bims/eval/tum_import.h>
+#include <bims/io/frame_files.h>
+#include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
 #include <bims_test/data.h>
 #include <bims_test/png_bomb.h>
 #include <bims_test/run_command.h>

@@ -3,9 +3,9 @@
 // convention by convention; bad input; the shared real capture (skipped without
 // it); the built program's command line.
 #include <bims/common/config.h>
-#include <bims/common/rawlog.h>
-#include <bims/common/trajectory.h>
 #include <bims/eval/stray_import.h>
+#include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
 #include <bims_test/data.h>
 #include <bims_test/run_command.h>
 #include <bims_test/tmp_dir.h>

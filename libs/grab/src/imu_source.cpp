@@ -1,7 +1,7 @@
 #include <bims/common/config.h>
-#include <bims/common/rawlog.h>
 #include <bims/grab/host_clock.h>
 #include <bims/grab/imu_source.h>
+#include <bims/io/rawlog.h>
 
 #include <mrpt/hwdrivers/CGenericSensor.h>
 #include <mrpt/hwdrivers/CIMUXSens_MT4.h>

@@ -1,11 +1,11 @@
 // libs/grab without hardware: clock mapping, the rawlog IMU source, our
 // OpenNI2 source on OpenNI2's Dummy device, and configuration errors.
 #include <bims/common/config.h>
-#include <bims/common/rawlog.h>
 #include <bims/grab/grabber.h>
 #include <bims/grab/host_clock.h>
 #include <bims/grab/imu_source.h>
 #include <bims/grab/openni2_source.h>
+#include <bims/io/rawlog.h>
 #include <gtest/gtest.h>
 
 #include <mrpt/config/CConfigFileMemory.h>

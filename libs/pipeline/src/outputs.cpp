@@ -1,14 +1,14 @@
 #include "outputs.h"
 #include <bims/common/clock.h>
-#include <bims/common/frame_files.h>
-#include <bims/common/json.h>
-#include <bims/common/output_paths.h>
+#include <bims/io/frame_files.h>
+#include <bims/io/json.h>
+#include <bims/io/output_paths.h>
 
 #include <bims/common/cpu_time.h>
 
-#include <bims/common/pixel_labels.h>
-#include <bims/common/trajectory.h>
 #include <bims/ego/flags.h>
+#include <bims/io/pixel_labels.h>
+#include <bims/io/trajectory.h>
 #include <bims/maps/export.h>
 #include <mrpt/obs/TPixelLabelInfo.h>
 
@@ -63,11 +63,13 @@ const OutputFolderLayout& runOutputLayout()
 	return layout;
 }
 
-OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p)
+OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p,
+                           const std::vector<std::string>& laterFiles)
     : dir_(dir), p_(p), worker_(kQueuedWrites, p.writer_thread)
 {
 	makeDirs(dir_);
 	manifest_ = std::make_unique<OutputManifest>(dir_, "bims-run");
+	for (const auto& f : laterFiles) manifest_->file(f);
 	makeDirs(dir_ + "/masks");
 	// written last: a folder without it is partial (an earlier run's would
 	// say otherwise)

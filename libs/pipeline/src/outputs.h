@@ -3,8 +3,8 @@
 // thread ([output] writer_thread), in the order the frames were given.
 #pragma once
 
-#include <bims/common/output_paths.h>
-#include <bims/common/rawlog.h>
+#include <bims/io/output_paths.h>
+#include <bims/io/rawlog.h>
 #include <bims/pipeline/pipeline.h>
 #include <bims/pipeline/run.h>
 
@@ -20,7 +20,10 @@ namespace bims::pipeline
 class OutputWriter
 {
  public:
-	OutputWriter(const std::string& dir, const OutputParams& p);
+	/** \a laterFiles: listed in the manifest from the start
+	 * (RunOptions::laterFiles). */
+	OutputWriter(const std::string& dir, const OutputParams& p,
+	             const std::vector<std::string>& laterFiles = {});
 	/** Queues the frame's outputs: mask PNG, moving-voxel PLY, trajectory and
 	 * CSV lines (flushed), and the scan into the labelled rawlog with the
 	 * mask as its pixel labels (set on \a scan itself, so the images are not

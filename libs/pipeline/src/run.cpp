@@ -1,10 +1,10 @@
 #include <bims/common/errors.h>
 #include <bims/common/imu_check.h>
 #include <bims/common/progress.h>
-#include <bims/common/rawlog.h>
-#include <bims/common/trajectory.h>
 #include <bims/ego/depth_correction.h>
 #include <bims/ego/flags.h>
+#include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
 #include <bims/maps/export.h>
 #include <bims/pipeline/run.h>
 #include <bims/pipeline/stepper.h>
@@ -94,7 +94,8 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	std::unique_ptr<OutputWriter> out;
 	if (!opt.outDir.empty())
 	{
-		out = std::make_unique<OutputWriter>(opt.outDir, cfg.output);
+		out = std::make_unique<OutputWriter>(opt.outDir, cfg.output,
+		                                     opt.laterFiles);
 		writeFileAtomically(out->file("effective.ini"), cfg.effectiveIni());
 	}
 

@@ -1,10 +1,10 @@
 // bims-run's runExperiment on inputs that are wrong in their values, not in
 // their bytes: IMU samples no sensor gives, a stray scan timestamp, a frame
 // whose outputs would not be finite.
-#include <bims/common/frame_files.h>
-#include <bims/common/json.h>
-#include <bims/common/rawlog.h>
 #include <bims/ego/flags.h>
+#include <bims/io/frame_files.h>
+#include <bims/io/json.h>
+#include <bims/io/rawlog.h>
 #include <bims/pipeline/run.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>

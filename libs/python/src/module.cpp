@@ -12,10 +12,10 @@
 #endif
 #include <bims/common/config.h>
 #include <bims/common/depth_image.h>
-#include <bims/common/rawlog.h>
 #include <bims/ego/attitude_filter.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/rgbd_input.h>
+#include <bims/io/rawlog.h>
 #include <bims/maps/export.h>
 #include <bims/pipeline/config.h>
 #include <bims/pipeline/pipeline.h>

@@ -1,6 +1,6 @@
 #include <bims/common/config.h>
 #include <bims/common/frames.h>
-#include <bims/common/output_paths.h>
+#include <bims/io/output_paths.h>
 #include <bims/sim/imu.h>
 #include <bims/sim/rng.h>
 #include <mrpt/system/datetime.h>

@@ -1,9 +1,9 @@
-#include <bims/common/frame_files.h>
-#include <bims/common/output_paths.h>
-#include <bims/common/pixel_labels.h>
 #include <bims/common/progress.h>
-#include <bims/common/rawlog.h>
-#include <bims/common/trajectory.h>
+#include <bims/io/frame_files.h>
+#include <bims/io/output_paths.h>
+#include <bims/io/pixel_labels.h>
+#include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
 #include <bims/sim/simulator.h>
 #include <mrpt/math/CMatrixFixed.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>

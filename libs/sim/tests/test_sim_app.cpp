@@ -1,9 +1,9 @@
 // End-to-end tests of bims-sim and bims-info: rawlog round trip through MRPT,
 // rawlog-edit, determinism, bad input, the bundled sample.
 #include <bims/common/frames.h>
-#include <bims/common/output_paths.h>
-#include <bims/common/rawlog.h>
-#include <bims/common/trajectory.h>
+#include <bims/io/output_paths.h>
+#include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
 #include <bims/sim/scene.h>
 #include <bims/sim/simulator.h>
 #include <bims_test/run_command.h>

@@ -1,7 +1,7 @@
 // The synthetic IMU of an import (bims-import-tum --synth-imu): R_IC and the
 // time offset from [calibration], the readings' label and time offset.
-#include <bims/common/rawlog.h>
-#include <bims/common/trajectory.h>
+#include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
 #include <bims/sim/imu.h>
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>

@@ -1,4 +1,4 @@
-#include <bims/common/rawlog.h>
+#include <bims/io/rawlog.h>
 #include <bims/source/frame_source.h>
 
 #include <stdexcept>

@@ -6,7 +6,7 @@
 // (threaded = false) next() reads on the caller's thread.
 #pragma once
 
-#include <bims/common/rawlog.h>
+#include <bims/io/rawlog.h>
 
 #include <condition_variable>
 #include <cstddef>

@@ -1,6 +1,6 @@
 // The frame source's reading thread (internal class): order across files,
 // errors in stream order, early stop.
-#include <bims/common/rawlog.h>
+#include <bims/io/rawlog.h>
 #include <gtest/gtest.h>
 #include <mrpt/obs/CObservationIMU.h>
 

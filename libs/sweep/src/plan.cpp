@@ -1,5 +1,5 @@
 #include <bims/common/config.h>
-#include <bims/common/output_paths.h>
+#include <bims/io/output_paths.h>
 #include <bims/pipeline/config.h>
 #include <bims/pipeline/run.h>
 #include <bims/sweep/plan.h>

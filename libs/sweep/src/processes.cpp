@@ -1,4 +1,4 @@
-#include <bims/common/output_paths.h>
+#include <bims/io/output_paths.h>
 #include <bims/sweep/processes.h>
 #include <fcntl.h>
 #include <sys/prctl.h>

@@ -1,6 +1,6 @@
-#include <bims/common/json.h>
-#include <bims/common/output_paths.h>
 #include <bims/eval/plots.h>
+#include <bims/io/json.h>
+#include <bims/io/output_paths.h>
 #include <bims/sweep/results.h>
 
 #include <algorithm>

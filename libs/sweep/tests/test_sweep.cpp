@@ -6,6 +6,7 @@
 #include <bims/sweep/plan.h>
 #include <bims/sweep/processes.h>
 #include <bims/sweep/results.h>
+#include <bims_test/error_of.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
@@ -19,6 +20,8 @@
 #include <sstream>
 #include <thread>
 #include "bims_test/text.h"
+
+using bims::test::errorOf;
 
 namespace fs = std::filesystem;
 namespace sw = bims::sweep;
@@ -36,19 +39,6 @@ void put(const std::string& path, const std::string& text)
 {
 	fs::create_directories(fs::path(path).parent_path());
 	std::ofstream(path) << text;
-}
-/** The message of the exception f throws ("" if none). */
-std::string errorOf(const std::function<void()>& f)
-{
-	try
-	{
-		f();
-	}
-	catch (const std::exception& e)
-	{
-		return e.what();
-	}
-	return {};
 }
 /** A folder with a.ini, sub/b.ini (copies of default.ini) and two
  * stand-in rawlogs x.rawlog, y.rawlog (planning only checks they exist);

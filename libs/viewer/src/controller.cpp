@@ -1,6 +1,6 @@
-#include <bims/common/frame_files.h>
 #include <bims/common/frames.h>
-#include <bims/common/image_file.h>
+#include <bims/io/frame_files.h>
+#include <bims/io/image_file.h>
 #include <bims/viewer/controller.h>
 #include <bims/viewer/panels.h>
 

@@ -1,4 +1,4 @@
-#include <bims/common/rawlog.h>
+#include <bims/io/rawlog.h>
 #include <bims/viewer/replay_source.h>
 
 #include <stdexcept>

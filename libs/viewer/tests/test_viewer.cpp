@@ -1,9 +1,9 @@
 // The viewer's controller, without any GUI: replay order, timeline, play
 // clock, pipeline while replaying, panels, results folders, and an offscreen
 // render of the 3D view in which the three tier colours must appear.
-#include <bims/common/output_paths.h>
-#include <bims/common/rawlog.h>
-#include <bims/common/trajectory.h>
+#include <bims/io/output_paths.h>
+#include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
 #include <bims/pipeline/run.h>
 #include <bims/viewer/controller.h>
 #include <bims/viewer/panels.h>

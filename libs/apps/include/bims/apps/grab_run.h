@@ -6,8 +6,8 @@
 #pragma once
 
 #include <bims/apps/progress_bar.h>
-#include <bims/common/rawlog.h>
 #include <bims/grab/grabber.h>
+#include <bims/io/rawlog.h>
 #include <bims/pipeline/stepper.h>
 
 #include <mrpt/config/CConfigFile.h>

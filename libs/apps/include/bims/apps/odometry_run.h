@@ -5,9 +5,9 @@
 #pragma once
 
 #include <bims/apps/odometry_replay.h>
-#include <bims/common/trajectory.h>
 #include <bims/ego/odometry.h>
 #include <bims/ego/rgbd_input.h>
+#include <bims/io/trajectory.h>
 
 #include <mrpt/poses/CPose3D.h>
 

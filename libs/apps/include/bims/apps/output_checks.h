@@ -1,10 +1,10 @@
 // The output rules of the programs that throw usage errors (exit code 2):
 // outputs never alias inputs, an output folder holding an earlier run is
 // refused unless --overwrite. The rest of the rule, for every library
-// (partial files, append-only files): bims/common/output_paths.h.
+// (partial files, append-only files): bims/io/output_paths.h.
 #pragma once
 
-#include <bims/common/output_paths.h>
+#include <bims/io/output_paths.h>
 
 #include <string>
 #include <vector>
@@ -27,7 +27,7 @@ void checkOutputsSpareInputs(const std::vector<std::string>& inputs,
  * of \a layout or a manifest (an earlier run), throws UsageError naming the
  * folder and one of them, and suggesting \a overwriteFlag. With
  * \a overwrite, removes what the earlier run's manifest lists (OutputManifest,
- * bims/common/output_paths.h: removeListedOutputs) and returns how many
+ * bims/io/output_paths.h: removeListedOutputs) and returns how many
  * files it removed; a file of \a layout the manifest does not list (no
  * manifest: any) is kept and refused (UsageError naming it), before
  * anything is removed. A symbolic link at an output name (a per-frame

@@ -6,8 +6,8 @@
 #pragma once
 
 #include <bims/common/progress.h>
-#include <bims/common/trajectory.h>
 #include <bims/eval/tum_import.h>
+#include <bims/io/trajectory.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/obs/CObservation.h>
 

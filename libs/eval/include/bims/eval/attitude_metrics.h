@@ -12,9 +12,9 @@
 // magnetometer leaves unobserved.
 #pragma once
 
-#include <bims/common/trajectory.h>
 #include <bims/eval/association.h>
 #include <bims/eval/trajectory_metrics.h>
+#include <bims/io/trajectory.h>
 
 #include <Eigen/Core>
 

@@ -4,8 +4,8 @@
 // wherever the same static surface is seen.
 #pragma once
 
-#include <bims/common/trajectory.h>
 #include <bims/eval/tum_import.h>
+#include <bims/io/trajectory.h>
 
 #include <opencv2/core.hpp>
 

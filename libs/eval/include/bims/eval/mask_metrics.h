@@ -2,9 +2,9 @@
 // ground-truth mask, counted over the pixels with valid depth.
 #pragma once
 
-#include <bims/common/image_file.h>
-#include <bims/common/json.h>
 #include <bims/eval/mask_labels.h>
+#include <bims/io/image_file.h>
+#include <bims/io/json.h>
 #include <opencv2/core.hpp>
 
 #include <cstdint>

@@ -1,8 +1,8 @@
 // PNG plots drawn with OpenCV (no GUI needed).
 #pragma once
 
-#include <bims/common/trajectory.h>
 #include <bims/eval/association.h>
+#include <bims/io/trajectory.h>
 
 #include <opencv2/core.hpp>
 

@@ -2,7 +2,7 @@
 // dataset's marker-to-camera conversion.
 #pragma once
 
-#include <bims/common/trajectory.h>
+#include <bims/io/trajectory.h>
 #include <mrpt/poses/CPose3D.h>
 
 #include <optional>

@@ -5,7 +5,7 @@
 // stamps come from.
 #pragma once
 
-#include <bims/common/image_file.h>
+#include <bims/io/image_file.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/img/TCamera.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>

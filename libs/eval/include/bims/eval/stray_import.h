@@ -7,10 +7,10 @@
 // (docs/eval.md, "Import of a Stray Scanner capture").
 #pragma once
 
-#include <bims/common/image_file.h>
 #include <bims/common/options.h>
 #include <bims/common/progress.h>
-#include <bims/common/trajectory.h>
+#include <bims/io/image_file.h>
+#include <bims/io/trajectory.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/img/TCamera.h>
 

@@ -4,9 +4,9 @@
 // docs/eval.md.
 #pragma once
 
-#include <bims/common/json.h>
-#include <bims/common/trajectory.h>
 #include <bims/eval/association.h>
+#include <bims/io/json.h>
+#include <bims/io/trajectory.h>
 #include <mrpt/poses/CPose3D.h>
 
 #include <string>

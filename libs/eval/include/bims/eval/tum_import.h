@@ -4,9 +4,9 @@
 #pragma once
 
 #include <bims/common/choice.h>
-#include <bims/common/image_file.h>
 #include <bims/common/progress.h>
-#include <bims/common/trajectory.h>
+#include <bims/io/image_file.h>
+#include <bims/io/trajectory.h>
 #include <bims/sensors/params.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/img/TCamera.h>

@@ -14,9 +14,9 @@
 //   driver=CIMUXSens_MT4  ; or RawlogImu (bims/grab/imu_source.h)
 #pragma once
 
-#include <bims/common/rawlog.h>
 #include <bims/grab/imu_source.h>
 #include <bims/grab/openni2_source.h>
+#include <bims/io/rawlog.h>
 
 #include <atomic>
 #include <functional>

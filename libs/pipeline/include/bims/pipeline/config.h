@@ -7,10 +7,10 @@
 #pragma once
 
 #include <bims/common/choice.h>
-#include <bims/common/image_file.h>
 #include <bims/common/options.h>
 #include <bims/ego/params.h>
 #include <bims/flow/params.h>
+#include <bims/io/image_file.h>
 #include <bims/maps/grid_params.h>
 #include <bims/pipeline/surface_fill.h>
 

@@ -4,9 +4,9 @@
 // runs through bims-run).
 #pragma once
 
-#include <bims/common/output_paths.h>
 #include <bims/common/progress.h>
 #include <bims/common/stats.h>
+#include <bims/io/output_paths.h>
 #include <bims/pipeline/pipeline.h>
 #include <bims/source/frame_source.h>
 
@@ -121,6 +121,10 @@ struct RunOptions
 	 * after the current frame: the frames done are written in full,
 	 * metrics.json says "status": "interrupted". */
 	const std::atomic<bool>* stop = nullptr;
+	/** Files the program writes into outDir after the run (bims-run's
+	 * report.md): listed in the folder's manifest with the run's own, so
+	 * that --overwrite removes them too. */
+	std::vector<std::string> laterFiles;
 };
 
 /** Throws std::runtime_error naming the frame (scan index and time) if

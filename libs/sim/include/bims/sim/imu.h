@@ -21,7 +21,7 @@
 //    b += sigma_rw * sqrt(dt) * N(0, 1).
 #pragma once
 
-#include <bims/common/trajectory.h>
+#include <bims/io/trajectory.h>
 #include <bims/sim/motion.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/obs/CObservationIMU.h>

@@ -2,7 +2,7 @@
 // agrees exactly with the ground-truth poses.
 #pragma once
 
-#include <bims/common/trajectory.h>
+#include <bims/io/trajectory.h>
 #include <mrpt/config/CConfigFileBase.h>
 
 #include <Eigen/Core>

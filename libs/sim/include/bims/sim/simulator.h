@@ -10,8 +10,8 @@
 // See docs/sim.md for every key, unit and default.
 #pragma once
 
-#include <bims/common/output_paths.h>
 #include <bims/common/progress.h>
+#include <bims/io/output_paths.h>
 #include <bims/sim/imu.h>
 #include <bims/sim/motion.h>
 #include <bims/sim/objects.h>

@@ -4,7 +4,7 @@
 // jobs file of the cluster mode.
 #pragma once
 
-#include <bims/common/json.h>
+#include <bims/io/json.h>
 
 #include <string>
 #include <utility>

@@ -5,7 +5,7 @@
 // content of the 3D view and of the 2D panels.
 #pragma once
 
-#include <bims/common/trajectory.h>
+#include <bims/io/trajectory.h>
 #include <bims/pipeline/pipeline.h>
 #include <bims/pipeline/stepper.h>
 #include <bims/viewer/frame_view.h>

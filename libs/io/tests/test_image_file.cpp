@@ -1,7 +1,7 @@
 // The one guarded image reader: headers of PNG, JPEG, TIFF and BMP read
 // for their size, a decompression bomb refused before decoding, and every
 // other bad file a one-line error naming it.
-#include <bims/common/image_file.h>
+#include <bims/io/image_file.h>
 #include <bims_test/png_bomb.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
-#include <bims/common/json.h>
-#include <bims/common/output_paths.h>
+#include <bims/io/json.h>
+#include <bims/io/output_paths.h>
 
 #include <cmath>
 #include <cstdio>

@@ -1,5 +1,5 @@
-#include <bims/common/output_paths.h>
-#include <bims/common/rawlog.h>
+#include <bims/io/output_paths.h>
+#include <bims/io/rawlog.h>
 
 #include <zlib.h>
 

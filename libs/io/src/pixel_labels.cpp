@@ -1,4 +1,4 @@
-#include <bims/common/pixel_labels.h>
+#include <bims/io/pixel_labels.h>
 
 #include <mrpt/serialization/CArchive.h>
 #include <mrpt/serialization/stl_serialization.h>

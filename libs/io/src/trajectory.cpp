@@ -1,5 +1,5 @@
-#include <bims/common/output_paths.h>
-#include <bims/common/trajectory.h>
+#include <bims/io/output_paths.h>
+#include <bims/io/trajectory.h>
 #include <mrpt/poses/CPose3DQuat.h>
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-#include <bims/common/output_paths.h>
+#include <bims/io/output_paths.h>
 #include <fcntl.h>
 #include <unistd.h>
 

@@ -1,12 +1,12 @@
 // JSON text that any parser reads back, whatever the strings hold.
-#include <bims/common/json.h>
+#include <bims/io/json.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
 #include <sstream>
 
-#include "tmp_path.h"
+#include <bims_test/tmp_dir.h>
 
 TEST(Json, ControlCharactersQuotesAndBadBytesStayValid)
 {
@@ -34,7 +34,7 @@ TEST(Json, NumbersAreRoundedAndNonFiniteIsNull)
 
 TEST(Json, WrittenFileParses)
 {
-	const std::string p = bims::test::tmpPath("written.json");
+	const std::string p = bims::test::tmpPath("bims_test_io", "written.json");
 	bims::Json j;
 	j["k"] = "v\x02";
 	bims::writeJsonFile(p, j);

@@ -1,7 +1,7 @@
 // The output rule of every library: created files replace symbolic links,
 // whole files appear only once complete (the programs' checks of outputs
 // against inputs: libs/apps/tests/test_output_checks.cpp).
-#include <bims/common/output_paths.h>
+#include <bims/io/output_paths.h>
 #include <gtest/gtest.h>
 
 #include <bims_test/file_size_limit.h>
@@ -13,8 +13,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <bims_test/tmp_dir.h>
 #include "bims_test/text.h"
-#include "tmp_path.h"
 
 namespace fs = std::filesystem;
 using bims::test::tmpPath;
@@ -23,7 +23,7 @@ namespace
 {
 std::string fresh(const std::string& name)
 {
-	const std::string d = tmpPath(name);
+	const std::string d = tmpPath("bims_test_io", name);
 	fs::remove_all(d);
 	fs::create_directories(d);
 	return d;

@@ -5,7 +5,7 @@
 // corrupt file raises RawlogError instead of ending silently.
 #pragma once
 
-#include <bims/common/output_paths.h>
+#include <bims/io/output_paths.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/obs/CObservation.h>
 #include <mrpt/serialization/CArchive.h>

@@ -1,4 +1,4 @@
-#include <bims/common/trajectory.h>
+#include <bims/io/trajectory.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "tmp_path.h"
+#include <bims_test/tmp_dir.h>
 
 using bims::test::tmpPath;
 
@@ -17,7 +17,7 @@ TEST(Trajectory, TumRoundTrip)
 		t.push_back(
 		    {1000.0 + i / 30.0, mrpt::poses::CPose3D(0.1 * i, -0.2 * i, 1.5,
 		                                             0.3 * i, -0.1, 0.05 * i)});
-	const auto p = tmpPath("traj.txt");
+	const auto p = tmpPath("bims_test_io", "traj.txt");
 	bims::saveTumTrajectory(p, t, "test");
 	const auto r = bims::loadTumTrajectory(p);
 	ASSERT_EQ(r.size(), t.size());
@@ -33,7 +33,7 @@ TEST(Trajectory, TumRoundTrip)
 
 TEST(Trajectory, MalformedLinesAreErrorsWithLineNumbers)
 {
-	const auto p = tmpPath("bad_traj.txt");
+	const auto p = tmpPath("bims_test_io", "bad_traj.txt");
 	{
 		std::ofstream f(p);
 		f << "# comment\n1 0 0 0 0 0 0 1\n2 0 0 0 0 0 0\n";
@@ -58,7 +58,7 @@ TEST(Trajectory, MalformedLinesAreErrorsWithLineNumbers)
 
 TEST(Trajectory, ANonFinitePoseIsAnErrorNamingItsTimeAndNothingIsWritten)
 {
-	const auto p = tmpPath("nan_traj.txt");
+	const auto p = tmpPath("bims_test_io", "nan_traj.txt");
 	std::remove(p.c_str());
 	bims::Trajectory t;
 	t.push_back({1.0, mrpt::poses::CPose3D(1, 2, 3, 0, 0, 0)});

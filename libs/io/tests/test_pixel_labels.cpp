@@ -1,6 +1,6 @@
 // BulkPixelLabels writes exactly the bytes of MRPT's TPixelLabelInfo<1>.
-#include <bims/common/pixel_labels.h>
-#include <bims/common/rawlog.h>
+#include <bims/io/pixel_labels.h>
+#include <bims/io/rawlog.h>
 #include <gtest/gtest.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>

@@ -9,7 +9,7 @@
 // and refuses declared sizes no real sensor produces.
 #pragma once
 
-#include <bims/common/image_file.h>
+#include <bims/io/image_file.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -20,7 +20,7 @@
 namespace bims
 {
 // The largest image side and pixel count a rawlog's scan may declare are
-// those of every image input (bims/common/image_file.h: a 16384 x 4096
+// those of every image input (bims/io/image_file.h: a 16384 x 4096
 // image; real RGB-D sensors give at most a few megapixels).
 /** Largest string or byte block (labels, file names, a JPEG image) an
  * observation may declare. */

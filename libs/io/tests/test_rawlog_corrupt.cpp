@@ -1,9 +1,10 @@
 // Corrupt rawlogs: declared sizes MRPT would trust, and a byte-flip campaign
 // over the bundled sample; every case must end in RawlogError or a clean
 // end, never a crash or a huge allocation.
-#include <bims/common/rawlog.h>
+#include <bims/io/rawlog.h>
 #include <gtest/gtest.h>
 
+#include <bims_test/tmp_dir.h>
 #include <mrpt/io/CFileOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/obs/CActionCollection.h>
@@ -13,7 +14,6 @@
 #include <mrpt/poses/CPose3D.h>
 #include <mrpt/rtti/CObject.h>
 #include <mrpt/serialization/CArchive.h>
-#include "tmp_path.h"
 
 #include <algorithm>
 #include <cstring>
@@ -125,7 +125,7 @@ void putU32(std::vector<uint8_t>& b, size_t at, uint32_t v)
 
 TEST(RawlogCorrupt, ASaneScanReadsBack)
 {
-	const auto p = tmpPath("scan_ok.rawlog");
+	const auto p = tmpPath("bims_test_io", "scan_ok.rawlog");
 	scanRawlog(p, 5);
 	bims::RawlogReader r(p);
 	auto s =
@@ -141,7 +141,7 @@ TEST(RawlogCorrupt, AHugeDepthImageSizeIsAnErrorNotAnAllocation)
 {
 	// MRPT 2.5.8 alone: a 1.3 TB allocation that fails silently, then a
 	// segmentation fault (rows 0x7fffffff), or a 270 M pixel allocation.
-	const auto p = tmpPath("scan_huge.rawlog");
+	const auto p = tmpPath("bims_test_io", "scan_huge.rawlog");
 	const auto good = scanRawlog(p, 0);
 	const size_t at = findPair(good, 37, 53);
 	const std::vector<std::pair<uint32_t, uint32_t>> sizes = {
@@ -165,7 +165,7 @@ TEST(RawlogCorrupt, AHugeDepthImageSizeIsAnErrorNotAnAllocation)
 
 TEST(RawlogCorrupt, AHugeStoredPointCountIsAnError)
 {
-	const auto p = tmpPath("scan_points.rawlog");
+	const auto p = tmpPath("bims_test_io", "scan_points.rawlog");
 	auto b = scanRawlog(p, 7);
 	// the count precedes the points; 7 as uint32 followed by x of point 0
 	// (0.0f) is the first such pair after the class name
@@ -182,7 +182,7 @@ TEST(RawlogCorrupt, AHugePixelLabelImageIsAnError)
 {
 	// the labels follow the RGB image, both camera models and the strings:
 	// the check walks every field of the scan up to them
-	const auto p = tmpPath("scan_labels.rawlog");
+	const auto p = tmpPath("bims_test_io", "scan_labels.rawlog");
 	auto b = scanRawlog(p, 0, true);
 	EXPECT_EQ(readError(p), "");
 	const size_t at = findPair(b, 41, 59);
@@ -208,7 +208,7 @@ size_t findText(const std::vector<uint8_t>& bytes, const std::string& text)
 // seen under LeakSanitizer): each part after it is checked first.
 TEST(RawlogCorrupt, CorruptPixelLabelNamesAreErrorsBeforeMrptReadsThem)
 {
-	const auto p = tmpPath("scan_label_names.rawlog");
+	const auto p = tmpPath("bims_test_io", "scan_label_names.rawlog");
 	const auto clean = scanRawlog(p, 0, true);
 	{
 		bims::RawlogReader r(p);  // names read back: the walk knows them
@@ -245,7 +245,7 @@ TEST(RawlogCorrupt, SizesAtTheLimitAreLeftToMrpt)
 {
 	// 4096 x 16384 is 2^26 pixels, allowed: the file then ends inside the
 	// image, which MRPT reports as a truncation.
-	const auto p = tmpPath("scan_limit.rawlog");
+	const auto p = tmpPath("bims_test_io", "scan_limit.rawlog");
 	auto b = scanRawlog(p, 0);
 	const size_t at = findPair(b, 37, 53);
 	putU32(b, at, 4096);
@@ -265,7 +265,7 @@ TEST(RawlogCorrupt, ByteFlipsOfTheSampleNeverCrash)
 	// a size field (a uint32 of the first scan equal to its image width or
 	// height: depth, camera models, pixel labels) set to a huge value; most
 	// of the others in the first scan's header.
-	const auto base = tmpPath("sample_head.rawlog");
+	const auto base = tmpPath("bims_test_io", "sample_head.rawlog");
 	size_t scans = 0, objects = 0;
 	uint32_t rows = 0, cols = 0;
 	{
@@ -305,7 +305,7 @@ TEST(RawlogCorrupt, ByteFlipsOfTheSampleNeverCrash)
 	{ return std::uniform_int_distribution<size_t>(0, n - 1)(rng); };
 	const uint32_t values[] = {0,           1,     0x7fffffffu, 0x80000000u,
 	                           0xffffffffu, 65536, 100000};
-	const auto p = tmpPath("sample_mutated.rawlog");
+	const auto p = tmpPath("bims_test_io", "sample_mutated.rawlog");
 	size_t errors = 0, clean = 0;
 	for (int k = 0; k < 300; k++)
 	{
@@ -354,7 +354,7 @@ TEST(RawlogCorrupt, HugeStringLengthsAreErrorsNotAllocations)
 	// oom-imu-label-length): an IMU observation whose sensor label declares
 	// 0xffffffff bytes made MRPT allocate 4 GB before failing. Likewise a
 	// 3D scan's label. The label "LBL1" is found by its bytes.
-	const auto p = tmpPath("imu_label.rawlog");
+	const auto p = tmpPath("bims_test_io", "imu_label.rawlog");
 	{
 		mrpt::obs::CObservationIMU imu;
 		imu.sensorLabel = "LBL1";
@@ -391,7 +391,7 @@ TEST(RawlogCorrupt, AnImuFlagThatIsNoBoolIsAnError)
 	// Found by the rawlog fuzz target (tests/fuzz/corpus/rawlog/
 	// ub-imu-flag-not-bool): a data-present flag stored as 10 is read into
 	// a bool by MRPT, undefined behaviour in its accessors.
-	const auto p = tmpPath("imu_flag.rawlog");
+	const auto p = tmpPath("bims_test_io", "imu_flag.rawlog");
 	auto bytes = imuRawlog(p);
 	EXPECT_EQ(readError(p), "");
 	// the flags follow the sensor pose's end byte 0x88 (its 12 doubles of a
@@ -411,7 +411,7 @@ TEST(RawlogCorrupt, AnInnerObjectOfAnotherClassIsAnError)
 	// Found by the rawlog fuzz target (tests/fuzz/corpus/rawlog/
 	// oom-imu-pose-class-name): an IMU observation whose sensor pose is
 	// named "mrpt::posei::CPose3D"; MRPT read on and allocated 4 GB.
-	const auto p = tmpPath("imu_pose_class.rawlog");
+	const auto p = tmpPath("bims_test_io", "imu_pose_class.rawlog");
 	auto bytes = imuRawlog(p);
 	const char* name = "mrpt::poses::";
 	auto at = std::search(bytes.begin(), bytes.end(), name, name + 13);
@@ -429,7 +429,7 @@ TEST(RawlogCorrupt, AnObjectOfAnUnknownClassIsAnError)
 	// Found by the rawlog fuzz target (tests/fuzz/corpus/rawlog/
 	// oom-unknown-class-name): a top-level object named
 	// "mbpt::obs::CObservationIMU"; MRPT read on and allocated 4 GB.
-	const auto p = tmpPath("unknown_class.rawlog");
+	const auto p = tmpPath("bims_test_io", "unknown_class.rawlog");
 	auto bytes = imuRawlog(p);
 	EXPECT_TRUE(mrpt::rtti::findRegisteredClass("CObservationIMU", true))
 	    << "a name without namespace is looked up as MRPT does";
@@ -449,7 +449,7 @@ TEST(RawlogCorrupt,
 	// a scan cut inside its depth image: the guard sees the image's bytes
 	// end with the file and says so (MRPT would allocate the whole image
 	// first, whatever size the bytes declare)
-	const auto p = tmpPath("cut_depth.rawlog");
+	const auto p = tmpPath("bims_test_io", "cut_depth.rawlog");
 	auto bytes = scanRawlog(p, 0);
 	const size_t at = findPair(bytes, 37, 53);  // the depth image's size
 	bytes.resize(at + 8 + 100);
@@ -468,7 +468,7 @@ TEST(RawlogCorrupt, AScanFlagThatIsNoBoolIsAnError)
 	// ub-scan-flag-not-bool): a scan's flag stored as 121, read by MRPT into
 	// a bool, undefined behaviour where bims reads it. Here range_is_depth:
 	// after the label "RGBD" and two (flag, empty file name) pairs.
-	const auto p = tmpPath("scan_flag.rawlog");
+	const auto p = tmpPath("bims_test_io", "scan_flag.rawlog");
 	auto bytes = scanRawlog(p, 0);
 	const char* label = "RGBD";
 	const auto at = std::search(bytes.begin(), bytes.end(), label, label + 4) -
@@ -490,7 +490,7 @@ TEST(RawlogCorrupt, AJpegImageWhoseBytesDoNotDecodeIsAnErrorNotAnExit)
 	// inside a scan of version 10, now refused): MRPT decodes a JPEG-stored
 	// image with libjpeg's default error handler, which ends the whole
 	// process ("Not a JPEG file") instead of throwing.
-	const auto p = tmpPath("jpeg.rawlog");
+	const auto p = tmpPath("bims_test_io", "jpeg.rawlog");
 	const bool was = mrpt::img::CImage::DISABLE_JPEG_COMPRESSION();
 	mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
 	scanRawlog(p, 0, true);  // its RGB image stored as JPEG
@@ -513,7 +513,7 @@ TEST(RawlogCorrupt, AJpegDeclaringAHugeImageIsAnErrorNotAnAllocation)
 	// OpenCV (the guard's decode check) and MRPT allocate the whole image a
 	// JPEG's frame header declares before decoding its few bytes: 30000 x
 	// 30000 (under OpenCV's own limit of 2^30 pixels) is 2.7 GB
-	const auto p = tmpPath("jpeg_size.rawlog");
+	const auto p = tmpPath("bims_test_io", "jpeg_size.rawlog");
 	const bool was = mrpt::img::CImage::DISABLE_JPEG_COMPRESSION();
 	mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
 	scanRawlog(p, 0, true);  // its RGB image stored as JPEG
@@ -542,7 +542,7 @@ TEST(RawlogCorrupt, AnImageOfAnotherFormatStoredAsJpegIsAnErrorNotAnExit)
 	// only JPEG, with libjpeg's handler that ends the process on other
 	// bytes: a valid PGM where the JPEG was must be refused (OpenCV would
 	// also allocate whatever size a PPM or BMP header declares)
-	const auto p = tmpPath("jpeg_pgm.rawlog");
+	const auto p = tmpPath("bims_test_io", "jpeg_pgm.rawlog");
 	const bool was = mrpt::img::CImage::DISABLE_JPEG_COMPRESSION();
 	mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
 	auto bytes = scanRawlog(p, 0, true);
@@ -784,7 +784,7 @@ OldScan oldScan(uint8_t version)
 
 std::string readOld(const std::string& name, const OldScan& o)
 {
-	const auto p = tmpPath(name);
+	const auto p = tmpPath("bims_test_io", name);
 	writeBytes(p, o.bytes());
 	return readError(p);
 }
@@ -798,7 +798,8 @@ TEST(RawlogCorrupt, ValidScansOfEveryOldLayoutAreRead)
 	{
 		// one file per version: the rawlog fuzz target's old-layout seeds
 		// (tests/fuzz/corpus/rawlog/old-scan-v*) are some of them
-		const auto p = tmpPath("old_scan_v" + std::to_string(v) + ".rawlog");
+		const auto p = tmpPath("bims_test_io",
+		                       "old_scan_v" + std::to_string(v) + ".rawlog");
 		writeBytes(p, oldScan(v).bytes());
 		bims::RawlogReader r(p);
 		mrpt::obs::CObservation::Ptr o;
@@ -895,7 +896,7 @@ TEST(RawlogCorrupt,
 	const auto clean = o.bytes();
 	auto b = clean;
 	putU32(b, findPair(b, 4, 4), 0x7ffffff0u);
-	const auto p = tmpPath("old_pose.rawlog");
+	const auto p = tmpPath("bims_test_io", "old_pose.rawlog");
 	writeBytes(p, b);
 	EXPECT_NE(readError(p).find("the 3D scan's pose matrix is 2147483632 x 4"),
 	          std::string::npos)
@@ -951,7 +952,7 @@ TEST(RawlogCorrupt, AScanCutInsideASizeFieldIsAnErrorNotAGarbageSize)
 	// and allocated 9 GB for the count.
 	auto o = oldScan(2);
 	auto b = o.bytes();
-	const auto p = tmpPath("cut_count.rawlog");
+	const auto p = tmpPath("bims_test_io", "cut_count.rawlog");
 	const size_t at = findPair(b, 2, 0x3f800000u);  // count 2, x = 1.0f
 	b.resize(at + 2);
 	writeBytes(p, b);
@@ -988,7 +989,7 @@ TEST(RawlogCorrupt, AnOldImuObservationWithAHugeVectorIsAnError)
 		for (uint32_t k = 0; k < std::min(values, 31u); k++) a.put(9.81);
 		return a.str("IMU1").end().b;
 	};
-	const auto p = tmpPath("old_imu.rawlog");
+	const auto p = tmpPath("bims_test_io", "old_imu.rawlog");
 	writeBytes(p, imu(21, 21));
 	{
 		bims::RawlogReader r(p);
@@ -1016,7 +1017,7 @@ TEST(RawlogCorrupt, ASensoryFrameDeclaringMoreObservationsThanBytesIsAnError)
 	// Found by the rawlog fuzz target (tests/fuzz/corpus/rawlog/
 	// oom-sensory-frame-count): a CSensorialFrame declaring 1 086 359 807
 	// observations; MRPT sized its list (16 GB) before reading any.
-	const auto p = tmpPath("sensory_frame.rawlog");
+	const auto p = tmpPath("bims_test_io", "sensory_frame.rawlog");
 	{
 		mrpt::obs::CSensoryFrame sf;
 		auto imu = mrpt::obs::CObservationIMU::Create();
@@ -1070,7 +1071,7 @@ TEST(RawlogCorrupt, AnObjectThatIsNoRawlogEntryIsAnErrorBeforeMrptReadsIt)
 	// CMatrixD declared 22 GB; MRPT allocated them before the reader could
 	// see the entry is no observation. A valid pose is refused as well, by
 	// the guard, naming its class.
-	const auto p = tmpPath("pose_entry.rawlog");
+	const auto p = tmpPath("bims_test_io", "pose_entry.rawlog");
 	{
 		auto f = mrpt::io::CFileOutputStream(p);
 		auto a = mrpt::serialization::archiveFrom(f);

@@ -1,5 +1,5 @@
-#include <bims/common/image_file.h>
 #include <bims/common/options.h>
+#include <bims/io/image_file.h>
 
 #include <filesystem>
 #include <fstream>

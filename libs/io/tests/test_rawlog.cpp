@@ -1,4 +1,4 @@
-#include <bims/common/rawlog.h>
+#include <bims/io/rawlog.h>
 #include <gtest/gtest.h>
 
 #include <bims_test/file_size_limit.h>
@@ -6,7 +6,7 @@
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/system/filesystem.h>
 
-#include "tmp_path.h"
+#include <bims_test/tmp_dir.h>
 
 #include <filesystem>
 #include <fstream>
@@ -34,7 +34,8 @@ TEST(Rawlog, RoundTripPlainAndGzip)
 {
 	for (int gz : {0, 1})
 	{
-		const auto p = tmpPath("rt" + std::to_string(gz) + ".rawlog");
+		const auto p =
+		    tmpPath("bims_test_io", "rt" + std::to_string(gz) + ".rawlog");
 		writeImus(p, 20, gz);
 		bims::RawlogReader r(p);
 		int n = 0;
@@ -53,7 +54,7 @@ TEST(Rawlog, MissingFileIsAClearError)
 {
 	try
 	{
-		bims::RawlogReader r(tmpPath("does_not_exist.rawlog"));
+		bims::RawlogReader r(tmpPath("bims_test_io", "does_not_exist.rawlog"));
 		FAIL() << "no exception";
 	}
 	catch (const bims::RawlogError& e)
@@ -65,7 +66,7 @@ TEST(Rawlog, MissingFileIsAClearError)
 
 TEST(Rawlog, TruncatedFileIsAnErrorNamingFileAndEntry)
 {
-	const auto p = tmpPath("trunc.rawlog");
+	const auto p = tmpPath("bims_test_io", "trunc.rawlog");
 	writeImus(p, 10, 0);
 	const auto size = std::filesystem::file_size(p);
 	std::filesystem::resize_file(p, size - 7);
@@ -89,7 +90,7 @@ TEST(Rawlog, TruncatedFileIsAnErrorNamingFileAndEntry)
 
 TEST(Rawlog, GarbageFileIsAnError)
 {
-	const auto p = tmpPath("garbage.rawlog");
+	const auto p = tmpPath("bims_test_io", "garbage.rawlog");
 	{
 		std::ofstream f(p, std::ios::binary);
 		for (int i = 0; i < 1000; i++)
@@ -118,7 +119,7 @@ TEST(Rawlog, AGzipRawlogWhoseTailFailsAtCloseIsAnError)
 	// limited to 1000-byte files (SIGXFSZ ignored: the write fails with
 	// EFBIG, as on a full disk): close() must report it (MRPT's gzip stream
 	// did not)
-	const auto p = tmpPath("gz_close_limit.rawlog");
+	const auto p = tmpPath("bims_test_io", "gz_close_limit.rawlog");
 	const int code = bims::test::exitOfChildWithFileSizeLimit(
 	    1000,
 	    [&]
@@ -158,7 +159,8 @@ TEST(Rawlog, DataBytesOfPlainAndGzipFilesAreWhatTheReaderReads)
 	// the progress line's share of the input read (bims-run)
 	for (int gz : {0, 6})
 	{
-		const auto p = tmpPath("bytes" + std::to_string(gz) + ".rawlog");
+		const auto p =
+		    tmpPath("bims_test_io", "bytes" + std::to_string(gz) + ".rawlog");
 		writeImus(p, 50, gz);
 		const uint64_t data = bims::rawlogDataBytes(p);
 		if (gz)
@@ -175,12 +177,13 @@ TEST(Rawlog, DataBytesOfPlainAndGzipFilesAreWhatTheReaderReads)
 		}
 		EXPECT_EQ(last, data) << gz;
 	}
-	EXPECT_EQ(bims::rawlogDataBytes(tmpPath("no_such.rawlog")), 0u);
+	EXPECT_EQ(bims::rawlogDataBytes(tmpPath("bims_test_io", "no_such.rawlog")),
+	          0u);
 }
 
 TEST(Rawlog, Count3DScansStopsAtTheLimitAndSkipsOtherLabels)
 {
-	const auto p = tmpPath("scans.rawlog");
+	const auto p = tmpPath("bims_test_io", "scans.rawlog");
 	{
 		bims::RawlogWriter w(p, 0);
 		for (int i = 0; i < 6; i++)
