@@ -2,6 +2,7 @@
 // content, each a usage error naming the command to use instead.
 #include <bims/apps/app.h>
 #include <bims/apps/input_kind.h>
+#include <bims_test/error_of.h>
 #include <bims_test/sample.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
@@ -16,19 +17,10 @@ using bims::apps::inputKind;
 
 namespace
 {
-/** The UsageError's text of \a f, or "" when it throws none. */
-template <typename F>
-std::string usageError(F f)
+/** The message of the UsageError that \a f throws ("" if none). */
+std::string usageError(const std::function<void()>& f)
 {
-	try
-	{
-		f();
-	}
-	catch (const bims::UsageError& e)
-	{
-		return e.what();
-	}
-	return "";
+	return bims::test::errorOf<bims::UsageError>(f);
 }
 }  // namespace
 

@@ -3,6 +3,7 @@
 // --overwrite.
 #include <bims/apps/app.h>
 #include <bims/apps/output_checks.h>
+#include <bims_test/error_of.h>
 #include <bims_test/text.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
@@ -21,18 +22,9 @@ std::string fresh(const std::string& name)
 }
 
 /** The message of the UsageError that \a f throws ("" if none). */
-template <class F>
-std::string usageError(F f)
+std::string usageError(const std::function<void()>& f)
 {
-	try
-	{
-		f();
-	}
-	catch (const bims::UsageError& e)
-	{
-		return e.what();
-	}
-	return "";
+	return bims::test::errorOf<bims::UsageError>(f);
 }
 }  // namespace
 
