@@ -23,6 +23,7 @@ std::runtime_error systemError(const std::string& path, const char* what)
 }
 void removeLayoutFiles(const std::string& dir,
                        const OutputFolderLayout& layout);
+void writeManifestOf(const std::string& dir);
 }  // namespace
 
 void checkOutputFilesWritable(const std::vector<std::string>& files)
@@ -126,6 +127,7 @@ void PartialDir::commit()
 		                          " (the new files stay in " + partial_ + ")");
 	};
 	std::error_code ec;
+	writeManifestOf(partial_);
 	const auto st = fs::symlink_status(final_, ec);
 	if (fs::is_symlink(st))
 	{
@@ -139,7 +141,12 @@ void PartialDir::commit()
 			                         ": exists and is not a folder (the new "
 			                         "files stay in " +
 			                         partial_ + ")");
-		removeLayoutFiles(final_, layout_);  // the earlier run's
+		// the earlier run's: what its manifest lists, or (a folder an
+		// older bims wrote, without one) the files of the layout
+		if (fs::exists(fs::path(final_) / kOutputManifest, ec))
+			removeListedOutputs(final_, "the new " + final_);
+		else
+			removeLayoutFiles(final_, layout_);
 		if (fs::is_empty(final_, ec)) fs::remove(final_, ec);
 	}
 	if (!fs::exists(fs::symlink_status(final_, ec)))
@@ -342,6 +349,19 @@ void removeLayoutFiles(const std::string& dir, const OutputFolderLayout& layout)
 		if (!sub.empty() && fs::is_empty(fs::path(dir) / sub, ec))
 			fs::remove(fs::path(dir) / sub, ec);
 	}
+}
+
+/** PartialDir's: the manifest of \a dir listing every file in it (sorted),
+ * so that the next run replaces exactly these. */
+void writeManifestOf(const std::string& dir)
+{
+	std::vector<std::string> files;
+	for (const auto& e : fs::recursive_directory_iterator(dir))
+		if (!e.is_directory())
+			files.push_back(e.path().lexically_relative(dir).string());
+	std::sort(files.begin(), files.end());
+	OutputManifest m(dir, "bims (the ground truth beside a rawlog)");
+	for (const auto& f : files) m.file(f);
 }
 
 /** \a rel's folders below \a dir are real folders (no link on the way). */

@@ -127,6 +127,10 @@ TEST(OutputPaths, APartialDirIsPutInPlaceWholeOrNotAtAll)
 	}
 	EXPECT_EQ(bims::test::fileText(d + "/x_gt/groundtruth.txt"), "one");
 	EXPECT_FALSE(fs::exists(d + "/x_gt.partial"));
+	// with the manifest of what it holds
+	EXPECT_EQ(bims::manifestFiles(d + "/x_gt"),
+	          (std::vector<std::string>{"groundtruth.txt", "masks/000000.png",
+	                                    "masks/000001.png"}));
 	// dropped (an error on the way): the earlier folder as it was
 	{
 		bims::PartialDir gt(d + "/x_gt", layout);
@@ -134,9 +138,11 @@ TEST(OutputPaths, APartialDirIsPutInPlaceWholeOrNotAtAll)
 	}
 	EXPECT_EQ(bims::test::fileText(d + "/x_gt/groundtruth.txt"), "one");
 	EXPECT_FALSE(fs::exists(d + "/x_gt.partial"));
-	// over an earlier run with a user's file: the run's files replaced
-	// (its extra mask gone), the user's kept
+	// over an earlier run with a user's files: the run's files replaced
+	// (its extra mask gone), the user's kept, even one named as the run
+	// names its masks (only what the earlier manifest lists goes)
 	write(d + "/x_gt/notes.txt", "mine");
+	write(d + "/x_gt/masks/000009.png", "my mask");
 	write(d + "/x_gt.partial/stale.png", "a killed run's");
 	{
 		bims::PartialDir gt(d + "/x_gt", layout);
@@ -149,7 +155,23 @@ TEST(OutputPaths, APartialDirIsPutInPlaceWholeOrNotAtAll)
 	EXPECT_EQ(bims::test::fileText(d + "/x_gt/masks/000000.png"), "n0");
 	EXPECT_FALSE(fs::exists(d + "/x_gt/masks/000001.png"));
 	EXPECT_EQ(bims::test::fileText(d + "/x_gt/notes.txt"), "mine");
+	EXPECT_EQ(bims::test::fileText(d + "/x_gt/masks/000009.png"), "my mask");
+	EXPECT_EQ(
+	    bims::manifestFiles(d + "/x_gt"),
+	    (std::vector<std::string>{"groundtruth.txt", "masks/000000.png"}));
 	EXPECT_FALSE(fs::exists(d + "/x_gt.partial"));
+	// a folder an older bims wrote (no manifest): the layout's files go
+	write(d + "/o_gt/groundtruth.txt", "old");
+	write(d + "/o_gt/masks/000003.png", "old mask");
+	write(d + "/o_gt/notes.txt", "mine");
+	{
+		bims::PartialDir gt(d + "/o_gt", layout);
+		write(gt.path() + "/groundtruth.txt", "new");
+		gt.commit();
+	}
+	EXPECT_EQ(bims::test::fileText(d + "/o_gt/groundtruth.txt"), "new");
+	EXPECT_FALSE(fs::exists(d + "/o_gt/masks"));
+	EXPECT_EQ(bims::test::fileText(d + "/o_gt/notes.txt"), "mine");
 	// a symbolic link at the name: replaced, its target untouched
 	write(d + "/elsewhere/groundtruth.txt", "theirs");
 	fs::create_directory_symlink(d + "/elsewhere", d + "/y_gt");

@@ -617,8 +617,16 @@ TEST(BimsSim, TheGroundTruthLayoutNamesEveryFileARunWrites)
 	     std::filesystem::recursive_directory_iterator(d + "/out_gt"))
 		if (!e.is_directory()) written.push_back(e.path().string());
 	std::sort(written.begin(), written.end());
-	EXPECT_EQ(written.size(), 8u);  // 5 files, 3 masks
+	EXPECT_EQ(written.size(), 9u);  // 5 files, 3 masks, the manifest
 	EXPECT_EQ(
 	    bims::earlierOutputs(d + "/out_gt", bims::sim::groundTruthLayout()),
 	    written);
+	// and the manifest lists every file but itself (what the next
+	// --overwrite removes)
+	std::vector<std::string> listed;
+	for (const auto& f : bims::manifestFiles(d + "/out_gt"))
+		listed.push_back(d + "/out_gt/" + f);
+	listed.push_back(d + "/out_gt/" + bims::kOutputManifest);
+	std::sort(listed.begin(), listed.end());
+	EXPECT_EQ(listed, written);
 }

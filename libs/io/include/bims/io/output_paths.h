@@ -87,9 +87,12 @@ class PartialFile
 
 /** A folder output (a rawlog's OUT_gt/) written as PATH.partial/ (a stale
  * one from a killed run is removed first) and put in place by commit():
- * an earlier run's files of \a layout in PATH are removed then (nothing
- * else; a symbolic link at PATH is replaced, never followed), and the new
- * folder renamed to PATH (its files moved in when PATH holds other files).
+ * the new folder gets a manifest (kOutputManifest) of every file in it;
+ * an earlier run's files in PATH are removed then, those its manifest
+ * lists (a folder of an older bims, without one: the files of \a layout),
+ * nothing else (a symbolic link at PATH is replaced, never followed), and
+ * the new folder renamed to PATH (its files moved in when PATH holds
+ * other files).
  * Dropped without commit(), PATH.partial/ is removed and PATH stays as it
  * was: a failed or killed run never leaves a new ground truth beside an old
  * rawlog. Commit it right after the rawlog's PartialFile. */
