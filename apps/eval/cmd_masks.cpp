@@ -90,6 +90,16 @@ int cmdMasks(int argc, char** argv)
 	    cmd);
 	TCLAP::SwitchArg quiet("q", "quiet", "no per-frame lines, no progress",
 	                       cmd);
+	TCLAP::ValueArg<long> maxSide(
+	    "", "image-max-side",
+	    "a label or mask declaring more pixels per side is refused before "
+	    "it is decoded (as [input] image_max_side)",
+	    false, bims::kMaxImageSide, "N", cmd);
+	TCLAP::ValueArg<long> maxPixels(
+	    "", "image-max-pixels",
+	    "a label or mask declaring more pixels (width x height) is refused "
+	    "before it is decoded (as [input] image_max_pixels)",
+	    false, static_cast<long>(bims::kMaxImagePixels), "N", cmd);
 	bims::parseCommandLine(cmd, argc, argv, {{"--plot-dir", "--out"}});
 	bims::apps::EvalMasksOptions o;
 	o.gtDir = gtArg.getValue();
@@ -110,5 +120,9 @@ int cmdMasks(int argc, char** argv)
 	o.stripFrames = stripFrames.getValue();
 	o.overwrite = overwrite.getValue();
 	o.quiet = quiet.getValue();
+	bims::inRange(maxSide, 1L, bims::ImageLimits::kSideAtMost);
+	bims::inRange(maxPixels, 1L, bims::ImageLimits::kPixelsAtMost);
+	o.images = {maxSide.getValue(), maxPixels.getValue(),
+	            "--image-max-side, --image-max-pixels"};
 	return bims::apps::runEvalMasks(o);
 }

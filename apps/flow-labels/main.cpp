@@ -33,8 +33,8 @@ int main(int argc, char** argv)
 		    TCLAP::ValueArg<std::string> aOut("o", "out", "output folder", true,
 		                                      "", "OUTDIR", cmd);
 		    TCLAP::ValueArg<std::string> aCfg(
-		        "c", "config", "experiment .ini ([flow] section)", false, "",
-		        "EXP.ini", cmd);
+		        "c", "config", "experiment .ini ([flow]; [input] image limits)",
+		        false, "", "EXP.ini", cmd);
 		    TCLAP::ValueArg<double> aScale("", "depth-scale",
 		                                   "depth units per metre", false,
 		                                   5000.0, "S", cmd);

@@ -151,7 +151,7 @@ void checkLabelValues(const EvalMasksOptions& o, const ev::MaskMatch& match,
 {
 	ev::LabelValueCounts counts;
 	for (const ev::MaskPair& pair : match.pairs)
-		counts.add(ev::loadMask(o.gtDir + "/" + pair.label->name));
+		counts.add(ev::loadMask(o.gtDir + "/" + pair.label->name, o.images));
 	const std::vector<int> unknown = counts.unknown(labels.convention);
 	if (unknown.empty()) return;
 	std::string values;
@@ -322,7 +322,8 @@ void scorePair(const EvalMasksOptions& o, const ev::MaskPair& pair,
 	const std::string gtPath = o.gtDir + "/" + pair.label->name;
 	const std::string frame =
 	    f.byTime() ? f.name.substr(0, f.name.size() - 4) : frameName(f.index);
-	const cv::Mat g = ev::loadMask(gtPath), pm = ev::loadMask(predPath);
+	const cv::Mat g = ev::loadMask(gtPath, o.images),
+	              pm = ev::loadMask(predPath, o.images);
 	FrameDepth d;
 	if (scans) d = frameDepth(*scans, f, *o.depthValid, gtPath, g);
 	ev::MaskMetrics m;

@@ -27,9 +27,9 @@ using flow::PairLabels;
 
 namespace
 {
-cv::Mat readImage(const std::string& path, int flags)
+cv::Mat readImage(const std::string& path, int flags, const ImageLimits& limits)
 {
-	return readImageFile(path, flags, "image");
+	return readImageFile(path, flags, "image", limits);
 }
 }  // namespace
 
@@ -49,6 +49,7 @@ int runFlowLabels(const FlowLabelsOptions& o)
 	checkOutputsSpareInputs({o.rgb0, o.rgb1, o.depth1, o.config.value_or("")},
 	                        {o.out});
 	FlowParams params;
+	ImageLimits limits;  // [input] of the config, else the defaults
 	if (o.config)
 	{
 		if (!mrpt::system::fileExists(*o.config))
@@ -56,10 +57,11 @@ int runFlowLabels(const FlowLabelsOptions& o)
 		const auto cfg = openIniFile(*o.config);
 		checkExperimentSections(*cfg);
 		params.loadFromConfigFile(*cfg, "flow");
+		limits.loadFromConfigFile(*cfg, "input");
 	}
-	const cv::Mat rgb0 = readImage(o.rgb0, cv::IMREAD_COLOR);
-	const cv::Mat rgb1 = readImage(o.rgb1, cv::IMREAD_COLOR);
-	const cv::Mat d16 = readImage(o.depth1, cv::IMREAD_UNCHANGED);
+	const cv::Mat rgb0 = readImage(o.rgb0, cv::IMREAD_COLOR, limits);
+	const cv::Mat rgb1 = readImage(o.rgb1, cv::IMREAD_COLOR, limits);
+	const cv::Mat d16 = readImage(o.depth1, cv::IMREAD_UNCHANGED, limits);
 	if (d16.type() != CV_16UC1)
 		throw std::runtime_error(o.depth1 +
 		                         ": depth must be a 16-bit single-channel PNG");

@@ -7,6 +7,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <stdexcept>
 
@@ -20,8 +21,14 @@ cv::Mat feedbackMask(const std::string& dir, const source::SourceFrame& f)
 	if (dir.empty() || f.index == 0) return {};
 	const std::string p = dir + "/" + frameFileName(f.index - 1);
 	if (!std::filesystem::exists(p)) return {};
-	cv::Mat mask = readImageFile(p, cv::IMREAD_UNCHANGED, "mask");
+	// a mask is the depth image's size: a file declaring more is refused
+	// before it is decoded
 	const auto& depth = f.scan->rangeImage;
+	const long w = static_cast<long>(depth.cols()),
+	           h = static_cast<long>(depth.rows());
+	cv::Mat mask = readImageFile(
+	    p, cv::IMREAD_UNCHANGED, "mask",
+	    ImageLimits{std::max(w, h), w * h, "the depth image's size"});
 	if (mask.type() != CV_8UC1 || mask.cols != static_cast<int>(depth.cols()) ||
 	    mask.rows != static_cast<int>(depth.rows()))
 		throw std::runtime_error(

@@ -98,7 +98,7 @@ int runFromCommandLine(const RunCommand& c)
 		try
 		{
 			writeRunReport({opt.outDir, opt.rawlogs, c.config,
-			                choiceName(cfg.ego.odometry.mode)});
+			                choiceName(cfg.ego.odometry.mode), cfg.input});
 			report = true;
 		}
 		catch (const std::exception& e)

@@ -99,9 +99,11 @@ std::string scores(const RunReportInputs& in)
 			const auto conv = ev::LabelConvention::explicitValues(255, 0, {});
 			ev::MaskMetrics m;
 			for (const auto& p : match.pairs)
-				m.accumulate(ev::loadMask(gtMasks + "/" + p.label->name),
-				             ev::loadMask(in.outDir + "/masks/" + p.pred->name),
-				             cv::Mat(), conv);
+				m.accumulate(
+				    ev::loadMask(gtMasks + "/" + p.label->name, in.images),
+				    ev::loadMask(in.outDir + "/masks/" + p.pred->name,
+				                 in.images),
+				    cv::Mat(), conv);
 			o << "- moving masks against `" << gtMasks << "` ("
 			  << match.pairs.size()
 			  << " frames, every pixel): " << m.scoresLine()

@@ -87,4 +87,14 @@ TEST(FlowLabelsRun, TheRunWritesFourPicturesAndNamesBadInputs)
 	EXPECT_NE(errorOf(bad).find("declares 30000 x 30000 pixels"),
 	          std::string::npos)
 	    << errorOf(bad);
+	// the limits are [input]'s of the config (issue 39)
+	bad = o;
+	bad.config = d + "/small.ini";
+	std::ofstream(*bad.config) << "[input]\nimage_max_side = 100\n";
+	EXPECT_NE(errorOf(bad).find(o.rgb0 +
+	                            ": cannot read image: declares 160 x 120 "
+	                            "pixels in its PNG header, beyond the 100 per "
+	                            "side"),
+	          std::string::npos)
+	    << errorOf(bad);
 }

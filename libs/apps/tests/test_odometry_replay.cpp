@@ -153,6 +153,23 @@ TEST(EndToEnd, MasksFolderReachesTheTrackerAsThePreviousFramesMask)
 		EXPECT_NE(std::string(e.what()).find("000000.png"), std::string::npos)
 		    << e.what();
 	}
+	// a mask declaring more pixels than the depth image is refused before
+	// it is decoded (issue 39: the depth image's size is the limit)
+	cv::imwrite(bad + "/000000.png", cv::Mat(241, 320, CV_8UC1, cv::Scalar(0)));
+	try
+	{
+		excludedFrames(bad, nullptr);
+		FAIL() << "a mask larger than the depth image must throw";
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find(
+		              "000000.png: cannot read mask: declares 320 x 241 pixels "
+		              "in its PNG header, beyond the 320 per side and 76800 "
+		              "pixels"),
+		          std::string::npos)
+		    << e.what();
+	}
 }
 
 TEST(EndToEnd, ReplayDropsAnImuSampleThatIsNotFiniteAndFlagsItsFrame)

@@ -63,7 +63,7 @@ TEST(RunReport, FiguresScoresAndLinksOfAHandMadeRun)
 		cv::imwrite(out + "/masks/" + n, p);
 	}
 	bims::apps::writeRunReport(
-	    {out, {d + "/in.rawlog"}, "default.ini", "vision"});
+	    {out, {d + "/in.rawlog"}, "default.ini", "vision", {}});
 	const std::string r = readText(out + "/report.md");
 	for (const std::string s :
 	     {"# bims-run report", "status: **done**", "variant: fused",
@@ -80,13 +80,14 @@ TEST(RunReport, FiguresScoresAndLinksOfAHandMadeRun)
 		EXPECT_NE(r.find(s), std::string::npos) << s << "\n" << r;
 	// without ground truth: says how to score
 	fs::remove_all(d + "/in_gt");
-	const std::string r2 =
-	    bims::apps::runReport({out, {d + "/in.rawlog"}, "default.ini", "imu"});
+	const std::string r2 = bims::apps::runReport(
+	    {out, {d + "/in.rawlog"}, "default.ini", "imu", {}});
 	EXPECT_NE(r2.find("No ground truth beside the input"), std::string::npos)
 	    << r2;
 	// no metrics.json: an error naming it
 	fs::remove(out + "/metrics.json");
-	EXPECT_THROW(bims::apps::runReport({out, {}, "", ""}), std::runtime_error);
+	EXPECT_THROW(bims::apps::runReport({out, {}, "", "", {}}),
+	             std::runtime_error);
 }
 
 TEST(RunReport, BimsRunWritesItBesideItsOutputs)

@@ -2,6 +2,7 @@
 #include <bims/eval/rgbd_frame.h>
 #include <bims/eval/tum_import.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -131,7 +132,11 @@ TumFolder readTumFolder(const std::string& folder, const ImportParams& params)
 
 cv::Mat loadDepthMeters(const std::string& path, const CameraIntrinsics& cam)
 {
-	const cv::Mat raw = readDepthPng(path);
+	// the camera's size: a file declaring more is refused before decoding
+	const cv::Mat raw = readDepthPng(
+	    path, ImageLimits{std::max<long>(cam.width, cam.height),
+	                      static_cast<long>(cam.width) * cam.height,
+	                      "[camera]'s size"});
 	if (raw.cols != cam.width || raw.rows != cam.height)
 		throw std::runtime_error(
 		    path + ": depth image is " + std::to_string(raw.cols) + "x" +

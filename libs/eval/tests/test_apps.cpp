@@ -248,6 +248,31 @@ TEST(EvalMasks, HandComputedTotalsAndErrors)
 	EXPECT_NE(r.out.find("missing: mask directory not found"),
 	          std::string::npos)
 	    << r.out;
+	// The image limits (issue 39): a label declaring more than
+	// --image-max-side / --image-max-pixels is refused before decoding,
+	// naming it; the limits' ranges are checked.
+	cv::imwrite(d + "/pred/000001.png", p1);
+	r = run(kBin + "/bims-eval masks " + d + "/gt " + d +
+	        "/pred --no-plots --image-max-side 7");
+	EXPECT_EQ(r.code, 1) << r.out;
+	EXPECT_NE(r.out.find(d + "/gt/000000.png: cannot read mask image: "
+	                         "declares 8 x 8 pixels in its PNG header, beyond "
+	                         "the 7 per side"),
+	          std::string::npos)
+	    << r.out;
+	r = run(kBin + "/bims-eval masks " + d + "/gt " + d +
+	        "/pred --no-plots --image-max-pixels 63");
+	EXPECT_EQ(r.code, 1) << r.out;
+	EXPECT_NE(r.out.find("and 63 pixels"), std::string::npos) << r.out;
+	r = run(kBin + "/bims-eval masks " + d + "/gt " + d +
+	        "/pred --no-plots --image-max-pixels 64 --image-max-side 8");
+	EXPECT_EQ(r.code, 0) << r.out;
+	r = run(kBin + "/bims-eval masks " + d + "/gt " + d +
+	        "/pred --no-plots --image-max-side 0");
+	EXPECT_EQ(r.code, 2) << r.out;
+	EXPECT_NE(r.out.find("--image-max-side 0: out of range [1, 65535]"),
+	          std::string::npos)
+	    << r.out;
 }
 
 TEST(EvalMasks, LabelsByTimestampWithIgnoredValues)

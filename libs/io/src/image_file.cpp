@@ -121,10 +121,10 @@ std::optional<ImageHeader> imageHeader(const uint8_t* p, size_t n)
 
 void ImageLimits::describe(OptionVisitor& v)
 {
-	v.integer("image_max_side", max_side, 1, 65535,
+	v.integer("image_max_side", max_side, 1, kSideAtMost,
 	          "an input image file (TUM folder, Stray capture, labels) "
 	          "declaring more pixels per side is refused before decoding");
-	v.integer("image_max_pixels", max_pixels, 1, 1L << 31,
+	v.integer("image_max_pixels", max_pixels, 1, kPixelsAtMost,
 	          "an input image file declaring more pixels (width x height) "
 	          "is refused before decoding");
 }
@@ -174,8 +174,7 @@ cv::Mat readImageFile(const std::string& path, int flags,
 		           std::to_string(h->height) + " pixels in its " + h->format +
 		           " header, beyond the " + std::to_string(limits.max_side) +
 		           " per side and " + std::to_string(limits.max_pixels) +
-		           " pixels bims reads ([input] image_max_side, "
-		           "image_max_pixels; not decoded)");
+		           " pixels bims reads (" + limits.origin + "; not decoded)");
 	if (h->width == 0 || h->height == 0)
 		throw fail(std::string("declares an empty image in its ") + h->format +
 		           " header");

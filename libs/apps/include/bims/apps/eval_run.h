@@ -4,11 +4,15 @@
 // its options here and run by one function.
 #pragma once
 
+#include <bims/io/image_file.h>
+
 #include <optional>
 #include <string>
 
 namespace bims::apps
 {
+using bims::ImageLimits;
+
 /** What bims-eval traj's command line gives (nullopt: not given). */
 struct EvalTrajOptions
 {
@@ -52,6 +56,9 @@ struct EvalMasksOptions
 	std::string stripFrames;           ///< "i,j,..": scan indices
 	bool overwrite = false;  ///< replace an earlier evaluation's overlays
 	bool quiet = false;      ///< no per-frame lines, no progress line
+	/** the labels' and masks' largest declared size, checked before they
+	 * are decoded (--image-max-side, --image-max-pixels) */
+	ImageLimits images;
 };
 
 /** bims-eval masks: checks the options (UsageError), pairs the labels

@@ -19,7 +19,7 @@ struct FlowLabelsOptions
 	std::string rgb1;                   ///< current RGB image
 	std::string depth1;                 ///< current depth (16-bit PNG)
 	std::string out;                    ///< output folder
-	std::optional<std::string> config;  ///< experiment .ini ([flow])
+	std::optional<std::string> config;  ///< experiment .ini ([flow], [input])
 	double depth_scale = 5000.0;        ///< depth units per metre
 	double fx = 0, fy = 0;    ///< focal lengths [px] (<= 0: the default)
 	double cx = -1, cy = -1;  ///< principal point [px] (< 0: the centre)

@@ -3,6 +3,8 @@
 // ground truth beside it, and links to the files the run wrote.
 #pragma once
 
+#include <bims/io/image_file.h>
+
 #include <string>
 #include <vector>
 
@@ -15,6 +17,7 @@ struct RunReportInputs
 	std::vector<std::string> rawlogs;  ///< its inputs
 	std::string config;                ///< the experiment .ini given
 	std::string odometryMode;          ///< [odometry] mode (imu, vision)
+	ImageLimits images;                ///< [input]: the masks' largest size
 };
 
 /** The report's Markdown: the run (status, variant, config, inputs),

@@ -36,6 +36,10 @@ struct ImageLimits
 {
 	long max_side = kMaxImageSide;      ///< [input] image_max_side
 	long max_pixels = kMaxImagePixels;  ///< [input] image_max_pixels
+	/** Where the two come from, for the error of an image beyond them. */
+	std::string origin = "[input] image_max_side, image_max_pixels";
+	/** The largest values the two may be given (from 1). */
+	static constexpr long kSideAtMost = 65535, kPixelsAtMost = 1L << 31;
 
 	void describe(OptionVisitor& v);
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
