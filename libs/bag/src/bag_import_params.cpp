@@ -2,6 +2,7 @@
 #include <bims/common/config.h>
 #include <bims/common/experiment.h>
 #include <bims/eval/rgbd_frame.h>
+#include <bims/sensors/params.h>
 
 namespace bims::bag
 {
@@ -105,24 +106,17 @@ void BagImportParams::loadFromConfigFile(
 			           "with SYNTH is the synthetic IMU's");
 	}
 	ConfigSection cam(cfg, "camera");
-	bool any = false;
-	for (const char* k : {"fx", "fy", "cx", "cy", "width", "height"})
-		any = any || cam.has(k);
 	if (cam.has("depth_scale"))
 		cam.fail("depth_scale",
 		         "does not apply to a bag: its depth encoding says the "
 		         "unit (16UC1 millimetres, 32FC1 metres; ROS REP 118)");
-	if (any)
+	// as bims-run reads it: the six together or none (then the bag's own)
+	sensors::CameraParams c;
+	c.loadFromConfigFile(cfg, "camera");
+	if (c.given)
 	{
-		eval::CameraIntrinsics c;
-		c.loadFromConfigFile(cfg, "camera");
 		camera = c.tcamera();
 		cameraFrom = "[camera] of " + cam.file();
-	}
-	else
-	{
-		cam.allow("max_range");
-		cam.finish();
 	}
 	eval::loadImportLabels(cfg, rgbdLabel, imuLabel);
 }

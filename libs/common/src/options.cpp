@@ -86,12 +86,16 @@ bool OptionReader::onGroup(const std::vector<const char*>& keys, bool)
 	for (const char* k : keys) n += s_.has(k) ? 1 : 0;
 	if (n > 0 && n < keys.size())
 	{
-		std::string all;
+		std::string all, given, missing;
 		for (const char* k : keys)
+		{
 			all += (all.empty() ? "" : " ") + std::string(k);
+			(s_.has(k) ? given : missing) += std::string(" ") + k;
+		}
 		for (const char* k : keys)
 			if (!s_.has(k))
-				s_.fail(k, "missing: give all of " + all + " or none");
+				s_.fail(k, all + ": all or none; given:" + given +
+				               ", missing:" + missing);
 	}
 	return n == keys.size();
 }

@@ -1,4 +1,5 @@
 #include <bims/common/config.h>
+#include <bims/common/experiment.h>
 #include <bims_test/error_of.h>
 #include <gtest/gtest.h>
 
@@ -8,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <set>
 
 using bims::ConfigError;
 using bims::ConfigSection;
@@ -114,6 +116,30 @@ TEST(ConfigSection, UnknownSectionsAreErrors)
 	const auto msg = errorOf<bims::ConfigError>(
 	    [&] { bims::checkSections(cfg, {"a"}, {"map_"}); });
 	EXPECT_NE(msg.find("[oops]: unknown section"), std::string::npos) << msg;
+}
+
+// The one table of the experiment's sections: unique names, each with who
+// reads it and a title; a name not in it is a program's error.
+TEST(ExperimentSections, OneTableNamesReadersAndTitles)
+{
+	const auto& t = bims::experimentSectionTable();
+	ASSERT_EQ(bims::experimentSections().size(), t.size());
+	std::set<std::string> names;
+	for (size_t k = 0; k < t.size(); ++k)
+	{
+		EXPECT_TRUE(names.insert(t[k].name).second) << t[k].name;
+		EXPECT_EQ(bims::experimentSections()[k], t[k].name);
+		EXPECT_GT(std::string(t[k].readBy).size(), 2u) << t[k].name;
+		EXPECT_GT(std::string(t[k].title).size(), 5u) << t[k].name;
+		EXPECT_EQ(&bims::experimentSection(t[k].name), &t[k]);
+	}
+	EXPECT_THROW(bims::experimentSection("nope"), std::logic_error);
+	mrpt::config::CConfigFileMemory cfg(
+	    "[grids]\nx = 1\n[import_bag]\ny = 1\n[gridz]\nz = 1\n");
+	EXPECT_NE(
+	    errorOf<bims::ConfigError>([&] { bims::checkExperimentSections(cfg); })
+	        .find("[gridz]: unknown section"),
+	    std::string::npos);
 }
 
 namespace

@@ -154,7 +154,7 @@ TEST(Options, AGroupIsAllOrNothing)
 	Pair p;
 	EXPECT_EQ(
 	    errorOf<bims::ConfigError>([&] { bims::readOptions(p, half, "s"); }),
-	    "<memory>: [s] b: missing: give all of a b or none");
+	    "<memory>: [s] b: a b: all or none; given: a, missing: b");
 }
 
 TEST(Options, WrittenValuesReadBackToTheSameOptions)

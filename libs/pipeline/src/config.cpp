@@ -84,26 +84,25 @@ void OutputParams::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 
 namespace
 {
-/** Every section of the experiment with its options and a title, in file
- * order: f(section, title, options). */
+/** Every section bims-run reads with its options, in file order:
+ * f(section, options); titles and readers: bims/common/experiment.h. */
 template <typename Config, typename F>
 void forEachSection(Config& c, F&& f)
 {
-	f("sensors", "sensor labels in the rawlog", c.ego.sensors);
-	f("calibration", "IMU-camera extrinsics", c.ego.calibration);
-	f("camera", "intrinsics", c.ego.camera);
-	f("depth_correction", "the depth sensor's smooth distortion",
-	  c.ego.depth_correction);
-	f("attitude", "IMU attitude filter", c.ego.attitude);
-	f("tracker", "gyro-aided KLT", c.ego.tracker);
-	f("translation", "robust translation and refinement", c.ego.translation);
-	f("odometry", "the egomotion's mode", c.ego.odometry);
-	f("anchor", "map-anchored (keyframe) tracking", c.ego.anchor);
-	f("flow", "observed and expected flow, Diff labels", c.flow);
-	f("grids", "the three Bayesian grids", c.grids);
-	f("pipeline", "orchestration, variant", c.pipeline);
-	f("output", "what bims-run writes", c.output);
-	f("input", "size limits of input image files", c.input);
+	f("sensors", c.ego.sensors);
+	f("calibration", c.ego.calibration);
+	f("camera", c.ego.camera);
+	f("depth_correction", c.ego.depth_correction);
+	f("attitude", c.ego.attitude);
+	f("tracker", c.ego.tracker);
+	f("translation", c.ego.translation);
+	f("odometry", c.ego.odometry);
+	f("anchor", c.ego.anchor);
+	f("flow", c.flow);
+	f("grids", c.grids);
+	f("pipeline", c.pipeline);
+	f("output", c.output);
+	f("input", c.input);
 }
 
 /** A table cell: no line breaks, '|' escaped. */
@@ -118,8 +117,7 @@ std::string cell(const std::string& s)
 void ExperimentConfig::saveToConfigFile(
     mrpt::config::CConfigFileBase& out) const
 {
-	forEachSection(*this,
-	               [&](const char* section, const char*, const auto& opts)
+	forEachSection(*this, [&](const char* section, const auto& opts)
 	               { writeOptions(opts, out, section); });
 }
 
@@ -146,17 +144,20 @@ std::string configReference()
 	    "The built-in defaults are the tuned model of `config/default.ini`; "
 	    "`config/paper.ini`\nis the paper's literal model. An absent key "
 	    "keeps its default, an unknown key\nor a value out of range is an "
-	    "error naming the file, the section and the key.\n"
-	    "`[import]`, `[import_stray]` and `[import_bag]` (read by "
-	    "`bims-import-tum`,\n`bims-import-stray` and `bims-import-bag` "
-	    "only: `docs/eval.md`, `docs/import-bag.md`)\nand MRPT map "
-	    "definitions (`[map...]`) are not listed. `[input]` is read by "
-	    "`bims-import-tum`\nand `bims-import-stray` (their `-c`) too.\n";
+	    "error naming the file, the section and the key.\n\n"
+	    "| section | read by | what |\n|---|---|---|\n";
+	for (const auto& s : experimentSectionTable())
+		md += std::string("| `[") + s.name + "]` | " + s.readBy + " | " +
+		      s.title + " |\n";
+	md +=
+	    "\nThe import sections (`docs/eval.md`, `docs/import-bag.md`) and MRPT "
+	    "map\ndefinitions (`[map...]`) are not listed below.\n";
 	const ExperimentConfig defaults;
 	forEachSection(defaults,
-	               [&](const char* section, const char* title, const auto& opts)
+	               [&](const char* section, const auto& opts)
 	               {
-		               md += std::string("\n## [") + section + "]: " + title +
+		               md += std::string("\n## [") + section +
+		                     "]: " + experimentSection(section).title +
 		                     "\n\n| key | default | range | meaning |\n"
 		                     "|---|---|---|---|\n";
 		               for (const auto& r : optionRows(opts))
