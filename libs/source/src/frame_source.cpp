@@ -188,14 +188,25 @@ bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
 				    quoted(p_.sensors.imu_label).c_str());
 			return true;
 		}
-		if (st_.imuRead++ == 0 && !(channels & kImuGyro) && p_.warnings)
-			std::fprintf(stderr,
-			             "%s: warning: %s: the IMU labelled %s measures %s: "
-			             "without a gyro the egomotion cannot use it (frames "
-			             "run as vision, flagged imu_missing)\n",
-			             p_.program.c_str(), where.c_str(),
-			             quoted(imu->sensorLabel).c_str(),
-			             imuChannelNames(channels).c_str());
+		// at the start, which IMU the run uses and what it measures (its
+		// count: in the summary; counting first would read the input twice)
+		if (st_.imuRead++ == 0 && p_.warnings)
+		{
+			if (channels & kImuGyro)
+				std::fprintf(stderr, "%s: %s: using the IMU labelled %s (%s)\n",
+				             p_.program.c_str(), where.c_str(),
+				             quoted(imu->sensorLabel).c_str(),
+				             imuChannelNames(channels).c_str());
+			else
+				std::fprintf(
+				    stderr,
+				    "%s: warning: %s: the IMU labelled %s measures %s: "
+				    "without a gyro the egomotion cannot use it (frames "
+				    "run as vision, flagged imu_missing)\n",
+				    p_.program.c_str(), where.c_str(),
+				    quoted(imu->sensorLabel).c_str(),
+				    imuChannelNames(channels).c_str());
+		}
 		st_.imuChannels |= channels;
 		if (p_.keepInput) input_.push_back(imu);
 		if (heldImu_)
@@ -231,7 +242,22 @@ bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
 			return true;
 		}
 		const size_t idx = scanIndex_++;
-		st_.scansRead++;
+		// the second scan and still no IMU sample of the label: said now,
+		// not only in the summary
+		if (++st_.scansRead == 2 && st_.imuRead == 0 && p_.warnings)
+			std::fprintf(
+			    stderr,
+			    "%s: %s: no IMU sample %s before the second 3D scan "
+			    "(%s): frames without one run without IMU data "
+			    "(imu_missing)\n",
+			    p_.program.c_str(), where.c_str(),
+			    p_.sensors.imu_label.empty()
+			        ? "of any label"
+			        : ("labelled " + quoted(p_.sensors.imu_label)).c_str(),
+			    st_.imuOtherLabels.empty()
+			        ? "none in the input so far"
+			        : "only under other labels so far: [sensors] "
+			          "imu_label");
 		if (held_)
 		{
 			// this scan follows the held one: the recording jumped

@@ -181,6 +181,53 @@ TEST(FrameOrder, ObservationsOfOtherLabelsAndClassesAreSkipped)
 	EXPECT_EQ(order.stats().imuRead, 2u);
 }
 
+// Issue 35: at the start a run says which IMU it uses and what it measures
+// (at its first sample), or that none of the label came before the second
+// scan; the counts follow in the summary (imuNotes).
+TEST(FrameOrder, TheImuInUseIsSaidAtTheStart)
+{
+	auto p = params();
+	p.sensors.imu_label = "IMU";
+	const auto stderrOf = [&](const std::vector<CObservation::Ptr>& in)
+	{
+		FrameOrder order(p);
+		testing::internal::CaptureStderr();
+		run(order, in);
+		return testing::internal::GetCapturedStderr();
+	};
+	const auto gyro = [](double t)
+	{
+		auto o = CObservationIMU::Create();
+		o->timestamp = mrpt::Clock::fromDouble(t);
+		o->sensorLabel = "IMU";
+		for (auto i : {mrpt::obs::IMU_WX, mrpt::obs::IMU_WY, mrpt::obs::IMU_WZ})
+			o->set(i, 0.1);
+		return o;
+	};
+	EXPECT_EQ(
+	    stderrOf({gyro(0.9), scan(1.0), gyro(1.05), scan(1.1), gyro(1.2)}),
+	    "test: test.rawlog: using the IMU labelled 'IMU' (gyro)\n");
+	EXPECT_EQ(
+	    stderrOf({scan(1.0), scan(1.1), scan(1.2)}),
+	    "test: test.rawlog: no IMU sample labelled 'IMU' before the second 3D "
+	    "scan (none in the input so far): frames without one run "
+	    "without IMU data (imu_missing)\n");
+	const std::string other =
+	    stderrOf({imu(0.9, 0.1, "GYRO"), scan(1.0), scan(1.1)});
+	EXPECT_NE(other.find("IMU samples labelled 'GYRO' (no gyro, accel or mag) "
+	                     "are not used: "
+	                     "[sensors] imu_label is 'IMU'"),
+	          std::string::npos)
+	    << other;
+	EXPECT_NE(other.find("no IMU sample labelled 'IMU' before the second 3D "
+	                     "scan (only under other labels so far: [sensors] "
+	                     "imu_label)"),
+	          std::string::npos)
+	    << other;
+	p.warnings = false;  // an indexing pass says nothing
+	EXPECT_EQ(stderrOf({scan(1.0), scan(1.1), scan(1.2)}), "");
+}
+
 // No IMU is left unused silently: the samples of other labels are counted
 // by label with what they measure, and the notes of a run say which IMU was
 // used, what it measures, and what was not used and how to use it.
