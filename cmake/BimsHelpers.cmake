@@ -162,6 +162,10 @@ function(bims_add_gtest)
   # helpers shared by the tests (bims_test/...)
   target_include_directories(${A_NAME} PRIVATE ${PROJECT_SOURCE_DIR}/tests/support)
   bims_target_defaults(${A_NAME})
+  # Each build tree's tests keep their scratch folders in the tree
+  # (TMPDIR), so that two trees tested at once never share a folder.
+  set(test_tmp "${PROJECT_BINARY_DIR}/test-tmp")
+  file(MAKE_DIRECTORY "${test_tmp}")
   if(BIMS_TEST_SHARDS GREATER 0)
     # A shard runs many cases: the time of the longest ones together.
     math(EXPR A_TIMEOUT "${A_TIMEOUT} * 4")
@@ -172,14 +176,15 @@ function(bims_add_gtest)
                WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
       set_tests_properties(${shard} PROPERTIES
         TIMEOUT ${A_TIMEOUT} LABELS "${A_LABELS}"
-        ENVIRONMENT "GTEST_TOTAL_SHARDS=${BIMS_TEST_SHARDS};GTEST_SHARD_INDEX=${index}")
+        ENVIRONMENT "GTEST_TOTAL_SHARDS=${BIMS_TEST_SHARDS};GTEST_SHARD_INDEX=${index};TMPDIR=${test_tmp}")
     endforeach()
     return()
   endif()
   gtest_discover_tests(${A_NAME}
     DISCOVERY_MODE PRE_TEST
     WORKING_DIRECTORY ${PROJECT_BINARY_DIR}
-    PROPERTIES TIMEOUT ${A_TIMEOUT} LABELS "${A_LABELS}")
+    PROPERTIES TIMEOUT ${A_TIMEOUT} ENVIRONMENT "TMPDIR=${test_tmp}"
+               LABELS "${A_LABELS}")
 endfunction()
 
 # bims_write_module_graph(FILE): one line per library module, "module: the

@@ -118,6 +118,16 @@ TEST(ConfigSection, UnknownSectionsAreErrors)
 	EXPECT_NE(msg.find("[oops]: unknown section"), std::string::npos) << msg;
 }
 
+// The tests' scratch folders (bims_test/tmp_dir.h) are in their build
+// tree (TMPDIR set by CTest: cmake/BimsHelpers.cmake): two trees tested at
+// once never share one.
+TEST(TestSupport, ScratchFoldersAreInTheBuildTree)
+{
+	const std::string tmp = bims::test::tmpPath("bims_test_common", "x");
+	EXPECT_EQ(tmp.rfind(std::string(BIMS_BINARY_DIR) + "/test-tmp/", 0), 0u)
+	    << tmp;
+}
+
 // The one table of the experiment's sections: unique names, each with who
 // reads it and a title; a name not in it is a program's error.
 TEST(ExperimentSections, OneTableNamesReadersAndTitles)
