@@ -50,6 +50,20 @@ InputKind inputKind(const std::string& path)
 
 namespace
 {
+/** Whether the .ini at \a path is a simulator scene (it has [sim]), not
+ * an experiment. */
+bool isSceneIni(const std::string& path)
+{
+	std::ifstream in(path);
+	for (std::string line; std::getline(in, line);)
+	{
+		const size_t a = line.find_first_not_of(" \t");
+		if (a != std::string::npos && line.compare(a, 5, "[sim]") == 0)
+			return true;
+	}
+	return false;
+}
+
 std::string folderKindName(InputKind k)
 {
 	return k == InputKind::TumFolder ? "a TUM RGB-D folder"
@@ -70,9 +84,13 @@ void checkRawlogInputKind(const std::string& r, const std::string& usage)
 {
 	const InputKind k = inputKind(r);
 	if (k == InputKind::IniText)
-		throw UsageError(r + ": an .ini where a rawlog belongs: " + usage +
-		                 " (a simulator scene makes a rawlog: bims-sim " + r +
-		                 " -o OUT.rawlog)");
+		throw UsageError(
+		    r + ": an .ini where a rawlog belongs: " + usage +
+		    (isSceneIni(r) ? " (a simulator scene makes a rawlog: bims-sim " +
+		                         r + " -o OUT.rawlog)"
+		                   : " (an experiment .ini: it goes with a rawlog, "
+		                     "e.g. bims-run " +
+		                         r + " IN.rawlog -o OUTDIR)"));
 	if (k == InputKind::TumFolder || k == InputKind::StrayFolder)
 		throw UsageError(r + ": " + folderKindName(k) +
 		                 ", not a rawlog; import it first: " +

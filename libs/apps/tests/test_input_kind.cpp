@@ -70,6 +70,18 @@ TEST(InputKind, BimsRunNamesTheCommandToUseInstead)
 	EXPECT_NE(e.find(cfg + ": an .ini where a rawlog belongs"),
 	          std::string::npos)
 	    << e;
+	// an experiment .ini goes with a rawlog; a scene makes one
+	EXPECT_NE(e.find("(an experiment .ini: it goes with a rawlog, e.g. "
+	                 "bims-run " +
+	                 cfg + " IN.rawlog -o OUTDIR)"),
+	          std::string::npos)
+	    << e;
+	std::ofstream(d + "/scene.ini") << "; a scene\n  [sim]\nframes = 3\n";
+	e = usageError([&] { checkRunInputKinds(cfg, {d + "/scene.ini"}); });
+	EXPECT_NE(e.find("(a simulator scene makes a rawlog: bims-sim " + d +
+	                 "/scene.ini -o OUT.rawlog)"),
+	          std::string::npos)
+	    << e;
 	// a TUM folder, as the rawlog or as the .ini
 	e = usageError([&] { checkRunInputKinds(cfg, {d + "/tum"}); });
 	EXPECT_NE(e.find("bims-import-tum " + d + "/tum -o OUT.rawlog"),
