@@ -265,8 +265,13 @@ std::string markdownText(const ResultTable& t, const std::string& plotMetric)
 	      "peak_resident_mib", "stage_ms.total.median"})
 		add(m);
 	add(plotMetric);
+	// the scores some run has a value of (a score no run has, e.g. the
+	// figures of frames without moving labels, is only in results.csv)
 	for (const auto& m : all)
-		if (isScore(m)) add(m);
+		if (isScore(m) && std::any_of(t.rows.begin(), t.rows.end(),
+		                              [&](const RunResult& r)
+		                              { return std::isfinite(r.metric(m)); }))
+			add(m);
 
 	std::string out = "# Sweep " + mdCell(t.plan.name) + "\n\n";
 	out += std::to_string(t.rows.size()) + " runs, " +

@@ -12,6 +12,7 @@
 #include <mrpt/config/CConfigFileMemory.h>
 
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -413,6 +414,29 @@ TEST(SweepResults, CsvAndMarkdownHoldEveryRunWithItsOverridesAndErrors)
 	EXPECT_NE(md.find("- 2: error, exit 1: x.rawlog: entry 3"),
 	          std::string::npos)
 	    << md;
+}
+
+// A score no run has a value of (NaN in every run: e.g. the figures of the
+// frames without moving labels when every frame has some) stays out of
+// results.md; it is still in results.csv.
+TEST(SweepResults, MarkdownLeavesOutScoresNoRunHas)
+{
+	const auto d = tmpDir("nan_scores");
+	auto t = table(d);
+	for (auto& r : t.rows)
+	{
+		r.metrics.push_back({"masks.total.f1", 0.9});
+		r.metrics.push_back({"masks.total_nothing_moving.f1", NAN});
+	}
+	const std::string md = sw::markdownText(t, "fps");
+	EXPECT_NE(md.find("| masks.total.f1 |"), std::string::npos) << md;
+	EXPECT_EQ(md.find("total_nothing_moving"), std::string::npos) << md;
+	EXPECT_NE(sw::csvText(t).find("masks.total_nothing_moving.f1"),
+	          std::string::npos);
+	// one run with a value: the column stays
+	t.rows[2].metrics.back().second = 0.5;
+	EXPECT_NE(sw::markdownText(t, "fps").find("masks.total_nothing_moving.f1"),
+	          std::string::npos);
 }
 
 TEST(SweepResults, PlotGroupsRunsByOverridesAndRefusesAnUnknownMetric)
