@@ -151,7 +151,8 @@ std::string configReference()
 	    "`bims-import-tum`,\n`bims-import-stray` and `bims-import-bag` "
 	    "only: `docs/eval.md`, `docs/import-bag.md`)\nand MRPT map "
 	    "definitions (`[map...]`) are not listed. `[input]` is read by "
-	    "`bims-import-tum`\nand `bims-import-stray` (their `-c`) too.\n";
+	    "`bims-import-tum`,\n`bims-import-stray` and `bims-import-bag` (their "
+	    "`-c`) too.\n";
 	const ExperimentConfig defaults;
 	forEachSection(defaults,
 	               [&](const char* section, const char* title, const auto& opts)
