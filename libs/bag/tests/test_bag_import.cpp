@@ -4,6 +4,7 @@
 // RealSense's two topics merged; a TUM-layout bag equal, byte for byte, to
 // the TUM folder of the same frames; and the bad bags users meet.
 #include <bims/bag/bag_import.h>
+#include <bims/bag/compressed_image.h>
 #include <bims/common/config.h>
 #include <bims/ego/attitude_filter.h>
 #include <bims/eval/tum_import.h>
@@ -601,6 +602,300 @@ TEST(ImportBag, StampsThatGoBackAreLeftOutAndCounted)
 	const auto got = readRawlog(d + "/back.rawlog");
 	ASSERT_EQ(got.frames.size(), 4u);
 	EXPECT_FALSE(got.frames[0]->hasIntensityImage);
+}
+
+/** Imports \a spec's bag of the sample's first \a n frames (auto layout,
+ * plain rawlog) into DIR/NAME.rawlog; returns the rawlog's bytes. */
+std::string importedBytes(const std::string& dir, const std::string& name,
+                          BagSpec spec, bag::BagImportSummary* sum = nullptr)
+{
+	writeBag(dir + "/" + name + ".bag", spec, sample().frames, sample().imu);
+	const auto s =
+	    import(dir + "/" + name + ".bag", dir + "/" + name + ".rawlog");
+	if (sum) *sum = s;
+	return test::fileText(dir + "/" + name + ".rawlog");
+}
+
+TEST(ImportBag, LosslessCompressedTopicsGiveTheRawTopicsRawlogByteForByte)
+{
+	const auto d = test::freshTmpDir("bims_bag", "compressed");
+	// realsense-ros: raw topics, against PNG colour and compressedDepth
+	// 16UC1 on image_transport's republished topics (the auto layout finds
+	// them); the format as the plugin writes it now, and the old "png"
+	BagSpec raw;
+	raw.frames = 12;
+	const std::string want = importedBytes(d, "raw", raw);
+	ASSERT_GT(want.size(), 500000u);
+	for (const std::string format : {"", "png"})
+	{
+		SCOPED_TRACE(format);
+		BagSpec c = raw;
+		c.colourCodec = "png";
+		c.colourFormat = format;
+		c.compressedDepth = true;
+		bag::BagImportSummary sum;
+		const std::string got = importedBytes(d, "c", c, &sum);
+		EXPECT_EQ(sum.layout, bag::BagLayout::RealSense);
+		EXPECT_EQ(sum.topics.colour, "/camera/color/image_raw/compressed");
+		EXPECT_EQ(sum.topics.depth,
+		          "/camera/aligned_depth_to_color/image_raw/compressedDepth");
+		EXPECT_EQ(sum.depthEncoding, "16UC1; compressedDepth png");
+		EXPECT_EQ(sum.frames, 12u);
+		EXPECT_TRUE(got == want)
+		    << firstDifference(d + "/raw.rawlog", d + "/c.rawlog");
+	}
+	// TUM's layout: 32FC1 depth (raw: compressedDepth quantises it), PNG
+	// colour
+	BagSpec tum;
+	tum.tum = true;
+	tum.frames = 6;
+	const std::string wantTum = importedBytes(d, "tumraw", tum);
+	tum.colourCodec = "png";
+	bag::BagImportSummary sum;
+	EXPECT_TRUE(importedBytes(d, "tumc", tum, &sum) == wantTum)
+	    << firstDifference(d + "/tumraw.rawlog", d + "/tumc.rawlog");
+	EXPECT_EQ(sum.layout, bag::BagLayout::Tum);
+	EXPECT_EQ(sum.colourEncoding, "rgb8; png compressed bgr8");
+}
+
+TEST(ImportBag, JpegColourIsWithinASmallToleranceOfTheRawFrame)
+{
+	const auto d = test::freshTmpDir("bims_bag", "jpeg");
+	BagSpec spec;
+	spec.frames = 6;
+	spec.colourCodec = "jpeg";
+	spec.compressedDepth = true;
+	importedBytes(d, "jpeg", spec);
+	const auto got = readRawlog(d + "/jpeg.rawlog");
+	ASSERT_EQ(got.frames.size(), 6u);
+	for (size_t k = 0; k < 6; k++)
+	{
+		const auto& a = *got.frames[k];
+		const auto& b = *sample().frames[k];
+		EXPECT_TRUE((a.rangeImage.array() == b.rangeImage.array()).all());
+		ASSERT_TRUE(a.hasIntensityImage);
+		// what image_transport's subscriber gives (OpenCV's decoding of
+		// the message), exactly
+		std::vector<uint8_t> jpeg;
+		cv::imencode(".jpg", bgrOf(b), jpeg, {cv::IMWRITE_JPEG_QUALITY, 90});
+		cv::Mat diff;
+		cv::absdiff(bgrOf(a), cv::imdecode(jpeg, cv::IMREAD_UNCHANGED), diff);
+		EXPECT_EQ(cv::countNonZero(diff.reshape(1)), 0) << "frame " << k;
+		// the raw frame within JPEG's loss (quality 90, chroma subsampled:
+		// the simulated texture loses 4 to 8 levels on average)
+		cv::absdiff(bgrOf(a), bgrOf(b), diff);
+		const cv::Scalar mean = cv::mean(diff);
+		for (int c = 0; c < 3; c++)
+			EXPECT_LT(mean[c], 10.0) << "frame " << k << " channel " << c;
+		EXPECT_GT(cv::PSNR(bgrOf(a), bgrOf(b)), 25.0) << "frame " << k;
+		// with red and blue swapped it would be far off
+		cv::Mat rgb;
+		cv::cvtColor(bgrOf(b), rgb, cv::COLOR_BGR2RGB);
+		cv::absdiff(bgrOf(a), rgb, diff);
+		const cv::Scalar swapped = cv::mean(diff);
+		EXPECT_GT(swapped[0] + swapped[2], 4 * (mean[0] + mean[2]));
+	}
+}
+
+TEST(ImportBag, CompressedDepthInMetresIsWithinItsQuantisationStep)
+{
+	const auto d = test::freshTmpDir("bims_bag", "invdepth");
+	BagSpec spec;
+	spec.tum = true;
+	spec.frames = 4;
+	importedBytes(d, "raw", spec);
+	spec.compressedDepth = true;
+	bag::BagImportSummary sum;
+	importedBytes(d, "c", spec, &sum);
+	EXPECT_EQ(sum.depthEncoding, "32FC1; compressedDepth png");
+	const auto a = readRawlog(d + "/raw.rawlog"),
+	           b = readRawlog(d + "/c.rawlog");
+	ASSERT_EQ(a.frames.size(), 4u);
+	ASSERT_EQ(b.frames.size(), 4u);
+	// the plugin's inverse depth, v = A / z + B truncated, gives back
+	// A / (v - B) in [z, z + z^2 / A) (A = 10100 with its defaults); then
+	// the rounding to millimetres
+	const double A = 100.0 * 101.0;
+	size_t readings = 0, off = 0;
+	for (size_t k = 0; k < 4; k++)
+	{
+		const auto& ra = a.frames[k]->rangeImage;
+		const auto& rb = b.frames[k]->rangeImage;
+		for (int v = 0; v < ra.rows(); v++)
+			for (int u = 0; u < ra.cols(); u++)
+			{
+				ASSERT_EQ(ra(v, u) == 0, rb(v, u) == 0) << v << " " << u;
+				if (ra(v, u) == 0) continue;
+				readings++;
+				const double z = ra(v, u) * 1e-3;
+				const double err = (rb(v, u) - double(ra(v, u))) * 1e-3;
+				EXPECT_GE(err, -0.001);
+				EXPECT_LE(err, z * z / A + 0.001) << z;
+				off += rb(v, u) != ra(v, u);
+			}
+	}
+	EXPECT_GT(readings, 100000u);
+	EXPECT_GT(off, 0u);  // quantised indeed
+}
+
+TEST(ImportBag, BadCompressedImagesAreErrorsNamingTopicAndMessage)
+{
+	const auto d = test::freshTmpDir("bims_bag", "badcompressed");
+	const std::string colour = "/camera/color/image_raw/compressed",
+	                  depth =
+	                      "/camera/aligned_depth_to_color/image_raw/"
+	                      "compressedDepth";
+	// five frames; \a spoil changes the messages of frame k
+	auto write =
+	    [&](const std::string& name,
+	        const std::function<void(size_t, sensor_msgs::CompressedImage&,
+	                                 sensor_msgs::CompressedImage&)>& spoil)
+	{
+		rosbag::Bag b(d + "/" + name, rosbag::bagmode::Write);
+		for (size_t k = 0; k < 5; k++)
+		{
+			const auto& f = *sample().frames[k];
+			const ros::Time t = rosTime(secondsOf(f.timestamp));
+			auto c = compressedColourMsg(f, "png");
+			auto z = compressedDepthMsg(f, false);
+			spoil(k, c, z);
+			b.write("/camera/color/camera_info", t, infoMsg(f));
+			b.write(colour, t, c);
+			b.write(depth, t, z);
+		}
+		return d + "/" + name;
+	};
+	auto importError =
+	    [&](const std::string& bagPath, bag::BagImportParams p = {})
+	{
+		fs::remove(d + "/o.rawlog");
+		return errorOf([&] { import(bagPath, d + "/o.rawlog", p); });
+	};
+	// a corrupt payload: the whole frames before it are kept
+	auto e = importError(write("cut.bag",
+	                           [](size_t k, auto& c, auto&)
+	                           {
+		                           if (k == 3) c.data.resize(c.data.size() / 2);
+	                           }));
+	EXPECT_NE(e.find("cut.bag: topic " + colour + ", message #4 of it"),
+	          std::string::npos)
+	    << e;
+	EXPECT_NE(e.find("do not decode as PNG"), std::string::npos) << e;
+	EXPECT_NE(e.find("the 3 whole frames before it are in"), std::string::npos)
+	    << e;
+	EXPECT_EQ(readRawlog(d + "/o.rawlog").frames.size(), 3u);
+
+	// a format image_transport does not write, an unsupported encoding
+	e = importError(write("webp.bag", [](size_t, auto& c, auto&)
+	                      { c.format = "rgb8; webp compressed bgr8"; }));
+	EXPECT_NE(e.find("topic " + colour + ", message #1 of it"),
+	          std::string::npos)
+	    << e;
+	EXPECT_NE(e.find("format 'rgb8; webp compressed bgr8' is none "
+	                 "image_transport writes"),
+	          std::string::npos)
+	    << e;
+	EXPECT_FALSE(fs::exists(d + "/o.rawlog"));
+	e = importError(write("rgba.bag", [](size_t, auto& c, auto&)
+	                      { c.format = "rgba8; png compressed bgra8"; }));
+	EXPECT_NE(e.find("encoding 'rgba8' is not supported"), std::string::npos)
+	    << e;
+	// a JPEG where the format says PNG
+	e = importError(write("jpegpng.bag",
+	                      [&](size_t k, auto& c, auto&)
+	                      {
+		                      c = compressedColourMsg(*sample().frames[k],
+		                                              "jpeg",
+		                                              "rgb8; png compressed "
+		                                              "bgr8");
+	                      }));
+	EXPECT_NE(e.find("a JPEG image, not PNG"), std::string::npos) << e;
+
+	// compressedDepth: a header cut short, RVL, another header format
+	e = importError(write("header.bag",
+	                      [](size_t k, auto&, auto& z)
+	                      {
+		                      if (k == 1) z.data.resize(7);
+	                      }));
+	EXPECT_NE(e.find("topic " + depth + ", message #2 of it"),
+	          std::string::npos)
+	    << e;
+	EXPECT_NE(e.find("7 bytes of data: cut inside its 12-byte compressedDepth "
+	                 "header"),
+	          std::string::npos)
+	    << e;
+	EXPECT_NE(e.find("the 1 whole frames before it are in"), std::string::npos)
+	    << e;
+	e = importError(write("rvl.bag", [](size_t, auto&, auto& z)
+	                      { z.format = "16UC1; compressedDepth rvl"; }));
+	EXPECT_NE(e.find("RVL is not read"), std::string::npos) << e;
+	EXPECT_NE(e.find("message #1 of it"), std::string::npos) << e;
+	e = importError(
+	    write("kind.bag", [](size_t, auto&, auto& z) { z.data[0] = 7; }));
+	EXPECT_NE(e.find("format is 7, not INV_DEPTH (0): corrupt"),
+	          std::string::npos)
+	    << e;
+	e = importError(write("notdepth.bag", [](size_t, auto&, auto& z)
+	                      { z.format = "16UC1; png compressed "; }));
+	EXPECT_NE(e.find("not compressed_depth_image_transport's"),
+	          std::string::npos)
+	    << e;
+
+	// a declared size other than the camera's, or beyond [input]'s limits:
+	// refused before decoding
+	e = importError(write("huge.bag",
+	                      [](size_t, auto& c, auto&)
+	                      {
+		                      // IHDR's width and height: 30000 x 30000
+		                      for (size_t at : {16, 20})
+		                      {
+			                      c.data[at] = 0;
+			                      c.data[at + 1] = 0;
+			                      c.data[at + 2] = 0x75;
+			                      c.data[at + 3] = 0x30;
+		                      }
+	                      }));
+	EXPECT_NE(e.find("its PNG header declares 30000x30000, the camera is "
+	                 "320x240 (not decoded)"),
+	          std::string::npos)
+	    << e;
+	{
+		std::ofstream(d + "/limits.ini") << "[input]\nimage_max_side = 300\n";
+	}
+	bag::BagImportParams p;
+	p.loadFromConfigFile(*openIniFile(d + "/limits.ini"));
+	e = importError(write("fine.bag", [](size_t, auto&, auto&) {}), p);
+	EXPECT_NE(e.find("topic " + depth + ", message #1 of it"),
+	          std::string::npos)
+	    << e;
+	EXPECT_NE(e.find("beyond the 300 per side"), std::string::npos) << e;
+	EXPECT_NE(e.find("[input] image_max_side"), std::string::npos) << e;
+	EXPECT_NO_THROW(import(d + "/fine.bag", d + "/fine.rawlog"));
+}
+
+TEST(ImportBag, CompressedFormatsAreParsedAsTheImageTransportPluginsWriteThem)
+{
+	const auto f = bag::parseCompressedFormat("rgb8; jpeg compressed bgr8");
+	EXPECT_EQ(f.encoding, "rgb8");
+	EXPECT_EQ(f.codec, "jpeg");
+	EXPECT_TRUE(f.bgr);
+	EXPECT_FALSE(f.depth);
+	EXPECT_FALSE(bag::parseCompressedFormat("rgb8; jpeg compressed").bgr);
+	EXPECT_EQ(bag::parseCompressedFormat("png").codec, "png");
+	EXPECT_TRUE(bag::parseCompressedFormat("png").encoding.empty());
+	const auto z = bag::parseCompressedFormat("32FC1; compressedDepth");
+	EXPECT_TRUE(z.depth);
+	EXPECT_EQ(z.codec, "png");
+	EXPECT_EQ(z.encoding, "32FC1");
+	EXPECT_EQ(bag::parseCompressedFormat("16UC1; compressedDepth rvl").codec,
+	          "rvl");
+	for (const char* bad :
+	     {"", "tiff", "jpeg png", "; png compressed bgr8", "rgb8; png",
+	      "16UC1; compressedDepth zstd", "rgb8; png compressed bgr8 x"})
+		EXPECT_NE(errorOf([&] { bag::parseCompressedFormat(bad); })
+		              .find("is none image_transport writes"),
+		          std::string::npos)
+		    << bad;
 }
 
 }  // namespace
