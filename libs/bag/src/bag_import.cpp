@@ -34,6 +34,8 @@
 
 #include <bims/bag/compressed_image.h>
 
+#include "bag_guard.h"
+
 // A message read for its header stamp only (the first pass over the images:
 // their pixels are read once, in the second). Every ROS message with a
 // std_msgs/Header starts with it: seq, stamp (sec, nsec), frame_id.
@@ -115,6 +117,8 @@ Bags openBags(const std::vector<std::string>& paths)
 		auto b = std::make_unique<rosbag::Bag>();
 		try
 		{
+			// lengths checked before rosbag allocates them (bag_guard.h)
+			checkBagRecords(p);
 			b->open(p, rosbag::bagmode::Read);
 		}
 		catch (const rosbag::BagUnindexedException&)

@@ -21,6 +21,7 @@
 #include <mrpt/obs/CObservationIMU.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -658,6 +659,40 @@ TEST(ImportBag, LosslessCompressedTopicsGiveTheRawTopicsRawlogByteForByte)
 	EXPECT_EQ(sum.colourEncoding, "rgb8; png compressed bgr8");
 }
 
+TEST(ImportBag, TheRawTopicIsReadWhenTheBagAlsoHasItsCompressedOne)
+{
+	const auto d = test::freshTmpDir("bims_bag", "both");
+	const std::string depth = "/camera/aligned_depth_to_color/image_raw";
+	{
+		rosbag::Bag b(d + "/both.bag", rosbag::bagmode::Write);
+		for (size_t k = 0; k < 3; k++)
+		{
+			const auto& f = *sample().frames[k];
+			const ros::Time t = rosTime(secondsOf(f.timestamp));
+			b.write("/camera/color/camera_info", t, infoMsg(f));
+			b.write(depth, t, depthMsg(f, false));
+			b.write(depth + "/compressedDepth", t,
+			        compressedDepthMsg(f, false));
+			b.write("/camera/color/image_raw/compressed", t,
+			        compressedColourMsg(f, "jpeg"));
+		}
+	}
+	// the preset's raw depth; its colour from /compressed (no raw one)
+	auto sum = import(d + "/both.bag", d + "/o.rawlog");
+	EXPECT_EQ(sum.topics.depth, depth);
+	EXPECT_EQ(sum.depthEncoding, "16UC1");
+	EXPECT_EQ(sum.topics.colour, "/camera/color/image_raw/compressed");
+	EXPECT_EQ(sum.colourEncoding, "rgb8; jpeg compressed bgr8");
+	EXPECT_EQ(sum.frames, 3u);
+	// a topic the .ini names is read as named
+	bag::BagImportParams p;
+	p.layout = bag::BagLayout::RealSense;
+	p.topics.depth = depth + "/compressedDepth";
+	sum = import(d + "/both.bag", d + "/p.rawlog", p);
+	EXPECT_EQ(sum.topics.depth, depth + "/compressedDepth");
+	EXPECT_EQ(sum.depthEncoding, "16UC1; compressedDepth png");
+}
+
 TEST(ImportBag, JpegColourIsWithinASmallToleranceOfTheRawFrame)
 {
 	const auto d = test::freshTmpDir("bims_bag", "jpeg");
@@ -896,6 +931,79 @@ TEST(ImportBag, CompressedFormatsAreParsedAsTheImageTransportPluginsWriteThem)
 		              .find("is none image_transport writes"),
 		          std::string::npos)
 		    << bad;
+}
+
+/** The bytes of \a path with the 4 bytes after the first \a field (a
+ * "name=" of a record header) from byte \a from on set to \a v; the
+ * field's position. */
+size_t patchField(const std::string& path, const std::string& field, uint32_t v,
+                  size_t from = 0)
+{
+	std::string b = test::fileText(path);
+	const size_t at = b.find(field, from);
+	if (at == std::string::npos) return at;
+	std::memcpy(&b[at + field.size()], &v, 4);
+	std::ofstream(path, std::ios::binary) << b;
+	return at;
+}
+
+TEST(ImportBag, LengthsBeyondTheFileAreErrorsBeforeRosbagAllocatesThem)
+{
+	// rosbag_storage allocates what a record declares before reading it
+	// (fuzz finding oom-record-header-length: 4 GB): checked first
+	const auto d = test::freshTmpDir("bims_bag", "lengths");
+	BagSpec spec;
+	spec.frames = 3;
+	spec.compression = rosbag::compression::LZ4;
+	writeBag(d + "/ok.bag", spec, sample().frames, sample().imu);
+	auto importError = [&](const std::string& bagPath)
+	{ return errorOf([&] { import(bagPath, d + "/o.rawlog"); }); };
+
+	// the first record at the index position: its header length
+	fs::copy_file(d + "/ok.bag", d + "/header.bag");
+	{
+		std::string b = test::fileText(d + "/header.bag");
+		const size_t f = b.find("index_pos=");
+		ASSERT_NE(f, std::string::npos);
+		uint64_t indexPos = 0;
+		std::memcpy(&indexPos, &b[f + 10], 8);
+		ASSERT_LT(indexPos + 4, b.size());
+		const uint32_t huge = 0xffffffffu;
+		std::memcpy(&b[indexPos], &huge, 4);
+		std::ofstream(d + "/header.bag", std::ios::binary) << b;
+		const auto e = importError(d + "/header.bag");
+		EXPECT_NE(e.find("header.bag: a ROS 1 bag cut short or damaged (the "
+		                 "record at byte " +
+		                 std::to_string(indexPos) +
+		                 ": its header declares 4294967295 bytes"),
+		          std::string::npos)
+		    << e;
+		EXPECT_NE(e.find("rosbag reindex"), std::string::npos) << e;
+	}
+	// a chunk declaring 3.75 GB uncompressed
+	fs::copy_file(d + "/ok.bag", d + "/chunk.bag");
+	const size_t lz4 = test::fileText(d + "/chunk.bag").find("compression=lz4");
+	ASSERT_NE(lz4, std::string::npos);
+	ASSERT_NE(patchField(d + "/chunk.bag", "size=", 0xf0000000u, lz4),
+	          std::string::npos);
+	auto e = importError(d + "/chunk.bag");
+	EXPECT_NE(e.find("a chunk of 4026531840 bytes uncompressed, beyond 1 GiB"),
+	          std::string::npos)
+	    << e;
+	// a header field longer than its header
+	fs::copy_file(d + "/ok.bag", d + "/field.bag");
+	{
+		std::string b = test::fileText(d + "/field.bag");
+		const size_t at = b.find("compression=lz4");
+		const uint32_t huge = 100000;
+		std::memcpy(&b[at - 4], &huge, 4);  // the field's length
+		std::ofstream(d + "/field.bag", std::ios::binary) << b;
+	}
+	e = importError(d + "/field.bag");
+	EXPECT_NE(e.find("a header field declares 100000 bytes"), std::string::npos)
+	    << e;
+	EXPECT_FALSE(fs::exists(d + "/o.rawlog"));
+	EXPECT_NO_THROW(import(d + "/ok.bag", d + "/ok.rawlog"));
 }
 
 }  // namespace
