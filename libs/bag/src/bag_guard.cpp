@@ -237,4 +237,71 @@ void checkBagRecords(const std::string& path)
 	Walker(path).walk();
 }
 
+namespace
+{
+/** Reads a serialized ROS message's fields in order, each length checked
+ * against the bytes left. */
+class Cursor
+{
+ public:
+	Cursor(const uint8_t* p, size_t n) : p_(p), n_(n) {}
+	void skip(uint64_t k, const char* what)
+	{
+		if (k > n_ - i_)
+			throw runtime_error("its " + std::string(what) + " declares " +
+			                    std::to_string(k) + " bytes, the message has " +
+			                    std::to_string(n_ - i_) + " left: corrupt");
+		i_ += static_cast<size_t>(k);
+	}
+	uint32_t u32(const char* what)
+	{
+		if (n_ - i_ < 4)
+			throw runtime_error("the message ends inside its " +
+			                    std::string(what) + ": corrupt");
+		uint32_t v = 0;
+		std::memcpy(&v, p_ + i_, 4);
+		i_ += 4;
+		return v;
+	}
+	/** A string or array of \a elem-byte elements. */
+	void array(uint64_t elem, const char* what)
+	{
+		skip(u32(what) * elem, what);
+	}
+	void header()
+	{
+		skip(12, "header");  // seq, stamp
+		array(1, "header's frame_id");
+	}
+
+ private:
+	const uint8_t* p_;
+	size_t n_, i_ = 0;
+};
+}  // namespace
+
+void checkMessageArrays(const uint8_t* bytes, size_t n, ArrayMessage kind)
+{
+	Cursor c(bytes, n);
+	c.header();
+	switch (kind)
+	{
+		case ArrayMessage::Image:
+			c.skip(8, "height and width");
+			c.array(1, "encoding");
+			c.skip(5, "is_bigendian and step");
+			c.array(1, "data");
+			break;
+		case ArrayMessage::CompressedImage:
+			c.array(1, "format");
+			c.array(1, "data");
+			break;
+		case ArrayMessage::CameraInfo:
+			c.skip(8, "height and width");
+			c.array(1, "distortion_model");
+			c.array(8, "D");
+			break;
+	}
+}
+
 }  // namespace bims::bag

@@ -511,7 +511,7 @@ Index readIndex(const Bags& bags, const BagTopics& t,
 			}
 			else if (topic == t.cameraInfo)
 			{
-				auto ci = m.instantiate<sensor_msgs::CameraInfo>();
+				auto ci = readMessage<sensor_msgs::CameraInfo>(m);
 				if (!ix.info) ix.info = ci;
 				ix.infoMessages++;
 			}
@@ -837,8 +837,7 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 			{
 				if (m.getDataType() == kCompressed)
 				{
-					const auto c =
-					    m.instantiate<sensor_msgs::CompressedImage>();
+					const auto c = readMessage<sensor_msgs::CompressedImage>(m);
 					if (!c)
 						throw std::runtime_error("not a " + m.getDataType());
 					encoding = c->format;
@@ -847,7 +846,7 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 					           : decodeCompressedColour(*c, W, H,
 					                                    params.images);
 				}
-				const auto r = m.instantiate<sensor_msgs::Image>();
+				const auto r = readMessage<sensor_msgs::Image>(m);
 				if (!r) throw std::runtime_error("not a sensor_msgs/Image");
 				encoding = r->encoding;
 				held = depth ? checkedImage(r, depthEncodings,

@@ -1006,4 +1006,54 @@ TEST(ImportBag, LengthsBeyondTheFileAreErrorsBeforeRosbagAllocatesThem)
 	EXPECT_NO_THROW(import(d + "/ok.bag", d + "/ok.rawlog"));
 }
 
+TEST(ImportBag, AMessageArrayLongerThanItsMessageIsAnErrorNotAnAllocation)
+{
+	// ROS's deserializer resizes a vector to the length a message declares
+	// before reading it (fuzz finding oom-compressed-image-data-length:
+	// 1.9 GB): checked against the message's bytes first
+	const auto d = test::freshTmpDir("bims_bag", "arrays");
+	auto spoil = [&](const std::string& name, const BagSpec& spec,
+	                 const std::string& before, long skip)
+	{
+		writeBag(d + "/" + name, spec, sample().frames, sample().imu);
+		std::string b = test::fileText(d + "/" + name);
+		const size_t at = b.find(before);
+		EXPECT_NE(at, std::string::npos) << before;
+		if (at == std::string::npos) return std::string();
+		const uint32_t huge = 0x70000000u;
+		std::memcpy(&b[at + before.size() + skip], &huge, 4);  // (skip < 0:
+		                                                       // in before)
+		std::ofstream(d + "/" + name, std::ios::binary) << b;
+		return errorOf([&] { import(d + "/" + name, d + "/o.rawlog"); });
+	};
+	BagSpec c;
+	c.frames = 2;
+	c.colourCodec = "png";
+	c.compressedDepth = true;
+	// the first colour message's data: after its format string
+	auto e = spoil("compressed.bag", c, "rgb8; png compressed bgr8", 0);
+	EXPECT_NE(e.find("/camera/color/image_raw/compressed, message #1 of it"),
+	          std::string::npos)
+	    << e;
+	EXPECT_NE(e.find("its data declares 1879048192 bytes, the message has"),
+	          std::string::npos)
+	    << e;
+	// a raw depth image's data: after its encoding, is_bigendian and step
+	BagSpec r;
+	r.frames = 2;
+	e = spoil("raw.bag", r, "16UC1", 5);
+	EXPECT_NE(e.find("/camera/aligned_depth_to_color/image_raw, message #1"),
+	          std::string::npos)
+	    << e;
+	EXPECT_NE(e.find("its data declares 1879048192 bytes"), std::string::npos)
+	    << e;
+	// CameraInfo's D (5 coefficients): after its distortion model (the
+	// message definition's text has the name too)
+	e = spoil("info.bag", r, std::string("plumb_bob\x05\0\0\0", 13), -4);
+	EXPECT_NE(e.find("/camera/color/camera_info, message #1 of it cannot be "
+	                 "read: its D declares 15032385536 bytes"),
+	          std::string::npos)
+	    << e;
+}
+
 }  // namespace
