@@ -1,6 +1,7 @@
 #include "bag_guard.h"
 
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -82,7 +83,10 @@ bool number(const Fields& f, const char* name, size_t bytes, uint64_t pos,
 class Walker
 {
  public:
-	explicit Walker(const std::string& path) : f_(path, std::ios::binary)
+	/** The records of \a path from byte \a start (after the version
+	 * line). */
+	Walker(const std::string& path, uint64_t start)
+	    : f_(path, std::ios::binary), start_(start)
 	{
 		f_.seekg(0, std::ios::end);
 		size_ = static_cast<uint64_t>(f_.tellg());
@@ -90,7 +94,7 @@ class Walker
 
 	void walk()
 	{
-		uint64_t pos = 13;  // "#ROSBAG V2.0\n"
+		uint64_t pos = start_;
 		uint64_t indexPos = 0, connections = 0, chunks = 0;
 		bool first = true;
 		size_t connectionsAfter = 0, chunkInfosAfter = 0;
@@ -221,20 +225,31 @@ class Walker
 	}
 
 	std::ifstream f_;
-	uint64_t size_ = 0;
+	uint64_t start_ = 0, size_ = 0;
 };
 }  // namespace
 
 void checkBagRecords(const std::string& path)
 {
+	// the version line as rosbag reads it: any "#ROS<word> V<major>.<minor>"
+	// up to the first newline (fuzz finding asan-version-line-header-field:
+	// "#ROSBAF V2.0" was read as a bag, and its header past its end)
+	std::string line;
 	{
 		std::ifstream f(path, std::ios::binary);
-		char magic[13] = {};
-		if (!f.read(magic, 13) ||
-		    std::string(magic, 13) != std::string("#ROSBAG V2.0\n"))
-			return;
+		std::getline(f, line);
+		if (!f) return;  // no newline: rosbag refuses it
 	}
-	Walker(path).walk();
+	char word[100];
+	int major = 0, minor = 0;
+	if (std::sscanf(line.c_str(), "#ROS%99s V%d.%d", word, &major, &minor) != 3)
+		return;  // rosbag refuses it
+	if (major != 2 || minor != 0)
+		throw runtime_error("bag format " + std::to_string(major) + "." +
+		                    std::to_string(minor) +
+		                    " (its first line): only 2.0, ROS's since 2010, "
+		                    "is read");
+	Walker(path, line.size() + 1).walk();
 }
 
 namespace

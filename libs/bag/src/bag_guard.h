@@ -24,8 +24,9 @@ namespace bims::bag
  * index position within the file and its connection and chunk counts not
  * beyond the records at that position, index records' entry counts within
  * their data. Throws std::runtime_error saying what is wrong and at which
- * byte (not naming the file: the caller does). A file that does not start
- * with "#ROSBAG V2.0\n" is left to rosbag (which refuses it). */
+ * byte (not naming the file: the caller does), or that the format is not
+ * 2.0. A file whose first line is no bag's version line (rosbag's
+ * "#ROS<word> V<major>.<minor>") is left to rosbag, which refuses it. */
 void checkBagRecords(const std::string& path);
 
 /** The messages whose variable-length arrays ROS's deserializer sizes

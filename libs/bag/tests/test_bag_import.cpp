@@ -1002,6 +1002,28 @@ TEST(ImportBag, LengthsBeyondTheFileAreErrorsBeforeRosbagAllocatesThem)
 	e = importError(d + "/field.bag");
 	EXPECT_NE(e.find("a header field declares 100000 bytes"), std::string::npos)
 	    << e;
+	// rosbag takes any "#ROS<word> V2.0" line for a bag (fuzz finding
+	// asan-version-line-header-field: its header was then read past its
+	// end): walked as well; other versions refused
+	{
+		std::string b = test::fileText(d + "/ok.bag");
+		b[6] = 'F';  // #ROSBAF
+		const uint32_t huge = 100000;
+		std::memcpy(&b[13 + 4], &huge, 4);  // the first field's length
+		std::ofstream(d + "/baf.bag", std::ios::binary) << b;
+		b = test::fileText(d + "/ok.bag");
+		b.replace(9, 3, "1.2");
+		std::ofstream(d + "/v12.bag", std::ios::binary) << b;
+	}
+	e = importError(d + "/baf.bag");
+	EXPECT_NE(e.find("the record at byte 13: a header field declares 100000 "
+	                 "bytes"),
+	          std::string::npos)
+	    << e;
+	e = importError(d + "/v12.bag");
+	EXPECT_NE(e.find("bag format 1.2 (its first line): only 2.0"),
+	          std::string::npos)
+	    << e;
 	EXPECT_FALSE(fs::exists(d + "/o.rawlog"));
 	EXPECT_NO_THROW(import(d + "/ok.bag", d + "/ok.rawlog"));
 }
