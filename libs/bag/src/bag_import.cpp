@@ -470,6 +470,21 @@ BagTopics chooseTopics(const BagImportParams& params,
 	return t;
 }
 
+/** \a msg, read from \a m; an error when it is null: the bag says the
+ * message is of another type than its topic's name says (its MD5 sum is
+ * another message's: rosbag gives no message, fuzz finding
+ * ub-imu-of-another-md5). */
+template <typename P>
+P typed(P msg, const rosbag::MessageInstance& m)
+{
+	if (!msg)
+		throw std::runtime_error(
+		    std::string("not a ") +
+		    ros::message_traits::datatype<typename P::element_type>() +
+		    ": its MD5 sum " + m.getMD5Sum() + " is another message's");
+	return msg;
+}
+
 /** The first pass: every message of the chosen topics in the bags' time
  * order; the images' header stamps only. */
 Index readIndex(const Bags& bags, const BagTopics& t,
@@ -511,13 +526,14 @@ Index readIndex(const Bags& bags, const BagTopics& t,
 			}
 			else if (topic == t.cameraInfo)
 			{
-				auto ci = readMessage<sensor_msgs::CameraInfo>(m);
+				auto ci = typed(readMessage<sensor_msgs::CameraInfo>(m), m);
 				if (!ix.info) ix.info = ci;
 				ix.infoMessages++;
 			}
 			else if (topic == t.mag)
 			{
-				const auto mf = m.instantiate<sensor_msgs::MagneticField>();
+				const auto mf =
+				    typed(m.instantiate<sensor_msgs::MagneticField>(), m);
 				ImuSample s;
 				s.t = stampSeconds(mf->header.stamp.sec, mf->header.stamp.nsec);
 				if (stampBack(topic, s.t))
@@ -534,7 +550,7 @@ Index readIndex(const Bags& bags, const BagTopics& t,
 			}
 			else
 			{
-				const auto im = m.instantiate<sensor_msgs::Imu>();
+				const auto im = typed(m.instantiate<sensor_msgs::Imu>(), m);
 				ImuSample s = imuSample(
 				    *im,
 				    stampSeconds(im->header.stamp.sec, im->header.stamp.nsec));
@@ -837,17 +853,15 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 			{
 				if (m.getDataType() == kCompressed)
 				{
-					const auto c = readMessage<sensor_msgs::CompressedImage>(m);
-					if (!c)
-						throw std::runtime_error("not a " + m.getDataType());
+					const auto c =
+					    typed(readMessage<sensor_msgs::CompressedImage>(m), m);
 					encoding = c->format;
 					return depth
 					           ? decodeCompressedDepth(*c, W, H, params.images)
 					           : decodeCompressedColour(*c, W, H,
 					                                    params.images);
 				}
-				const auto r = readMessage<sensor_msgs::Image>(m);
-				if (!r) throw std::runtime_error("not a sensor_msgs/Image");
+				const auto r = typed(readMessage<sensor_msgs::Image>(m), m);
 				encoding = r->encoding;
 				held = depth ? checkedImage(r, depthEncodings,
 				                            "the depth image", W, H, "")

@@ -1078,4 +1078,28 @@ TEST(ImportBag, AMessageArrayLongerThanItsMessageIsAnErrorNotAnAllocation)
 	    << e;
 }
 
+TEST(ImportBag, AMessageOfAnotherMd5SumThanItsTypeIsAnErrorNotANullMessage)
+{
+	// a connection of type sensor_msgs/Imu whose MD5 sum is another's:
+	// rosbag gives no message (fuzz finding ub-imu-of-another-md5: a null
+	// message was read, undefined behaviour)
+	const auto d = test::freshTmpDir("bims_bag", "md5");
+	BagSpec spec;
+	spec.frames = 2;
+	writeBag(d + "/imu.bag", spec, sample().frames, sample().imu);
+	std::string b = test::fileText(d + "/imu.bag");
+	const std::string md5 = ros::message_traits::md5sum<sensor_msgs::Imu>();
+	size_t n = 0;
+	for (size_t at = b.find(md5); at != std::string::npos;
+	     at = b.find(md5, at + 1), n++)
+		b[at] = b[at] == '0' ? '1' : '0';
+	ASSERT_GT(n, 0u);
+	std::ofstream(d + "/imu.bag", std::ios::binary) << b;
+	const auto e = errorOf([&] { import(d + "/imu.bag", d + "/o.rawlog"); });
+	EXPECT_NE(e.find("topic /camera/imu, message #1 of it cannot be read: "
+	                 "not a sensor_msgs/Imu: its MD5 sum"),
+	          std::string::npos)
+	    << e;
+}
+
 }  // namespace
