@@ -1,7 +1,8 @@
 // bims-import-bag BAG... -o OUT.rawlog [--layout tum|realsense|auto]
 //   [-c CONFIG.ini] [--max-frames N] [--gz L] [--topics] [-q]
-// Converts ROS 1 bags (sensor_msgs/Image depth and colour, CameraInfo, Imu,
-// MagneticField) into a bims rawlog. See docs/import-bag.md.
+// Converts ROS 1 bags (depth and colour sensor_msgs/Image or
+// CompressedImage, CameraInfo, Imu, MagneticField) into a bims rawlog. See
+// docs/import-bag.md.
 #include <bims/apps/app.h>
 #include <bims/apps/bag_import_run.h>
 
@@ -14,12 +15,14 @@ int main(int argc, char** argv)
 	    [&]()
 	    {
 		    TCLAP::CmdLine cmd(
-		        "Import ROS 1 bags (depth and colour sensor_msgs/Image, "
-		        "their CameraInfo, sensor_msgs/Imu or separate accelerometer "
-		        "and gyro topics, MagneticField) into a rawlog of RGB-D "
-		        "frames and IMU samples. Depth and colour are paired by "
-		        "stamp; the stamps are the messages' header stamps. Several "
-		        "bags are read as one recording.",
+		        "Import ROS 1 bags (depth and colour sensor_msgs/Image, or "
+		        "sensor_msgs/CompressedImage as image_transport writes it: "
+		        "JPEG or PNG colour, compressedDepth PNG depth; their "
+		        "CameraInfo, sensor_msgs/Imu or separate accelerometer and "
+		        "gyro topics, MagneticField) into a rawlog of RGB-D frames "
+		        "and IMU samples. Depth and colour are paired by stamp; the "
+		        "stamps are the messages' header stamps. Several bags are "
+		        "read as one recording.",
 		        ' ', bims::version());
 		    TCLAP::UnlabeledMultiArg<std::string> bags(
 		        "BAG", "ROS 1 bag files (.bag)", true, "BAG", cmd);
@@ -29,13 +32,16 @@ int main(int argc, char** argv)
 		        "", "layout",
 		        "preset topics: realsense (realsense-ros, aligned depth), tum "
 		        "(TUM RGB-D's bags), auto (default: the first whose depth "
-		        "topic the bag has)",
+		        "topic the bag has); a preset image topic the bag lacks is "
+		        "read from its /compressed or /compressedDepth republished "
+		        "topic when the bag has that",
 		        false, "", "realsense|tum|auto", cmd);
 		    TCLAP::ValueArg<std::string> config(
 		        "c", "config",
 		        "experiment .ini: [import_bag] topics and pairing, [camera] "
-		        "intrinsics over the bag's CameraInfo, [sensors] labels (e.g. "
-		        "the preset realsense.ini of share/bims)",
+		        "intrinsics over the bag's CameraInfo, [sensors] labels, "
+		        "[input] the limits of compressed images (e.g. the preset "
+		        "realsense.ini of share/bims)",
 		        false, "", "CONFIG.ini", cmd);
 		    TCLAP::ValueArg<long> maxFrames(
 		        "", "max-frames", "import only the first N frames (0 = all)",

@@ -2,13 +2,20 @@
 //   fuzz_make_seeds SAMPLE.rawlog OUT_DIR
 // OUT_DIR/rawlog: the sample's first scans shrunk to 32 x 24 (depth,
 // intensity, camera models) with the IMU samples between them, plain;
-// OUT_DIR/labels and OUT_DIR/tum: small hand-made inputs of each kind.
+// OUT_DIR/labels and OUT_DIR/tum: small hand-made inputs of each kind;
+// OUT_DIR/bag: ROS 1 bags of the sample's first 3 scans shrunk so, in each
+// layout, raw and compressed, plain and LZ4 / BZ2 chunks (when bims-import-bag
+// is built).
 #include <bims/io/rawlog.h>
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
 
 #include <opencv2/imgcodecs.hpp>
+
+#ifdef BIMS_FUZZ_BAG_SEEDS
+#include <bims_test/bag_writer.h>
+#endif
 
 #include <filesystem>
 #include <fstream>
@@ -39,6 +46,62 @@ void shrink(mrpt::obs::CObservation3DRangeScan& s, int W, int H)
 	s.pixelLabels.reset();
 }
 
+#ifdef BIMS_FUZZ_BAG_SEEDS
+/** Bags of the sample's first 3 scans, shrunk to 32 x 24, and the IMU
+ * samples up to the third, each well under fuzz.sh's 64 kB inputs. */
+void writeBagSeeds(const std::string& sample, const std::filesystem::path& dir)
+{
+	using namespace mrpt::obs;
+	std::vector<CObservation3DRangeScan::Ptr> frames;
+	std::vector<CObservationIMU::Ptr> imu;
+	bims::RawlogReader in(sample);
+	while (frames.size() < 3)
+	{
+		const auto o = in.next();
+		if (!o) break;
+		if (auto s = std::dynamic_pointer_cast<CObservation3DRangeScan>(o))
+		{
+			s->load();
+			shrink(*s, 32, 24);
+			frames.push_back(s);
+		}
+		else if (auto m = std::dynamic_pointer_cast<CObservationIMU>(o))
+			imu.push_back(m);
+	}
+	using bims::test::BagSpec;
+	const auto lz4 = rosbag::compression::LZ4, bz2 = rosbag::compression::BZ2;
+	struct Seed
+	{
+		const char* name;
+		BagSpec spec;
+	};
+	std::vector<Seed> seeds;
+	auto add = [&](const char* name, bool tum, const char* codec,
+	               bool compressedDepth, rosbag::compression::CompressionType c,
+	               bool split)
+	{
+		BagSpec s;
+		s.tum = tum;
+		s.colourCodec = codec;
+		s.compressedDepth = compressedDepth;
+		s.compression = c;
+		s.splitImu = split;
+		s.frames = frames.size();
+		seeds.push_back({name, s});
+	};
+	const auto plain = rosbag::compression::Uncompressed;
+	add("realsense-raw.bag", false, "", false, plain, false);
+	add("realsense-split-imu-lz4.bag", false, "", false, lz4, true);
+	add("realsense-jpeg-compresseddepth.bag", false, "jpeg", true, plain,
+	    false);
+	add("realsense-png-compresseddepth-bz2.bag", false, "png", true, bz2, true);
+	add("tum-raw.bag", true, "", false, plain, false);
+	add("tum-png-compresseddepth.bag", true, "png", true, plain, false);
+	for (const auto& s : seeds)
+		bims::test::writeBag((dir / s.name).string(), s.spec, frames, imu);
+}
+#endif
+
 void writeText(const std::filesystem::path& p, const std::string& text)
 {
 	std::ofstream f(p, std::ios::binary);
@@ -60,6 +123,10 @@ int main(int argc, char** argv)
 		const fs::path out = argv[2];
 		for (const char* d : {"rawlog", "labels", "tum", "image", "stray"})
 			fs::create_directories(out / d);
+#ifdef BIMS_FUZZ_BAG_SEEDS
+		fs::create_directories(out / "bag");
+		writeBagSeeds(argv[1], out / "bag");
+#endif
 		{
 			bims::RawlogReader in(argv[1]);
 			bims::RawlogWriter w(

@@ -10,6 +10,7 @@
 #include <rosbag/exceptions.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/MagneticField.h>
@@ -30,6 +31,10 @@
 #include <set>
 #include <stdexcept>
 #include <thread>
+
+#include <bims/bag/compressed_image.h>
+
+#include "bag_guard.h"
 
 // A message read for its header stamp only (the first pass over the images:
 // their pixels are read once, in the second). Every ROS message with a
@@ -112,6 +117,8 @@ Bags openBags(const std::vector<std::string>& paths)
 		auto b = std::make_unique<rosbag::Bag>();
 		try
 		{
+			// lengths checked before rosbag allocates them (bag_guard.h)
+			checkBagRecords(p);
 			b->open(p, rosbag::bagmode::Read);
 		}
 		catch (const rosbag::BagUnindexedException&)
@@ -190,6 +197,14 @@ const BagTopicInfo* findTopic(const std::vector<BagTopicInfo>& topics,
 	for (const auto& t : topics)
 		if (t.name == name) return &t;
 	return nullptr;
+}
+
+/** image_transport's republished topic of a preset image topic: the
+ * compressed plugin's "/compressed" (colour), compressed_depth's
+ * "/compressedDepth" (depth). */
+std::string transportTopic(const std::string& raw, bool depth)
+{
+	return raw + (depth ? "/compressedDepth" : "/compressed");
 }
 
 /** The channels a sensor_msgs/Imu holds: a covariance whose first element
@@ -312,7 +327,9 @@ BagLayout detectLayout(const std::vector<BagTopicInfo>& topics,
                        const std::string& bagNames)
 {
 	for (const auto l : {BagLayout::RealSense, BagLayout::Tum})
-		if (findTopic(topics, layoutTopics(l).depth)) return l;
+		if (findTopic(topics, layoutTopics(l).depth) ||
+		    findTopic(topics, transportTopic(layoutTopics(l).depth, true)))
+			return l;
 	throw std::runtime_error(
 	    bagNames + ": no depth topic of a known layout (realsense: " +
 	    layoutTopics(BagLayout::RealSense).depth +
@@ -371,18 +388,20 @@ struct Index
 	std::vector<ImuSample> imu, accel, gyro, mag;
 };
 
+constexpr const char* kImage = "sensor_msgs/Image";
+constexpr const char* kCompressed = "sensor_msgs/CompressedImage";
+
+/** The topic \a name, when the bag has it, must be of \a type (or of
+ * \a other, when given). */
 void requireType(const std::vector<BagTopicInfo>& topics,
                  const std::string& name, const std::string& type,
-                 const std::string& bagNames)
+                 const std::string& bagNames, const char* other = nullptr)
 {
 	const auto* t = findTopic(topics, name);
-	if (t && t->type != type)
+	if (t && t->type != type && !(other && t->type == other))
 		throw std::runtime_error(bagNames + ": topic " + name + " is " +
 		                         t->type + ", expected " + type +
-		                         (t->type == "sensor_msgs/CompressedImage"
-		                              ? " (compressed images are not read "
-		                                "yet: record the raw topic)"
-		                              : ""));
+		                         (other ? std::string(" or ") + other : ""));
 }
 
 /** The topics actually read: those of the layout the bag has, and every
@@ -408,6 +427,17 @@ BagTopics chooseTopics(const BagImportParams& params,
 	if (t.depth.empty())
 		throw std::runtime_error(bagNames +
 		                         ": no depth topic ([import_bag] depth_topic)");
+	// a preset image topic the bag lacks: its image_transport republished
+	// topic when the bag has that (docs/import-bag.md)
+	auto orTransport =
+	    [&](std::string& name, const std::string& given, bool depth)
+	{
+		if (given.empty() && !name.empty() && !findTopic(topics, name) &&
+		    findTopic(topics, transportTopic(name, depth)))
+			name = transportTopic(name, depth);
+	};
+	orTransport(t.depth, params.topics.depth, true);
+	orTransport(t.colour, params.topics.colour, false);
 	if (!findTopic(topics, t.depth)) throw missing(t.depth, "depth");
 	// a topic the .ini names must be there; a preset's may be absent
 	auto keep =
@@ -431,13 +461,28 @@ BagTopics chooseTopics(const BagImportParams& params,
 		    "[import_bag] camera_info_topic or give [camera] fx fy cx cy "
 		    "width height (-c). The bag has: " +
 		    topicList(topics));
-	requireType(topics, t.depth, "sensor_msgs/Image", bagNames);
-	requireType(topics, t.colour, "sensor_msgs/Image", bagNames);
+	requireType(topics, t.depth, kImage, bagNames, kCompressed);
+	requireType(topics, t.colour, kImage, bagNames, kCompressed);
 	requireType(topics, t.cameraInfo, "sensor_msgs/CameraInfo", bagNames);
 	for (const auto* n : {&t.imu, &t.accel, &t.gyro})
 		requireType(topics, *n, "sensor_msgs/Imu", bagNames);
 	requireType(topics, t.mag, "sensor_msgs/MagneticField", bagNames);
 	return t;
+}
+
+/** \a msg, read from \a m; an error when it is null: the bag says the
+ * message is of another type than its topic's name says (its MD5 sum is
+ * another message's: rosbag gives no message, fuzz finding
+ * ub-imu-of-another-md5). */
+template <typename P>
+P typed(P msg, const rosbag::MessageInstance& m)
+{
+	if (!msg)
+		throw std::runtime_error(
+		    std::string("not a ") +
+		    ros::message_traits::datatype<typename P::element_type>() +
+		    ": its MD5 sum " + m.getMD5Sum() + " is another message's");
+	return msg;
 }
 
 /** The first pass: every message of the chosen topics in the bags' time
@@ -481,13 +526,14 @@ Index readIndex(const Bags& bags, const BagTopics& t,
 			}
 			else if (topic == t.cameraInfo)
 			{
-				auto ci = m.instantiate<sensor_msgs::CameraInfo>();
+				auto ci = typed(readMessage<sensor_msgs::CameraInfo>(m), m);
 				if (!ix.info) ix.info = ci;
 				ix.infoMessages++;
 			}
 			else if (topic == t.mag)
 			{
-				const auto mf = m.instantiate<sensor_msgs::MagneticField>();
+				const auto mf =
+				    typed(m.instantiate<sensor_msgs::MagneticField>(), m);
 				ImuSample s;
 				s.t = stampSeconds(mf->header.stamp.sec, mf->header.stamp.nsec);
 				if (stampBack(topic, s.t))
@@ -504,7 +550,7 @@ Index readIndex(const Bags& bags, const BagTopics& t,
 			}
 			else
 			{
-				const auto im = m.instantiate<sensor_msgs::Imu>();
+				const auto im = typed(m.instantiate<sensor_msgs::Imu>(), m);
 				ImuSample s = imuSample(
 				    *im,
 				    stampSeconds(im->header.stamp.sec, im->header.stamp.nsec));
@@ -799,25 +845,42 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 		const ImageRef* current = f.depth;
 		try
 		{
-			const auto d = f.depth->msg.instantiate<sensor_msgs::Image>();
-			if (!d) throw std::runtime_error("not a sensor_msgs/Image");
-			const auto dcv =
-			    checkedImage(d, depthEncodings, "the depth image", W, H, "");
-			depthEncoding = d->encoding;
+			// the image of a message, raw or compressed (its topic's type);
+			// \a held keeps a raw message's pixels while they are used
+			auto image = [&](const rosbag::MessageInstance& m, bool depth,
+			                 std::string& encoding,
+			                 cv_bridge::CvImageConstPtr& held) -> cv::Mat
+			{
+				if (m.getDataType() == kCompressed)
+				{
+					const auto c =
+					    typed(readMessage<sensor_msgs::CompressedImage>(m), m);
+					encoding = c->format;
+					return depth
+					           ? decodeCompressedDepth(*c, W, H, params.images)
+					           : decodeCompressedColour(*c, W, H,
+					                                    params.images);
+				}
+				const auto r = typed(readMessage<sensor_msgs::Image>(m), m);
+				encoding = r->encoding;
+				held = depth ? checkedImage(r, depthEncodings,
+				                            "the depth image", W, H, "")
+				             : checkedImage(r, colourEncodings,
+				                            "the colour image", W, H, "bgr8");
+				return held->image;
+			};
+			cv_bridge::CvImageConstPtr heldDepth, heldColour;
+			const cv::Mat depth =
+			    image(f.depth->msg, true, depthEncoding, heldDepth);
 			// REP 118: 16UC1 millimetres, 32FC1 metres
 			auto o = eval::depthObservation(
-			    dcv->image, dcv->image.type() == CV_32FC1 ? 1.0 : 0.001, cam,
+			    depth, depth.type() == CV_32FC1 ? 1.0 : 0.001, cam,
 			    params.rgbdLabel, f.t, params.rangeUnits);
 			if (f.colour)
 			{
 				current = f.colour;
-				const auto c = f.colour->msg.instantiate<sensor_msgs::Image>();
-				if (!c) throw std::runtime_error("not a sensor_msgs/Image");
-				colourEncoding = c->encoding;
-				eval::attachColour(
-				    *o, checkedImage(c, colourEncodings, "the colour image", W,
-				                     H, "bgr8")
-				            ->image);
+				eval::attachColour(*o, image(f.colour->msg, false,
+				                             colourEncoding, heldColour));
 			}
 			return o;
 		}

@@ -63,10 +63,11 @@ void BagImportParams::describe(OptionVisitor& v)
 	         "topic the bag has); --layout overrides");
 	// each topic key: empty takes the layout's topic, "none" reads none
 	v.text("depth_topic", topics.depth,
-	       "depth image topic, 16UC1 mm or 32FC1 m (empty: the layout's; "
-	       "none: not read)");
+	       "depth image topic, 16UC1 mm or 32FC1 m, raw or compressedDepth "
+	       "(empty: the layout's; none: not read)");
 	v.text("colour_topic", topics.colour,
-	       "colour image topic, rgb8 bgr8 mono8 (empty: the layout's)");
+	       "colour image topic, rgb8 bgr8 mono8, raw or compressed (empty: "
+	       "the layout's)");
 	v.text("camera_info_topic", topics.cameraInfo,
 	       "CameraInfo topic of the registered depth image (empty: the "
 	       "layout's)");
@@ -119,6 +120,7 @@ void BagImportParams::loadFromConfigFile(
 		cameraFrom = "[camera] of " + cam.file();
 	}
 	eval::loadImportLabels(cfg, rgbdLabel, imuLabel);
+	images.loadFromConfigFile(cfg, "input");
 }
 
 }  // namespace bims::bag

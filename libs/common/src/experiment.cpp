@@ -22,7 +22,7 @@ const std::vector<ExperimentSection>& experimentSectionTable()
 	    {"grids", "maps", "the three Bayesian grids"},
 	    {"pipeline", "pipeline", "orchestration, variant"},
 	    {"output", "pipeline (bims-run)", "what bims-run writes"},
-	    {"input", "io (bims-run, the importers, bims-flow-labels)",
+	    {"input", "io (bims-run, the three importers, bims-flow-labels)",
 	     "size limits of input image files"},
 	    {"import", "eval (bims-import-tum)",
 	     "TUM/Bonn import: association, ground truth"},

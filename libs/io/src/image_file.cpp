@@ -122,11 +122,12 @@ std::optional<ImageHeader> imageHeader(const uint8_t* p, size_t n)
 void ImageLimits::describe(OptionVisitor& v)
 {
 	v.integer("image_max_side", max_side, 1, kSideAtMost,
-	          "an input image file (TUM folder, Stray capture, labels) "
-	          "declaring more pixels per side is refused before decoding");
+	          "an input image file (TUM folder, Stray capture, labels) or a "
+	          "bag's compressed image declaring more pixels per side is "
+	          "refused before decoding");
 	v.integer("image_max_pixels", max_pixels, 1, kPixelsAtMost,
-	          "an input image file declaring more pixels (width x height) "
-	          "is refused before decoding");
+	          "an input image file or a bag's compressed image declaring more "
+	          "pixels (width x height) is refused before decoding");
 }
 
 void ImageLimits::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
@@ -141,6 +142,46 @@ bool imageSizeWithinLimits(uint64_t rows, uint64_t cols,
 	const auto side = static_cast<uint64_t>(limits.max_side);
 	return rows <= side && cols <= side &&
 	       rows * cols <= static_cast<uint64_t>(limits.max_pixels);
+}
+
+cv::Mat decodeImage(const uint8_t* p, size_t n, int flags,
+                    const ImageLimits& limits, const char* format)
+{
+	using std::runtime_error;
+	const auto h = imageHeader(p, n);
+	if (!h)
+		throw runtime_error(
+		    format
+		        ? std::string("not a ") + format + " image (no header of one)"
+		        : "not a PNG, JPEG, TIFF or BMP image (no header of one)");
+	if (format && std::string(h->format) != format)
+		throw runtime_error(std::string("a ") + h->format + " image, not " +
+		                    format);
+	if (!imageSizeWithinLimits(h->height, h->width, limits))
+		throw runtime_error(
+		    "declares " + std::to_string(h->width) + " x " +
+		    std::to_string(h->height) + " pixels in its " + h->format +
+		    " header, beyond the " + std::to_string(limits.max_side) +
+		    " per side and " + std::to_string(limits.max_pixels) +
+		    " pixels bims reads (" + limits.origin + "; not decoded)");
+	if (h->width == 0 || h->height == 0)
+		throw runtime_error(std::string("declares an empty image in its ") +
+		                    h->format + " header");
+	cv::Mat img;
+	try
+	{
+		// (imdecode does not write to its input)
+		img = cv::imdecode(
+		    cv::Mat(1, static_cast<int>(n), CV_8UC1, const_cast<uint8_t*>(p)),
+		    flags);
+	}
+	catch (const cv::Exception&)
+	{
+	}
+	if (img.empty())
+		throw runtime_error(std::string("its bytes do not decode as ") +
+		                    h->format + " (damaged or truncated)");
+	return img;
 }
 
 cv::Mat readImageFile(const std::string& path, int flags,
@@ -164,34 +205,15 @@ cv::Mat readImageFile(const std::string& path, int flags,
 	if (!f.read(reinterpret_cast<char*>(bytes.data()),
 	            static_cast<std::streamsize>(bytes.size())))
 		throw fail("the file ends early");
-	const auto h = imageHeader(bytes.data(), bytes.size());
-	if (!h)
-		throw fail(bytes.empty() ? std::string("the file is empty")
-		                         : std::string("not a PNG, JPEG, TIFF or BMP "
-		                                       "image (no header of one)"));
-	if (!imageSizeWithinLimits(h->height, h->width, limits))
-		throw fail("declares " + std::to_string(h->width) + " x " +
-		           std::to_string(h->height) + " pixels in its " + h->format +
-		           " header, beyond the " + std::to_string(limits.max_side) +
-		           " per side and " + std::to_string(limits.max_pixels) +
-		           " pixels bims reads (" + limits.origin + "; not decoded)");
-	if (h->width == 0 || h->height == 0)
-		throw fail(std::string("declares an empty image in its ") + h->format +
-		           " header");
-	cv::Mat img;
+	if (bytes.empty()) throw fail("the file is empty");
 	try
 	{
-		img = cv::imdecode(
-		    cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, bytes.data()),
-		    flags);
+		return decodeImage(bytes.data(), bytes.size(), flags, limits);
 	}
-	catch (const cv::Exception&)
+	catch (const std::runtime_error& e)
 	{
+		throw fail(e.what());
 	}
-	if (img.empty())
-		throw fail(std::string("its bytes do not decode as ") + h->format +
-		           " (a damaged or truncated file)");
-	return img;
 }
 
 }  // namespace bims

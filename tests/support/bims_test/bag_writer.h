@@ -2,7 +2,9 @@
 // realsense-ros or TUM RGB-D recording holds them (the tests and the bench
 // of bims-import-bag): depth (16UC1 mm or 32FC1 m), colour, CameraInfo,
 // sensor_msgs/Imu as one topic, as separate accelerometer and gyro topics
-// at different rates, or accelerometer only, MagneticField.
+// at different rates, or accelerometer only, MagneticField; the images
+// also as image_transport's plugins republish them (sensor_msgs/
+// CompressedImage: compressed colour, compressedDepth depth).
 #pragma once
 
 #include <bims/bag/bag_import.h>
@@ -10,11 +12,15 @@
 #include <mrpt/obs/CObservationIMU.h>
 #include <rosbag/bag.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/MagneticField.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
@@ -106,6 +112,72 @@ inline sensor_msgs::Image colourMsg(const CObservation3DRangeScan& f,
 	return m;
 }
 
+/** The colour as compressed_image_transport writes it: \a codec "jpeg"
+ * (quality \a jpegQuality) or "png" of the BGR pixels, the format
+ * "rgb8; CODEC compressed bgr8" (or \a format when given). */
+inline sensor_msgs::CompressedImage compressedColourMsg(
+    const CObservation3DRangeScan& f, const std::string& codec,
+    const std::string& format = "", int jpegQuality = 90)
+{
+	sensor_msgs::CompressedImage m;
+	m.header = header(secondsOf(f.timestamp), "colour");
+	m.format = format.empty() ? "rgb8; " + codec + " compressed bgr8" : format;
+	const bool jpeg = codec == "jpeg";
+	const std::vector<int> params = {
+	    jpeg ? cv::IMWRITE_JPEG_QUALITY : cv::IMWRITE_PNG_COMPRESSION,
+	    jpeg ? jpegQuality : 1};
+	cv::imencode(jpeg ? ".jpg" : ".png", bgrOf(f), m.data, params);
+	return m;
+}
+
+/** The depth as compressed_depth_image_transport writes it (format
+ * "16UC1; compressedDepth png" or "32FC1; ..."): its 12-byte ConfigHeader
+ * (format INV_DEPTH = 0, depthQuantA, depthQuantB), then a PNG of the
+ * 16UC1 millimetres as they are, or of the 32FC1 metres' inverse quantised
+ * as the plugin does it with its defaults (depth_quantization 100,
+ * depth_max 10 m: v = A / d + B truncated, 0 beyond depth_max and for no
+ * reading, 0 or NaN; the plugin's float-to-uint16 conversion of A / 0 is
+ * undefined, 0 on x86). (The plugin also zeroes 16UC1 readings beyond
+ * depth_max; the sample has none.) */
+inline sensor_msgs::CompressedImage compressedDepthMsg(
+    const CObservation3DRangeScan& f, bool metres)
+{
+	const sensor_msgs::Image raw = depthMsg(f, metres);
+	sensor_msgs::CompressedImage m;
+	m.header = raw.header;
+	m.format = raw.encoding + "; compressedDepth png";
+	const int W = static_cast<int>(raw.width), H = static_cast<int>(raw.height);
+	float quant[2] = {0, 0};
+	cv::Mat png(H, W, CV_16UC1);
+	if (metres)
+	{
+		const float z0 = 100, depthMax = 10;
+		quant[0] = z0 * (z0 + 1.0f);
+		quant[1] = 1.0f - quant[0] / depthMax;
+		const auto* d = reinterpret_cast<const float*>(raw.data.data());
+		for (int v = 0; v < H; v++)
+			for (int u = 0; u < W; u++)
+			{
+				const float z = d[v * W + u];
+				png.at<uint16_t>(v, u) =
+				    z > 0 && z < depthMax
+				        ? static_cast<uint16_t>(
+				              std::min(65535.0f, quant[0] / z + quant[1]))
+				        : 0;
+			}
+	}
+	else
+		std::memcpy(png.data, raw.data.data(), raw.data.size());
+	m.data.resize(12);
+	const int32_t invDepth = 0;
+	std::memcpy(m.data.data(), &invDepth, 4);
+	std::memcpy(m.data.data() + 4, quant, 8);
+	std::vector<uint8_t> bytes;
+	cv::imencode(".png", png, bytes, {cv::IMWRITE_PNG_COMPRESSION, 1});
+	m.data.insert(m.data.end(), bytes.begin(), bytes.end());
+	return m;
+}
+
 inline sensor_msgs::CameraInfo infoMsg(const CObservation3DRangeScan& f)
 {
 	sensor_msgs::CameraInfo m;
@@ -168,6 +240,14 @@ struct BagSpec
 	bool splitImu = false;  ///< RealSense's accel + gyro topics
 	bool mag = false;       ///< a /imu/mag MagneticField topic
 	std::string colour = "rgb8";
+	/** "jpeg" or "png": the colour as a CompressedImage on the layout's
+	 * colour topic + "/compressed" (format colourFormat, when given),
+	 * instead of the raw topic. */
+	std::string colourCodec;
+	std::string colourFormat;
+	/** The depth as compressed_depth_image_transport's, on the layout's
+	 * depth topic + "/compressedDepth", instead of the raw topic. */
+	bool compressedDepth = false;
 	rosbag::compression::CompressionType compression =
 	    rosbag::compression::Uncompressed;
 	size_t frames = 24;  ///< the first N frames
@@ -208,8 +288,17 @@ inline void writeBag(const std::string& path, const BagSpec& spec,
 		}
 		const ros::Time t = rosTime(tf);
 		bag.write(layout.cameraInfo, t, infoMsg(f));
-		bag.write(layout.depth, t, depthMsg(f, spec.tum));
-		bag.write(layout.colour, t, colourMsg(f, spec.colour));
+		if (spec.compressedDepth)
+			bag.write(layout.depth + "/compressedDepth", t,
+			          compressedDepthMsg(f, spec.tum));
+		else
+			bag.write(layout.depth, t, depthMsg(f, spec.tum));
+		if (!spec.colourCodec.empty())
+			bag.write(
+			    layout.colour + "/compressed", t,
+			    compressedColourMsg(f, spec.colourCodec, spec.colourFormat));
+		else
+			bag.write(layout.colour, t, colourMsg(f, spec.colour));
 	}
 	bag.close();
 }

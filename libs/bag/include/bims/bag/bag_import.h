@@ -1,16 +1,17 @@
-// Import of ROS 1 bags (sensor_msgs/Image depth and colour, CameraInfo, Imu,
-// optional MagneticField) into a bims rawlog, with Debian's rosbag_storage
-// (docs/import-bag.md). Depth and colour are paired by stamp as the TUM
-// importer pairs them (associateGreedy); IMU samples keep their own stamps;
-// the stamps are the messages' header stamps (the sensors' clock), never
-// the bag's record times. A bag of TUM RGB-D's layout gives the same rawlog
-// as the TUM folder of the same frames.
+// Import of ROS 1 bags (depth and colour sensor_msgs/Image or
+// CompressedImage, CameraInfo, Imu, optional MagneticField) into a bims
+// rawlog, with Debian's rosbag_storage (docs/import-bag.md). Depth and colour
+// are paired by stamp as the TUM importer pairs them (associateGreedy); IMU
+// samples keep their own stamps; the stamps are the messages' header stamps
+// (the sensors' clock), never the bag's record times. A bag of TUM RGB-D's
+// layout gives the same rawlog as the TUM folder of the same frames.
 #pragma once
 
 #include <bims/common/choice.h>
 #include <bims/common/options.h>
 #include <bims/common/progress.h>
 #include <bims/eval/tum_import.h>
+#include <bims/io/image_file.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/img/TCamera.h>
 
@@ -40,8 +41,12 @@ inline Choices<BagLayout> choices(BagLayout)
 /** The topics read. An empty name: not read. */
 struct BagTopics
 {
-	std::string depth;       ///< sensor_msgs/Image, 16UC1 mm or 32FC1 m
-	std::string colour;      ///< sensor_msgs/Image, rgb8 bgr8 mono8
+	/** sensor_msgs/Image, 16UC1 mm or 32FC1 m, or CompressedImage of
+	 * compressed_depth_image_transport (PNG) */
+	std::string depth;
+	/** sensor_msgs/Image, rgb8 bgr8 mono8, or CompressedImage (JPEG, PNG)
+	 */
+	std::string colour;
 	std::string cameraInfo;  ///< sensor_msgs/CameraInfo of the depth image
 	std::string imu;         ///< sensor_msgs/Imu (gyro and/or accel)
 	std::string accel;       ///< sensor_msgs/Imu, accelerometer only
@@ -54,7 +59,8 @@ BagTopics layoutTopics(BagLayout layout);
 
 /** What bims-import-bag reads from an experiment .ini: [import_bag]
  * (describe()), [camera] (intrinsics overriding the bag's CameraInfo: all
- * of fx fy cx cy width height or none) and [sensors] (the labels). */
+ * of fx fy cx cy width height or none), [sensors] (the labels) and [input]
+ * (the limits of compressed images). */
 struct BagImportParams
 {
 	/** [import_bag] layout (--layout overrides): whose preset topics. */
@@ -77,6 +83,10 @@ struct BagImportParams
 	std::string cameraFrom;  ///< "[camera] of FILE" when given
 	/** [sensors] rgbd_label, imu_label. */
 	std::string rgbdLabel = "RGBD", imuLabel = "IMU";
+	/** [input] image_max_side, image_max_pixels: a compressed image
+	 * (sensor_msgs/CompressedImage) declaring more is refused before it
+	 * is decoded. */
+	ImageLimits images;
 
 	/** The keys of [import_bag] (bims/common/options.h). */
 	void describe(OptionVisitor& v);

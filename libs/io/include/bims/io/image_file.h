@@ -62,13 +62,24 @@ std::optional<ImageHeader> imageHeader(const uint8_t* p, size_t n);
 bool imageSizeWithinLimits(uint64_t rows, uint64_t cols,
                            const ImageLimits& limits = {});
 
+/** Decodes the \a n bytes at \a p (an image file's contents, or a ROS
+ * CompressedImage's data) as cv::imdecode(\a flags) does, but first checks
+ * that they start with the header of one of the formats of imageHeader()
+ * (\a format, e.g. "PNG", when given: that one) declaring a size within
+ * \a limits; decodes only then. Throws std::runtime_error saying why: not
+ * an image of those formats (or of \a format), a size beyond the limits
+ * (with the size and the format), an empty image, or bytes that do not
+ * decode. The one rule of readImageFile() and the bag importer. */
+cv::Mat decodeImage(const uint8_t* p, size_t n, int flags,
+                    const ImageLimits& limits = {},
+                    const char* format = nullptr);
+
 /** Reads the image file \a path as cv::imread(path, \a flags) does, but
  * first checks that it is a readable file in one of the formats of
  * imageHeader() whose declared size is within \a limits; decodes only
  * then. Throws std::runtime_error "PATH: cannot read WHAT: why" (\a what:
- * e.g. "depth image", "label"; why: no such file, a folder, empty, not an
- * image of those formats, a size beyond the limits (with the size and the
- * format), or bytes that do not decode). */
+ * e.g. "depth image", "label"; why: no such file, a folder, empty, or
+ * decodeImage()'s). */
 cv::Mat readImageFile(const std::string& path, int flags,
                       const std::string& what = "image",
                       const ImageLimits& limits = {});
