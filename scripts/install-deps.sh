@@ -8,7 +8,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build lld pkg-config clang-format ccache help2man
   libmrpt-dev mrpt-apps
-  libopencv-dev libeigen3-dev nlohmann-json3-dev zlib1g-dev
+  libopencv-dev libeigen3-dev nlohmann-json3-dev libdeflate-dev
   libopenni2-dev openni2-utils
   libwxgtk3.2-dev
   liboctomap-dev

@@ -1,7 +1,7 @@
 #include <bims/io/output_paths.h>
 #include <bims/io/rawlog.h>
 
-#include <zlib.h>
+#include <bims/io/gzip_members.h>
 
 #include <fstream>
 
@@ -258,21 +258,7 @@ size_t count3DScans(const std::vector<std::string>& rawlogs,
 
 uint64_t rawlogDataBytes(const std::string& path)
 {
-	std::ifstream f(path, std::ios::binary);
-	if (!f) return 0;
-	unsigned char head[2] = {0, 0};
-	f.read(reinterpret_cast<char*>(head), 2);
-	f.seekg(0, std::ios::end);
-	const auto size = static_cast<uint64_t>(f.tellg());
-	if (!f || head[0] != 0x1f || head[1] != 0x8b || size < 18) return size;
-	// gzip: the trailer's last 4 bytes are the data's size modulo 2^32
-	unsigned char t[4];
-	f.seekg(-4, std::ios::end);
-	f.read(reinterpret_cast<char*>(t), 4);
-	if (!f) return size;
-	uint64_t data = t[0] | (t[1] << 8) | (t[2] << 16) | (uint64_t(t[3]) << 24);
-	while (data < size) data += uint64_t(1) << 32;
-	return data;
+	return gzipDataBytes(path);  // a plain file's size too
 }
 
 mrpt::obs::CObservation::Ptr RawlogReader::next()
@@ -336,42 +322,21 @@ mrpt::obs::CObservation::Ptr RawlogReader::next()
 	return o;
 }
 
-namespace
-{
-/** zlib's text of the last error of \a f (errno's when it is a file
- * error). */
-std::string gzipError(gzFile f)
-{
-	int code = 0;
-	const char* msg = gzerror(f, &code);
-	if (code == Z_ERRNO) return std::strerror(errno);
-	return msg && *msg ? msg : "zlib error " + std::to_string(code);
-}
-}  // namespace
-
 RawlogWriter::RawlogWriter(const std::string& path, int gzLevel) : path_(path)
 {
 	if (gzLevel < 0 || gzLevel > 9)
 		throw RawlogError(path + ": gzip level must be in 0..9");
-	if (gzLevel == 0)
+	try
 	{
-		try
-		{
+		if (gzLevel == 0)
 			plain_ = std::make_unique<AppendFile>(path);
-		}
-		catch (const std::exception& e)
-		{
-			throw RawlogError(std::string(e.what()) + " (rawlog file)");
-		}
+		else
+			gz_ = std::make_unique<GzipMemberWriter>(path, gzLevel,
+			                                         kCompressionThreads);
 	}
-	else
+	catch (const std::exception& e)
 	{
-		replaceSymlink(path);
-		// zlib directly (MRPT's CFileGZOutputStream, the same bytes, does
-		// not report a failed close: the buffered tail of a full disk)
-		const std::string mode = "wb" + std::to_string(gzLevel);
-		gz_ = gzopen(path.c_str(), mode.c_str());
-		if (!gz_) throw RawlogError(path + ": cannot create rawlog file");
+		throw RawlogError(std::string(e.what()) + " (rawlog file)");
 	}
 	arch_ = std::make_unique<VectorArchive>(buf_);
 	open_ = true;
@@ -400,30 +365,33 @@ void RawlogWriter::write(const mrpt::obs::CObservation& obs)
 	{
 		throw RawlogError(path_ + ": write failed: " + e.what());
 	}
-	const auto n = buf_.size();
-	if (plain_)
+	try
 	{
-		try
-		{
-			plain_->append(buf_.data(), n);
-		}
-		catch (const std::exception& e)
-		{
-			throw RawlogError(e.what());
-		}
+		if (plain_)
+			plain_->append(buf_.data(), buf_.size());
+		else
+			gz_->append(buf_.data(), buf_.size());
 	}
-	else if (n > 0 && gzwrite(gz_, buf_.data(), static_cast<unsigned>(n)) !=
-	                      static_cast<int>(n))
-		throw RawlogError(path_ + ": write failed: " + gzipError(gz_));
+	catch (const std::exception& e)
+	{
+		throw RawlogError(e.what());
+	}
 	++n_;
 }
 
 void RawlogWriter::flush()
 {
 	// a plain rawlog reaches the OS object by object (AppendFile); a gzip
-	// one gets its pending bytes out, ending a deflate block on a byte
-	if (gz_ && gzflush(gz_, Z_SYNC_FLUSH) != Z_OK)
-		throw RawlogError(path_ + ": write failed: " + gzipError(gz_));
+	// one ends its member and waits for it to be in the file
+	if (!gz_) return;
+	try
+	{
+		gz_->flush();
+	}
+	catch (const std::exception& e)
+	{
+		throw RawlogError(e.what());
+	}
 }
 
 void RawlogWriter::close()
@@ -431,28 +399,16 @@ void RawlogWriter::close()
 	if (!open_) return;
 	open_ = false;
 	arch_.reset();
-	if (plain_)
+	auto plain = std::move(plain_);
+	auto gz = std::move(gz_);
+	try
 	{
-		auto f = std::move(plain_);
-		try
-		{
-			f->close();
-		}
-		catch (const std::exception& e)
-		{
-			throw RawlogError(e.what());
-		}
+		if (plain) plain->close();
+		if (gz) gz->close();
 	}
-	if (gz_)
+	catch (const std::exception& e)
 	{
-		gzFile f = gz_;
-		gz_ = nullptr;
-		const int rc = gzclose(f);
-		if (rc != Z_OK)
-			throw RawlogError(path_ + ": closing failed: " +
-			                  (rc == Z_ERRNO
-			                       ? std::string(std::strerror(errno))
-			                       : "zlib error " + std::to_string(rc)));
+		throw RawlogError(e.what());
 	}
 }
 

@@ -17,10 +17,10 @@
 #include <string>
 #include <vector>
 
-struct gzFile_s;  // zlib's gzFile
-
 namespace bims
 {
+class GzipMemberWriter;
+
 /** Error reading or writing a rawlog; the message names the file. */
 class RawlogError : public std::runtime_error
 {
@@ -34,9 +34,9 @@ class RawlogError : public std::runtime_error
 std::string rawlogImagesDirectory(const std::string& rawlogPath);
 
 /** The bytes of data a rawlog file holds, for showing how far a reading
- * has come: its size; for a gzip file, the size of the data inside as its
- * trailer gives it (modulo 4 GiB: taken as the smallest such size not below
- * the compressed size, an estimate past 4 GiB). 0 when the file cannot be
+ * has come: its size; for a gzip file, the size of the data inside
+ * (gzipDataBytes: exact for RawlogWriter's files, an estimate for other
+ * writers' past 4 GiB or of several members). 0 when the file cannot be
  * read. */
 uint64_t rawlogDataBytes(const std::string& path);
 
@@ -88,7 +88,13 @@ class RawlogWriter
 	/** Creates (truncates) \a path (a symbolic link there is replaced, its
 	 * target untouched). gzLevel 1..9 writes a gzip-compressed rawlog, 0 a
 	 * plain one (for live grabbing). Throws RawlogError if the file cannot
-	 * be created. */
+	 * be created.
+	 *
+	 * A gzip rawlog is written as independent gzip members of ~2 MB of
+	 * whole observations (GzipMemberWriter: compressed on worker threads,
+	 * written in order; every gzip reader reads them as one stream). The
+	 * members end where the writes and flushes say, never by timing: the
+	 * same observations give the same file byte for byte. */
 	explicit RawlogWriter(const std::string& path, int gzLevel = 1);
 	~RawlogWriter();
 	RawlogWriter(const RawlogWriter&) = delete;
@@ -96,13 +102,18 @@ class RawlogWriter
 
 	/** Appends one observation (observations-only rawlog format). A plain
 	 * rawlog gets it at once or not at all (bims::AppendFile: a failed write
-	 * leaves the file at its last whole observation and throws naming it). */
+	 * leaves the file at its last whole observation and throws naming it); a
+	 * gzip rawlog gets it in its current member, and a member that cannot be
+	 * written leaves the file at its last whole member and throws naming it
+	 * at this call or the next (write, flush or close). */
 	void write(const mrpt::obs::CObservation& obs);
 	/** Everything written so far reaches the OS: a killed program leaves
 	 * the file readable up to here. Nothing to do for a plain rawlog (each
-	 * object reaches the OS when written); a gzip rawlog's stream is
-	 * flushed to a byte boundary (zlib's Z_SYNC_FLUSH: a few bytes more per
-	 * call). Throws RawlogError naming the file if the write fails. */
+	 * object reaches the OS when written); a gzip rawlog ends its current
+	 * member and waits until it is in the file (a whole gzip file: ~40 bytes
+	 * more per call, and the next member starts without the dictionary of
+	 * the data before). Throws RawlogError naming the file if the write
+	 * fails. */
 	void flush();
 	/** Closes the file; throws RawlogError naming it if the last bytes
 	 * could not be written (plain and gzip rawlogs). */
@@ -112,9 +123,12 @@ class RawlogWriter
 
  private:
 	std::string path_;
-	std::unique_ptr<AppendFile> plain_;  ///< a plain rawlog
-	gzFile_s* gz_ = nullptr;             ///< a gzip rawlog (zlib's gzFile)
-	std::vector<uint8_t> buf_;           ///< the object being written
+	/** Workers compressing a gzip rawlog's members (the caller serializes
+	 * beside them). */
+	static constexpr int kCompressionThreads = 2;
+	std::unique_ptr<AppendFile> plain_;     ///< a plain rawlog
+	std::unique_ptr<GzipMemberWriter> gz_;  ///< a gzip rawlog
+	std::vector<uint8_t> buf_;              ///< the object being written
 	std::unique_ptr<mrpt::serialization::CArchive> arch_;
 	bool open_ = false;
 	size_t n_ = 0;
