@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <bims_test/file_size_limit.h>
+#include <bims_test/incompressible_rawlog.h>
 #include <bims_test/run_command.h>
 #include <bims_test/tmp_dir.h>
 #include <mrpt/io/CFileGZInputStream.h>
@@ -254,37 +255,8 @@ TEST(Rawlog, AFullDiskLeavesAGzipRawlogAtItsLastWholeMember)
 	// 3 MB files: the first member (7 of them, ~2.1 MB) is written, the
 	// second fails; the error names the file and the file reads back whole
 	const auto p = tmpPath("bims_test_io", "gz_full.rawlog");
-	const int code = bims::test::exitOfChildWithFileSizeLimit(
-	    3'000'000,
-	    [&]
-	    {
-		    try
-		    {
-			    bims::RawlogWriter w(p, 1);
-			    uint32_t x = 99;
-			    for (int i = 0; i < 20; i++)
-			    {
-				    CObservationIMU imu;
-				    imu.timestamp = mrpt::Clock::fromDouble(10.0 + i);
-				    for (int k = 0; k < 300'000; k++)
-				    {
-					    x = x * 1664525u + 1013904223u;
-					    imu.sensorLabel += static_cast<char>(x >> 24);
-				    }
-				    w.write(imu);
-			    }
-			    w.close();
-			    return 0;
-		    }
-		    catch (const bims::RawlogError& e)
-		    {
-			    const std::string m = e.what();
-			    return m.find(p + ": write failed") == 0 &&
-			                   m.find("File too large") != std::string::npos
-			               ? 3
-			               : 4;
-		    }
-	    });
+	const int code = bims::test::writeIncompressibleOnAFullDisk(
+	    p, 1, 3'000'000, 20, 300'000, p + ": write failed");
 	EXPECT_EQ(code, 3);
 	bims::RawlogReader r(p);
 	int n = 0;

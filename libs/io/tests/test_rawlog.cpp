@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <bims_test/file_size_limit.h>
+#include <bims_test/incompressible_rawlog.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/system/filesystem.h>
@@ -120,36 +121,8 @@ TEST(Rawlog, AGzipRawlogWhoseTailFailsAtCloseIsAnError)
 	// EFBIG, as on a full disk): close() must report it (MRPT's gzip stream
 	// did not)
 	const auto p = tmpPath("bims_test_io", "gz_close_limit.rawlog");
-	const int code = bims::test::exitOfChildWithFileSizeLimit(
-	    1000,
-	    [&]
-	    {
-		    try
-		    {
-			    bims::RawlogWriter w(p, 9);
-			    uint32_t x = 12345;
-			    for (int i = 0; i < 15; i++)
-			    {
-				    mrpt::obs::CObservationIMU imu;
-				    for (int k = 0; k < 400; k++)
-				    {
-					    x = x * 1664525u + 1013904223u;
-					    imu.sensorLabel += static_cast<char>(x >> 24);
-				    }
-				    w.write(imu);
-			    }
-			    w.close();
-			    return 0;
-		    }
-		    catch (const bims::RawlogError& e)
-		    {
-			    const std::string m = e.what();
-			    return m.find(p + ": ") == 0 &&
-			                   m.find("File too large") != std::string::npos
-			               ? 3
-			               : 4;
-		    }
-	    });
+	const int code = bims::test::writeIncompressibleOnAFullDisk(p, 9, 1000, 15,
+	                                                            400, p + ": ");
 	std::filesystem::remove(p);
 	EXPECT_EQ(code, 3);
 }
