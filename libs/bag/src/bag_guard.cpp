@@ -5,6 +5,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -197,7 +198,10 @@ class Walker
 			throw runtime_error(at(pos) + ": a chunk of " +
 			                    std::to_string(size) +
 			                    " bytes uncompressed, beyond 1 GiB");
-		if (c->second != "none") return;  // (its records: not walked)
+		chunkSize_ = size;
+		messageStarts_.clear();
+		walkedChunk_ = c->second == "none";
+		if (!walkedChunk_) return;  // (its records: not walked)
 		if (size != r.dataLen)
 			throw runtime_error(at(pos) + ": an uncompressed chunk of " +
 			                    std::to_string(r.dataLen) +
@@ -208,6 +212,7 @@ class Walker
 			if (m.op != kMessage && m.op != kConnection)
 				throw runtime_error(at(p) + ": a record of op " +
 				                    std::to_string(m.op) + " inside a chunk");
+			if (m.op == kMessage) messageStarts_.insert(p - r.data);
 			p = m.end;
 		}
 	}
@@ -222,10 +227,31 @@ class Walker
 			throw runtime_error(at(pos) + ": " + std::to_string(count) +
 			                    " index entries of " + std::to_string(each) +
 			                    " bytes in " + std::to_string(r.dataLen));
+		if (r.op != kIndex) return;
+		// the chunk's messages these entries point at: rosbag reads a
+		// record header at each offset in the chunk, unchecked
+		for (uint64_t k = 0; k < count; k++)
+		{
+			const uint64_t offset = u32(r.data + k * each + 8);
+			const bool within = offset + 8 <= chunkSize_;
+			if (!within || (walkedChunk_ && !messageStarts_.count(offset)))
+				throw runtime_error(
+				    at(pos) + ": index entry " + std::to_string(k) +
+				    " points at byte " + std::to_string(offset) +
+				    " of its chunk, " +
+				    (within ? std::string("not the start of a message there")
+				            : "beyond its " + std::to_string(chunkSize_) +
+				                  " bytes"));
+		}
 	}
 
 	std::ifstream f_;
 	uint64_t start_ = 0, size_ = 0;
+	/** The last chunk read: its uncompressed size and, when it was walked
+	 * (uncompressed), where its messages start (from its data). */
+	uint64_t chunkSize_ = 0;
+	bool walkedChunk_ = false;
+	std::set<uint64_t> messageStarts_;
 };
 }  // namespace
 

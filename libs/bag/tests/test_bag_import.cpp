@@ -947,6 +947,55 @@ size_t patchField(const std::string& path, const std::string& field, uint32_t v,
 	return at;
 }
 
+// rosbag reads a message's record header at the offset an index entry gives
+// within its chunk, unchecked (fuzz finding segv-index-offset-beyond-chunk,
+// session 28's 30-minute run: a SEGV in readHeaderFromBuffer): each offset
+// must lie in the chunk, and in an uncompressed chunk start a message.
+TEST(ImportBag, AnIndexEntryOutsideItsChunksMessagesIsAnErrorBeforeRosbagReads)
+{
+	const auto d = test::freshTmpDir("bims_bag", "index_offsets");
+	BagSpec spec;
+	spec.frames = 2;
+	writeBag(d + "/ok.bag", spec, sample().frames, sample().imu);
+	const std::string ok = test::fileText(d + "/ok.bag");
+	// the first index data record's first entry: its offset's byte
+	const auto u32 = [&](size_t at)
+	{
+		uint32_t v = 0;
+		std::memcpy(&v, &ok[at], 4);
+		return size_t{v};
+	};
+	size_t entry = 0;
+	for (size_t pos = ok.find('\n') + 1; pos + 8 < ok.size() && !entry;)
+	{
+		const size_t hl = u32(pos), dl = u32(pos + 4 + hl);
+		const std::string header = ok.substr(pos + 4, hl);
+		if (header.find(std::string("op=\x04", 4)) != std::string::npos)
+			entry = pos + 8 + hl + 8;  // after the entry's time
+		pos += 8 + hl + dl;
+	}
+	ASSERT_GT(entry, 0u);
+	for (const auto& [offset, want] :
+	     std::vector<std::pair<uint32_t, std::string>>{
+	         {0x7fffffffu,
+	          "index entry 0 points at byte 2147483647 of its "
+	          "chunk, beyond its "},
+	         {1u,
+	          "index entry 0 points at byte 1 of its chunk, not the start "
+	          "of a message there"}})
+	{
+		std::string b = ok;
+		std::memcpy(&b[entry], &offset, 4);
+		std::ofstream(d + "/bad.bag", std::ios::binary) << b;
+		const auto e =
+		    errorOf([&] { import(d + "/bad.bag", d + "/o.rawlog"); });
+		EXPECT_NE(e.find("bad.bag: a ROS 1 bag cut short or damaged"),
+		          std::string::npos)
+		    << e;
+		EXPECT_NE(e.find(want), std::string::npos) << e;
+	}
+}
+
 TEST(ImportBag, LengthsBeyondTheFileAreErrorsBeforeRosbagAllocatesThem)
 {
 	// rosbag_storage allocates what a record declares before reading it
