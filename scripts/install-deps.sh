@@ -13,6 +13,7 @@ PACKAGES=(
   libwxgtk3.2-dev
   liboctomap-dev
   librosbag-storage-dev libcv-bridge-dev libsensor-msgs-dev pluginlib-dev
+  libroslz4-dev libbz2-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth imagemagick xdotool x11-apps libgl1-mesa-dri
   python3-dev pybind11-dev python3-numpy python3-opencv

@@ -1,10 +1,10 @@
 // Fuzz target: a ROS 1 bag as bims-import-bag reads it (bims/bag/
-// bag_import.h): Debian's rosbag_storage opens it (its index, connections,
-// chunks, LZ4 and BZ2 decompression), then the import proper: the layout
-// found from its topics, the stamps, CameraInfo, the IMU streams, the
-// images raw and compressed (the guarded decoding), into a plain rawlog.
-// rosbag opens files only: the input is written to this process's scratch
-// folder (TMPDIR; /dev/shm is a good one).
+// bag_import.h): bims's reading of its records (bag_file.h: connections,
+// chunks, LZ4 and BZ2 decompression, a bag cut short), then the import
+// proper: the layout found from its topics, the stamps, CameraInfo, the IMU
+// streams, the images raw and compressed (the guarded decoding), into a
+// plain rawlog. The bag is mapped from a file: the input is written to this
+// process's scratch folder (TMPDIR; /dev/shm is a good one).
 #include <bims/bag/bag_import.h>
 
 #include <exception>

@@ -44,6 +44,7 @@ std::string bagImportReport(const std::string& out, const BagImportSummary& sum,
 	        ? "no colour"
 	        : ("colour " + sum.colourEncoding + " from " + sum.topics.colour)
 	              .c_str());
+	for (const auto& n : sum.notes) r += n + "\n";
 	if (sum.layout != BagLayout::Auto)
 		r += "layout: " + std::string(choices(sum.layout).name(sum.layout)) +
 		     "\n";

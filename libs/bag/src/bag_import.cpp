@@ -6,9 +6,6 @@
 #include <bims/io/rawlog.h>
 #include <cv_bridge/cv_bridge.h>
 #include <mrpt/core/format.h>
-#include <rosbag/bag.h>
-#include <rosbag/exceptions.h>
-#include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
@@ -34,56 +31,8 @@
 
 #include <bims/bag/compressed_image.h>
 
+#include "bag_file.h"
 #include "bag_guard.h"
-
-// A message read for its header stamp only (the first pass over the images:
-// their pixels are read once, in the second). Every ROS message with a
-// std_msgs/Header starts with it: seq, stamp (sec, nsec), frame_id.
-namespace bims::bag
-{
-struct StampOnly
-{
-	uint32_t sec = 0, nsec = 0;
-};
-}  // namespace bims::bag
-
-namespace ros::message_traits
-{
-template <>
-struct MD5Sum<bims::bag::StampOnly>
-{
-	static const char* value() { return "*"; }
-	static const char* value(const bims::bag::StampOnly&) { return "*"; }
-};
-template <>
-struct DataType<bims::bag::StampOnly>
-{
-	static const char* value() { return "*"; }
-	static const char* value(const bims::bag::StampOnly&) { return "*"; }
-};
-template <>
-struct Definition<bims::bag::StampOnly>
-{
-	static const char* value() { return ""; }
-	static const char* value(const bims::bag::StampOnly&) { return ""; }
-};
-}  // namespace ros::message_traits
-
-namespace ros::serialization
-{
-template <>
-struct Serializer<bims::bag::StampOnly>
-{
-	template <typename Stream>
-	inline static void read(Stream& stream, bims::bag::StampOnly& m)
-	{
-		uint32_t seq = 0;
-		stream.next(seq);
-		stream.next(m.sec);
-		stream.next(m.nsec);
-	}
-};
-}  // namespace ros::serialization
 
 namespace bims::bag
 {
@@ -98,9 +47,10 @@ double stampSeconds(uint32_t sec, uint32_t nsec)
 
 namespace
 {
-using Bags = std::vector<std::unique_ptr<rosbag::Bag>>;
+/** The bags read as one recording. */
+using Bags = std::vector<std::unique_ptr<BagFile>>;
 
-Bags openBags(const std::vector<std::string>& paths)
+Bags openBags(const std::vector<std::string>& paths, size_t cacheBytes)
 {
 	Bags bags;
 	for (const auto& p : paths)
@@ -114,40 +64,14 @@ Bags openBags(const std::vector<std::string>& paths)
 			         ? " (a ROS 2 bag: convert it to ROS 1, e.g. with the "
 			           "rosbags package's rosbags-convert)"
 			         : ""));
-		auto b = std::make_unique<rosbag::Bag>();
 		try
 		{
-			// lengths checked before rosbag allocates them (bag_guard.h)
-			checkBagRecords(p);
-			b->open(p, rosbag::bagmode::Read);
-		}
-		catch (const rosbag::BagUnindexedException&)
-		{
-			throw std::runtime_error(
-			    p +
-			    ": the bag has no index (its recording was cut short, or is "
-			    "still being written): ROS's 'rosbag reindex' rebuilds it "
-			    "(Debian's python3-rosbag), then import it again");
+			bags.push_back(std::make_unique<BagFile>(p, cacheBytes));
 		}
 		catch (const std::exception& e)
 		{
-			// a bag whose header is there but whose end is not: cut short
-			std::ifstream f(p, std::ios::binary);
-			char magic[13] = {};
-			f.read(magic, 12);
-			if (std::string(magic) == "#ROSBAG V2.0")
-				throw std::runtime_error(
-				    p + ": a ROS 1 bag cut short or damaged (" + e.what() +
-				    "): ROS's 'rosbag reindex' (Debian's python3-rosbag) "
-				    "rebuilds its index from the whole messages it holds, "
-				    "then import it again");
-			throw std::runtime_error(
-			    p +
-			    ": not a readable ROS 1 bag (it does not start with "
-			    "'#ROSBAG V2.0'): " +
-			    e.what());
+			throw std::runtime_error(p + ": " + e.what());
 		}
-		bags.push_back(std::move(b));
 	}
 	return bags;
 }
@@ -159,36 +83,13 @@ std::string joined(const std::vector<std::string>& v)
 	return s;
 }
 
-/** Where a message is: "BAG: topic /x, message #n (stamp s)". */
-std::string where(const rosbag::MessageInstance& m, size_t n, double t = -1)
+/** Where a message is: "topic /x, message #n of it (stamp s)". */
+std::string where(const std::string& topic, size_t n, double t = -1)
 {
-	std::string s = "topic " + m.getTopic() + ", message #" +
-	                std::to_string(n + 1) + " of it";
+	std::string s =
+	    "topic " + topic + ", message #" + std::to_string(n + 1) + " of it";
 	if (t >= 0) s += mrpt::format(" (stamp %.6f)", t);
 	return s;
-}
-
-std::vector<BagTopicInfo> topicsOf(const Bags& bags)
-{
-	std::map<std::string, BagTopicInfo> m;
-	for (const auto& b : bags)
-	{
-		rosbag::View all(*b);
-		for (const auto* c : all.getConnections())
-		{
-			auto& t = m[c->topic];
-			t.name = c->topic;
-			t.type = c->datatype;
-		}
-		for (auto& [name, t] : m)
-		{
-			rosbag::View one(*b, rosbag::TopicQuery(name));
-			t.messages += one.size();
-		}
-	}
-	std::vector<BagTopicInfo> out;
-	for (auto& [name, t] : m) out.push_back(t);
-	return out;
 }
 
 const BagTopicInfo* findTopic(const std::vector<BagTopicInfo>& topics,
@@ -308,11 +209,6 @@ std::string topicList(const std::vector<BagTopicInfo>& topics)
 }
 }  // namespace
 
-std::vector<BagTopicInfo> bagTopics(const std::vector<std::string>& bagPaths)
-{
-	return topicsOf(openBags(bagPaths));
-}
-
 std::string describeTopics(const std::vector<BagTopicInfo>& topics)
 {
 	std::string s;
@@ -370,24 +266,6 @@ void attachMagnetometer(std::vector<ImuSample>& imu,
 
 namespace
 {
-/** An image message found in the first pass: its stamp and where it is. */
-struct ImageRef
-{
-	double t = 0;
-	size_t n = 0;  ///< its index on its topic
-	rosbag::MessageInstance msg;
-};
-
-/** Everything the first pass reads: the images' stamps, the camera, the
- * IMU streams. */
-struct Index
-{
-	std::vector<ImageRef> depth, colour;
-	boost::shared_ptr<sensor_msgs::CameraInfo> info;
-	size_t infoMessages = 0;
-	std::vector<ImuSample> imu, accel, gyro, mag;
-};
-
 constexpr const char* kImage = "sensor_msgs/Image";
 constexpr const char* kCompressed = "sensor_msgs/CompressedImage";
 
@@ -470,95 +348,228 @@ BagTopics chooseTopics(const BagImportParams& params,
 	return t;
 }
 
-/** \a msg, read from \a m; an error when it is null: the bag says the
- * message is of another type than its topic's name says (its MD5 sum is
- * another message's: rosbag gives no message, fuzz finding
- * ub-imu-of-another-md5). */
+/** \a msg; an error when it is null: its connection's MD5 sum \a md5 is
+ * another type's (fuzz finding ub-imu-of-another-md5: rosbag gave a null
+ * message, which was read). */
 template <typename P>
-P typed(P msg, const rosbag::MessageInstance& m)
+P typed(P msg, const std::string& md5)
 {
 	if (!msg)
 		throw std::runtime_error(
 		    std::string("not a ") +
 		    ros::message_traits::datatype<typename P::element_type>() +
-		    ": its MD5 sum " + m.getMD5Sum() + " is another message's");
+		    ": its MD5 sum " + md5 + " is another message's");
 	return msg;
 }
 
-/** The first pass: every message of the chosen topics in the bags' time
- * order; the images' header stamps only. */
-Index readIndex(const Bags& bags, const BagTopics& t,
+template <typename M>
+boost::shared_ptr<M> read(const uint8_t* data, size_t n, const std::string& md5)
+{
+	return typed(readMessage<M>(data, n, md5), md5);
+}
+
+/** The stamp of a message that starts with a std_msgs/Header (seq, stamp,
+ * frame_id), as every image does: read without the pixels. */
+double headerStamp(const uint8_t* p, size_t n)
+{
+	if (n < 12)
+		throw std::runtime_error("it ends inside its header's stamp: corrupt");
+	uint32_t sec = 0, nsec = 0;
+	std::memcpy(&sec, p + 4, 4);
+	std::memcpy(&nsec, p + 8, 4);
+	return stampSeconds(sec, nsec);
+}
+
+/** One message as the scan read it: where it is, and what the first pass
+ * needs of it (an image's stamp; an Imu, MagneticField or CameraInfo
+ * whole). */
+struct Scanned
+{
+	size_t bag = 0;
+	BagMessageRef ref;
+	double t = -1;  ///< its header stamp [s] (images, Imu, MagneticField)
+	ImuSample imu;  ///< an Imu's or a MagneticField's
+	boost::shared_ptr<sensor_msgs::CameraInfo> info;
+	std::string error;  ///< why it cannot be read (said if it is used)
+};
+
+void extract(Scanned& s, const BagConnection& c, const uint8_t* p, size_t n)
+{
+	if (c.type == kImage || c.type == kCompressed)
+		s.t = headerStamp(p, n);
+	else if (c.type == "sensor_msgs/CameraInfo")
+		s.info = read<sensor_msgs::CameraInfo>(p, n, c.md5);
+	else if (c.type == "sensor_msgs/Imu")
+	{
+		const auto m = read<sensor_msgs::Imu>(p, n, c.md5);
+		s.t = stampSeconds(m->header.stamp.sec, m->header.stamp.nsec);
+		s.imu = imuSample(*m, s.t);
+	}
+	else if (c.type == "sensor_msgs/MagneticField")
+	{
+		const auto m = read<sensor_msgs::MagneticField>(p, n, c.md5);
+		s.t = stampSeconds(m->header.stamp.sec, m->header.stamp.nsec);
+		s.imu.t = s.t;
+		s.imu.hasMag = true;
+		// tesla to gauss (MRPT's IMU_MAG_* unit)
+		s.imu.m[0] = m->magnetic_field.x * 1e4;
+		s.imu.m[1] = m->magnetic_field.y * 1e4;
+		s.imu.m[2] = m->magnetic_field.z * 1e4;
+	}
+}
+
+/** What the scan of the bags read: every topic's messages in the bags'
+ * time order (record times, as rosbag's View orders them). */
+struct Scan
+{
+	struct Topic
+	{
+		std::string type;
+		std::vector<Scanned> messages;
+	};
+	std::map<std::string, Topic> topics;
+	/** A bag damaged where messages were ("BAG: cut short or damaged:
+	 * ..."): the messages after it are lost. */
+	std::string lost;
+	size_t lostBag = 0;
+	std::vector<std::string> notes;  ///< damage that loses nothing
+
+	std::vector<BagTopicInfo> topicInfo() const
+	{
+		std::vector<BagTopicInfo> out;
+		for (const auto& [name, t] : topics)
+			out.push_back({name, t.type, t.messages.size()});
+		return out;
+	}
+};
+
+/** Reads every chunk of \a bag (the \a b th, \a path) once into \a scan:
+ * each message's place, and what extract() reads of it when
+ * \a extracting (else it is only counted). */
+void scanBag(BagFile& bag, size_t b, const std::string& path, bool extracting,
+             Scan& scan)
+{
+	bag.scan(
+	    [&](const BagMessageRef& ref, const uint8_t* data)
+	    {
+		    const BagConnection& c = bag.connections()[ref.connection];
+		    Scan::Topic& topic = scan.topics[c.topic];
+		    if (topic.type.empty()) topic.type = c.type;
+		    Scanned s;
+		    s.bag = b;
+		    s.ref = ref;
+		    try
+		    {
+			    if (extracting) extract(s, c, data, ref.size);
+		    }
+		    catch (const std::exception& e)
+		    {
+			    s.error = e.what();
+		    }
+		    topic.messages.push_back(std::move(s));
+	    });
+	if (bag.damage().empty()) return;
+	if (!bag.damageLosesMessages())
+		scan.notes.push_back(path + ": its index at its end is damaged (" +
+		                     bag.damage() +
+		                     "): not needed, every chunk was read");
+	else if (scan.lost.empty())
+	{
+		scan.lost = path + ": cut short or damaged: " + bag.damage();
+		scan.lostBag = b;
+	}
+}
+
+/** scanBag of every bag, then each topic in the bags' time order. */
+Scan scanBags(const Bags& bags, const std::vector<std::string>& paths)
+{
+	Scan scan;
+	for (size_t b = 0; b < bags.size(); b++)
+		scanBag(*bags[b], b, paths[b], true, scan);
+	for (auto& [name, t] : scan.topics)
+		std::stable_sort(t.messages.begin(), t.messages.end(),
+		                 [](const Scanned& x, const Scanned& y)
+		                 { return x.ref.time < y.ref.time; });
+	return scan;
+}
+
+/** An image message of the first pass: its stamp and where it is. */
+struct ImageRef
+{
+	double t = 0;
+	size_t n = 0;  ///< its index on its topic
+	const std::string* topic = nullptr;
+	const Scanned* msg = nullptr;
+};
+
+/** Everything the first pass reads: the images' stamps, the camera, the
+ * IMU streams. */
+struct Index
+{
+	std::vector<ImageRef> depth, colour;
+	boost::shared_ptr<sensor_msgs::CameraInfo> info;
+	size_t infoMessages = 0;
+	std::vector<ImuSample> imu, accel, gyro, mag;
+};
+
+/** The first pass: the chosen topics' messages in the bags' time order;
+ * a message that cannot be read is an error naming it. */
+Index readIndex(const Scan& scan, const Bags& bags, const BagTopics& t,
                 const std::string& bagNames, BagImportSummary& sum)
 {
-	std::vector<std::string> names;
+	std::set<std::string> names;
 	for (const auto* n : {&t.depth, &t.colour, &t.cameraInfo, &t.imu, &t.accel,
 	                      &t.gyro, &t.mag})
-		if (!n->empty()) names.push_back(*n);
-	rosbag::View view;
-	for (const auto& b : bags) view.addQuery(*b, rosbag::TopicQuery(names));
-
+		if (!n->empty()) names.insert(*n);
 	Index ix;
-	std::map<std::string, size_t> count;
-	std::map<std::string, double> last;
-	auto stampBack = [&](const std::string& topic, double s)
+	for (const std::string& topic : names)
 	{
-		auto it = last.find(topic);
-		if (it != last.end() && s <= it->second) return true;
-		last[topic] = s;
-		return false;
-	};
-	for (const rosbag::MessageInstance& m : view)
-	{
-		const std::string& topic = m.getTopic();
-		const size_t n = count[topic]++;
-		try
+		const auto it = scan.topics.find(topic);
+		if (it == scan.topics.end()) continue;
+		double last = -1;
+		bool any = false;
+		auto stampBack = [&](double s)
 		{
+			if (any && s <= last) return true;
+			any = true;
+			last = s;
+			return false;
+		};
+		const std::string& name = it->first;
+		for (size_t n = 0; n < it->second.messages.size(); n++)
+		{
+			const Scanned& m = it->second.messages[n];
+			const std::string& type =
+			    bags[m.bag]->connections()[m.ref.connection].type;
+			if (m.error.empty() && type != it->second.type)
+				throw std::runtime_error(bagNames + ": " + where(name, n) +
+				                         ": a " + type + " on a topic of " +
+				                         it->second.type);
+			if (!m.error.empty())
+				throw std::runtime_error(bagNames + ": " + where(name, n) +
+				                         " cannot be read: " + m.error);
 			if (topic == t.depth || topic == t.colour)
 			{
-				const auto s = m.instantiate<StampOnly>();
-				const double ts = stampSeconds(s->sec, s->nsec);
-				if (stampBack(topic, ts))
+				if (stampBack(m.t))
 				{
 					sum.stampsBack++;
 					continue;
 				}
-				(topic == t.depth ? ix.depth : ix.colour).push_back({ts, n, m});
+				(topic == t.depth ? ix.depth : ix.colour)
+				    .push_back({m.t, n, &name, &m});
 			}
 			else if (topic == t.cameraInfo)
 			{
-				auto ci = typed(readMessage<sensor_msgs::CameraInfo>(m), m);
-				if (!ix.info) ix.info = ci;
+				if (!ix.info) ix.info = m.info;
 				ix.infoMessages++;
 			}
+			else if (stampBack(m.t))
+				sum.imuStampsBack++;
 			else if (topic == t.mag)
-			{
-				const auto mf =
-				    typed(m.instantiate<sensor_msgs::MagneticField>(), m);
-				ImuSample s;
-				s.t = stampSeconds(mf->header.stamp.sec, mf->header.stamp.nsec);
-				if (stampBack(topic, s.t))
-				{
-					sum.imuStampsBack++;
-					continue;
-				}
-				s.hasMag = true;
-				// tesla to gauss (MRPT's IMU_MAG_* unit)
-				s.m[0] = mf->magnetic_field.x * 1e4;
-				s.m[1] = mf->magnetic_field.y * 1e4;
-				s.m[2] = mf->magnetic_field.z * 1e4;
-				ix.mag.push_back(s);
-			}
+				ix.mag.push_back(m.imu);
 			else
 			{
-				const auto im = typed(m.instantiate<sensor_msgs::Imu>(), m);
-				ImuSample s = imuSample(
-				    *im,
-				    stampSeconds(im->header.stamp.sec, im->header.stamp.nsec));
-				if (stampBack(topic, s.t))
-				{
-					sum.imuStampsBack++;
-					continue;
-				}
+				ImuSample s = m.imu;
 				if (topic == t.imu) ix.imu.push_back(s);
 				if (topic == t.accel)
 				{
@@ -571,11 +582,6 @@ Index readIndex(const Bags& bags, const BagTopics& t,
 					ix.gyro.push_back(s);
 				}
 			}
-		}
-		catch (const std::exception& e)
-		{
-			throw std::runtime_error(bagNames + ": " + where(m, n) +
-			                         " cannot be read: " + e.what());
 		}
 	}
 	sum.depthMessages = ix.depth.size();
@@ -771,25 +777,74 @@ class AheadQueue
 
 }  // namespace
 
+std::vector<BagTopicInfo> bagTopics(const std::vector<std::string>& bagPaths)
+{
+	const Bags bags = openBags(bagPaths, BagImportOptions().chunkCacheBytes);
+	std::map<std::string, BagTopicInfo> all;
+	for (size_t b = 0; b < bags.size(); b++)
+	{
+		// the index when it is whole; otherwise the chunks, counted
+		std::vector<BagTopicInfo> topics = bags[b]->indexTopics();
+		if (topics.empty())
+		{
+			Scan scan;
+			scanBag(*bags[b], b, bagPaths[b], false, scan);
+			topics = scan.topicInfo();
+		}
+		for (const auto& t : topics)
+		{
+			auto& a = all[t.name];
+			a.name = t.name;
+			if (a.type.empty()) a.type = t.type;
+			a.messages += t.messages;
+		}
+	}
+	std::vector<BagTopicInfo> out;
+	for (auto& [name, t] : all) out.push_back(t);
+	return out;
+}
+
 BagImportSummary importBag(const std::vector<std::string>& bagPaths,
                            const std::string& outRawlog,
                            const BagImportParams& params,
                            const BagImportOptions& options)
 {
 	if (bagPaths.empty()) throw std::runtime_error("no bag to import");
-	const Bags bags = openBags(bagPaths);
+	const Bags bags = openBags(bagPaths, options.chunkCacheBytes);
 	const std::string bagNames = joined(bagPaths);
-	const auto topics = topicsOf(bags);
+	const Scan scan = scanBags(bags, bagPaths);
 
 	BagImportSummary sum;
+	sum.notes = scan.notes;
 	BagLayout layout = BagLayout::Auto;
-	const BagTopics t = chooseTopics(params, topics, bagNames, layout);
-	sum.topics = t;
-	sum.layout = layout;
-	Index ix = readIndex(bags, t, bagNames, sum);
-	std::vector<Frame> frames = pairFrames(ix, params, bagNames, sum);
-	if (options.maxFrames > 0 && frames.size() > options.maxFrames)
+	BagTopics t;
+	Index ix;
+	std::vector<Frame> frames;
+	try
+	{
+		t = chooseTopics(params, scan.topicInfo(), bagNames, layout);
+		sum.topics = t;
+		sum.layout = layout;
+		ix = readIndex(scan, bags, t, bagNames, sum);
+		frames = pairFrames(ix, params, bagNames, sum);
+	}
+	catch (const std::exception& e)
+	{
+		// what was read before a damage may lack what it lost
+		if (scan.lost.empty()) throw;
+		throw std::runtime_error(scan.lost + "; before it: " + e.what());
+	}
+	// a bag damaged where messages were: every whole frame before the
+	// damage is written, then the error says so (unless --max-frames is
+	// reached before it)
+	std::string lost = scan.lost;
+	if (options.maxFrames > 0 && frames.size() >= options.maxFrames)
+	{
+		if (!lost.empty())
+			sum.notes.push_back(lost + " (after the frames imported)");
+		lost.clear();
 		frames.resize(options.maxFrames);
+	}
 	const mrpt::img::TCamera cam = cameraOf(ix, params, t, bagNames, sum);
 	if (ix.info &&
 	    (ix.info->width != cam.ncols || ix.info->height != cam.nrows))
@@ -847,21 +902,25 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 		{
 			// the image of a message, raw or compressed (its topic's type);
 			// \a held keeps a raw message's pixels while they are used
-			auto image = [&](const rosbag::MessageInstance& m, bool depth,
+			auto image = [&](const ImageRef& ref, bool depth,
 			                 std::string& encoding,
 			                 cv_bridge::CvImageConstPtr& held) -> cv::Mat
 			{
-				if (m.getDataType() == kCompressed)
+				const Scanned& m = *ref.msg;
+				BagFile& bag = *bags[m.bag];
+				const BagConnection& c = bag.connections()[m.ref.connection];
+				const BagBytes b = bag.message(m.ref);
+				if (c.type == kCompressed)
 				{
-					const auto c =
-					    typed(readMessage<sensor_msgs::CompressedImage>(m), m);
-					encoding = c->format;
+					const auto ci = read<sensor_msgs::CompressedImage>(
+					    b.data, b.size, c.md5);
+					encoding = ci->format;
 					return depth
-					           ? decodeCompressedDepth(*c, W, H, params.images)
-					           : decodeCompressedColour(*c, W, H,
+					           ? decodeCompressedDepth(*ci, W, H, params.images)
+					           : decodeCompressedColour(*ci, W, H,
 					                                    params.images);
 				}
-				const auto r = typed(readMessage<sensor_msgs::Image>(m), m);
+				const auto r = read<sensor_msgs::Image>(b.data, b.size, c.md5);
 				encoding = r->encoding;
 				held = depth ? checkedImage(r, depthEncodings,
 				                            "the depth image", W, H, "")
@@ -871,7 +930,7 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 			};
 			cv_bridge::CvImageConstPtr heldDepth, heldColour;
 			const cv::Mat depth =
-			    image(f.depth->msg, true, depthEncoding, heldDepth);
+			    image(*f.depth, true, depthEncoding, heldDepth);
 			// REP 118: 16UC1 millimetres, 32FC1 metres
 			auto o = eval::depthObservation(
 			    depth, depth.type() == CV_32FC1 ? 1.0 : 0.001, cam,
@@ -879,16 +938,17 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 			if (f.colour)
 			{
 				current = f.colour;
-				eval::attachColour(*o, image(f.colour->msg, false,
-				                             colourEncoding, heldColour));
+				eval::attachColour(
+				    *o, image(*f.colour, false, colourEncoding, heldColour));
 			}
 			return o;
 		}
 		catch (const std::exception& e)
 		{
 			throw std::runtime_error(
-			    bagNames + ": " + where(current->msg, current->n, current->t) +
-			    ": " + e.what());
+			    bagNames + ": " +
+			    where(*current->topic, current->n, current->t) + ": " +
+			    e.what());
 		}
 	};
 	AheadQueue ahead(items.size(), [&](size_t k) { return decode(items[k]); });
@@ -898,21 +958,22 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 	Progress progress;
 	progress.total = frames.size();
 	reportProgress(options.progress, progress);
+	// an error after whole frames: they are kept, and the error says so
+	auto keepAndThrow = [&](const std::string& error)
+	{
+		if (sum.frames == 0) throw std::runtime_error(error);
+		w.close();
+		part.commit();
+		throw std::runtime_error(
+		    error +
+		    mrpt::format("; the %zu whole frames before it are in ",
+		                 sum.frames) +
+		    outRawlog);
+	};
 	for (size_t k = 0; k < items.size(); k++)
 	{
 		const auto next = ahead.pop();
-		if (!next.error.empty())
-		{
-			if (sum.frames == 0) throw std::runtime_error(next.error);
-			// the whole frames before it are kept
-			w.close();
-			part.commit();
-			throw std::runtime_error(
-			    next.error +
-			    mrpt::format("; the %zu whole frames before it are in ",
-			                 sum.frames) +
-			    outRawlog);
-		}
+		if (!next.error.empty()) keepAndThrow(next.error);
 		w.write(*next.obs);
 		if (items[k].kind == 1)
 		{
@@ -930,6 +991,7 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 	ahead.join();
 	sum.depthEncoding = depthEncoding;
 	sum.colourEncoding = colourEncoding;
+	if (!lost.empty()) keepAndThrow(lost);
 	w.close();
 	part.commit();
 	progress.finished = true;

@@ -1,8 +1,9 @@
 // Import of ROS 1 bags (depth and colour sensor_msgs/Image or
 // CompressedImage, CameraInfo, Imu, optional MagneticField) into a bims
-// rawlog, with Debian's rosbag_storage (docs/import-bag.md). Depth and colour
-// are paired by stamp as the TUM importer pairs them (associateGreedy); IMU
-// samples keep their own stamps; the stamps are the messages' header stamps
+// rawlog: the bag's records read by bims (bag_file.h), the messages
+// deserialized by ROS's own message classes (docs/import-bag.md). Depth and
+// colour are paired by stamp as the TUM importer pairs them (associateGreedy);
+// IMU samples keep their own stamps; the stamps are the messages' header stamps
 // (the sensors' clock), never the bag's record times. A bag of TUM RGB-D's
 // layout gives the same rawlog as the TUM folder of the same frames.
 #pragma once
@@ -107,9 +108,10 @@ struct BagTopicInfo
 	size_t messages = 0;
 };
 
-/** The topics of \a bagPaths (all bags together), sorted by name. Throws
- * std::runtime_error naming the bag when it cannot be opened (missing,
- * not a bag, unindexed: a recording cut short). */
+/** The topics of \a bagPaths (all bags together), sorted by name: from a
+ * bag's index when it is whole, else counted in its chunks (a recording
+ * cut short). Throws std::runtime_error naming the bag when it cannot be
+ * opened (missing, not a ROS 1 bag of format 2.0). */
 std::vector<BagTopicInfo> bagTopics(const std::vector<std::string>& bagPaths);
 
 /** "  /camera/imu  sensor_msgs/Imu  2000 messages" lines. */
@@ -151,6 +153,10 @@ struct BagImportOptions
 {
 	size_t maxFrames = 0;  ///< 0 = all
 	int gzLevel = 1;       ///< 0 = plain rawlog, 1..9 gzip
+	/** Bytes of decompressed (bz2, lz4) chunks kept from the scan of the
+	 * bags to the reading of their images: a bag whose chunks fit is
+	 * decompressed once, a larger one partly twice. */
+	size_t chunkCacheBytes = size_t{1} << 30;
 	/** The frames written (none: silent). */
 	ProgressCallback progress;
 };
@@ -175,8 +181,11 @@ struct BagImportSummary
 	/** The CameraInfo has non-zero distortion coefficients, which the
 	 * pinhole model of bims leaves out (images are not undistorted). */
 	bool distortionIgnored = false;
-	std::string distortionModel;         ///< its distortion_model then
-	BagTopics topics;                    ///< the topics read
+	std::string distortionModel;  ///< its distortion_model then
+	BagTopics topics;             ///< the topics read
+	/** Damage that lost nothing imported (an index damaged at the bag's
+	 * end; damage after the --max-frames imported), one line each. */
+	std::vector<std::string> notes;
 	BagLayout layout = BagLayout::Auto;  ///< whose presets (Auto: none)
 };
 
@@ -189,7 +198,9 @@ struct BagImportSummary
  * encoding, a CameraInfo that disagrees with the image size, a message that
  * cannot be read. When a message of a frame cannot be read, the whole
  * frames before it are kept: the rawlog is renamed into place with them,
- * and the error says how many. */
+ * and the error says how many. So it is when a bag is cut short or damaged
+ * (its messages are read from its chunks, not its index): every whole frame
+ * before the damage is written, and the error names the bag and the byte. */
 BagImportSummary importBag(const std::vector<std::string>& bagPaths,
                            const std::string& outRawlog,
                            const BagImportParams& params,
