@@ -199,8 +199,11 @@ BagFile::BagFile(const std::string& path, size_t cacheBytes)
 		::close(fd);
 
 	// the version line: "#ROSBAG V<major>.<minor>\n"
-	const auto* nl = static_cast<const uint8_t*>(
-	    std::memchr(bytes_, '\n', std::min<uint64_t>(size_, 64)));
+	// (an empty file maps nothing: fuzz finding ub-empty-bag-memchr)
+	const auto* nl = size_ == 0
+	                     ? nullptr
+	                     : static_cast<const uint8_t*>(std::memchr(
+	                           bytes_, '\n', std::min<uint64_t>(size_, 64)));
 	const std::string line =
 	    nl ? std::string(reinterpret_cast<const char*>(bytes_),
 	                     static_cast<size_t>(nl - bytes_))

@@ -35,10 +35,29 @@ class Cursor
 		i_ += 4;
 		return v;
 	}
+	uint8_t u8(const char* what)
+	{
+		if (n_ == i_)
+			throw runtime_error("the message ends before its " +
+			                    std::string(what) + ": corrupt");
+		return p_[i_++];
+	}
+	/** \a k bytes, skipped: where they are. */
+	const uint8_t* take(uint64_t k, const char* what)
+	{
+		const uint8_t* at = p_ + i_;
+		skip(k, what);
+		return at;
+	}
 	/** A string or array of \a elem-byte elements. */
 	void array(uint64_t elem, const char* what)
 	{
 		skip(u32(what) * elem, what);
+	}
+	std::string string(const char* what)
+	{
+		const uint32_t k = u32(what);
+		return std::string(reinterpret_cast<const char*>(take(k, what)), k);
 	}
 	void header()
 	{
@@ -51,6 +70,21 @@ class Cursor
 	size_t n_, i_ = 0;
 };
 }  // namespace
+
+ImageView imageView(const uint8_t* bytes, size_t n)
+{
+	Cursor c(bytes, n);
+	c.header();
+	ImageView v;
+	v.height = c.u32("height");
+	v.width = c.u32("width");
+	v.encoding = c.string("encoding");
+	v.bigEndian = c.u8("is_bigendian") != 0;
+	v.step = c.u32("step");
+	v.size = c.u32("data");
+	v.data = c.take(v.size, "data");
+	return v;
+}
 
 void checkMessageArrays(const uint8_t* bytes, size_t n, ArrayMessage kind)
 {

@@ -57,15 +57,34 @@ inline ArrayMessage arrayMessage(const sensor_msgs::MagneticField*)
  * std::runtime_error saying which is not. */
 void checkMessageArrays(const uint8_t* bytes, size_t n, ArrayMessage kind);
 
-/** The serialized message \a bytes (\a n of them) as a \a M; null when its
- * connection's MD5 sum \a md5 is another type's (as rosbag's instantiate).
- * Its arrays are checked (checkMessageArrays), then it is deserialized
- * from the bag's bytes, not copied first. */
+/** \a md5, a connection's MD5 sum, is \a M's (or "*": any). */
 template <typename M>
-boost::shared_ptr<M> readMessage(const uint8_t* bytes, size_t n,
-                                 const std::string& md5)
+bool isType(const std::string& md5)
 {
-	if (md5 != "*" && md5 != ros::message_traits::md5sum<M>()) return nullptr;
+	return md5 == "*" || md5 == ros::message_traits::md5sum<M>();
+}
+
+/** A sensor_msgs/Image read in place: its fields, and its pixels where
+ * they are in the bag's bytes (not copied). */
+struct ImageView
+{
+	uint32_t height = 0, width = 0, step = 0;
+	std::string encoding;
+	bool bigEndian = false;
+	const uint8_t* data = nullptr;
+	size_t size = 0;
+};
+
+/** The serialized sensor_msgs/Image \a bytes (\a n of them), every length
+ * checked against them; throws std::runtime_error saying which is not. */
+ImageView imageView(const uint8_t* bytes, size_t n);
+
+/** The serialized message \a bytes (\a n of them) as a \a M: its arrays
+ * checked (checkMessageArrays), then deserialized from the bag's bytes,
+ * not copied first. */
+template <typename M>
+boost::shared_ptr<M> readMessage(const uint8_t* bytes, size_t n)
+{
 	checkMessageArrays(bytes, n, arrayMessage(static_cast<M*>(nullptr)));
 	auto msg = boost::make_shared<M>();
 	// (IStream takes its bytes as not const; it only reads them)

@@ -157,40 +157,52 @@ class StreamInterpolator
 	size_t j_ = 0;
 };
 
-/** The image of one message as OpenCV sees it, after the checks a corrupt
+/** The pixels of a raw image message as OpenCV sees them, in place in the
+ * bag's bytes (as BGR when \a bgr: converted), after the checks a corrupt
  * or foreign message fails: encoding, size, step, data length. */
-cv_bridge::CvImageConstPtr checkedImage(
-    const boost::shared_ptr<const sensor_msgs::Image>& img,
-    const std::set<std::string>& encodings, const char* what, int width,
-    int height, const std::string& target)
+cv::Mat checkedImage(const ImageView& img,
+                     const std::set<std::string>& encodings, const char* what,
+                     int width, int height, bool bgr)
 {
-	if (!encodings.count(img->encoding))
+	if (!encodings.count(img.encoding))
 	{
 		std::vector<std::string> e(encodings.begin(), encodings.end());
 		throw std::runtime_error(std::string(what) + " encoding '" +
-		                         img->encoding + "' is not supported (" +
+		                         img.encoding + "' is not supported (" +
 		                         joined(e) + ")");
 	}
-	if (static_cast<int>(img->width) != width ||
-	    static_cast<int>(img->height) != height)
+	if (static_cast<int>(img.width) != width ||
+	    static_cast<int>(img.height) != height)
 		throw std::runtime_error(mrpt::format("%s is %ux%u, the camera %dx%d",
-		                                      what, img->width, img->height,
+		                                      what, img.width, img.height,
 		                                      width, height));
 	const size_t bpp = static_cast<size_t>(
-	    sensor_msgs::image_encodings::numChannels(img->encoding) *
-	    sensor_msgs::image_encodings::bitDepth(img->encoding) / 8);
-	if (img->step < img->width * bpp ||
-	    img->data.size() < static_cast<size_t>(img->step) * img->height)
+	    sensor_msgs::image_encodings::numChannels(img.encoding) *
+	    sensor_msgs::image_encodings::bitDepth(img.encoding) / 8);
+	if (img.step < img.width * bpp ||
+	    img.size < static_cast<size_t>(img.step) * img.height)
 		throw std::runtime_error(mrpt::format(
 		    "%s has %zu bytes of data for %u rows of step %u (%ux%u %s): "
 		    "corrupt",
-		    what, img->data.size(), img->height, img->step, img->width,
-		    img->height, img->encoding.c_str()));
-	if (img->is_bigendian && bpp > 1 && img->encoding != "rgb8" &&
-	    img->encoding != "bgr8")
+		    what, img.size, img.height, img.step, img.width, img.height,
+		    img.encoding.c_str()));
+	if (img.bigEndian && bpp > 1 && img.encoding != "rgb8" &&
+	    img.encoding != "bgr8")
 		throw std::runtime_error(std::string(what) +
 		                         " is big-endian: not supported");
-	return cv_bridge::toCvShare(img, target);
+	const cv::Mat m(height, width, cv_bridge::getCvType(img.encoding),
+	                const_cast<uint8_t*>(img.data), img.step);
+	// 16- and 32-bit pixels where the bag has them may be misaligned for
+	// their type (fuzz finding ub-misaligned-depth-pixels): then copied
+	const size_t align = m.elemSize1();
+	if (reinterpret_cast<uintptr_t>(m.data) % align != 0 || m.step % align != 0)
+		return m.clone();
+	if (!bgr || img.encoding == "bgr8") return m;
+	cv::Mat out;
+	cv::cvtColor(
+	    m, out,
+	    img.encoding == "rgb8" ? cv::COLOR_RGB2BGR : cv::COLOR_GRAY2BGR);
+	return out;
 }
 
 }  // namespace
@@ -348,24 +360,23 @@ BagTopics chooseTopics(const BagImportParams& params,
 	return t;
 }
 
-/** \a msg; an error when it is null: its connection's MD5 sum \a md5 is
- * another type's (fuzz finding ub-imu-of-another-md5: rosbag gave a null
- * message, which was read). */
-template <typename P>
-P typed(P msg, const std::string& md5)
+/** A message's connection's MD5 sum \a md5 must be \a M's: else an error
+ * (fuzz finding ub-imu-of-another-md5: rosbag gave a null message for it,
+ * which was read). */
+template <typename M>
+void checkMd5(const std::string& md5)
 {
-	if (!msg)
+	if (!isType<M>(md5))
 		throw std::runtime_error(
-		    std::string("not a ") +
-		    ros::message_traits::datatype<typename P::element_type>() +
+		    std::string("not a ") + ros::message_traits::datatype<M>() +
 		    ": its MD5 sum " + md5 + " is another message's");
-	return msg;
 }
 
 template <typename M>
 boost::shared_ptr<M> read(const uint8_t* data, size_t n, const std::string& md5)
 {
-	return typed(readMessage<M>(data, n, md5), md5);
+	checkMd5<M>(md5);
+	return readMessage<M>(data, n);
 }
 
 /** The stamp of a message that starts with a std_msgs/Header (seq, stamp,
@@ -901,34 +912,33 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 		try
 		{
 			// the image of a message, raw or compressed (its topic's type);
-			// \a held keeps a raw message's pixels while they are used
+			// \a held keeps a raw message's bytes while its pixels are used
 			auto image = [&](const ImageRef& ref, bool depth,
-			                 std::string& encoding,
-			                 cv_bridge::CvImageConstPtr& held) -> cv::Mat
+			                 std::string& encoding, BagBytes& held) -> cv::Mat
 			{
 				const Scanned& m = *ref.msg;
 				BagFile& bag = *bags[m.bag];
 				const BagConnection& c = bag.connections()[m.ref.connection];
-				const BagBytes b = bag.message(m.ref);
+				held = bag.message(m.ref);
 				if (c.type == kCompressed)
 				{
 					const auto ci = read<sensor_msgs::CompressedImage>(
-					    b.data, b.size, c.md5);
+					    held.data, held.size, c.md5);
 					encoding = ci->format;
 					return depth
 					           ? decodeCompressedDepth(*ci, W, H, params.images)
 					           : decodeCompressedColour(*ci, W, H,
 					                                    params.images);
 				}
-				const auto r = read<sensor_msgs::Image>(b.data, b.size, c.md5);
-				encoding = r->encoding;
-				held = depth ? checkedImage(r, depthEncodings,
-				                            "the depth image", W, H, "")
+				checkMd5<sensor_msgs::Image>(c.md5);
+				const ImageView r = imageView(held.data, held.size);
+				encoding = r.encoding;
+				return depth ? checkedImage(r, depthEncodings,
+				                            "the depth image", W, H, false)
 				             : checkedImage(r, colourEncodings,
-				                            "the colour image", W, H, "bgr8");
-				return held->image;
+				                            "the colour image", W, H, true);
 			};
-			cv_bridge::CvImageConstPtr heldDepth, heldColour;
+			BagBytes heldDepth, heldColour;
 			const cv::Mat depth =
 			    image(*f.depth, true, depthEncoding, heldDepth);
 			// REP 118: 16UC1 millimetres, 32FC1 metres
