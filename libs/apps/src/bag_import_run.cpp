@@ -141,7 +141,10 @@ int runBagImport(const BagImportRunOptions& o)
 	if (o.listTopics)
 	{
 		checkBagsAndGz(o);
-		std::fputs(describeTopics(bagTopics(o.bags)).c_str(), stdout);
+		std::vector<std::string> damage;
+		std::fputs(describeTopics(bagTopics(o.bags, &damage)).c_str(), stdout);
+		for (const auto& d : damage)
+			std::fprintf(stderr, "bims-import-bag: warning: %s\n", d.c_str());
 		return 0;
 	}
 	ProgressBar bar("import", 0, o.progress);

@@ -788,7 +788,8 @@ class AheadQueue
 
 }  // namespace
 
-std::vector<BagTopicInfo> bagTopics(const std::vector<std::string>& bagPaths)
+std::vector<BagTopicInfo> bagTopics(const std::vector<std::string>& bagPaths,
+                                    std::vector<std::string>* damage)
 {
 	const Bags bags = openBags(bagPaths, BagImportOptions().chunkCacheBytes);
 	std::map<std::string, BagTopicInfo> all;
@@ -801,6 +802,10 @@ std::vector<BagTopicInfo> bagTopics(const std::vector<std::string>& bagPaths)
 			Scan scan;
 			scanBag(*bags[b], b, bagPaths[b], false, scan);
 			topics = scan.topicInfo();
+			if (damage && !scan.lost.empty()) damage->push_back(scan.lost);
+			if (damage)
+				damage->insert(damage->end(), scan.notes.begin(),
+				               scan.notes.end());
 		}
 		for (const auto& t : topics)
 		{

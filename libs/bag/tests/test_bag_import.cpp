@@ -612,6 +612,18 @@ TEST(ImportBag, ACutShortBagGivesEveryWholeFrameBeforeTheCut)
 			          std::string::npos)
 			    << e;
 			EXPECT_GE(got.frames.size(), part < 0.6 ? 2u : 4u);
+			// --topics: the topics before the cut, and the damage said
+			std::vector<std::string> damage;
+			const auto topics = bag::bagTopics({cut}, &damage);
+			ASSERT_EQ(damage.size(), 1u);
+			EXPECT_EQ(damage[0], e.substr(0, damage[0].size()));
+			const auto depth = std::find_if(
+			    topics.begin(), topics.end(),
+			    [](const bag::BagTopicInfo& t) {
+				    return t.name == "/camera/aligned_depth_to_color/image_raw";
+			    });
+			ASSERT_NE(depth, topics.end());
+			EXPECT_GE(depth->messages, got.frames.size());
 			EXPECT_LT(got.frames.size(), 8u);
 			for (const auto& f : got.frames) f->load();
 			expectTheSampleFrames(got, got.frames.size());

@@ -111,8 +111,11 @@ struct BagTopicInfo
 /** The topics of \a bagPaths (all bags together), sorted by name: from a
  * bag's index when it is whole, else counted in its chunks (a recording
  * cut short). Throws std::runtime_error naming the bag when it cannot be
- * opened (missing, not a ROS 1 bag of format 2.0). */
-std::vector<BagTopicInfo> bagTopics(const std::vector<std::string>& bagPaths);
+ * opened (missing, not a ROS 1 bag of format 2.0). A bag cut short or
+ * damaged adds a line to \a damage, when given: "BAG: cut short or
+ * damaged: ..." (its topics are those before the damage). */
+std::vector<BagTopicInfo> bagTopics(const std::vector<std::string>& bagPaths,
+                                    std::vector<std::string>* damage = nullptr);
 
 /** "  /camera/imu  sensor_msgs/Imu  2000 messages" lines. */
 std::string describeTopics(const std::vector<BagTopicInfo>& topics);
