@@ -64,9 +64,9 @@ class BagFile
 	 * Throws std::runtime_error (not naming the file: the caller does)
 	 * when it is no ROS 1 bag of format 2.0 or its first record is not the
 	 * bag header; a record that does not fit later ends the walk: damage()
-	 * says where. Up to \a cacheBytes of decompressed chunks are kept
+	 * says where. Up to \a cacheBytes of decompressed BZ2 chunks are kept
 	 * from the scan for message(): a bag whose chunks fit is decompressed
-	 * once. */
+	 * once (LZ4 chunks are decompressed again: as fast as keeping them). */
 	BagFile(const std::string& path, size_t cacheBytes);
 	~BagFile();
 	BagFile(const BagFile&) = delete;

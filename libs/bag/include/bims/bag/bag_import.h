@@ -156,9 +156,10 @@ struct BagImportOptions
 {
 	size_t maxFrames = 0;  ///< 0 = all
 	int gzLevel = 1;       ///< 0 = plain rawlog, 1..9 gzip
-	/** Bytes of decompressed (bz2, lz4) chunks kept from the scan of the
-	 * bags to the reading of their images: a bag whose chunks fit is
-	 * decompressed once, a larger one partly twice. */
+	/** Bytes of decompressed BZ2 chunks kept from the scan of the bags to
+	 * the reading of their images: a bag whose chunks fit is decompressed
+	 * once, a larger one partly twice (LZ4 chunks: always twice, which
+	 * costs less than keeping them). */
 	size_t chunkCacheBytes = size_t{1} << 30;
 	/** The frames written (none: silent). */
 	ProgressCallback progress;
