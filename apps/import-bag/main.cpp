@@ -17,7 +17,7 @@ int main(int argc, char** argv)
 		    TCLAP::CmdLine cmd(
 		        "Import ROS 1 bags (depth and colour sensor_msgs/Image, or "
 		        "sensor_msgs/CompressedImage as image_transport writes it: "
-		        "JPEG or PNG colour, compressedDepth PNG depth; their "
+		        "JPEG or PNG colour, compressedDepth PNG or RVL depth; their "
 		        "CameraInfo, sensor_msgs/Imu or separate accelerometer and "
 		        "gyro topics, MagneticField) into a rawlog of RGB-D frames "
 		        "and IMU samples. Depth and colour are paired by stamp; the "

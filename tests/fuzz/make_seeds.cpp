@@ -4,8 +4,8 @@
 // intensity, camera models) with the IMU samples between them, plain;
 // OUT_DIR/labels and OUT_DIR/tum: small hand-made inputs of each kind;
 // OUT_DIR/bag: ROS 1 bags of the sample's first 3 scans shrunk so, in each
-// layout, raw and compressed, plain and LZ4 / BZ2 chunks (when bims-import-bag
-// is built).
+// layout, raw and compressed (compressedDepth PNG and RVL), plain and LZ4 / BZ2
+// chunks (when bims-import-bag is built).
 #include <bims/io/rawlog.h>
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -78,12 +78,13 @@ void writeBagSeeds(const std::string& sample, const std::filesystem::path& dir)
 	std::vector<Seed> seeds;
 	auto add = [&](const char* name, bool tum, const char* codec,
 	               bool compressedDepth, rosbag::compression::CompressionType c,
-	               bool split)
+	               bool split, const char* depthCodec = "png")
 	{
 		BagSpec s;
 		s.tum = tum;
 		s.colourCodec = codec;
 		s.compressedDepth = compressedDepth;
+		s.depthCodec = depthCodec;
 		s.compression = c;
 		s.splitImu = split;
 		s.frames = frames.size();
@@ -97,6 +98,10 @@ void writeBagSeeds(const std::string& sample, const std::filesystem::path& dir)
 	add("realsense-png-compresseddepth-bz2.bag", false, "png", true, bz2, true);
 	add("tum-raw.bag", true, "", false, plain, false);
 	add("tum-png-compresseddepth.bag", true, "png", true, plain, false);
+	// RVL depth in plain chunks: its stream is what the mutations reach
+	add("realsense-rvl-compresseddepth.bag", false, "", true, plain, false,
+	    "rvl");
+	add("tum-rvl-compresseddepth.bag", true, "", true, plain, false, "rvl");
 	for (const auto& s : seeds)
 		bims::test::writeBag((dir / s.name).string(), s.spec, frames, imu);
 }

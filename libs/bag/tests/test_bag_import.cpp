@@ -27,6 +27,7 @@
 #include <functional>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
 
 namespace
 {
@@ -674,26 +675,30 @@ TEST(ImportBag, LosslessCompressedTopicsGiveTheRawTopicsRawlogByteForByte)
 {
 	const auto d = test::freshTmpDir("bims_bag", "compressed");
 	// realsense-ros: raw topics, against PNG colour and compressedDepth
-	// 16UC1 on image_transport's republished topics (the auto layout finds
-	// them); the format as the plugin writes it now, and the old "png"
+	// 16UC1 (PNG and RVL) on image_transport's republished topics (the auto
+	// layout finds them); the colour format as the plugin writes it now,
+	// and the old "png"
 	BagSpec raw;
 	raw.frames = 12;
 	const std::string want = importedBytes(d, "raw", raw);
 	ASSERT_GT(want.size(), 500000u);
-	for (const std::string format : {"", "png"})
+	const std::pair<std::string, std::string> variants[] = {
+	    {"", "png"}, {"png", "png"}, {"", "rvl"}};
+	for (const auto& [format, depthCodec] : variants)
 	{
-		SCOPED_TRACE(format);
+		SCOPED_TRACE(format + " " + depthCodec);
 		BagSpec c = raw;
 		c.colourCodec = "png";
 		c.colourFormat = format;
 		c.compressedDepth = true;
+		c.depthCodec = depthCodec;
 		bag::BagImportSummary sum;
 		const std::string got = importedBytes(d, "c", c, &sum);
 		EXPECT_EQ(sum.layout, bag::BagLayout::RealSense);
 		EXPECT_EQ(sum.topics.colour, "/camera/color/image_raw/compressed");
 		EXPECT_EQ(sum.topics.depth,
 		          "/camera/aligned_depth_to_color/image_raw/compressedDepth");
-		EXPECT_EQ(sum.depthEncoding, "16UC1; compressedDepth png");
+		EXPECT_EQ(sum.depthEncoding, "16UC1; compressedDepth " + depthCodec);
 		EXPECT_EQ(sum.frames, 12u);
 		EXPECT_TRUE(got == want)
 		    << firstDifference(d + "/raw.rawlog", d + "/c.rawlog");
@@ -824,6 +829,14 @@ TEST(ImportBag, CompressedDepthInMetresIsWithinItsQuantisationStep)
 	}
 	EXPECT_GT(readings, 100000u);
 	EXPECT_GT(off, 0u);  // quantised indeed
+	// the same inverse depth compressed by RVL: the PNG's rawlog, byte for
+	// byte
+	spec.depthCodec = "rvl";
+	importedBytes(d, "rvl", spec, &sum);
+	EXPECT_EQ(sum.depthEncoding, "32FC1; compressedDepth rvl");
+	EXPECT_TRUE(test::fileText(d + "/rvl.rawlog") ==
+	            test::fileText(d + "/c.rawlog"))
+	    << firstDifference(d + "/c.rawlog", d + "/rvl.rawlog");
 }
 
 TEST(ImportBag, BadCompressedImagesAreErrorsNamingTopicAndMessage)
@@ -899,7 +912,8 @@ TEST(ImportBag, BadCompressedImagesAreErrorsNamingTopicAndMessage)
 	                      }));
 	EXPECT_NE(e.find("a JPEG image, not PNG"), std::string::npos) << e;
 
-	// compressedDepth: a header cut short, RVL, another header format
+	// compressedDepth: a header cut short, a truncated RVL stream, another
+	// header format
 	e = importError(write("header.bag",
 	                      [](size_t k, auto&, auto& z)
 	                      {
@@ -914,10 +928,22 @@ TEST(ImportBag, BadCompressedImagesAreErrorsNamingTopicAndMessage)
 	    << e;
 	EXPECT_NE(e.find("the 1 whole frames before it are in"), std::string::npos)
 	    << e;
-	e = importError(write("rvl.bag", [](size_t, auto&, auto& z)
-	                      { z.format = "16UC1; compressedDepth rvl"; }));
-	EXPECT_NE(e.find("RVL is not read"), std::string::npos) << e;
-	EXPECT_NE(e.find("message #1 of it"), std::string::npos) << e;
+	e = importError(write("rvl.bag",
+	                      [](size_t k, auto&, auto& z)
+	                      {
+		                      z = compressedDepthMsg(*sample().frames[k], false,
+		                                             "rvl");
+		                      if (k == 2) z.data.resize(z.data.size() - 4);
+	                      }));
+	EXPECT_NE(e.find("topic " + depth + ", message #3 of it"),
+	          std::string::npos)
+	    << e;
+	EXPECT_NE(e.find("format '16UC1; compressedDepth rvl'"), std::string::npos)
+	    << e;
+	EXPECT_NE(e.find("ends early, at pixel "), std::string::npos) << e;
+	EXPECT_NE(e.find("of 76800: corrupt"), std::string::npos) << e;
+	EXPECT_NE(e.find("the 2 whole frames before it are in"), std::string::npos)
+	    << e;
 	e = importError(
 	    write("kind.bag", [](size_t, auto&, auto& z) { z.data[0] = 7; }));
 	EXPECT_NE(e.find("format is 7, not INV_DEPTH (0): corrupt"),
@@ -984,6 +1010,319 @@ TEST(ImportBag, CompressedFormatsAreParsedAsTheImageTransportPluginsWriteThem)
 		              .find("is none image_transport writes"),
 		          std::string::npos)
 		    << bad;
+}
+
+/** A compressedDepth message of the 16-bit image \a v: 16UC1 millimetres
+ * (\a encoding), as the plugin's \a codec ("png", "rvl") writes them. */
+sensor_msgs::CompressedImage depthOf(const cv::Mat& v, const std::string& codec,
+                                     const std::string& encoding = "16UC1")
+{
+	sensor_msgs::CompressedImage m;
+	m.format = encoding + "; compressedDepth " + codec;
+	const float quant[2] = {0, 0};
+	m.data = compressedDepthData(v, codec, quant);
+	return m;
+}
+
+/** A W x H depth image of holes (zeros, single and in runs, at both ends),
+ * jumps across the whole 16-bit range, smooth stretches and noise. */
+cv::Mat holesAndJumps(int W, int H, uint32_t seed)
+{
+	std::mt19937 rng(seed);
+	cv::Mat v(H, W, CV_16UC1);
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++)
+		{
+			const int i = r * W + c;
+			uint16_t x = static_cast<uint16_t>(1000 + 3 * c + r);
+			switch (rng() % 8)
+			{
+				case 0:
+					x = 0;
+					break;
+				case 1:
+					x = 65535;
+					break;
+				case 2:
+					x = 1;
+					break;
+				case 3:
+					x = static_cast<uint16_t>(rng());
+					break;
+				default:
+					break;
+			}
+			if (i < 5 || i >= W * H - 7 || (r == 3 && c > 2)) x = 0;
+			v.at<uint16_t>(r, c) = x;
+		}
+	return v;
+}
+
+bool samePixels(const cv::Mat& a, const cv::Mat& b)
+{
+	return a.type() == b.type() && a.size() == b.size() &&
+	       cv::countNonZero(a != b) == 0;
+}
+
+// The plugin's stream, worked by hand from its algorithm: nibbles of 3 bits
+// (lowest first, the 4th bit: more follow) filling 32-bit words from the
+// high end; the runs of zeros and readings, the zig-zagged differences.
+TEST(ImportBag, RvlRunsAndNumbersArePackedAsThePluginWritesThem)
+{
+	struct Case
+	{
+		std::vector<uint16_t> px;
+		uint32_t word;
+	};
+	const Case cases[] = {
+	    // 2 zeros, 2 readings: 5 (+5: 10 = 2 | 8, 1), 7 (+2: 4); padding
+	    {{0, 0, 5, 7}, 0x22A14000},
+	    // 0 zeros, 2 readings: 3 (+3: 6), 1 (-2: 3)
+	    {{3, 1}, 0x02630000},
+	    // 0 zeros, 1 reading: 4 (+4: 8 = 0 | 8, 1); 2 zeros, 0 readings
+	    {{4, 0, 0}, 0x01812000},
+	};
+	for (const auto& c : cases)
+	{
+		std::vector<uint8_t> want(4);
+		std::memcpy(want.data(), &c.word, 4);  // the writer's byte order
+		EXPECT_EQ(rvlEncoded(c.px.data(), c.px.size()), want)
+		    << std::hex << c.word;
+		const int W = static_cast<int>(c.px.size());
+		const cv::Mat v(1, W, CV_16UC1, const_cast<uint16_t*>(c.px.data()));
+		EXPECT_TRUE(samePixels(
+		    bag::decodeCompressedDepth(depthOf(v, "rvl"), W, 1, {}), v))
+		    << std::hex << c.word;
+	}
+	// numbers of several nibbles: 64 (0 | 8, 0 | 8, 1), 9 (1 | 8, 1)
+	RvlWriter w;
+	w.number(64);
+	w.number(9);
+	const uint32_t word = 0x88191000;
+	std::vector<uint8_t> want(4);
+	std::memcpy(want.data(), &word, 4);
+	EXPECT_EQ(w.finish(), want);
+}
+
+TEST(ImportBag, RvlDepthDecodesToTheOriginalPixelForPixel)
+{
+	// the sample's frames, as the PNG codec gives them too
+	for (size_t k = 0; k < 3; k++)
+	{
+		const auto& f = *sample().frames[k];
+		sensor_msgs::Image raw = depthMsg(f, false);
+		const cv::Mat v(240, 320, CV_16UC1, raw.data.data());
+		const cv::Mat rvl =
+		    bag::decodeCompressedDepth(depthOf(v, "rvl"), 320, 240, {});
+		EXPECT_TRUE(samePixels(rvl, v)) << "frame " << k;
+		EXPECT_TRUE(samePixels(
+		    rvl, bag::decodeCompressedDepth(depthOf(v, "png"), 320, 240, {})));
+	}
+	// holes, jumps between 0, 1 and 65535, sizes of no whole word
+	const std::pair<int, int> sizes[] = {{37, 11}, {1, 1}, {64, 48}, {5, 3}};
+	for (const auto& [W, H] : sizes)
+		for (uint32_t seed = 1; seed <= 20; seed++)
+		{
+			const cv::Mat v = holesAndJumps(W, H, seed);
+			EXPECT_TRUE(samePixels(
+			    bag::decodeCompressedDepth(depthOf(v, "rvl"), W, H, {}), v))
+			    << W << "x" << H << " seed " << seed;
+		}
+	// one run each: no reading, all readings alike, the largest jump on
+	// every pixel; mono16 as 16UC1
+	cv::Mat zeros = cv::Mat::zeros(48, 64, CV_16UC1),
+	        flat(48, 64, CV_16UC1, cv::Scalar(4321));
+	cv::Mat zigzag(48, 64, CV_16UC1);
+	for (int i = 0; i < 48 * 64; i++)
+		zigzag.at<uint16_t>(i / 64, i % 64) = i % 2 ? 1 : 65535;
+	for (const cv::Mat* v : {&zeros, &flat, &zigzag})
+		EXPECT_TRUE(samePixels(bag::decodeCompressedDepth(
+		                           depthOf(*v, "rvl", "mono16"), 64, 48, {}),
+		                       *v));
+}
+
+TEST(ImportBag, RvlInverseDepthInMetresDecodesAsThePngOfIt)
+{
+	for (size_t k = 0; k < 3; k++)
+	{
+		// the sample's metres, with holes: no reading (0, NaN), beyond the
+		// plugin's depth_max (10 m)
+		const auto& f = *sample().frames[k];
+		sensor_msgs::Image raw = depthMsg(f, true);
+		cv::Mat z = cv::Mat(240, 320, CV_32FC1, raw.data.data()).clone();
+		z(cv::Rect(0, 0, 40, 3)).setTo(0);
+		z(cv::Rect(100, 50, 7, 60)).setTo(NAN);
+		z(cv::Rect(300, 230, 20, 10)).setTo(12.5);
+		float quant[2];
+		const cv::Mat v = quantisedInverseDepth(z, quant);
+		sensor_msgs::CompressedImage png, rvl;
+		png.format = "32FC1; compressedDepth png";
+		rvl.format = "32FC1; compressedDepth rvl";
+		png.data = compressedDepthData(v, "png", quant);
+		rvl.data = compressedDepthData(v, "rvl", quant);
+		const cv::Mat a = bag::decodeCompressedDepth(png, 320, 240, {}),
+		              b = bag::decodeCompressedDepth(rvl, 320, 240, {});
+		ASSERT_EQ(b.type(), CV_32FC1);
+		ASSERT_EQ(a.size(), b.size());
+		// bit for bit: the same readings, NaN (no reading) at the same
+		// pixels
+		EXPECT_EQ(std::memcmp(a.data, b.data, a.total() * 4), 0)
+		    << "frame " << k;
+		const auto* p = a.ptr<float>();
+		const auto holes = std::count_if(p, p + a.total(),
+		                                 [](float x) { return std::isnan(x); });
+		EXPECT_GE(holes, 40 * 3 + 7 * 60 + 20 * 10) << "frame " << k;
+		EXPECT_LT(holes, 320 * 240 / 10) << "frame " << k;
+		// as the bag writer's messages of the frame
+		EXPECT_EQ(compressedDepthMsg(f, true, "rvl").format,
+		          "32FC1; compressedDepth rvl");
+		const cv::Mat c = bag::decodeCompressedDepth(
+		                  compressedDepthMsg(f, true, "png"), 320, 240, {}),
+		              d = bag::decodeCompressedDepth(
+		                  compressedDepthMsg(f, true, "rvl"), 320, 240, {});
+		EXPECT_EQ(std::memcmp(c.data, d.data, c.total() * 4), 0)
+		    << "frame " << k;
+	}
+}
+
+TEST(ImportBag, CorruptRvlStreamsAreErrorsNotCrashes)
+{
+	const cv::Mat v = holesAndJumps(32, 24, 7);
+	const auto good = depthOf(v, "rvl");
+	auto decodeError = [](const sensor_msgs::CompressedImage& m, int W = 32,
+	                      int H = 24, const ImageLimits& limits = {})
+	{ return errorOf([&] { bag::decodeCompressedDepth(m, W, H, limits); }); };
+	auto spoilt = [&](const std::function<void(std::vector<uint8_t>&)>& f)
+	{
+		auto m = good;
+		f(m.data);
+		return decodeError(m);
+	};
+	auto expectIn = [](const std::string& e, const std::string& what)
+	{
+		EXPECT_NE(e.find("the depth image (CompressedImage, format '16UC1; "
+		                 "compressedDepth rvl'): "),
+		          std::string::npos)
+		    << e;
+		EXPECT_NE(e.find(what), std::string::npos) << e;
+	};
+	const size_t n = good.data.size() - 20;  // the stream's bytes
+	ASSERT_EQ(decodeError(good), "(no error)");
+
+	// the header or the image's size cut; no stream
+	expectIn(spoilt([](auto& d) { d.resize(17); }),
+	         "17 bytes of data: cut inside the RVL image's size (uint32 "
+	         "cols, rows) after its 12-byte compressedDepth header");
+	expectIn(spoilt([](auto& d) { d.resize(9); }),
+	         "9 bytes of data: cut inside its 12-byte compressedDepth header");
+	expectIn(spoilt([](auto& d) { d.resize(20); }),
+	         "its RVL stream (0 bytes) ends early, at pixel 0 of 768: "
+	         "corrupt");
+	// truncated by a word, by a byte
+	for (size_t cut : {4, 1})
+		expectIn(spoilt([&](auto& d) { d.resize(d.size() - cut); }),
+		         mrpt::format("its RVL stream (%zu bytes) ends early, at "
+		                      "pixel ",
+		                      n - cut));
+	// a size other than the camera's, not decoded
+	expectIn(spoilt([](auto& d) { d[12] = 33; }),
+	         "its RVL header declares 33x24, the camera is 32x24 (not "
+	         "decoded)");
+	expectIn(spoilt([](auto& d) { std::swap(d[12], d[16]); }),
+	         "its RVL header declares 24x32, the camera is 32x24");
+	// a camera's size beyond the limits: refused before any allocation
+	{
+		auto m = good;
+		const uint32_t side = 100000;
+		std::memcpy(&m.data[12], &side, 4);
+		std::memcpy(&m.data[16], &side, 4);
+		expectIn(decodeError(m, 100000, 100000),
+		         "declares 100000 x 100000 pixels in its RVL header, beyond "
+		         "the 16384 per side");
+	}
+
+	// a stream of more pixels than the image's, of fewer, or going on
+	auto ofSize = [](const cv::Mat& img)
+	{
+		auto m = depthOf(img, "rvl");
+		const uint32_t size[2] = {32, 24};
+		std::memcpy(&m.data[12], size, 8);
+		return m;
+	};
+	const cv::Mat readings(25, 32, CV_16UC1, cv::Scalar(900));
+	expectIn(decodeError(ofSize(readings)),
+	         "has a run of 800 readings where 768 pixels are left, at pixel 0 "
+	         "of 768: corrupt");
+	cv::Mat thenZeros = readings.clone();
+	thenZeros.row(24).setTo(0);
+	expectIn(decodeError(ofSize(thenZeros)),
+	         "goes on after the image's last pixel: corrupt");
+	cv::Mat zerosLast(25, 32, CV_16UC1, cv::Scalar(900));
+	zerosLast.rowRange(23, 25).setTo(0);
+	expectIn(decodeError(ofSize(zerosLast)),
+	         "has a run of 64 zeros where 32 pixels are left, at pixel 736 of "
+	         "768: corrupt");
+	expectIn(decodeError(ofSize(readings.rowRange(0, 23))),
+	         "ends early, at pixel 736 of 768: corrupt");
+	expectIn(spoilt([](auto& d) { d.insert(d.end(), 4, 0x11); }),
+	         "goes on after the image's last pixel: corrupt");
+	{
+		// its padding not zero
+		const uint16_t px[4] = {0, 0, 5, 7};
+		auto m =
+		    depthOf(cv::Mat(1, 4, CV_16UC1, const_cast<uint16_t*>(px)), "rvl");
+		uint32_t word = 0;
+		std::memcpy(&word, &m.data[20], 4);
+		word ^= 1;  // the last of its 3 nibbles of padding
+		std::memcpy(&m.data[20], &word, 4);
+		EXPECT_NE(decodeError(m, 4, 1).find("goes on after the image's last "
+		                                    "pixel: corrupt"),
+		          std::string::npos);
+	}
+
+	// numbers no writer writes: a difference to a reading of 0 or beyond
+	// 16 bits, a number of 12 nibbles
+	auto ofWords = [](std::vector<uint32_t> words, uint32_t W)
+	{
+		sensor_msgs::CompressedImage m;
+		m.format = "16UC1; compressedDepth rvl";
+		m.data.assign(12, 0);
+		const uint32_t size[2] = {W, 1};
+		m.data.resize(20 + 4 * words.size());
+		std::memcpy(&m.data[12], size, 8);
+		std::memcpy(&m.data[20], words.data(), 4 * words.size());
+		return m;
+	};
+	expectIn(decodeError(ofWords({0x01000000}, 4), 4, 1),
+	         "gives a reading of 0 (a difference of 0 from 0) at pixel 0 of 4: "
+	         "corrupt");
+	expectIn(
+	    decodeError(ofWords({0x01888884}, 1), 1, 1),
+	    "gives a reading of 65536 (a difference of 65536 from 0) at pixel 0 "
+	    "of 1");
+	expectIn(
+	    decodeError(ofWords({0x02A1B100}, 2), 2, 1),
+	    "gives a reading of -1 (a difference of -6 from 5) at pixel 1 of 2");
+	expectIn(decodeError(ofWords({0x0FFFFFFF, 0xFFFFFFFF}, 4), 4, 1),
+	         "has a number of more than 11 nibbles at pixel 0 of 4: corrupt");
+
+	// random bytes after a valid size, and the valid stream with a byte
+	// changed: an error or an image, never more (the sanitizer build)
+	std::mt19937 rng(35);
+	for (int i = 0; i < 3000; i++)
+	{
+		auto m = good;
+		if (i % 2)
+			m.data[20 + rng() % n] = static_cast<uint8_t>(rng());
+		else
+		{
+			m.data.resize(20 + rng() % 64);
+			for (size_t b = 20; b < m.data.size(); b++)
+				m.data[b] = static_cast<uint8_t>(rng());
+		}
+		const std::string e = decodeError(m);
+		EXPECT_TRUE(e == "(no error)" || e.find(": corrupt") != e.npos) << e;
+	}
 }
 
 /** The bytes of \a path with the 4 bytes after the first \a field (a

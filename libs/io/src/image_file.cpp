@@ -144,6 +144,21 @@ bool imageSizeWithinLimits(uint64_t rows, uint64_t cols,
 	       rows * cols <= static_cast<uint64_t>(limits.max_pixels);
 }
 
+void checkImageWithinLimits(const ImageHeader& h, const ImageLimits& limits)
+{
+	using std::runtime_error;
+	if (!imageSizeWithinLimits(h.height, h.width, limits))
+		throw runtime_error(
+		    "declares " + std::to_string(h.width) + " x " +
+		    std::to_string(h.height) + " pixels in its " + h.format +
+		    " header, beyond the " + std::to_string(limits.max_side) +
+		    " per side and " + std::to_string(limits.max_pixels) +
+		    " pixels bims reads (" + limits.origin + "; not decoded)");
+	if (h.width == 0 || h.height == 0)
+		throw runtime_error(std::string("declares an empty image in its ") +
+		                    h.format + " header");
+}
+
 cv::Mat decodeImage(const uint8_t* p, size_t n, int flags,
                     const ImageLimits& limits, const char* format)
 {
@@ -157,16 +172,7 @@ cv::Mat decodeImage(const uint8_t* p, size_t n, int flags,
 	if (format && std::string(h->format) != format)
 		throw runtime_error(std::string("a ") + h->format + " image, not " +
 		                    format);
-	if (!imageSizeWithinLimits(h->height, h->width, limits))
-		throw runtime_error(
-		    "declares " + std::to_string(h->width) + " x " +
-		    std::to_string(h->height) + " pixels in its " + h->format +
-		    " header, beyond the " + std::to_string(limits.max_side) +
-		    " per side and " + std::to_string(limits.max_pixels) +
-		    " pixels bims reads (" + limits.origin + "; not decoded)");
-	if (h->width == 0 || h->height == 0)
-		throw runtime_error(std::string("declares an empty image in its ") +
-		                    h->format + " header");
+	checkImageWithinLimits(*h, limits);
 	cv::Mat img;
 	try
 	{

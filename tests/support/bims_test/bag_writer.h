@@ -4,7 +4,7 @@
 // sensor_msgs/Imu as one topic, as separate accelerometer and gyro topics
 // at different rates, or accelerometer only, MagneticField; the images
 // also as image_transport's plugins republish them (sensor_msgs/
-// CompressedImage: compressed colour, compressedDepth depth).
+// CompressedImage: compressed colour, compressedDepth depth as PNG or RVL).
 #pragma once
 
 #include <bims/bag/bag_import.h>
@@ -130,51 +130,156 @@ inline sensor_msgs::CompressedImage compressedColourMsg(
 	return m;
 }
 
-/** The depth as compressed_depth_image_transport writes it (format
- * "16UC1; compressedDepth png" or "32FC1; ..."): its 12-byte ConfigHeader
- * (format INV_DEPTH = 0, depthQuantA, depthQuantB), then a PNG of the
- * 16UC1 millimetres as they are, or of the 32FC1 metres' inverse quantised
- * as the plugin does it with its defaults (depth_quantization 100,
- * depth_max 10 m: v = A / d + B truncated, 0 beyond depth_max and for no
- * reading, 0 or NaN; the plugin's float-to-uint16 conversion of A / 0 is
- * undefined, 0 on x86). (The plugin also zeroes 16UC1 readings beyond
- * depth_max; the sample has none.) */
-inline sensor_msgs::CompressedImage compressedDepthMsg(
-    const CObservation3DRangeScan& f, bool metres)
+/** Andrew D. Wilson's RVL ("Fast Lossless Depth Image Compression", ISS
+ * 2017) as compressed_depth_image_transport writes it: the tests' own
+ * encoder, written from the algorithm, for the importer's decoder to be
+ * checked against. Numbers are written 3 bits a nibble, the lowest first,
+ * the nibble's high bit set when more follow; the nibbles fill 32-bit words
+ * (in this machine's byte order, as the plugin's) from the high end, the
+ * last word padded with zero nibbles. */
+class RvlWriter
 {
-	const sensor_msgs::Image raw = depthMsg(f, metres);
-	sensor_msgs::CompressedImage m;
-	m.header = raw.header;
-	m.format = raw.encoding + "; compressedDepth png";
-	const int W = static_cast<int>(raw.width), H = static_cast<int>(raw.height);
-	float quant[2] = {0, 0};
-	cv::Mat png(H, W, CV_16UC1);
-	if (metres)
+ public:
+	void number(uint32_t v)
 	{
-		const float z0 = 100, depthMax = 10;
-		quant[0] = z0 * (z0 + 1.0f);
-		quant[1] = 1.0f - quant[0] / depthMax;
-		const auto* d = reinterpret_cast<const float*>(raw.data.data());
-		for (int v = 0; v < H; v++)
-			for (int u = 0; u < W; u++)
-			{
-				const float z = d[v * W + u];
-				png.at<uint16_t>(v, u) =
-				    z > 0 && z < depthMax
-				        ? static_cast<uint16_t>(
-				              std::min(65535.0f, quant[0] / z + quant[1]))
-				        : 0;
-			}
+		do
+		{
+			const uint32_t low = v & 7;
+			v >>= 3;
+			nibble(v ? low | 8 : low);
+		} while (v);
+	}
+
+	std::vector<uint8_t> finish()
+	{
+		if (nibbles_ > 0)
+		{
+			word_ <<= 4 * (8 - nibbles_);
+			flush();
+		}
+		return std::move(bytes_);
+	}
+
+ private:
+	void nibble(uint32_t x)
+	{
+		word_ = word_ << 4 | x;
+		if (++nibbles_ == 8) flush();
+	}
+
+	void flush()
+	{
+		const size_t at = bytes_.size();
+		bytes_.resize(at + 4);
+		std::memcpy(&bytes_[at], &word_, 4);
+		word_ = 0;
+		nibbles_ = 0;
+	}
+
+	std::vector<uint8_t> bytes_;
+	uint32_t word_ = 0;
+	int nibbles_ = 0;
+};
+
+/** The RVL stream of the \a n pixels at \a px: pairs of runs, the count of
+ * zeros then of readings (non-zero), each reading as its difference d from
+ * the reading before (across runs and rows; the first from 0), zig-zagged
+ * to a natural number: 2d, or -2d - 1 below 0. */
+inline std::vector<uint8_t> rvlEncoded(const uint16_t* px, size_t n)
+{
+	RvlWriter w;
+	int previous = 0;
+	for (size_t i = 0; i < n;)
+	{
+		const size_t zeros =
+		    std::find_if(px + i, px + n, [](uint16_t v) { return v != 0; }) -
+		    (px + i);
+		const size_t readings =
+		    std::find(px + i + zeros, px + n, uint16_t{0}) - (px + i + zeros);
+		w.number(static_cast<uint32_t>(zeros));
+		w.number(static_cast<uint32_t>(readings));
+		i += zeros;
+		for (size_t k = 0; k < readings; k++, i++)
+		{
+			const int d = px[i] - previous;
+			w.number(static_cast<uint32_t>(d >= 0 ? 2 * d : -2 * d - 1));
+			previous = px[i];
+		}
+	}
+	return w.finish();
+}
+
+/** The 32FC1 metres \a z as compressed_depth_image_transport quantises
+ * them, with its defaults (depth_quantization 100, depth_max 10 m): v = A /
+ * z + B truncated, 0 beyond depth_max and for no reading, 0 or NaN (the
+ * plugin's float-to-uint16 conversion of A / 0 is undefined, 0 on x86);
+ * \a quant: A and B, for the ConfigHeader. */
+inline cv::Mat quantisedInverseDepth(const cv::Mat& z, float quant[2])
+{
+	const float z0 = 100, depthMax = 10;
+	quant[0] = z0 * (z0 + 1.0f);
+	quant[1] = 1.0f - quant[0] / depthMax;
+	cv::Mat v(z.size(), CV_16UC1);
+	for (int r = 0; r < z.rows; r++)
+		for (int c = 0; c < z.cols; c++)
+		{
+			const float d = z.at<float>(r, c);
+			v.at<uint16_t>(r, c) = d > 0 && d < depthMax
+			                           ? static_cast<uint16_t>(std::min(
+			                                 65535.0f, quant[0] / d + quant[1]))
+			                           : 0;
+		}
+	return v;
+}
+
+/** compressed_depth_image_transport's data for the 16-bit image \a v (the
+ * millimetres, or the quantised inverse depth of \a quant): its 12-byte
+ * ConfigHeader (format INV_DEPTH = 0, depthQuantA, depthQuantB), then a PNG
+ * of \a v, or (\a codec "rvl") v's cols and rows as uint32 and its RVL
+ * stream. */
+inline std::vector<uint8_t> compressedDepthData(const cv::Mat& v,
+                                                const std::string& codec,
+                                                const float quant[2])
+{
+	std::vector<uint8_t> data(12), bytes;
+	const int32_t invDepth = 0;
+	std::memcpy(data.data(), &invDepth, 4);
+	std::memcpy(data.data() + 4, quant, 8);
+	if (codec == "rvl")
+	{
+		const cv::Mat c = v.clone();  // continuous
+		const uint32_t size[2] = {static_cast<uint32_t>(c.cols),
+		                          static_cast<uint32_t>(c.rows)};
+		bytes.resize(8);
+		std::memcpy(bytes.data(), size, 8);
+		const auto rvl = rvlEncoded(c.ptr<uint16_t>(), c.total());
+		bytes.insert(bytes.end(), rvl.begin(), rvl.end());
 	}
 	else
-		std::memcpy(png.data, raw.data.data(), raw.data.size());
-	m.data.resize(12);
-	const int32_t invDepth = 0;
-	std::memcpy(m.data.data(), &invDepth, 4);
-	std::memcpy(m.data.data() + 4, quant, 8);
-	std::vector<uint8_t> bytes;
-	cv::imencode(".png", png, bytes, {cv::IMWRITE_PNG_COMPRESSION, 1});
-	m.data.insert(m.data.end(), bytes.begin(), bytes.end());
+		cv::imencode(".png", v, bytes, {cv::IMWRITE_PNG_COMPRESSION, 1});
+	data.insert(data.end(), bytes.begin(), bytes.end());
+	return data;
+}
+
+/** The depth as compressed_depth_image_transport writes it (format
+ * "16UC1; compressedDepth CODEC" or "32FC1; ...", \a codec "png" or
+ * "rvl"): the 16UC1 millimetres as they are, or the 32FC1 metres' inverse
+ * quantised as the plugin does it with its defaults. (The plugin also zeroes
+ * 16UC1 readings beyond depth_max; the sample has none.) */
+inline sensor_msgs::CompressedImage compressedDepthMsg(
+    const CObservation3DRangeScan& f, bool metres,
+    const std::string& codec = "png")
+{
+	sensor_msgs::Image raw = depthMsg(f, metres);
+	sensor_msgs::CompressedImage m;
+	m.header = raw.header;
+	m.format = raw.encoding + "; compressedDepth " + codec;
+	const cv::Mat plane(static_cast<int>(raw.height),
+	                    static_cast<int>(raw.width),
+	                    metres ? CV_32FC1 : CV_16UC1, raw.data.data());
+	float quant[2] = {0, 0};
+	m.data = compressedDepthData(
+	    metres ? quantisedInverseDepth(plane, quant) : plane, codec, quant);
 	return m;
 }
 
@@ -245,9 +350,11 @@ struct BagSpec
 	 * instead of the raw topic. */
 	std::string colourCodec;
 	std::string colourFormat;
-	/** The depth as compressed_depth_image_transport's, on the layout's
-	 * depth topic + "/compressedDepth", instead of the raw topic. */
+	/** The depth as compressed_depth_image_transport's (its codec
+	 * depthCodec: "png" or "rvl"), on the layout's depth topic +
+	 * "/compressedDepth", instead of the raw topic. */
 	bool compressedDepth = false;
+	std::string depthCodec = "png";
 	rosbag::compression::CompressionType compression =
 	    rosbag::compression::Uncompressed;
 	size_t frames = 24;  ///< the first N frames
@@ -290,7 +397,7 @@ inline void writeBag(const std::string& path, const BagSpec& spec,
 		bag.write(layout.cameraInfo, t, infoMsg(f));
 		if (spec.compressedDepth)
 			bag.write(layout.depth + "/compressedDepth", t,
-			          compressedDepthMsg(f, spec.tum));
+			          compressedDepthMsg(f, spec.tum, spec.depthCodec));
 		else
 			bag.write(layout.depth, t, depthMsg(f, spec.tum));
 		if (!spec.colourCodec.empty())

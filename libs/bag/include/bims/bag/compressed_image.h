@@ -1,9 +1,10 @@
 // sensor_msgs/CompressedImage as image_transport's plugins write it
 // (docs/import-bag.md, "Compressed images"): compressed_image_transport's
 // JPEG or PNG colour, compressed_depth_image_transport's depth (a 12-byte
-// ConfigHeader, then a PNG of the depth or of its quantised inverse).
-// Decoded through the guarded image decoder (bims/io/image_file.h): the
-// size a message's image declares is checked before anything is decoded.
+// ConfigHeader, then the depth or its quantised inverse as a PNG, or as its
+// size and an RVL stream). Decoded through the guarded image decoder
+// (bims/io/image_file.h), RVL by our own guarded decoder: the size a
+// message's image declares is checked before anything is decoded.
 #pragma once
 
 #include <bims/io/image_file.h>
@@ -42,11 +43,12 @@ CompressedFormat parseCompressedFormat(const std::string& format);
 cv::Mat decodeCompressedColour(const sensor_msgs::CompressedImage& m, int width,
                                int height, const ImageLimits& limits);
 
-/** The depth image of \a m (compressed_depth_image_transport, PNG), as the
- * raw topic holds it: 16UC1 (or mono16) millimetres as stored, or 32FC1
- * metres from the quantised inverse depth, depthQuantA / (v -
+/** The depth image of \a m (compressed_depth_image_transport, PNG or RVL),
+ * as the raw topic holds it: 16UC1 (or mono16) millimetres as stored, or
+ * 32FC1 metres from the quantised inverse depth, depthQuantA / (v -
  * depthQuantB), 0 being NaN (no reading). Throws std::runtime_error as
- * decodeCompressedColour(); RVL is refused. */
+ * decodeCompressedColour(), and for an RVL stream that does not fill the
+ * image's pixels exactly (corrupt). */
 cv::Mat decodeCompressedDepth(const sensor_msgs::CompressedImage& m, int width,
                               int height, const ImageLimits& limits);
 

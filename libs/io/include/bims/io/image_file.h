@@ -62,6 +62,12 @@ std::optional<ImageHeader> imageHeader(const uint8_t* p, size_t n);
 bool imageSizeWithinLimits(uint64_t rows, uint64_t cols,
                            const ImageLimits& limits = {});
 
+/** Throws std::runtime_error when the size \a h declares is beyond \a limits
+ * (naming the size, the format and where the limits come from) or empty:
+ * decodeImage()'s check, for a size read before anything is decoded (also a
+ * compressedDepth RVL image's, whose header is none of imageHeader()'s). */
+void checkImageWithinLimits(const ImageHeader& h, const ImageLimits& limits);
+
 /** Decodes the \a n bytes at \a p (an image file's contents, or a ROS
  * CompressedImage's data) as cv::imdecode(\a flags) does, but first checks
  * that they start with the header of one of the formats of imageHeader()
