@@ -265,15 +265,8 @@ void BagFile::walk(uint64_t start)
 					break;
 				case kConnection:
 				{
-					const auto id = static_cast<uint32_t>(
-					    required(r.fields, "conn", 4, pos, "a connection"));
-					const auto t = r.fields.find("topic");
-					if (t == r.fields.end())
-						throw runtime_error(at(pos) +
-						                    ": a connection without a topic");
-					addConnection(id, t->second, bytes_ + r.data, r.dataLen,
-					              pos);
-					indexTopicOf[id] = t->second;
+					const uint32_t id = addConnection(r, bytes_, pos);
+					indexTopicOf[id] = r.fields.at("topic");
 					break;
 				}
 				case kChunkInfo:
@@ -357,13 +350,18 @@ void BagFile::addChunk(const detail::BagRecord& r, uint64_t pos)
 	chunks_.push_back(k);
 }
 
-void BagFile::addConnection(uint32_t id, const std::string& topic,
-                            const uint8_t* data, uint64_t n, uint64_t pos)
+uint32_t BagFile::addConnection(const detail::BagRecord& r,
+                                const uint8_t* bytes, uint64_t pos)
 {
-	if (connectionIds_.count(id)) return;  // (again, in the index)
-	const Fields f = parseFields(data, n, pos);
+	const auto id = static_cast<uint32_t>(
+	    required(r.fields, "conn", 4, pos, "a connection"));
+	const auto topic = r.fields.find("topic");
+	if (topic == r.fields.end())
+		throw runtime_error(at(pos) + ": a connection without a topic");
+	if (connectionIds_.count(id)) return id;  // (again, in the index)
+	const Fields f = parseFields(bytes + r.data, r.dataLen, pos);
 	BagConnection c;
-	c.topic = topic;
+	c.topic = topic->second;
 	const auto type = f.find("type"), md5 = f.find("md5sum");
 	if (type == f.end() || md5 == f.end())
 		throw runtime_error(at(pos) +
@@ -372,6 +370,7 @@ void BagFile::addConnection(uint32_t id, const std::string& topic,
 	c.md5 = md5->second;
 	connectionIds_[id] = static_cast<uint32_t>(connections_.size());
 	connections_.push_back(c);
+	return id;
 }
 
 std::vector<BagTopicInfo> BagFile::indexTopics() const
@@ -445,13 +444,7 @@ bool BagFile::walkChunk(size_t k, const BagBytes& bytes,
 			m = record(bytes.data, p, bytes.size);
 			if (m.op == kConnection)
 			{
-				const auto id = static_cast<uint32_t>(
-				    required(m.fields, "conn", 4, p, "a connection"));
-				const auto t = m.fields.find("topic");
-				if (t == m.fields.end())
-					throw runtime_error(at(p) +
-					                    ": a connection without a topic");
-				addConnection(id, t->second, bytes.data + m.data, m.dataLen, p);
+				addConnection(m, bytes.data, p);
 				p = m.end;
 				continue;
 			}

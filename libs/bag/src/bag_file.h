@@ -128,8 +128,10 @@ class BagFile
 	/** The records from byte \a start (after the version line). */
 	void walk(uint64_t start);
 	void addChunk(const detail::BagRecord& r, uint64_t pos);
-	void addConnection(uint32_t id, const std::string& topic,
-	                   const uint8_t* data, uint64_t n, uint64_t pos);
+	/** Registers the connection record \a r (at \a pos of \a bytes) unless
+	 * its id is known; returns its id. */
+	uint32_t addConnection(const detail::BagRecord& r, const uint8_t* bytes,
+	                       uint64_t pos);
 	Buffer decompress(const Chunk& c) const;
 	/** Chunk \a k's uncompressed bytes; throws saying why not. */
 	BagBytes chunkBytes(size_t k) const;
