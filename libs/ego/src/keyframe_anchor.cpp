@@ -71,45 +71,71 @@ AnchorResult KeyframeAnchor::track(const RgbdFrame& f,
 		r.why = "no keyframe yet";
 		return r;
 	}
-	alignTo(*k, R_pred, t_pred, others, R_prior, r);
+	Attempt best = alignTo(*k, R_pred, t_pred, others, R_prior, r);
 	// The nearest keyframe may be an old one the pose has drifted from (a
 	// correction too large to take): the newest keyframe then anchors it.
 	// Or it may hold too little static scene (made while a mover filled the
-	// view): the next nearest ones then, up to kMoreKeyframes of them.
+	// view): the next nearest ones then, up to kMoreKeyframes of them. Such
+	// a keyframe may also accept the frame on a small share of it (less
+	// than keyframe_min_overlap of its points inliers: the mover dropped
+	// from it counts as covered, so no new keyframe comes while the static
+	// scene behind the mover is revealed, and what its mask missed of the
+	// mover, near and moving, pulls the pose); the others are then tried
+	// too, and the one that finds the most inliers anchors the frame.
+	const auto weak = [this](const AnchorResult& a)
+	{ return !a.accepted || a.overlap < p_.keyframe_min_overlap; };
 	constexpr size_t kMoreKeyframes = 3;
 	std::vector<Keyframe*> tried = {k};
-	for (size_t n = 0; !r.accepted && n <= kMoreKeyframes; n++)
+	for (size_t n = 0; weak(best.r) && n <= kMoreKeyframes; n++)
 	{
 		Keyframe* q = n == 0 ? &kf_.back() : nearest(R_pred, t_pred, tried);
 		if (!q || std::find(tried.begin(), tried.end(), q) != tried.end())
 			continue;
 		tried.push_back(q);
-		AnchorResult again = r;
-		alignTo(*q, R_pred, t_pred, others, R_prior, again);
-		if (again.accepted) r = again;
+		Attempt again = alignTo(*q, R_pred, t_pred, others, R_prior, best.r);
+		if (again.r.accepted &&
+		    (!best.r.accepted || again.r.inliers > best.r.inliers))
+			best = std::move(again);
 	}
 	// The mask may have left too little to align (or be wrong): once more
 	// with every pixel, flagged (the feedback must not starve the tracker).
-	if (!r.accepted && !moving.empty())
+	if (!best.r.accepted && !moving.empty())
 	{
 		for (DenseLevel& L : cur_.levels) L.exclude.release();
-		AnchorResult again = r;
-		alignTo(*k, R_pred, t_pred, others, R_prior, again);
-		if (again.accepted)
+		Attempt again = alignTo(*k, R_pred, t_pred, others, R_prior, best.r);
+		if (again.r.accepted)
 		{
-			r = again;
-			r.maskIgnored = true;
+			best = std::move(again);
+			best.r.maskIgnored = true;
 		}
 	}
-	r.ms = msSince(t0);
-	return r;
+	take(best);
+	best.r.ms = msSince(t0);
+	return best.r;
 }
 
-void KeyframeAnchor::alignTo(Keyframe& k, const Eigen::Matrix3d& R_pred,
-                             const Eigen::Vector3d& t_pred,
-                             const std::vector<InitialGuess>& others,
-                             const Eigen::Matrix3d* R_prior, AnchorResult& r)
+void KeyframeAnchor::take(Attempt& a)
 {
+	if (!a.r.accepted) return;
+	lastOutliers_ = a.r.outliers;
+	lastConsistent_ = a.consistent;
+	// what the keyframe held there has moved away: not static
+	if (a.seenThrough.empty()) return;
+	const DenseLevel& L =
+	    a.k->frame.levels[static_cast<size_t>(p_.finest_level)];
+	cv::Mat m = cv::Mat::zeros(L.depth.size(), CV_8UC1);
+	for (int i : a.seenThrough) m.data[i] = 255;
+	cv::dilate(m, m, cv::Mat());
+	a.k->frame.dropReadings(m, p_);
+}
+
+KeyframeAnchor::Attempt KeyframeAnchor::alignTo(
+    Keyframe& k, const Eigen::Matrix3d& R_pred, const Eigen::Vector3d& t_pred,
+    const std::vector<InitialGuess>& others, const Eigen::Matrix3d* R_prior,
+    const AnchorResult& start)
+{
+	Attempt out{start, &k, cv::Mat(), {}};
+	AnchorResult& r = out.r;
 	// guesses of T_KC = T_WK^-1 T_WC
 	std::vector<InitialGuess> inits;
 	inits.push_back(
@@ -131,8 +157,7 @@ void KeyframeAnchor::alignTo(Keyframe& k, const Eigen::Matrix3d& R_pred,
 	r.coverage = a.coverage;
 	r.guess = a.guess;
 	r.outliers = a.outliers;
-	lastOutliers_ = a.outliers;
-	lastConsistent_ = a.consistent;
+	out.consistent = a.consistent;
 	const Eigen::Matrix3d R_WC = k.R_WK * a.R_RC;
 	const Eigen::Vector3d t_WC = k.R_WK * a.t_RC + k.t_WK;
 	// The correction against the nearest guess: a result next to the
@@ -170,21 +195,13 @@ void KeyframeAnchor::alignTo(Keyframe& k, const Eigen::Matrix3d& R_pred,
 		else
 			r.why = "correction too large";
 	}
-	if (!r.why.empty()) return;
+	if (!r.why.empty()) return out;
 	r.accepted = true;
 	r.R_WC = R_WC;
 	r.t_WC = t_WC;
-	// what the keyframe held there has moved away: not static
 	r.seen_through = static_cast<int>(a.seenThrough.size());
-	if (!a.seenThrough.empty())
-	{
-		const DenseLevel& L =
-		    k.frame.levels[static_cast<size_t>(p_.finest_level)];
-		cv::Mat m = cv::Mat::zeros(L.depth.size(), CV_8UC1);
-		for (int i : a.seenThrough) m.data[i] = 255;
-		cv::dilate(m, m, cv::Mat());
-		k.frame.dropReadings(m, p_);
-	}
+	out.seenThrough = a.seenThrough;
+	return out;
 }
 
 bool KeyframeAnchor::wantKeyframe(const AnchorResult& r,

@@ -211,7 +211,9 @@ void AnchorParams::describe(OptionVisitor& v)
 	v.real("keyframe_angle_deg", keyframe_angle_deg, 0.01, 180,
 	       "... or this angle [deg]");
 	v.real("keyframe_min_overlap", keyframe_min_overlap, 0, 1,
-	       "... or when the keyframe covers less than this of the points");
+	       "... or when the keyframe covers less than this of the points; "
+	       "an alignment with fewer of them inliers also tries the other "
+	       "keyframes");
 	v.integer("max_keyframes", max_keyframes, 1, 100000,
 	          "oldest keyframes dropped beyond this");
 	v.integer("lost_frames", lost_frames, 1, 1000000,

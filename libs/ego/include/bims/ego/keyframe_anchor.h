@@ -103,12 +103,24 @@ class KeyframeAnchor
 	};
 	Keyframe* nearest(const Eigen::Matrix3d& R_WC, const Eigen::Vector3d& t_WC,
 	                  const std::vector<Keyframe*>& skip = {});
-	/** Aligns the frame in cur_ to \a k; fills \a r (accepted or why not)
-	 * and drops from \a k what the frame saw through. */
-	void alignTo(Keyframe& k, const Eigen::Matrix3d& R_pred,
-	             const Eigen::Vector3d& t_pred,
-	             const std::vector<InitialGuess>& others,
-	             const Eigen::Matrix3d* R_prior, AnchorResult& r);
+	/** One alignment of the frame to a keyframe, before it is taken. */
+	struct Attempt
+	{
+		AnchorResult r;  ///< accepted or why not
+		Keyframe* k = nullptr;
+		cv::Mat consistent;            ///< DenseAlignResult::consistent
+		std::vector<int> seenThrough;  ///< of k's finest level, if accepted
+	};
+	/** Aligns the frame in cur_ to \a k; \a start gives the fields an
+	 * alignment does not set (the prediction when not accepted). */
+	Attempt alignTo(Keyframe& k, const Eigen::Matrix3d& R_pred,
+	                const Eigen::Vector3d& t_pred,
+	                const std::vector<InitialGuess>& others,
+	                const Eigen::Matrix3d* R_prior, const AnchorResult& start);
+	/** Takes the chosen alignment, when accepted: its outlier and
+	 * consistent images (the keyframe the frame may become, the veto) and
+	 * what the frame saw through of its keyframe dropped from it. */
+	void take(Attempt& a);
 
 	AnchorParams p_;
 	std::deque<Keyframe> kf_;

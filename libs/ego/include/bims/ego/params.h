@@ -270,7 +270,11 @@ struct AnchorParams
 	double relocalise_overlap = 0.35;
 	/** A new keyframe when the frame is farther than this from its
 	 * keyframe [m], [deg], or when the keyframe covers less than
-	 * keyframe_min_overlap of its points (occluders count as covered). */
+	 * keyframe_min_overlap of its points (occluders count as covered).
+	 * An accepted alignment with less than keyframe_min_overlap of the
+	 * frame's points inliers also tries the other keyframes (the newest,
+	 * the next nearest), and the one with the most inliers anchors the
+	 * frame (KeyframeAnchor::track). */
 	double keyframe_distance_m = 0.3;
 	double keyframe_angle_deg = 15;
 	double keyframe_min_overlap = 0.5;
