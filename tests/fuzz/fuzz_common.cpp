@@ -44,7 +44,8 @@ std::string writeFile(const std::string& name, const uint8_t* data, size_t size)
 	const std::string path = scratchDir() + "/" + name;
 	FILE* f = std::fopen(path.c_str(), "wb");
 	if (!f) throw std::runtime_error("fuzz: cannot write " + path);
-	const bool ok = std::fwrite(data, 1, size, f) == size;
+	// (an empty input may come as a null pointer: not given to fwrite)
+	const bool ok = size == 0 || std::fwrite(data, 1, size, f) == size;
 	if (std::fclose(f) != 0 || !ok)
 		throw std::runtime_error("fuzz: cannot write " + path);
 	return path;
