@@ -10,7 +10,9 @@ int cmdTraj(int argc, char** argv)
 	TCLAP::CmdLine cmd(
 	    "ATE RMSE (after SE(3) Horn alignment) and RPE (m/s, deg/s) of an "
 	    "estimated TUM trajectory against ground truth, as the TUM RGB-D "
-	    "benchmark tools; writes a PNG plot.",
+	    "benchmark tools, and the frame-to-frame figures (the largest "
+	    "translation difference from GT's, the frames over --jump-m, the "
+	    "largest speed); writes a PNG plot.",
 	    ' ', bims::version());
 	TCLAP::UnlabeledValueArg<std::string> gtArg(
 	    "GT", "ground-truth trajectory (TUM format)", true, "", "GT.txt", cmd);
@@ -30,6 +32,11 @@ int cmdTraj(int argc, char** argv)
 	TCLAP::ValueArg<double> offset("", "offset",
 	                               "time offset added to EST stamps [s] (0)",
 	                               false, 0.0, "S", cmd);
+	TCLAP::ValueArg<double> jumpM(
+	    "", "jump-m",
+	    "count the frames whose translation differs from GT's by more [m] "
+	    "(0.03)",
+	    false, 0.03, "M", cmd);
 	bims::parseCommandLine(cmd, argc, argv, {{"--plot", "--out"}});
 	bims::apps::EvalTrajOptions o;
 	o.gt = gtArg.getValue();
@@ -40,5 +47,6 @@ int cmdTraj(int argc, char** argv)
 	o.maxDt = maxDt.getValue();
 	o.delta = delta.getValue();
 	o.offset = offset.getValue();
+	o.jumpM = jumpM.getValue();
 	return bims::apps::runEvalTraj(o);
 }

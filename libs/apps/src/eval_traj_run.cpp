@@ -1,4 +1,5 @@
 // bims-eval traj (eval_run.h).
+#include <bims/apps/app.h>
 #include <bims/apps/eval_run.h>
 #include <bims/apps/output_checks.h>
 #include <bims/eval/plots.h>
@@ -50,10 +51,28 @@ void warnIfOrientationsDisagree(const EvalTrajOptions& o,
 	    disp.rmse > 0 ? rep.rpe.trans.rmse / disp.rmse : INFINITY, disp.rmse,
 	    rep.ate.stats.rmse, o.gt.c_str(), o.est.c_str());
 }
+
+/** The frame-to-frame lines (docs/eval.md): the key, the value, details. */
+void printJumps(const ev::JumpResult& j)
+{
+	std::printf(
+	    "max_frame_trans_err %.4f m (at t %.6f, est pose %zu; median %.4f over "
+	    "%zu frame pairs)\n",
+	    j.stats.max, j.maxTime, j.maxEstIndex, j.stats.median,
+	    j.transErrors.size());
+	std::printf("frames_over_jump %zu (of %zu frame pairs, error > %.3f m)\n",
+	            j.framesOverJump, j.transErrors.size(), j.jumpM);
+	std::printf(
+	    "max_speed %.4f m/s (at t %.6f, est pose %zu; reference %.4f m/s "
+	    "there)\n",
+	    j.maxSpeed, j.maxSpeedTime, j.maxSpeedEstIndex, j.refSpeedAtMax);
+}
 }  // namespace
 
 int runEvalTraj(const EvalTrajOptions& o)
 {
+	if (!(o.jumpM >= 0) || !std::isfinite(o.jumpM))
+		throw UsageError("--jump-m must be >= 0");
 	std::vector<std::string> outputs;
 	for (const auto* out : {&o.plot, &o.json})
 		if (*out) outputs.push_back(**out);
@@ -89,6 +108,8 @@ int runEvalTraj(const EvalTrajOptions& o)
 		rpeError = e.what();
 	}
 
+	rep.jumps = ev::computeJumps(gt, est, rep.ate.pairs, {o.jumpM});
+
 	std::printf(
 	    "associated %zu of %zu estimated poses with %zu ground-truth poses "
 	    "(max dt %.3f s)\n",
@@ -109,6 +130,7 @@ int runEvalTraj(const EvalTrajOptions& o)
 	}
 	else
 		std::printf("rpe not available: %s\n", rpeError.c_str());
+	printJumps(rep.jumps);
 
 	if (o.json)
 	{

@@ -166,6 +166,64 @@ RpeResult computeRpe(const Trajectory& gt, const Trajectory& est,
 	return r;
 }
 
+namespace
+{
+/** |p_b - p_a| / (t_b - t_a), or -1 when the stamps do not increase. */
+double speed(const Trajectory& t, size_t a, size_t b)
+{
+	const double dt = t[b].t - t[a].t;
+	const Eigen::Vector3d d =
+	    toIso(t[b].T_WC).translation() - toIso(t[a].T_WC).translation();
+	return dt > 0 ? d.norm() / dt : -1.0;
+}
+Eigen::Vector3d relativeTranslation(const Trajectory& t, size_t a, size_t b)
+{
+	return (toIso(t[a].T_WC).inverse() * toIso(t[b].T_WC)).translation();
+}
+}  // namespace
+
+JumpResult computeJumps(const Trajectory& gt, const Trajectory& est,
+                        const IndexPairs& pairs, const JumpOptions& opt)
+{
+	if (!(opt.jumpM >= 0) || !std::isfinite(opt.jumpM))
+		throw std::invalid_argument("jump threshold must be >= 0 m");
+	if (pairs.size() < 2)
+		throw std::invalid_argument(
+		    "frame-to-frame errors need at least 2 associated poses");
+	IndexPairs byEst = pairs;
+	std::sort(byEst.begin(), byEst.end(),
+	          [](const auto& a, const auto& b) { return a.second < b.second; });
+	JumpResult r;
+	r.jumpM = opt.jumpM;
+	double worst = -1, fastest = -1;
+	for (size_t k = 0; k + 1 < byEst.size(); k++)
+	{
+		const auto [g0, e0] = byEst[k];
+		const auto [g1, e1] = byEst[k + 1];
+		const double err =
+		    (relativeTranslation(est, e0, e1) - relativeTranslation(gt, g0, g1))
+		        .norm();
+		r.transErrors.push_back(err);
+		if (err > opt.jumpM) r.framesOverJump++;
+		if (err > worst)
+		{
+			worst = err;
+			r.maxEstIndex = e1;
+			r.maxTime = est[e1].t;
+		}
+		const double v = speed(est, e0, e1);
+		if (v > fastest)
+		{
+			fastest = r.maxSpeed = v;
+			r.refSpeedAtMax = std::max(0.0, speed(gt, g0, g1));
+			r.maxSpeedEstIndex = e1;
+			r.maxSpeedTime = est[e1].t;
+		}
+	}
+	r.stats = ErrorStats::of(r.transErrors);
+	return r;
+}
+
 ErrorStats displacementErrors(const Trajectory& gt, const Trajectory& est,
                               const RpeResult& rpe, const AteResult& ate,
                               const RpeOptions& opt)
@@ -231,6 +289,18 @@ Json TrajectoryReport::toJson() const
 	            {"pairs", rpe.pairs.size()},
 	            {"trans_m_per_s", statsJson(rpe.trans)},
 	            {"rot_deg_per_s", statsJson(rpe.rot)}};
+	j["frame_to_frame"] = {
+	    {"frame_pairs", jumps.transErrors.size()},
+	    {"trans_err_m", statsJson(jumps.stats)},
+	    {"max_frame_trans_err_m", jsonNumber(jumps.stats.max)},
+	    {"max_at_t", jsonNumber(jumps.maxTime, 6)},
+	    {"max_est_index", jumps.maxEstIndex},
+	    {"jump_m", jsonNumber(jumps.jumpM)},
+	    {"frames_over_jump", jumps.framesOverJump},
+	    {"max_speed_m_per_s", jsonNumber(jumps.maxSpeed)},
+	    {"max_speed_at_t", jsonNumber(jumps.maxSpeedTime, 6)},
+	    {"max_speed_est_index", jumps.maxSpeedEstIndex},
+	    {"ref_speed_at_max_m_per_s", jsonNumber(jumps.refSpeedAtMax)}};
 	return j;
 }
 

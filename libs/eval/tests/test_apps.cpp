@@ -566,6 +566,56 @@ TEST(EvalTraj, BadInputIsAClearError)
 	EXPECT_EQ(r.code, 2);
 }
 
+TEST(EvalTraj, AJumpIsReportedWithItsFrameCountAndSpeed)
+{
+	// 0.5 m/s along x at 30 Hz; the estimate 5 cm off along y from frame 20
+	const auto d = tmpDir("traj_jump");
+	std::ofstream gt(d + "/gt.txt"), est(d + "/est.txt");
+	for (int k = 0; k <= 30; k++)
+	{
+		char g[128], e[128];
+		const double t = 10 + k / 30.0;
+		std::snprintf(g, sizeof(g), "%.9f %.9f 0 1 0 0 0 1\n", t, 0.5 * k / 30);
+		std::snprintf(e, sizeof(e), "%.9f %.9f %.2f 1 0 0 0 1\n", t,
+		              0.5 * k / 30, k >= 20 ? 0.05 : 0.0);
+		gt << g;
+		est << e;
+	}
+	gt.close();
+	est.close();
+	const std::string cmd = kBin + "/bims-eval traj " + d + "/gt.txt " + d +
+	                        "/est.txt --no-plot --json " + d + "/t.json";
+	auto r = run(cmd);
+	ASSERT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("\nmax_frame_trans_err 0.0500 m (at t 10.666667, "
+	                     "est pose 20;"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("\nframes_over_jump 1 (of 30 frame pairs, error > "
+	                     "0.030 m)"),
+	          std::string::npos)
+	    << r.out;
+	// |(0.5 / 30, 0.05)| * 30 = 1.5811 m/s
+	EXPECT_NE(r.out.find("\nmax_speed 1.5811 m/s (at t 10.666667, est pose "
+	                     "20; reference 0.5000 m/s there)"),
+	          std::string::npos)
+	    << r.out;
+	const auto json = bims::test::fileText(d + "/t.json");
+	EXPECT_NE(json.find("\"frames_over_jump\": 1"), std::string::npos) << json;
+	EXPECT_NE(json.find("\"max_est_index\": 20"), std::string::npos) << json;
+	r = run(cmd + " --jump-m 0.06");
+	EXPECT_NE(r.out.find("\nframes_over_jump 0 "), std::string::npos) << r.out;
+	r = run(cmd + " --jump-m -1");
+	EXPECT_EQ(r.code, 2) << r.out;
+	EXPECT_NE(r.out.find("--jump-m must be >= 0"), std::string::npos) << r.out;
+	// the trajectory against itself: no jump
+	r = run(kBin + "/bims-eval traj " + d + "/gt.txt " + d +
+	        "/gt.txt --no-plot");
+	EXPECT_NE(r.out.find("\nmax_frame_trans_err 0.0000 m"), std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find("\nframes_over_jump 0 "), std::string::npos) << r.out;
+}
+
 TEST(ImportTum, SynthImuFromConvertedGroundTruthSeesGravityUp)
 {
 	// Synthetic IMU from the converted Bonn poses: the world must be z up

@@ -2,6 +2,8 @@
 #include <bims/eval/trajectory_metrics.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
+
 #include <cstdio>
 
 #include <cmath>
@@ -231,4 +233,87 @@ TEST(TrajectoryReport, JsonHasTheFigures)
 	const auto j = bims::jsonText(rep.toJson());
 	EXPECT_NE(j.find("\"rmse\": 0.25"), std::string::npos) << j;
 	EXPECT_NE(j.find("g\\\"t.txt"), std::string::npos) << j;
+}
+
+namespace
+{
+// A camera walking along x at 0.5 m/s and turning, 30 Hz for 2 s; the
+// estimate is the same motion in another world (T_WeWg), 4 ms late, with
+// every pose from frame 20 on shifted by 5 cm along the estimate's world y
+// (one jump) and from frame 40 on by 2 cm more along its z (a smaller one).
+constexpr double kFps = 30;
+Trajectory walkingGt()
+{
+	Trajectory gt;
+	for (int k = 0; k <= 60; k++)
+	{
+		const double t = 100 + k / kFps;
+		gt.push_back({t, CPose3D(0.5 * (t - 100), 0.3, 1.2, 0.4 * std::sin(t),
+		                         0.1 * std::cos(2 * t), 0.05)});
+	}
+	return gt;
+}
+const CPose3D T_WeWg(2, -1, 0.5, 1.1, -0.2, 0.3);
+Trajectory estimateOf(const Trajectory& gt, double jump20, double jump40)
+{
+	Trajectory est;
+	for (size_t k = 0; k < gt.size(); k++)
+	{
+		CPose3D p = T_WeWg + gt[k].T_WC;
+		if (k >= 20) p.y_incr(jump20);
+		if (k >= 40) p.z_incr(jump40);
+		est.push_back({gt[k].t + 0.004, p});
+	}
+	return est;
+}
+}  // namespace
+
+TEST(Jumps, OneInjectedJumpGivesItsSizeFrameCountAndSpeed)
+{
+	const Trajectory gt = walkingGt();
+	const Trajectory est = estimateOf(gt, 0.05, 0.02);
+	const auto ate = ev::computeAte(gt, est);
+	ASSERT_EQ(ate.pairs.size(), gt.size());
+	const auto j = ev::computeJumps(gt, est, ate.pairs);
+	ASSERT_EQ(j.transErrors.size(), 60u);
+	// the shift, whatever the frames' rotations: |R_E19^T d| = |d|
+	EXPECT_NEAR(j.stats.max, 0.05, 1e-9);
+	EXPECT_EQ(j.maxEstIndex, 20u);
+	EXPECT_DOUBLE_EQ(j.maxTime, est[20].t);
+	EXPECT_NEAR(j.transErrors[39], 0.02, 1e-9);  // frame 40: under 3 cm
+	EXPECT_EQ(j.framesOverJump, 1u);
+	for (size_t k = 0; k < j.transErrors.size(); k++)
+	{
+		if (k != 19 && k != 39)
+		{
+			EXPECT_LT(j.transErrors[k], 1e-9) << k;
+		}
+	}
+	// 0.5 m/s along the reference's x, plus 5 cm along the estimate's y
+	// within one frame
+	const auto R = T_WeWg.getRotationMatrix().asEigen();
+	const Eigen::Vector3d step =
+	    R * Eigen::Vector3d(0.5 / kFps, 0, 0) + Eigen::Vector3d(0, 0.05, 0);
+	EXPECT_NEAR(j.maxSpeed, step.norm() * kFps, 1e-6);
+	EXPECT_GT(j.maxSpeed, 1.0);
+	EXPECT_EQ(j.maxSpeedEstIndex, 20u);
+	EXPECT_DOUBLE_EQ(j.maxSpeedTime, est[20].t);
+	EXPECT_NEAR(j.refSpeedAtMax, 0.5, 1e-6);
+	// a lower threshold counts the smaller jump too
+	EXPECT_EQ(ev::computeJumps(gt, est, ate.pairs, {0.01}).framesOverJump, 2u);
+	EXPECT_THROW(ev::computeJumps(gt, est, ate.pairs, {-1}),
+	             std::invalid_argument);
+	EXPECT_THROW(ev::computeJumps(gt, est, {ate.pairs[0]}),
+	             std::invalid_argument);
+}
+
+TEST(Jumps, ACleanTrajectoryHasNoJumpAndTheReferencesSpeed)
+{
+	const Trajectory gt = walkingGt();
+	const Trajectory est = estimateOf(gt, 0, 0);
+	const auto j = ev::computeJumps(gt, est, ev::computeAte(gt, est).pairs);
+	EXPECT_LT(j.stats.max, 1e-9);
+	EXPECT_EQ(j.framesOverJump, 0u);
+	EXPECT_NEAR(j.maxSpeed, 0.5, 1e-6);
+	EXPECT_NEAR(j.refSpeedAtMax, 0.5, 1e-6);
 }

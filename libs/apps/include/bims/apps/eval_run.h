@@ -24,10 +24,14 @@ struct EvalTrajOptions
 	double maxDt = 0.02;  ///< max time difference to associate poses [s]
 	double delta = 1.0;   ///< RPE interval [s]
 	double offset = 0.0;  ///< time offset added to EST stamps [s]
+	/** a frame whose translation differs from the reference's by more is
+	 * counted [m] */
+	double jumpM = 0.03;
 };
 
-/** bims-eval traj: ATE after Horn's alignment and RPE, printed on stdout,
- * the plot and the JSON. Checks that no output is an input (UsageError).
+/** bims-eval traj: ATE after Horn's alignment, RPE and the frame-to-frame
+ * figures (eval::computeJumps), printed on stdout, the plot and the JSON.
+ * Checks that no output is an input and the options' ranges (UsageError).
  * Returns the exit code (0); errors are thrown. */
 int runEvalTraj(const EvalTrajOptions& o);
 

@@ -112,6 +112,42 @@ bool orientationsDisagreeWithPositions(const ErrorStats& rpeTrans,
                                        const ErrorStats& displacement,
                                        const ErrorStats& ate, double delta);
 
+/** Frame-to-frame figures: what an ATE can hide (one catastrophic frame). */
+struct JumpOptions
+{
+	/** A frame whose translation error exceeds this is counted [m]. */
+	double jumpM = 0.03;
+};
+
+/** Over consecutive associated poses (k, k+1) in the estimate's time
+ * order (the ATE's association): the 1-frame RPE's translation and the
+ * speed the estimate implies. */
+struct JumpResult
+{
+	/** Per frame pair, |t(E_k^-1 E_k+1) - t(G_k^-1 G_k+1)| [m] (each
+	 * relative motion in its earlier frame; the norm of the translation of
+	 * the 1-frame RPE). */
+	std::vector<double> transErrors;
+	ErrorStats stats;  ///< of \a transErrors [m]
+	/** The frame of the largest error: the later pose of its pair. */
+	size_t maxEstIndex = 0;
+	double maxTime = 0;         ///< its estimate's stamp [s]
+	size_t framesOverJump = 0;  ///< frame pairs whose error > jumpM
+	double jumpM = 0.03;        ///< the threshold used [m]
+	/** Largest |t_est(k+1) - t_est(k)| / (its stamps' difference) [m/s]
+	 * (pairs whose stamps do not increase are left out), at the later pose
+	 * of its pair, and the reference's over the same pair (its own stamps). */
+	double maxSpeed = 0, refSpeedAtMax = 0;
+	size_t maxSpeedEstIndex = 0;
+	double maxSpeedTime = 0;  ///< [s]
+};
+
+/** The frame-to-frame figures over the associated \a pairs (gt index, est
+ * index) of computeAte. Throws std::invalid_argument with fewer than 2
+ * pairs. */
+JumpResult computeJumps(const Trajectory& gt, const Trajectory& est,
+                        const IndexPairs& pairs, const JumpOptions& opt = {});
+
 /** Both metrics plus the inputs' sizes, for reports. */
 struct TrajectoryReport
 {
@@ -121,6 +157,7 @@ struct TrajectoryReport
 	RpeOptions rpeOptions;
 	AteResult ate;
 	RpeResult rpe;
+	JumpResult jumps;
 	/** A JSON object (summaries only, no per-pair arrays). */
 	Json toJson() const;
 };
