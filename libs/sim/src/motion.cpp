@@ -29,6 +29,28 @@ void channel(double A, double fHz, int ch, double t, double& f, double& d1,
 	     A2 * w2 * w2 * std::sin(w2 * t + b);
 }
 
+/** The motion's own time s(t) and its first two derivatives
+ * (HandheldMotionParams::startFromRestS). */
+struct EasedTime
+{
+	double s, ds, dds;
+};
+EasedTime easedTime(double tau, double t)
+{
+	if (tau <= 0) return {t, 1, 0};
+	if (t <= 0) return {0, 0, 0};  // held still before the start
+	const double e = std::exp(-t / tau);
+	return {t - tau * (1 - e), 1 - e, e / tau};
+}
+/** A channel's derivatives in s turned into derivatives in t (the chain
+ * rule); none when s = t (the values stay those of the plain time). */
+void chainRule(const EasedTime& w, double& d1, double& d2)
+{
+	if (w.ds == 1 && w.dds == 0) return;
+	d2 = d2 * w.ds * w.ds + d1 * w.dds;
+	d1 *= w.ds;
+}
+
 Eigen::Matrix3d R_SC_eigen()
 {
 	Eigen::Matrix3d R;
@@ -50,16 +72,25 @@ void HandheldMotionParams::loadFromConfigFile(
 	rotAmplitudeDeg = vec3(
 	    s.getDoubles("rot_amplitude_deg", stdv(rotAmplitudeDeg), 3, 0, 80));
 	rotFreqHz = vec3(s.getDoubles("rot_freq_hz", stdv(rotFreqHz), 3, 0, 20));
+	velocity = vec3(s.getDoubles("velocity", stdv(velocity), 3, -5, 5));
+	startFromRestS = s.getDouble("start_from_rest_s", startFromRestS, 0, 100);
 	s.finish();
 }
 
 Kinematics HandheldMotion::at(double t) const
 {
 	Kinematics k;
+	const EasedTime w = easedTime(p_.startFromRestS, t);
 	double f, d1, d2;
 	for (int i = 0; i < 3; i++)
 	{
-		channel(p_.posAmplitude[i], p_.posFreqHz[i], i, t, f, d1, d2);
+		channel(p_.posAmplitude[i], p_.posFreqHz[i], i, w.s, f, d1, d2);
+		if (p_.velocity[i] != 0)
+		{
+			f += p_.velocity[i] * w.s;
+			d1 += p_.velocity[i];
+		}
+		chainRule(w, d1, d2);
 		k.p_WC[i] = p_.position[i] + f;
 		k.v_W[i] = d1;
 		k.a_W[i] = d2;
@@ -67,8 +98,9 @@ Kinematics HandheldMotion::at(double t) const
 	double ang[3], rate[3];
 	for (int i = 0; i < 3; i++)
 	{
-		channel(p_.rotAmplitudeDeg[i] * kDeg, p_.rotFreqHz[i], 3 + i, t, f, d1,
-		        d2);
+		channel(p_.rotAmplitudeDeg[i] * kDeg, p_.rotFreqHz[i], 3 + i, w.s, f,
+		        d1, d2);
+		chainRule(w, d1, d2);
 		ang[i] = p_.yprDeg[i] * kDeg + f;
 		rate[i] = d1;
 	}

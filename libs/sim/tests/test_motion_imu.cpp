@@ -93,6 +93,49 @@ TEST(HandheldMotion, AngularVelocityMatchesFiniteDifferences)
 	}
 }
 
+TEST(HandheldMotion, AWalkEasedFromRestStartsStillWithExactDerivatives)
+{
+	HandheldMotionParams mp;
+	mp.velocity = {0.6, -0.2, 0};
+	mp.startFromRestS = 0.8;
+	const HandheldMotion m(mp);
+	const auto k0 = m.at(0);
+	EXPECT_LT(k0.v_W.norm(), 1e-12);
+	EXPECT_LT(k0.omega_C.norm(), 1e-12);
+	EXPECT_LT((k0.p_WC - mp.position).norm(), 1e-12);
+	// held still before the start
+	EXPECT_LT((m.at(-0.5).p_WC - mp.position).norm(), 1e-12);
+	const double h = 1e-5;
+	for (double t = 0.05; t < 9; t += 0.41)
+	{
+		const auto k = m.at(t);
+		const Eigen::Matrix3d dR =
+		    m.at(t - h).R_WC.transpose() * m.at(t + h).R_WC;
+		const Eigen::AngleAxisd aa(dR);
+		EXPECT_LT((aa.axis() * aa.angle() / (2 * h) - k.omega_C).norm(), 1e-6)
+		    << "t=" << t;
+		EXPECT_LT(
+		    ((m.at(t + h).p_WC - m.at(t - h).p_WC) / (2 * h) - k.v_W).norm(),
+		    1e-6)
+		    << "t=" << t;
+		EXPECT_LT(
+		    ((m.at(t + h).v_W - m.at(t - h).v_W) / (2 * h) - k.a_W).norm(),
+		    1e-5)
+		    << "t=" << t;
+	}
+	// after a few time constants: the walk plus the sway, travelled on
+	const HandheldMotion still(
+	    [&]
+	    {
+		    HandheldMotionParams q = mp;
+		    q.posAmplitude.setZero();
+		    return q;
+	    }());
+	EXPECT_NEAR(still.at(20).v_W.x(), 0.6, 1e-6);
+	EXPECT_NEAR(still.at(20).p_WC.y() - mp.position.y(), -0.2 * (20 - 0.8),
+	            1e-6);
+}
+
 TEST(HandheldMotion, FastRotationPresetPeaksAbove180DegPerSecond)
 {
 	HandheldMotionParams mp;  // the values of config/sim/fast_rotation.ini

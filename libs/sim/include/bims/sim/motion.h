@@ -42,9 +42,12 @@ class MotionModel
 };
 
 /** [motion]: hand-held camera motion. Each of the 6 channels (x, y, z, yaw,
- * pitch, roll) is base + A (sin(w t + a) - sin a) + 0.35 A (sin(1.73 w t + b) -
- * sin b) with w = 2 pi f and fixed per-channel phases a, b: smooth
- * (C-infinity), starts at the base pose, derivatives are analytic.
+ * pitch, roll) is base + A (sin(w s + a) - sin a) + 0.35 A (sin(1.73 w s + b) -
+ * sin b) with w = 2 pi f and fixed per-channel phases a, b, plus velocity * s
+ * on x, y, z (a walk): smooth, starts at the base pose, derivatives are
+ * analytic. s is the time t, or with start_from_rest_s = tau > 0 the eased
+ * time s = t - tau (1 - exp(-t / tau)) (s' = 0 at t = 0: the camera starts
+ * at rest, velocity and angular rate 0, and is held still before t = 0).
  * The attitude is given for MRPT's scan frame {S} (x forward, y left, z up):
  * yaw/pitch/roll = 0 looks along +x (north), level; R_WC = R_WS(ypr) * R_SC. */
 struct HandheldMotionParams
@@ -57,6 +60,8 @@ struct HandheldMotionParams
 	Eigen::Vector3d rotAmplitudeDeg{8, 4,
 	                                2};  ///< yaw, pitch, roll amplitudes [deg]
 	Eigen::Vector3d rotFreqHz{0.13, 0.19, 0.29};  ///< [Hz]
+	Eigen::Vector3d velocity{0, 0, 0};  ///< steady velocity in {W} [m/s]
+	double startFromRestS = 0;  ///< ease-in time constant tau [s]; 0 = off
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	                        const std::string& section);
 };
