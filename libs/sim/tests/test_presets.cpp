@@ -3,7 +3,10 @@
 #include <bims/sim/simulator.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
+#include <string>
 
 using namespace bims::sim;
 
@@ -54,6 +57,104 @@ double movingFraction(const SimConfig& c, int n)
 		            uint64_t(i)));
 	return sum / n;
 }
+/** The point-to-plane information of a frame's static depth readings for
+ * a small motion of the camera, in {C}: the sum over the pixels of J^T J,
+ * J = [n^T, (p x n)^T], p the pixel's point and n its surface's unit normal
+ * (from the noiseless depth two pixels either side, where those points lie
+ * on one line each way: not across an edge). */
+struct DepthInformation
+{
+	Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+	size_t points = 0;
+};
+DepthInformation depthInformation(const RenderedFrame& f,
+                                  const CameraParams& cam)
+{
+	constexpr int k = 2;
+	const int w = f.width, h = f.height;
+	const auto point = [&](int u, int v)
+	{
+		const double z = f.depthTrue[size_t(v) * w + u];
+		return Eigen::Vector3d(z * (u - cam.cxS()) / cam.fxS(),
+		                       z * (v - cam.cyS()) / cam.fyS(), z);
+	};
+	const auto straight = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+	                         const Eigen::Vector3d& c)
+	{
+		const Eigen::Vector3d d1 = b - a, d2 = c - b;
+		return d1.cross(d2).norm() < 1e-4 * d1.norm() * d2.norm();
+	};
+	DepthInformation info;
+	for (int v = k; v < h - k; v++)
+		for (int u = k; u < w - k; u++)
+		{
+			static constexpr int du[] = {0, -k, k, 0, 0},
+			                     dv[] = {0, 0, 0, -k, k};
+			bool ok = true;
+			for (int j = 0; j < 5; j++)
+			{
+				const size_t i = size_t(v + dv[j]) * w + (u + du[j]);
+				ok = ok && f.depthMm[i] > 0 && f.mask[i] == 0;
+			}
+			if (!ok) continue;
+			const Eigen::Vector3d p = point(u, v), l = point(u - k, v),
+			                      r = point(u + k, v), up = point(u, v - k),
+			                      dn = point(u, v + k);
+			if (!straight(l, p, r) || !straight(up, p, dn)) continue;
+			const Eigen::Vector3d n = (r - l).cross(dn - up).normalized();
+			Eigen::Matrix<double, 6, 1> J;
+			J << n, p.cross(n);
+			info.H += J * J.transpose();
+			info.points++;
+		}
+	return info;
+}
+/** The translation block of H, or what is left of it once the rotation is
+ * free (the Schur complement). */
+Eigen::Matrix3d translationInformation(const DepthInformation& d,
+                                       bool rotationFree)
+{
+	const Eigen::Matrix3d Htt = d.H.topLeftCorner<3, 3>();
+	if (!rotationFree) return Htt;
+	const Eigen::Matrix3d Htr = d.H.topRightCorner<3, 3>();
+	return Htt -
+	       Htr * d.H.bottomRightCorner<3, 3>().ldlt().solve(Htr.transpose());
+}
+/** d^T A d over A's largest eigenvalue, for a world direction d. */
+double shareAlong(const Eigen::Matrix3d& A, const Eigen::Matrix3d& R_WC,
+                  const Eigen::Vector3d& d_W)
+{
+	const Eigen::Vector3d d = R_WC.transpose() * d_W.normalized();
+	return d.dot(A * d) / Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(A)
+	                          .eigenvalues()
+	                          .maxCoeff();
+}
+/** Sorted eigenvalues of A over the largest. */
+Eigen::Vector3d relativeEigenvalues(const Eigen::Matrix3d& A)
+{
+	const Eigen::Vector3d e =
+	    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(A).eigenvalues();
+	return e / e.maxCoeff();
+}
+/** Calls \a check(frame information, R_WC, t) at n times over the preset's
+ * sequence, each frame rendered at 320x240; checks most pixels count. */
+template <class Check>
+void forFramesOf(const std::string& preset, int n, const Check& check)
+{
+	SCOPED_TRACE(preset);
+	const SimConfig c = SimConfig::load(kPresets + preset + ".ini");
+	const PresetView view(c);
+	const CameraParams cam = PresetView::cam320(c);
+	for (int i = 0; i < n; i++)
+	{
+		const double t = (c.seq.frames - 1) / c.seq.fps * i / (n - 1);
+		SCOPED_TRACE("t = " + std::to_string(t));
+		const DepthInformation d = depthInformation(view.at(t), cam);
+		EXPECT_GT(d.points, size_t(0.3 * cam.width * cam.height));
+		check(d, view.motion.at(t).R_WC);
+	}
+}
+
 double peakRateDegS(const SimConfig& c)
 {
 	const HandheldMotion m(c.motion);
@@ -125,4 +226,66 @@ TEST(Presets, EachHasItsPromisedProperty)
 	}
 	EXPECT_EQ(before, 0.0);
 	EXPECT_GE(longest, 1.0);
+}
+
+// Issue 52: scenes where the depth alone leaves a translation unseen (the
+// IMU has to carry it), and one where it does not.
+TEST(Presets, BlankWallAndCorridorHideATranslationFromTheDepth)
+{
+	// the wall's plane x = 3: nothing along y or z, everything along x
+	forFramesOf(
+	    "blank_wall", 5,
+	    [](const DepthInformation& d, const Eigen::Matrix3d& R_WC)
+	    {
+		    const Eigen::Matrix3d A = translationInformation(d, false);
+		    EXPECT_LT(shareAlong(A, R_WC, Eigen::Vector3d::UnitY()), 1e-3);
+		    EXPECT_LT(shareAlong(A, R_WC, Eigen::Vector3d::UnitZ()), 1e-3);
+		    EXPECT_GT(shareAlong(A, R_WC, Eigen::Vector3d::UnitX()), 0.99);
+	    });
+	// the corridor along x: nothing along it, even with the rotation fixed;
+	// across it and up and down, well seen even with the rotation free
+	forFramesOf("corridor", 5,
+	            [](const DepthInformation& d, const Eigen::Matrix3d& R_WC)
+	            {
+		            EXPECT_LT(shareAlong(translationInformation(d, false), R_WC,
+		                                 Eigen::Vector3d::UnitX()),
+		                      1e-3);
+		            const Eigen::Vector3d e =
+		                relativeEigenvalues(translationInformation(d, true));
+		            EXPECT_LT(e[0], 1e-3);
+		            EXPECT_GT(e[1], 0.05);
+	            });
+}
+
+TEST(Presets, PendulumSlowDepthSeesEveryTranslation)
+{
+	forFramesOf("pendulum_slow", 5,
+	            [](const DepthInformation& d, const Eigen::Matrix3d&) {
+		            EXPECT_GT(
+		                relativeEigenvalues(translationInformation(d, true))[0],
+		                0.01);
+	            });
+}
+
+TEST(Presets, BlankWallAndCorridorAreHandHeldWalksFromRest)
+{
+	for (const char* p : {"blank_wall", "corridor"})
+	{
+		SCOPED_TRACE(p);
+		const SimConfig c = SimConfig::load(kPresets + p + ".ini");
+		EXPECT_TRUE(c.pendulums.empty() && c.boxes.empty() &&
+		            c.walkers.empty());
+		const HandheldMotion m(c.motion);
+		EXPECT_LT(m.at(0).v_W.norm(), 1e-12);
+		double peak = 0, travelled = 0;
+		for (double t = 0; t < c.seq.frames / c.seq.fps; t += 0.01)
+		{
+			peak = std::max(peak, m.at(t).v_W.norm());
+			travelled =
+			    std::max(travelled, (m.at(t).p_WC - m.at(0).p_WC).norm());
+		}
+		EXPECT_LT(peak, 1.0);
+		EXPECT_GT(travelled, 2.0);
+		EXPECT_LT(peakRateDegS(c), 30.0);
+	}
 }
