@@ -9,7 +9,10 @@
 #   3. the egomotion against ARKit's poses (a reference, not ground truth):
 #      ATE RMSE (SE(3)-aligned), RPE over 1 s, frames measured, for depth +
 #      IMU (bims-odom mode imu), depth only without the IMU (mode vision), and
-#      bims-run (its moving masks fed back) for the variants;
+#      bims-run (its moving masks fed back) for the variants; and the largest
+#      per-frame translation error [m] with the frames over 3 cm (bims-eval
+#      traj's max_frame_trans_err, frames_over_jump: poses paired with the
+#      reference's by time stamp);
 #   4. bims-run's masks against the capture's masks_proxy labels (255 moving,
 #      0 static, 150 and 50 not scored; paired by time stamp): precision,
 #      recall, F1, IoU, the share of labelled-static pixels called moving
@@ -64,17 +67,21 @@ traj() { # EST -> "ate | rpe_t | rpe_r"
 	"$BIN/bims-eval" traj "$REF" "$1" --no-plot 2>/dev/null |
 		awk '/^ate_rmse/{a=$2} /^rpe_trans_rmse/{t=$2} /^rpe_rot_rmse/{r=$2} END{printf "%s | %s | %s", a, t, r}'
 }
+jumps() { # EST -> "max per-frame translation error | frames over 3 cm"
+	"$BIN/bims-eval" traj "$REF" "$1" --no-plot --jump-m 0.03 2>/dev/null |
+		awk '/^max_frame_trans_err/{m=$2} /^frames_over_jump/{n=$2 " of " $4} END{printf "%s | %s", m, n}'
+}
 echo
 echo "3. Egomotion vs ARKit's poses"
 echo
-echo "| run | ATE RMSE [m] | RPE [m/s] | RPE [deg/s] | frames measured | egomotion ms (median) |"
-echo "|---|---|---|---|---|---|"
+echo "| run | ATE RMSE [m] | RPE [m/s] | RPE [deg/s] | frames measured | egomotion ms (median) | max per-frame translation error [m] | frames over 3 cm |"
+echo "|---|---|---|---|---|---|---|---|"
 "$BIN/bims-odom" "$CONFIG" "$RAWLOG" -o "$DATA/odom_vision.txt" --mode vision \
 	--csv "$DATA/odom_vision.csv" -q 2> "$DATA/odom_vision.log"
 for m in imu vision; do
 	ms=$(sed -n 's/.*egomotion \([0-9.]*\).*/\1/p' "$DATA/odom_$m.log")
 	what=$([ $m = imu ] && echo "depth + IMU (bims-odom, no mask)" || echo "depth only, no IMU (bims-odom --mode vision)")
-	echo "| $what | $(traj "$DATA/odom_$m.txt") | $(measured "$DATA/odom_$m.csv") | $ms |"
+	echo "| $what | $(traj "$DATA/odom_$m.txt") | $(measured "$DATA/odom_$m.csv") | $ms | $(jumps "$DATA/odom_$m.txt") |"
 done
 CONV=(--moving-value 255 --static-value 0 --ignore-values 150,50)
 pct() { awk -v x="$1" 'BEGIN{ if (x == "nan" || x == "") print "-"; else printf "%.2f %%", 100 * x }'; }
@@ -86,7 +93,7 @@ for v in $VARIANTS; do
 		{ echo "stray_real.sh: bims-run --variant $v failed, see $out.log" >&2; exit 1; }
 	ms=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["stage_ms"]["egomotion"]["median"])' "$out/metrics.json")
 	n=$(awk -F, 'NR > 1 {n++} NR > 1 && $3 >= 2048 && int($3 / 2048) % 2 == 1 {a++} END{printf "%d of %d", a, n}' "$out/frames.csv")
-	echo "| bims-run --variant $v (masks fed back) | $(traj "$out/trajectory.txt") | $n | $ms |"
+	echo "| bims-run --variant $v (masks fed back) | $(traj "$out/trajectory.txt") | $n | $ms | $(jumps "$out/trajectory.txt") |"
 	fps=$(grep -o '"fps": [0-9.]*' "$out/metrics.json" | awk '{print $2}')
 	if [ -d "$STRAY/masks_proxy" ]; then
 		"$BIN/bims-eval" masks "$STRAY/masks_proxy" "$out/masks" "${CONV[@]}" --no-plots -q > "$out.eval" 2> "$out.eval.err" ||
