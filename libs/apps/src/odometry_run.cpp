@@ -111,25 +111,29 @@ const char* odometryCsvHeader()
 	       "anchor_keyframe,anchor_inliers,anchor_inlier_fraction,"
 	       "anchor_overlap,anchor_coverage,anchor_guess,anchor_correction_m,"
 	       "anchor_correction_deg,anchor_excluded,anchor_seen_through,"
-	       "ms_anchor,anchor_note\n";
+	       "ms_anchor,anchor_note,degenerate_dirs,inertial_nis,"
+	       "position_info_min,position_info_max,vx,vy,vz\n";
 }
 
 std::string odometryCsvLine(const ego::FrameEgomotion& r,
                             const TrackerTruth& truth)
 {
-	char buf[512];
+	char buf[768];
 	const auto& a = r.anchor;
 	std::snprintf(
 	    buf, sizeof(buf),
 	    "%.6f,%s,%s,%d,%d,%.5f,%zu,%.3f,%.3f,%.3f,%.3f,%d,%d,"
-	    "%d,%d,%.3f,%.3f,%.3f,%d,%.4f,%.3f,%.3f,%d,%.3f,%s\n",
+	    "%d,%d,%.3f,%.3f,%.3f,%d,%.4f,%.3f,%.3f,%d,%.3f,%s,%d,%.3f,%.4g,%.4g,"
+	    "%.4f,%.4f,%.4f\n",
 	    r.t, ego::flagsToString(r.flags).c_str(), ego::toString(r.R_source),
 	    r.correspondences, r.inliers, r.residual_rms_m, r.tracks.size(),
 	    r.ms_input, r.ms_track, r.ms_motion, truth.rate_deg_s,
 	    truth.attempted_with_depth, truth.tracked_within_2px, a.keyframe,
 	    a.inliers, a.inlier_fraction, a.overlap, a.coverage, a.guess,
 	    a.correction_m, a.correction_deg, a.excluded_fraction, a.seen_through,
-	    r.ms_anchor, a.why.empty() ? "-" : a.why.c_str());
+	    r.ms_anchor, a.why.empty() ? "-" : a.why.c_str(), r.degenerate,
+	    r.inertial_nis, r.position_information.x(), r.position_information.z(),
+	    r.v_W.x(), r.v_W.y(), r.v_W.z());
 	return buf;
 }
 

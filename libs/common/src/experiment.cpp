@@ -18,6 +18,7 @@ const std::vector<ExperimentSection>& experimentSectionTable()
 	    {"translation", "ego", "robust translation and refinement"},
 	    {"odometry", "ego", "the egomotion's mode"},
 	    {"anchor", "ego", "map-anchored (keyframe) tracking"},
+	    {"inertial", "ego", "depth-inertial translation filter"},
 	    {"flow", "flow", "observed and expected flow, Diff labels"},
 	    {"grids", "maps", "the three Bayesian grids"},
 	    {"pipeline", "pipeline", "orchestration, variant"},

@@ -327,7 +327,11 @@ std::vector<const char*> flagNames(uint32_t flags)
 	    {kFlagAnchorRelocalised, "anchor_relocalised"},
 	    {kFlagImuRejected, "imu_rejected"},
 	    {kFlagNoImage, "no_image"},
-	    {kFlagMaskVetoed, "mask_vetoed"}};
+	    {kFlagMaskVetoed, "mask_vetoed"},
+	    {kFlagDegenerate, "degenerate"},
+	    {kFlagInertialRejected, "inertial_rejected"},
+	    {kFlagInertialPrior, "inertial_prior"},
+	    {kFlagAccelSaturated, "accel_saturated"}};
 	std::vector<const char*> out;
 	for (const auto& [bit, name] : names)
 		if (flags & bit) out.push_back(name);

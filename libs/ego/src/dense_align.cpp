@@ -458,23 +458,31 @@ int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
                  Eigen::Matrix3d& R, Eigen::Vector3d& t, float& offset,
                  double& photoSigma, const AnchorParams& p,
                  const Eigen::Matrix3d* R_prior, double sigmaPrior_rad,
-                 NormalEquations6& rows, int* inliers,
-                 const Pass* first = nullptr)
+                 const TranslationPrior* tPrior, NormalEquations6& rows,
+                 int* inliers, const Pass* first = nullptr,
+                 Mat6* information = nullptr)
 {
 	const bool fixRotation = R_prior && !(sigmaPrior_rad > 0);
 	if (fixRotation) R = *R_prior;
 	const double wPrior =
 	    R_prior && !fixRotation ? 1 / (sigmaPrior_rad * sigmaPrior_rad) : 0;
-	auto priorCost = [&](const Eigen::Matrix3d& Rx)
+	auto priorCost = [&](const Eigen::Matrix3d& Rx, const Eigen::Vector3d& tx)
 	{
-		return wPrior > 0 ? 0.5 * wPrior *
-		                        logSO3(R_prior->transpose() * Rx).squaredNorm()
-		                  : 0.0;
+		double c =
+		    wPrior > 0
+		        ? 0.5 * wPrior * logSO3(R_prior->transpose() * Rx).squaredNorm()
+		        : 0.0;
+		if (tPrior)
+		{
+			const Eigen::Vector3d e = tx - tPrior->t;
+			c += 0.5 * e.dot(tPrior->info * e);
+		}
+		return c;
 	};
 	Pass cur = first && !fixRotation ? *first
 	                                 : pass(Lr, samples, R, t, offset,
 	                                        photoSigma, p, &rows, nullptr);
-	double curCost = cur.cost + priorCost(R);
+	double curCost = cur.cost + priorCost(R, t);
 	double lambda = 1e-4;
 	int steps = 0;
 	for (int it = 0; it < p.iterations && cur.inliers >= 6; it++)
@@ -487,6 +495,16 @@ int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
 			const Eigen::Vector3d e = logSO3(R_prior->transpose() * R);
 			H.block<3, 3>(3, 3) += wPrior * Eigen::Matrix3d::Identity();
 			b.segment<3>(3) += wPrior * (R * e);
+		}
+		if (tPrior)
+		{
+			// r = t - t_prior; t <- Exp(w) t + v: dr/d(v, w) = [I, -[t]x]
+			Eigen::Matrix<double, 3, 6> J;
+			J.leftCols<3>().setIdentity();
+			J.rightCols<3>() = -skew(t);
+			if (fixRotation) J.rightCols<3>().setZero();
+			H += J.transpose() * tPrior->info * J;
+			b += J.transpose() * (tPrior->info * (t - tPrior->t));
 		}
 		Vec6 d = Vec6::Zero();
 		if (fixRotation)
@@ -506,7 +524,7 @@ int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
 		const Eigen::Vector3d tn = dR * t + d.head<3>();
 		Pass nxt =
 		    pass(Lr, samples, Rn, tn, offset, photoSigma, p, &rows, nullptr);
-		const double nxtCost = nxt.cost + priorCost(Rn);
+		const double nxtCost = nxt.cost + priorCost(Rn, tn);
 		++steps;
 		if (nxtCost < curCost)
 		{
@@ -524,6 +542,7 @@ int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
 		}
 	}
 	if (inliers) *inliers = cur.inliers;
+	if (information) *information = cur.H;
 	// the next level's photometric scale and brightness offset, from the
 	// residuals at this level's result
 	photoSigma = std::max(p.photo_sigma_grey, cur.photoScaleEstimate());
@@ -571,16 +590,19 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
                             const Eigen::Vector3d& t_init,
                             const AnchorParams& p,
                             const Eigen::Matrix3d* R_prior,
-                            double sigmaPrior_rad)
+                            double sigmaPrior_rad,
+                            const TranslationPrior* tPrior)
 {
-	return alignDense(ref, cur, {{R_init, t_init}}, p, R_prior, sigmaPrior_rad);
+	return alignDense(ref, cur, {{R_init, t_init}}, p, R_prior, sigmaPrior_rad,
+	                  tPrior);
 }
 
 DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
                             const std::vector<InitialGuess>& inits,
                             const AnchorParams& params,
                             const Eigen::Matrix3d* R_prior,
-                            double sigmaPrior_rad)
+                            double sigmaPrior_rad,
+                            const TranslationPrior* tPrior)
 {
 	// the photometric term needs an image in both frames (else depth only)
 	AnchorParams p = params;
@@ -613,6 +635,7 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 	const double sigma0 = std::max(p.photo_sigma_grey, 40.0);
 	double photoSigma = sigma0;
 	NormalEquations6 rows;
+	Mat6 H = Mat6::Zero();  // the data's normal equations at the result
 	int best = -1;
 	int firstInliers = -1;  // the first guess's, before iterating
 	for (size_t k = 0; k < inits.size(); k++)
@@ -622,6 +645,7 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 		float ok = 0;
 		double sk = sigma0;
 		int inl = 0;
+		Mat6 Hk = Mat6::Zero();
 		// A later guess is iterated only when it starts with more inliers
 		// than the first one did (the frame-to-frame guess is usually the
 		// better one: 4 Gauss-Newton passes saved; docs/ego.md). A single
@@ -641,12 +665,14 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 			else if (start <= firstInliers)
 				continue;
 		}
-		r.iterations += iterateLevel(
-		    ref.levels[static_cast<size_t>(top)], coarse, Rk, tk, ok, sk, p,
-		    R_prior, sigmaPrior_rad, rows, &inl, reuse ? &counted : nullptr);
+		r.iterations +=
+		    iterateLevel(ref.levels[static_cast<size_t>(top)], coarse, Rk, tk,
+		                 ok, sk, p, R_prior, sigmaPrior_rad, tPrior, rows, &inl,
+		                 reuse ? &counted : nullptr, &Hk);
 		if (inl > best)
 		{
 			best = inl;
+			H = Hk;
 			R = Rk;
 			t = tk;
 			offset = ok;
@@ -658,9 +684,10 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 	for (int l = top - 1; l >= fine; l--)
 	{
 		samples = samplesOf(cur.levels[static_cast<size_t>(l)], strideAt(l));
-		r.iterations += iterateLevel(ref.levels[static_cast<size_t>(l)],
-		                             samples, R, t, offset, photoSigma, p,
-		                             R_prior, sigmaPrior_rad, rows, nullptr);
+		r.iterations +=
+		    iterateLevel(ref.levels[static_cast<size_t>(l)], samples, R, t,
+		                 offset, photoSigma, p, R_prior, sigmaPrior_rad, tPrior,
+		                 rows, nullptr, nullptr, l == fine ? &H : nullptr);
 	}
 	// Final counts and the outlier image at the finest level.
 	const DenseLevel& Lf = cur.levels[static_cast<size_t>(fine)];
@@ -678,6 +705,7 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 	}
 	r.R_RC = orthonormalize(R);
 	r.t_RC = t;
+	r.information = H;
 	r.points = 0;
 	for (const Sample& q : samples) r.points += q.excluded ? 0 : 1;
 	r.associated = fin.associated;
@@ -697,6 +725,21 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 		r.why = "inlier fraction " + std::to_string(r.inlier_fraction);
 	r.ok = r.why.empty();
 	return r;
+}
+
+Eigen::Matrix3d translationInformation(const Eigen::Matrix<double, 6, 6>& H,
+                                       double rotationPriorInfo)
+{
+	const Eigen::Matrix3d Htt = H.topLeftCorner<3, 3>();
+	if (std::isinf(rotationPriorInfo)) return Htt;
+	Eigen::Matrix3d Hrr = H.bottomRightCorner<3, 3>();
+	Hrr.diagonal().array() += rotationPriorInfo;
+	const Eigen::Matrix3d Htr = H.topRightCorner<3, 3>();
+	const Eigen::LDLT<Eigen::Matrix3d> ldlt(Hrr);
+	if (ldlt.info() != Eigen::Success || Hrr.diagonal().minCoeff() <= 0)
+		return Eigen::Matrix3d::Zero();
+	const Eigen::Matrix3d S = Htt - Htr * ldlt.solve(Htr.transpose());
+	return 0.5 * (S + S.transpose());
 }
 
 }  // namespace bims::ego

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace bims::ego
 {
@@ -48,12 +49,11 @@ KeyframeAnchor::Keyframe* KeyframeAnchor::nearest(
 	return best;
 }
 
-AnchorResult KeyframeAnchor::track(const RgbdFrame& f,
-                                   const Eigen::Matrix3d& R_pred,
-                                   const Eigen::Vector3d& t_pred,
-                                   const std::vector<InitialGuess>& others,
-                                   const Eigen::Matrix3d* R_prior,
-                                   const cv::Mat& moving)
+AnchorResult KeyframeAnchor::track(
+    const RgbdFrame& f, const Eigen::Matrix3d& R_pred,
+    const Eigen::Vector3d& t_pred, const std::vector<InitialGuess>& others,
+    const Eigen::Matrix3d* R_prior, const cv::Mat& moving,
+    const TranslationPrior* tPrior, const AnchorGate* gate)
 {
 	const auto t0 = std::chrono::steady_clock::now();
 	AnchorResult r;
@@ -71,7 +71,8 @@ AnchorResult KeyframeAnchor::track(const RgbdFrame& f,
 		r.why = "no keyframe yet";
 		return r;
 	}
-	Attempt best = alignTo(*k, R_pred, t_pred, others, R_prior, r);
+	Attempt best =
+	    alignTo(*k, R_pred, t_pred, others, R_prior, r, tPrior, gate);
 	// The nearest keyframe may be an old one the pose has drifted from (a
 	// correction too large to take): the newest keyframe then anchors it.
 	// Or it may hold too little static scene (made while a mover filled the
@@ -92,7 +93,8 @@ AnchorResult KeyframeAnchor::track(const RgbdFrame& f,
 		if (!q || std::find(tried.begin(), tried.end(), q) != tried.end())
 			continue;
 		tried.push_back(q);
-		Attempt again = alignTo(*q, R_pred, t_pred, others, R_prior, best.r);
+		Attempt again =
+		    alignTo(*q, R_pred, t_pred, others, R_prior, best.r, tPrior, gate);
 		if (again.r.accepted &&
 		    (!best.r.accepted || again.r.inliers > best.r.inliers))
 			best = std::move(again);
@@ -102,7 +104,8 @@ AnchorResult KeyframeAnchor::track(const RgbdFrame& f,
 	if (!best.r.accepted && !moving.empty())
 	{
 		for (DenseLevel& L : cur_.levels) L.exclude.release();
-		Attempt again = alignTo(*k, R_pred, t_pred, others, R_prior, best.r);
+		Attempt again =
+		    alignTo(*k, R_pred, t_pred, others, R_prior, best.r, tPrior, gate);
 		if (again.r.accepted)
 		{
 			best = std::move(again);
@@ -132,7 +135,8 @@ void KeyframeAnchor::take(Attempt& a)
 KeyframeAnchor::Attempt KeyframeAnchor::alignTo(
     Keyframe& k, const Eigen::Matrix3d& R_pred, const Eigen::Vector3d& t_pred,
     const std::vector<InitialGuess>& others, const Eigen::Matrix3d* R_prior,
-    const AnchorResult& start)
+    const AnchorResult& start, const TranslationPrior* tPrior,
+    const AnchorGate* gate)
 {
 	Attempt out{start, &k, cv::Mat(), {}};
 	AnchorResult& r = out.r;
@@ -145,9 +149,24 @@ KeyframeAnchor::Attempt KeyframeAnchor::alignTo(
 		    {k.R_WK.transpose() * g.R, k.R_WK.transpose() * (g.t - k.t_WK)});
 	Eigen::Matrix3d R_KCprior;
 	if (R_prior) R_KCprior = k.R_WK.transpose() * *R_prior;
+	// the translation prior in the keyframe's frame: t_KC = R_WK^T (t - t_WK)
+	TranslationPrior tK;
+	if (tPrior)
+	{
+		tK.t = k.R_WK.transpose() * (tPrior->t - k.t_WK);
+		tK.info = k.R_WK.transpose() * tPrior->info * k.R_WK;
+	}
+	const double sigmaRot = p_.rotation_prior_sigma_deg * kDeg;
 	const DenseAlignResult a =
 	    alignDense(k.frame, cur_, inits, p_, R_prior ? &R_KCprior : nullptr,
-	               p_.rotation_prior_sigma_deg * kDeg);
+	               sigmaRot, tPrior ? &tK : nullptr);
+	const double rotationInfo = !R_prior ? 0.0
+	                            : sigmaRot > 0
+	                                ? 1 / (sigmaRot * sigmaRot)
+	                                : std::numeric_limits<double>::infinity();
+	r.position_information =
+	    k.R_WK * translationInformation(a.information, rotationInfo) *
+	    k.R_WK.transpose();
 	r.tried = true;
 	r.keyframe = k.id;
 	r.points = a.points;
@@ -194,6 +213,12 @@ KeyframeAnchor::Attempt KeyframeAnchor::alignTo(
 			r.relocalised = true;
 		else
 			r.why = "correction too large";
+	}
+	r.gated = false;
+	if (r.why.empty() && gate && !(*gate)(t_WC, r.position_information))
+	{
+		r.gated = true;
+		r.why = "inconsistent with the inertial prediction";
 	}
 	if (!r.why.empty()) return out;
 	r.accepted = true;

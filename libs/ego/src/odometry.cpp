@@ -55,8 +55,15 @@ Odometry::Odometry(const EgoConfig& cfg)
       att_(cfg.attitude),
       klt_(cfg.tracker),
       est_(cfg.translation),
-      anchor_(cfg.anchor)
+      anchor_(cfg.anchor),
+      inertial_(cfg.inertial)
 {
+}
+
+bool Odometry::inertialOn() const
+{
+	return cfg_.inertial.enable && cfg_.odometry.mode == OdometryMode::Imu &&
+	       cfg_.calibration.has_R_IC;
 }
 
 uint32_t Odometry::addImu(const mrpt::obs::CObservationIMU& obs)
@@ -69,6 +76,7 @@ uint32_t Odometry::addImu(const mrpt::obs::CObservationIMU& obs)
 
 uint32_t Odometry::addImu(const ImuSample& s)
 {
+	if (s.hasAcc && inertialOn()) inertial_.addAccel(s.t, s.acc);
 	return att_.add(s);
 }
 
@@ -143,7 +151,10 @@ FrameEgomotion Odometry::processFrame(const RgbdFrame& f, const cv::Mat* mask)
 	const auto t2 = std::chrono::steady_clock::now();
 	FrameToFrame m = estimate(f, imu, r);
 	predictPose(imu, m, r);
-	if (cfg_.anchor.enable) anchorToKeyframes(f, mask, m, r);
+	const std::optional<InertialPrediction> in = predictInertial(f, r);
+	if (in) m.t_rel = R_WCprev_.transpose() * (t_WC_ - t_WCprev_);
+	if (cfg_.anchor.enable)
+		anchorToKeyframes(f, mask, in ? &*in : nullptr, m, r);
 	r.ms_motion = msSince(t2);
 	commit(f, imu, m, r);
 	return r;
@@ -208,6 +219,8 @@ FrameEgomotion Odometry::firstFrame(const RgbdFrame& f,
 		r.R_source = RotationSource::Imu;
 	}
 	T_WC_ = toPose(R_WC_, t_WC_);
+	if (inertialOn())
+		inertial_.initialize(f.t + cfg_.calibration.time_offset_s, t_WC_);
 	const auto t1 = std::chrono::steady_clock::now();
 	if (f.hasImage())
 		klt_.track(f.grey, f.K, nullptr, mask);
@@ -410,17 +423,63 @@ void Odometry::predictPose(const ImuPrediction& imu, const FrameToFrame& m,
 	}
 }
 
+std::optional<Odometry::InertialPrediction> Odometry::predictInertial(
+    const RgbdFrame& f, FrameEgomotion& r)
+{
+	if (!inertialOn()) return std::nullopt;
+	const double off = cfg_.calibration.time_offset_s;
+	// (re)started where the world was turned to the IMU's first attitude
+	if (!inertial_.initialized() || (r.flags & kFlagWorldReanchored))
+		inertial_.initialize(tPrev_ + off, t_WCprev_);
+	// R_WI at IMU time tau: the previous frame's, carried by the gyro chain
+	// (without it, this frame's predicted rotation)
+	const Eigen::Matrix3d R_CI = cfg_.calibration.R_IC.transpose();
+	const Eigen::Matrix3d R_WIprev = R_WCprev_ * R_CI;
+	const Eigen::Matrix3d R_WInow = R_WC_ * R_CI;
+	const auto qPrev = att_.gyroAttitudeAt(tPrev_ + off);
+	const auto R_WI = [&](double tau) -> std::optional<Eigen::Matrix3d>
+	{
+		if (qPrev)
+			if (const auto q = att_.gyroAttitudeAt(tau))
+				return Eigen::Matrix3d(
+				    R_WIprev * (qPrev->conjugate() * *q).toRotationMatrix());
+		return R_WInow;
+	};
+	const InertialPropagation pr = inertial_.propagate(f.t + off, R_WI);
+	if (pr.prior_s > 0) r.flags |= kFlagInertialPrior;
+	if (pr.saturated) r.flags |= kFlagAccelSaturated;
+	InertialPrediction out;
+	out.t_frameToFrame = t_WC_;
+	out.prior.t = inertial_.state().p_WC;
+	// the alignment weighs its data unscaled: the prior's information in
+	// the same units (the filter scales the data instead)
+	out.prior.info = inertial_.positionInformation() /
+	                 cfg_.inertial.alignment_information_scale;
+	t_WC_ = out.prior.t;
+	r.inertial = true;
+	return out;
+}
+
 void Odometry::anchorToKeyframes(const RgbdFrame& f, const cv::Mat* mask,
-                                 FrameToFrame& m, FrameEgomotion& r)
+                                 const InertialPrediction* in, FrameToFrame& m,
+                                 FrameEgomotion& r)
 {
 	// Measure the pose against the static scene, from the
 	// frame-to-frame guess (and the IMU rotation as the prior).
 	// The frame-to-frame estimate first; the constant-velocity
 	// prediction as a second guess (features on people can corrupt the
 	// first).
-	const InitialGuess constVel{
-	    m.useImu ? R_WC_ : Eigen::Matrix3d(R_WCprev_ * lastR_rel_),
-	    t_WCprev_ + R_WCprev_ * lastT_rel_};
+	// With the inertial prediction as the first guess, the frame-to-frame
+	// estimate is the second.
+	const InitialGuess second =
+	    in ? InitialGuess{R_WC_, in->t_frameToFrame}
+	       : InitialGuess{
+	             m.useImu ? R_WC_ : Eigen::Matrix3d(R_WCprev_ * lastR_rel_),
+	             t_WCprev_ + R_WCprev_ * lastT_rel_};
+	const double infoScale = cfg_.inertial.alignment_information_scale;
+	const AnchorGate gate =
+	    [this, infoScale](const Eigen::Vector3d& t, const Eigen::Matrix3d& info)
+	{ return inertial_.check(t, infoScale * info).accepted; };
 	const Eigen::Matrix3d R_prior = R_WC_;
 	// The previous frame's movers where they are expected in this one,
 	// with the motion predicted as for the alignment's second guess (the
@@ -441,8 +500,9 @@ void Odometry::anchorToKeyframes(const RgbdFrame& f, const cv::Mat* mask,
 			exclude.release();
 		}
 	}
-	r.anchor = anchor_.track(f, R_WC_, t_WC_, {constVel},
-	                         m.useImu ? &R_prior : nullptr, exclude);
+	r.anchor =
+	    anchor_.track(f, R_WC_, t_WC_, {second}, m.useImu ? &R_prior : nullptr,
+	                  exclude, in ? &in->prior : nullptr, in ? &gate : nullptr);
 	r.anchor.excluded_fraction = excluded;
 	r.ms_anchor = r.anchor.ms;
 	if (r.anchor.maskIgnored) r.flags |= kFlagMaskIgnored;
@@ -451,6 +511,17 @@ void Odometry::anchorToKeyframes(const RgbdFrame& f, const cv::Mat* mask,
 	{
 		R_WC_ = orthonormalize(r.anchor.R_WC);
 		t_WC_ = r.anchor.t_WC;
+		if (in)
+		{
+			// the position the filter keeps: the alignment's where it
+			// measured, the prediction along what it left unconstrained
+			const InertialUpdate u = inertial_.update(
+			    t_WC_, infoScale * r.anchor.position_information);
+			r.degenerate = u.degeneracy.count;
+			r.inertial_nis = u.nis;
+			r.position_information = u.degeneracy.eigenvalues;
+			t_WC_ = inertial_.state().p_WC;
+		}
 		m.R_rel = R_WCprev_.transpose() * R_WC_;
 		m.t_rel = R_WCprev_.transpose() * (t_WC_ - t_WCprev_);
 		r.flags |= kFlagAnchored;
@@ -461,6 +532,16 @@ void Odometry::anchorToKeyframes(const RgbdFrame& f, const cv::Mat* mask,
 	else if (r.anchor.tried)
 	{
 		r.flags |= kFlagAnchorFailed;
+		if (r.anchor.gated) r.flags |= kFlagInertialRejected;
+		if (in)
+		{
+			const Degeneracy d =
+			    analyseDegeneracy(infoScale * r.anchor.position_information,
+			                      cfg_.inertial.degenerate_sigma_m,
+			                      cfg_.inertial.degenerate_ratio);
+			r.degenerate = d.count;
+			r.position_information = d.eigenvalues;
+		}
 		lost = ++anchorFailures_ >= cfg_.anchor.lost_frames;
 	}
 	if (lost)
@@ -470,6 +551,7 @@ void Odometry::anchorToKeyframes(const RgbdFrame& f, const cv::Mat* mask,
 		r.flags |= kFlagAnchorLost;
 		anchorFailures_ = 0;
 	}
+	if (r.degenerate > 0) r.flags |= kFlagDegenerate;
 	anchor_.wantKeyframe(r.anchor, R_WC_, t_WC_,
 	                     lost || (r.flags & kFlagWorldReanchored));
 }
@@ -482,6 +564,11 @@ void Odometry::commit(const RgbdFrame& f, const ImuPrediction& imu,
 	T_WC_ = toPose(R_WC_, t_WC_);
 	r.T_WC = T_WC_;
 	r.T_CprevC = toPose(m.R_rel, m.t_rel);
+	if (r.inertial)
+	{
+		r.v_W = inertial_.state().v_W;
+		r.acc_bias = inertial_.state().b_a;
+	}
 	tPrev_ = f.t;
 	depthPrev_ = f.depth.clone();
 	R_WC_imuPrev_ = imu.R_WC;
@@ -514,6 +601,9 @@ mrpt::poses::CPose3D Odometry::correctLastMotion(
 	lastR_rel_ = R;
 	lastT_rel_ = t;
 	T_WC_ = toPose(R_WC_, t_WC_);
+	// the filter's position follows (its uncertainty stays)
+	if (inertialOn() && inertial_.initialized())
+		inertial_.resetPosition(t_WC_, 0);
 	return T_WC_;
 }
 

@@ -166,6 +166,49 @@ void OdometryParams::loadFromConfigFile(
 	readOptions(*this, cfg, section);
 }
 
+void InertialParams::describe(OptionVisitor& v)
+{
+	v.flag("enable", enable,
+	       "depth-inertial translation: the IMU predicts each frame's "
+	       "position, the alignment corrects what the depth constrains");
+	v.real("acc_noise_density", acc_noise_density, 1e-5, 10,
+	       "accelerometer white noise as the filter sees it [m/s^2/sqrt(Hz)]");
+	v.real("acc_bias_walk", acc_bias_walk, 0, 1,
+	       "accelerometer bias random walk [m/s^3/sqrt(Hz)]");
+	v.real("gravity_walk", gravity_walk, 0, 1,
+	       "random walk of gravity in the odometry's world [m/s^2/sqrt(s)]");
+	v.real("motion_accel_density", motion_accel_density, 1e-3, 100,
+	       "without accelerometer samples: a hand-held camera's random "
+	       "acceleration [m/s^2/sqrt(Hz)]");
+	v.real("init_velocity_sigma", init_velocity_sigma, 1e-3, 100,
+	       "velocity uncertainty at the first frame [m/s]");
+	v.real("init_acc_bias_sigma", init_acc_bias_sigma, 1e-4, 10,
+	       "accelerometer bias uncertainty at the first frame [m/s^2]");
+	v.real("init_gravity_sigma", init_gravity_sigma, 1e-4, 10,
+	       "gravity uncertainty at the first frame [m/s^2]");
+	v.real("alignment_information_scale", alignment_information_scale, 1e-6, 1,
+	       "the alignment's information is scaled by this (its points' "
+	       "errors are not independent)");
+	v.real("degenerate_sigma_m", degenerate_sigma_m, 1e-5, 10,
+	       "a direction the depth pins to worse than this in one frame is "
+	       "degenerate [m]");
+	v.real("degenerate_ratio", degenerate_ratio, 0, 1,
+	       "... or whose information is below this share of the best-known "
+	       "direction's (0: off)");
+	v.real("gate_sigma", gate_sigma, 1, 100,
+	       "an alignment whose innovation lies beyond this many standard "
+	       "deviations is refused");
+	v.real("accel_range_ms2", accel_range_ms2, 1, 10000,
+	       "accelerometer samples with a component at or beyond this are "
+	       "saturated and left out [m/s^2]");
+}
+
+void InertialParams::loadFromConfigFile(
+    const mrpt::config::CConfigFileBase& cfg, const std::string& section)
+{
+	readOptions(*this, cfg, section);
+}
+
 void AnchorParams::describe(OptionVisitor& v)
 {
 	v.flag("enable", enable,
@@ -250,6 +293,7 @@ void EgoConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
 	translation.loadFromConfigFile(cfg);
 	odometry.loadFromConfigFile(cfg);
 	anchor.loadFromConfigFile(cfg);
+	inertial.loadFromConfigFile(cfg);
 	SensorConfig::loadFromConfigFile(
 	    cfg, requireCalibration && odometry.mode == OdometryMode::Imu);
 }

@@ -98,6 +98,7 @@ void forEachSection(Config& c, F&& f)
 	f("translation", c.ego.translation);
 	f("odometry", c.ego.odometry);
 	f("anchor", c.ego.anchor);
+	f("inertial", c.ego.inertial);
 	f("flow", c.flow);
 	f("grids", c.grids);
 	f("pipeline", c.pipeline);

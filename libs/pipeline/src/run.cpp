@@ -51,6 +51,13 @@ void checkFiniteOutputs(const FrameResult& r)
 
 namespace
 {
+/** The frames flagged \a name (its ego flag's name). */
+size_t flaggedBy(const RunSummary& s, const char* name)
+{
+	const auto it = s.framesFlaggedBy.find(name);
+	return it == s.framesFlaggedBy.end() ? 0 : it->second;
+}
+
 /** cv::setNumThreads(n) for the lifetime of the object (n > 0), then the
  * previous setting again. */
 class OpenCvThreads
@@ -259,6 +266,28 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		    "(rotation and translation from the tracked 3D features, the "
 		    "tracker seeded at constant velocity), each flagged "
 		    "imu_missing");
+	if (const size_t n = flaggedBy(sum, "degenerate"))
+		sum.notes.push_back(
+		    std::to_string(n) + " of " + std::to_string(sum.framesProcessed) +
+		    " frames were degenerate: their depth left directions of the "
+		    "position unconstrained (a wall, a corridor, glass; frames.csv "
+		    "degenerate_dirs), the inertial prediction carried those");
+	if (const size_t n = flaggedBy(sum, "inertial_rejected"))
+		sum.notes.push_back(
+		    std::to_string(n) +
+		    " alignments disagreed with the IMU's prediction beyond its "
+		    "uncertainty and were refused (inertial_rejected): the prediction "
+		    "stood");
+	if (const size_t n = flaggedBy(sum, "inertial_prior"))
+		sum.notes.push_back(
+		    std::to_string(n) +
+		    " frames had intervals without accelerometer samples (a gap, an "
+		    "IMU that stopped, stamps on another clock): constant velocity "
+		    "carried them (inertial_prior)");
+	if (const size_t n = flaggedBy(sum, "accel_saturated"))
+		sum.notes.push_back(std::to_string(n) +
+		                    " frames had saturated accelerometer samples, left "
+		                    "out ([inertial] accel_range_ms2)");
 	if (sum.framesWithoutFlow > 0)
 		sum.notes.push_back(
 		    std::to_string(sum.framesWithoutFlow) + " of " +

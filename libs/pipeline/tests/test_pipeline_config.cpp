@@ -160,9 +160,10 @@ TEST(PipelineConfig, EffectiveIniHasEverySectionAndAMeaningPerKey)
 	// (bims-import-tum's), [import_stray] (bims-import-stray's) and
 	// [import_bag] (bims-import-bag's)
 	EXPECT_EQ(sections.size(), bims::experimentSections().size() - 4);
-	for (const char* s : {"sensors", "calibration", "depth_correction",
-	                      "attitude", "tracker", "translation", "odometry",
-	                      "anchor", "flow", "grids", "pipeline", "output"})
+	for (const char* s :
+	     {"sensors", "calibration", "depth_correction", "attitude", "tracker",
+	      "translation", "odometry", "anchor", "inertial", "flow", "grids",
+	      "pipeline", "output"})
 		EXPECT_TRUE(m.sectionExists(s)) << s;
 	EXPECT_NE(text.find("\ndecay = raycast // "), std::string::npos);
 	EXPECT_NE(text.find("\nvariant = fused // "), std::string::npos);

@@ -109,6 +109,13 @@ struct DenseAlignResult
 	 * ones too) lies on the reference's surface within the gate and Tukey's
 	 * limit: it agrees with the static scene. */
 	cv::Mat consistent;
+	/** The normal equations of the data alone (no prior) at the result,
+	 * finest level: H = sum w J^T J over the increment (v, w) of T_RC
+	 * (translation first, reference frame), residuals in their noise's
+	 * units: the information the frame's depth (and image) gives about its
+	 * pose [1/m^2, 1/(m rad), 1/rad^2]. */
+	Eigen::Matrix<double, 6, 6> information =
+	    Eigen::Matrix<double, 6, 6>::Zero();
 	/** Reference pixels (finest level, v * width + u) that a current point
 	 * lies behind by more than the gate: the reference's surface there has
 	 * moved away (a static surface is never seen through). */
@@ -120,6 +127,15 @@ struct InitialGuess
 {
 	Eigen::Matrix3d R;
 	Eigen::Vector3d t;
+};
+
+/** A Gaussian prior on the translation t_RC (e.g. the inertial
+ * prediction): mean \a t, information \a info (3x3, reference frame,
+ * [1/m^2]). */
+struct TranslationPrior
+{
+	Eigen::Vector3d t = Eigen::Vector3d::Zero();
+	Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
 };
 
 // The per-point terms of alignDense(), on a current point moved by the pose
@@ -182,13 +198,16 @@ inline void photometricJacobian(T X, T Y, T Z, T iz, T gx, T gy, T fx, T fy,
 /** Aligns \a cur to \a ref (ref.isReference()) from the initial guess
  * (R_init, t_init) = T_RC. \param R_prior optional prior on R_RC with
  * std. dev. \a sigmaPrior_rad (the IMU's rotation); sigmaPrior_rad = 0
- * holds the rotation at R_prior and estimates the translation only. */
+ * holds the rotation at R_prior and estimates the translation only.
+ * \param tPrior optional prior on t_RC (the IMU's prediction): the
+ * result is the most probable pose given the data and both priors. */
 DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
                             const Eigen::Matrix3d& R_init,
                             const Eigen::Vector3d& t_init,
                             const AnchorParams& p,
                             const Eigen::Matrix3d* R_prior = nullptr,
-                            double sigmaPrior_rad = 0);
+                            double sigmaPrior_rad = 0,
+                            const TranslationPrior* tPrior = nullptr);
 
 /** Same, from several initial guesses (the photometric term only when both
  * frames have an image): each is iterated at the coarsest
@@ -200,6 +219,15 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
                             const std::vector<InitialGuess>& inits,
                             const AnchorParams& p,
                             const Eigen::Matrix3d* R_prior = nullptr,
-                            double sigmaPrior_rad = 0);
+                            double sigmaPrior_rad = 0,
+                            const TranslationPrior* tPrior = nullptr);
+
+/** The information the data give about the translation alone (3x3, the
+ * reference frame [1/m^2]): the translation block of \a H with the
+ * rotation marginalised out (Schur complement), the rotation's prior
+ * information \a rotationPriorInfo [1/rad^2] added to its block first (a
+ * rotation held fixed: pass infinity). */
+Eigen::Matrix3d translationInformation(const Eigen::Matrix<double, 6, 6>& H,
+                                       double rotationPriorInfo);
 
 }  // namespace bims::ego

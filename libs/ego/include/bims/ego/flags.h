@@ -59,6 +59,20 @@ enum EgoFlag : uint32_t
 	 * alignment found those regions on the static keyframe's surface
 	 * ([anchor] mask_veto_consistent). */
 	kFlagMaskVetoed = 1u << 19,
+	/** The depth alignment left directions of the position unconstrained
+	 * ([inertial] degenerate_sigma_m; FrameEgomotion::degenerate says how
+	 * many): along them the inertial prediction stands. */
+	kFlagDegenerate = 1u << 20,
+	/** The alignment disagreed with the inertial prediction beyond
+	 * [inertial] gate_sigma: refused, the prediction stands. */
+	kFlagInertialRejected = 1u << 21,
+	/** Part of the interval had no accelerometer sample (a gap, an IMU
+	 * that stopped or runs on another clock): the motion prior (constant
+	 * velocity) carried it. */
+	kFlagInertialPrior = 1u << 22,
+	/** An accelerometer sample at or beyond [inertial] accel_range_ms2 was
+	 * left out (saturated). */
+	kFlagAccelSaturated = 1u << 23,
 };
 
 /** The names of the set bits, in bit order ("imu_gap", "too_few_tracks");

@@ -18,6 +18,7 @@
 #include <opencv2/core.hpp>
 
 #include <deque>
+#include <functional>
 #include <vector>
 
 namespace bims::ego
@@ -37,18 +38,31 @@ struct AnchorResult
 	/** Keyframe readings this frame saw through (dropped from it). */
 	int seen_through = 0;
 	double correction_m = 0, correction_deg = 0;  ///< anchored vs predicted
+	/** The information the alignment's data alone give about the position
+	 * t_WC (world frame [1/m^2]; the rotation marginalised with its prior),
+	 * of the alignment that anchored the frame (or of the last tried). */
+	Eigen::Matrix3d position_information = Eigen::Matrix3d::Zero();
 	/** Share of the frame's pixels excluded by the moving mask (set by the
 	 * caller, Odometry, that judges the mask). */
 	double excluded_fraction = 0;
 	/** The mask was not used: too large, or the alignment failed with it
 	 * and was accepted without it. */
 	bool maskIgnored = false;
+	/** Refused by the caller's gate (the inertial prediction): the
+	 * alignment disagreed with it beyond its uncertainty. */
+	bool gated = false;
 	/** Accepted with a correction beyond max_correction_* (the frame fits
 	 * the keyframe almost entirely: the pose had drifted). */
 	bool relocalised = false;
 	cv::Mat outliers;  ///< alignment outliers (finest level), or empty
 	double ms = 0;     ///< time of this frame's anchoring [ms]
 };
+
+/** The caller's test of an alignment it is offered: the anchored t_WC and
+ * the information its data give about it (world frame); false refuses it
+ * (AnchorResult::gated) and the other keyframes are tried. */
+using AnchorGate = std::function<bool(const Eigen::Vector3d& t_WC,
+                                      const Eigen::Matrix3d& information_W)>;
 
 class KeyframeAnchor
 {
@@ -59,14 +73,19 @@ class KeyframeAnchor
 	 * t_pred) = T_WC. \param others more initial guesses of T_WC (e.g. the
 	 * constant-velocity one; the best at the coarsest level goes on).
 	 * \param R_prior rotation prior (T_WC's rotation, e.g. the IMU's), or
-	 * nullptr. \param moving CV_8UC1 pixels of \a f predicted moving
+	 * nullptr. \param tPrior prior on t_WC (world frame: the inertial
+	 * prediction), or nullptr. \param gate the caller's test of an
+	 * alignment before it is accepted (AnchorGate), or nullptr.
+	 * \param moving CV_8UC1 pixels of \a f predicted moving
 	 * (excluded; the caller judged it not too large), or empty. An
 	 * alignment that fails with it is tried once more without it
 	 * (maskIgnored). Keeps \a f for addPending(). */
 	AnchorResult track(const RgbdFrame& f, const Eigen::Matrix3d& R_pred,
 	                   const Eigen::Vector3d& t_pred,
 	                   const std::vector<InitialGuess>& others,
-	                   const Eigen::Matrix3d* R_prior, const cv::Mat& moving);
+	                   const Eigen::Matrix3d* R_prior, const cv::Mat& moving,
+	                   const TranslationPrior* tPrior = nullptr,
+	                   const AnchorGate* gate = nullptr);
 
 	/** Whether the frame of the last track() should become a keyframe at
 	 * (R_WC, t_WC) (its final pose): no keyframe yet, its keyframe covers
@@ -116,7 +135,8 @@ class KeyframeAnchor
 	Attempt alignTo(Keyframe& k, const Eigen::Matrix3d& R_pred,
 	                const Eigen::Vector3d& t_pred,
 	                const std::vector<InitialGuess>& others,
-	                const Eigen::Matrix3d* R_prior, const AnchorResult& start);
+	                const Eigen::Matrix3d* R_prior, const AnchorResult& start,
+	                const TranslationPrior* tPrior, const AnchorGate* gate);
 	/** Takes the chosen alignment, when accepted: its outlier and
 	 * consistent images (the keyframe the frame may become, the veto) and
 	 * what the frame saw through of its keyframe dropped from it. */

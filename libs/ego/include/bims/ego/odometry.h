@@ -19,6 +19,7 @@
 
 #include <bims/ego/attitude_filter.h>
 #include <bims/ego/gyro_klt.h>
+#include <bims/ego/inertial_filter.h>
 #include <bims/ego/keyframe_anchor.h>
 #include <bims/ego/params.h>
 #include <bims/ego/rgbd_input.h>
@@ -62,7 +63,19 @@ struct FrameEgomotion
 	/** Share of the fed-back moving mask's pixels the geometry vetoed
 	 * (KeyframeAnchor::vetoMask; kFlagMaskVetoed). */
 	double mask_vetoed = 0;
-	double ms_input = 0, ms_track = 0, ms_motion = 0;  ///< stage times [ms]
+	/** The depth-inertial translation ([inertial]): whether the filter
+	 * carried this frame, the directions of its position the alignment left
+	 * unconstrained (-1: no alignment analysed), its innovation (NIS) and
+	 * the filter's velocity and accelerometer bias after the frame. */
+	bool inertial = false;
+	int degenerate = -1;
+	double inertial_nis = 0;
+	/** Eigenvalues of the alignment's position information as the filter
+	 * took it, ascending [1/m^2]. */
+	Eigen::Vector3d position_information = Eigen::Vector3d::Zero();
+	Eigen::Vector3d v_W = Eigen::Vector3d::Zero();       ///< [m/s]
+	Eigen::Vector3d acc_bias = Eigen::Vector3d::Zero();  ///< {I} [m/s^2]
+	double ms_input = 0, ms_track = 0, ms_motion = 0;    ///< stage times [ms]
 	double ms_anchor = 0;  ///< of ms_motion: the keyframe alignment [ms]
 	TrackerStats tracker;  ///< KLT counters of this frame
 	/** Previous-image positions of all features the KLT tried [px]. */
@@ -169,10 +182,28 @@ class Odometry
 	 * converges; the world turned to the IMU's first attitude). */
 	void predictPose(const ImuPrediction& imu, const FrameToFrame& m,
 	                 FrameEgomotion& r);
+	/** The inertial prediction of the frame's position ([inertial]): the
+	 * alignment's translation prior, and the frame-to-frame position it
+	 * replaces as the prediction (the alignment's second guess). */
+	struct InertialPrediction
+	{
+		TranslationPrior prior;  ///< t_WC and the information for the fit
+		Eigen::Vector3d t_frameToFrame;
+	};
+	/** Propagates the filter to the frame (nullopt when it is off): the
+	 * prediction becomes the frame's position. */
+	std::optional<InertialPrediction> predictInertial(const RgbdFrame& f,
+	                                                  FrameEgomotion& r);
 	/** The pose measured against the static scene's keyframes ([anchor]):
-	 * when accepted it replaces the prediction and \a m's motion. */
+	 * when accepted it replaces the prediction and \a m's motion; with the
+	 * inertial prediction \a in as the translation's prior and gate, and
+	 * the filter updated with the accepted alignment. */
 	void anchorToKeyframes(const RgbdFrame& f, const cv::Mat* mask,
-	                       FrameToFrame& m, FrameEgomotion& r);
+	                       const InertialPrediction* in, FrameToFrame& m,
+	                       FrameEgomotion& r);
+	/** Whether the depth-inertial filter runs ([inertial] enable, mode imu
+	 * with R_IC). */
+	bool inertialOn() const;
 	/** The frame becomes the next one's previous. */
 	void commit(const RgbdFrame& f, const ImuPrediction& imu,
 	            const FrameToFrame& m, FrameEgomotion& r);
@@ -187,6 +218,7 @@ class Odometry
 	GyroAidedKLT klt_;
 	TranslationEstimator est_;
 	KeyframeAnchor anchor_;
+	InertialFilter inertial_;
 	int anchorFailures_ = 0;  // frames in a row without an accepted anchor
 	bool lastAnchored_ = false;
 	bool havePrev_ = false;

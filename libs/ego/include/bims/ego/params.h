@@ -221,6 +221,64 @@ struct OdometryParams
 	                        const std::string& section = "odometry");
 };
 
+/** [inertial]: the depth-inertial translation (InertialFilter,
+ * docs/ego.md "Depth-inertial translation"). With accelerometer samples
+ * (mode = imu) the camera's position, velocity, the accelerometer's bias
+ * and gravity are filtered: the IMU predicts each frame's position and its
+ * uncertainty, the keyframe alignment takes that as its prior and measures
+ * what the depth constrains; what it does not constrain (a blank wall, a
+ * corridor, glass) keeps the inertial prediction. The noise figures are a
+ * phone's or a robot's MEMS IMU held in a hand, with the rotation's and the
+ * clock's errors folded in. */
+struct InertialParams
+{
+	/** false: the translation as before (the frame-to-frame and
+	 * constant-velocity guesses, no inertial prior). */
+	bool enable = true;
+	/** Accelerometer white noise as the filter sees it [m/s^2/sqrt(Hz)]:
+	 * the sensor's own (~0.002 on a phone) is the least of it; the
+	 * rotation it is turned into the world with (R_IC known to a few
+	 * degrees on a phone: 0.5 m/s^2 of gravity), the lever arm and the
+	 * clock add far more (measured on the phone captures: docs/ego.md). */
+	double acc_noise_density = 0.2;
+	double acc_bias_walk = 1e-3;  ///< bias random walk [m/s^3/sqrt(Hz)]
+	/** Random walk of gravity in the odometry's world [m/s^2/sqrt(s)] (the
+	 * attitude blend turns that world slowly). */
+	double gravity_walk = 5e-3;
+	/** Where no accelerometer sample covers an interval (a gap, an IMU that
+	 * stopped): constant velocity with a hand-held camera's random
+	 * acceleration of this density [m/s^2/sqrt(Hz)]. */
+	double motion_accel_density = 1.0;
+	double init_velocity_sigma = 0.5;  ///< at the first frame [m/s]
+	double init_acc_bias_sigma = 0.1;  ///< [m/s^2] per axis
+	double init_gravity_sigma = 0.3;   ///< [m/s^2] per axis (~2 deg tilt)
+	/** The alignment's information (its normal equations over the sampled
+	 * points, residuals in their noise's units) times this: neighbouring
+	 * points' errors are not independent (a keyframe's error is shared by
+	 * all its points). */
+	double alignment_information_scale = 0.3;
+	/** A direction of the position the depth pins to worse than this in
+	 * one frame is degenerate (the frame is flagged) [m]. */
+	double degenerate_sigma_m = 0.05;
+	/** ... or whose information is below this share of the best-known
+	 * direction's (a flat wall's noisy normals give its in-plane directions
+	 * ~0.02 of the normal's). 0: off, the default: on the phone captures a
+	 * weak direction still carries information the IMU alone cannot replace
+	 * for long (docs/ego.md). */
+	double degenerate_ratio = 0;
+	/** An alignment whose innovation over the directions it constrains lies
+	 * beyond this many standard deviations (chi-square of their number) is
+	 * refused: the prediction stands (flagged inertial_rejected). */
+	double gate_sigma = 5;
+	/** Accelerometer samples with a component at or beyond this are
+	 * saturated and left out (the motion prior covers them) [m/s^2]; 8 g. */
+	double accel_range_ms2 = 78.0;
+
+	void describe(OptionVisitor& v);
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg,
+	                        const std::string& section = "inertial");
+};
+
 /** [anchor]: map-anchored tracking. Each frame is aligned densely
  * (point-to-plane ICP + photometric, robust Tukey weights, coarse to fine) to
  * a keyframe of the static scene registered in the same world, starting from
@@ -334,6 +392,7 @@ struct EgoConfig : sensors::SensorConfig
 	TranslationParams translation;
 	OdometryParams odometry;
 	AnchorParams anchor;
+	InertialParams inertial;
 
 	/** Reads all sections above (each optional, defaults otherwise);
 	 * R_IC is required when odometry.mode = imu and \a requireCalibration
