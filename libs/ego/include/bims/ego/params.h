@@ -232,9 +232,11 @@ struct OdometryParams
  * clock's errors folded in. */
 struct InertialParams
 {
-	/** false: the translation as before (the frame-to-frame and
-	 * constant-velocity guesses, no inertial prior). */
-	bool enable = true;
+	/** false (the default): the translation as before (the frame-to-frame
+	 * and constant-velocity guesses, no inertial prior). On for the phone
+	 * captures (config/stray.ini); on the simulator's depth-only sample it
+	 * still costs (ATE 0.015 -> 0.027 m: docs/ego.md). */
+	bool enable = false;
 	/** Accelerometer white noise as the filter sees it [m/s^2/sqrt(Hz)]:
 	 * the sensor's own (~0.002 on a phone) is the least of it; the
 	 * rotation it is turned into the world with (R_IC known to a few
