@@ -112,7 +112,8 @@ const char* odometryCsvHeader()
 	       "anchor_overlap,anchor_coverage,anchor_guess,anchor_correction_m,"
 	       "anchor_correction_deg,anchor_excluded,anchor_seen_through,"
 	       "ms_anchor,anchor_note,degenerate_dirs,inertial_nis,"
-	       "position_info_min,position_info_max,vx,vy,vz\n";
+	       "position_info_min,position_info_max,vx,vy,vz,gx,gy,gz,"
+	       "acc_bias_x,acc_bias_y,acc_bias_z\n";
 }
 
 std::string odometryCsvLine(const ego::FrameEgomotion& r,
@@ -124,7 +125,7 @@ std::string odometryCsvLine(const ego::FrameEgomotion& r,
 	    buf, sizeof(buf),
 	    "%.6f,%s,%s,%d,%d,%.5f,%zu,%.3f,%.3f,%.3f,%.3f,%d,%d,"
 	    "%d,%d,%.3f,%.3f,%.3f,%d,%.4f,%.3f,%.3f,%d,%.3f,%s,%d,%.3f,%.4g,%.4g,"
-	    "%.4f,%.4f,%.4f\n",
+	    "%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n",
 	    r.t, ego::flagsToString(r.flags).c_str(), ego::toString(r.R_source),
 	    r.correspondences, r.inliers, r.residual_rms_m, r.tracks.size(),
 	    r.ms_input, r.ms_track, r.ms_motion, truth.rate_deg_s,
@@ -133,7 +134,8 @@ std::string odometryCsvLine(const ego::FrameEgomotion& r,
 	    a.correction_m, a.correction_deg, a.excluded_fraction, a.seen_through,
 	    r.ms_anchor, a.why.empty() ? "-" : a.why.c_str(), r.degenerate,
 	    r.inertial_nis, r.position_information.x(), r.position_information.z(),
-	    r.v_W.x(), r.v_W.y(), r.v_W.z());
+	    r.v_W.x(), r.v_W.y(), r.v_W.z(), r.gravity_W.x(), r.gravity_W.y(),
+	    r.gravity_W.z(), r.acc_bias.x(), r.acc_bias.y(), r.acc_bias.z());
 	return buf;
 }
 

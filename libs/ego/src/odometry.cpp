@@ -568,6 +568,7 @@ void Odometry::commit(const RgbdFrame& f, const ImuPrediction& imu,
 	{
 		r.v_W = inertial_.state().v_W;
 		r.acc_bias = inertial_.state().b_a;
+		r.gravity_W = inertial_.state().g_W;
 	}
 	tPrev_ = f.t;
 	depthPrev_ = f.depth.clone();

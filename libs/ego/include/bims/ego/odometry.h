@@ -75,7 +75,10 @@ struct FrameEgomotion
 	Eigen::Vector3d position_information = Eigen::Vector3d::Zero();
 	Eigen::Vector3d v_W = Eigen::Vector3d::Zero();       ///< [m/s]
 	Eigen::Vector3d acc_bias = Eigen::Vector3d::Zero();  ///< {I} [m/s^2]
-	double ms_input = 0, ms_track = 0, ms_motion = 0;    ///< stage times [ms]
+	/** Gravity in the odometry's world as the filter estimates it [m/s^2]
+	 * (the world's vertical is the attitude filter's first one). */
+	Eigen::Vector3d gravity_W = Eigen::Vector3d::Zero();
+	double ms_input = 0, ms_track = 0, ms_motion = 0;  ///< stage times [ms]
 	double ms_anchor = 0;  ///< of ms_motion: the keyframe alignment [ms]
 	TrackerStats tracker;  ///< KLT counters of this frame
 	/** Previous-image positions of all features the KLT tried [px]. */
