@@ -55,8 +55,15 @@ struct BagTopics
 	std::string mag;         ///< sensor_msgs/MagneticField
 };
 
-/** The preset topics of \a layout (Auto: none). */
+/** The preset topics of \a layout (Auto: none): ROS 1's names. */
 BagTopics layoutTopics(BagLayout layout);
+
+/** Every variant of \a layout's preset, in the order they are tried: ROS
+ * 1's names first (layoutTopics()), then realsense-ros 4.x's ROS 2 names
+ * (/camera/camera/...: aligned depth with colour, else the depth alone,
+ * which is not registered to the colour). The import reads the first whose
+ * depth topic the recording has. */
+std::vector<BagTopics> layoutVariants(BagLayout layout);
 
 /** What bims-import-bag reads from an experiment .ini: [import_bag]
  * (describe()), [camera] (intrinsics overriding the bag's CameraInfo: all
@@ -100,6 +107,8 @@ struct BagImportParams
 /** The topics read with \a layout (not Auto): the preset's, each replaced
  * by the one \a given names ("none": not read). */
 BagTopics resolveTopics(const BagTopics& given, BagLayout layout);
+/** The same over the topics \a preset (a variant of a layout). */
+BagTopics resolveTopics(const BagTopics& given, const BagTopics& preset);
 
 /** One topic of a bag: name, message type, message count. */
 struct BagTopicInfo
