@@ -244,11 +244,10 @@ void McapFile::walk()
 		try
 		{
 			if (len > left && op != kChunk)
-				throw runtime_error(mrpt::format(
-				    "it declares %llu bytes, %llu follow: cut short or "
-				    "damaged",
-				    static_cast<unsigned long long>(len),
-				    static_cast<unsigned long long>(left)));
+				throw runtime_error(
+				    mrpt::format("it declares %llu bytes, %llu follow",
+				                 static_cast<unsigned long long>(len),
+				                 static_cast<unsigned long long>(left)));
 			Cursor c(bytes_ + content, std::min(len, left));
 			switch (op)
 			{
@@ -281,15 +280,14 @@ void McapFile::walk()
 						// cut: an uncompressed chunk's whole records are read
 						ch.cut = true;
 						ch.dataLen = std::min(ch.dataLen, c.left());
-						setDamage(pos,
-						          mrpt::format(
-						              "the chunk at byte %llu: it declares "
-						              "%llu bytes, %llu follow: cut short or "
-						              "damaged",
-						              static_cast<unsigned long long>(pos),
-						              static_cast<unsigned long long>(len),
-						              static_cast<unsigned long long>(left)),
-						          true);
+						setDamage(
+						    pos,
+						    mrpt::format("the chunk at byte %llu: it declares "
+						                 "%llu bytes, %llu follow",
+						                 static_cast<unsigned long long>(pos),
+						                 static_cast<unsigned long long>(len),
+						                 static_cast<unsigned long long>(left)),
+						    true);
 						if (!ch.compression.empty()) return;
 					}
 					items_.push_back({op, pos, content, len,
