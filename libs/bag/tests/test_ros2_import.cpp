@@ -593,6 +593,20 @@ TEST(Ros2Import, RealSenseRos2TopicNamesAreThePresetsAndTheImuIsMerged)
 	EXPECT_TRUE(test::fileText(d + "/rs.rawlog") ==
 	            test::fileText(d + "/db3.rawlog"));
 
+	// without align_depth: the depth alone, in its own camera (the colour,
+	// not registered to it, is not attached)
+	Names unaligned = kRealSense2;
+	unaligned.depth = "/camera/camera/depth/image_rect_raw";
+	unaligned.info = "/camera/camera/depth/camera_info";
+	writeMcap(smallBag(4, unaligned), d + "/unaligned.mcap");
+	const auto u = import(d + "/unaligned.mcap", d + "/unaligned.rawlog");
+	EXPECT_EQ(u.layout, bag::BagLayout::RealSense);
+	EXPECT_EQ(u.frames, 4u);
+	EXPECT_EQ(u.topics.depth, unaligned.depth);
+	EXPECT_TRUE(u.topics.colour.empty());
+	EXPECT_EQ(u.cameraFrom, "CameraInfo /camera/camera/depth/camera_info");
+	EXPECT_FALSE(framesOf(d + "/unaligned.rawlog")[0]->hasIntensityImage);
+
 	// a preset topic of another type: an error naming it
 	Names wrong = kRealSense2;
 	BagSpec b = smallBag(3, wrong);
@@ -862,6 +876,31 @@ TEST(Ros2Import, CdrOfEitherByteOrderIsReadAlignedFromItsHeader)
 	                "not CDR_BE or CDR_LE"));
 }
 
+/** \a mcap with its chunks' and data section's CRCs set to 0 ("not
+ * computed"): a fuzzer's mutations of its chunks then reach the messages. */
+std::string withoutCrcs(std::string mcap)
+{
+	auto u64 = [&](size_t at)
+	{
+		uint64_t v = 0;
+		std::memcpy(&v, mcap.data() + at, 8);
+		return v;
+	};
+	for (size_t pos = 8; pos + 9 <= mcap.size();)
+	{
+		const auto op = static_cast<uint8_t>(mcap[pos]);
+		const size_t content = pos + 9;
+		if (op == 0x06) std::memset(&mcap[content + 24], 0, 4);  // Chunk
+		if (op == 0x0f)                                          // DataEnd
+		{
+			std::memset(&mcap[content], 0, 4);
+			break;
+		}
+		pos = content + static_cast<size_t>(u64(pos + 1));
+	}
+	return mcap;
+}
+
 /** The fuzz targets' seeds (tests/fuzz/corpus/{mcap,db3,cdr}), written
  * when BIMS_WRITE_FUZZ_SEEDS names the corpus folder (docs/fuzz.md). */
 TEST(Ros2Import, FuzzSeeds)
@@ -879,6 +918,9 @@ TEST(Ros2Import, FuzzSeeds)
 	writeMcap(tum, c + "/mcap/seed-tum-lz4.mcap", "lz4", true, 8000);
 	writeMcap(tum, c + "/mcap/seed-tum-nosummary.mcap", "", false, 8000);
 	writeMcap(realsense, c + "/mcap/seed-realsense-zstd.mcap", "zstd");
+	for (const char* f : {"seed-tum", "seed-realsense-zstd"})
+		writeText(c + "/mcap/" + f + "-nocrc.mcap",
+		          withoutCrcs(test::fileText(c + "/mcap/" + f + ".mcap")));
 	writeDb3(tum, c + "/db3/seed-tum.db3");
 	writeDb3(realsense, c + "/db3/seed-realsense.db3");
 	// each message type once, as its CDR bytes after the target's type byte
