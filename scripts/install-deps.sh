@@ -14,7 +14,7 @@ PACKAGES=(
   liboctomap-dev
   librosbag-storage-dev libcv-bridge-dev libsensor-msgs-dev pluginlib-dev
   libroslz4-dev libbz2-dev
-  libzstd-dev liblz4-dev libsqlite3-dev libyaml-cpp-dev zlib1g-dev
+  libzstd-dev liblz4-dev libsqlite3-dev libyaml-cpp-dev
   nodejs
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth imagemagick xdotool x11-apps libgl1-mesa-dri
