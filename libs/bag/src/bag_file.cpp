@@ -193,7 +193,7 @@ BagFile::BagFile(const std::string& path, size_t cacheBytes)
 	    2)
 		throw runtime_error(
 		    "not a readable ROS 1 bag (it does not start with '#ROSBAG "
-		    "V2.0')");
+		    "V2.0'), nor a ROS 2 one (MCAP's magic, sqlite3's header)");
 	if (major != 2 || minor != 0)
 		throw runtime_error("bag format " + std::to_string(major) + "." +
 		                    std::to_string(minor) +

@@ -128,9 +128,10 @@ struct BagSpec
  * "lz4" or another name) at \a out. */
 void writeMcap(BagSpec b, const std::string& out,
                const std::string& compression = "", bool summary = true,
-               size_t chunkSize = 1 << 20)
+               size_t chunkSize = 1 << 20, bool chunks = true)
 {
 	b.spec["out"] = out;
+	b.spec["useChunks"] = chunks;
 	b.spec["compression"] = compression;
 	b.spec["summary"] = summary;
 	b.spec["chunkSize"] = chunkSize;
@@ -619,6 +620,39 @@ TEST(Ros2Import, RealSenseRos2TopicNamesAreThePresetsAndTheImuIsMerged)
 	    << e;
 }
 
+TEST(Ros2Import, ABagFolderOfSeveralFilesIsReadAsOneRecording)
+{
+	SKIP_WITHOUT_WRITER();
+	const auto d = test::freshTmpDir("bims_ros2", "split");
+	const BagSpec whole = smallBag(8, kRealSense2);
+	writeMcap(whole, d + "/whole.mcap", "zstd");
+	import(d + "/whole.mcap", d + "/whole.rawlog");
+	// ros2 bag record --max-bag-size: the messages in log-time order over
+	// the files, each file with every topic
+	BagSpec first = whole, second = whole;
+	auto& all = whole.spec["messages"];
+	first.spec["messages"] = json::array();
+	second.spec["messages"] = json::array();
+	for (size_t k = 0; k < all.size(); k++)
+		(k < all.size() / 2 ? first : second)
+		    .spec["messages"]
+		    .push_back(all[k]);
+	fs::create_directories(d + "/bag");
+	writeMcap(first, d + "/bag/bag_0.mcap", "zstd");
+	writeMcap(second, d + "/bag/bag_1.mcap", "lz4");
+	writeText(d + "/bag/metadata.yaml",
+	          "rosbag2_bagfile_information:\n  version: 5\n"
+	          "  storage_identifier: mcap\n"
+	          "  relative_file_paths:\n  - bag_0.mcap\n  - bag_1.mcap\n");
+	const auto sum = import(d + "/bag", d + "/split.rawlog");
+	EXPECT_EQ(sum.frames, 8u);
+	EXPECT_TRUE(test::fileText(d + "/split.rawlog") ==
+	            test::fileText(d + "/whole.rawlog"));
+	const auto r =
+	    test::runCommand("'" + kImport + "' '" + d + "/bag' --topics");
+	EXPECT_TRUE(has(r.out, "8 messages") && has(r.out, "56 messages")) << r.out;
+}
+
 TEST(Ros2Import, AFolderWhoseMetadataNamesMissingFilesIsAClearError)
 {
 	const auto d = test::freshTmpDir("bims_ros2", "metadata");
@@ -790,6 +824,12 @@ TEST(Ros2Import, ACutShortMcapGivesEveryWholeFrameBeforeTheCut)
 		writeMcap(smallBag(12), d + "/nosummary.mcap", c, false, 6000);
 		import(d + "/nosummary.mcap", d + "/nosummary.rawlog");
 		EXPECT_TRUE(test::fileText(d + "/nosummary.rawlog") ==
+		            test::fileText(d + "/whole.rawlog"))
+		    << c;
+		// messages outside chunks: the same rawlog
+		writeMcap(smallBag(12), d + "/unchunked.mcap", c, true, 6000, false);
+		import(d + "/unchunked.mcap", d + "/unchunked.rawlog");
+		EXPECT_TRUE(test::fileText(d + "/unchunked.rawlog") ==
 		            test::fileText(d + "/whole.rawlog"))
 		    << c;
 		const std::string bytes = test::fileText(whole);
