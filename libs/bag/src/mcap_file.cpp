@@ -275,14 +275,23 @@ void McapFile::walk()
 					{
 						// cut: an uncompressed chunk's whole records are read
 						ch.cut = true;
+						const uint64_t declared = ch.dataLen;
 						ch.dataLen = std::min(ch.dataLen, c.left());
+						const auto u = [](uint64_t v)
+						{ return static_cast<unsigned long long>(v); };
 						setDamage(
 						    pos,
-						    mrpt::format("the chunk at byte %llu: it declares "
-						                 "%llu bytes, %llu follow",
-						                 static_cast<unsigned long long>(pos),
-						                 static_cast<unsigned long long>(len),
-						                 static_cast<unsigned long long>(left)),
+						    len > left
+						        ? mrpt::format("the chunk at byte %llu: it "
+						                       "declares %llu bytes, %llu "
+						                       "follow",
+						                       u(pos), u(len), u(left))
+						        : mrpt::format("the chunk at byte %llu: its "
+						                       "records declare %llu bytes, "
+						                       "the chunk has %llu left: "
+						                       "corrupt",
+						                       u(pos), u(declared),
+						                       u(ch.dataLen)),
 						    true);
 						if (!ch.compression.empty()) return;
 					}

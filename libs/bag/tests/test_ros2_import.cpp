@@ -825,6 +825,46 @@ TEST(Ros2Import, AChunkWhoseCrcDoesNotMatchKeepsTheWholeFramesBeforeIt)
 	expectFirstFrames(d + "/bad.rawlog", d + "/whole.rawlog");
 }
 
+TEST(Ros2Import, LengthsBeyondTheirRecordOrFileAreErrorsNotReads)
+{
+	SKIP_WITHOUT_WRITER();
+	const auto d = test::freshTmpDir("bims_ros2", "lengths");
+	writeMcap(smallBag(4), d + "/whole.mcap", "", true, 4000);
+	const std::string whole = test::fileText(d + "/whole.mcap");
+	// the first chunk: after the magic and the header record
+	uint64_t headerLen = 0;
+	std::memcpy(&headerLen, whole.data() + 9, 8);
+	const size_t chunk = 8 + 9 + static_cast<size_t>(headerLen);
+	ASSERT_EQ(whole[chunk], '\x06');
+	auto spoilt = [&](size_t at, uint64_t v)
+	{
+		std::string b = whole;
+		std::memcpy(&b[at], &v, 8);
+		writeText(d + "/bad.mcap", b);
+		return errorOf([&] { import(d + "/bad.mcap", d + "/bad.rawlog"); });
+	};
+	// the chunk record's length: beyond the file
+	std::string e = spoilt(chunk + 1, uint64_t{1} << 62);
+	EXPECT_TRUE(has(e, "bad.mcap: cut short or damaged: the chunk at byte " +
+	                       std::to_string(chunk) + ": it declares " +
+	                       std::to_string(uint64_t{1} << 62) + " bytes"))
+	    << e;
+	// its records' length (after 3 times 8, 4 and the empty compression's
+	// 4 bytes): beyond the chunk
+	e = spoilt(chunk + 9 + 32, 0xffffffffffull);
+	EXPECT_TRUE(has(e, "its records declare 1099511627775 bytes")) << e;
+	// its uncompressed size: more than 1 GiB is not allocated
+	writeMcap(smallBag(4), d + "/zstd.mcap", "zstd", true, 4000);
+	std::string z = test::fileText(d + "/zstd.mcap");
+	const uint64_t huge = uint64_t{3} << 30;
+	std::memcpy(&z[chunk + 9 + 16], &huge, 8);
+	writeText(d + "/huge.mcap", z);
+	e = errorOf([&] { import(d + "/huge.mcap", d + "/bad.rawlog"); });
+	EXPECT_TRUE(
+	    has(e, "declares 3221225472 uncompressed bytes: more than 1 GiB"))
+	    << e;
+}
+
 TEST(Ros2Import, AMessageShorterThanItsTypeIsAnErrorNamingTopicAndMessage)
 {
 	SKIP_WITHOUT_WRITER();
