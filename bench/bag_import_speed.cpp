@@ -1,17 +1,24 @@
 // bims-import-bag's speed: the bundled sample's frames upscaled to 640x480
 // (depth nearest, colour bilinear; the camera scaled), repeated to N frames
-// with their IMU, written as realsense-ros bags (uncompressed, LZ4, BZ2),
-// then imported (bims::bag::importBag) into a plain and a gzip rawlog.
-// Prints the frames per second of each, the best of 3 runs.
+// with their IMU, written as realsense-ros bags (uncompressed, LZ4, BZ2)
+// and, when node and the tests' ROS 2 writer are installed
+// (tests/ros2_writer), as a realsense-ros 4.x ROS 2 bag in MCAP with zstd
+// chunks of 768 KiB (rosbag2's default), then imported
+// (bims::bag::importBag) into a plain and a gzip rawlog. Prints the frames
+// per second of each, the best of 3 runs.
 //   build/bin/bag_import_speed [N=300] [WORK_DIR=/tmp/bims_bag_bench]
 #include <bims/bag/bag_import.h>
 #include <bims/io/rawlog.h>
 #include <bims_test/bag_writer.h>
+#include <mrpt/obs/CObservationIMU.h>
+
+#include <nlohmann/json.hpp>
 
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <opencv2/imgproc.hpp>
 
 namespace
@@ -41,6 +48,145 @@ CObservation3DRangeScan::Ptr upscaled(const CObservation3DRangeScan& f,
 	o->timestamp =
 	    mrpt::Clock::fromDouble(mrpt::Clock::toDouble(f.timestamp) + shift);
 	return o;
+}
+/** \a t as ROS 2's builtin_interfaces/Time. */
+nlohmann::json rosStamp(double t)
+{
+	const ros::Time r = test::rosTime(t);
+	return {{"stamp", {{"sec", r.sec}, {"nanosec", r.nsec}}},
+	        {"frame_id", "camera"}};
+}
+
+/** \a frames and \a imu as a realsense-ros 4.x ROS 2 bag at \a path (MCAP,
+ * zstd chunks) by the tests' independent writer; false when node or its
+ * packages are not installed. */
+bool writeRos2Bag(const std::string& path,
+                  const std::vector<CObservation3DRangeScan::Ptr>& frames,
+                  const std::vector<CObservationIMU::Ptr>& imu)
+{
+	const std::string writer = BIMS_ROS2_WRITER_DIR;
+	if (!std::filesystem::exists(writer + "/node_modules/@mcap/core") ||
+	    std::system("node --version > /dev/null 2>&1") != 0)
+		return false;
+	using json = nlohmann::json;
+	json spec;
+	spec["out"] = path;
+	spec["compression"] = "zstd";
+	spec["chunkSize"] = 768 * 1024;
+	spec["blob"] = path + ".blob";
+	for (const char* t : {"/camera/camera/aligned_depth_to_color/image_raw",
+	                      "/camera/camera/color/image_raw"})
+		spec["topics"].push_back(
+		    {{"name", t}, {"type", "sensor_msgs/msg/Image"}});
+	spec["topics"].push_back({{"name", "/camera/camera/color/camera_info"},
+	                          {"type", "sensor_msgs/msg/CameraInfo"}});
+	spec["topics"].push_back(
+	    {{"name", "/camera/camera/imu"}, {"type", "sensor_msgs/msg/Imu"}});
+	std::ofstream blob(path + ".blob", std::ios::binary);
+	size_t at = 0;
+	struct Msg
+	{
+		double t;
+		json m;
+	};
+	std::vector<Msg> msgs;
+	auto logTime = [](double t)
+	{
+		const ros::Time r = test::rosTime(t);
+		return std::to_string(uint64_t(r.sec) * 1000000000u + r.nsec);
+	};
+	for (const auto& f : frames)
+	{
+		const double t = mrpt::Clock::toDouble(f->timestamp);
+		const int W = int(f->rangeImage.cols()), H = int(f->rangeImage.rows());
+		std::vector<uint16_t> depth(size_t(W) * H);
+		for (int v = 0; v < H; v++)
+			for (int u = 0; u < W; u++)
+				depth[size_t(v) * W + u] = f->rangeImage(v, u);
+		cv::Mat rgb;
+		cv::cvtColor(
+		    f->intensityImage.asCvMat<cv::Mat>(mrpt::img::SHALLOW_COPY), rgb,
+		    cv::COLOR_BGR2RGB);
+		blob.write(reinterpret_cast<const char*>(depth.data()),
+		           std::streamsize(depth.size() * 2));
+		blob.write(reinterpret_cast<const char*>(rgb.data),
+		           std::streamsize(rgb.total() * 3));
+		auto image = [&](const char* enc, int bpp)
+		{
+			return json{{"header", rosStamp(t)},
+			            {"height", H},
+			            {"width", W},
+			            {"encoding", enc},
+			            {"is_bigendian", 0},
+			            {"step", W * bpp}};
+		};
+		msgs.push_back({t,
+		                {{"topic", 0},
+		                 {"logTime", logTime(t)},
+		                 {"msg", image("16UC1", 2)},
+		                 {"data", {at, depth.size() * 2}}}});
+		at += depth.size() * 2;
+		msgs.push_back({t,
+		                {{"topic", 1},
+		                 {"logTime", logTime(t)},
+		                 {"msg", image("rgb8", 3)},
+		                 {"data", {at, rgb.total() * 3}}}});
+		at += rgb.total() * 3;
+		const auto& c = f->cameraParams;
+		msgs.push_back(
+		    {t,
+		     {{"topic", 2},
+		      {"logTime", logTime(t)},
+		      {"msg",
+		       {{"header", rosStamp(t)},
+		        {"height", H},
+		        {"width", W},
+		        {"distortion_model", "plumb_bob"},
+		        {"d", json::array()},
+		        {"k", {c.fx(), 0, c.cx(), 0, c.fy(), c.cy(), 0, 0, 1}},
+		        {"r", {1, 0, 0, 0, 1, 0, 0, 0, 1}},
+		        {"p", {c.fx(), 0, c.cx(), 0, 0, c.fy(), c.cy(), 0, 0, 0, 1, 0}},
+		        {"binning_x", 0},
+		        {"binning_y", 0},
+		        {"roi",
+		         {{"x_offset", 0},
+		          {"y_offset", 0},
+		          {"height", 0},
+		          {"width", 0},
+		          {"do_rectify", false}}}}}}});
+	}
+	const json zero = {0, 0, 0, 0, 0, 0, 0, 0, 0},
+	           none = {-1, 0, 0, 0, 0, 0, 0, 0, 0};
+	for (const auto& m : imu)
+	{
+		using namespace mrpt::obs;
+		const double t = mrpt::Clock::toDouble(m->timestamp);
+		auto v = [&](TIMUDataIndex x, TIMUDataIndex y, TIMUDataIndex z) {
+			return json{{"x", m->get(x)}, {"y", m->get(y)}, {"z", m->get(z)}};
+		};
+		msgs.push_back(
+		    {t,
+		     {{"topic", 3},
+		      {"logTime", logTime(t)},
+		      {"msg",
+		       {{"header", rosStamp(t)},
+		        {"orientation", {{"x", 0}, {"y", 0}, {"z", 0}, {"w", 1}}},
+		        {"orientation_covariance", none},
+		        {"angular_velocity", v(IMU_WX, IMU_WY, IMU_WZ)},
+		        {"angular_velocity_covariance", zero},
+		        {"linear_acceleration", v(IMU_X_ACC, IMU_Y_ACC, IMU_Z_ACC)},
+		        {"linear_acceleration_covariance", zero}}}}});
+	}
+	std::stable_sort(msgs.begin(), msgs.end(),
+	                 [](const Msg& a, const Msg& b) { return a.t < b.t; });
+	for (auto& m : msgs) spec["messages"].push_back(std::move(m.m));
+	blob.close();
+	std::ofstream(path + ".json") << spec.dump();
+	const int rc = std::system(
+	    ("node '" + writer + "/write_bag.mjs' '" + path + ".json'").c_str());
+	std::filesystem::remove(path + ".blob");
+	std::filesystem::remove(path + ".json");
+	return rc == 0;
 }
 }  // namespace
 
@@ -95,13 +241,8 @@ int main(int argc, char** argv)
 	} kinds[] = {{"uncompressed", rosbag::compression::Uncompressed},
 	             {"lz4", rosbag::compression::LZ4},
 	             {"bz2", rosbag::compression::BZ2}};
-	for (const auto& k : kinds)
+	auto measure = [&](const char* name, const std::string& bag)
 	{
-		test::BagSpec spec;
-		spec.compression = k.c;
-		spec.frames = frames.size();
-		const std::string bag = dir + "/" + k.name + ".bag";
-		test::writeBag(bag, spec, frames, imu);
 		double fps[2] = {0, 0};
 		for (int gz : {0, 1})
 			for (int run = 0; run < 3; run++)
@@ -116,9 +257,25 @@ int main(int argc, char** argv)
 				                     .count();
 				fps[gz] = std::max(fps[gz], double(sum.frames) / s);
 			}
-		std::printf("%-13s %10.1f %12.1f %12.1f\n", k.name,
+		std::printf("%-13s %10.1f %12.1f %12.1f\n", name,
 		            double(std::filesystem::file_size(bag)) / 1e6, fps[0],
 		            fps[1]);
+	};
+	for (const auto& k : kinds)
+	{
+		test::BagSpec spec;
+		spec.compression = k.c;
+		spec.frames = frames.size();
+		const std::string bag = dir + "/" + k.name + ".bag";
+		test::writeBag(bag, spec, frames, imu);
+		measure(k.name, bag);
 	}
+	const std::string mcap = dir + "/ros2_zstd.mcap";
+	if (writeRos2Bag(mcap, frames, imu))
+		measure("ros2 mcap zstd", mcap);
+	else
+		std::printf(
+		    "ros2 mcap zstd: skipped (node or tests/ros2_writer's npm "
+		    "packages are not installed)\n");
 	return 0;
 }

@@ -3,7 +3,7 @@
 #
 #   scripts/fuzz.sh TARGET SECONDS [JOBS]
 #
-# TARGET: rawlog | ini | tum | labels | image | stray | bag. Builds the target with clang,
+# TARGET: rawlog | ini | tum | labels | image | stray | bag | mcap | db3 | cdr. Builds the target with clang,
 # AddressSanitizer, UndefinedBehaviorSanitizer and libFuzzer in build-fuzz/
 # (BIMS_FUZZ_BUILD=DIR for another folder; GUI, OpenNI2 and benchmarks
 # off), seeds a working corpus from tests/fuzz/corpus/TARGET (and config/
@@ -15,8 +15,8 @@ set -euo pipefail
 TARGET=${1:?usage: scripts/fuzz.sh TARGET SECONDS [JOBS]}
 SECONDS_TOTAL=${2:?usage: scripts/fuzz.sh TARGET SECONDS [JOBS]}
 JOBS=${3:-1}
-case "$TARGET" in rawlog | ini | tum | labels | image | stray | bag) ;; *)
-	echo "fuzz.sh: unknown target '$TARGET' (rawlog, ini, tum, labels, image, stray, bag)" >&2
+case "$TARGET" in rawlog | ini | tum | labels | image | stray | bag | mcap | db3 | cdr) ;; *)
+	echo "fuzz.sh: unknown target '$TARGET' (rawlog, ini, tum, labels, image, stray, bag, mcap, db3, cdr)" >&2
 	exit 2
 	;;
 esac
@@ -43,7 +43,7 @@ export LSAN_OPTIONS="suppressions=$ROOT/tests/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1"
 # the bag target writes each input to a file (rosbag opens files only): in
 # memory when the machine has /dev/shm
-[ "$TARGET" = bag ] && [ -d /dev/shm ] && [ -w /dev/shm ] && export TMPDIR=/dev/shm
+case "$TARGET" in bag | mcap | db3) [ -d /dev/shm ] && [ -w /dev/shm ] && export TMPDIR=/dev/shm ;; esac
 echo "fuzz.sh: $TARGET for $SECONDS_TOTAL s, $JOBS job(s); corpus $WORK; findings $FOUND"
 PAR=()
 [ "$JOBS" -gt 1 ] && PAR=(-jobs="$JOBS" -workers="$JOBS")

@@ -14,6 +14,8 @@ PACKAGES=(
   liboctomap-dev
   librosbag-storage-dev libcv-bridge-dev libsensor-msgs-dev pluginlib-dev
   libroslz4-dev libbz2-dev
+  libzstd-dev liblz4-dev libsqlite3-dev libyaml-cpp-dev
+  nodejs
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth imagemagick xdotool x11-apps libgl1-mesa-dri
   python3-dev pybind11-dev python3-numpy python3-opencv
@@ -30,17 +32,39 @@ for p in "${PACKAGES[@]}"; do
   fi
 done
 
-if [ ${#missing[@]} -eq 0 ]; then
-  echo "[deps] all ${#PACKAGES[@]} packages present"
-  exit 0
-fi
+# The ROS 2 bag tests' independent writer (tests/ros2_writer: MCAP and CDR
+# by npm packages, locked in its package-lock.json; never the product's
+# runtime): installed once, again when the lock file changes.
+npm_writer() {
+  local dir
+  dir="$(cd "$(dirname "$0")/.." && pwd)/tests/ros2_writer"
+  [ -f "$dir/package-lock.json" ] || return 0
+  if ! command -v npm > /dev/null; then
+    $SUDO apt-get install -y -qq --no-install-recommends npm || true
+  fi
+  if [ -f "$dir/node_modules/.package-lock.json" ] &&
+    [ "$dir/node_modules/.package-lock.json" -nt "$dir/package-lock.json" ]; then
+    return 0
+  fi
+  echo "[deps] npm ci in tests/ros2_writer (the ROS 2 bag tests' writer)"
+  (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error) ||
+    echo "[deps] warning: npm ci failed: the ROS 2 bag tests will skip" >&2
+}
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then
   SUDO="sudo"
 fi
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "[deps] all ${#PACKAGES[@]} packages present"
+  npm_writer
+  exit 0
+fi
+
 echo "[deps] installing ${#missing[@]} missing packages: ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+npm_writer
 echo "[deps] done"

@@ -1,6 +1,6 @@
 // bims-import-bag BAG... -o OUT.rawlog [--layout tum|realsense|auto]
 //   [-c CONFIG.ini] [--max-frames N] [--gz L] [--topics] [-q]
-// Converts ROS 1 bags (depth and colour sensor_msgs/Image or
+// Converts ROS 1 and ROS 2 bags (depth and colour sensor_msgs/Image or
 // CompressedImage, CameraInfo, Imu, MagneticField) into a bims rawlog. See
 // docs/import-bag.md.
 #include <bims/apps/app.h>
@@ -15,7 +15,9 @@ int main(int argc, char** argv)
 	    [&]()
 	    {
 		    TCLAP::CmdLine cmd(
-		        "Import ROS 1 bags (depth and colour sensor_msgs/Image, or "
+		        "Import ROS 1 bags, ROS 2 bags (a folder with its "
+		        "metadata.yaml, or one .mcap or .db3 file) (depth and colour "
+		        "sensor_msgs/Image, or "
 		        "sensor_msgs/CompressedImage as image_transport writes it: "
 		        "JPEG or PNG colour, compressedDepth PNG or RVL depth; their "
 		        "CameraInfo, sensor_msgs/Imu or separate accelerometer and "
@@ -25,12 +27,16 @@ int main(int argc, char** argv)
 		        "read as one recording.",
 		        ' ', bims::version());
 		    TCLAP::UnlabeledMultiArg<std::string> bags(
-		        "BAG", "ROS 1 bag files (.bag)", true, "BAG", cmd);
+		        "BAG",
+		        "ROS 1 bag files (.bag), ROS 2 bag folders, .mcap or .db3 "
+		        "files",
+		        true, "BAG", cmd);
 		    TCLAP::ValueArg<std::string> out("o", "out", "output rawlog", false,
 		                                     "", "OUT.rawlog", cmd);
 		    TCLAP::ValueArg<std::string> layout(
 		        "", "layout",
-		        "preset topics: realsense (realsense-ros, aligned depth), tum "
+		        "preset topics: realsense (realsense-ros, aligned depth; ROS "
+		        "2: realsense-ros 4.x's /camera/camera/...), tum "
 		        "(TUM RGB-D's bags), auto (default: the first whose depth "
 		        "topic the bag has); a preset image topic the bag lacks is "
 		        "read from its /compressed or /compressedDepth republished "

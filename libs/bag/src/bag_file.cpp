@@ -1,5 +1,7 @@
 #include "bag_file.h"
 
+#include "mapped_file.h"
+
 #include <bzlib.h>
 #include <fcntl.h>
 #include <roslz4/lz4s.h>
@@ -170,33 +172,10 @@ const char* bz2Error(int e)
 BagFile::BagFile(const std::string& path, size_t cacheBytes)
     : cacheBudget_(cacheBytes)
 {
-	const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-	if (fd < 0)
-		throw runtime_error(std::string("cannot be opened: ") +
-		                    std::strerror(errno));
-	struct stat st = {};
-	if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
-	{
-		::close(fd);
-		throw runtime_error("not a file");
-	}
-	size_ = static_cast<uint64_t>(st.st_size);
-	if (size_ > 0)
-	{
-		void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);
-		const int err = errno;
-		::close(fd);
-		if (p == MAP_FAILED)
-			throw runtime_error(std::string("cannot be mapped: ") +
-			                    std::strerror(err));
-		::madvise(p, size_, MADV_SEQUENTIAL);
-		const uint64_t n = size_;
-		map_ = std::shared_ptr<const void>(
-		    p, [n](const void* q) { ::munmap(const_cast<void*>(q), n); });
-		bytes_ = static_cast<const uint8_t*>(p);
-	}
-	else
-		::close(fd);
+	const MappedFile f = mapFile(path);
+	map_ = f.owner;
+	bytes_ = f.bytes;
+	size_ = f.size;
 
 	// the version line: "#ROSBAG V<major>.<minor>\n"
 	// (an empty file maps nothing: fuzz finding ub-empty-bag-memchr)
@@ -214,7 +193,7 @@ BagFile::BagFile(const std::string& path, size_t cacheBytes)
 	    2)
 		throw runtime_error(
 		    "not a readable ROS 1 bag (it does not start with '#ROSBAG "
-		    "V2.0')");
+		    "V2.0'), nor a ROS 2 one (MCAP's magic, sqlite3's header)");
 	if (major != 2 || minor != 0)
 		throw runtime_error("bag format " + std::to_string(major) + "." +
 		                    std::to_string(minor) +

@@ -13,6 +13,8 @@
 
 #include <bims/bag/bag_import.h>
 
+#include "message_source.h"
+
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -29,37 +31,9 @@ namespace detail
 struct BagRecord;  ///< one record as read (bag_file.cpp)
 }
 
-/** Bytes of a bag, kept valid by their owner (the mapped file or a
- * decompressed chunk). */
-struct BagBytes
-{
-	std::shared_ptr<const void> owner;
-	const uint8_t* data = nullptr;
-	size_t size = 0;
-};
-
-/** A connection record: one topic's messages and their type. */
-struct BagConnection
-{
-	std::string topic, type, md5;
-};
-
-/** One message: where its data is. */
-struct BagMessageRef
-{
-	uint32_t connection = 0;  ///< index into BagFile::connections()
-	uint64_t time = 0;        ///< its record time [ns] (not its stamp)
-	uint32_t chunk = 0;       ///< its chunk, in file order
-	uint64_t offset = 0;      ///< its data within the chunk's bytes
-	uint32_t size = 0;        ///< its data's length
-};
-
-class BagFile
+class BagFile : public MessageSource
 {
  public:
-	using MessageFn =
-	    std::function<void(const BagMessageRef&, const uint8_t* data)>;
-
 	/** Maps \a path and walks its records (not yet the chunks' contents).
 	 * Throws std::runtime_error (not naming the file: the caller does)
 	 * when it is no ROS 1 bag of format 2.0 or its first record is not the
@@ -68,7 +42,7 @@ class BagFile
 	 * from the scan for message(): a bag whose chunks fit is decompressed
 	 * once (LZ4 chunks are decompressed again: as fast as keeping them). */
 	BagFile(const std::string& path, size_t cacheBytes);
-	~BagFile();
+	~BagFile() override;
 	BagFile(const BagFile&) = delete;
 	BagFile& operator=(const BagFile&) = delete;
 
@@ -77,27 +51,27 @@ class BagFile
 	 * chunk that cannot be read ends the scan (damage()); the messages
 	 * before it in that chunk are handed over. Connections are known as
 	 * their records come. */
-	void scan(const MessageFn& message);
+	void scan(const MessageFn& message) override;
 
 	/** The data of a message the scan handed over. Throws
 	 * std::runtime_error when its chunk cannot be decompressed again. */
-	BagBytes message(const BagMessageRef& m);
+	BagBytes message(const BagMessageRef& m) override;
 
-	const std::vector<BagConnection>& connections() const
+	const std::vector<BagConnection>& connections() const override
 	{
 		return connections_;
 	}
 
 	/** The topics the bag's index lists, with their message counts; empty
 	 * when the index is missing or damaged (then scan() knows them). */
-	std::vector<BagTopicInfo> indexTopics() const;
+	std::vector<BagTopicInfo> indexTopics() const override;
 
 	/** Where and why the bag stops being readable ("the record at byte N:
 	 * ..."); empty when it is whole. */
-	const std::string& damage() const { return damage_; }
+	const std::string& damage() const override { return damage_; }
 	/** The damage is where messages are (not only in the index at the
 	 * bag's end): messages after it are lost. */
-	bool damageLosesMessages() const { return damageLoses_; }
+	bool damageLosesMessages() const override { return damageLoses_; }
 
  private:
 	struct Chunk

@@ -86,6 +86,21 @@ ImageView imageView(const uint8_t* bytes, size_t n)
 	return v;
 }
 
+CompressedView compressedView(const uint8_t* bytes, size_t n)
+{
+	Cursor c(bytes, n);
+	c.header();
+	CompressedView v;
+	uint32_t sec = 0, nsec = 0;
+	std::memcpy(&sec, bytes + 4, 4);
+	std::memcpy(&nsec, bytes + 8, 4);
+	v.t = stampSeconds(sec, nsec);
+	v.format = c.string("format");
+	v.size = c.u32("data");
+	v.data = c.take(v.size, "data");
+	return v;
+}
+
 void checkMessageArrays(const uint8_t* bytes, size_t n, ArrayMessage kind)
 {
 	Cursor c(bytes, n);

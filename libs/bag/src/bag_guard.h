@@ -18,6 +18,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "messages.h"
+
 namespace bims::bag
 {
 /** The messages whose variable-length arrays ROS's deserializer sizes
@@ -64,20 +66,13 @@ bool isType(const std::string& md5)
 	return md5 == "*" || md5 == ros::message_traits::md5sum<M>();
 }
 
-/** A sensor_msgs/Image read in place: its fields, and its pixels where
- * they are in the bag's bytes (not copied). */
-struct ImageView
-{
-	uint32_t height = 0, width = 0, step = 0;
-	std::string encoding;
-	bool bigEndian = false;
-	const uint8_t* data = nullptr;
-	size_t size = 0;
-};
-
 /** The serialized sensor_msgs/Image \a bytes (\a n of them), every length
  * checked against them; throws std::runtime_error saying which is not. */
 ImageView imageView(const uint8_t* bytes, size_t n);
+
+/** The serialized sensor_msgs/CompressedImage \a bytes (\a n of them)
+ * read in place, every length checked against them. */
+CompressedView compressedView(const uint8_t* bytes, size_t n);
 
 /** The serialized message \a bytes (\a n of them) as a \a M: its arrays
  * checked (checkMessageArrays), then deserialized from the bag's bytes,

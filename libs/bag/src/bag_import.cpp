@@ -6,11 +6,6 @@
 #include <bims/io/rawlog.h>
 #include <cv_bridge/cv_bridge.h>
 #include <mrpt/core/format.h>
-#include <sensor_msgs/CameraInfo.h>
-#include <sensor_msgs/CompressedImage.h>
-#include <sensor_msgs/Image.h>
-#include <sensor_msgs/Imu.h>
-#include <sensor_msgs/MagneticField.h>
 #include <sensor_msgs/image_encodings.h>
 
 #include <algorithm>
@@ -32,7 +27,10 @@
 #include <bims/bag/compressed_image.h>
 
 #include "bag_file.h"
-#include "bag_guard.h"
+#include "db3_file.h"
+#include "mcap_file.h"
+#include "messages.h"
+#include "ros2_metadata.h"
 
 namespace bims::bag
 {
@@ -47,8 +45,43 @@ double stampSeconds(uint32_t sec, uint32_t nsec)
 
 namespace
 {
-/** The bags read as one recording. */
-using Bags = std::vector<std::unique_ptr<BagFile>>;
+/** The files read as one recording: ROS 1 bags, ROS 2 MCAP or sqlite3
+ * files (a ROS 2 bag folder: the files its metadata.yaml lists). */
+struct Bags
+{
+	std::vector<std::unique_ptr<MessageSource>> files;
+	std::vector<std::string> paths;  ///< each file's, for the errors
+	size_t size() const { return files.size(); }
+	const std::unique_ptr<MessageSource>& operator[](size_t k) const
+	{
+		return files[k];
+	}
+};
+
+/** The kind of file \a p is, by its first bytes (else its extension). */
+enum class FileKind
+{
+	Ros1,
+	Mcap,
+	Db3
+};
+FileKind fileKind(const std::string& p)
+{
+	char head[16] = {};
+	std::ifstream in(p, std::ios::binary);
+	in.read(head, sizeof(head));
+	const auto got = static_cast<size_t>(in.gcount());
+	if (got >= 5 && std::memcmp(head, "\x89MCAP", 5) == 0)
+		return FileKind::Mcap;
+	if (got == 16 && std::memcmp(head, "SQLite format 3", 16) == 0)
+		return FileKind::Db3;
+	if (got >= 8 && std::memcmp(head, "#ROSBAG ", 8) == 0)
+		return FileKind::Ros1;
+	const std::string ext = fs::path(p).extension().string();
+	if (ext == ".mcap") return FileKind::Mcap;
+	if (ext == ".db3") return FileKind::Db3;
+	return FileKind::Ros1;
+}
 
 Bags openBags(const std::vector<std::string>& paths, size_t cacheBytes)
 {
@@ -57,20 +90,40 @@ Bags openBags(const std::vector<std::string>& paths, size_t cacheBytes)
 	{
 		std::error_code ec;
 		if (!fs::exists(p, ec)) throw std::runtime_error(p + ": no such bag");
+		std::vector<std::string> files = {p};
 		if (fs::is_directory(p, ec))
-			throw std::runtime_error(
-			    p + ": a folder, not a ROS 1 bag" +
-			    (fs::exists(fs::path(p) / "metadata.yaml", ec)
-			         ? " (a ROS 2 bag: convert it to ROS 1, e.g. with the "
-			           "rosbags package's rosbags-convert)"
-			         : ""));
-		try
 		{
-			bags.push_back(std::make_unique<BagFile>(p, cacheBytes));
+			if (!fs::exists(fs::path(p) / "metadata.yaml", ec))
+				throw std::runtime_error(
+				    p +
+				    ": a folder without a metadata.yaml: not a ROS 2 bag "
+				    "(a ROS 1 bag is a file)");
+			files = ros2BagFiles(p);
 		}
-		catch (const std::exception& e)
+		for (const auto& f : files)
 		{
-			throw std::runtime_error(p + ": " + e.what());
+			try
+			{
+				switch (fileKind(f))
+				{
+					case FileKind::Mcap:
+						bags.files.push_back(
+						    std::make_unique<McapFile>(f, cacheBytes));
+						break;
+					case FileKind::Db3:
+						bags.files.push_back(std::make_unique<Db3File>(f));
+						break;
+					case FileKind::Ros1:
+						bags.files.push_back(
+						    std::make_unique<BagFile>(f, cacheBytes));
+						break;
+				}
+			}
+			catch (const std::exception& e)
+			{
+				throw std::runtime_error(f + ": " + e.what());
+			}
+			bags.paths.push_back(f);
 		}
 	}
 	return bags;
@@ -106,23 +159,6 @@ const BagTopicInfo* findTopic(const std::vector<BagTopicInfo>& topics,
 std::string transportTopic(const std::string& raw, bool depth)
 {
 	return raw + (depth ? "/compressedDepth" : "/compressed");
-}
-
-/** The channels a sensor_msgs/Imu holds: a covariance whose first element
- * is -1 marks the quantity as not measured (the message's convention). */
-ImuSample imuSample(const sensor_msgs::Imu& m, double t)
-{
-	ImuSample s;
-	s.t = t;
-	s.hasGyro = m.angular_velocity_covariance[0] != -1;
-	s.hasAccel = m.linear_acceleration_covariance[0] != -1;
-	s.w[0] = m.angular_velocity.x;
-	s.w[1] = m.angular_velocity.y;
-	s.w[2] = m.angular_velocity.z;
-	s.a[0] = m.linear_acceleration.x;
-	s.a[1] = m.linear_acceleration.y;
-	s.a[2] = m.linear_acceleration.z;
-	return s;
 }
 
 /** One vector of a time-sorted stream (the accelerometer's, the
@@ -235,9 +271,10 @@ BagLayout detectLayout(const std::vector<BagTopicInfo>& topics,
                        const std::string& bagNames)
 {
 	for (const auto l : {BagLayout::RealSense, BagLayout::Tum})
-		if (findTopic(topics, layoutTopics(l).depth) ||
-		    findTopic(topics, transportTopic(layoutTopics(l).depth, true)))
-			return l;
+		for (const BagTopics& v : layoutVariants(l))
+			if (findTopic(topics, v.depth) ||
+			    findTopic(topics, transportTopic(v.depth, true)))
+				return l;
 	throw std::runtime_error(
 	    bagNames + ": no depth topic of a known layout (realsense: " +
 	    layoutTopics(BagLayout::RealSense).depth +
@@ -282,16 +319,29 @@ constexpr const char* kImage = "sensor_msgs/Image";
 constexpr const char* kCompressed = "sensor_msgs/CompressedImage";
 
 /** The topic \a name, when the bag has it, must be of \a type (or of
- * \a other, when given). */
+ * \a other, when given): ROS 1's name or ROS 2's ("sensor_msgs/msg/Image"). */
 void requireType(const std::vector<BagTopicInfo>& topics,
                  const std::string& name, const std::string& type,
                  const std::string& bagNames, const char* other = nullptr)
 {
 	const auto* t = findTopic(topics, name);
-	if (t && t->type != type && !(other && t->type == other))
+	if (t && baseType(t->type) != type &&
+	    !(other && baseType(t->type) == other))
 		throw std::runtime_error(bagNames + ": topic " + name + " is " +
 		                         t->type + ", expected " + type +
 		                         (other ? std::string(" or ") + other : ""));
+}
+
+/** The preset topics of \a layout the bag has: of the first of its
+ * variants (ROS 1's names, realsense-ros 4.x's ROS 2 names) whose depth
+ * topic, or its image_transport topic, is in \a topics. */
+BagTopics presetFor(BagLayout layout, const std::vector<BagTopicInfo>& topics)
+{
+	for (const BagTopics& v : layoutVariants(layout))
+		if (findTopic(topics, v.depth) ||
+		    findTopic(topics, transportTopic(v.depth, true)))
+			return v;
+	return layoutTopics(layout);
 }
 
 /** The topics actually read: those of the layout the bag has, and every
@@ -305,7 +355,7 @@ BagTopics chooseTopics(const BagImportParams& params,
 		layout = params.topics.depth.empty() || params.topics.depth == "none"
 		             ? detectLayout(topics, bagNames)
 		             : BagLayout::Auto;
-	BagTopics t = resolveTopics(params.topics, layout);
+	BagTopics t = resolveTopics(params.topics, presetFor(layout, topics));
 	auto missing = [&](const std::string& name, const char* what)
 	{
 		return std::runtime_error(
@@ -360,37 +410,6 @@ BagTopics chooseTopics(const BagImportParams& params,
 	return t;
 }
 
-/** A message's connection's MD5 sum \a md5 must be \a M's: else an error
- * (fuzz finding ub-imu-of-another-md5: rosbag gave a null message for it,
- * which was read). */
-template <typename M>
-void checkMd5(const std::string& md5)
-{
-	if (!isType<M>(md5))
-		throw std::runtime_error(
-		    std::string("not a ") + ros::message_traits::datatype<M>() +
-		    ": its MD5 sum " + md5 + " is another message's");
-}
-
-template <typename M>
-boost::shared_ptr<M> read(const uint8_t* data, size_t n, const std::string& md5)
-{
-	checkMd5<M>(md5);
-	return readMessage<M>(data, n);
-}
-
-/** The stamp of a message that starts with a std_msgs/Header (seq, stamp,
- * frame_id), as every image does: read without the pixels. */
-double headerStamp(const uint8_t* p, size_t n)
-{
-	if (n < 12)
-		throw std::runtime_error("it ends inside its header's stamp: corrupt");
-	uint32_t sec = 0, nsec = 0;
-	std::memcpy(&sec, p + 4, 4);
-	std::memcpy(&nsec, p + 8, 4);
-	return stampSeconds(sec, nsec);
-}
-
 /** One message as the scan read it: where it is, and what the first pass
  * needs of it (an image's stamp; an Imu, MagneticField or CameraInfo
  * whole). */
@@ -400,32 +419,32 @@ struct Scanned
 	BagMessageRef ref;
 	double t = -1;  ///< its header stamp [s] (images, Imu, MagneticField)
 	ImuSample imu;  ///< an Imu's or a MagneticField's
-	boost::shared_ptr<sensor_msgs::CameraInfo> info;
+	std::shared_ptr<const CameraInfoView> info;
 	std::string error;  ///< why it cannot be read (said if it is used)
 };
 
 void extract(Scanned& s, const BagConnection& c, const uint8_t* p, size_t n)
 {
-	if (c.type == kImage || c.type == kCompressed)
-		s.t = headerStamp(p, n);
-	else if (c.type == "sensor_msgs/CameraInfo")
-		s.info = read<sensor_msgs::CameraInfo>(p, n, c.md5);
-	else if (c.type == "sensor_msgs/Imu")
+	switch (messageKind(c.type))
 	{
-		const auto m = read<sensor_msgs::Imu>(p, n, c.md5);
-		s.t = stampSeconds(m->header.stamp.sec, m->header.stamp.nsec);
-		s.imu = imuSample(*m, s.t);
-	}
-	else if (c.type == "sensor_msgs/MagneticField")
-	{
-		const auto m = read<sensor_msgs::MagneticField>(p, n, c.md5);
-		s.t = stampSeconds(m->header.stamp.sec, m->header.stamp.nsec);
-		s.imu.t = s.t;
-		s.imu.hasMag = true;
-		// tesla to gauss (MRPT's IMU_MAG_* unit)
-		s.imu.m[0] = m->magnetic_field.x * 1e4;
-		s.imu.m[1] = m->magnetic_field.y * 1e4;
-		s.imu.m[2] = m->magnetic_field.z * 1e4;
+		case MessageKind::Image:
+		case MessageKind::CompressedImage:
+			s.t = headerStamp(c, p, n);
+			break;
+		case MessageKind::CameraInfo:
+			s.info =
+			    std::make_shared<const CameraInfoView>(readCameraInfo(c, p, n));
+			break;
+		case MessageKind::Imu:
+			s.imu = readImu(c, p, n);
+			s.t = s.imu.t;
+			break;
+		case MessageKind::MagneticField:
+			s.imu = readMagneticField(c, p, n);
+			s.t = s.imu.t;
+			break;
+		case MessageKind::Other:
+			break;
 	}
 }
 
@@ -457,8 +476,8 @@ struct Scan
 /** Reads every chunk of \a bag (the \a b th, \a path) once into \a scan:
  * each message's place, and what extract() reads of it when
  * \a extracting (else it is only counted). */
-void scanBag(BagFile& bag, size_t b, const std::string& path, bool extracting,
-             Scan& scan)
+void scanBag(MessageSource& bag, size_t b, const std::string& path,
+             bool extracting, Scan& scan)
 {
 	bag.scan(
 	    [&](const BagMessageRef& ref, const uint8_t* data)
@@ -492,11 +511,11 @@ void scanBag(BagFile& bag, size_t b, const std::string& path, bool extracting,
 }
 
 /** scanBag of every bag, then each topic in the bags' time order. */
-Scan scanBags(const Bags& bags, const std::vector<std::string>& paths)
+Scan scanBags(const Bags& bags)
 {
 	Scan scan;
 	for (size_t b = 0; b < bags.size(); b++)
-		scanBag(*bags[b], b, paths[b], true, scan);
+		scanBag(*bags[b], b, bags.paths[b], true, scan);
 	for (auto& [name, t] : scan.topics)
 		std::stable_sort(t.messages.begin(), t.messages.end(),
 		                 [](const Scanned& x, const Scanned& y)
@@ -518,7 +537,7 @@ struct ImageRef
 struct Index
 {
 	std::vector<ImageRef> depth, colour;
-	boost::shared_ptr<sensor_msgs::CameraInfo> info;
+	std::shared_ptr<const CameraInfoView> info;
 	size_t infoMessages = 0;
 	std::vector<ImuSample> imu, accel, gyro, mag;
 };
@@ -677,7 +696,7 @@ mrpt::img::TCamera cameraOf(const Index& ix, const BagImportParams& params,
 	c.distortion = mrpt::img::DistortionModel::none;
 	sum.cameraFrom = "CameraInfo " + t.cameraInfo;
 	for (const double k : ci.D) sum.distortionIgnored |= k != 0;
-	if (sum.distortionIgnored) sum.distortionModel = ci.distortion_model;
+	if (sum.distortionIgnored) sum.distortionModel = ci.distortionModel;
 	return c;
 }
 
@@ -800,7 +819,7 @@ std::vector<BagTopicInfo> bagTopics(const std::vector<std::string>& bagPaths,
 		if (topics.empty())
 		{
 			Scan scan;
-			scanBag(*bags[b], b, bagPaths[b], false, scan);
+			scanBag(*bags[b], b, bags.paths[b], false, scan);
 			topics = scan.topicInfo();
 			if (damage && !scan.lost.empty()) damage->push_back(scan.lost);
 			if (damage)
@@ -828,7 +847,7 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 	if (bagPaths.empty()) throw std::runtime_error("no bag to import");
 	const Bags bags = openBags(bagPaths, options.chunkCacheBytes);
 	const std::string bagNames = joined(bagPaths);
-	const Scan scan = scanBags(bags, bagPaths);
+	const Scan scan = scanBags(bags);
 
 	BagImportSummary sum;
 	sum.notes = scan.notes;
@@ -922,21 +941,22 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 			                 std::string& encoding, BagBytes& held) -> cv::Mat
 			{
 				const Scanned& m = *ref.msg;
-				BagFile& bag = *bags[m.bag];
+				MessageSource& bag = *bags[m.bag];
 				const BagConnection& c = bag.connections()[m.ref.connection];
 				held = bag.message(m.ref);
-				if (c.type == kCompressed)
+				if (messageKind(c.type) == MessageKind::CompressedImage)
 				{
-					const auto ci = read<sensor_msgs::CompressedImage>(
-					    held.data, held.size, c.md5);
-					encoding = ci->format;
-					return depth
-					           ? decodeCompressedDepth(*ci, W, H, params.images)
-					           : decodeCompressedColour(*ci, W, H,
-					                                    params.images);
+					const CompressedView ci =
+					    readCompressed(c, held.data, held.size);
+					encoding = ci.format;
+					return depth ? decodeCompressedDepth(ci.format, ci.data,
+					                                     ci.size, W, H,
+					                                     params.images)
+					             : decodeCompressedColour(ci.format, ci.data,
+					                                      ci.size, W, H,
+					                                      params.images);
 				}
-				checkMd5<sensor_msgs::Image>(c.md5);
-				const ImageView r = imageView(held.data, held.size);
+				const ImageView r = readImage(c, held.data, held.size);
 				encoding = r.encoding;
 				return depth ? checkedImage(r, depthEncodings,
 				                            "the depth image", W, H, false)

@@ -35,9 +35,36 @@ BagTopics layoutTopics(BagLayout layout)
 	return t;
 }
 
+std::vector<BagTopics> layoutVariants(BagLayout layout)
+{
+	std::vector<BagTopics> v = {layoutTopics(layout)};
+	if (layout != BagLayout::RealSense) return v;
+	// realsense-ros 4.x (ROS 2): its node in namespace "camera" named
+	// "camera"; with align_depth.enable:=true the aligned depth, else the
+	// depth alone (in the depth camera's frame: no colour attached)
+	BagTopics t;
+	t.depth = "/camera/camera/aligned_depth_to_color/image_raw";
+	t.colour = "/camera/camera/color/image_raw";
+	t.cameraInfo = "/camera/camera/color/camera_info";
+	t.imu = "/camera/camera/imu";
+	t.accel = "/camera/camera/accel/sample";
+	t.gyro = "/camera/camera/gyro/sample";
+	v.push_back(t);
+	t.depth = "/camera/camera/depth/image_rect_raw";
+	t.colour.clear();
+	t.cameraInfo = "/camera/camera/depth/camera_info";
+	v.push_back(t);
+	return v;
+}
+
 BagTopics resolveTopics(const BagTopics& given, BagLayout layout)
 {
-	BagTopics t = layoutTopics(layout);
+	return resolveTopics(given, layoutTopics(layout));
+}
+
+BagTopics resolveTopics(const BagTopics& given, const BagTopics& preset)
+{
+	BagTopics t = preset;
 	auto pick = [](std::string& preset, const std::string& g)
 	{
 		if (g == "none")

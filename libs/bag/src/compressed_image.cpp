@@ -60,19 +60,19 @@ struct DepthHeader
 };
 
 /** The ConfigHeader of \a data, checked; an image must follow it. */
-DepthHeader depthHeader(const std::vector<uint8_t>& data, bool metres)
+DepthHeader depthHeader(const uint8_t* data, size_t size, bool metres)
 {
-	if (data.size() <= kDepthHeader)
+	if (size <= kDepthHeader)
 		throw runtime_error(
-		    mrpt::format("%zu bytes of data: %s", data.size(),
-		                 data.size() < kDepthHeader
+		    mrpt::format("%zu bytes of data: %s", size,
+		                 size < kDepthHeader
 		                     ? "cut inside its 12-byte compressedDepth header"
 		                     : "its 12-byte compressedDepth header, no image"));
 	int32_t kind = 0;
 	DepthHeader h;
-	std::memcpy(&kind, data.data(), 4);
-	std::memcpy(&h.quantA, data.data() + 4, 4);
-	std::memcpy(&h.quantB, data.data() + 8, 4);
+	std::memcpy(&kind, data, 4);
+	std::memcpy(&h.quantA, data + 4, 4);
+	std::memcpy(&h.quantB, data + 8, 4);
 	if (kind != 0)
 		throw runtime_error(mrpt::format(
 		    "its compressedDepth header's format is %d, not INV_DEPTH (0): "
@@ -299,14 +299,15 @@ CompressedFormat parseCompressedFormat(const std::string& format)
 	return f;
 }
 
-cv::Mat decodeCompressedColour(const sensor_msgs::CompressedImage& m, int width,
-                               int height, const ImageLimits& limits)
+cv::Mat decodeCompressedColour(const std::string& format, const uint8_t* data,
+                               size_t size, int width, int height,
+                               const ImageLimits& limits)
 {
 	return described(
-	    "the colour image", m.format,
+	    "the colour image", format,
 	    [&]
 	    {
-		    const CompressedFormat f = parseCompressedFormat(m.format);
+		    const CompressedFormat f = parseCompressedFormat(format);
 		    if (f.depth)
 			    throw runtime_error(
 			        "a compressedDepth image where colour belongs");
@@ -315,8 +316,8 @@ cv::Mat decodeCompressedColour(const sensor_msgs::CompressedImage& m, int width,
 		    if (!f.encoding.empty() && !encodings.count(f.encoding))
 			    throw runtime_error("encoding '" + f.encoding +
 			                        "' is not supported (bgr8, mono8, rgb8)");
-		    const uint8_t* p = m.data.data();
-		    const size_t n = m.data.size();
+		    const uint8_t* p = data;
+		    const size_t n = size;
 		    checkDeclaredSize(p, n, width, height);
 		    const cv::Mat img = decodeImage(p, n, cv::IMREAD_UNCHANGED, limits,
 		                                    f.codec == "png" ? "PNG" : "JPEG");
@@ -339,14 +340,15 @@ cv::Mat decodeCompressedColour(const sensor_msgs::CompressedImage& m, int width,
 	    });
 }
 
-cv::Mat decodeCompressedDepth(const sensor_msgs::CompressedImage& m, int width,
-                              int height, const ImageLimits& limits)
+cv::Mat decodeCompressedDepth(const std::string& format, const uint8_t* data,
+                              size_t size, int width, int height,
+                              const ImageLimits& limits)
 {
 	return described(
-	    "the depth image", m.format,
+	    "the depth image", format,
 	    [&]
 	    {
-		    const CompressedFormat f = parseCompressedFormat(m.format);
+		    const CompressedFormat f = parseCompressedFormat(format);
 		    if (!f.depth)
 			    throw runtime_error(
 			        "not compressed_depth_image_transport's compressedDepth "
@@ -357,9 +359,9 @@ cv::Mat decodeCompressedDepth(const sensor_msgs::CompressedImage& m, int width,
 			    throw runtime_error("encoding '" + f.encoding +
 			                        "' is not supported (16UC1, 32FC1, "
 			                        "mono16)");
-		    const DepthHeader h = depthHeader(m.data, metres);
-		    const uint8_t* p = m.data.data() + kDepthHeader;
-		    const size_t n = m.data.size() - kDepthHeader;
+		    const DepthHeader h = depthHeader(data, size, metres);
+		    const uint8_t* p = data + kDepthHeader;
+		    const size_t n = size - kDepthHeader;
 		    const cv::Mat img = f.codec == "rvl"
 		                            ? rvlDepth(p, n, width, height, limits)
 		                            : pngDepth(p, n, width, height, limits);

@@ -742,8 +742,9 @@ PYBIND11_MODULE(_bims, m)
 	      py::arg("config") = py::none(), py::arg("layout") = py::none(),
 	      py::arg("max_frames") = 0, py::arg("gz_level") = 1,
 	      py::arg("progress") = py::none(),
-	      "ROS 1 bags (one path or a list, read as one recording) into an "
-	      "MRPT rawlog, as bims-import-bag; returns its summary");
+	      "ROS 1 or ROS 2 bags (one path or a list, read as one recording: "
+	      ".bag files, ROS 2 bag folders, .mcap or .db3 files) into an MRPT "
+	      "rawlog, as bims-import-bag; returns its summary");
 #endif
 #endif
 

@@ -16,7 +16,7 @@ namespace bims::apps
 /** What bims-import-bag's command line gives (nullopt: not given). */
 struct BagImportRunOptions
 {
-	std::vector<std::string> bags;      ///< ROS 1 bags, read as one
+	std::vector<std::string> bags;      ///< ROS 1 or 2 bags, read as one
 	std::string out;                    ///< output rawlog
 	std::optional<std::string> config;  ///< experiment .ini
 	std::optional<std::string> layout;  ///< --layout (overrides the .ini's)

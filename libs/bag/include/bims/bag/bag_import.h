@@ -1,7 +1,9 @@
-// Import of ROS 1 bags (depth and colour sensor_msgs/Image or
+// Import of ROS 1 and ROS 2 bags (depth and colour sensor_msgs/Image or
 // CompressedImage, CameraInfo, Imu, optional MagneticField) into a bims
-// rawlog: the bag's records read by bims (bag_file.h), the messages
-// deserialized by ROS's own message classes (docs/import-bag.md). Depth and
+// rawlog: the files read by bims (ROS 1: bag_file.h; ROS 2: a bag folder's
+// metadata.yaml, MCAP (mcap_file.h) or sqlite3 (db3_file.h)), the messages
+// by ROS's own message classes (ROS 1) or bims's CDR decoder (ROS 2), both
+// behind one set of message views (messages.h; docs/import-bag.md). Depth and
 // colour are paired by stamp as the TUM importer pairs them (associateGreedy);
 // IMU samples keep their own stamps; the stamps are the messages' header stamps
 // (the sensors' clock), never the bag's record times. A bag of TUM RGB-D's
@@ -55,8 +57,15 @@ struct BagTopics
 	std::string mag;         ///< sensor_msgs/MagneticField
 };
 
-/** The preset topics of \a layout (Auto: none). */
+/** The preset topics of \a layout (Auto: none): ROS 1's names. */
 BagTopics layoutTopics(BagLayout layout);
+
+/** Every variant of \a layout's preset, in the order they are tried: ROS
+ * 1's names first (layoutTopics()), then realsense-ros 4.x's ROS 2 names
+ * (/camera/camera/...: aligned depth with colour, else the depth alone,
+ * which is not registered to the colour). The import reads the first whose
+ * depth topic the recording has. */
+std::vector<BagTopics> layoutVariants(BagLayout layout);
 
 /** What bims-import-bag reads from an experiment .ini: [import_bag]
  * (describe()), [camera] (intrinsics overriding the bag's CameraInfo: all
@@ -100,6 +109,8 @@ struct BagImportParams
 /** The topics read with \a layout (not Auto): the preset's, each replaced
  * by the one \a given names ("none": not read). */
 BagTopics resolveTopics(const BagTopics& given, BagLayout layout);
+/** The same over the topics \a preset (a variant of a layout). */
+BagTopics resolveTopics(const BagTopics& given, const BagTopics& preset);
 
 /** One topic of a bag: name, message type, message count. */
 struct BagTopicInfo
@@ -193,7 +204,9 @@ struct BagImportSummary
 	BagLayout layout = BagLayout::Auto;  ///< whose presets (Auto: none)
 };
 
-/** Imports \a bagPaths (read as one recording) into \a outRawlog (written
+/** Imports \a bagPaths (read as one recording: ROS 1 bag files, ROS 2 bag
+ * folders (their metadata.yaml's files), .mcap or .db3 files, each kind
+ * known by its first bytes) into \a outRawlog (written
  * as OUT.rawlog.partial, renamed when complete): frames and IMU samples in
  * time order, IMU first at equal stamps; IMU samples outside the frames'
  * time span are left out as the TUM importer does. Throws

@@ -1,0 +1,33 @@
+// ROS 2's messages as CDR (OMG's Common Data Representation, XCDR1 as
+// ROS 2's middlewares write it), read by a guarded decoder of our own: the
+// 4-byte encapsulation header (CDR_LE or CDR_BE), then the fields, each
+// primitive aligned to its size (at most 8) from the end of that header;
+// a string is its length (with its terminating NUL) and bytes, a sequence
+// its count and elements. Every length is checked against the bytes left
+// before anything is allocated; a message shorter than its type is an
+// error saying which field it ends in (docs/import-bag.md, "ROS 2").
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "messages.h"
+
+namespace bims::bag::cdr
+{
+/** The header's stamp of a message that starts with a std_msgs/Header
+ * (builtin_interfaces/Time, then frame_id), as every message read does. */
+double headerStamp(const uint8_t* p, size_t n);
+/** sensor_msgs/msg/Image: its data in place. */
+ImageView image(const uint8_t* p, size_t n);
+/** sensor_msgs/msg/CompressedImage: its data in place. */
+CompressedView compressedImage(const uint8_t* p, size_t n);
+/** sensor_msgs/msg/CameraInfo, read whole (d, k, r, p, binning, roi). */
+CameraInfoView cameraInfo(const uint8_t* p, size_t n);
+/** sensor_msgs/msg/Imu, read whole. */
+ImuSample imu(const uint8_t* p, size_t n);
+/** sensor_msgs/msg/MagneticField, read whole. */
+ImuSample magneticField(const uint8_t* p, size_t n);
+
+}  // namespace bims::bag::cdr
