@@ -3,6 +3,8 @@
 # ~1 minute): imports a Stray Scanner capture with CONFIG, then prints
 #   1. the IMU attitude filter against ARKit's attitude: tilt RMS [deg] and
 #      heading drift [deg/min] (bims-odom --attitude, bims-eval attitude; the
+#      odometry's attitude levelled by the inertial filter's gravity too,
+#      --gravity-attitude, when CONFIG has [inertial] enable = true; the
 #      filter's first init_time_s seconds left out), the IMU alone;
 #   2. bims-calib-imu: R_IC from the capture alone, its angle to CONFIG's and
 #      its 1-sigma uncertainty;
@@ -51,9 +53,16 @@ INIT=$("$BIN/bims-run" --print-config "$CONFIG" | awk -F'[ =]+' '/^init_time_s/{
 
 echo
 echo "1. IMU attitude filter vs ARKit (first ${INIT} s left out)"
-"$BIN/bims-odom" "$CONFIG" "$RAWLOG" -o "$DATA/odom_imu.txt" --attitude "$DATA/attitude.txt" \
+INERTIAL=$("$BIN/bims-run" --print-config "$CONFIG" | awk -F'[ =]+' '/^\[/{s=$0} s=="[inertial]" && /^enable/{print $2}')
+GRAV=()
+[ "$INERTIAL" = true ] && GRAV=(--gravity-attitude "$DATA/attitude_gravity.txt")
+"$BIN/bims-odom" "$CONFIG" "$RAWLOG" -o "$DATA/odom_imu.txt" --attitude "$DATA/attitude.txt" "${GRAV[@]}" \
 	--csv "$DATA/odom_imu.csv" -q 2> "$DATA/odom_imu.log"
 "$BIN/bims-eval" attitude "$REF" "$DATA/attitude.txt" --ref-up y --skip-s "$INIT" | sed 's/^/    /'
+if [ ${#GRAV[@]} -gt 0 ]; then
+	echo "    the odometry's attitude levelled by the inertial filter's gravity (bims-odom --gravity-attitude):"
+	"$BIN/bims-eval" attitude "$REF" "$DATA/attitude_gravity.txt" --ref-up y --skip-s "$INIT" | sed 's/^/    /'
+fi
 
 echo
 echo "2. bims-calib-imu (R_IC from the capture alone)"

@@ -61,6 +61,13 @@ int main(int argc, char** argv)
 		        "R_IC at each frame (TUM, translation 0; compare with "
 		        "bims-eval attitude)",
 		        false, "", "ATT.txt", cmd);
+		    TCLAP::ValueArg<std::string> gravArg(
+		        "", "gravity-attitude",
+		        "also write the odometry's R_WC levelled by the inertial "
+		        "filter's gravity ([inertial]: the accelerometer's bias "
+		        "estimated) at each frame (TUM, translation 0; compare with "
+		        "bims-eval attitude)",
+		        false, "", "ATT.txt", cmd);
 		    TCLAP::ValueArg<long> maxArg(
 		        "", "max-frames", "stop after N frames", false, 0, "N", cmd);
 		    TCLAP::SwitchArg quiet("q", "quiet", "no progress line", cmd);
@@ -72,6 +79,6 @@ int main(int argc, char** argv)
 		         givenValue(csvArg), givenValue(masksArg), givenValue(gtArg),
 		         static_cast<size_t>(
 		             bims::inRange(maxArg, 0L, 100000000L, "0 = all")),
-		         !quiet.getValue(), givenValue(attArg)});
+		         !quiet.getValue(), givenValue(attArg), givenValue(gravArg)});
 	    });
 }

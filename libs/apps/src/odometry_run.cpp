@@ -144,6 +144,8 @@ int runOdometry(const OdometryRunOptions& o)
 	std::vector<std::string> outputs = {o.out};
 	if (o.csv) outputs.insert(outputs.begin(), *o.csv);
 	if (o.attitude) outputs.insert(outputs.begin(), *o.attitude);
+	if (o.gravity_attitude)
+		outputs.insert(outputs.begin(), *o.gravity_attitude);
 	std::vector<std::string> inputs = {o.config, o.rawlog, o.calib,
 	                                   o.masks.value_or(""), o.gt.value_or("")};
 	// the masks fed back are inputs too (-o MASKS/000000.png)
@@ -154,7 +156,7 @@ int runOdometry(const OdometryRunOptions& o)
 	checkOutputFilesWritable(outputs);
 	const ego::EgoConfig ec = odometryConfig(o);
 	ego::Odometry odo(ec);
-	Trajectory traj, attitude;
+	Trajectory traj, attitude, levelled;
 	std::vector<double> msIn, msTrack, msMotion, msEgo;
 	std::unique_ptr<AppendFile> csv;  // each line checked
 	if (o.csv)
@@ -197,6 +199,17 @@ int runOdometry(const OdometryRunOptions& o)
 			            o.attitude ? odo.imuRotation(r.t) : std::nullopt)
 				    attitude.push_back(
 				        {r.t, ego::toPose(*R, Eigen::Vector3d::Zero())});
+			    if (o.gravity_attitude && r.inertial)
+			    {
+				    const Eigen::Matrix3d R =
+				        ego::levellingRotation(r.gravity_W);
+				    Eigen::Matrix3d R_WC;
+				    const auto& Rm = r.T_WC.getRotationMatrix();
+				    for (int i = 0; i < 3; i++)
+					    for (int j = 0; j < 3; j++) R_WC(i, j) = Rm(i, j);
+				    levelled.push_back(
+				        {r.t, ego::toPose(R * R_WC, Eigen::Vector3d::Zero())});
+			    }
 			    msIn.push_back(r.ms_input);
 			    msTrack.push_back(r.ms_track);
 			    msMotion.push_back(r.ms_motion);
@@ -247,6 +260,19 @@ int runOdometry(const OdometryRunOptions& o)
 		saveTumTrajectory(*o.attitude, attitude,
 		                  "bims-odom: the IMU attitude filter's R_WC = R_WI "
 		                  "R_IC at each frame (translation not estimated: 0)");
+	}
+	if (o.gravity_attitude)
+	{
+		if (levelled.empty())
+			throw std::runtime_error(
+			    o.rawlog +
+			    ": --gravity-attitude: the inertial filter carried no frame "
+			    "([inertial] enable = false, mode = vision, no IMU samples or "
+			    "no [calibration] R_IC)");
+		saveTumTrajectory(*o.gravity_attitude, levelled,
+		                  "bims-odom: the odometry's R_WC levelled by the "
+		                  "inertial filter's gravity at each frame "
+		                  "(translation not estimated: 0)");
 	}
 	const auto pIn = Percentiles::of(msIn), pTrack = Percentiles::of(msTrack),
 	           pMotion = Percentiles::of(msMotion),

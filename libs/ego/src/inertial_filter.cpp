@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
@@ -54,6 +55,14 @@ Degeneracy analyseDegeneracy(const Eigen::Matrix3d& Lambda, double sigma_m,
 	for (int i = 0; i < 3; i++)
 		if (!(d.eigenvalues[i] >= minInfo)) ++d.count;
 	return d;
+}
+
+Eigen::Matrix3d levellingRotation(const Eigen::Vector3d& g_W)
+{
+	if (!(g_W.norm() > 0)) return Eigen::Matrix3d::Identity();
+	return Eigen::Quaterniond::FromTwoVectors(g_W.normalized(),
+	                                          Eigen::Vector3d(0, 0, -1))
+	    .toRotationMatrix();
 }
 
 InertialFilter::InertialFilter(const InertialParams& p) : p_(p)

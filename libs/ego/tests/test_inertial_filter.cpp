@@ -233,3 +233,17 @@ TEST(InertialFilter, SaturatedSamplesAreLeftOut)
 	// what was integrated was at rest: no velocity from the clipped samples
 	EXPECT_LT(f.state().v_W.norm(), 1e-6);
 }
+
+TEST(InertialFilter, LevellingTurnsTheEstimatedGravityStraightDown)
+{
+	// gravity 2 deg off the world's -z: the levelling is that 2 deg rotation
+	const Eigen::Vector3d g =
+	    expSO3(Eigen::Vector3d(2 * M_PI / 180, 0, 0)) * kG +
+	    Eigen::Vector3d::Zero();
+	const Eigen::Matrix3d R = levellingRotation(g);
+	EXPECT_LT((R * g - kG).norm(), 1e-9);
+	EXPECT_NEAR(angleSO3(R), 2 * M_PI / 180, 1e-9);
+	EXPECT_TRUE(levellingRotation(kG).isApprox(Eigen::Matrix3d::Identity()));
+	EXPECT_TRUE(levellingRotation(Eigen::Vector3d::Zero())
+	                .isApprox(Eigen::Matrix3d::Identity()));
+}

@@ -38,6 +38,10 @@ struct OdometryRunOptions
 	/** the IMU attitude filter's R_WC = R_WI R_IC at each frame's stamp
 	 * (zero translation; frames without an attitude left out), TUM */
 	std::optional<std::string> attitude;
+	/** the odometry's R_WC levelled by the inertial filter's gravity at
+	 * each frame ([inertial]; translation 0; frames the filter did not
+	 * carry left out), TUM */
+	std::optional<std::string> gravity_attitude;
 };
 
 /** Overrides \a ec's [calibration] [camera] [sensors] with those of the

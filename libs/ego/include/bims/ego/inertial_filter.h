@@ -55,6 +55,12 @@ struct Degeneracy
 Degeneracy analyseDegeneracy(const Eigen::Matrix3d& Lambda, double sigma_m,
                              double ratio = 0);
 
+/** The smallest rotation that turns \a g_W (gravity in a world whose z
+ * should point up) to straight down: R_W'W, with which R_W'C = R_W'W R_WC
+ * is the attitude levelled by the estimated gravity. Identity for a zero
+ * vector. */
+Eigen::Matrix3d levellingRotation(const Eigen::Vector3d& g_W);
+
 /** The filter's state and covariance (error state [dp, dv, db_a, dg]). */
 struct InertialState
 {
