@@ -308,6 +308,7 @@ TEST(DepthInertial, OnABlankWallTheImuCarriesWhatTheDepthCannotSee)
 		o.calib = gt + "calibration.ini";
 		o.out = d + "/traj" + std::to_string(on) + ".txt";
 		o.progress = false;
+		if (on) o.gravity_attitude = d + "/levelled.txt";
 		ASSERT_EQ(runOdometry(o), 0);
 		ate[on] = bims::eval::computeAte(
 		              bims::loadTumTrajectory(gt + "groundtruth.txt"),
@@ -320,6 +321,26 @@ TEST(DepthInertial, OnABlankWallTheImuCarriesWhatTheDepthCannotSee)
 	    ate[1], ate[0]);
 	EXPECT_LT(ate[1], 0.02);  // measured 0.004
 	EXPECT_GT(ate[0], 0.10);  // measured 0.165
+	// the attitude levelled by the filter's gravity: the camera's up
+	// direction against the truth's (both worlds z up)
+	const auto truth = bims::loadTumTrajectory(gt + "groundtruth.txt");
+	const auto levelled = bims::loadTumTrajectory(d + "/levelled.txt");
+	ASSERT_EQ(levelled.size(), truth.size() - 1);  // the first frame: none
+	double sum2 = 0;
+	for (size_t i = 0; i < levelled.size(); i++)
+	{
+		const auto up = [](const mrpt::poses::CPose3D& T)
+		{
+			const auto& R = T.getRotationMatrix();
+			return Eigen::Vector3d(R(2, 0), R(2, 1), R(2, 2));  // R^T z
+		};
+		const double a = std::acos(std::clamp(
+		    up(levelled[i].T_WC).dot(up(truth[i + 1].T_WC)), -1.0, 1.0));
+		sum2 += a * a;
+	}
+	const double tiltDeg = std::sqrt(sum2 / levelled.size()) * 180 / M_PI;
+	std::printf("levelled attitude: tilt %.3f deg RMS\n", tiltDeg);
+	EXPECT_LT(tiltDeg, 1.0);
 }
 
 namespace
