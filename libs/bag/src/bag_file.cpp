@@ -170,7 +170,7 @@ const char* bz2Error(int e)
 }  // namespace
 
 BagFile::BagFile(const std::string& path, size_t cacheBytes)
-    : cacheBudget_(cacheBytes)
+    : cache_(cacheBytes)
 {
 	const MappedFile f = mapFile(path);
 	map_ = f.owner;
@@ -504,15 +504,9 @@ void BagFile::scan(const MessageFn& message)
 		// times reading it back; an LZ4 chunk decompresses about as fast as
 		// the fresh memory to keep it takes to fault in (docs/import-bag.md)
 		if (chunks_[k].kind == Chunk::Bz2)
-		{
-			const std::lock_guard<std::mutex> lock(cacheMutex_);
-			if (cacheBytes_ + r.bytes.size <= cacheBudget_)
-			{
-				cache_[static_cast<uint32_t>(k)] =
-				    std::static_pointer_cast<const ChunkData>(r.bytes.owner);
-				cacheBytes_ += r.bytes.size;
-			}
-		}
+			cache_.keep(
+			    static_cast<uint32_t>(k),
+			    std::static_pointer_cast<const ChunkData>(r.bytes.owner));
 		if (!walkChunk(k, r.bytes, message)) break;
 	}
 }
@@ -522,38 +516,7 @@ BagBytes BagFile::message(const BagMessageRef& m)
 	const Chunk& c = chunks_.at(m.chunk);
 	if (c.kind == Chunk::None)
 		return {map_, bytes_ + c.data + m.offset, m.size};
-	Buffer b;
-	{
-		const std::lock_guard<std::mutex> lock(cacheMutex_);
-		const auto it = cache_.find(m.chunk);
-		if (it != cache_.end())
-			b = it->second;
-		else if (last_ && lastChunk_ == m.chunk)
-			b = last_;
-	}
-	if (!b)
-	{
-		try
-		{
-			b = decompress(c);
-		}
-		catch (const runtime_error& e)
-		{
-			throw runtime_error("the chunk at byte " + std::to_string(c.pos) +
-			                    ": " + e.what());
-		}
-		const std::lock_guard<std::mutex> lock(cacheMutex_);
-		last_ = b;
-		lastChunk_ = m.chunk;
-		// the messages are read in about the chunks' order: the chunks
-		// well behind this one are done with
-		for (auto it = cache_.begin();
-		     it != cache_.end() && it->first + 2 < m.chunk;)
-		{
-			cacheBytes_ -= it->second->size();
-			it = cache_.erase(it);
-		}
-	}
+	const Buffer b = cache_.get(m.chunk, c.pos, [&] { return decompress(c); });
 	if (m.offset + m.size > b->size())
 		throw runtime_error("a message beyond its chunk");  // (not reached)
 	return {b, b->data() + m.offset, m.size};

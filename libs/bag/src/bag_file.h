@@ -13,6 +13,7 @@
 
 #include <bims/bag/bag_import.h>
 
+#include "chunk_cache.h"
 #include "message_source.h"
 
 #include <cstddef>
@@ -90,14 +91,7 @@ class BagFile : public MessageSource
 	};
 	/** A decompressed chunk: its bytes are not zeroed first (all are
 	 * written), which would cost a pass over them. */
-	struct ChunkData
-	{
-		std::unique_ptr<uint8_t[]> bytes;
-		size_t n = 0;
-		const uint8_t* data() const { return bytes.get(); }
-		size_t size() const { return n; }
-	};
-	using Buffer = std::shared_ptr<const ChunkData>;
+	using Buffer = ChunkBuffer;
 
 	/** The records from byte \a start (after the version line). */
 	void walk(uint64_t start);
@@ -130,11 +124,7 @@ class BagFile : public MessageSource
 	uint64_t damagePos_ = 0;
 	bool damageLoses_ = false;
 
-	std::mutex cacheMutex_;
-	size_t cacheBudget_ = 0, cacheBytes_ = 0;
-	std::map<uint32_t, Buffer> cache_;  ///< kept from the scan
-	Buffer last_;  ///< the chunk decompressed last, beyond the cache
-	uint32_t lastChunk_ = 0;
+	ChunkCache cache_;
 };
 
 }  // namespace bims::bag

@@ -116,7 +116,7 @@ uint32_t channelIndex(const std::map<uint16_t, uint32_t>& ids, uint16_t id)
 }  // namespace
 
 McapFile::McapFile(const std::string& path, size_t cacheBytes)
-    : cacheBudget_(cacheBytes)
+    : cache_(cacheBytes)
 {
 	const MappedFile f = mapFile(path);
 	map_ = f.owner;
@@ -631,15 +631,8 @@ void McapFile::scan(const MessageFn& message)
 			return;  // (the futures left are waited for as they go)
 		}
 		if (!chunks_[it.chunk].compression.empty())
-		{
-			const std::lock_guard<std::mutex> lock(cacheMutex_);
-			if (cacheBytes_ + r.bytes.size <= cacheBudget_)
-			{
-				cache_[it.chunk] =
-				    std::static_pointer_cast<const ChunkData>(r.bytes.owner);
-				cacheBytes_ += r.bytes.size;
-			}
-		}
+			cache_.keep(it.chunk, std::static_pointer_cast<const ChunkData>(
+			                          r.bytes.owner));
 		if (!walkChunk(it.chunk, r.bytes, message)) return;
 	}
 }
@@ -650,39 +643,10 @@ BagBytes McapFile::message(const BagMessageRef& m)
 	const Chunk& c = chunks_.at(m.chunk);
 	if (c.compression.empty())
 		return {map_, bytes_ + c.data + m.offset, m.size};
-	Buffer b;
-	{
-		const std::lock_guard<std::mutex> lock(cacheMutex_);
-		const auto it = cache_.find(m.chunk);
-		if (it != cache_.end())
-			b = it->second;
-		else if (last_ && lastChunk_ == m.chunk)
-			b = last_;
-	}
-	if (!b)
-	{
-		try
-		{
-			b = decompress(c);
-		}
-		catch (const runtime_error& e)
-		{
-			throw runtime_error("the chunk at byte " + std::to_string(c.pos) +
-			                    ": " + e.what());
-		}
-		const std::lock_guard<std::mutex> lock(cacheMutex_);
-		last_ = b;
-		lastChunk_ = m.chunk;
-		for (auto it = cache_.begin();
-		     it != cache_.end() && it->first + 2 < m.chunk;)
-		{
-			cacheBytes_ -= it->second->n;
-			it = cache_.erase(it);
-		}
-	}
-	if (m.offset + m.size > b->n)
+	const Buffer b = cache_.get(m.chunk, c.pos, [&] { return decompress(c); });
+	if (m.offset + m.size > b->size())
 		throw runtime_error("a message beyond its chunk");  // (not reached)
-	return {b, b->bytes.get() + m.offset, m.size};
+	return {b, b->data() + m.offset, m.size};
 }
 
 }  // namespace bims::bag

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "chunk_cache.h"
 #include "message_source.h"
 
 namespace bims::bag
@@ -60,12 +61,7 @@ class McapFile : public MessageSource
 		std::string compression;
 		bool cut = false;  ///< the file ends inside it (uncompressed)
 	};
-	struct ChunkData
-	{
-		std::unique_ptr<uint8_t[]> bytes;
-		size_t n = 0;
-	};
-	using Buffer = std::shared_ptr<const ChunkData>;
+	using Buffer = ChunkBuffer;
 	/** A record of the data section, in file order: a chunk, or a message,
 	 * schema or channel outside chunks. */
 	struct Item
@@ -106,11 +102,7 @@ class McapFile : public MessageSource
 	uint64_t damagePos_ = 0;
 	bool damageLoses_ = false;
 
-	std::mutex cacheMutex_;
-	size_t cacheBudget_ = 0, cacheBytes_ = 0;
-	std::map<uint32_t, Buffer> cache_;
-	Buffer last_;
-	uint32_t lastChunk_ = 0;
+	ChunkCache cache_;
 };
 
 }  // namespace bims::bag
