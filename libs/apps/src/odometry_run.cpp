@@ -203,10 +203,8 @@ int runOdometry(const OdometryRunOptions& o)
 			    {
 				    const Eigen::Matrix3d R =
 				        ego::levellingRotation(r.gravity_W);
-				    Eigen::Matrix3d R_WC;
-				    const auto& Rm = r.T_WC.getRotationMatrix();
-				    for (int i = 0; i < 3; i++)
-					    for (int j = 0; j < 3; j++) R_WC(i, j) = Rm(i, j);
+				    const Eigen::Matrix3d R_WC =
+				        r.T_WC.getRotationMatrix().asEigen();
 				    levelled.push_back(
 				        {r.t, ego::toPose(R * R_WC, Eigen::Vector3d::Zero())});
 			    }

@@ -266,28 +266,29 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		    "(rotation and translation from the tracked 3D features, the "
 		    "tracker seeded at constant velocity), each flagged "
 		    "imu_missing");
-	if (const size_t n = flaggedBy(sum, "degenerate"))
-		sum.notes.push_back(
-		    std::to_string(n) + " of " + std::to_string(sum.framesProcessed) +
-		    " frames were degenerate: their depth left directions of the "
-		    "position unconstrained (a wall, a corridor, glass; frames.csv "
-		    "degenerate_dirs), the inertial prediction carried those");
-	if (const size_t n = flaggedBy(sum, "inertial_rejected"))
-		sum.notes.push_back(
-		    std::to_string(n) +
-		    " alignments disagreed with the IMU's prediction beyond its "
-		    "uncertainty and were refused (inertial_rejected): the prediction "
-		    "stood");
-	if (const size_t n = flaggedBy(sum, "inertial_prior"))
-		sum.notes.push_back(
-		    std::to_string(n) +
-		    " frames had intervals without accelerometer samples (a gap, an "
-		    "IMU that stopped, stamps on another clock): constant velocity "
-		    "carried them (inertial_prior)");
-	if (const size_t n = flaggedBy(sum, "accel_saturated"))
-		sum.notes.push_back(std::to_string(n) +
-		                    " frames had saturated accelerometer samples, left "
-		                    "out ([inertial] accel_range_ms2)");
+	// the inertial filter's flags, each said once: how many frames, what
+	// it means
+	const std::pair<const char*, const char*> inertialNotes[] = {
+	    {"degenerate",
+	     "were degenerate: their depth left directions of the position "
+	     "unconstrained (a wall, a corridor, glass; frames.csv "
+	     "degenerate_dirs), the inertial prediction carried those"},
+	    {"inertial_rejected",
+	     "had alignments that disagreed with the IMU's prediction beyond its "
+	     "uncertainty and were refused (inertial_rejected): the prediction "
+	     "stood"},
+	    {"inertial_prior",
+	     "had intervals without accelerometer samples (a gap, an IMU that "
+	     "stopped, stamps on another clock): constant velocity carried them "
+	     "(inertial_prior)"},
+	    {"accel_saturated",
+	     "had saturated accelerometer samples, left out ([inertial] "
+	     "accel_range_ms2)"}};
+	for (const auto& [flag, text] : inertialNotes)
+		if (const size_t n = flaggedBy(sum, flag))
+			sum.notes.push_back(std::to_string(n) + " of " +
+			                    std::to_string(sum.framesProcessed) +
+			                    " frames " + text);
 	if (sum.framesWithoutFlow > 0)
 		sum.notes.push_back(
 		    std::to_string(sum.framesWithoutFlow) + " of " +
