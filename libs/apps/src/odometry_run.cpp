@@ -139,6 +139,22 @@ std::string odometryCsvLine(const ego::FrameEgomotion& r,
 	return buf;
 }
 
+namespace
+{
+/** An attitude output of bims-odom (translation 0) written to \a path when
+ * asked for; none to write is an error: \a what, then \a whyNone. */
+void saveAttitude(const std::optional<std::string>& path,
+                  const Trajectory& poses, const std::string& what,
+                  const std::string& whyNone, const std::string& rotation)
+{
+	if (!path) return;
+	if (poses.empty()) throw std::runtime_error(what + ": " + whyNone);
+	saveTumTrajectory(*path, poses,
+	                  "bims-odom: " + rotation +
+	                      " at each frame (translation not estimated: 0)");
+}
+}  // namespace
+
 int runOdometry(const OdometryRunOptions& o)
 {
 	std::vector<std::string> outputs = {o.out};
@@ -248,30 +264,17 @@ int runOdometry(const OdometryRunOptions& o)
 		    o.rawlog + ": no usable RGB-D frame (check [sensors] rgbd_label)");
 	if (csv) csv->close();
 	saveTumTrajectory(o.out, traj, header);
-	if (o.attitude)
-	{
-		if (attitude.empty())
-			throw std::runtime_error(
-			    o.rawlog +
-			    ": --attitude: no frame has an IMU attitude (no IMU samples "
-			    "with [sensors] imu_label, or no [calibration] R_IC)");
-		saveTumTrajectory(*o.attitude, attitude,
-		                  "bims-odom: the IMU attitude filter's R_WC = R_WI "
-		                  "R_IC at each frame (translation not estimated: 0)");
-	}
-	if (o.gravity_attitude)
-	{
-		if (levelled.empty())
-			throw std::runtime_error(
-			    o.rawlog +
-			    ": --gravity-attitude: the inertial filter carried no frame "
-			    "([inertial] enable = false, mode = vision, no IMU samples or "
-			    "no [calibration] R_IC)");
-		saveTumTrajectory(*o.gravity_attitude, levelled,
-		                  "bims-odom: the odometry's R_WC levelled by the "
-		                  "inertial filter's gravity at each frame "
-		                  "(translation not estimated: 0)");
-	}
+	saveAttitude(o.attitude, attitude, o.rawlog + ": --attitude",
+	             "no frame has an IMU attitude (no IMU samples with [sensors] "
+	             "imu_label, or no [calibration] R_IC)",
+	             "the IMU attitude filter's R_WC = R_WI R_IC");
+	saveAttitude(o.gravity_attitude, levelled,
+	             o.rawlog + ": --gravity-attitude",
+	             "the inertial filter carried no frame ([inertial] enable = "
+	             "false, mode = vision, no IMU samples or no [calibration] "
+	             "R_IC)",
+	             "the odometry's R_WC levelled by the inertial filter's "
+	             "gravity");
 	const auto pIn = Percentiles::of(msIn), pTrack = Percentiles::of(msTrack),
 	           pMotion = Percentiles::of(msMotion),
 	           pEgo = Percentiles::of(msEgo);
