@@ -75,7 +75,7 @@ struct InertialState
 /** What propagate() did over one interval. */
 struct InertialPropagation
 {
-	int samples = 0;         ///< accelerometer samples integrated
+	int samples = 0;         ///< steps integrated with the accelerometer
 	double covered_s = 0;    ///< time integrated with the accelerometer [s]
 	double prior_s = 0;      ///< time under the motion prior (no samples) [s]
 	bool saturated = false;  ///< a sample beyond accel_range_ms2 was left out
