@@ -5,8 +5,11 @@
 #include <opencv2/imgproc.hpp>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace bims::ego
 {
@@ -183,15 +186,40 @@ struct Pass
 	}
 };
 
+/** How a pass associates a sample with a reference pixel. */
+struct Association
+{
+	/** The reference pixel of each sample (-1: none): written by a pass
+	 * that projects (when \a record), read by one that keeps them. */
+	std::vector<int> pixel;
+	bool record = false;  ///< project, and write pixel
+	bool keep = false;    ///< do not project: use pixel (the linear model)
+	/** When \a residuals: each sample's point-to-plane residual in its
+	 * noise's units (NaN where it has none: not associated, beyond the gate,
+	 * no normal) and Tukey's weight s^2 of it. */
+	bool residuals = false;
+	std::vector<float> r, w;
+};
+
 /** One pass over the samples at pose (R, t): the normal equations (with
  * \a rows, their scratch) and the counts; \a outliers (optional) gets 255 at
- * the samples that are associated but not inliers. */
+ * the samples that are associated but not inliers. \a assoc (optional):
+ * record each sample's reference pixel, or keep the recorded ones instead
+ * of projecting. */
 Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
           const Eigen::Matrix3d& R, const Eigen::Vector3d& t, float offset,
           double photoSigma, const AnchorParams& p, NormalEquations6* rows,
           cv::Mat* outliers, std::vector<int>* seenThrough = nullptr,
-          cv::Mat* consistent = nullptr)
+          cv::Mat* consistent = nullptr, Association* assoc = nullptr)
 {
+	const bool record = assoc && assoc->record,
+	           keep = assoc && assoc->keep && !record;
+	if (record) assoc->pixel.assign(cur.size(), -1);
+	if (assoc && assoc->residuals)
+	{
+		assoc->r.assign(cur.size(), std::numeric_limits<float>::quiet_NaN());
+		assoc->w.assign(cur.size(), 0.f);
+	}
 	const bool normalEquations = rows != nullptr;
 	Pass out;
 	const int W = ref.depth.cols, H = ref.depth.rows;
@@ -214,8 +242,9 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 	// the photometric residual's a = r / (sp c), and the square root of
 	// its weight's scale, photo_weight / sp^2
 	const double photoA = 1 / (sp * c), photoRootScale = std::sqrt(photoScale);
-	for (const Sample& s : cur)
+	for (size_t i = 0; i < cur.size(); i++)
 	{
+		const Sample& s = cur[i];
 		// excluded samples (predicted moving) only get classified, in the
 		// final pass, for the outlier image
 		if (s.excluded && !outliers) continue;
@@ -231,15 +260,21 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 		const float iz = 1.f / Z;
 		float u, v;
 		denseProject(X, Y, iz, fx, fy, cx, cy, u, v);
-		if (!(u > -0.5f && v > -0.5f && u < W - 0.5f && v < H - 0.5f))
+		int pix;
+		if (keep)
+			pix = assoc->pixel[i];
+		else if (!(u > -0.5f && v > -0.5f && u < W - 0.5f && v < H - 0.5f))
+			pix = -1;
+		else
+			pix = static_cast<int>(v + 0.5f) * W + static_cast<int>(u + 0.5f);
+		if (record) assoc->pixel[i] = pix;
+		if (pix < 0)
 		{
 			if (counts) out.cost += rhoMax;
 			continue;
 		}
-		const int ui = static_cast<int>(u + 0.5f),
-		          vi = static_cast<int>(v + 0.5f);
 		const RefPixel* P = ref.packed.data();
-		const RefPixel& q = P[vi * W + ui];
+		const RefPixel& q = P[pix];
 		const float zr = q.z;
 		if (zr == 0)
 		{
@@ -258,7 +293,7 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 			if (!counts) continue;
 			++out.associated;
 			++out.seenThrough;
-			if (seenThrough) seenThrough->push_back(vi * W + ui);
+			if (seenThrough) seenThrough->push_back(pix);
 			out.cost += rhoMax;
 			continue;
 		}
@@ -283,6 +318,11 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 			rg = pointToPlaneResidual(X, Y, Z, q.nx, q.ny, q.nz, q.d);
 			invSg = 1 / (p.geo_sigma_m + p.geo_sigma_z2 * zr * zr);
 			tg = Tukey::at(rg * invSg * invC, c);
+			if (assoc && assoc->residuals)
+			{
+				assoc->r[i] = float(rg * invSg);
+				assoc->w[i] = float(tg.s * tg.s);
+			}
 		}
 		if (tg.s <= 0 && outliers) outliers->data[s.pix] = 255;
 		if (tg.s > 0 && consistent) consistent->data[s.pix] = 255;
@@ -549,6 +589,87 @@ int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
 	if (cur.photoW > 0) offset = float(cur.photoSum / cur.photoW);
 	return steps;
 }
+
+/** \a H with the depth's information about the translation measured on
+ * the geometry itself. H is the data's curvature with every point held on
+ * the reference pixel it lands on now (the Jacobian of the point-to-plane
+ * residual). Along a flat wall that is the wall's noisy normals: they give
+ * its in-plane directions information that sliding along the wall does not
+ * bear out (the slid points land on other pixels of the same plane, where
+ * the residual is noise again). So along each eigenvector d of the
+ * geometric term's translation block (eigenvalue a) the frame is slid by
+ * +- delta (max(2 / sqrt(a), 2 pixels' footprint at the samples' median
+ * depth)) and each point's residual evaluated twice: re-associated (what
+ * the geometry says) and on the pixel it had (what H says). The regression
+ * gain of the first change on the second (Tukey-weighted, over the inliers
+ * at the result that stay within the gate) is how much of H's sensitivity
+ * is real: the geometric information along d is scaled by its square,
+ * clamped to [0, 1] (a congruence: H stays positive semi-definite). A
+ * planar world with exact normals gives a gain of 1 (a point re-associated
+ * on the same plane has the same residual); a flat wall's in-plane
+ * directions ~0. The photometric information is kept as it is.
+ * docs/ego.md, "Depth-inertial translation". */
+Mat6 measuredInformation(const DenseLevel& ref, const std::vector<Sample>& cur,
+                         const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                         const AnchorParams& params, const Mat6& H,
+                         NormalEquations6& rows)
+{
+	AnchorParams p = params;
+	p.photo_weight = 0;
+	Association at;
+	at.record = true;
+	at.residuals = true;
+	const Pass atPass =
+	    pass(ref, cur, R, t, 0, 1, p, &rows, nullptr, nullptr, nullptr, &at);
+	const Mat6 Hgeo = atPass.H;
+	const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(
+	    Hgeo.topLeftCorner<3, 3>());
+	if (es.info() != Eigen::Success) return H;
+	// one pixel's footprint at the samples' median depth [m]
+	std::vector<float> z;
+	z.reserve(cur.size());
+	for (const Sample& s : cur)
+		if (!s.excluded) z.push_back(s.z);
+	if (z.empty()) return H;
+	std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
+	const double pixel = z[z.size() / 2] / std::max(ref.fx, ref.fy);
+	Association moved, held;
+	moved.residuals = held.residuals = true;
+	held.keep = true;
+	held.pixel = at.pixel;
+	Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+	for (int k = 0; k < 3; k++)
+	{
+		const double a = es.eigenvalues()[k];
+		if (!(a > 0)) continue;
+		const Eigen::Vector3d d = es.eigenvectors().col(k);
+		const double delta = std::max(2 / std::sqrt(a), 2 * pixel);
+		double sxy = 0, sxx = 0;
+		for (const double sign : {1.0, -1.0})
+		{
+			const Eigen::Vector3d tn = t + sign * delta * d;
+			pass(ref, cur, R, tn, 0, 1, p, nullptr, nullptr, nullptr, nullptr,
+			     &moved);
+			pass(ref, cur, R, tn, 0, 1, p, nullptr, nullptr, nullptr, nullptr,
+			     &held);
+			for (size_t i = 0; i < cur.size(); i++)
+			{
+				const double w = at.w[i];
+				if (!(w > 0) || std::isnan(moved.r[i]) || std::isnan(held.r[i]))
+					continue;
+				const double x = held.r[i] - at.r[i], y = moved.r[i] - at.r[i];
+				sxy += w * x * y;
+				sxx += w * x * x;
+			}
+		}
+		const double gain = sxx > 0 ? std::clamp(sxy / sxx, 0.0, 1.0) : 1.0;
+		scale[k] = gain;
+	}
+	Mat6 S = Mat6::Identity();
+	S.topLeftCorner<3, 3>() =
+	    es.eigenvectors() * scale.asDiagonal() * es.eigenvectors().transpose();
+	return H - Hgeo + S * Hgeo * S;
+}
 }  // namespace
 
 void DenseFrame::dropReadings(const cv::Mat& m, const AnchorParams& p)
@@ -690,6 +811,11 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 		                 rows, nullptr, nullptr, l == fine ? &H : nullptr);
 	}
 	// Final counts and the outlier image at the finest level.
+	// with a translation prior (the inertial filter's), the information is
+	// its measurement's: measured on the cost where a pixel is exceeded
+	if (tPrior)
+		H = measuredInformation(ref.levels[static_cast<size_t>(fine)], samples,
+		                        R, t, p, H, rows);
 	const DenseLevel& Lf = cur.levels[static_cast<size_t>(fine)];
 	r.outliers = cv::Mat::zeros(Lf.depth.size(), CV_8UC1);
 	r.consistent = cv::Mat::zeros(Lf.depth.size(), CV_8UC1);

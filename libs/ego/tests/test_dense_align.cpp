@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -642,4 +644,104 @@ TEST(DenseAlign, JacobianMatchesCentralDifferences)
 	    "point-to-plane: max abs %.2e, rel %.2e; photometric: max abs "
 	    "%.2e, rel %.2e; float: rel %.2e\n",
 	    geo.abs, geo.rel, photo.abs, photo.rel, inFloat.rel);
+}
+
+namespace
+{
+/** The translation information (Schur complement, rotation free) of an
+ * alignment of \a cur to \a ref, depth only, with a weak translation prior
+ * (the inertial filter's: its information measured on the geometry) or
+ * without (the linearised one). */
+Eigen::Matrix3d translationInfo(const cv::Mat& refDepth,
+                                const cv::Mat& curDepth, bool withPrior)
+{
+	const AnchorParams p = params320();
+	DenseFrame ref, cur;
+	ref.build(cv::Mat(), refDepth, K320(), p);
+	ref.prepareReference(p);
+	cur.build(cv::Mat(), curDepth, K320(), p);
+	TranslationPrior prior;
+	prior.info = Eigen::Matrix3d::Identity() / (0.5 * 0.5);
+	const DenseAlignResult a = alignDense(ref, cur, Eigen::Matrix3d::Identity(),
+	                                      Eigen::Vector3d::Zero(), p, nullptr,
+	                                      0, withPrior ? &prior : nullptr);
+	EXPECT_TRUE(a.ok) << a.why;
+	return translationInformation(a.information, 0);
+}
+
+/** A fronto-parallel wall at 2 m, depth noise 5 mm per pixel. */
+cv::Mat noisyWall(uint32_t seed)
+{
+	std::mt19937 rng(seed);
+	std::normal_distribution<float> n(0, 0.005f);
+	cv::Mat d(240, 320, CV_32FC1);
+	for (int v = 0; v < d.rows; v++)
+		for (int u = 0; u < d.cols; u++) d.at<float>(v, u) = 2.f + n(rng);
+	return d;
+}
+}  // namespace
+
+// Issue 52: a flat wall's noisy normals give the linearised alignment
+// information along the wall that sliding along it does not bear out: with
+// a translation prior (the inertial filter's) the information is measured
+// on the geometry, and the wall keeps only its normal's. A furnished room
+// keeps what it has.
+TEST(DenseAlign, TheInformationAlongAFlatWallIsMeasuredAsNone)
+{
+	const cv::Mat a = noisyWall(1), b = noisyWall(2);
+	const Eigen::Matrix3d lin = translationInfo(a, b, false),
+	                      meas = translationInfo(a, b, true);
+	std::printf(
+	    "flat wall: information x %.3g -> %.3g, y %.3g -> %.3g, z "
+	    "%.3g -> %.3g [1/m^2]\n",
+	    lin(0, 0), meas(0, 0), lin(1, 1), meas(1, 1), lin(2, 2), meas(2, 2));
+	// the linearised one: the in-plane directions pinned to ~1 cm (the
+	// noisy normals), the normal to well under 1 mm
+	EXPECT_GT(lin(0, 0), 1 / (0.02 * 0.02));
+	EXPECT_GT(lin(1, 1), 1 / (0.02 * 0.02));
+	// measured: along the wall under a tenth of that, the normal kept
+	EXPECT_LT(meas(0, 0), 0.1 * lin(0, 0));
+	EXPECT_LT(meas(1, 1), 0.1 * lin(1, 1));
+	EXPECT_GT(meas(2, 2), 0.9 * lin(2, 2));
+
+	// the synthetic room's walls and floor in view, with the same noise:
+	// the directions their corners pin (in the exact depth) stay, the one
+	// they do not (along the two walls in view, x) has only the noise's and
+	// loses it
+	Pair s = pairAt(0.1);
+	const Eigen::Matrix3d exact =
+	    translationInfo(s.ref.depth, s.cur.depth, false);
+	std::mt19937 rng(3);
+	std::normal_distribution<float> n(0, 0.005f);
+	for (cv::Mat* d : {&s.ref.depth, &s.cur.depth})
+		for (auto it = d->begin<float>(); it != d->end<float>(); ++it)
+			*it += n(rng);
+	const Eigen::Matrix3d linRoom =
+	                          translationInfo(s.ref.depth, s.cur.depth, false),
+	                      measRoom =
+	                          translationInfo(s.ref.depth, s.cur.depth, true);
+	const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(linRoom);
+	int pinned = 0, free = 0;
+	for (int k = 0; k < 3; k++)
+	{
+		const Eigen::Vector3d d = es.eigenvectors().col(k);
+		const double real = d.dot(exact * d), before = d.dot(linRoom * d),
+		             after = d.dot(measRoom * d);
+		std::printf(
+		    "room: information along (%.2f %.2f %.2f): exact depth "
+		    "%.3g, noisy %.3g, measured %.3g\n",
+		    d.x(), d.y(), d.z(), real, before, after);
+		if (real > 0.5 * before)
+		{
+			++pinned;
+			EXPECT_GT(after, 0.7 * before) << "room, " << d.transpose();
+		}
+		else
+		{
+			++free;
+			EXPECT_LT(after, 0.1 * before) << "room, " << d.transpose();
+		}
+	}
+	EXPECT_EQ(pinned, 2);
+	EXPECT_EQ(free, 1);
 }
