@@ -718,6 +718,120 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 	                  tPrior);
 }
 
+namespace
+{
+/** Where the alignment stands: the pose, the photometric term's brightness
+ * offset and scale, and the data's normal equations there. */
+struct Estimate
+{
+	Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+	Eigen::Vector3d t = Eigen::Vector3d::Zero();
+	float offset = 0;
+	double photoSigma = 0;
+	Mat6 H = Mat6::Zero();
+	int guess = 0;       ///< the initial guess it started from
+	int iterations = 0;  ///< Gauss-Newton steps so far
+};
+
+/** The priors of one alignment (the arguments of alignDense()). */
+struct Priors
+{
+	const Eigen::Matrix3d* R = nullptr;
+	double sigmaR_rad = 0;
+	const TranslationPrior* t = nullptr;
+};
+
+/** The coarsest level from each guess: the one with most inliers there.
+ * A later guess is iterated only when it starts with more inliers than the
+ * first one did (the frame-to-frame guess is usually the better one: 4
+ * Gauss-Newton passes saved; docs/ego.md). */
+Estimate bestCoarseGuess(const DenseLevel& Lr,
+                         const std::vector<Sample>& coarse,
+                         const std::vector<InitialGuess>& inits,
+                         const AnchorParams& p, const Priors& pr,
+                         NormalEquations6& rows)
+{
+	// a wide first scale; each pass then estimates it from its residuals
+	const double sigma0 = std::max(p.photo_sigma_grey, 40.0);
+	Estimate best;
+	best.R = inits.front().R;
+	best.t = inits.front().t;
+	best.photoSigma = sigma0;
+	int bestInliers = -1, iterations = 0;
+	int firstInliers = -1;  // the first guess's, before iterating
+	for (size_t k = 0; k < inits.size(); k++)
+	{
+		Estimate e;
+		e.R = inits[k].R;
+		e.t = inits[k].t;
+		e.photoSigma = sigma0;
+		e.guess = static_cast<int>(k);
+		int inl = 0;
+		// The first guess's count is also its level's first pass (with the
+		// normal equations); a later one's only counts (it is usually not
+		// iterated). A single guess needs no count.
+		const bool reuse = inits.size() > 1 && k == 0;
+		Pass counted;
+		if (inits.size() > 1)
+		{
+			counted = pass(Lr, coarse, e.R, e.t, 0, sigma0, p,
+			               reuse ? &rows : nullptr, nullptr);
+			if (k == 0)
+				firstInliers = counted.inliers;
+			else if (counted.inliers <= firstInliers)
+				continue;
+		}
+		iterations += iterateLevel(Lr, coarse, e.R, e.t, e.offset, e.photoSigma,
+		                           p, pr.R, pr.sigmaR_rad, pr.t, rows, &inl,
+		                           reuse ? &counted : nullptr, &e.H);
+		if (inl > bestInliers)
+		{
+			bestInliers = inl;
+			best = e;
+		}
+	}
+	best.iterations = iterations;
+	return best;
+}
+
+/** The finest level's counts, outlier and consistency images at \a e into
+ * \a r, and whether the result holds (r.ok, r.why). */
+void finalCounts(const DenseLevel& Lr, const DenseLevel& Lc,
+                 const std::vector<Sample>& samples, const Estimate& e,
+                 const AnchorParams& p, DenseAlignResult& r)
+{
+	r.outliers = cv::Mat::zeros(Lc.depth.size(), CV_8UC1);
+	r.consistent = cv::Mat::zeros(Lc.depth.size(), CV_8UC1);
+	const Pass fin = pass(Lr, samples, e.R, e.t, e.offset, e.photoSigma, p,
+	                      nullptr, &r.outliers, &r.seenThrough, &r.consistent);
+	if (p.stride_px > 1)
+	{
+		// a sample stands for its stride x stride block
+		const cv::Mat k(p.stride_px, p.stride_px, CV_8UC1, cv::Scalar(1));
+		cv::dilate(r.outliers, r.outliers, k, cv::Point(0, 0));
+		cv::dilate(r.consistent, r.consistent, k, cv::Point(0, 0));
+	}
+	r.points = 0;
+	for (const Sample& q : samples) r.points += q.excluded ? 0 : 1;
+	r.associated = fin.associated;
+	r.inliers = fin.inliers;
+	// occluders and surfaces seen through are explained by motion in the
+	// scene: the fraction is over the points that landed on a surface
+	const int onSurface = fin.associated - fin.occluding - fin.seenThrough;
+	r.inlier_fraction = onSurface > 0 ? double(fin.inliers) / onSurface : 0;
+	r.overlap = r.points > 0 ? double(fin.inliers) / r.points : 0;
+	r.coverage = r.points > 0 ? double(fin.associated) / r.points : 0;
+	r.rms_geo_m = fin.inliers > 0 ? std::sqrt(fin.sumGeo2 / fin.inliers) : 0;
+	if (!e.R.allFinite() || !e.t.allFinite())
+		r.why = "diverged";
+	else if (r.inliers < p.min_inliers)
+		r.why = "too few inliers (" + std::to_string(r.inliers) + ")";
+	else if (r.inlier_fraction < p.min_inlier_fraction)
+		r.why = "inlier fraction " + std::to_string(r.inlier_fraction);
+	r.ok = r.why.empty();
+}
+}  // namespace
+
 DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
                             const std::vector<InitialGuess>& inits,
                             const AnchorParams& params,
@@ -742,114 +856,37 @@ DenseAlignResult alignDense(const DenseFrame& ref, const DenseFrame& cur,
 		                      : "frames not prepared for these levels";
 		return r;
 	}
+	const auto level = [](const DenseFrame& f, int l) -> const DenseLevel&
+	{ return f.levels[static_cast<size_t>(l)]; };
 	// about as many samples at every level: stride_px at the finest, half
 	// that a level up, ...
-	const auto strideAt = [&p, fine](int l)
-	{ return std::max(1, p.stride_px >> (l - fine)); };
-	// The coarsest level from each guess; the one with most inliers goes on.
-	const std::vector<Sample> coarse =
-	    samplesOf(cur.levels[static_cast<size_t>(top)], strideAt(top));
-	Eigen::Matrix3d R = r.R_RC;
-	Eigen::Vector3d t = r.t_RC;
-	float offset = 0;
-	// a wide first scale; each pass then estimates it from its residuals
-	const double sigma0 = std::max(p.photo_sigma_grey, 40.0);
-	double photoSigma = sigma0;
+	const auto samplesAt = [&](int l) {
+		return samplesOf(level(cur, l), std::max(1, p.stride_px >> (l - fine)));
+	};
+	const Priors priors{R_prior, sigmaPrior_rad, tPrior};
 	NormalEquations6 rows;
-	Mat6 H = Mat6::Zero();  // the data's normal equations at the result
-	int best = -1;
-	int firstInliers = -1;  // the first guess's, before iterating
-	for (size_t k = 0; k < inits.size(); k++)
-	{
-		Eigen::Matrix3d Rk = inits[k].R;
-		Eigen::Vector3d tk = inits[k].t;
-		float ok = 0;
-		double sk = sigma0;
-		int inl = 0;
-		Mat6 Hk = Mat6::Zero();
-		// A later guess is iterated only when it starts with more inliers
-		// than the first one did (the frame-to-frame guess is usually the
-		// better one: 4 Gauss-Newton passes saved; docs/ego.md). A single
-		// guess needs no count.
-		// The first guess's count is also its level's first pass (with the
-		// normal equations); a later one's only counts (it is usually not
-		// iterated).
-		const bool reuse = inits.size() > 1 && k == 0;
-		Pass counted;
-		if (inits.size() > 1)
-		{
-			counted = pass(ref.levels[static_cast<size_t>(top)], coarse, Rk, tk,
-			               0, sigma0, p, reuse ? &rows : nullptr, nullptr);
-			const int start = counted.inliers;
-			if (k == 0)
-				firstInliers = start;
-			else if (start <= firstInliers)
-				continue;
-		}
-		r.iterations +=
-		    iterateLevel(ref.levels[static_cast<size_t>(top)], coarse, Rk, tk,
-		                 ok, sk, p, R_prior, sigmaPrior_rad, tPrior, rows, &inl,
-		                 reuse ? &counted : nullptr, &Hk);
-		if (inl > best)
-		{
-			best = inl;
-			H = Hk;
-			R = Rk;
-			t = tk;
-			offset = ok;
-			photoSigma = sk;
-			r.guess = static_cast<int>(k);
-		}
-	}
-	std::vector<Sample> samples = coarse;
+	std::vector<Sample> samples = samplesAt(top);
+	Estimate e =
+	    bestCoarseGuess(level(ref, top), samples, inits, p, priors, rows);
 	for (int l = top - 1; l >= fine; l--)
 	{
-		samples = samplesOf(cur.levels[static_cast<size_t>(l)], strideAt(l));
-		r.iterations +=
-		    iterateLevel(ref.levels[static_cast<size_t>(l)], samples, R, t,
-		                 offset, photoSigma, p, R_prior, sigmaPrior_rad, tPrior,
-		                 rows, nullptr, nullptr, l == fine ? &H : nullptr);
+		samples = samplesAt(l);
+		e.iterations +=
+		    iterateLevel(level(ref, l), samples, e.R, e.t, e.offset,
+		                 e.photoSigma, p, R_prior, sigmaPrior_rad, tPrior, rows,
+		                 nullptr, nullptr, l == fine ? &e.H : nullptr);
 	}
-	// Final counts and the outlier image at the finest level.
 	// with a translation prior (the inertial filter's), the information is
 	// its measurement's: measured on the cost where a pixel is exceeded
 	if (tPrior)
-		H = measuredInformation(ref.levels[static_cast<size_t>(fine)], samples,
-		                        R, t, p, H, rows);
-	const DenseLevel& Lf = cur.levels[static_cast<size_t>(fine)];
-	r.outliers = cv::Mat::zeros(Lf.depth.size(), CV_8UC1);
-	r.consistent = cv::Mat::zeros(Lf.depth.size(), CV_8UC1);
-	const Pass fin = pass(ref.levels[static_cast<size_t>(fine)], samples, R, t,
-	                      offset, photoSigma, p, nullptr, &r.outliers,
-	                      &r.seenThrough, &r.consistent);
-	if (p.stride_px > 1)
-	{
-		// a sample stands for its stride x stride block
-		const cv::Mat k(p.stride_px, p.stride_px, CV_8UC1, cv::Scalar(1));
-		cv::dilate(r.outliers, r.outliers, k, cv::Point(0, 0));
-		cv::dilate(r.consistent, r.consistent, k, cv::Point(0, 0));
-	}
-	r.R_RC = orthonormalize(R);
-	r.t_RC = t;
-	r.information = H;
-	r.points = 0;
-	for (const Sample& q : samples) r.points += q.excluded ? 0 : 1;
-	r.associated = fin.associated;
-	r.inliers = fin.inliers;
-	// occluders and surfaces seen through are explained by motion in the
-	// scene: the fraction is over the points that landed on a surface
-	const int onSurface = fin.associated - fin.occluding - fin.seenThrough;
-	r.inlier_fraction = onSurface > 0 ? double(fin.inliers) / onSurface : 0;
-	r.overlap = r.points > 0 ? double(fin.inliers) / r.points : 0;
-	r.coverage = r.points > 0 ? double(fin.associated) / r.points : 0;
-	r.rms_geo_m = fin.inliers > 0 ? std::sqrt(fin.sumGeo2 / fin.inliers) : 0;
-	if (!R.allFinite() || !t.allFinite())
-		r.why = "diverged";
-	else if (r.inliers < p.min_inliers)
-		r.why = "too few inliers (" + std::to_string(r.inliers) + ")";
-	else if (r.inlier_fraction < p.min_inlier_fraction)
-		r.why = "inlier fraction " + std::to_string(r.inlier_fraction);
-	r.ok = r.why.empty();
+		e.H = measuredInformation(level(ref, fine), samples, e.R, e.t, p, e.H,
+		                          rows);
+	finalCounts(level(ref, fine), level(cur, fine), samples, e, p, r);
+	r.R_RC = orthonormalize(e.R);
+	r.t_RC = e.t;
+	r.information = e.H;
+	r.guess = e.guess;
+	r.iterations = e.iterations;
 	return r;
 }
 

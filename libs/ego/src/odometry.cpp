@@ -28,6 +28,13 @@ const char* toString(RotationSource s)
 	}
 }
 
+bool FrameEgomotion::registered() const
+{
+	if (flags & kFlagFirstFrame) return true;
+	if (!ok()) return false;
+	return !(flags & kFlagInertialRejected) || (flags & kFlagAnchored);
+}
+
 bool FrameEgomotion::ok() const
 {
 	if (flags & (kFlagOutOfOrder | kFlagBadImage)) return false;

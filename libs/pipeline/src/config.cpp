@@ -49,6 +49,10 @@ void PipelineParams::describe(OptionVisitor& v)
 	v.real("surface_horizontal_deg", surface.horizontalDeg, 0.0, 89.0,
 	       "with the IMU's gravity, pixels within this angle of horizontal "
 	       "(floors) belong to no surface (0 = off)");
+	v.flag("hold_unregistered", hold_unregistered,
+	       "a frame whose pose was not measured against the static scene "
+	       "(lost, or every alignment refused by the IMU) is not put into the "
+	       "grids and its mask is empty");
 }
 
 void PipelineParams::loadFromConfigFile(

@@ -87,7 +87,7 @@ OutputWriter::OutputWriter(const std::string& dir, const OutputParams& p,
 	    "index,t,ego_flags,correspondences,inliers,residual_m,hit_voxels,"
 	    "moving_voxels,moving_px,diff_px,notdiff_px,"
 	    "ms_input,ms_ego,ms_flow,ms_grids,ms_total,filled_px,degenerate_dirs,"
-	    "ego_flag_names\n");
+	    "held,ego_flag_names\n");
 	if (p_.labelled_rawlog)
 		rawlog_ = std::make_unique<RawlogWriter>(file("segmented.rawlog"),
 		                                         p_.labelled_rawlog_gz_level);
@@ -172,13 +172,13 @@ void OutputWriter::doWriteFrame(const FrameResult& r,
 	char buf[512];
 	std::snprintf(buf, sizeof(buf),
 	              "%zu,%.6f,%u,%d,%d,%.5f,%zu,%zu,%d,%zu,%zu,%.3f,%.3f,%.3f,%."
-	              "3f,%.3f,%d,%d,%s\n",
+	              "3f,%.3f,%d,%d,%d,%s\n",
 	              r.index, r.t, r.ego.flags, r.ego.correspondences,
 	              r.ego.inliers, r.ego.residual_rms_m, r.hitVoxels,
 	              r.movingVoxels, cv::countNonZero(r.mask), r.labelStats.diff,
 	              r.labelStats.notDiff, r.ms.input, r.ms.egomotion, r.ms.flow,
 	              r.ms.grids, r.ms.total, r.surfaceFill.added,
-	              std::max(0, r.ego.degenerate),
+	              std::max(0, r.ego.degenerate), r.held ? 1 : 0,
 	              ego::flagsToString(r.ego.flags).c_str());
 	csv_->append(buf);
 }
@@ -317,6 +317,7 @@ const std::vector<MetricField>& metricFields()
 	     [](M m) { return Json(m.sum.framesSurfaceFilled); }},
 	    {"pixels_surface_filled", K::Number,
 	     [](M m) { return Json(m.sum.pixelsSurfaceFilled); }},
+	    {"frames_held", K::Number, [](M m) { return Json(m.sum.framesHeld); }},
 	    {"frames_without_imu", K::Number,
 	     [](M m) { return Json(m.sum.framesWithoutImu); }},
 	    {"imu_rejected", K::Number,

@@ -364,6 +364,16 @@ void Pipeline::runGrids(const maps::PixelLabels* labels, FrameResult& r,
 	const auto t = Clock::now();
 	r.ms.gridsDecay = settleDecay();
 	jobs.built();
+	if (cfg_.pipeline.hold_unregistered && !r.ego.registered())
+	{
+		// The frame's cloud stays out of the grids; the tracker keeps the
+		// last mask fed back (what moved is likely still there).
+		r.held = true;
+		r.mask = r.maskTier1 = r.maskTier2 =
+		    cv::Mat::zeros(cur_.size(), CV_8UC1);
+		r.ms.grids = msSince(t);
+		return;
+	}
 	const auto& g = grids_.processBuiltFrame(labels, r.flowOff);
 	const cv::Size size = cur_.size();
 	r.maskTier1 = toMat(g.maskTier1(), size);

@@ -128,6 +128,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		sum.framesProcessed++;
 		if (r.flowAhead) sum.framesFlowAhead++;
 		if (r.flowOff) sum.framesWithoutFlow++;
+		if (r.held) sum.framesHeld++;
 		if (r.surfaceFill.added > 0)
 		{
 			sum.framesSurfaceFilled++;
@@ -297,6 +298,14 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		    "only): the flow tier was off for them (tier 1 decided, tier 2 "
 		    "equals it) and their egomotion came from the keyframe "
 		    "alignment's geometric term alone (flagged no_image)");
+	if (sum.framesHeld > 0)
+		sum.notes.push_back(
+		    std::to_string(sum.framesHeld) + " of " +
+		    std::to_string(sum.framesProcessed) +
+		    " frames were held out of the grids, their masks empty: their "
+		    "pose was not measured against the static scene (lost, or every "
+		    "alignment refused by the IMU; frames.csv held, [pipeline] "
+		    "hold_unregistered)");
 	if (sum.framesSurfaceFilled > 0)
 		sum.notes.push_back(
 		    "the surface fill ([pipeline] surface_fill) called " +

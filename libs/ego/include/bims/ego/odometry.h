@@ -86,6 +86,11 @@ struct FrameEgomotion
 
 	/** true when the motion was measured (no failure flag). */
 	bool ok() const;
+	/** true when the pose was measured against the static scene (or is the
+	 * first frame's, which defines the world): ok(), and not every keyframe
+	 * alignment refused by the IMU's gate (the pose then is the inertial
+	 * prediction, which nothing checked). */
+	bool registered() const;
 };
 
 class Odometry

@@ -114,6 +114,12 @@ struct PipelineParams
 	SurfaceFill surface_fill = SurfaceFill::DepthOnly;
 	/** surface_depth_jump, surface_min_moving, surface_max_area. */
 	SurfaceFillParams surface;
+	/** A frame whose pose was not measured against the static scene (the
+	 * egomotion lost it, or the IMU's gate refused every alignment: the
+	 * pose is a prediction) is held: not integrated into the grids, its
+	 * mask empty (FrameResult::held). A pose nobody checked would paint the
+	 * static scene where it is not, and call it moving. */
+	bool hold_unregistered = true;
 
 	/** Every key of the section (bims/common/options.h). */
 	void describe(OptionVisitor& v);

@@ -67,6 +67,9 @@ struct FrameResult
 	ego::FrameEgomotion ego;        ///< egomotion details (flags, inliers, ...)
 	flow::FlowPoseResult flowPose;  ///< the dense-flow refinement, if any
 	bool warmup = false;            ///< mask forced empty (warm-up frame)
+	/** Not put into the grids, masks empty: its pose was not measured
+	 * against the static scene ([pipeline] hold_unregistered). */
+	bool held = false;
 	/** The flow tier is off for this frame: it or the previous one has no
 	 * image (depth only). Tier 1 decides; tier 2 equals it; no labels. */
 	bool flowOff = false;

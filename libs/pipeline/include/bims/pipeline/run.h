@@ -56,6 +56,8 @@ struct RunSummary : source::FrameOrderStats
 	 * surface_fill), and the pixels it added over the run */
 	size_t framesSurfaceFilled = 0;
 	size_t pixelsSurfaceFilled = 0;
+	/** frames held out of the grids (FrameResult::held) */
+	size_t framesHeld = 0;
 	/** frames flagged imu_missing or imu_gap: no IMU data for their
 	 * interval */
 	size_t framesWithoutImu = 0;
