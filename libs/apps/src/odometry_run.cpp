@@ -155,7 +155,11 @@ void saveAttitude(const std::optional<std::string>& path,
 }
 }  // namespace
 
-int runOdometry(const OdometryRunOptions& o)
+namespace
+{
+/** Refuses outputs that are inputs and outputs whose folder is not there,
+ * before any work. */
+void checkOdometryFiles(const OdometryRunOptions& o)
 {
 	std::vector<std::string> outputs = {o.out};
 	if (o.csv) outputs.insert(outputs.begin(), *o.csv);
@@ -170,114 +174,110 @@ int runOdometry(const OdometryRunOptions& o)
 	checkOutputsSpareInputs(inputs, outputs);
 	// written at the end of the run: a folder that is not there is said now
 	checkOutputFilesWritable(outputs);
-	const ego::EgoConfig ec = odometryConfig(o);
-	ego::Odometry odo(ec);
+}
+
+/** What a run collects frame by frame: the poses, the attitudes, the stage
+ * times and the CSV lines (with the tracker against the ground truth). */
+class OdometryRecorder
+{
+ public:
+	OdometryRecorder(const OdometryRunOptions& o, const ego::EgoConfig& ec,
+	                 const ego::Odometry& odo)
+	    : o_(o), ec_(ec), odo_(odo)
+	{
+		if (o.csv)
+		{
+			csv_ = std::make_unique<AppendFile>(*o.csv);
+			csv_->append(odometryCsvHeader());
+		}
+		if (o.gt) gt_ = loadTumTrajectory(*o.gt);
+	}
+
+	void add(const ego::FrameEgomotion& r,
+	         const mrpt::obs::CObservation3DRangeScan& scan)
+	{
+		if (r.flags & ego::kFlagOutOfOrder || r.flags & ego::kFlagBadImage)
+			return;  // no pose for this frame
+		traj.push_back({r.t, r.T_WC});
+		if (const auto R = o_.attitude ? odo_.imuRotation(r.t) : std::nullopt)
+			attitude.push_back({r.t, ego::toPose(*R, Eigen::Vector3d::Zero())});
+		if (o_.gravity_attitude && r.inertial)
+		{
+			const Eigen::Matrix3d R = ego::levellingRotation(r.gravity_W);
+			const Eigen::Matrix3d R_WC = r.T_WC.getRotationMatrix().asEigen();
+			levelled.push_back(
+			    {r.t, ego::toPose(R * R_WC, Eigen::Vector3d::Zero())});
+		}
+		msIn.push_back(r.ms_input);
+		msTrack.push_back(r.ms_track);
+		msMotion.push_back(r.ms_motion);
+		msEgo.push_back(r.ms_track + r.ms_motion);
+		if (csv_) csv_->append(odometryCsvLine(r, truthOf(r, scan)));
+	}
+
+	void closeCsv()
+	{
+		if (csv_) csv_->close();
+	}
+
 	Trajectory traj, attitude, levelled;
 	std::vector<double> msIn, msTrack, msMotion, msEgo;
-	std::unique_ptr<AppendFile> csv;  // each line checked
-	if (o.csv)
+
+ private:
+	/** The tracker's accuracy against the ground truth (none without). */
+	TrackerTruth truthOf(const ego::FrameEgomotion& r,
+	                     const mrpt::obs::CObservation3DRangeScan& scan)
 	{
-		csv = std::make_unique<AppendFile>(*o.csv);
-		csv->append(odometryCsvHeader());
+		TrackerTruth truth;
+		ego::RgbdFrame cur;
+		if (!gt_.empty() && ego::rgbdFrameFrom(scan, ec_.camera, cur).empty())
+		{
+			// ground-truth poses nearest to the stamps (within 5 ms)
+			const StampedPose* g1 = poseNear(gt_, r.t, 5e-3);
+			const StampedPose* g0 = poseNear(gt_, prevT_, 5e-3);
+			if (g0 && g1 && !prevDepth_.empty())
+				truth = trackerAgainstTruth(r, prevDepth_, cur.K,
+				                            g1->T_WC - g0->T_WC, r.t - prevT_);
+			prevDepth_ = cur.depth;
+		}
+		prevT_ = r.t;
+		return truth;
 	}
-	Trajectory gt;
-	if (o.gt) gt = loadTumTrajectory(*o.gt);
-	// Ground-truth pose nearest to t (within 5 ms), or nullptr.
-	const auto gtAt = [&gt](double t) { return poseNear(gt, t, 5e-3); };
-	cv::Mat prevDepth;
-	double prevT = 0;
-	ReplayOptions ro;
-	ro.max_frames = o.max_frames;
-	ro.progress = o.progress;
-	if (o.masks)
-	{
-		if (!mrpt::system::directoryExists(*o.masks))
-			throw std::runtime_error(*o.masks + ": mask directory not found");
-		ro.masks_dir = *o.masks;
-	}
-	const char* mode = choiceName(ec.odometry.mode);
-	const char* aid = ec.odometry.gyro_aid ? "true" : "false";
-	const std::string header =
-	    std::string("bims-odom mode=") + mode + " gyro_aid=" + aid;
-	ReplayStats st;
-	try
-	{
-		st = replayRawlog(
-		    o.rawlog, odo,
-		    [&](const ego::FrameEgomotion& r,
-		        const mrpt::obs::CObservation3DRangeScan& scan)
-		    {
-			    if (r.flags & ego::kFlagOutOfOrder ||
-			        r.flags & ego::kFlagBadImage)
-				    return;  // no pose for this frame
-			    traj.push_back({r.t, r.T_WC});
-			    if (const auto R =
-			            o.attitude ? odo.imuRotation(r.t) : std::nullopt)
-				    attitude.push_back(
-				        {r.t, ego::toPose(*R, Eigen::Vector3d::Zero())});
-			    if (o.gravity_attitude && r.inertial)
-			    {
-				    const Eigen::Matrix3d R =
-				        ego::levellingRotation(r.gravity_W);
-				    const Eigen::Matrix3d R_WC =
-				        r.T_WC.getRotationMatrix().asEigen();
-				    levelled.push_back(
-				        {r.t, ego::toPose(R * R_WC, Eigen::Vector3d::Zero())});
-			    }
-			    msIn.push_back(r.ms_input);
-			    msTrack.push_back(r.ms_track);
-			    msMotion.push_back(r.ms_motion);
-			    msEgo.push_back(r.ms_track + r.ms_motion);
-			    // Tracker accuracy against the ground truth.
-			    TrackerTruth truth;
-			    ego::RgbdFrame cur;
-			    if (!gt.empty() &&
-			        ego::rgbdFrameFrom(scan, ec.camera, cur).empty())
-			    {
-				    const StampedPose* g1 = gtAt(r.t);
-				    const StampedPose* g0 = gtAt(prevT);
-				    if (g0 && g1 && !prevDepth.empty())
-					    truth = trackerAgainstTruth(r, prevDepth, cur.K,
-					                                g1->T_WC - g0->T_WC,
-					                                r.t - prevT);
-				    prevDepth = cur.depth;
-			    }
-			    prevT = r.t;
-			    if (csv) csv->append(odometryCsvLine(r, truth));
-		    },
-		    ro);
-	}
-	catch (const RawlogError& e)
-	{
-		// a rawlog cut short: the poses of the frames before the cut are
-		// kept, as bims-run keeps its outputs
-		if (traj.empty()) throw;
-		if (csv) csv->close();
-		saveTumTrajectory(
-		    o.out, traj, header + " (the input ended early: " + e.what() + ")");
-		throw std::runtime_error(std::string(e.what()) + "; the poses of the " +
-		                         std::to_string(traj.size()) +
-		                         " frames before it are in " + o.out);
-	}
-	if (traj.empty())
-		throw std::runtime_error(
-		    o.rawlog + ": no usable RGB-D frame (check [sensors] rgbd_label)");
-	if (csv) csv->close();
-	saveTumTrajectory(o.out, traj, header);
-	saveAttitude(o.attitude, attitude, o.rawlog + ": --attitude",
+
+	const OdometryRunOptions& o_;
+	const ego::EgoConfig& ec_;
+	const ego::Odometry& odo_;
+	std::unique_ptr<AppendFile> csv_;  // each line checked
+	Trajectory gt_;
+	cv::Mat prevDepth_;
+	double prevT_ = 0;
+};
+
+/** The attitude outputs (--attitude, --gravity-attitude), each when asked. */
+void saveAttitudes(const OdometryRunOptions& o, const OdometryRecorder& rec)
+{
+	saveAttitude(o.attitude, rec.attitude, o.rawlog + ": --attitude",
 	             "no frame has an IMU attitude (no IMU samples with [sensors] "
 	             "imu_label, or no [calibration] R_IC)",
 	             "the IMU attitude filter's R_WC = R_WI R_IC");
-	saveAttitude(o.gravity_attitude, levelled,
+	saveAttitude(o.gravity_attitude, rec.levelled,
 	             o.rawlog + ": --gravity-attitude",
 	             "the inertial filter carried no frame ([inertial] enable = "
 	             "false, mode = vision, no IMU samples or no [calibration] "
 	             "R_IC)",
 	             "the odometry's R_WC levelled by the inertial filter's "
 	             "gravity");
-	const auto pIn = Percentiles::of(msIn), pTrack = Percentiles::of(msTrack),
-	           pMotion = Percentiles::of(msMotion),
-	           pEgo = Percentiles::of(msEgo);
+}
+
+/** The run's summary on stderr: frames, stage times, masks, IMU notes. */
+void reportOdometry(const OdometryRunOptions& o, const ReplayOptions& ro,
+                    const ReplayStats& st, const OdometryRecorder& rec,
+                    const char* mode, const char* aid)
+{
+	const auto pIn = Percentiles::of(rec.msIn),
+	           pTrack = Percentiles::of(rec.msTrack),
+	           pMotion = Percentiles::of(rec.msMotion),
+	           pEgo = Percentiles::of(rec.msEgo);
 	std::fprintf(
 	    stderr,
 	    "bims-odom: %zu frames (%zu with the motion not measured), %zu IMU "
@@ -303,6 +303,58 @@ int runOdometry(const OdometryRunOptions& o)
 		             "finite or beyond any sensor's range); their frames "
 		             "are flagged imu_rejected\n",
 		             st.imuRejected);
+}
+}  // namespace
+
+int runOdometry(const OdometryRunOptions& o)
+{
+	checkOdometryFiles(o);
+	const ego::EgoConfig ec = odometryConfig(o);
+	ego::Odometry odo(ec);
+	OdometryRecorder rec(o, ec, odo);
+	ReplayOptions ro;
+	ro.max_frames = o.max_frames;
+	ro.progress = o.progress;
+	if (o.masks)
+	{
+		if (!mrpt::system::directoryExists(*o.masks))
+			throw std::runtime_error(*o.masks + ": mask directory not found");
+		ro.masks_dir = *o.masks;
+	}
+	const char* mode = choiceName(ec.odometry.mode);
+	const char* aid = ec.odometry.gyro_aid ? "true" : "false";
+	const std::string header =
+	    std::string("bims-odom mode=") + mode + " gyro_aid=" + aid;
+	ReplayStats st;
+	try
+	{
+		st = replayRawlog(
+		    o.rawlog, odo,
+		    [&rec](const ego::FrameEgomotion& r,
+		           const mrpt::obs::CObservation3DRangeScan& scan)
+		    { rec.add(r, scan); },
+		    ro);
+	}
+	catch (const RawlogError& e)
+	{
+		// a rawlog cut short: the poses of the frames before the cut are
+		// kept, as bims-run keeps its outputs
+		if (rec.traj.empty()) throw;
+		rec.closeCsv();
+		saveTumTrajectory(
+		    o.out, rec.traj,
+		    header + " (the input ended early: " + e.what() + ")");
+		throw std::runtime_error(std::string(e.what()) + "; the poses of the " +
+		                         std::to_string(rec.traj.size()) +
+		                         " frames before it are in " + o.out);
+	}
+	if (rec.traj.empty())
+		throw std::runtime_error(
+		    o.rawlog + ": no usable RGB-D frame (check [sensors] rgbd_label)");
+	rec.closeCsv();
+	saveTumTrajectory(o.out, rec.traj, header);
+	saveAttitudes(o, rec);
+	reportOdometry(o, ro, st, rec, mode, aid);
 	return 0;
 }
 
