@@ -1,5 +1,6 @@
-// bims-import-bag BAG... -o OUT.rawlog [--layout tum|realsense|auto]
-//   [-c CONFIG.ini] [--max-frames N] [--gz L] [--topics] [-q]
+// bims-import-bag BAG... -o OUT.rawlog [--layout tum|realsense|rs-sdk|auto]
+//   [-c CONFIG.ini] [--depth-units M] [--max-frames N] [--gz L] [--topics]
+//   [-q]
 // Converts ROS 1 and ROS 2 bags (depth and colour sensor_msgs/Image or
 // CompressedImage, CameraInfo, Imu, MagneticField) into a bims rawlog. See
 // docs/import-bag.md.
@@ -38,10 +39,17 @@ int main(int argc, char** argv)
 		        "preset topics: realsense (realsense-ros, aligned depth; ROS "
 		        "2: realsense-ros 4.x's /camera/camera/...), tum "
 		        "(TUM RGB-D's bags), auto (default: the first whose depth "
-		        "topic the bag has); a preset image topic the bag lacks is "
-		        "read from its /compressed or /compressedDepth republished "
+		        "topic the bag has), rs-sdk (the RealSense SDK's own "
+		        "recordings: RealSense Viewer, rs-record; writes "
+		        "OUT_gt/calibration.ini); a preset image topic the bag lacks "
+		        "is read from its /compressed or /compressedDepth republished "
 		        "topic when the bag has that",
-		        false, "", "realsense|tum|auto", cmd);
+		        false, "", "realsense|tum|rs-sdk|auto", cmd);
+		    TCLAP::ValueArg<double> depthUnits(
+		        "", "depth-units",
+		        "rs-sdk: metres per unit of the recording's depth, replacing "
+		        "its Depth Units option (needed when it has none)",
+		        false, 0, "M", cmd);
 		    TCLAP::ValueArg<std::string> config(
 		        "c", "config",
 		        "experiment .ini: [import_bag] topics and pairing, [camera] "
@@ -65,6 +73,7 @@ int main(int argc, char** argv)
 		    o.out = out.getValue();
 		    o.config = bims::givenValue(config);
 		    o.layout = bims::givenValue(layout);
+		    o.depthUnits = bims::givenValue(depthUnits);
 		    o.max_frames = static_cast<size_t>(
 		        bims::inRange(maxFrames, 0L, 100000000L, "0 = all"));
 		    o.gz = gz.getValue();

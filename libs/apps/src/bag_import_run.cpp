@@ -4,6 +4,7 @@
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
 #include <bims/common/config.h>
+#include <bims/io/output_paths.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/format.h>
 
@@ -48,6 +49,30 @@ std::string bagImportReport(const std::string& out, const BagImportSummary& sum,
 	if (sum.layout != BagLayout::Auto)
 		r += "layout: " + std::string(choices(sum.layout).name(sum.layout)) +
 		     "\n";
+	if (sum.depthUnits > 0)
+		r += mrpt::format("depth units %g m from %s\n", sum.depthUnits,
+		                  sum.depthUnitsFrom.c_str());
+	if (sum.depthToColour)
+	{
+		const auto& T = *sum.depthToColour;
+		r += mrpt::format(
+		    "depth registered to the colour camera with the recording's "
+		    "extrinsics: t = (%.4f %.4f %.4f) m, rotation %.3f deg\n",
+		    T.t[0], T.t[1], T.t[2], bag::rotationDeg(T));
+	}
+	if (sum.cameraToImu)
+	{
+		const auto& R = sum.cameraToImu->R;
+		r += mrpt::format(
+		    "IMU extrinsics from %s: R_IC = %.4f %.4f %.4f  %.4f %.4f %.4f  "
+		    "%.4f %.4f %.4f\n",
+		    sum.cameraToImuFrom.c_str(), R[0], R[1], R[2], R[3], R[4], R[5],
+		    R[6], R[7], R[8]);
+	}
+	if (!sum.calibrationFile.empty())
+		r += "camera and IMU calibration in " + sum.calibrationFile +
+		     " (bims-odom --calib; copy its [calibration] into the "
+		     "experiment's .ini for bims-run)\n";
 	r += mrpt::format("intrinsics from %s: fx %.4f fy %.4f cx %.4f cy %.4f\n",
 	                  sum.cameraFrom.c_str(), sum.camera.fx(), sum.camera.fy(),
 	                  sum.camera.cx(), sum.camera.cy());
@@ -115,7 +140,7 @@ BagImport importBagChecked(const BagImportRunOptions& o,
 	std::vector<std::string> inputs = o.bags;
 	inputs.push_back(o.config.value_or(""));
 	if (o.out.empty()) throw UsageError("-o OUT.rawlog is required");
-	checkOutputsSpareInputs(inputs, {o.out});
+	checkOutputsSpareInputs(inputs, {o.out, groundTruthDirFor(o.out)});
 
 	BagImportParams params;
 	if (const auto cfg = openImportConfig(o.config))
@@ -126,8 +151,16 @@ BagImport importBagChecked(const BagImportRunOptions& o,
 		const auto l = c.find(*o.layout);
 		if (!l)
 			throw UsageError("--layout " + *o.layout +
-			                 ": one of auto, realsense, tum");
+			                 ": one of auto, realsense, tum, rs-sdk");
 		params.layout = *l;
+	}
+	if (o.depthUnits)
+	{
+		if (!(*o.depthUnits >= 1e-6 && *o.depthUnits <= 0.1))
+			throw UsageError(mrpt::format(
+			    "--depth-units %g: metres per unit, in [1e-6, 0.1]",
+			    *o.depthUnits));
+		params.depthUnits = *o.depthUnits;
 	}
 	BagImportOptions opt;
 	opt.maxFrames = o.max_frames;

@@ -59,6 +59,12 @@ class Cursor
 		const uint32_t k = u32(what);
 		return std::string(reinterpret_cast<const char*>(take(k, what)), k);
 	}
+	/** Where the bytes not read yet are, and how many. */
+	const uint8_t* rest(size_t& k) const
+	{
+		k = n_ - i_;
+		return p_ + i_;
+	}
 	void header()
 	{
 		skip(12, "header");  // seq, stamp
@@ -83,6 +89,7 @@ ImageView imageView(const uint8_t* bytes, size_t n)
 	v.step = c.u32("step");
 	v.size = c.u32("data");
 	v.data = c.take(v.size, "data");
+	v.tail = c.rest(v.tailSize);
 	return v;
 }
 

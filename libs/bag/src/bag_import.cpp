@@ -13,6 +13,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +21,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <thread>
@@ -31,6 +33,7 @@
 #include "mcap_file.h"
 #include "messages.h"
 #include "ros2_metadata.h"
+#include "rs_sdk.h"
 
 namespace bims::bag
 {
@@ -275,11 +278,13 @@ BagLayout detectLayout(const std::vector<BagTopicInfo>& topics,
 			if (findTopic(topics, v.depth) ||
 			    findTopic(topics, transportTopic(v.depth, true)))
 				return l;
+	if (!rsSdkTopics(topics).depth.empty()) return BagLayout::RsSdk;
 	throw std::runtime_error(
 	    bagNames + ": no depth topic of a known layout (realsense: " +
 	    layoutTopics(BagLayout::RealSense).depth +
 	    ", tum: " + layoutTopics(BagLayout::Tum).depth +
-	    "); name yours in [import_bag] depth_topic (-c). The bag has: " +
+	    ", rs-sdk: /device_N/sensor_N/Depth_N/image/data); name yours in "
+	    "[import_bag] depth_topic (-c). The bag has: " +
 	    topicList(topics));
 }
 
@@ -337,6 +342,7 @@ void requireType(const std::vector<BagTopicInfo>& topics,
  * topic, or its image_transport topic, is in \a topics. */
 BagTopics presetFor(BagLayout layout, const std::vector<BagTopicInfo>& topics)
 {
+	if (layout == BagLayout::RsSdk) return rsSdkTopics(topics);
 	for (const BagTopics& v : layoutVariants(layout))
 		if (findTopic(topics, v.depth) ||
 		    findTopic(topics, transportTopic(v.depth, true)))
@@ -365,8 +371,14 @@ BagTopics chooseTopics(const BagImportParams& params,
 		    topicList(topics));
 	};
 	if (t.depth.empty())
-		throw std::runtime_error(bagNames +
-		                         ": no depth topic ([import_bag] depth_topic)");
+		throw std::runtime_error(
+		    bagNames +
+		    (layout == BagLayout::RsSdk
+		         ? ": no depth stream of a RealSense SDK recording "
+		           "(/device_N/sensor_N/Depth_N/image/data; "
+		           "[import_bag] depth_topic names another). The bag has: " +
+		               topicList(topics)
+		         : ": no depth topic ([import_bag] depth_topic)"));
 	// a preset image topic the bag lacks: its image_transport republished
 	// topic when the bag has that (docs/import-bag.md)
 	auto orTransport =
@@ -393,11 +405,32 @@ BagTopics chooseTopics(const BagImportParams& params,
 	keep(t.accel, params.topics.accel, "accelerometer");
 	keep(t.gyro, params.topics.gyro, "gyro");
 	keep(t.mag, params.topics.mag, "magnetometer");
+	for (auto* n : {&t.depthCameraInfo, &t.depthUnits, &t.depthTf, &t.colourTf,
+	                &t.accelTf, &t.gyroTf})
+		keep(*n, "", "");
 	if (!t.imu.empty()) t.accel.clear(), t.gyro.clear();  // one IMU
+	if (layout == BagLayout::RsSdk && t.colour.empty() &&
+	    !t.depthCameraInfo.empty())
+	{
+		// colour_topic = none: the depth alone, in its own camera
+		if (params.topics.cameraInfo.empty()) t.cameraInfo = t.depthCameraInfo;
+		t.depthCameraInfo.clear();
+	}
+	if (layout == BagLayout::RsSdk && !t.colour.empty() &&
+	    t.depthCameraInfo.empty())
+		throw std::runtime_error(
+		    bagNames + ": the depth stream " + t.depth +
+		    " has no camera_info (" + rsSdkTopics(topics).depthCameraInfo +
+		    "): its depth cannot be registered to the colour camera "
+		    "([import_bag] colour_topic = none imports the depth alone, "
+		    "which needs it too). The bag has: " +
+		    topicList(topics));
+	const std::string presetInfo = presetFor(layout, topics).cameraInfo;
 	if (t.cameraInfo.empty() && !params.camera)
 		throw std::runtime_error(
-		    bagNames +
-		    ": no CameraInfo topic for the intrinsics; name it in "
+		    bagNames + ": no CameraInfo topic" +
+		    (presetInfo.empty() ? std::string() : " " + presetInfo) +
+		    " for the intrinsics; name it in "
 		    "[import_bag] camera_info_topic or give [camera] fx fy cx cy "
 		    "width height (-c). The bag has: " +
 		    topicList(topics));
@@ -407,6 +440,10 @@ BagTopics chooseTopics(const BagImportParams& params,
 	for (const auto* n : {&t.imu, &t.accel, &t.gyro})
 		requireType(topics, *n, "sensor_msgs/Imu", bagNames);
 	requireType(topics, t.mag, "sensor_msgs/MagneticField", bagNames);
+	requireType(topics, t.depthCameraInfo, "sensor_msgs/CameraInfo", bagNames);
+	requireType(topics, t.depthUnits, "std_msgs/Float32", bagNames);
+	for (const auto* n : {&t.depthTf, &t.colourTf, &t.accelTf, &t.gyroTf})
+		requireType(topics, *n, "geometry_msgs/Transform", bagNames);
 	return t;
 }
 
@@ -420,6 +457,10 @@ struct Scanned
 	double t = -1;  ///< its header stamp [s] (images, Imu, MagneticField)
 	ImuSample imu;  ///< an Imu's or a MagneticField's
 	std::shared_ptr<const CameraInfoView> info;
+	std::shared_ptr<const TransformView> tf;  ///< a Transform's
+	/** A Float32's value; a raw image's float32 after its data
+	 * (librealsense's depth units), else 0. */
+	float value = 0;
 	std::string error;  ///< why it cannot be read (said if it is used)
 };
 
@@ -428,8 +469,30 @@ void extract(Scanned& s, const BagConnection& c, const uint8_t* p, size_t n)
 	switch (messageKind(c.type))
 	{
 		case MessageKind::Image:
+			s.t = headerStamp(c, p, n);
+			if (c.wire == Wire::Ros1)
+			{
+				// the depth units librealsense's recorder appends (read
+				// when the image is; its errors are said then)
+				try
+				{
+					const ImageView v = readImage(c, p, n);
+					if (v.tailSize == 4) std::memcpy(&s.value, v.tail, 4);
+				}
+				catch (const std::exception&)
+				{
+				}
+			}
+			break;
 		case MessageKind::CompressedImage:
 			s.t = headerStamp(c, p, n);
+			break;
+		case MessageKind::Float32:
+			s.value = readFloat32(c, p, n);
+			break;
+		case MessageKind::Transform:
+			s.tf =
+			    std::make_shared<const TransformView>(readTransform(c, p, n));
 			break;
 		case MessageKind::CameraInfo:
 			s.info =
@@ -540,6 +603,11 @@ struct Index
 	std::shared_ptr<const CameraInfoView> info;
 	size_t infoMessages = 0;
 	std::vector<ImuSample> imu, accel, gyro, mag;
+	/** rs-sdk: the depth stream's camera, the Depth Units option's values
+	 * (in order), each tf topic's first message. */
+	std::shared_ptr<const CameraInfoView> depthInfo;
+	std::vector<float> units;
+	std::map<std::string, std::shared_ptr<const TransformView>> tf;
 };
 
 /** The first pass: the chosen topics' messages in the bags' time order;
@@ -549,7 +617,8 @@ Index readIndex(const Scan& scan, const Bags& bags, const BagTopics& t,
 {
 	std::set<std::string> names;
 	for (const auto* n : {&t.depth, &t.colour, &t.cameraInfo, &t.imu, &t.accel,
-	                      &t.gyro, &t.mag})
+	                      &t.gyro, &t.mag, &t.depthCameraInfo, &t.depthUnits,
+	                      &t.depthTf, &t.colourTf, &t.accelTf, &t.gyroTf})
 		if (!n->empty()) names.insert(*n);
 	Index ix;
 	for (const std::string& topic : names)
@@ -592,6 +661,16 @@ Index readIndex(const Scan& scan, const Bags& bags, const BagTopics& t,
 			{
 				if (!ix.info) ix.info = m.info;
 				ix.infoMessages++;
+			}
+			else if (topic == t.depthCameraInfo)
+			{
+				if (!ix.depthInfo) ix.depthInfo = m.info;
+			}
+			else if (topic == t.depthUnits)
+				ix.units.push_back(m.value);
+			else if (m.tf)
+			{
+				if (!ix.tf.count(topic)) ix.tf[topic] = m.tf;
 			}
 			else if (stampBack(m.t))
 				sum.imuStampsBack++;
@@ -667,6 +746,33 @@ std::vector<Frame> pairFrames(const Index& ix, const BagImportParams& params,
 	return frames;
 }
 
+/** The pinhole camera of the CameraInfo \a ci of \a topic (its first
+ * message), checked: an error naming the bag and topic when it has no
+ * message or K is not a camera. */
+mrpt::img::TCamera cameraOfInfo(const CameraInfoView* ci,
+                                const std::string& topic,
+                                const std::string& bagNames)
+{
+	if (!ci)
+		throw std::runtime_error(bagNames + ": topic " + topic +
+		                         " has no message");
+	const double fx = ci->K[0], fy = ci->K[4], cx = ci->K[2], cy = ci->K[5];
+	if (!(fx > 0 && fy > 0 && std::isfinite(fx) && std::isfinite(fy) &&
+	      std::isfinite(cx) && std::isfinite(cy)) ||
+	    ci->width == 0 || ci->height == 0)
+		throw std::runtime_error(mrpt::format(
+		    "%s: topic %s: CameraInfo K = [%g 0 %g; 0 %g %g] of a %ux%u "
+		    "image is not a camera",
+		    bagNames.c_str(), topic.c_str(), fx, cx, fy, cy, ci->width,
+		    ci->height));
+	mrpt::img::TCamera c;
+	c.ncols = ci->width;
+	c.nrows = ci->height;
+	c.setIntrinsicParamsFromValues(fx, fy, cx, cy);
+	c.distortion = mrpt::img::DistortionModel::none;
+	return c;
+}
+
 mrpt::img::TCamera cameraOf(const Index& ix, const BagImportParams& params,
                             const BagTopics& t, const std::string& bagNames,
                             BagImportSummary& sum)
@@ -676,28 +782,227 @@ mrpt::img::TCamera cameraOf(const Index& ix, const BagImportParams& params,
 		sum.cameraFrom = params.cameraFrom;
 		return *params.camera;
 	}
-	if (!ix.info)
-		throw std::runtime_error(bagNames + ": topic " + t.cameraInfo +
-		                         " has no message");
-	const auto& ci = *ix.info;
-	const double fx = ci.K[0], fy = ci.K[4], cx = ci.K[2], cy = ci.K[5];
-	if (!(fx > 0 && fy > 0 && std::isfinite(fx) && std::isfinite(fy) &&
-	      std::isfinite(cx) && std::isfinite(cy)) ||
-	    ci.width == 0 || ci.height == 0)
-		throw std::runtime_error(mrpt::format(
-		    "%s: topic %s: CameraInfo K = [%g 0 %g; 0 %g %g] of a %ux%u "
-		    "image is not a camera",
-		    bagNames.c_str(), t.cameraInfo.c_str(), fx, cx, fy, cy, ci.width,
-		    ci.height));
-	mrpt::img::TCamera c;
-	c.ncols = ci.width;
-	c.nrows = ci.height;
-	c.setIntrinsicParamsFromValues(fx, fy, cx, cy);
-	c.distortion = mrpt::img::DistortionModel::none;
+	const mrpt::img::TCamera c =
+	    cameraOfInfo(ix.info.get(), t.cameraInfo, bagNames);
 	sum.cameraFrom = "CameraInfo " + t.cameraInfo;
-	for (const double k : ci.D) sum.distortionIgnored |= k != 0;
-	if (sum.distortionIgnored) sum.distortionModel = ci.distortionModel;
+	for (const double k : ix.info->D) sum.distortionIgnored |= k != 0;
+	if (sum.distortionIgnored) sum.distortionModel = ix.info->distortionModel;
 	return c;
+}
+
+/** What an rs-sdk import needs beyond the other layouts': the depth's
+ * units and, when it is registered to the colour camera, its own camera
+ * and the extrinsics between them. */
+struct RsSdkDepth
+{
+	bool on = false;          ///< the rs-sdk layout
+	double units = 0;         ///< metres per unit of the depth images
+	bool unitsGiven = false;  ///< by [import_bag] depth_units
+	bool fromImages = false;  ///< the units the depth images carry
+	std::optional<mrpt::img::TCamera> depthCamera;  ///< registration's
+	RigidTransform depthToColour;
+};
+
+/** The reference stream of a tf topic: the N of ".../tf/N". */
+std::string tfReference(const std::string& topic)
+{
+	return topic.substr(topic.rfind('/') + 1);
+}
+
+/** The transform of tf topic \a topic (its first message), checked. */
+RigidTransform transformOf(const Index& ix, const std::string& topic,
+                           const std::string& bagNames)
+{
+	const auto it = ix.tf.find(topic);
+	if (it == ix.tf.end())
+		throw std::runtime_error(bagNames + ": topic " + topic +
+		                         " has no message");
+	try
+	{
+		return rigidTransformOf(*it->second);
+	}
+	catch (const std::exception& e)
+	{
+		throw std::runtime_error(bagNames + ": " + where(topic, 0) +
+		                         ": the extrinsics' " + e.what());
+	}
+}
+
+/** The units of \a topic's messages, \a what: one value, a depth unit. */
+double unitsOf(const std::vector<float>& v, const std::string& topic,
+               const std::string& bagNames)
+{
+	for (size_t k = 0; k < v.size(); k++)
+	{
+		if (v[k] != v.front())
+			throw std::runtime_error(
+			    bagNames + ": " + where(topic, k) +
+			    mrpt::format(": the depth units change during the recording "
+			                 "(%g m, then %g m): not supported",
+			                 v.front(), v[k]));
+		if (!(v[k] >= 1e-6f && v[k] <= 0.1f))
+			throw std::runtime_error(
+			    bagNames + ": " + where(topic, k) +
+			    mrpt::format(": depth units of %g m: not in [1e-6, 0.1] m",
+			                 v[k]));
+	}
+	return v.front();
+}
+
+/** The rs-sdk layout's depth units, registration and extrinsics (into
+ * \a sum, with notes): errors name the bag, topic and message. */
+RsSdkDepth rsSdkDepth(const Index& ix, const BagTopics& t,
+                      const BagImportParams& params,
+                      const std::vector<Frame>& frames,
+                      const std::string& bagNames, BagImportSummary& sum)
+{
+	RsSdkDepth d;
+	d.on = true;
+	if (params.depthUnits > 0)
+	{
+		d.units = params.depthUnits;
+		d.unitsGiven = true;
+		sum.depthUnitsFrom = "[import_bag] depth_units (--depth-units)";
+	}
+	else if (!ix.units.empty())
+	{
+		d.units = unitsOf(ix.units, t.depthUnits, bagNames);
+		sum.depthUnitsFrom = "the Depth Units option " + t.depthUnits;
+	}
+	else if (frames.front().depth->msg->value != 0)
+	{
+		const ImageRef& first = *frames.front().depth;
+		d.units = unitsOf({first.msg->value}, t.depth, bagNames);
+		d.fromImages = true;
+		sum.depthUnitsFrom = "the depth images' own depth_units " + t.depth;
+	}
+	else
+		throw std::runtime_error(
+		    bagNames +
+		    ": no depth units: the recording has no Depth Units option "
+		    "(/device_N/sensor_N/option/Depth Units/value, or Depth_Units) "
+		    "and its depth images (topic " +
+		    t.depth +
+		    ") carry none; give them with --depth-units M ([import_bag] "
+		    "depth_units), e.g. 0.001 (1 mm, a D400's default)");
+	sum.depthUnits = d.units;
+
+	if (!t.depthCameraInfo.empty())
+	{
+		// the depth registered to the colour camera with their extrinsics
+		d.depthCamera =
+		    cameraOfInfo(ix.depthInfo.get(), t.depthCameraInfo, bagNames);
+		if (t.depthTf.empty() || t.colourTf.empty())
+			throw std::runtime_error(
+			    bagNames + ": no extrinsics between the depth stream " +
+			    t.depth + " and the colour stream " + t.colour +
+			    " (no tf/N topic of the " +
+			    (t.depthTf.empty() ? "depth" : "colour") +
+			    " stream): the depth cannot be registered to the colour "
+			    "camera ([import_bag] colour_topic = none imports the depth "
+			    "alone)");
+		if (tfReference(t.depthTf) != tfReference(t.colourTf))
+			throw std::runtime_error(
+			    bagNames + ": the extrinsics " + t.depthTf + " and " +
+			    t.colourTf +
+			    " are from different reference streams: not supported");
+		d.depthToColour =
+		    compose(transformOf(ix, t.colourTf, bagNames),
+		            inverse(transformOf(ix, t.depthTf, bagNames)));
+		sum.depthToColour = d.depthToColour;
+	}
+	// the IMU's axes: the gyro's (the merged samples are at its stamps),
+	// else the accelerometer's; the frames' camera: the colour's when the
+	// depth is registered to it
+	const std::string& cameraTf = d.depthCamera ? t.colourTf : t.depthTf;
+	const std::string& imuTf = t.gyro.empty() ? t.accelTf : t.gyroTf;
+	const std::string& imuTopic = t.gyro.empty() ? t.accel : t.gyro;
+	if (!imuTopic.empty())
+	{
+		if (imuTf.empty() || cameraTf.empty())
+			sum.notes.push_back(
+			    "warning: no extrinsics (tf/N) of the IMU stream " + imuTopic +
+			    " or of the camera: no [calibration] R_IC written; give it "
+			    "in the experiment's .ini");
+		else if (tfReference(imuTf) != tfReference(cameraTf))
+			sum.notes.push_back("warning: the extrinsics " + imuTf + " and " +
+			                    cameraTf +
+			                    " are from different reference streams: no "
+			                    "[calibration] R_IC written");
+		else
+		{
+			const RigidTransform imu = transformOf(ix, imuTf, bagNames);
+			sum.cameraToImu =
+			    compose(imu, inverse(transformOf(ix, cameraTf, bagNames)));
+			sum.cameraToImuFrom = "tf " + imuTf + " and " + cameraTf;
+			if (!t.gyro.empty() && !t.accel.empty() && !t.accelTf.empty() &&
+			    tfReference(t.accelTf) == tfReference(imuTf))
+			{
+				const double deg = rotationDeg(compose(
+				    transformOf(ix, t.accelTf, bagNames), inverse(imu)));
+				if (deg > 0.5)
+					sum.notes.push_back(mrpt::format(
+					    "warning: the accelerometer's axes (%s) are %.2f deg "
+					    "from the gyro's (%s): the merged samples are in the "
+					    "gyro's axes, the accelerometer's not rotated",
+					    t.accelTf.c_str(), deg, imuTf.c_str()));
+			}
+		}
+	}
+	if (!t.accel.empty() && t.gyro.empty())
+		sum.notes.push_back(
+		    "warning: the accelerometer stream " + t.accel +
+		    " has no gyro stream beside it (/device_N/sensor_N/Gyro_N/imu/"
+		    "data): accelerometer-only samples (labelled " +
+		    params.accelLabel + "), no IMU rotation between frames");
+	return d;
+}
+
+/** OUT_gt/calibration.ini of an rs-sdk import: the frames' camera, the
+ * IMU's rotation (when its extrinsics are known) and the labels, the
+ * sections of an experiment .ini (bims-odom --calib reads it). */
+std::string calibrationIni(const BagImportSummary& sum,
+                           const BagImportParams& params,
+                           const std::string& bagNames)
+{
+	const auto& c = sum.camera;
+	std::string s =
+	    "# Written by bims-import-bag from the RealSense SDK recording " +
+	    bagNames +
+	    ": the camera of the imported rawlog and the IMU's extrinsics.\n" +
+	    mrpt::format(
+	        "[camera]\nfx = %.9g\nfy = %.9g\ncx = %.9g\ncy = %.9g\nwidth = "
+	        "%u\nheight = %u\n",
+	        c.fx(), c.fy(), c.cx(), c.cy(), c.ncols, c.nrows);
+	if (sum.depthToColour)
+	{
+		const auto& T = *sum.depthToColour;
+		s += "# the depth was registered to this (the colour) camera with "
+		     "the depth-to-colour extrinsics of the recording's tf, p_colour "
+		     "= R p_depth + t:\n" +
+		     mrpt::format(
+		         "# R = %.9g %.9g %.9g  %.9g %.9g %.9g  %.9g %.9g "
+		         "%.9g\n# t = %.9g %.9g %.9g m\n",
+		         T.R[0], T.R[1], T.R[2], T.R[3], T.R[4], T.R[5], T.R[6], T.R[7],
+		         T.R[8], T.t[0], T.t[1], T.t[2]);
+	}
+	if (sum.cameraToImu)
+	{
+		const auto& T = *sum.cameraToImu;
+		s += "\n[calibration]\n# camera optical frame in the IMU frame, from "
+		     "the recording's " +
+		     sum.cameraToImuFrom + ": p_I = R_IC p_C + t\n" +
+		     mrpt::format(
+		         "R_IC = %.9g %.9g %.9g  %.9g %.9g %.9g  %.9g %.9g "
+		         "%.9g\n# t = %.9g %.9g %.9g m (not used by bims)\n",
+		         T.R[0], T.R[1], T.R[2], T.R[3], T.R[4], T.R[5], T.R[6], T.R[7],
+		         T.R[8], T.t[0], T.t[1], T.t[2]) +
+		     "# the SDK stamps its IMU and camera frames on one clock\n"
+		     "time_offset_s = 0\n";
+	}
+	s += "\n[sensors]\nrgbd_label = " + params.rgbdLabel +
+	     "\nimu_label = " + params.imuLabel + "\n";
+	return s;
 }
 
 /** The IMU stream written: the Imu topic, or accel and gyro merged, with
@@ -890,6 +1195,10 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 	sum.camera = cam;
 	sum.width = static_cast<int>(cam.ncols);
 	sum.height = static_cast<int>(cam.nrows);
+	const RsSdkDepth sdk =
+	    layout == BagLayout::RsSdk
+	        ? rsSdkDepth(ix, t, params, frames, bagNames, sum)
+	        : RsSdkDepth();
 	const std::vector<ImuSample> imu = imuStream(ix, t, sum);
 
 	// frames and IMU samples in time order, IMU first at equal stamps; the
@@ -919,7 +1228,14 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 	                                                     "mono16"};
 	static const std::set<std::string> colourEncodings = {"rgb8", "bgr8",
 	                                                      "mono8"};
+	// the SDK's depth: Z16 as mono16 (or 16UC1), in its Depth Units
+	static const std::set<std::string> sdkDepthEncodings = {"16UC1", "mono16"};
 	const int W = sum.width, H = sum.height;
+	// the depth image's size: the colour camera's, unless registered to it
+	const int DW = sdk.depthCamera ? static_cast<int>(sdk.depthCamera->ncols)
+	                               : W,
+	          DH = sdk.depthCamera ? static_cast<int>(sdk.depthCamera->nrows)
+	                               : H;
 	std::string depthEncoding, colourEncoding;  // the decoder's
 	auto decode = [&](const Item& it) -> mrpt::obs::CObservation::Ptr
 	{
@@ -950,7 +1266,7 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 					    readCompressed(c, held.data, held.size);
 					encoding = ci.format;
 					return depth ? decodeCompressedDepth(ci.format, ci.data,
-					                                     ci.size, W, H,
+					                                     ci.size, DW, DH,
 					                                     params.images)
 					             : decodeCompressedColour(ci.format, ci.data,
 					                                      ci.size, W, H,
@@ -958,18 +1274,45 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 				}
 				const ImageView r = readImage(c, held.data, held.size);
 				encoding = r.encoding;
-				return depth ? checkedImage(r, depthEncodings,
-				                            "the depth image", W, H, false)
-				             : checkedImage(r, colourEncodings,
-				                            "the colour image", W, H, true);
+				return depth
+				           ? checkedImage(
+				                 r, sdk.on ? sdkDepthEncodings : depthEncodings,
+				                 "the depth image", DW, DH, false)
+				           : checkedImage(r, colourEncodings,
+				                          "the colour image", W, H, true);
 			};
 			BagBytes heldDepth, heldColour;
 			const cv::Mat depth =
 			    image(*f.depth, true, depthEncoding, heldDepth);
-			// REP 118: 16UC1 millimetres, 32FC1 metres
+			// REP 118: 16UC1 millimetres, 32FC1 metres; the SDK's in its
+			// Depth Units
+			double units = depth.type() == CV_32FC1 ? 1.0 : 0.001;
+			cv::Mat metric = depth;
+			if (sdk.on)
+			{
+				const float own = f.depth->msg->value;
+				if (depth.type() != CV_16UC1)
+					throw std::runtime_error(
+					    "the depth image is not 16-bit: not a RealSense "
+					    "SDK's Z16 depth");
+				if (sdk.fromImages && own == 0)
+					throw std::runtime_error(
+					    "it carries no depth units, as the first did");
+				if (!sdk.unitsGiven && own != 0 &&
+				    std::abs(own - sdk.units) > 1e-6 * sdk.units)
+					throw std::runtime_error(mrpt::format(
+					    "its own depth units %g m differ from %s's %g m", own,
+					    sum.depthUnitsFrom.c_str(), sdk.units));
+				units = sdk.units;
+				if (sdk.depthCamera)
+				{
+					metric = registerDepth(depth, units, *sdk.depthCamera, cam,
+					                       sdk.depthToColour);
+					units = 1.0;
+				}
+			}
 			auto o = eval::depthObservation(
-			    depth, depth.type() == CV_32FC1 ? 1.0 : 0.001, cam,
-			    params.rgbdLabel, f.t, params.rangeUnits);
+			    metric, units, cam, params.rgbdLabel, f.t, params.rangeUnits);
 			if (f.colour)
 			{
 				current = f.colour;
@@ -989,6 +1332,16 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 	AheadQueue ahead(items.size(), [&](size_t k) { return decode(items[k]); });
 
 	PartialFile part(outRawlog);
+	// rs-sdk: OUT_gt/calibration.ini, put in place with the rawlog
+	std::optional<PartialDir> gt;
+	if (sdk.on)
+	{
+		gt.emplace(groundTruthDirFor(outRawlog),
+		           OutputFolderLayout{{"calibration.ini"}, {}});
+		writeFileAtomically(gt->path() + "/calibration.ini",
+		                    calibrationIni(sum, params, bagNames));
+		sum.calibrationFile = gt->finalPath() + "/calibration.ini";
+	}
 	RawlogWriter w(part.path(), options.gzLevel);
 	Progress progress;
 	progress.total = frames.size();
@@ -999,6 +1352,7 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 		if (sum.frames == 0) throw std::runtime_error(error);
 		w.close();
 		part.commit();
+		if (gt) gt->commit();
 		throw std::runtime_error(
 		    error +
 		    mrpt::format("; the %zu whole frames before it are in ",
@@ -1029,6 +1383,7 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 	if (!lost.empty()) keepAndThrow(lost);
 	w.close();
 	part.commit();
+	if (gt) gt->commit();
 	progress.finished = true;
 	reportProgress(options.progress, progress);
 	return sum;

@@ -30,6 +30,7 @@ BagTopics layoutTopics(BagLayout layout)
 			t.imu = "/imu";
 			break;
 		case BagLayout::Auto:
+		case BagLayout::RsSdk:  // found by name: rsSdkTopics()
 			break;
 	}
 	return t;
@@ -86,8 +87,9 @@ void BagImportParams::describe(OptionVisitor& v)
 {
 	v.choice("layout", layout,
 	         "whose preset topics: realsense (realsense-ros, aligned "
-	         "depth), tum (TUM RGB-D's bags), auto (the first whose depth "
-	         "topic the bag has); --layout overrides");
+	         "depth), tum (TUM RGB-D's bags), rs-sdk (the RealSense SDK's "
+	         "own recordings: RealSense Viewer, rs-record), auto (the first "
+	         "whose depth topic the bag has); --layout overrides");
 	// each topic key: empty takes the layout's topic, "none" reads none
 	v.text("depth_topic", topics.depth,
 	       "depth image topic, 16UC1 mm or 32FC1 m, raw or compressedDepth "
@@ -112,6 +114,10 @@ void BagImportParams::describe(OptionVisitor& v)
 	       "max |t_colour - t_depth| to pair a depth and a colour image [s]");
 	v.choice("timestamp", timestampFrom,
 	         "which image's stamp a frame takes (the geometry's: depth)");
+	v.real("depth_units", depthUnits, 0.0, 0.1,
+	       "rs-sdk: metres per unit of the recording's 16-bit depth (0: its "
+	       "Depth Units option, else its images' own); given, it replaces "
+	       "the recording's; --depth-units overrides");
 	v.real("range_units", rangeUnits, 1e-6, 0.1,
 	       "metres per unit of the rawlog's uint16 range image");
 	v.text("accel_label", accelLabel,
@@ -127,6 +133,9 @@ void BagImportParams::loadFromConfigFile(
 	{
 		ConfigSection s(cfg, "import_bag");
 		if (accelLabel.empty()) s.fail("accel_label", "must not be empty");
+		if (depthUnits != 0 && depthUnits < 1e-6)
+			s.fail("depth_units",
+			       "must be 0 (the recording's) or in [1e-6, 0.1] m");
 		if (accelLabel.find("SYNTH") != std::string::npos)
 			s.fail("accel_label",
 			       "'" + accelLabel +

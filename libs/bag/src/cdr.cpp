@@ -197,4 +197,19 @@ ImuSample magneticField(const uint8_t* p, size_t n)
 	return magSampleOf(t, m);
 }
 
+float float32(const uint8_t* p, size_t n)
+{
+	Reader r(p, n);
+	return r.get<float>("data");
+}
+
+TransformView transform(const uint8_t* p, size_t n)
+{
+	Reader r(p, n);
+	TransformView v;
+	r.f64s(v.t, 3, "translation");
+	r.f64s(v.q, 4, "rotation");
+	return v;
+}
+
 }  // namespace bims::bag::cdr

@@ -29,5 +29,9 @@ CameraInfoView cameraInfo(const uint8_t* p, size_t n);
 ImuSample imu(const uint8_t* p, size_t n);
 /** sensor_msgs/msg/MagneticField, read whole. */
 ImuSample magneticField(const uint8_t* p, size_t n);
+/** std_msgs/msg/Float32. */
+float float32(const uint8_t* p, size_t n);
+/** geometry_msgs/msg/Transform. */
+TransformView transform(const uint8_t* p, size_t n);
 
 }  // namespace bims::bag::cdr

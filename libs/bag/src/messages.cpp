@@ -1,6 +1,8 @@
 #include "messages.h"
 
+#include <geometry_msgs/Transform.h>
 #include <mrpt/core/format.h>
+#include <std_msgs/Float32.h>
 
 #include <cstring>
 #include <stdexcept>
@@ -69,6 +71,8 @@ MessageKind messageKind(const std::string& type)
 	if (t == "sensor_msgs/CameraInfo") return MessageKind::CameraInfo;
 	if (t == "sensor_msgs/Imu") return MessageKind::Imu;
 	if (t == "sensor_msgs/MagneticField") return MessageKind::MagneticField;
+	if (t == "std_msgs/Float32") return MessageKind::Float32;
+	if (t == "geometry_msgs/Transform") return MessageKind::Transform;
 	return MessageKind::Other;
 }
 
@@ -160,6 +164,34 @@ ImuSample readMagneticField(const BagConnection& c, const uint8_t* p, size_t n)
 	                     m->magnetic_field.z};
 	return magSampleOf(stampSeconds(m->header.stamp.sec, m->header.stamp.nsec),
 	                   v);
+}
+
+float readFloat32(const BagConnection& c, const uint8_t* p, size_t n)
+{
+	check(c, MessageKind::Float32);
+	if (c.wire == Wire::Cdr) return cdr::float32(p, n);
+	checkMd5<std_msgs::Float32>(c.md5);
+	if (n < 4)
+		throw runtime_error(
+		    mrpt::format("%zu bytes: shorter than a std_msgs/Float32", n));
+	float v = 0;
+	std::memcpy(&v, p, 4);
+	return v;
+}
+
+TransformView readTransform(const BagConnection& c, const uint8_t* p, size_t n)
+{
+	check(c, MessageKind::Transform);
+	if (c.wire == Wire::Cdr) return cdr::transform(p, n);
+	checkMd5<geometry_msgs::Transform>(c.md5);
+	// translation (Vector3), rotation (Quaternion): seven float64
+	if (n < 56)
+		throw runtime_error(mrpt::format(
+		    "%zu bytes: shorter than a geometry_msgs/Transform (56)", n));
+	TransformView v;
+	std::memcpy(v.t, p, 24);
+	std::memcpy(v.q, p + 24, 32);
+	return v;
 }
 
 }  // namespace bims::bag

@@ -26,6 +26,10 @@ struct ImageView
 	bool bigEndian = false;
 	const uint8_t* data = nullptr;
 	size_t size = 0;
+	/** Bytes after the message's data (ROS 1): librealsense's recorder
+	 * appends its depth units there (a float32) in its newer versions. */
+	const uint8_t* tail = nullptr;
+	size_t tailSize = 0;
 };
 
 /** A sensor_msgs/CompressedImage read in place. */
@@ -54,6 +58,8 @@ enum class MessageKind
 	CameraInfo,
 	Imu,
 	MagneticField,
+	Float32,    ///< std_msgs/Float32 (the RealSense SDK's option values)
+	Transform,  ///< geometry_msgs/Transform (the RealSense SDK's tf)
 	Other
 };
 
@@ -85,5 +91,13 @@ CameraInfoView readCameraInfo(const BagConnection& c, const uint8_t* p,
                               size_t n);
 ImuSample readImu(const BagConnection& c, const uint8_t* p, size_t n);
 ImuSample readMagneticField(const BagConnection& c, const uint8_t* p, size_t n);
+float readFloat32(const BagConnection& c, const uint8_t* p, size_t n);
+/** geometry_msgs/Transform: translation, then the rotation's quaternion
+ * x y z w, as they are (not checked: the caller says what is wrong). */
+struct TransformView
+{
+	double t[3] = {}, q[4] = {};
+};
+TransformView readTransform(const BagConnection& c, const uint8_t* p, size_t n);
 
 }  // namespace bims::bag

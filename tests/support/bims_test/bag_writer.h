@@ -8,6 +8,7 @@
 #pragma once
 
 #include <bims/bag/bag_import.h>
+#include <geometry_msgs/Transform.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
 #include <rosbag/bag.h>
@@ -16,10 +17,16 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Imu.h>
 #include <sensor_msgs/MagneticField.h>
+#include <std_msgs/Float32.h>
+#include <std_msgs/String.h>
+#include <std_msgs/UInt32.h>
+
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -406,6 +413,266 @@ inline void writeBag(const std::string& path, const BagSpec& spec,
 			    compressedColourMsg(f, spec.colourCodec, spec.colourFormat));
 		else
 			bag.write(layout.colour, t, colourMsg(f, spec.colour));
+	}
+	bag.close();
+}
+
+// ---------------------------------------------------------------------
+// The RealSense SDK's own recordings (librealsense's "ROS file format", as
+// RealSense Viewer and rs-record write them), written here from its
+// documented layout (librealsense's src/media/ros/ros_file_format.h and
+// ros_writer.cpp), independently of bims's reader: /file_version, per
+// stream /device_0/sensor_S/<Stream>_0/{image|imu}/data, its
+// info/camera_info, its tf/0 (geometry_msgs/Transform from the reference
+// stream, the depth, to the stream: p_stream = R p_ref + t), the depth
+// sensor's option/Depth Units/value (std_msgs/Float32). Motion samples are
+// sensor_msgs/Imu with one field filled and every covariance 0, accel and
+// gyro on streams of their own at different rates; stamps the device's,
+// record times from the recording's start.
+// ---------------------------------------------------------------------
+
+/** A sensor_msgs/Image as librealsense's recorder serializes a depth frame
+ * since it keeps the depth units with it: the message, then a float32 (the
+ * same type and MD5 sum). */
+struct RsSdkImage
+{
+	sensor_msgs::Image image;
+	float depthUnits = 0;
+};
+}  // namespace bims::test
+
+namespace ros::message_traits
+{
+template <>
+struct MD5Sum<bims::test::RsSdkImage>
+{
+	static const char* value() { return MD5Sum<sensor_msgs::Image>::value(); }
+	static const char* value(const bims::test::RsSdkImage&) { return value(); }
+};
+template <>
+struct DataType<bims::test::RsSdkImage>
+{
+	static const char* value() { return DataType<sensor_msgs::Image>::value(); }
+	static const char* value(const bims::test::RsSdkImage&) { return value(); }
+};
+template <>
+struct Definition<bims::test::RsSdkImage>
+{
+	static const char* value()
+	{
+		return Definition<sensor_msgs::Image>::value();
+	}
+	static const char* value(const bims::test::RsSdkImage&) { return value(); }
+};
+}  // namespace ros::message_traits
+
+namespace ros::serialization
+{
+template <>
+struct Serializer<bims::test::RsSdkImage>
+{
+	template <typename Stream>
+	inline static void write(Stream& s, const bims::test::RsSdkImage& m)
+	{
+		s.next(m.image);
+		s.next(m.depthUnits);
+	}
+	template <typename Stream>
+	inline static void read(Stream& s, bims::test::RsSdkImage& m)
+	{
+		s.next(m.image);
+		s.next(m.depthUnits);
+	}
+	inline static uint32_t serializedLength(const bims::test::RsSdkImage& m)
+	{
+		return serializationLength(m.image) + 4;
+	}
+};
+}  // namespace ros::serialization
+
+namespace bims::test
+{
+/** What an SDK recording of the sample holds. */
+struct RsSdkSpec
+{
+	size_t frames = 24;
+	/** The sensors' numbers (a D435i's: stereo module 0, RGB camera 1,
+	 * motion module 2; other models differ). */
+	int depthSensor = 0, colourSensor = 1, motionSensor = 2;
+	/** The option's name in its topic ("Depth Units", newer librealsense
+	 * "Depth_Units"); empty: no option. */
+	std::string unitsOption = "Depth Units";
+	float units = 0.001f;  ///< metres per unit of the depth images
+	/** The depth units after each depth image's data, as the newer
+	 * recorder appends them (0: none). */
+	float imageUnits = 0;
+	std::string depthEncoding = "mono16";  ///< or 16UC1; 32FC1: metres
+	bool colour = true, depthInfo = true, colourInfo = true;
+	bool accel = true, gyro = true, tf = true;
+	/** The colour camera: the depth's scaled by this (its images the
+	 * sample's resized). */
+	int colourScale = 1;
+	/** From the depth (the reference stream) to the colour and to the
+	 * motion module's accel and gyro. */
+	bag::RigidTransform colourTf, imuTf;
+	bool nanColourTf = false;  ///< the colour's tf all NaN
+};
+
+inline geometry_msgs::Transform tfMsg(const bag::RigidTransform& T)
+{
+	Eigen::Matrix3d R;
+	for (int i = 0; i < 9; i++) R(i / 3, i % 3) = T.R[i];
+	const Eigen::Quaterniond q(R);
+	geometry_msgs::Transform m;
+	m.translation.x = T.t[0];
+	m.translation.y = T.t[1];
+	m.translation.z = T.t[2];
+	m.rotation.x = q.x();
+	m.rotation.y = q.y();
+	m.rotation.z = q.z();
+	m.rotation.w = q.w();
+	return m;
+}
+
+/** The sample's camera scaled by \a s (pixel centres kept in place). */
+inline sensor_msgs::CameraInfo scaledInfoMsg(const CObservation3DRangeScan& f,
+                                             int s)
+{
+	sensor_msgs::CameraInfo m = infoMsg(f);
+	m.width *= s;
+	m.height *= s;
+	m.K[0] *= s;
+	m.K[4] *= s;
+	m.K[2] = (m.K[2] + 0.5) * s - 0.5;
+	m.K[5] = (m.K[5] + 0.5) * s - 0.5;
+	// librealsense writes its distortion model's name and 5 coefficients
+	m.distortion_model = "Brown Conrady";
+	return m;
+}
+
+/** The SDK's motion sample: one vector filled, every covariance 0. */
+inline sensor_msgs::Imu sdkImuMsg(const CObservationIMU& o, bool gyro)
+{
+	using namespace mrpt::obs;
+	sensor_msgs::Imu m;
+	m.header = header(secondsOf(o.timestamp), "");
+	if (gyro)
+	{
+		m.angular_velocity.x = o.get(IMU_WX);
+		m.angular_velocity.y = o.get(IMU_WY);
+		m.angular_velocity.z = o.get(IMU_WZ);
+	}
+	else
+	{
+		m.linear_acceleration.x = o.get(IMU_X_ACC);
+		m.linear_acceleration.y = o.get(IMU_Y_ACC);
+		m.linear_acceleration.z = o.get(IMU_Z_ACC);
+	}
+	return m;
+}
+
+/** Writes the first spec.frames of \a frames and the IMU samples up to the
+ * last as a RealSense SDK recording. */
+inline void writeRsSdkBag(
+    const std::string& path, const RsSdkSpec& spec,
+    const std::vector<CObservation3DRangeScan::Ptr>& frames,
+    const std::vector<CObservationIMU::Ptr>& imu)
+{
+	rosbag::Bag bag(path, rosbag::bagmode::Write);
+	bag.setChunkThreshold(256 * 1024);
+	const double t0 = secondsOf(frames.front()->timestamp) - 0.5;
+	// record times from the recording's start, as the SDK's
+	auto rec = [&](double t) { return ros::Time(1.0 + t - t0); };
+	const std::string dev = "/device_0/";
+	auto sensor = [&](int s) { return dev + "sensor_" + std::to_string(s); };
+	const std::string depth = sensor(spec.depthSensor) + "/Depth_0",
+	                  colour = sensor(spec.colourSensor) + "/Color_0",
+	                  accel = sensor(spec.motionSensor) + "/Accel_0",
+	                  gyro = sensor(spec.motionSensor) + "/Gyro_0";
+	const ros::Time start = rec(t0);
+	std_msgs::UInt32 version;
+	version.data = 4;
+	bag.write("/file_version", start, version);
+	const auto& f0 = *frames.front();
+	if (!spec.unitsOption.empty())
+	{
+		const std::string opt =
+		    sensor(spec.depthSensor) + "/option/" + spec.unitsOption;
+		std_msgs::Float32 u;
+		u.data = spec.units;
+		bag.write(opt + "/value", start, u);
+		std_msgs::String d;
+		d.data = "Number of meters represented by a single depth unit";
+		bag.write(opt + "/description", start, d);
+	}
+	if (spec.depthInfo)
+		bag.write(depth + "/info/camera_info", start, scaledInfoMsg(f0, 1));
+	if (spec.colour && spec.colourInfo)
+		bag.write(colour + "/info/camera_info", start,
+		          scaledInfoMsg(f0, spec.colourScale));
+	size_t i = 0, n = 0;
+	bool tfWritten = false;
+	for (size_t k = 0; k < spec.frames; k++)
+	{
+		const auto& f = *frames[k];
+		const double tf = secondsOf(f.timestamp);
+		for (; i < imu.size() && secondsOf(imu[i]->timestamp) <= tf; i++)
+		{
+			const auto& o = *imu[i];
+			const ros::Time t = rec(secondsOf(o.timestamp));
+			if (spec.gyro) bag.write(gyro + "/imu/data", t, sdkImuMsg(o, true));
+			if (spec.accel && n++ % 2 == 0)  // at half the gyro's rate
+				bag.write(accel + "/imu/data", t, sdkImuMsg(o, false));
+		}
+		const ros::Time t = rec(tf);
+		RsSdkImage d;
+		d.image = depthMsg(f, spec.depthEncoding == "32FC1");
+		d.image.header.frame_id.clear();
+		if (spec.depthEncoding != "32FC1")
+		{
+			d.image.encoding = spec.depthEncoding;
+			auto* p = reinterpret_cast<uint16_t*>(d.image.data.data());
+			for (size_t j = 0; j < d.image.data.size() / 2; j++)
+				p[j] = static_cast<uint16_t>(
+				    std::lround(p[j] * (0.001 / spec.units)));
+		}
+		d.depthUnits = spec.imageUnits;
+		if (spec.imageUnits != 0)
+			bag.write(depth + "/image/data", t, d);
+		else
+			bag.write(depth + "/image/data", t, d.image);
+		if (spec.colour)
+		{
+			auto c = colourMsg(f, "rgb8");
+			if (spec.colourScale != 1)
+			{
+				cv::Mat img(c.height, c.width, CV_8UC3, c.data.data());
+				cv::Mat big;
+				cv::resize(img, big, cv::Size(), spec.colourScale,
+				           spec.colourScale, cv::INTER_NEAREST);
+				c.width = big.cols;
+				c.height = big.rows;
+				c.step = big.cols * 3;
+				c.data.assign(big.data, big.data + big.total() * 3);
+			}
+			bag.write(colour + "/image/data", t, c);
+		}
+		if (!tfWritten && spec.tf)
+		{
+			// written with each stream's first frame, as the recorder does
+			tfWritten = true;
+			bag.write(depth + "/tf/0", t, tfMsg(bag::RigidTransform()));
+			if (spec.colour)
+			{
+				auto m = tfMsg(spec.colourTf);
+				if (spec.nanColourTf)
+					m.translation.x = m.rotation.w =
+					    std::numeric_limits<double>::quiet_NaN();
+				bag.write(colour + "/tf/0", t, m);
+			}
+			if (spec.accel) bag.write(accel + "/tf/0", t, tfMsg(spec.imuTf));
+			if (spec.gyro) bag.write(gyro + "/tf/0", t, tfMsg(spec.imuTf));
+		}
 	}
 	bag.close();
 }

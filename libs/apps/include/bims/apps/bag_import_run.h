@@ -20,10 +20,13 @@ struct BagImportRunOptions
 	std::string out;                    ///< output rawlog
 	std::optional<std::string> config;  ///< experiment .ini
 	std::optional<std::string> layout;  ///< --layout (overrides the .ini's)
-	size_t max_frames = 0;              ///< only the first N frames (0: all)
-	int gz = 1;                         ///< gzip level of the rawlog (0: plain)
-	bool progress = true;               ///< progress line on stderr
-	bool listTopics = false;            ///< --topics: list them, no import
+	/** --depth-units: metres per unit of an rs-sdk recording's depth
+	 * (overrides the .ini's and the recording's) */
+	std::optional<double> depthUnits;
+	size_t max_frames = 0;    ///< only the first N frames (0: all)
+	int gz = 1;               ///< gzip level of the rawlog (0: plain)
+	bool progress = true;     ///< progress line on stderr
+	bool listTopics = false;  ///< --topics: list them, no import
 };
 
 /** The lines bims-import-bag prints on stdout after importing into \a out:

@@ -30,14 +30,18 @@ enum class BagLayout
 {
 	Auto,       ///< the first preset whose depth topic the bag has
 	RealSense,  ///< realsense-ros: aligned depth, colour, imu or accel+gyro
-	Tum         ///< TUM RGB-D's own bags: depth in metres, accel-only /imu
+	Tum,        ///< TUM RGB-D's own bags: depth in metres, accel-only /imu
+	/** the RealSense SDK's own recordings (librealsense's "ROS file
+	 * format": RealSense Viewer, rs-record): its streams found by name */
+	RsSdk
 };
 inline Choices<BagLayout> choices(BagLayout)
 {
 	static constexpr ChoiceName<BagLayout> t[] = {
 	    {BagLayout::Auto, "auto"},
 	    {BagLayout::RealSense, "realsense"},
-	    {BagLayout::Tum, "tum"}};
+	    {BagLayout::Tum, "tum"},
+	    {BagLayout::RsSdk, "rs-sdk"}};
 	return t;
 }
 
@@ -55,9 +59,18 @@ struct BagTopics
 	std::string accel;       ///< sensor_msgs/Imu, accelerometer only
 	std::string gyro;        ///< sensor_msgs/Imu, gyro only (merged)
 	std::string mag;         ///< sensor_msgs/MagneticField
+	/** The rs-sdk layout's (found in the bag, never given): the depth
+	 * stream's CameraInfo when the depth is registered to the colour
+	 * camera by the import (otherwise cameraInfo is the depth's); the
+	 * std_msgs/Float32 Depth Units option [m per unit]; each stream's
+	 * geometry_msgs/Transform extrinsics (tf/N: from the reference stream
+	 * N to the stream, p_stream = R p_ref + t). */
+	std::string depthCameraInfo, depthUnits;
+	std::string depthTf, colourTf, accelTf, gyroTf;
 };
 
-/** The preset topics of \a layout (Auto: none): ROS 1's names. */
+/** The preset topics of \a layout (Auto, RsSdk: none, the latter's
+ * streams are found by name: rsSdkTopics()): ROS 1's names. */
 BagTopics layoutTopics(BagLayout layout);
 
 /** Every variant of \a layout's preset, in the order they are tried: ROS
@@ -82,6 +95,11 @@ struct BagImportParams
 	double maxTimeGap = 0.02;
 	/** [import_bag] timestamp: the stamp of a frame (depth by default). */
 	eval::TimestampSource timestampFrom = eval::TimestampSource::Depth;
+	/** [import_bag] depth_units: metres per unit of an rs-sdk recording's
+	 * 16-bit depth (0: the recording's Depth Units option, else the
+	 * units its depth images carry); given, it replaces the recording's.
+	 * --depth-units overrides. */
+	double depthUnits = 0;
 	/** [import_bag] range_units: metres per unit of the range image. */
 	double rangeUnits = 0.001;
 	/** [import_bag] accel_label: the label of IMU samples without a gyro
@@ -135,6 +153,24 @@ std::string describeTopics(const std::vector<BagTopicInfo>& topics);
  * naming the bags and listing their topics when none does. */
 BagLayout detectLayout(const std::vector<BagTopicInfo>& topics,
                        const std::string& bagNames);
+
+/** The streams of a RealSense SDK recording among \a topics, found by
+ * their names (/device_D/sensor_S/<Stream>_I/...: the sensor numbers vary
+ * by model): the first device's first Depth stream, its camera_info,
+ * tf and its sensor's Depth Units option ("Depth Units" or
+ * "Depth_Units", as librealsense versions name it), the first Color
+ * stream (its CameraInfo then cameraInfo, the depth's depthCameraInfo),
+ * the Accel and Gyro streams. depth is empty when there is none. */
+BagTopics rsSdkTopics(const std::vector<BagTopicInfo>& topics);
+
+/** A rigid transform p_to = R p_from + t (R row major) [m]. */
+struct RigidTransform
+{
+	double R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+	double t[3] = {0, 0, 0};
+};
+/** The angle of \a a's rotation [deg]. */
+double rotationDeg(const RigidTransform& a);
 
 /** One IMU sample of the merged stream [s, rad/s, m/s^2, T]. */
 struct ImuSample
@@ -202,6 +238,19 @@ struct BagImportSummary
 	 * end; damage after the --max-frames imported), one line each. */
 	std::vector<std::string> notes;
 	BagLayout layout = BagLayout::Auto;  ///< whose presets (Auto: none)
+	/** rs-sdk: metres per unit of the depth images, and where from. */
+	double depthUnits = 0;
+	std::string depthUnitsFrom;
+	/** rs-sdk with colour: the depth camera to the colour camera (the
+	 * depth registered to the colour with it), from the tf topics. */
+	std::optional<RigidTransform> depthToColour;
+	/** rs-sdk: the frames' camera to the IMU (the gyro's tf): R is
+	 * [calibration] R_IC (p_I = R_IC p_C + t). */
+	std::optional<RigidTransform> cameraToImu;
+	std::string cameraToImuFrom;  ///< "tf /a and /b"
+	/** rs-sdk: OUT_gt/calibration.ini ([camera], [calibration] R_IC,
+	 * [sensors]) written beside the rawlog; empty: none. */
+	std::string calibrationFile;
 };
 
 /** Imports \a bagPaths (read as one recording: ROS 1 bag files, ROS 2 bag
