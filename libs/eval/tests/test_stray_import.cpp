@@ -1275,19 +1275,49 @@ TEST(ImportStray, OutputsAreNeverDevicesAndTwoRunsNeverMix)
 		fs::remove(dev);
 	}
 
-	// two runs at once: 6 and 3 frames into one output, three times
+	// two runs at once into one output, 400 and 200 frames of 256x192 (long
+	// enough for their writing to overlap), three times
+	const auto big = bims::test::freshTmpDir("bims_test_stray", "big");
+	{
+		fs::create_directories(big + "/depth");
+		std::ofstream odo(big + "/odometry.csv");
+		odo << "timestamp, frame, x, y, z, qx, qy, qz, qw\n";
+		std::vector<uint8_t> png;
+		cv::Mat depth(192, 256, CV_16UC1);
+		cv::randu(depth, 300, 3000);  // (incompressible: ~100 kB a frame)
+		cv::imencode(".png", depth, png);
+		for (int k = 0; k < 400; k++)
+		{
+			char n[16];
+			std::snprintf(n, sizeof(n), "%06d", k);
+			std::ofstream(big + "/depth/" + n + ".png", std::ios::binary)
+			    .write(reinterpret_cast<const char*>(png.data()),
+			           static_cast<std::streamsize>(png.size()));
+			odo << 100 + 0.02 * k << ", " << n << ", " << (k < 2 ? 0 : 0.01 * k)
+			    << ", 0, 0, 0, 0, 0, 1\n";
+		}
+		std::ofstream(big + "/camera_matrix.csv")
+		    << "1400, 0, 960\n0, 1400, 720\n0, 0, 1\n";
+	}
 	const std::string out = d + "/../both.rawlog";
 	const std::string ref = d + "/../both_arkit_reference.txt";
 	for (int round = 0; round < 3; round++)
 	{
 		const auto r = bims::test::runCommand(
-		    "(" + bin + " " + d + " -q --gz 0 -o " + out + " & " + bin + " " +
-		    d + " -q --gz 0 --max-frames 3 -o " + out + " & wait)");
+		    "(" + bin + " " + big + " -q --gz 0 -o " + out + " & " + bin + " " +
+		    big + " -q --gz 0 --max-frames 200 -o " + out + " & wait)");
 		size_t scans = 0;
-		for (const auto& o : readAll(out))
-			scans += std::dynamic_pointer_cast<CObservation3DRangeScan>(o) !=
-			         nullptr;
-		EXPECT_TRUE(scans == 6 || scans == 3) << scans << "\n" << r.out;
+		try
+		{
+			for (const auto& o : readAll(out))
+				scans += std::dynamic_pointer_cast<CObservation3DRangeScan>(
+				             o) != nullptr;
+		}
+		catch (const std::exception& e)
+		{
+			ADD_FAILURE() << "round " << round << ": " << e.what();
+		}
+		EXPECT_TRUE(scans == 400 || scans == 200) << scans << "\n" << r.out;
 		// the reference of the same run: 2 frames without position
 		EXPECT_EQ(bims::loadTumTrajectory(ref).size(), scans - 2) << r.out;
 		for (const auto& e : fs::directory_iterator(d + "/.."))
