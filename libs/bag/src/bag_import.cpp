@@ -1,4 +1,5 @@
 #include <bims/bag/bag_import.h>
+#include <bims/common/input_file.h>
 #include <bims/common/progress.h>
 #include <bims/eval/association.h>
 #include <bims/eval/rgbd_frame.h>
@@ -73,9 +74,11 @@ enum class FileKind
 FileKind fileKind(const std::string& p)
 {
 	char head[16] = {};
-	std::ifstream in(p, std::ios::binary);
-	in.read(head, sizeof(head));
-	const auto got = static_cast<size_t>(in.gcount());
+	// a regular file only: a FIFO is refused, not waited on
+	InputFile in(p, "bag");
+	size_t got = 0;
+	for (size_t n = 1; got < sizeof(head) && n > 0; got += n)
+		n = in.read(head + got, sizeof(head) - got);
 	if (got >= 5 && std::memcmp(head, "\x89MCAP", 5) == 0)
 		return FileKind::Mcap;
 	if (got == 16 && std::memcmp(head, "SQLite format 3", 16) == 0)

@@ -19,7 +19,9 @@
 #include <mrpt/core/format.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
+#include <sys/stat.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -377,6 +379,32 @@ TEST(ImportBag, IntrinsicsThatCannotBeAreRefusedAndAChangeIsNoted)
 		                   "2 on): the first is used for every frame") !=
 		                   std::string::npos;
 	EXPECT_TRUE(said);
+}
+
+// Issue 55, item 1: an output that is a FIFO was replaced by a regular
+// file; refused, naming it, and left as it was (the output guard's rule:
+// OutputPaths.AFifoOrADeviceAsOutputIsRefusedNeverReplaced). A bag that is
+// a FIFO is refused too, not waited on.
+TEST(ImportBag, AFifoAsOutputOrAsBagIsRefusedNamingIt)
+{
+	const auto d = test::freshTmpDir("bims_bag", "fifo");
+	if (::mkfifo((d + "/out.rawlog").c_str(), 0600) != 0 ||
+	    ::mkfifo((d + "/in.bag").c_str(), 0600) != 0)
+		GTEST_SKIP() << "mkfifo refused here: " << std::strerror(errno);
+	BagSpec spec;
+	spec.frames = 3;
+	writeBag(d + "/s.bag", spec, sample().frames, sample().imu);
+	auto e = errorOf([&] { import(d + "/s.bag", d + "/out.rawlog"); });
+	EXPECT_NE(e.find(d + "/out.rawlog: is a FIFO (named pipe), not a regular "
+	                     "file"),
+	          std::string::npos)
+	    << e;
+	EXPECT_TRUE(fs::is_fifo(d + "/out.rawlog"));
+	e = errorOf([&] { import(d + "/in.bag", d + "/o.rawlog"); });
+	EXPECT_NE(e.find("a FIFO (named pipe), not a regular file"),
+	          std::string::npos)
+	    << e;
+	EXPECT_FALSE(fs::exists(d + "/o.rawlog"));
 }
 
 /** The sample as a TUM RGB-D folder: rgb.txt, depth.txt (PNGs, 5000 per
