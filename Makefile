@@ -80,7 +80,7 @@ demo: build
 bench: build
 	@./scripts/bench.sh $(BUILD_DIR)
 
-# make fuzz TARGET=rawlog|ini|tum|labels|image|stray|bag SECONDS=N (docs/fuzz.md)
+# make fuzz TARGET=rawlog|ini|tum|labels|image|stray|stray_capture|bag SECONDS=N (docs/fuzz.md)
 fuzz:
 	@./scripts/fuzz.sh $(TARGET) $(SECONDS)
 

@@ -3,7 +3,7 @@
 #
 #   scripts/fuzz.sh TARGET SECONDS [JOBS]
 #
-# TARGET: rawlog | ini | tum | labels | image | stray | bag | mcap | db3 | cdr. Builds the target with clang,
+# TARGET: rawlog | ini | tum | labels | image | stray | stray_capture | bag | mcap | db3 | cdr. Builds the target with clang,
 # AddressSanitizer, UndefinedBehaviorSanitizer and libFuzzer in build-fuzz/
 # (BIMS_FUZZ_BUILD=DIR for another folder; GUI, OpenNI2 and benchmarks
 # off), seeds a working corpus from tests/fuzz/corpus/TARGET (and config/
@@ -15,8 +15,8 @@ set -euo pipefail
 TARGET=${1:?usage: scripts/fuzz.sh TARGET SECONDS [JOBS]}
 SECONDS_TOTAL=${2:?usage: scripts/fuzz.sh TARGET SECONDS [JOBS]}
 JOBS=${3:-1}
-case "$TARGET" in rawlog | ini | tum | labels | image | stray | bag | mcap | db3 | cdr) ;; *)
-	echo "fuzz.sh: unknown target '$TARGET' (rawlog, ini, tum, labels, image, stray, bag, mcap, db3, cdr)" >&2
+case "$TARGET" in rawlog | ini | tum | labels | image | stray | stray_capture | bag | mcap | db3 | cdr) ;; *)
+	echo "fuzz.sh: unknown target '$TARGET' (rawlog, ini, tum, labels, image, stray, stray_capture, bag, mcap, db3, cdr)" >&2
 	exit 2
 	;;
 esac

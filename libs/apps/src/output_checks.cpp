@@ -99,11 +99,7 @@ size_t prepareOutputFolder(const std::string& dir,
 	std::set<std::string> listed;
 	try
 	{
-		for (const auto& f : manifestFiles(dir))
-		{
-			listed.insert(f);
-			listed.insert(f + ".partial");
-		}
+		for (const auto& f : manifestFiles(dir)) listed.insert(f);
 	}
 	catch (const std::runtime_error& e)
 	{
@@ -116,7 +112,14 @@ size_t prepareOutputFolder(const std::string& dir,
 		if (std::error_code ec; fs::is_symlink(f, ec))
 			links.push_back(f);
 		else if (rel != kOutputManifest && !listed.count(rel))
-			kept.push_back(rel);
+		{
+			// a partial file (of any run) of a listed file goes with it
+			const fs::path r(rel);
+			const std::string base = partialTarget(r.filename().string());
+			if (base.empty() ||
+			    !listed.count((r.parent_path() / base).string()))
+				kept.push_back(rel);
+		}
 	}
 	if (!kept.empty())
 	{

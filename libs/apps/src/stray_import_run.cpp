@@ -55,6 +55,12 @@ std::string strayImportReport(const std::string& out,
 	    "%s: %zu ARKit poses (a reference, not ground truth), the first %zu "
 	    "frames left out (no position yet)\n",
 	    sum.referencePath.c_str(), sum.referencePoses, sum.referenceLeftOut);
+	if (sum.framesSameStamp + sum.imuSameStamp + sum.imuAfterLast > 0)
+		r += mrpt::format(
+		    "left out: %zu frames and %zu IMU samples on the 100 ns tick of "
+		    "the one before, %zu IMU samples after the last frame\n",
+		    sum.framesSameStamp, sum.imuSameStamp, sum.imuAfterLast);
+	for (const auto& n : sum.notes) r += n + "\n";
 	return r;
 }
 
@@ -91,6 +97,8 @@ int runStrayImport(const StrayImportRunOptions& o)
 {
 	ProgressBar bar("bims-import-stray", 0, o.progress);
 	const auto sum = importStrayChecked(o, bar.callback());
+	for (const auto& w : sum.warnings)
+		std::fprintf(stderr, "bims-import-stray: warning: %s\n", w.c_str());
 	std::fputs(strayImportReport(o.out, sum).c_str(), stdout);
 	return 0;
 }

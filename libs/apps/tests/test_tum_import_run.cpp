@@ -137,6 +137,35 @@ TEST(ImportRun, TheImageLimitsOfTheConfigApplyToTheFoldersImages)
 	EXPECT_TRUE(fs::exists(o.out));
 }
 
+// Issue 55, item 6: [camera] intrinsics that cannot be the images' camera
+// (a principal point outside them, a field of view of no camera) are
+// refused before any output, saying what is accepted.
+TEST(ImportRun, IntrinsicsThatCannotBeTheImagesCameraAreRefused)
+{
+	const auto d = tumFolder("intrinsics", false);
+	bims::apps::ImportRunOptions o;
+	o.folder = d;
+	o.out = d + "/x.rawlog";
+	o.progress = false;
+	o.config = d + "/camera.ini";
+	std::ofstream(*o.config) << "[camera]\nfx = 525\nfy = 525\ncx = -129\n"
+	                            "cy = 239.5\nwidth = 640\nheight = 480\n";
+	std::string e = errorOf<std::runtime_error>(o);
+	EXPECT_NE(e.find("[camera] of the import: the principal point (cx -129, "
+	                 "cy 239.5) is outside the 640x480 image (accepted: 0 <= "
+	                 "cx <= 640"),
+	          std::string::npos)
+	    << e;
+	EXPECT_FALSE(fs::exists(o.out));
+	std::ofstream(*o.config) << "[camera]\nfx = 90000\nfy = 525\ncx = 319.5\n"
+	                            "cy = 239.5\nwidth = 640\nheight = 480\n";
+	e = errorOf<std::runtime_error>(o);
+	EXPECT_NE(e.find("fx 90000 gives a field of view of 0.407 deg"),
+	          std::string::npos)
+	    << e;
+	EXPECT_FALSE(fs::exists(o.out));
+}
+
 TEST(ImportRun, SynthImuTakesTheConvertedTruthLabelCalibrationAndSeed)
 {
 	const auto d = tumFolder("synth", true);

@@ -1,9 +1,11 @@
 #include <bims/bag/bag_import.h>
+#include <bims/common/input_file.h>
 #include <bims/common/progress.h>
 #include <bims/eval/association.h>
 #include <bims/eval/rgbd_frame.h>
 #include <bims/io/output_paths.h>
 #include <bims/io/rawlog.h>
+#include <bims/sensors/camera.h>
 #include <cv_bridge/cv_bridge.h>
 #include <mrpt/core/format.h>
 #include <sensor_msgs/image_encodings.h>
@@ -41,8 +43,12 @@ namespace fs = std::filesystem;
 
 double stampSeconds(uint32_t sec, uint32_t nsec)
 {
-	char buf[32];
-	std::snprintf(buf, sizeof(buf), "%u.%09u", sec, nsec);
+	// nanoseconds of a second or more carried into the seconds, as ROS's
+	// normalizeSecNSec does (a stamp written without normalising)
+	const uint64_t s = uint64_t{sec} + nsec / 1000000000u;
+	char buf[40];
+	std::snprintf(buf, sizeof(buf), "%llu.%09u",
+	              static_cast<unsigned long long>(s), nsec % 1000000000u);
 	return std::strtod(buf, nullptr);
 }
 
@@ -71,9 +77,11 @@ enum class FileKind
 FileKind fileKind(const std::string& p)
 {
 	char head[16] = {};
-	std::ifstream in(p, std::ios::binary);
-	in.read(head, sizeof(head));
-	const auto got = static_cast<size_t>(in.gcount());
+	// a regular file only: a FIFO is refused, not waited on
+	InputFile in(p, "bag");
+	size_t got = 0;
+	for (size_t n = 1; got < sizeof(head) && n > 0; got += n)
+		n = in.read(head + got, sizeof(head) - got);
 	if (got >= 5 && std::memcmp(head, "\x89MCAP", 5) == 0)
 		return FileKind::Mcap;
 	if (got == 16 && std::memcmp(head, "SQLite format 3", 16) == 0)
@@ -595,6 +603,14 @@ struct ImageRef
 	const Scanned* msg = nullptr;
 };
 
+/** Whether two CameraInfo messages describe the same camera: image size
+ * and K. */
+bool sameCamera(const CameraInfoView& a, const CameraInfoView& b)
+{
+	return a.width == b.width && a.height == b.height &&
+	       std::equal(a.K, a.K + 9, b.K);
+}
+
 /** Everything the first pass reads: the images' stamps, the camera, the
  * IMU streams. */
 struct Index
@@ -659,7 +675,14 @@ Index readIndex(const Scan& scan, const Bags& bags, const BagTopics& t,
 			}
 			else if (topic == t.cameraInfo)
 			{
-				if (!ix.info) ix.info = m.info;
+				if (!ix.info)
+					ix.info = m.info;
+				else if (!sameCamera(*ix.info, *m.info))
+				{
+					// the first is used for every frame: said once
+					if (sum.cameraInfoChanges++ == 0)
+						sum.firstCameraInfoChange = n;
+				}
 				ix.infoMessages++;
 			}
 			else if (topic == t.depthCameraInfo)
@@ -765,6 +788,12 @@ mrpt::img::TCamera cameraOfInfo(const CameraInfoView* ci,
 		    "image is not a camera",
 		    bagNames.c_str(), topic.c_str(), fx, cx, fy, cy, ci->width,
 		    ci->height));
+	sensors::checkIntrinsics({static_cast<int>(ci->width),
+	                          static_cast<int>(ci->height), fx, fy, cx, cy},
+	                         bagNames + ": topic " + topic +
+	                             ": CameraInfo K of a " +
+	                             std::to_string(ci->width) + "x" +
+	                             std::to_string(ci->height) + " image");
 	mrpt::img::TCamera c;
 	c.ncols = ci->width;
 	c.nrows = ci->height;
@@ -780,11 +809,20 @@ mrpt::img::TCamera cameraOf(const Index& ix, const BagImportParams& params,
 	if (params.camera)
 	{
 		sum.cameraFrom = params.cameraFrom;
+		sensors::checkIntrinsics(sensors::PinholeCamera::of(*params.camera),
+		                         params.cameraFrom);
 		return *params.camera;
 	}
 	const mrpt::img::TCamera c =
 	    cameraOfInfo(ix.info.get(), t.cameraInfo, bagNames);
 	sum.cameraFrom = "CameraInfo " + t.cameraInfo;
+	if (sum.cameraInfoChanges > 0)
+		sum.notes.push_back(mrpt::format(
+		    "warning: topic %s: the CameraInfo changes mid-bag (%zu of its "
+		    "%zu messages differ from the first, from message %zu on): the "
+		    "first is used for every frame",
+		    t.cameraInfo.c_str(), sum.cameraInfoChanges, ix.infoMessages,
+		    sum.firstCameraInfoChange));
 	for (const double k : ix.info->D) sum.distortionIgnored |= k != 0;
 	if (sum.distortionIgnored) sum.distortionModel = ix.info->distortionModel;
 	return c;

@@ -89,7 +89,9 @@ class Reader
 	{
 		const int32_t sec = get<int32_t>("header's stamp");
 		const uint32_t nsec = u32("header's stamp");
-		if (sec < 0 || nsec >= 1000000000u)
+		// (nanoseconds of a second or more: carried into the seconds by
+		// stampSeconds, as ROS normalises them)
+		if (sec < 0)
 			throw runtime_error(mrpt::format(
 			    "its header's stamp %d s %u ns is not a time: corrupt", sec,
 			    nsec));

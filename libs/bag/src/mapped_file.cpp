@@ -1,5 +1,6 @@
 #include "mapped_file.h"
 
+#include <bims/common/input_file.h>
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
@@ -15,7 +16,10 @@ MappedFile mapFile(const std::string& path)
 {
 	using std::runtime_error;
 	MappedFile f;
-	const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+	// a regular file only (a FIFO would block the open): what it is named
+	if (const std::string why = inputFileProblem(path); !why.empty())
+		throw runtime_error(why);
+	const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
 	if (fd < 0)
 		throw runtime_error(std::string("cannot be opened: ") +
 		                    std::strerror(errno));
@@ -23,7 +27,7 @@ MappedFile mapFile(const std::string& path)
 	if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
 	{
 		::close(fd);
-		throw runtime_error("not a file");
+		throw runtime_error("not a regular file");
 	}
 	f.size = static_cast<uint64_t>(st.st_size);
 	if (f.size == 0)

@@ -19,7 +19,9 @@
 #include <mrpt/core/format.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
+#include <sys/stat.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -268,6 +270,141 @@ TEST(ImportBag, StampsAreTheDecimalsOfTheirSecondsAndNanoseconds)
 	          std::strtod("1305031102.175304", nullptr));
 	EXPECT_EQ(bag::stampSeconds(0, 1), 1e-9);
 	EXPECT_EQ(bag::stampSeconds(12, 0), 12.0);
+}
+
+// Issue 55, item 7: a stamp of nsec >= 1e9 (written without ROS's
+// normalisation) was read as the text "sec.nsec" (999 s 1e9 ns as 999.1);
+// normalised as ROS does, for the ROS 1 reader (ROS 2: Ros2Import.*).
+TEST(ImportBag, NonCanonicalStampsAreNormalisedAsRosDoes)
+{
+	EXPECT_EQ(bag::stampSeconds(999, 1000000000), 1000.0);
+	EXPECT_EQ(bag::stampSeconds(999, 1500000000), 1000.5);
+	EXPECT_EQ(bag::stampSeconds(4294967295u, 4294967295u),
+	          std::strtod("4294967299.294967295", nullptr));
+	// a bag whose headers all carry a second in their nanoseconds
+	const auto d = test::freshTmpDir("bims_bag", "nsec");
+	const auto shifted = [](std_msgs::Header& h)
+	{
+		h.stamp.sec -= 1;
+		h.stamp.nsec += 1000000000;
+	};
+	{
+		rosbag::Bag b(d + "/nsec.bag", rosbag::bagmode::Write);
+		const auto layout = bag::layoutTopics(bag::BagLayout::RealSense);
+		for (size_t k = 0; k < 3; k++)
+		{
+			const auto& f = *sample().frames[k];
+			const ros::Time t = rosTime(secondsOf(f.timestamp));
+			auto info = infoMsg(f);
+			auto depth = depthMsg(f, false);
+			auto colour = colourMsg(f, "rgb8");
+			shifted(info.header);
+			shifted(depth.header);
+			shifted(colour.header);
+			b.write(layout.cameraInfo, t, info);
+			b.write(layout.depth, t, depth);
+			b.write(layout.colour, t, colour);
+		}
+	}
+	const auto sum = import(d + "/nsec.bag", d + "/o.rawlog");
+	EXPECT_EQ(sum.frames, 3u);
+	expectTheSampleFrames(readRawlog(d + "/o.rawlog"), 3);
+}
+
+// Issue 55, item 6: a CameraInfo that cannot be the images' camera is
+// refused saying what is accepted; a K that changes mid-bag is noted (the
+// first is used for every frame).
+TEST(ImportBag, IntrinsicsThatCannotBeAreRefusedAndAChangeIsNoted)
+{
+	const auto d = test::freshTmpDir("bims_bag", "intrinsics");
+	const auto layout = bag::layoutTopics(bag::BagLayout::RealSense);
+	const auto write =
+	    [&](const std::string& path,
+	        const std::function<void(sensor_msgs::CameraInfo&, size_t)>& edit)
+	{
+		rosbag::Bag b(path, rosbag::bagmode::Write);
+		for (size_t k = 0; k < 4; k++)
+		{
+			const auto& f = *sample().frames[k];
+			const ros::Time t = rosTime(secondsOf(f.timestamp));
+			auto info = infoMsg(f);
+			edit(info, k);
+			b.write(layout.cameraInfo, t, info);
+			b.write(layout.depth, t, depthMsg(f, false));
+			b.write(layout.colour, t, colourMsg(f, "rgb8"));
+		}
+	};
+	write(d + "/cx.bag",
+	      [](sensor_msgs::CameraInfo& m, size_t) { m.K[2] = -1e6; });
+	auto e = errorOf([&] { import(d + "/cx.bag", d + "/o.rawlog"); });
+	EXPECT_NE(e.find("topic /camera/color/camera_info: CameraInfo K of a "
+	                 "320x240 image: the principal point (cx -1e+06"),
+	          std::string::npos)
+	    << e;
+	EXPECT_NE(e.find("accepted: 0 <= cx <= 320"), std::string::npos) << e;
+	EXPECT_FALSE(fs::exists(d + "/o.rawlog"));
+	// a K made for 1280x960 on these images
+	write(d + "/big.bag",
+	      [](sensor_msgs::CameraInfo& m, size_t)
+	      {
+		      m.K[0] = m.K[4] = 1100;
+		      m.K[2] = 640;
+		      m.K[5] = 480;
+	      });
+	e = errorOf([&] { import(d + "/big.bag", d + "/o.rawlog"); });
+	EXPECT_NE(e.find("is outside the 320x240 image"), std::string::npos) << e;
+	// a focal length of no camera
+	write(d + "/fx.bag",
+	      [](sensor_msgs::CameraInfo& m, size_t) { m.K[0] = 1e300; });
+	e = errorOf([&] { import(d + "/fx.bag", d + "/o.rawlog"); });
+	EXPECT_NE(e.find("fx 1e+300 gives a field of view of 0 deg"),
+	          std::string::npos)
+	    << e;
+	// K changes from the third message on
+	write(d + "/change.bag",
+	      [](sensor_msgs::CameraInfo& m, size_t k)
+	      {
+		      if (k >= 2) m.K[0] += 10;
+	      });
+	const auto sum = import(d + "/change.bag", d + "/o.rawlog");
+	EXPECT_EQ(sum.frames, 4u);
+	EXPECT_EQ(sum.cameraInfoChanges, 2u);
+	EXPECT_EQ(sum.camera.fx(), sample().frames[0]->cameraParams.fx());
+	bool said = false;
+	for (const auto& n : sum.notes)
+		said = said || n.find(
+		                   "topic /camera/color/camera_info: the "
+		                   "CameraInfo changes mid-bag (2 of its 4 "
+		                   "messages differ from the first, from message "
+		                   "2 on): the first is used for every frame") !=
+		                   std::string::npos;
+	EXPECT_TRUE(said);
+}
+
+// Issue 55, item 1: an output that is a FIFO was replaced by a regular
+// file; refused, naming it, and left as it was (the output guard's rule:
+// OutputPaths.AFifoOrADeviceAsOutputIsRefusedNeverReplaced). A bag that is
+// a FIFO is refused too, not waited on.
+TEST(ImportBag, AFifoAsOutputOrAsBagIsRefusedNamingIt)
+{
+	const auto d = test::freshTmpDir("bims_bag", "fifo");
+	if (::mkfifo((d + "/out.rawlog").c_str(), 0600) != 0 ||
+	    ::mkfifo((d + "/in.bag").c_str(), 0600) != 0)
+		GTEST_SKIP() << "mkfifo refused here: " << std::strerror(errno);
+	BagSpec spec;
+	spec.frames = 3;
+	writeBag(d + "/s.bag", spec, sample().frames, sample().imu);
+	auto e = errorOf([&] { import(d + "/s.bag", d + "/out.rawlog"); });
+	EXPECT_NE(e.find(d + "/out.rawlog: is a FIFO (named pipe), not a regular "
+	                     "file"),
+	          std::string::npos)
+	    << e;
+	EXPECT_TRUE(fs::is_fifo(d + "/out.rawlog"));
+	e = errorOf([&] { import(d + "/in.bag", d + "/o.rawlog"); });
+	EXPECT_NE(e.find("a FIFO (named pipe), not a regular file"),
+	          std::string::npos)
+	    << e;
+	EXPECT_FALSE(fs::exists(d + "/o.rawlog"));
 }
 
 /** The sample as a TUM RGB-D folder: rgb.txt, depth.txt (PNGs, 5000 per

@@ -1035,6 +1035,39 @@ TEST(Ros2Import, CdrOfEitherByteOrderIsReadAlignedFromItsHeader)
 	                "not CDR_BE or CDR_LE"));
 }
 
+// Issue 55, item 7: a header stamp with nanosec >= 1e9 (non-canonical)
+// was refused as corrupt; ROS carries the whole seconds into sec.
+TEST(Ros2Import, ANonCanonicalCdrStampIsNormalisedAsRosDoes)
+{
+	auto le = [](std::string& s, const void* v, size_t n)
+	{ s.append(static_cast<const char*>(v), n); };
+	std::string m("\x00\x01\x00\x00", 4);  // CDR_LE
+	const int32_t sec = 999;
+	const uint32_t nsec = 1500000000, len = 3;
+	le(m, &sec, 4);
+	le(m, &nsec, 4);
+	le(m, &len, 4);
+	m += std::string("ab\0", 3);
+	m += std::string(1, '\0');
+	for (const double v :
+	     {1e-5, -2e-5, 3e-5, 0., 0., 0., 0., 0., 0., 0., 0., 0.})
+		le(m, &v, 8);
+	const auto* p = reinterpret_cast<const uint8_t*>(m.data());
+	std::string e;
+	bag::ImuSample s;
+	try
+	{
+		s = bag::cdr::magneticField(p, m.size());
+	}
+	catch (const std::exception& x)
+	{
+		e = x.what();
+	}
+	EXPECT_EQ(e, "");
+	EXPECT_EQ(s.t, 1000.5);  // not 999.15
+	EXPECT_DOUBLE_EQ(s.m[0], 0.1);
+}
+
 /** \a mcap with its chunks' and data section's CRCs set to 0 ("not
  * computed"): a fuzzer's mutations of its chunks then reach the messages. */
 std::string withoutCrcs(std::string mcap)

@@ -1,5 +1,6 @@
 // Reading a Stray Scanner capture's files: odometry.csv, imu.csv,
 // camera_matrix.csv and the depth/ listing (stray_import.h).
+#include <bims/common/input_file.h>
 #include <bims/eval/stray_import.h>
 #include <mrpt/poses/CPose3DQuat.h>
 
@@ -8,7 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -45,6 +46,27 @@ std::string joined(const std::vector<std::string>& names)
 	return s;
 }
 
+/** \a s with bytes outside printable ASCII shown as \xNN (a byte-order
+ * mark in the middle, a binary byte), cut to 120 characters. */
+std::string printable(const std::string& s)
+{
+	std::string out;
+	for (const char ch : s)
+	{
+		const auto c = static_cast<unsigned char>(ch);
+		if (c >= 0x20 && c < 0x7f)
+			out += ch;
+		else
+		{
+			char b[8];
+			std::snprintf(b, sizeof(b), "\\x%02X", c);
+			out += b;
+		}
+		if (out.size() > 120) return out + "...";
+	}
+	return out;
+}
+
 std::runtime_error rowError(const std::string& path, size_t line,
                             const std::string& what)
 {
@@ -52,69 +74,91 @@ std::runtime_error rowError(const std::string& path, size_t line,
 }
 
 /** A CSV of a header line \a names and rows of as many finite numbers, time
- * (the first column) strictly increasing: each row and its line. */
-struct CsvRow
-{
-	size_t line;
-	std::vector<double> v;
-	std::vector<std::string> text;
-};
+ * (the first column) strictly increasing, read one row at a time (nothing
+ * of a row is kept but what \a row takes): \a row(line, values, cells). */
+using CsvRowFn = std::function<void(size_t, const std::vector<double>&,
+                                    const std::vector<std::string>&)>;
 
-std::vector<CsvRow> readNumericCsv(const std::string& path,
-                                   const std::vector<std::string>& names)
+void readNumericCsv(const std::string& path,
+                    const std::vector<std::string>& names, const CsvRowFn& row)
 {
-	std::ifstream f(path);
-	if (!f) throw std::runtime_error(path + ": cannot open");
+	LineReader f(path, "CSV file");
 	std::string line;
-	size_t n = 0;
 	// the header: the columns' names in this order (the meaning and the
 	// sign of every column below depend on it)
-	while (std::getline(f, line))
-	{
-		n++;
-		if (!trim(line).empty()) break;
-	}
+	bool any = false;
+	while (f.next(line))
+		if (!trim(line).empty())
+		{
+			any = true;
+			break;
+		}
+	if (!any) throw std::runtime_error(path + ": empty (no header, no rows)");
 	if (fields(line) != names)
-		throw rowError(path, n,
+		throw rowError(path, f.lineNumber(),
 		               "expected the header '" + joined(names) + "', got '" +
-		                   trim(line) + "'");
-	std::vector<CsvRow> rows;
-	while (std::getline(f, line))
+		                   printable(trim(line)) + "'");
+	size_t rows = 0;
+	double previous = 0;
+	std::vector<double> v(names.size());
+	while (f.next(line))
 	{
-		n++;
+		const size_t n = f.lineNumber();
 		if (trim(line).empty()) continue;
-		CsvRow r{n, {}, fields(line)};
-		if (r.text.size() != names.size())
+		const std::vector<std::string> text = fields(line);
+		if (text.size() != names.size())
 			throw rowError(path, n,
 			               "expected " + std::to_string(names.size()) +
 			                   " comma-separated values (" + joined(names) +
-			                   "), got " + std::to_string(r.text.size()) +
+			                   "), got " + std::to_string(text.size()) +
 			                   " (a truncated row?)");
 		for (size_t i = 0; i < names.size(); i++)
 		{
-			const std::string& s = r.text[i];
+			const std::string& s = text[i];
 			char* end = nullptr;
 			errno = 0;
 			const double x = std::strtod(s.c_str(), &end);
 			if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE ||
 			    !std::isfinite(x))
-				throw rowError(
-				    path, n, names[i] + " '" + s + "' is not a finite number");
-			r.v.push_back(x);
+				throw rowError(path, n,
+				               names[i] + " '" + printable(s) +
+				                   "' is not a finite number");
+			v[i] = x;
 		}
-		if (!rows.empty() && !(r.v[0] > rows.back().v[0]))
+		// the rawlog's clock holds no time before 1970 (a negative stamp
+		// would wrap) and bims refuses absurd ones
+		if (!(v[0] >= 0 && v[0] <= kMaxStraySeconds))
+		{
+			char b[200];
+			std::snprintf(b, sizeof(b),
+			              "timestamp %.9g is not a time bims takes: seconds "
+			              "from 0 to %.0f (ROS's range, to the year 2106) "
+			              "are accepted",
+			              v[0], kMaxStraySeconds);
+			throw rowError(path, n, b);
+		}
+		if (rows > 0 && !(v[0] > previous))
 		{
 			char b[160];
 			std::snprintf(b, sizeof(b),
 			              "timestamp %.9f is not after the previous row's "
 			              "%.9f (time must increase)",
-			              r.v[0], rows.back().v[0]);
+			              v[0], previous);
 			throw rowError(path, n, b);
 		}
-		rows.push_back(std::move(r));
+		previous = v[0];
+		rows++;
+		row(n, v, text);
 	}
-	if (rows.empty()) throw std::runtime_error(path + ": no rows");
-	return rows;
+	if (rows == 0) throw std::runtime_error(path + ": no rows");
+}
+
+/** Whether nothing is at \a path: no file and no symbolic link (a link
+ * to nothing or a link loop is there, and its reader names it). */
+bool absent(const std::string& path)
+{
+	std::error_code ec;
+	return !fs::exists(fs::symlink_status(path, ec));
 }
 
 /** "000123" -> 123; -1 when not all digits. */
@@ -138,67 +182,70 @@ mrpt::poses::CPose3D StrayFrame::pose() const
 
 std::vector<StrayFrame> readStrayOdometry(const std::string& path)
 {
-	const auto rows = readNumericCsv(
-	    path, {"timestamp", "frame", "x", "y", "z", "qx", "qy", "qz", "qw"});
 	std::vector<StrayFrame> out;
 	std::map<long, size_t> lineOf;
-	for (const auto& r : rows)
-	{
-		StrayFrame f;
-		f.t = r.v[0];
-		f.line = r.line;
-		f.index = frameNumber(r.text[1]);
-		if (f.index < 0)
-			throw rowError(
-			    path, r.line,
-			    "frame '" + r.text[1] + "' is not a frame number (digits)");
-		if (const auto it = lineOf.find(f.index); it != lineOf.end())
-			throw rowError(path, r.line,
-			               "frame " + r.text[1] + " is given twice (line " +
-			                   std::to_string(it->second) + ")");
-		lineOf[f.index] = r.line;
-		for (int i = 0; i < 3; i++) f.p[i] = r.v[2 + i];
-		for (int i = 0; i < 4; i++) f.q[i] = r.v[5 + i];
-		const double qn = std::sqrt(f.q[0] * f.q[0] + f.q[1] * f.q[1] +
-		                            f.q[2] * f.q[2] + f.q[3] * f.q[3]);
-		if (std::abs(qn - 1.0) > 1e-3)
-			throw rowError(path, r.line,
-			               "quaternion qx qy qz qw is not unit (norm " +
-			                   std::to_string(qn) + ")");
-		out.push_back(f);
-	}
+	readNumericCsv(
+	    path, {"timestamp", "frame", "x", "y", "z", "qx", "qy", "qz", "qw"},
+	    [&](size_t line, const std::vector<double>& v,
+	        const std::vector<std::string>& text)
+	    {
+		    StrayFrame f;
+		    f.t = v[0];
+		    f.line = line;
+		    f.index = frameNumber(text[1]);
+		    if (f.index < 0)
+			    throw rowError(path, line,
+			                   "frame '" + printable(text[1]) +
+			                       "' is not a frame number (digits)");
+		    if (const auto it = lineOf.find(f.index); it != lineOf.end())
+			    throw rowError(path, line,
+			                   "frame " + text[1] + " is given twice (line " +
+			                       std::to_string(it->second) + ")");
+		    lineOf[f.index] = line;
+		    for (int i = 0; i < 3; i++) f.p[i] = v[2 + i];
+		    for (int i = 0; i < 4; i++) f.q[i] = v[5 + i];
+		    const double qn = std::sqrt(f.q[0] * f.q[0] + f.q[1] * f.q[1] +
+		                                f.q[2] * f.q[2] + f.q[3] * f.q[3]);
+		    if (std::abs(qn - 1.0) > 1e-3)
+			    throw rowError(path, line,
+			                   "quaternion qx qy qz qw is not unit (norm " +
+			                       std::to_string(qn) + ")");
+		    out.push_back(f);
+	    });
 	return out;
 }
 
 std::vector<StrayImuSample> readStrayImu(const std::string& path)
 {
-	const auto rows = readNumericCsv(path, {"timestamp", "a_x", "a_y", "a_z",
-	                                        "alpha_x", "alpha_y", "alpha_z"});
 	std::vector<StrayImuSample> out;
-	out.reserve(rows.size());
-	for (const auto& r : rows)
-	{
-		StrayImuSample s;
-		s.t = r.v[0];
-		for (int i = 0; i < 3; i++)
-		{
-			s.a[i] = r.v[1 + i];
-			s.alpha[i] = r.v[4 + i];
-		}
-		out.push_back(s);
-	}
+	readNumericCsv(
+	    path,
+	    {"timestamp", "a_x", "a_y", "a_z", "alpha_x", "alpha_y", "alpha_z"},
+	    [&](size_t, const std::vector<double>& v,
+	        const std::vector<std::string>&)
+	    {
+		    StrayImuSample s;
+		    s.t = v[0];
+		    for (int i = 0; i < 3; i++)
+		    {
+			    s.a[i] = v[1 + i];
+			    s.alpha[i] = v[4 + i];
+		    }
+		    out.push_back(s);
+	    });
 	return out;
 }
 
 void readStrayCameraMatrix(const std::string& path, double K[3][3])
 {
-	std::ifstream f(path);
-	if (!f) throw std::runtime_error(path + ": cannot open");
+	if (inputFileProblem(path) == "no such file")
+		throw std::runtime_error(path + ": cannot open: no such file");
+	LineReader f(path, "camera matrix");
 	std::string line;
 	size_t n = 0, row = 0;
-	while (std::getline(f, line))
+	while (f.next(line))
 	{
-		n++;
+		n = f.lineNumber();
 		if (trim(line).empty()) continue;
 		if (row == 3)
 			throw rowError(path, n, "a 4th row: expected a 3x3 matrix");
@@ -213,8 +260,9 @@ void readStrayCameraMatrix(const std::string& path, double K[3][3])
 			const double x = std::strtod(cells[i].c_str(), &end);
 			if (cells[i].empty() || end != cells[i].c_str() + cells[i].size() ||
 			    !std::isfinite(x))
-				throw rowError(path, n,
-				               "'" + cells[i] + "' is not a finite number");
+				throw rowError(
+				    path, n,
+				    "'" + printable(cells[i]) + "' is not a finite number");
 			K[row][i] = x;
 		}
 		const bool ok = row == 0 ? K[0][0] > 0 && K[0][1] == 0
@@ -242,13 +290,14 @@ StrayCapture readStrayCapture(const std::string& folder)
 	StrayCapture c;
 	c.path = folder;
 	const std::string odometry = (dir / "odometry.csv").string();
-	if (!fs::exists(odometry))
+	if (absent(odometry))
 		throw std::runtime_error(odometry +
 		                         ": not found (the frames' poses and clock; "
 		                         "is this a Stray Scanner capture?)");
 	c.frames = readStrayOdometry(odometry);
 
 	// depth/NNNNNN.png: exactly the frames of odometry.csv
+	std::error_code ec;
 	const fs::path depthDir = dir / "depth";
 	if (!fs::is_directory(depthDir))
 		throw std::runtime_error(depthDir.string() +
@@ -265,7 +314,16 @@ StrayCapture readStrayCapture(const std::string& folder)
 			    "odometry.csv)");
 		depthOf[k] = e.path().string();
 	}
-	c.hasConfidence = fs::is_directory(dir / "confidence");
+	const std::string confDir = (dir / "confidence").string();
+	c.hasConfidence = !absent(confDir);
+	if (c.hasConfidence && !fs::is_directory(confDir, ec))
+	{
+		const std::string why = inputFileProblem(confDir);
+		throw std::runtime_error(confDir +
+		                         ": not a folder of ARKit confidence images (" +
+		                         (why.empty() ? std::string("a file") : why) +
+		                         "): remove it to import without confidence");
+	}
 	for (auto& f : c.frames)
 	{
 		const auto it = depthOf.find(f.index);
@@ -292,7 +350,7 @@ StrayCapture readStrayCapture(const std::string& folder)
 	readStrayCameraMatrix((dir / "camera_matrix.csv").string(), c.K);
 
 	const std::string imu = (dir / "imu.csv").string();
-	c.hasImu = fs::exists(imu);
+	c.hasImu = !absent(imu);
 	if (c.hasImu)
 		c.imu = readStrayImu(imu);
 	else
@@ -305,8 +363,11 @@ StrayCapture readStrayCapture(const std::string& folder)
 		             "bims-import-stray: warning: %s: not found: every depth "
 		             "reading kept (no ARKit confidence to filter by)\n",
 		             (dir / "confidence").string().c_str());
-	if (fs::exists(dir / "rgb.mp4"))
+	if (!absent((dir / "rgb.mp4").string()))
+	{
 		c.videoPath = (dir / "rgb.mp4").string();
+		checkInputFile(c.videoPath, "video");  // (a FIFO would block)
+	}
 	else
 		std::fprintf(stderr,
 		             "bims-import-stray: note: %s: not found: depth and IMU "

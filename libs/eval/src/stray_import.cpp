@@ -5,8 +5,12 @@
 #include <bims/io/image_file.h>
 #include <bims/io/output_paths.h>
 #include <bims/io/rawlog.h>
+#include <bims/io/trajectory.h>
+#include <bims/sensors/camera.h>
 #include <mrpt/core/Clock.h>
 #include <mrpt/obs/CObservationIMU.h>
+
+#include <mrpt/core/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -142,11 +146,65 @@ StrayImportSummary importStray(const StrayCapture& cap,
 			    sizeText(sum.videoWidth, sum.videoHeight) +
 			    ", not of the depth images' aspect ratio (" +
 			    sizeText(sum.width, sum.height) + ", " + firstDepth + ")");
-		colourW = sum.videoWidth;
-		colourH = sum.videoHeight;
+		// the grid camera_matrix.csv was made for: its principal point near
+		// the centre of the video's frames, or else of the [import_stray]
+		// colour size (a re-encoded video: the same view, scaled)
+		const double cx = cap.K[0][2], cy = cap.K[1][2];
+		const auto central = [&](int w, int h)
+		{
+			return w > 0 && h > 0 &&
+			       std::abs(cx / w - 0.5) <= kStrayCentreTolerance &&
+			       std::abs(cy / h - 0.5) <= kStrayCentreTolerance;
+		};
+		const double va = double(sum.videoWidth) * params.colour_height,
+		             vb = double(sum.videoHeight) * params.colour_width;
+		if (central(sum.videoWidth, sum.videoHeight))
+		{
+			colourW = sum.videoWidth;
+			colourH = sum.videoHeight;
+		}
+		else if (central(params.colour_width, params.colour_height) &&
+		         std::abs(va - vb) <= 0.01 * std::max(va, vb))
+			sum.notes.push_back(
+			    vp + ": frames of " +
+			    sizeText(sum.videoWidth, sum.videoHeight) + ", " + folder +
+			    "/camera_matrix.csv of the " +
+			    sizeText(params.colour_width, params.colour_height) +
+			    " colour stream ([import_stray] colour_width, colour_height): "
+			    "the video is taken as that view scaled");
+		else
+			throw std::runtime_error(mrpt::format(
+			    "%s: frames of %s, but the principal point of %s/"
+			    "camera_matrix.csv (cx %g, cy %g) is not near their centre "
+			    "(within %g of the size) nor that of the %s colour stream of "
+			    "[import_stray] colour_width, colour_height with the video's "
+			    "aspect ratio: the matrix is of another image size (give the "
+			    "size it was made for as colour_width, colour_height)",
+			    vp.c_str(), sizeText(sum.videoWidth, sum.videoHeight).c_str(),
+			    folder.c_str(), cx, cy, kStrayCentreTolerance,
+			    sizeText(params.colour_width, params.colour_height).c_str()));
 	}
 	sum.camera =
 	    strayDepthCamera(cap.K, colourW, colourH, sum.width, sum.height);
+	sensors::checkIntrinsics(
+	    sensors::PinholeCamera::of(sum.camera),
+	    folder + "/camera_matrix.csv (of a " + sizeText(colourW, colourH) +
+	        " colour image, scaled to the " + sizeText(sum.width, sum.height) +
+	        " depth grid)");
+
+	// The rawlog's clock ticks in 100 ns: a frame (an IMU sample) on the
+	// tick of the one before would be dropped by every reader; it is left
+	// out here and counted
+	std::vector<bool> written(frames.size(), true);
+	for (size_t i = 1, last = 0; i < frames.size(); i++)
+		if (mrpt::Clock::fromDouble(frames[i].t) ==
+		    mrpt::Clock::fromDouble(frames[last].t))
+		{
+			written[i] = false;
+			sum.framesSameStamp++;
+		}
+		else
+			last = i;
 
 	// Frames and IMU by time: (t, kind, index); kind 0 = IMU first at equal
 	// stamps. IMU from the start of the file (the attitude filter wants
@@ -158,12 +216,50 @@ StrayImportSummary importStray(const StrayCapture& cap,
 		size_t i;
 	};
 	const double t0 = frames.front().t, t1 = frames.back().t;
+	const double tEnd = cap.frames.back().t;  // of the whole capture
 	std::vector<Item> items;
-	for (size_t i = 0; i < cap.imu.size() && cap.imu[i].t <= t1; i++)
+	size_t inSpan = 0;
+	for (size_t i = 0, last = 0; i < cap.imu.size(); i++)
 	{
-		items.push_back({cap.imu[i].t, 0, i});
-		sum.imuBeforeFirst += cap.imu[i].t < t0;
+		const double t = cap.imu[i].t;
+		if (t > tEnd) sum.imuAfterLast++;
+		if (t > t1) continue;
+		if (!items.empty() && mrpt::Clock::fromDouble(t) ==
+		                          mrpt::Clock::fromDouble(cap.imu[last].t))
+		{
+			sum.imuSameStamp++;
+			continue;
+		}
+		last = i;
+		items.push_back({t, 0, i});
+		sum.imuBeforeFirst += t < t0;
+		inSpan += t >= t0;
 	}
+	const std::string imuCsv = folder + "/imu.csv";
+	if (sum.imuAfterLast > 0)
+		sum.warnings.push_back(mrpt::format(
+		    "%s: %zu of its %zu samples are after the capture's last frame "
+		    "(t %.6f s) and were left out: is the IMU on odometry.csv's clock "
+		    "and in seconds?",
+		    imuCsv.c_str(), sum.imuAfterLast, cap.imu.size(), tEnd));
+	if (!cap.imu.empty() && inSpan == 0)
+		sum.warnings.push_back(mrpt::format(
+		    "%s: none of its %zu samples (t %.6f to %.6f s) is within the "
+		    "frames' time span (%.6f to %.6f s): another clock or other "
+		    "units? The frames get no IMU",
+		    imuCsv.c_str(), cap.imu.size(), cap.imu.front().t, cap.imu.back().t,
+		    t0, t1));
+	if (sum.imuSameStamp > 0)
+		sum.warnings.push_back(mrpt::format(
+		    "%s: %zu samples left out: each on the 100 ns tick of the sample "
+		    "before (the rawlog's clock)",
+		    imuCsv.c_str(), sum.imuSameStamp));
+	if (sum.framesSameStamp > 0)
+		sum.warnings.push_back(mrpt::format(
+		    "%s/odometry.csv: %zu frames left out: each within the 100 ns "
+		    "tick of the frame before (the rawlog's clock: two scans of one "
+		    "stamp are one too many for every reader)",
+		    folder.c_str(), sum.framesSameStamp));
 	for (size_t i = 0; i < frames.size(); i++)
 		items.push_back({frames[i].t, 1, i});
 	std::stable_sort(items.begin(), items.end(),
@@ -174,7 +270,7 @@ StrayImportSummary importStray(const StrayCapture& cap,
 	PartialFile part(outRawlog);
 	RawlogWriter w(part.path(), options.gzLevel);
 	Progress progress;
-	progress.total = frames.size();
+	progress.total = frames.size() - sum.framesSameStamp;
 	reportProgress(options.progress, progress);
 	cv::Mat bgr, small;
 	for (const auto& it : items)
@@ -186,6 +282,16 @@ StrayImportSummary importStray(const StrayCapture& cap,
 			continue;
 		}
 		const StrayFrame& f = frames[it.i];
+		if (!written[it.i])
+		{
+			// its video frame is skipped with it
+			if (sum.colour && !video.grab())
+				throw std::runtime_error(
+				    cap.videoPath + ": ends after " + std::to_string(it.i) +
+				    " frames, but the capture has " +
+				    std::to_string(cap.frames.size()) + " depth frames");
+			continue;
+		}
 		cv::Mat depth = readDepthPng(f.depthPath, params.images);
 		if (depth.cols != sum.width || depth.rows != sum.height)
 			throw std::runtime_error(f.depthPath + ": depth image is " +
@@ -256,9 +362,6 @@ StrayImportSummary importStray(const StrayCapture& cap,
 		    " video frames, but the capture has " +
 		    std::to_string(cap.frames.size()) + " depth frames");
 	w.close();
-	part.commit();
-	progress.finished = true;
-	reportProgress(options.progress, progress);
 
 	// ARKit's poses at the written frames, from the first with a position
 	sum.referencePath = strayReferencePathFor(outRawlog);
@@ -266,18 +369,28 @@ StrayImportSummary importStray(const StrayCapture& cap,
 	while (k < frames.size() && frames[k].p[0] == 0 && frames[k].p[1] == 0 &&
 	       frames[k].p[2] == 0)
 		k++;
-	sum.referenceLeftOut = k;
+	for (size_t j = 0; j < k; j++) sum.referenceLeftOut += written[j];
 	for (; k < frames.size(); k++)
-		sum.reference.push_back({frames[k].t, frames[k].pose()});
+		if (written[k])
+			sum.reference.push_back({frames[k].t, frames[k].pose()});
 	sum.referencePoses = sum.reference.size();
-	saveTumTrajectory(
-	    sum.referencePath, sum.reference,
-	    "ARKit's visual-inertial estimate, NOT ground truth: a reference. "
-	    "T_WC of the camera optical frame (x right, y down, z forward) in "
-	    "ARKit's world (y up) at each 3D scan's stamp, from " +
-	        folder + "/odometry.csv; the first " +
-	        std::to_string(sum.referenceLeftOut) +
-	        " frames (translation exactly 0: ARKit initialising) left out");
+	// the rawlog and its reference put in place together (another run
+	// writing the same OUT at once: one run's pair wins whole)
+	PartialFile ref(sum.referencePath);
+	writePartialFile(
+	    ref,
+	    tumTrajectoryText(
+	        sum.referencePath, sum.reference,
+	        "ARKit's visual-inertial estimate, NOT ground truth: a reference. "
+	        "T_WC of the camera optical frame (x right, y down, z forward) in "
+	        "ARKit's world (y up) at each 3D scan's stamp, from " +
+	            folder + "/odometry.csv; the first " +
+	            std::to_string(sum.referenceLeftOut) +
+	            " frames (translation exactly 0: ARKit initialising) left "
+	            "out"));
+	commitTogether({&part, &ref});
+	progress.finished = true;
+	reportProgress(options.progress, progress);
 	return sum;
 }
 

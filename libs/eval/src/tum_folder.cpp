@@ -1,3 +1,4 @@
+#include <bims/common/input_file.h>
 #include <bims/eval/association.h>
 #include <bims/eval/rgbd_frame.h>
 #include <bims/eval/tum_import.h>
@@ -31,14 +32,15 @@ bool skipLine(const std::string& line)
 /** rgb.txt / depth.txt: "timestamp filename" per line. */
 std::vector<StampedFile> readFileList(const fs::path& listPath)
 {
-	std::ifstream f(listPath);
-	if (!f)
+	if (inputFileProblem(listPath.string()) == "no such file")
 		throw std::runtime_error(listPath.string() +
 		                         ": cannot open (is this a TUM RGB-D folder?)");
+	LineReader f(listPath.string(), "file list");
 	std::vector<StampedFile> out;
 	std::string line;
-	for (size_t n = 1; std::getline(f, line); n++)
+	while (f.next(line))
 	{
+		const size_t n = f.lineNumber();
 		if (skipLine(line)) continue;
 		std::istringstream ss(line);
 		StampedFile e;
@@ -60,12 +62,12 @@ std::vector<StampedFile> readFileList(const fs::path& listPath)
 
 std::vector<AccelSample> readAccel(const fs::path& p)
 {
-	std::ifstream f(p);
-	if (!f) throw std::runtime_error(p.string() + ": cannot open");
+	LineReader f(p.string(), "accelerometer file");
 	std::vector<AccelSample> out;
 	std::string line;
-	for (size_t n = 1; std::getline(f, line); n++)
+	while (f.next(line))
 	{
+		const size_t n = f.lineNumber();
 		if (skipLine(line)) continue;
 		std::istringstream ss(line);
 		AccelSample a;

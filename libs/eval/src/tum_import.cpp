@@ -5,6 +5,7 @@
 #include <bims/io/image_file.h>
 #include <bims/io/output_paths.h>
 #include <bims/io/rawlog.h>
+#include <bims/sensors/camera.h>
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/system/datetime.h>
 
@@ -95,6 +96,8 @@ ImportSummary importTum(TumFolder tum, const std::string& outRawlog,
                         const ImportOptions& options)
 {
 	const std::string& folder = tum.path;
+	// the intrinsics can be a camera of the images they are given for
+	sensors::checkIntrinsics(params.camera, "[camera] of the import");
 	if (options.maxFrames > 0 && tum.frames.size() > options.maxFrames)
 		tum.frames.resize(options.maxFrames);
 	const double t0 = tum.frames.front().t, t1 = tum.frames.back().t;

@@ -6,8 +6,10 @@
 #include <bims/eval/stray_import.h>
 #include <bims/io/rawlog.h>
 #include <bims/io/trajectory.h>
+#include <bims/sensors/camera.h>
 #include <bims_test/data.h>
 #include <bims_test/run_command.h>
+#include <bims_test/text.h>
 #include <bims_test/tmp_dir.h>
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFile.h>
@@ -15,6 +17,8 @@
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/poses/CPose3DQuat.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -155,9 +159,13 @@ std::string makeCapture(const std::string& name, const CaptureSpec& spec = {})
 		              q[3]);
 		odo << row;
 	}
-	// no newline after the last row, as Stray writes it
+	// no newline after the last row, as Stray writes it; of the video's
+	// size, or without one of [import_stray]'s default colour size
+	// (1920x1440, 15 times the video's): the same view either way
 	std::ofstream(d + "/camera_matrix.csv")
-	    << "100.0, 0.0, 64.5\n0.0, 96.0, 47.25\n0.0, 0.0, 1.0";
+	    << (spec.video ? "100.0, 0.0, 64.5\n0.0, 96.0, 47.25\n0.0, 0.0, 1.0"
+	                   : "1500.0, 0.0, 967.5\n0.0, 1440.0, 708.75\n0.0, 0.0, "
+	                     "1.0");
 	if (spec.imu)
 	{
 		std::ofstream imu(d + "/imu.csv");
@@ -484,20 +492,20 @@ TEST(ImportStray, WithoutVideoScansHaveNoColourAndItIsSaidOnce)
 			EXPECT_FALSE(s->hasIntensityImage);
 			// camera_matrix.csv's colour stream: [import_stray]
 			// colour_width x colour_height (default 1920x1440)
-			EXPECT_DOUBLE_EQ(s->cameraParams.fx(), 100.0 * 32 / 1920);
-			EXPECT_DOUBLE_EQ(s->cameraParams.cy(), 47.25 * 24 / 1440);
+			EXPECT_DOUBLE_EQ(s->cameraParams.fx(), 1500.0 * 32 / 1920);
+			EXPECT_DOUBLE_EQ(s->cameraParams.cy(), 708.75 * 24 / 1440);
 		}
 	EXPECT_EQ(scans, size_t(kFrames));
 	// the colour size from the .ini
 	mrpt::config::CConfigFileMemory ini(
-	    "[import_stray]\ncolour_width = 128\ncolour_height = 96\n");
+	    "[import_stray]\ncolour_width = 2400\ncolour_height = 1800\n");
 	ev::StrayImportParams p;
 	p.loadFromConfigFile(ini);
 	testing::internal::CaptureStderr();
 	const auto s2 = ev::importStray(d, d + "/../novideo2.rawlog", p, quiet());
 	testing::internal::GetCapturedStderr();
-	EXPECT_DOUBLE_EQ(s2.camera.fx(), 25.0);
-	EXPECT_DOUBLE_EQ(s2.camera.cx(), 64.5 / 4);
+	EXPECT_DOUBLE_EQ(s2.camera.fx(), 1500.0 * 32 / 2400);
+	EXPECT_DOUBLE_EQ(s2.camera.cx(), 967.5 * 32 / 2400);
 }
 
 TEST(ImportStray, WithoutConfidenceEveryReadingIsKeptAndItIsSaidOnce)
@@ -905,4 +913,418 @@ TEST(ImportStray, TheProgramTakesItsCommandLine)
 	          std::string::npos)
 	    << r.out;
 	EXPECT_NE(r.out.find(out + ": 4 RGB-D frames"), std::string::npos) << r.out;
+}
+
+// Issue 55, item 3 and the unclear messages: inputs that are not regular
+// files (a FIFO blocked the import forever, /dev/zero ate memory) are
+// refused naming the file and what it is; a symbolic link loop is named
+// as one; a confidence "folder" that is a file is said to be one. A failed
+// import leaves no partial rawlog.
+TEST(ImportStray, InputsThatAreNotRegularFilesAreRefusedNamingThem)
+{
+	CaptureSpec noVideo;
+	noVideo.video = false;
+	const auto leavesNothing = [](const std::string& d)
+	{
+		for (const auto& e : fs::directory_iterator(d + "/.."))
+			EXPECT_EQ(e.path().string().find("out.rawlog"), std::string::npos)
+			    << e.path();
+	};
+	bool fifos = true;
+	for (const std::string file :
+	     {"odometry.csv", "imu.csv", "depth/000003.png", "rgb.mp4",
+	      "confidence/000002.png"})
+	{
+		std::string name = "fifo_" + file;
+		std::replace(name.begin(), name.end(), '/', '_');
+		const auto d =
+		    makeCapture(name, file == "rgb.mp4" ? CaptureSpec{} : noVideo);
+		fs::remove(d + "/" + file);
+		if (::mkfifo((d + "/" + file).c_str(), 0600) != 0)
+		{
+			fifos = false;
+			break;
+		}
+		// (without the rule: blocked until the test's timeout)
+		const auto e = importError(d);
+		EXPECT_NE(e.find(d + "/" + file + ": cannot read "), std::string::npos)
+		    << e;
+		EXPECT_NE(e.find("a FIFO (named pipe), not a regular file"),
+		          std::string::npos)
+		    << e;
+		leavesNothing(d);
+	}
+	// /dev/zero (only read) linked as the IMU's file
+	{
+		const auto d = makeCapture("zero_imu", noVideo);
+		fs::remove(d + "/imu.csv");
+		fs::create_symlink("/dev/zero", d + "/imu.csv");
+		const auto e = importError(d);
+		EXPECT_NE(e.find(d + "/imu.csv: cannot read CSV file: a character "
+		                     "device, not a regular file"),
+		          std::string::npos)
+		    << e;
+	}
+	// a symbolic link loop: named as one, not "not found"
+	{
+		const auto d = makeCapture("loop", noVideo);
+		fs::remove(d + "/odometry.csv");
+		fs::create_symlink("odometry2.csv", d + "/odometry.csv");
+		fs::create_symlink("odometry.csv", d + "/odometry2.csv");
+		const auto e = importError(d);
+		EXPECT_NE(e.find(d + "/odometry.csv: cannot read CSV file: a symbolic "
+		                     "link loop"),
+		          std::string::npos)
+		    << e;
+	}
+	// confidence: a file where the folder goes
+	{
+		const auto d = makeCapture("confidence_file", noVideo);
+		fs::remove_all(d + "/confidence");
+		std::ofstream(d + "/confidence") << "not a folder";
+		const auto e = importError(d);
+		EXPECT_NE(e.find(d + "/confidence: not a folder of ARKit confidence "
+		                     "images (a file)"),
+		          std::string::npos)
+		    << e;
+	}
+	if (!fifos) GTEST_SKIP() << "mkfifo refused here: FIFOs not tried";
+}
+
+// Issue 55, item 4 and the unclear messages: the CSVs are read row by row
+// with a line's length bounded (a file of one endless line: an error with
+// file and line, not gigabytes); a byte-order mark before the header is
+// skipped and CR-only line ends are lines.
+TEST(ImportStray, CsvLinesAreBoundedAndBomOrCrOnlyFilesAreRead)
+{
+	CaptureSpec noVideo;
+	noVideo.video = false;
+	const auto d = makeCapture("long_line", noVideo);
+	{
+		std::ofstream f(d + "/imu.csv", std::ios::binary);
+		f << "timestamp, a_x, a_y, a_z, alpha_x, alpha_y, alpha_z\n";
+		f << std::string(3 << 20, '\0');  // 3 MB, no line end
+	}
+	auto e = importError(d);
+	EXPECT_NE(e.find(d + "/imu.csv:2: a line longer than 65536 bytes"),
+	          std::string::npos)
+	    << e;
+	// a BOM, CR-only line ends: the same import as the plain files
+	const auto plain = makeCapture("plain_csv", noVideo);
+	testing::internal::CaptureStderr();
+	const auto want =
+	    ev::importStray(plain, plain + "/../plain.rawlog", {}, quiet());
+	const auto edit = [](const std::string& path, bool bom, bool crOnly)
+	{
+		std::string text = bims::test::fileText(path);
+		if (crOnly) std::replace(text.begin(), text.end(), '\n', '\r');
+		std::ofstream(path, std::ios::binary)
+		    << (bom ? "\xEF\xBB\xBF" : "") << text;
+	};
+	const auto odd = makeCapture("odd_csv", noVideo);
+	edit(odd + "/odometry.csv", true, false);
+	edit(odd + "/imu.csv", false, true);
+	edit(odd + "/camera_matrix.csv", true, true);
+	const auto got = ev::importStray(odd, odd + "/../odd.rawlog", {}, quiet());
+	testing::internal::GetCapturedStderr();
+	EXPECT_EQ(got.frames, want.frames);
+	EXPECT_EQ(got.imu, want.imu);
+	EXPECT_EQ(got.camera.fx(), want.camera.fx());
+	const auto a = bims::loadTumTrajectory(odd + "/../odd_arkit_reference.txt");
+	const auto b =
+	    bims::loadTumTrajectory(plain + "/../plain_arkit_reference.txt");
+	ASSERT_EQ(a.size(), b.size());
+	for (size_t i = 0; i < a.size(); i++) EXPECT_EQ(a[i].t, b[i].t);
+	// a BOM in the middle of a header is shown, not printed raw
+	std::ofstream(odd + "/imu.csv")
+	    << "timestamp, a_x,\xEF\xBB\xBF a_y, a_z, alpha_x, alpha_y, alpha_z\n";
+	e = importError(odd);
+	EXPECT_NE(e.find("\\xEF\\xBB\\xBF"), std::string::npos) << e;
+}
+
+// Issue 55, item 6: intrinsics that cannot be are refused, saying what is
+// accepted; a video of another size than camera_matrix.csv's colour stream
+// is scaled when its aspect ratio agrees, refused otherwise.
+TEST(ImportStray, IntrinsicsThatCannotBeAreRefused)
+{
+	namespace sn = bims::sensors;
+	EXPECT_EQ(sn::intrinsicsProblem({256, 192, 177, 177, 129.3, 95.4}), "");
+	EXPECT_NE(sn::intrinsicsProblem({256, 192, 177, 177, -129, 1.3e8})
+	              .find("the principal point (cx -129, cy 1.3e+08) is outside "
+	                    "the 256x192 image (accepted: 0 <= cx <= 256, 0 <= cy "
+	                    "<= 192)"),
+	          std::string::npos);
+	const std::string far =
+	    sn::intrinsicsProblem({256, 192, 1e300, 177, 128, 96});
+	EXPECT_NE(far.find("fx 1e+300 gives a field of view of 0 deg"),
+	          std::string::npos)
+	    << far;
+	EXPECT_NE(far.find("accepted: 10 to 160 deg"), std::string::npos) << far;
+	// a K of 1280x960 on 64x48 images
+	EXPECT_NE(sn::intrinsicsProblem({64, 48, 1000, 1000, 640, 480})
+	              .find("outside the 64x48 image"),
+	          std::string::npos);
+	EXPECT_NE(sn::intrinsicsProblem({64, 48, 1000, 1000, 32, 24})
+	              .find("fx 1000 gives a field of view of 3.67 deg"),
+	          std::string::npos);
+
+	CaptureSpec noVideo;
+	noVideo.video = false;
+	const auto d = makeCapture("bad_intrinsics", noVideo);
+	std::ofstream(d + "/camera_matrix.csv")
+	    << "1500, 0, -129\n0, 1440, 1.3e8\n0, 0, 1\n";
+	auto e = importError(d);
+	EXPECT_NE(
+	    e.find(d + "/camera_matrix.csv (of a 1920x1440 colour image, "
+	               "scaled to the 32x24 depth grid): the principal point"),
+	    std::string::npos)
+	    << e;
+	EXPECT_FALSE(fs::exists(d + "/../out.rawlog"));
+	std::ofstream(d + "/camera_matrix.csv")
+	    << "1e300, 0, 960\n0, 1440, 720\n0, 0, 1\n";
+	e = importError(d);
+	EXPECT_NE(e.find("fx 1.66667e+298 gives a field of view of 0 deg"),
+	          std::string::npos)
+	    << e;
+
+	// a re-encoded video (of the 1920x1440 stream's aspect ratio, 128x96)
+	// with camera_matrix.csv of the 1920x1440 stream: scaled from 1920x1440
+	const auto v = makeCapture("reencoded");
+	std::ofstream(v + "/camera_matrix.csv")
+	    << "1500.0, 0.0, 967.5\n0.0, 1440.0, 708.75\n0.0, 0.0, 1.0";
+	const auto sum =
+	    ev::importStray(v, v + "/../reencoded.rawlog", {}, quiet());
+	EXPECT_DOUBLE_EQ(sum.camera.fx(), 25.0);
+	EXPECT_DOUBLE_EQ(sum.camera.cx(), 967.5 * 32 / 1920);
+	ASSERT_EQ(sum.notes.size(), 1u);
+	EXPECT_NE(sum.notes[0].find("rgb.mp4: frames of 128x96, " + v +
+	                            "/camera_matrix.csv of the 1920x1440 colour "
+	                            "stream"),
+	          std::string::npos)
+	    << sum.notes[0];
+	// ... and of another aspect ratio than that stream: refused
+	mrpt::config::CConfigFileMemory ini(
+	    "[import_stray]\ncolour_width = 1920\ncolour_height = 1080\n");
+	ev::StrayImportParams p;
+	p.loadFromConfigFile(ini);
+	e = importError(v, p);
+	EXPECT_NE(e.find(v +
+	                 "/rgb.mp4: frames of 128x96, but the principal point "
+	                 "of " +
+	                 v +
+	                 "/camera_matrix.csv (cx 967.5, cy 708.75) is not "
+	                 "near their centre"),
+	          std::string::npos)
+	    << e;
+}
+
+// Issue 55, item 7: stamps the rawlog cannot hold are refused with what is
+// accepted; frames on one 100 ns tick of the rawlog's clock are left out
+// and counted, never dropped without a word.
+TEST(ImportStray, TimeStampsAreRefusedOrCountedNeverWrapped)
+{
+	CaptureSpec noVideo;
+	noVideo.video = false;
+	const auto d = makeCapture("negative_time", noVideo);
+	auto lines = [](const std::string& path)
+	{
+		std::vector<std::string> v;
+		std::istringstream in(bims::test::fileText(path));
+		for (std::string l; std::getline(in, l);) v.push_back(l);
+		return v;
+	};
+	auto odo = lines(d + "/odometry.csv");
+	const auto rewrite =
+	    [&](const std::string& path, const std::vector<std::string>& rows)
+	{
+		std::ofstream f(path);
+		for (const auto& r : rows) f << r << "\n";
+	};
+	auto bad = odo;
+	bad[1] = "-10000000" + bad[1].substr(bad[1].find(','));
+	rewrite(d + "/odometry.csv", bad);
+	auto e = importError(d);
+	EXPECT_NE(e.find(d + "/odometry.csv:2: timestamp -10000000 is not a time "
+	                     "bims takes: seconds from 0 to 4294967295"),
+	          std::string::npos)
+	    << e;
+	bad = odo;
+	bad[6] = "1e12" + bad[6].substr(bad[6].find(','));
+	rewrite(d + "/odometry.csv", bad);
+	e = importError(d);
+	EXPECT_NE(e.find(d + "/odometry.csv:7: timestamp 1e+12 is not a time"),
+	          std::string::npos)
+	    << e;
+
+	// frames 2 and 3 within one tick (0.1 and 0.4 of it): frame 3 left out
+	// and counted, the reference without it too
+	const auto c = makeCapture("same_tick");
+	odo = lines(c + "/odometry.csv");
+	odo[3] = "248630.60330001" + odo[3].substr(odo[3].find(','));
+	odo[4] = "248630.60330004" + odo[4].substr(odo[4].find(','));
+	rewrite(c + "/odometry.csv", odo);
+	const auto sum = ev::importStray(c, c + "/../tick.rawlog", {}, quiet());
+	EXPECT_EQ(sum.framesSameStamp, 1u);
+	EXPECT_EQ(sum.frames, size_t(kFrames - 1));
+	EXPECT_EQ(sum.referencePoses, size_t(kFrames - 3));
+	ASSERT_FALSE(sum.warnings.empty());
+	EXPECT_NE(sum.warnings.back().find(c + "/odometry.csv: 1 frames left out: "
+	                                       "each within the 100 ns tick"),
+	          std::string::npos)
+	    << sum.warnings.back();
+	// the frames after it keep their colour (the video frame skipped too)
+	std::vector<double> stamps;
+	for (const auto& o : readAll(c + "/../tick.rawlog"))
+		if (auto s = std::dynamic_pointer_cast<CObservation3DRangeScan>(o))
+		{
+			stamps.push_back(stampOf(*s));
+			if (stamps.size() == 5)  // frame 5's: colour 5
+			{
+				const auto px =
+				    s->intensityImage.asCvMat<cv::Mat>(mrpt::img::SHALLOW_COPY)
+				        .at<cv::Vec3b>(12, 16);
+				for (int ch = 0; ch < 3; ch++)
+					EXPECT_NEAR(px[ch], colour(5)[ch], 40) << ch;
+			}
+		}
+	ASSERT_EQ(stamps.size(), size_t(kFrames - 1));
+	for (size_t i = 1; i < stamps.size(); i++)
+		EXPECT_GT(stamps[i], stamps[i - 1]);
+}
+
+// Issue 55, item 8: an IMU on another clock or in other units: the samples
+// left out are counted and said, naming the file and why.
+TEST(ImportStray, AnImuOnAnotherClockIsCountedAndSaid)
+{
+	CaptureSpec noVideo;
+	noVideo.video = false;
+	const auto d = makeCapture("imu_clock", noVideo);
+	// the IMU in milliseconds: every sample after the last frame
+	std::ofstream imu(d + "/imu.csv");
+	imu << "timestamp, a_x, a_y, a_z, alpha_x, alpha_y, alpha_z\n";
+	const auto rows = imuRows();
+	for (const auto& r : rows)
+		imu << std::to_string(r.t * 1000) << ", 0.1, -9.8, 0.2, 0, 0, 0\n";
+	imu.close();
+	testing::internal::CaptureStderr();
+	const auto sum =
+	    ev::importStray(d, d + "/../imu_clock.rawlog", {}, quiet());
+	testing::internal::GetCapturedStderr();
+	EXPECT_EQ(sum.imu, 0u);
+	EXPECT_EQ(sum.imuAfterLast, rows.size());
+	ASSERT_GE(sum.warnings.size(), 2u);
+	EXPECT_NE(
+	    sum.warnings[0].find(d + "/imu.csv: " + std::to_string(rows.size()) +
+	                         " of its " + std::to_string(rows.size()) +
+	                         " samples are after the capture's last frame"),
+	    std::string::npos)
+	    << sum.warnings[0];
+	EXPECT_NE(sum.warnings[0].find("is the IMU on odometry.csv's clock and "
+	                               "in seconds?"),
+	          std::string::npos)
+	    << sum.warnings[0];
+	EXPECT_NE(sum.warnings[1].find("none of its"), std::string::npos)
+	    << sum.warnings[1];
+	// the program says it on stderr and in its report
+	const std::string bin = std::string(BIMS_BIN_DIR) + "/bims-import-stray";
+	const auto r = bims::test::runCommand(bin + " " + d + " -q -o " + d +
+	                                      "/../imu_clock2.rawlog");
+	EXPECT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("bims-import-stray: warning: " + d + "/imu.csv: " +
+	                     std::to_string(rows.size()) + " of its"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_NE(r.out.find(std::to_string(rows.size()) +
+	                     " IMU samples after the last frame"),
+	          std::string::npos)
+	    << r.out;
+}
+
+// Issue 55, items 1 and 11: an output that is a FIFO or a device is
+// refused, never replaced by a file; two runs of one output at once leave
+// one run's rawlog and reference, whole.
+TEST(ImportStray, OutputsAreNeverDevicesAndTwoRunsNeverMix)
+{
+	const std::string bin = std::string(BIMS_BIN_DIR) + "/bims-import-stray";
+	CaptureSpec noVideo;
+	noVideo.video = false;
+	const auto d = makeCapture("out_special", noVideo);
+	const std::string fifo = d + "/../out_fifo.rawlog";
+	fs::remove(fifo);
+	if (::mkfifo(fifo.c_str(), 0600) == 0)
+	{
+		const auto r = bims::test::runCommand(bin + " " + d + " -q -o " + fifo);
+		EXPECT_EQ(r.code, 1) << r.out;
+		EXPECT_NE(r.out.find(fifo + ": is a FIFO (named pipe), not a regular "
+		                            "file"),
+		          std::string::npos)
+		    << r.out;
+		EXPECT_TRUE(fs::is_fifo(fifo));
+	}
+	// a character device of its own (root only): mknod c 1 3 is /dev/null
+	const std::string dev = d + "/../out_dev.rawlog";
+	fs::remove(dev);
+	if (::mknod(dev.c_str(), S_IFCHR | 0666, makedev(1, 3)) == 0)
+	{
+		const auto r = bims::test::runCommand(bin + " " + d + " -q -o " + dev);
+		EXPECT_EQ(r.code, 1) << r.out;
+		EXPECT_NE(r.out.find(dev + ": is a character device"),
+		          std::string::npos)
+		    << r.out;
+		EXPECT_TRUE(fs::is_character_file(dev));
+		fs::remove(dev);
+	}
+
+	// two runs at once into one output, 400 and 200 frames of 256x192 (long
+	// enough for their writing to overlap), three times
+	const auto big = bims::test::freshTmpDir("bims_test_stray", "big");
+	{
+		fs::create_directories(big + "/depth");
+		std::ofstream odo(big + "/odometry.csv");
+		odo << "timestamp, frame, x, y, z, qx, qy, qz, qw\n";
+		std::vector<uint8_t> png;
+		cv::Mat depth(192, 256, CV_16UC1);
+		cv::randu(depth, 300, 3000);  // (incompressible: ~100 kB a frame)
+		cv::imencode(".png", depth, png);
+		for (int k = 0; k < 400; k++)
+		{
+			char n[16];
+			std::snprintf(n, sizeof(n), "%06d", k);
+			std::ofstream(big + "/depth/" + n + ".png", std::ios::binary)
+			    .write(reinterpret_cast<const char*>(png.data()),
+			           static_cast<std::streamsize>(png.size()));
+			odo << 100 + 0.02 * k << ", " << n << ", " << (k < 2 ? 0 : 0.01 * k)
+			    << ", 0, 0, 0, 0, 0, 1\n";
+		}
+		std::ofstream(big + "/camera_matrix.csv")
+		    << "1400, 0, 960\n0, 1400, 720\n0, 0, 1\n";
+	}
+	const std::string out = d + "/../both.rawlog";
+	const std::string ref = d + "/../both_arkit_reference.txt";
+	for (int round = 0; round < 3; round++)
+	{
+		const auto r = bims::test::runCommand(
+		    "(" + bin + " " + big + " -q --gz 0 -o " + out + " & " + bin + " " +
+		    big + " -q --gz 0 --max-frames 200 -o " + out + " & wait)");
+		size_t scans = 0;
+		try
+		{
+			for (const auto& o : readAll(out))
+				scans += std::dynamic_pointer_cast<CObservation3DRangeScan>(
+				             o) != nullptr;
+		}
+		catch (const std::exception& e)
+		{
+			ADD_FAILURE() << "round " << round << ": " << e.what();
+		}
+		EXPECT_TRUE(scans == 400 || scans == 200) << scans << "\n" << r.out;
+		// the reference of the same run: 2 frames without position
+		EXPECT_EQ(bims::loadTumTrajectory(ref).size(), scans - 2) << r.out;
+		for (const auto& e : fs::directory_iterator(d + "/.."))
+			EXPECT_EQ(e.path().filename().string().find("both.rawlog."),
+			          std::string::npos)
+			    << "a partial file left: " << e.path();
+	}
+	if (!fs::exists(fifo))
+		GTEST_SKIP() << "mkfifo refused here: the FIFO output not tried";
 }

@@ -1,8 +1,7 @@
+#include <bims/common/input_file.h>
 #include <bims/common/options.h>
 #include <bims/io/image_file.h>
 
-#include <filesystem>
-#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 #include <vector>
@@ -193,24 +192,24 @@ cv::Mat decodeImage(const uint8_t* p, size_t n, int flags,
 cv::Mat readImageFile(const std::string& path, int flags,
                       const std::string& what, const ImageLimits& limits)
 {
-	namespace fs = std::filesystem;
 	const auto fail = [&](const std::string& why)
 	{ return std::runtime_error(path + ": cannot read " + what + ": " + why); };
-	std::error_code ec;
-	const auto st = fs::status(path, ec);
-	if (!fs::exists(st)) throw fail("no such file");
-	if (fs::is_directory(st)) throw fail("a folder, not an image file");
-	std::ifstream f(path, std::ios::binary);
-	if (!f) throw fail("cannot open the file");
+	// a regular file only (a FIFO would block, /dev/zero never end): the
+	// error names the file and what it is
+	InputFile f(path, what);
 	// a compressed image is never larger than its pixels (at 8 bytes each)
-	const uint64_t size = fs::file_size(path, ec);
-	if (ec || size > static_cast<uint64_t>(limits.max_pixels) * 8)
+	const uint64_t size = f.size();
+	if (size > static_cast<uint64_t>(limits.max_pixels) * 8)
 		throw fail("larger than any image bims reads (" + std::to_string(size) +
 		           " bytes)");
 	std::vector<uint8_t> bytes(static_cast<size_t>(size));
-	if (!f.read(reinterpret_cast<char*>(bytes.data()),
-	            static_cast<std::streamsize>(bytes.size())))
-		throw fail("the file ends early");
+	size_t got = 0;
+	while (got < bytes.size())
+	{
+		const size_t n = f.read(bytes.data() + got, bytes.size() - got);
+		if (n == 0) throw fail("the file ends early");
+		got += n;
+	}
 	if (bytes.empty()) throw fail("the file is empty");
 	try
 	{

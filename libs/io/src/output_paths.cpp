@@ -1,14 +1,21 @@
 #include <bims/io/output_paths.h>
 #include <fcntl.h>
+#include <signal.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <opencv2/imgcodecs.hpp>
+#include <random>
 #include <stdexcept>
 
 namespace fs = std::filesystem;
@@ -24,13 +31,107 @@ std::runtime_error systemError(const std::string& path, const char* what)
 void removeLayoutFiles(const std::string& dir,
                        const OutputFolderLayout& layout);
 void writeManifestOf(const std::string& dir);
+
+/** What the file at \a path is when it is neither a regular file, a
+ * folder, a symbolic link nor absent ("a FIFO (named pipe)"); "" else. */
+std::string specialFileKind(const std::string& path)
+{
+	struct stat st;
+	if (::lstat(path.c_str(), &st) != 0) return "";
+	const mode_t m = st.st_mode;
+	if (S_ISREG(m) || S_ISDIR(m) || S_ISLNK(m)) return "";
+	return S_ISFIFO(m)   ? "a FIFO (named pipe)"
+	       : S_ISCHR(m)  ? "a character device"
+	       : S_ISBLK(m)  ? "a block device"
+	       : S_ISSOCK(m) ? "a socket"
+	                     : "a special file";
+}
+
+/** The process id in a partial file's name "NAME.PID-TAG.partial"; 0 for
+ * another name. */
+long partialPid(const std::string& name)
+{
+	const std::string base = partialTarget(name);
+	if (base.empty() || base.size() + 8 == name.size()) return 0;
+	const std::string tag = name.substr(base.size() + 1);
+	return std::strtol(tag.c_str(), nullptr, 10);
+}
+
+/** Once per folder and process: removes the partial files in \a dir that
+ * a run which no longer exists left (killed: its PID is in the name), so
+ * that they do not pile up. Another live run's are never touched. */
+void sweepStalePartials(const fs::path& dir)
+{
+	static std::mutex m;
+	static std::set<std::string> swept;
+	{
+		std::lock_guard<std::mutex> lock(m);
+		if (!swept.insert(dir.string()).second) return;
+	}
+	std::error_code ec;
+	for (const auto& e : fs::directory_iterator(dir, ec))
+	{
+		const long pid = partialPid(e.path().filename().string());
+		if (pid <= 0 || pid == ::getpid()) continue;
+		if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH)
+			continue;  // alive (or not ours to ask): kept
+		std::error_code rc;
+		if (fs::is_regular_file(fs::symlink_status(e.path(), rc)))
+			fs::remove(e.path(), rc);
+	}
+}
+
+/** A process-unique tag of hexadecimal digits for a partial file's name. */
+std::string randomTag()
+{
+	static std::mutex m;
+	static std::mt19937_64 gen(std::random_device{}());
+	std::lock_guard<std::mutex> lock(m);
+	char b[24];
+	std::snprintf(b, sizeof(b), "%08llx",
+	              static_cast<unsigned long long>(gen() & 0xffffffffu));
+	return b;
+}
 }  // namespace
+
+void refuseSpecialOutput(const std::string& path)
+{
+	const std::string kind = specialFileKind(path);
+	if (!kind.empty())
+		throw std::runtime_error(
+		    path + ": is " + kind +
+		    ", not a regular file: bims writes its outputs as regular files "
+		    "(written whole and renamed into place), which would replace "
+		    "it; refused: give the path of a file");
+}
+
+std::string partialTarget(const std::string& name)
+{
+	static const std::string ext = ".partial";
+	if (name.size() <= ext.size() ||
+	    name.compare(name.size() - ext.size(), ext.size(), ext) != 0)
+		return "";
+	std::string base = name.substr(0, name.size() - ext.size());
+	// a run's tag: ".<pid>-<8 hex digits>"
+	const size_t dot = base.rfind('.');
+	if (dot == std::string::npos || dot == 0) return base;
+	const std::string tag = base.substr(dot + 1);
+	const size_t dash = tag.find('-');
+	if (dash == std::string::npos || dash == 0 || tag.size() - dash - 1 != 8)
+		return base;
+	for (size_t i = 0; i < tag.size(); i++)
+		if (i != dash && !(i < dash ? std::isdigit(uint8_t(tag[i]))
+		                            : std::isxdigit(uint8_t(tag[i]))))
+			return base;
+	return base.substr(0, dot);
+}
 
 void checkOutputFilesWritable(const std::vector<std::string>& files)
 {
 	for (const auto& f : files)
 	{
 		if (f.empty()) continue;
+		refuseSpecialOutput(f);
 		std::error_code ec;
 		if (fs::is_directory(f, ec))
 			throw std::runtime_error(f +
@@ -66,20 +167,44 @@ void replaceSymlink(const std::string& path)
 	const auto st = fs::symlink_status(path, ec);
 	if (fs::is_directory(st))
 		throw std::runtime_error(path + ": is a folder, cannot write a file");
+	refuseSpecialOutput(path);
 	if (!fs::is_symlink(st)) return;
 	if (!fs::remove(path, ec) || ec)
 		throw std::runtime_error(
 		    path + ": cannot replace the symbolic link: " + ec.message());
 }
 
-PartialFile::PartialFile(std::string finalPath)
-    : final_(std::move(finalPath)), partial_(final_ + ".partial")
+PartialFile::PartialFile(std::string finalPath) : final_(std::move(finalPath))
 {
 	if (final_.empty()) throw std::invalid_argument("the output path is empty");
-	replaceSymlink(partial_);
 	std::error_code ec;
 	if (fs::is_directory(fs::symlink_status(final_, ec)))
 		throw std::runtime_error(final_ + ": is a folder, cannot write a file");
+	refuseSpecialOutput(final_);
+	// a killed run's partial files: the old fixed name, and those of
+	// processes that no longer exist
+	fs::path dir = fs::path(final_).parent_path();
+	if (dir.empty()) dir = ".";
+	if (fs::is_regular_file(fs::symlink_status(final_ + ".partial", ec)) ||
+	    fs::is_symlink(fs::symlink_status(final_ + ".partial", ec)))
+		fs::remove(final_ + ".partial", ec);
+	sweepStalePartials(dir);
+	// a name of this run's own, created here (O_EXCL): two runs writing
+	// the same output at once never write into one file
+	const std::string stem = final_ + "." + std::to_string(::getpid()) + "-";
+	for (int attempt = 0;; attempt++)
+	{
+		partial_ = stem + randomTag() + ".partial";
+		const int fd = ::open(partial_.c_str(),
+		                      O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+		if (fd >= 0)
+		{
+			::close(fd);
+			break;
+		}
+		if (errno != EEXIST || attempt == 100)
+			throw systemError(partial_, "cannot create");
+	}
 }
 
 PartialFile::~PartialFile()
@@ -87,9 +212,34 @@ PartialFile::~PartialFile()
 	if (!done_) std::remove(partial_.c_str());
 }
 
+void commitTogether(const std::vector<PartialFile*>& parts)
+{
+	if (parts.empty()) return;
+	fs::path dir = fs::path(parts.front()->finalPath()).parent_path();
+	if (dir.empty()) dir = ".";
+	// an exclusive lock on the folder while the files are renamed: another
+	// run's set goes in wholly before or after this one's
+	const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+	if (fd >= 0)
+		while (::flock(fd, LOCK_EX) != 0 && errno == EINTR)
+		{
+		}
+	try
+	{
+		for (PartialFile* p : parts) p->commit();
+	}
+	catch (...)
+	{
+		if (fd >= 0) ::close(fd);
+		throw;
+	}
+	if (fd >= 0) ::close(fd);  // (releases the lock)
+}
+
 void PartialFile::commit()
 {
 	if (done_) return;
+	refuseSpecialOutput(final_);  // (made there since the start?)
 	if (std::rename(partial_.c_str(), final_.c_str()) != 0)
 		throw std::runtime_error(final_ + ": cannot rename " + partial_ +
 		                         " to it: " + std::strerror(errno));
@@ -185,6 +335,13 @@ std::string groundTruthDirFor(const std::string& rawlogPath)
 void writeFileAtomically(const std::string& path, const std::string& bytes)
 {
 	PartialFile part(path);
+	writePartialFile(part, bytes);
+	part.commit();
+}
+
+void writePartialFile(PartialFile& part, const std::string& bytes)
+{
+	const std::string& path = part.finalPath();
 	const int fd = ::open(part.path().c_str(),
 	                      O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
 	if (fd < 0) throw systemError(path, "cannot create");
@@ -202,7 +359,6 @@ void writeFileAtomically(const std::string& path, const std::string& bytes)
 		done += static_cast<size_t>(n);
 	}
 	if (::close(fd) != 0) throw systemError(path, "write failed on close");
-	part.commit();
 }
 
 AppendFile::AppendFile(std::string path) : path_(std::move(path))
@@ -297,12 +453,24 @@ std::vector<std::string> earlierOutputs(const std::string& dir,
 	    fs::is_symlink(m, ec) || fs::exists(m, ec))
 		found.push_back(m.string());
 	for (const auto& f : layout.files)
-		for (const std::string& name : {f, f + ".partial"})
+	{
+		const fs::path p = fs::path(dir) / f;
+		if (fs::is_symlink(p, ec) || fs::exists(p, ec))
+			found.push_back(p.string());
+	}
+	// their partial files, of any run (NAME.partial, NAME.TAG.partial)
+	if (!layout.files.empty())
+	{
+		const std::set<std::string> names(layout.files.begin(),
+		                                  layout.files.end());
+		for (const auto& e : fs::directory_iterator(dir, ec))
 		{
-			const fs::path p = fs::path(dir) / name;
-			if (fs::is_symlink(p, ec) || fs::exists(p, ec))
-				found.push_back(p.string());
+			const std::string base =
+			    partialTarget(e.path().filename().string());
+			if (!base.empty() && names.count(base))
+				found.push_back(e.path().string());
 		}
+	}
 	for (const auto& [sub, ext] : layout.frameFolders)
 	{
 		const fs::path d = sub.empty() ? fs::path(dir) : fs::path(dir) / sub;
@@ -317,9 +485,7 @@ std::vector<std::string> earlierOutputs(const std::string& dir,
 		{
 			const std::string name = e.path().filename().string();
 			if (isFrameFileName(name, ext) ||
-			    (name.size() > 8 &&
-			     name.compare(name.size() - 8, 8, ".partial") == 0 &&
-			     isFrameFileName(name.substr(0, name.size() - 8), ext)))
+			    isFrameFileName(partialTarget(name), ext))
 				found.push_back(e.path().string());
 		}
 	}
@@ -423,10 +589,34 @@ size_t removeListedOutputs(const std::string& dir, const std::string& why)
 	const auto listed = manifestFiles(dir);
 	size_t removed = 0;
 	std::set<fs::path> folders;
+	// the partial files of each folder, of any run: NAME -> its partials
+	std::map<fs::path, std::map<std::string, std::vector<std::string>>>
+	    partials;
+	const auto partialsOf = [&](const fs::path& rel)
+	{
+		const fs::path sub = rel.parent_path();
+		auto [it, fresh] = partials.try_emplace(sub);
+		if (fresh)
+		{
+			std::error_code ec;
+			for (const auto& e :
+			     fs::directory_iterator(fs::path(dir) / sub, ec))
+			{
+				const std::string name = e.path().filename().string();
+				const std::string base = partialTarget(name);
+				if (!base.empty())
+					it->second[base].push_back((sub / name).string());
+			}
+		}
+		const auto p = it->second.find(rel.filename().string());
+		return p == it->second.end() ? std::vector<std::string>{} : p->second;
+	};
 	for (const auto& rel : listed)
 	{
 		if (!reachedWithoutLinks(dir, rel)) continue;  // never followed
-		for (const std::string& name : {rel, rel + ".partial"})
+		std::vector<std::string> names = partialsOf(rel);
+		names.insert(names.begin(), rel);
+		for (const std::string& name : names)
 		{
 			const fs::path p = fs::path(dir) / name;
 			std::error_code ec;

@@ -1,3 +1,4 @@
+#include <bims/common/input_file.h>
 #include <bims/io/output_paths.h>
 #include <bims/io/trajectory.h>
 #include <mrpt/poses/CPose3DQuat.h>
@@ -13,14 +14,14 @@ namespace bims
 {
 Trajectory loadTumTrajectory(const std::string& path)
 {
-	std::ifstream f(path);
-	if (!f) throw std::runtime_error(path + ": cannot open trajectory file");
+	if (inputFileProblem(path) == "no such file")
+		throw std::runtime_error(path + ": cannot open trajectory file");
+	LineReader f(path, "trajectory file");
 	Trajectory out;
 	std::string line;
-	size_t lineNo = 0;
-	while (std::getline(f, line))
+	while (f.next(line))
 	{
-		++lineNo;
+		const size_t lineNo = f.lineNumber();
 		const auto p = line.find_first_not_of(" \t\r");
 		if (p == std::string::npos || line[p] == '#') continue;
 		std::istringstream ss(line);
@@ -66,6 +67,12 @@ std::string tumHeader(const std::string& comment)
 void saveTumTrajectory(const std::string& path, const Trajectory& traj,
                        const std::string& headerComment)
 {
+	writeFileAtomically(path, tumTrajectoryText(path, traj, headerComment));
+}
+
+std::string tumTrajectoryText(const std::string& path, const Trajectory& traj,
+                              const std::string& headerComment)
+{
 	std::string text = tumHeader(headerComment);
 	for (const auto& p : traj)
 	{
@@ -78,7 +85,7 @@ void saveTumTrajectory(const std::string& path, const Trajectory& traj,
 			                         line + "); nothing written");
 		text += line + "\n";
 	}
-	writeFileAtomically(path, text);
+	return text;
 }
 
 const StampedPose* poseNear(const Trajectory& traj, double t, double maxDt)

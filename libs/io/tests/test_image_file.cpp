@@ -78,6 +78,40 @@ TEST(ImageFile, ADecompressionBombIsRefusedBeforeDecoding)
 	          std::string::npos);
 }
 
+// Issue 55: a FIFO as a depth PNG blocked the import forever; /dev/zero
+// was "18446744073709551615 bytes"; a symbolic link loop "no such file".
+TEST(ImageFile, AFifoIsRefusedNotWaitedOn)
+{
+	const std::string d = bims::test::freshTmpDir("bims_test_image", "fifo");
+	if (::mkfifo((d + "/fifo.png").c_str(), 0600) != 0)
+		GTEST_SKIP() << "mkfifo refused here: " << std::strerror(errno);
+	const std::string e = errorOf(d + "/fifo.png");
+	EXPECT_NE(e.find(d + "/fifo.png: cannot read test image: a FIFO (named "
+	                     "pipe), not a regular file"),
+	          std::string::npos)
+	    << e;
+}
+
+TEST(ImageFile, ADeviceOrALinkLoopIsRefusedNamingWhatItIs)
+{
+	const std::string d = bims::test::freshTmpDir("bims_test_image", "special");
+	const auto has = [](const std::string& e, const std::string& s)
+	{ return e.find(s) != std::string::npos; };
+	struct stat st;
+	if (::stat("/dev/zero", &st) == 0 && S_ISCHR(st.st_mode))
+	{
+		std::filesystem::create_symlink("/dev/zero", d + "/zero.png");
+		EXPECT_TRUE(has(errorOf(d + "/zero.png"),
+		                d + "/zero.png: cannot read test image: a character "
+		                    "device, not a regular file"))
+		    << errorOf(d + "/zero.png");
+	}
+	std::filesystem::create_symlink("loop2.png", d + "/loop1.png");
+	std::filesystem::create_symlink("loop1.png", d + "/loop2.png");
+	EXPECT_TRUE(has(errorOf(d + "/loop1.png"), "a symbolic link loop"))
+	    << errorOf(d + "/loop1.png");
+}
+
 TEST(ImageFile, EveryOtherBadFileIsAnErrorNamingIt)
 {
 	const std::string d = bims::test::freshTmpDir("bims_test_image", "bad");
@@ -85,7 +119,7 @@ TEST(ImageFile, EveryOtherBadFileIsAnErrorNamingIt)
 	{ return e.find(s) != std::string::npos; };
 	EXPECT_TRUE(has(errorOf(d + "/none.png"),
 	                d + "/none.png: cannot read test image: no such file"));
-	EXPECT_TRUE(has(errorOf(d), "a folder, not an image file"));
+	EXPECT_TRUE(has(errorOf(d), "a folder, not a file"));
 	std::ofstream(d + "/empty.png");
 	EXPECT_TRUE(has(errorOf(d + "/empty.png"), "the file is empty"));
 	std::ofstream(d + "/text.png") << "timestamp filename\n";

@@ -5,9 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <bims_test/file_size_limit.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <csignal>
+#include <cstring>
+#include <functional>
 
 #include <filesystem>
 #include <fstream>
@@ -51,13 +55,26 @@ TEST(OutputPaths, APartialFileAppearsOnlyWhenCommitted)
 {
 	const auto d = fresh("partial");
 	std::ofstream(d + "/out.rawlog") << "old";
+	const auto onlyOut = [&]
+	{
+		std::vector<std::string> names;
+		for (const auto& e : fs::directory_iterator(d))
+			names.push_back(e.path().filename().string());
+		EXPECT_EQ(names, std::vector<std::string>{"out.rawlog"});
+	};
 	{
 		bims::PartialFile p(d + "/out.rawlog");
-		EXPECT_EQ(p.path(), d + "/out.rawlog.partial");
+		// OUT.PID-TAG.partial: a name of this run's own
+		const std::string name = fs::path(p.path()).filename().string();
+		EXPECT_EQ(
+		    name.rfind("out.rawlog." + std::to_string(::getpid()) + "-", 0), 0u)
+		    << name;
+		EXPECT_EQ(bims::partialTarget(name), "out.rawlog");
+		EXPECT_TRUE(fs::exists(p.path()));
 		std::ofstream(p.path()) << "half";
 		// dropped without commit: an error on the way
 	}
-	EXPECT_FALSE(fs::exists(d + "/out.rawlog.partial"));
+	onlyOut();
 	EXPECT_EQ(bims::test::fileText(d + "/out.rawlog"), "old");
 	{
 		bims::PartialFile p(d + "/out.rawlog");
@@ -65,7 +82,85 @@ TEST(OutputPaths, APartialFileAppearsOnlyWhenCommitted)
 		p.commit();
 	}
 	EXPECT_EQ(bims::test::fileText(d + "/out.rawlog"), "whole");
-	EXPECT_FALSE(fs::exists(d + "/out.rawlog.partial"));
+	onlyOut();
+}
+
+// Issue 55, item 11: two runs writing one output at once wrote into one
+// OUT.partial, a mix of both; each now has its own, and a run's set of
+// files is put in place together.
+TEST(OutputPaths, TwoWritersOfOneOutputNeverShareAPartialFile)
+{
+	const auto d = fresh("two_writers");
+	bims::PartialFile a(d + "/out.rawlog"), b(d + "/out.rawlog");
+	EXPECT_NE(a.path(), b.path());
+	bims::PartialFile aRef(d + "/out_ref.txt"), bRef(d + "/out_ref.txt");
+	bims::writePartialFile(a, "run a");
+	bims::writePartialFile(b, "run b");
+	bims::writePartialFile(aRef, "ref a");
+	bims::writePartialFile(bRef, "ref b");
+	bims::commitTogether({&b, &bRef});
+	bims::commitTogether({&a, &aRef});
+	EXPECT_EQ(bims::test::fileText(d + "/out.rawlog"), "run a");
+	EXPECT_EQ(bims::test::fileText(d + "/out_ref.txt"), "ref a");
+	EXPECT_EQ(
+	    std::distance(fs::directory_iterator(d), fs::directory_iterator{}), 2);
+	// the names partialTarget() takes, and those it does not
+	EXPECT_EQ(bims::partialTarget("x.png.partial"), "x.png");
+	EXPECT_EQ(bims::partialTarget("x.png.123-0123abcd.partial"), "x.png");
+	EXPECT_EQ(bims::partialTarget("x.png.12a-0123abcd.partial"),
+	          "x.png.12a-0123abcd");
+	EXPECT_EQ(bims::partialTarget("x.png"), "");
+}
+
+// Issue 55, item 1: an output that is a FIFO or a device was replaced by
+// a regular file (as root, -o /dev/null would destroy /dev/null). Refused,
+// naming it; a symbolic link to a device is replaced, never its target.
+TEST(OutputPaths, AFifoOrADeviceAsOutputIsRefusedNeverReplaced)
+{
+	const auto d = fresh("special");
+	const std::string fifo = d + "/out.rawlog";
+	if (::mkfifo(fifo.c_str(), 0600) != 0)
+		GTEST_SKIP() << "mkfifo refused here: " << std::strerror(errno);
+	const auto refused = [&](const std::function<void()>& f)
+	{
+		try
+		{
+			f();
+		}
+		catch (const std::runtime_error& e)
+		{
+			return std::string(e.what());
+		}
+		return std::string("nothing thrown");
+	};
+	for (const auto& e :
+	     {refused([&] { bims::PartialFile p(fifo); }),
+	      refused([&] { bims::writeFileAtomically(fifo, "x"); }),
+	      refused([&] { bims::AppendFile f(fifo); }),
+	      refused([&] { bims::checkOutputFilesWritable({fifo}); })})
+		EXPECT_NE(e.find(fifo + ": is a FIFO (named pipe), not a regular file"),
+		          std::string::npos)
+		    << e;
+	EXPECT_TRUE(fs::is_fifo(fifo));
+	EXPECT_EQ(
+	    std::distance(fs::directory_iterator(d), fs::directory_iterator{}), 1);
+	// made a FIFO between the start and the commit: still refused
+	{
+		bims::PartialFile p(d + "/late.rawlog");
+		ASSERT_EQ(::mkfifo((d + "/late.rawlog").c_str(), 0600), 0);
+		EXPECT_THROW(p.commit(), std::runtime_error);
+		EXPECT_TRUE(fs::is_fifo(d + "/late.rawlog"));
+	}
+	// a link to /dev/null: the link is replaced, /dev/null stays a device
+	struct stat st;
+	if (::stat("/dev/null", &st) == 0 && S_ISCHR(st.st_mode))
+	{
+		fs::create_symlink("/dev/null", d + "/null.rawlog");
+		bims::writeFileAtomically(d + "/null.rawlog", "x");
+		EXPECT_TRUE(
+		    fs::is_regular_file(fs::symlink_status(d + "/null.rawlog")));
+		EXPECT_TRUE(fs::is_character_file("/dev/null"));
+	}
 }
 
 TEST(OutputPaths, APartialFileOfNoPathIsAPlainError)

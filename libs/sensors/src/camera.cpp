@@ -1,7 +1,9 @@
 #include <bims/sensors/camera.h>
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
+#include <stdexcept>
 
 namespace bims::sensors
 {
@@ -69,6 +71,57 @@ std::string intrinsicsOf(const mrpt::obs::CObservation3DRangeScan& obs,
 	}
 	K << cp.fx(), 0, cp.cx(), 0, cp.fy(), cp.cy(), 0, 0, 1;
 	return {};
+}
+
+std::string intrinsicsProblem(const PinholeCamera& c)
+{
+	char b[400];
+	if (!(c.width > 0 && c.height > 0))
+	{
+		std::snprintf(b, sizeof(b), "an image of %dx%d pixels: not an image",
+		              c.width, c.height);
+		return b;
+	}
+	if (!(std::isfinite(c.fx) && std::isfinite(c.fy) && std::isfinite(c.cx) &&
+	      std::isfinite(c.cy)))
+		return "a value of fx fy cx cy is not a finite number";
+	if (!(c.cx >= 0 && c.cx <= c.width && c.cy >= 0 && c.cy <= c.height))
+	{
+		std::snprintf(b, sizeof(b),
+		              "the principal point (cx %g, cy %g) is outside the "
+		              "%dx%d image (accepted: 0 <= cx <= %d, 0 <= cy <= %d): "
+		              "intrinsics of another image size?",
+		              c.cx, c.cy, c.width, c.height, c.width, c.height);
+		return b;
+	}
+	constexpr double kPi = 3.14159265358979323846;
+	const auto rad = [&](double deg) { return deg * kPi / 180; };
+	for (const int axis : {0, 1})
+	{
+		const double f = axis == 0 ? c.fx : c.fy;
+		const int n = axis == 0 ? c.width : c.height;
+		// the focal lengths of the widest and the narrowest view accepted
+		const double fLo = n / (2 * std::tan(rad(kMaxFieldOfViewDeg) / 2)),
+		             fHi = n / (2 * std::tan(rad(kMinFieldOfViewDeg) / 2));
+		if (f >= fLo && f <= fHi) continue;
+		double fov = f > 0 ? 2 * std::atan(n / (2 * f)) * 180 / kPi : 180.0;
+		if (fov < 1e-3) fov = 0;  // (said as 0, not 1.83e-296)
+		std::snprintf(b, sizeof(b),
+		              "%s %g gives a field of view of %.3g deg over the "
+		              "image's %d pixels (accepted: %g to %g deg, i.e. %s from "
+		              "%.4g to %.4g): intrinsics of another image size, or "
+		              "not a camera's?",
+		              axis == 0 ? "fx" : "fy", f, fov, n, kMinFieldOfViewDeg,
+		              kMaxFieldOfViewDeg, axis == 0 ? "fx" : "fy", fLo, fHi);
+		return b;
+	}
+	return "";
+}
+
+void checkIntrinsics(const PinholeCamera& c, const std::string& where)
+{
+	const std::string why = intrinsicsProblem(c);
+	if (!why.empty()) throw std::runtime_error(where + ": " + why);
 }
 
 }  // namespace bims::sensors

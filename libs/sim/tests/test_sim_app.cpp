@@ -41,6 +41,16 @@ std::string tmpDir(const std::string& name)
 	std::system(("rm -rf '" + d + "' && mkdir -p '" + d + "'").c_str());
 	return d;
 }
+
+/** The partial file of NAME in \a dir (NAME.PID-TAG.partial, a run's own:
+ * bims/io/output_paths.h); "" when there is none. */
+std::string partialOf(const std::string& dir, const std::string& name)
+{
+	for (const auto& e : std::filesystem::directory_iterator(dir))
+		if (bims::partialTarget(e.path().filename().string()) == name)
+			return e.path().string();
+	return "";
+}
 /** Runs a shell command; returns the exit code, output (stdout+stderr) in out.
  */
 int run(const std::string& cmd, std::string& out)
@@ -455,10 +465,10 @@ TEST(BimsSim, AFullDiskIsAnErrorAndLeavesNoRawlogUnderItsName)
 	            "/x.rawlog' --max-frames 40 -q\"",
 	        out);
 	EXPECT_EQ(rc, 1) << out;
-	EXPECT_NE(out.find("x.rawlog.partial: write failed"), std::string::npos)
-	    << out;
+	EXPECT_NE(out.find(d + "/x.rawlog."), std::string::npos) << out;
+	EXPECT_NE(out.find(".partial: write failed"), std::string::npos) << out;
 	EXPECT_FALSE(std::filesystem::exists(d + "/x.rawlog"));
-	EXPECT_FALSE(std::filesystem::exists(d + "/x.rawlog.partial"));
+	EXPECT_EQ(partialOf(d, "x.rawlog"), "");
 }
 
 TEST(BimsSim, SigintAndSigtermEndACompleteShorterSequence)
@@ -499,7 +509,7 @@ TEST(BimsSim, SigintAndSigtermEndACompleteShorterSequence)
 		     std::filesystem::directory_iterator(d + "/x_gt/masks"))
 			masks++;
 		EXPECT_EQ(masks, scans);
-		EXPECT_FALSE(std::filesystem::exists(d + "/x.rawlog.partial"));
+		EXPECT_EQ(partialOf(d, "x.rawlog"), "");
 		EXPECT_FALSE(std::filesystem::exists(d + "/x_gt.partial"));
 	}
 }
@@ -522,7 +532,9 @@ TEST(BimsSim, AKilledRunLeavesEveryFrameWrittenSoFarReadable)
 	std::string torn;  // the reader's message at a torn end, if any
 	try
 	{
-		bims::RawlogReader r(d + "/x.rawlog.partial");
+		// OUT.rawlog.PID-TAG.partial: the killed run's own
+		ASSERT_NE(partialOf(d, "x.rawlog"), "");
+		bims::RawlogReader r(partialOf(d, "x.rawlog"));
 		while (auto o = r.next())
 			if (IS_CLASS(*o, mrpt::obs::CObservation3DRangeScan)) scans++;
 	}
@@ -532,7 +544,8 @@ TEST(BimsSim, AKilledRunLeavesEveryFrameWrittenSoFarReadable)
 	}
 	if (!torn.empty())
 	{
-		EXPECT_NE(torn.find("x.rawlog.partial"), std::string::npos) << torn;
+		EXPECT_NE(torn.find(partialOf(d, "x.rawlog")), std::string::npos)
+		    << torn;
 	}
 	// frame 5 was flushed before its mask was written
 	EXPECT_GE(scans, 6u) << torn;
@@ -580,6 +593,8 @@ TEST(BimsSim, AKilledOverwriteLeavesTheEarlierRawlogAndGroundTruthTogether)
 	          0)
 	    << out;
 	EXPECT_FALSE(std::filesystem::exists(d + "/x_gt.partial"));
+	// ... and the killed run's partial rawlog (its process is gone)
+	EXPECT_EQ(partialOf(d, "x.rawlog"), "");
 	EXPECT_EQ(bims::loadTumTrajectory(d + "/x_gt/groundtruth.txt").size(), 4u);
 }
 

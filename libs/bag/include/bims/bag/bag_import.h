@@ -196,7 +196,8 @@ void attachMagnetometer(std::vector<ImuSample>& imu,
 
 /** A ROS stamp (sec, nsec) as seconds, correctly rounded (the double
  * nearest to the decimal "sec.nnnnnnnnn", as a TUM file's stamp is
- * parsed). */
+ * parsed). A non-canonical stamp, nsec >= 1e9, is normalised as ROS does:
+ * the whole seconds of nsec carried into sec (999 s 1e9 ns = 1000.0 s). */
 double stampSeconds(uint32_t sec, uint32_t nsec);
 
 struct BagImportOptions
@@ -232,6 +233,10 @@ struct BagImportSummary
 	/** The CameraInfo has non-zero distortion coefficients, which the
 	 * pinhole model of bims leaves out (images are not undistorted). */
 	bool distortionIgnored = false;
+	/** CameraInfo messages that differ (size or K) from the first, which
+	 * is used for every frame (a note says so), and the first of them (its
+	 * index on the topic). */
+	size_t cameraInfoChanges = 0, firstCameraInfoChange = 0;
 	std::string distortionModel;  ///< its distortion_model then
 	BagTopics topics;             ///< the topics read
 	/** Damage that lost nothing imported (an index damaged at the bag's

@@ -49,6 +49,15 @@ struct StrayImportParams
  * millimetres, kept exactly. */
 constexpr double kStrayRangeUnits = 0.001;
 
+/** The largest time stamp the Stray CSVs may hold [s] (ROS's unsigned
+ * 32-bit seconds, to the year 2106); negative stamps are refused too. */
+constexpr double kMaxStraySeconds = 4294967295.0;
+
+/** How far camera_matrix.csv's principal point may be from the centre of
+ * the colour image it was made for, as a share of its size: the rule that
+ * tells which size that was (rgb.mp4's or [import_stray]'s). */
+constexpr double kStrayCentreTolerance = 0.2;
+
 /** One row of odometry.csv: a depth frame. */
 struct StrayFrame
 {
@@ -86,8 +95,10 @@ struct StrayCapture
 
 /** Reads odometry.csv (required; header "timestamp, frame, x, y, z, qx, qy,
  * qz, qw"): each row 9 finite numbers, a unit quaternion, time strictly
- * increasing. Throws std::runtime_error naming the file and the row's line
- * (1-based). */
+ * increasing and within [0, kMaxStraySeconds]. Read a row at a time
+ * (bims::LineReader: a regular file only, a line at most 64 KiB, a UTF-8
+ * byte-order mark skipped, CR, LF or CRLF line ends). Throws
+ * std::runtime_error naming the file and the row's line (1-based). */
 std::vector<StrayFrame> readStrayOdometry(const std::string& path);
 
 /** Reads imu.csv (header "timestamp, a_x, a_y, a_z, alpha_x, alpha_y,
@@ -101,8 +112,9 @@ void readStrayCameraMatrix(const std::string& path, double K[3][3]);
 
 /** Indexes the folder: odometry.csv, depth/ (every depth/NNNNNN.png has a row
  * and every row its PNG, else an error naming both), camera_matrix.csv,
- * imu.csv and confidence/ when present (a note once on stderr when not),
- * rgb.mp4 when present (a note once on stderr when not). */
+ * imu.csv and confidence/ when present (a note once on stderr when not;
+ * confidence that is no folder: an error), rgb.mp4 when present (a note
+ * once on stderr when not; one that is no regular file: an error). */
 StrayCapture readStrayCapture(const std::string& folder);
 
 /** Every file of \a cap the import reads (the output guard's inputs). */
@@ -139,18 +151,35 @@ struct StrayImportSummary
 	size_t referencePoses = 0;    ///< poses written there
 	size_t referenceLeftOut = 0;  ///< leading frames without position
 	Trajectory reference;         ///< what the reference file holds
+	/** Frames left out: on the rawlog clock's 100 ns tick of the frame
+	 * before (two scans of one stamp: every reader drops one). */
+	size_t framesSameStamp = 0;
+	/** IMU samples left out: on the tick of the sample before. */
+	size_t imuSameStamp = 0;
+	/** Samples of imu.csv after the capture's last frame (left out). */
+	size_t imuAfterLast = 0;
+	/** What the import did that its caller must see (the program prints
+	 * each on stderr as a warning): samples or frames left out, and why,
+	 * naming the file. */
+	std::vector<std::string> warnings;
+	/** What the report says besides its figures (a video scaled). */
+	std::vector<std::string> notes;
 };
 
 /** "OUT_arkit_reference.txt" for "OUT.rawlog" (or OUT.rawlog.gz; the
  * extension removed as groundTruthDirFor does). */
 std::string strayReferencePathFor(const std::string& rawlogPath);
 
-/** Imports the capture \a folder into \a outRawlog (written as
- * OUT.rawlog.partial and renamed when complete) and writes ARKit's poses
+/** Imports the capture \a folder into \a outRawlog and writes ARKit's poses
  * at the written frames to strayReferencePathFor(outRawlog), leaving out
- * the leading rows whose translation is exactly 0 (ARKit initialising).
- * Frames and IMU samples (from the start of imu.csv up to the last written
- * frame) in time order, IMU first at equal stamps. Throws
+ * the leading rows whose translation is exactly 0 (ARKit initialising);
+ * both are written as partial files of the run's own and put in place
+ * together (bims::commitTogether). Frames and IMU samples (from the start
+ * of imu.csv up to the last written frame) in time order, IMU first at
+ * equal stamps; a frame or sample on the rawlog clock's 100 ns tick of the
+ * one before is left out and counted, samples after the capture's last
+ * frame too (StrayImportSummary::warnings says so). The intrinsics on the
+ * depth grid must be a camera's (sensors::checkIntrinsics). Throws
  * std::runtime_error naming the file (and row) on bad input. */
 StrayImportSummary importStray(const std::string& folder,
                                const std::string& outRawlog,

@@ -1,7 +1,9 @@
 // The one rule of every bims program that writes files: a file the program
-// creates replaces a symbolic link instead of writing through it, and
-// whole-file outputs appear under their final name only once complete
-// (written as NAME.partial, then renamed). The programs' checks before any
+// creates replaces a symbolic link instead of writing through it, an output
+// path that is a FIFO or a device is refused (never replaced by a regular
+// file, never written into), and whole-file outputs appear under their
+// final name only once complete (written as NAME.PID-TAG.partial, a name of
+// the run's own, then renamed). The programs' checks before any
 // work (outputs never alias inputs, an earlier run's folder refused unless
 // --overwrite) are libs/apps's: bims/apps/output_checks.h.
 #pragma once
@@ -25,6 +27,17 @@ namespace bims
  * files at the end of a long run: checked before any work. Empty strings
  * (optional outputs not given) are ignored. */
 void checkOutputFilesWritable(const std::vector<std::string>& files);
+
+/** Throws std::runtime_error naming \a path and what it is when it is a
+ * FIFO, a character or block device or a socket (not followed through a
+ * symbolic link: a link is replaced, not its target): a program's output
+ * is a regular file, which would replace it. Every constructor below and
+ * checkOutputFilesWritable() check this. */
+void refuseSpecialOutput(const std::string& path);
+
+/** "NAME" for a partial file's name "NAME.partial" or "NAME.PID-TAG.partial"
+ * (PartialFile's: PID digits, TAG 8 hex digits); "" for another name. */
+std::string partialTarget(const std::string& name);
 
 /** Creates a directory and its parents; throws naming it on failure. */
 void makeDirs(const std::string& path);
@@ -62,10 +75,14 @@ struct OutputFolderLayout
 std::vector<std::string> earlierOutputs(const std::string& dir,
                                         const OutputFolderLayout& layout);
 
-/** A whole-file output written under PATH.partial and renamed to PATH by
- * commit() (std::rename: atomic, and it replaces a symbolic link at PATH,
- * not its target). Dropped without commit() (an error on the way), the
- * partial file is removed: PATH is never a half-written file. */
+/** A whole-file output written under PATH.PID-TAG.partial (created by the
+ * constructor with O_EXCL: a name no other run or object writes, PID the
+ * process's id, TAG 8 random hex digits) and renamed to PATH by commit()
+ * (std::rename: atomic, and it replaces a symbolic link at PATH, not its
+ * target; two runs writing PATH at once each put their own whole file in
+ * place, the last one to finish wins). Dropped without commit() (an error
+ * on the way), the partial file is removed: PATH is never a half-written
+ * file. PATH a FIFO or a device: refused (refuseSpecialOutput). */
 class PartialFile
 {
  public:
@@ -74,16 +91,22 @@ class PartialFile
 	PartialFile(const PartialFile&) = delete;
 	PartialFile& operator=(const PartialFile&) = delete;
 
-	/** Where to write: PATH.partial. */
+	/** Where to write: PATH.PID-TAG.partial (exists, empty). */
 	const std::string& path() const { return partial_; }
 	const std::string& finalPath() const { return final_; }
-	/** Renames PATH.partial to PATH; throws naming both on failure. */
+	/** Renames the partial file to PATH; throws naming both on failure. */
 	void commit();
 
  private:
 	std::string final_, partial_;
 	bool done_ = false;
 };
+
+/** Commits \a parts in order (the outputs of one run, e.g. a rawlog and
+ * its reference trajectory) holding an exclusive lock (flock(2)) on the
+ * folder of the first: of two runs writing the same outputs at once, one
+ * run's set is put in place wholly after the other's, never a mix. */
+void commitTogether(const std::vector<PartialFile*>& parts);
 
 /** A folder output (a rawlog's OUT_gt/) written as PATH.partial/ (a stale
  * one from a killed run is removed first) and put in place by commit():
@@ -180,7 +203,8 @@ class OutputManifest
  * path is absolute or leaves the folder (`..`): no manifest bims wrote. */
 std::vector<std::string> manifestFiles(const std::string& dir);
 
-/** Removes what the manifest of \a dir lists (each file and its .partial;
+/** Removes what the manifest of \a dir lists (each file and its partial
+ * files of any run (partialTarget);
  * a symbolic link removed, never followed, and a path through a linked
  * folder skipped), then the sub-folders that leaves empty, then the
  * manifest; never anything else. Returns how many files it removed; throws
@@ -193,6 +217,10 @@ size_t removeListedOutputs(const std::string& dir,
  * close checked (a full disk is an error naming the file, never a short
  * file), then renamed. */
 void writeFileAtomically(const std::string& path, const std::string& bytes);
+
+/** Writes \a bytes into \a part's partial file, every write and the close
+ * checked (errors name the final path); commit it afterwards. */
+void writePartialFile(PartialFile& part, const std::string& bytes);
 
 /** Encodes \a img in the format of the path's extension (.png) and writes
  * it with writeFileAtomically; throws naming the file. */

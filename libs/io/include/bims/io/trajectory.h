@@ -30,6 +30,11 @@ Trajectory loadTumTrajectory(const std::string& path);
 void saveTumTrajectory(const std::string& path, const Trajectory& traj,
                        const std::string& headerComment = {});
 
+/** The text saveTumTrajectory() writes; throws as it does (\a path named
+ * in the error). */
+std::string tumTrajectoryText(const std::string& path, const Trajectory& traj,
+                              const std::string& headerComment = {});
+
 /** The pose of \a traj (sorted by time) nearest to \a t, if it is less
  * than \a maxDt away [s]; else nullptr. */
 const StampedPose* poseNear(const Trajectory& traj, double t, double maxDt);
