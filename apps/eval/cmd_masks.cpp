@@ -65,7 +65,7 @@ int cmdMasks(int argc, char** argv)
 	TCLAP::SwitchArg sparse(
 	    "", "sparse-labels",
 	    "labels are a subset of the frames: a prediction inside the labels' "
-	    "time span without a label is accepted (not scored)",
+	    "span (by index or time) without a label is accepted (not scored)",
 	    cmd);
 	TCLAP::ValueArg<std::string> span(
 	    "", "span",

@@ -233,6 +233,23 @@ std::unique_ptr<MaskPairing> pairMasks(const EvalMasksOptions& o)
 		    (o.span == "run" ? " inside the run's span" : "") +
 		    " have a prediction within " + std::to_string(o.maxDt) +
 		    " s: the predictions are not of these frames (another run?)");
+	if (!p.match.predictionsWithoutLabel.empty() && !o.sparseLabels &&
+	    !p.gtFiles.front().byTime())
+	{
+		// by index: the labels missing, as named
+		const auto& missing = p.match.predictionsWithoutLabel;
+		std::string names;
+		for (size_t k = 0; k < missing.size() && k < 5; ++k)
+			names += (k ? ", " : "") + missing[k]->name;
+		if (missing.size() > 5) names += ", ...";
+		throw std::runtime_error(
+		    gtDir + ": no label of the same name for " +
+		    std::to_string(missing.size()) + " prediction(s) of " + predDir +
+		    " inside the labels' span (" + p.gtFiles.front().name + " to " +
+		    p.gtFiles.back().name + "): " + names +
+		    ": missing label frames? (--sparse-labels if the labels are a "
+		    "subset)");
+	}
 	if (!p.match.predictionsWithoutLabel.empty() && !o.sparseLabels)
 	{
 		const ev::MaskFile* f = p.match.predictionsWithoutLabel.front();
@@ -403,7 +420,7 @@ void printUnpaired(const EvalMasksOptions& o, const MaskPairing& p)
 	if (match.predictionsOutside > 0 || !match.predictionsWithoutLabel.empty())
 		std::fprintf(stderr,
 		             "bims-eval masks: %zu predictions without a label (%d "
-		             "outside the labels' time span), not scored\n",
+		             "outside the labels' span), not scored\n",
 		             match.predictionsWithoutLabel.size() +
 		                 size_t(match.predictionsOutside),
 		             match.predictionsOutside);

@@ -319,6 +319,18 @@ MaskMatch matchMasks(const std::vector<MaskFile>& labels,
 					m.labelsOutsidePredictions.push_back(&l);
 			}
 		}
+		// predictions without the label of their index: inside the labels'
+		// span a missing label, outside it a longer run
+		size_t i = 0;
+		for (const MaskFile& p : preds)
+		{
+			while (i < labels.size() && labels[i].index < p.index) ++i;
+			if (i < labels.size() && labels[i].index == p.index) continue;
+			if (p.index < labels.front().index || p.index > labels.back().index)
+				++m.predictionsOutside;
+			else
+				m.predictionsWithoutLabel.push_back(&p);
+		}
 		return m;
 	}
 	// time stamps of both sides, sorted (the files are)

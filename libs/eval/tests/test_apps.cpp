@@ -275,6 +275,52 @@ TEST(EvalMasks, HandComputedTotalsAndErrors)
 	    << r.out;
 }
 
+// Issue 55: labels named by index with frames missing in the middle were
+// scored without them (exit 0, a higher F1, no note); as with labels named
+// by time, a prediction inside the labels' span without its label is an
+// error naming the missing labels, unless --sparse-labels.
+TEST(EvalMasks, IndexNamedLabelsMissingInsideTheirSpanAreAnError)
+{
+	const auto d = tmpDir("missing_index_labels");
+	fs::create_directories(d + "/gt");
+	fs::create_directories(d + "/pred");
+	cv::Mat g(8, 8, CV_8UC1, cv::Scalar(0)), p = g.clone();
+	g(cv::Rect(0, 0, 4, 8)) = 255;
+	p(cv::Rect(0, 0, 3, 8)) = 255;
+	char name[16];
+	for (int k = 0; k < 12; ++k)  // predictions 0-11, labels 0-9
+	{
+		std::snprintf(name, sizeof(name), "/%06d.png", k);
+		cv::imwrite(d + "/pred" + name, p);
+		if (k < 10) cv::imwrite(d + "/gt" + name, g);
+	}
+	auto r = run(kBin + "/bims-eval masks " + d + "/gt " + d +
+	             "/pred --no-plots -q");
+	ASSERT_EQ(r.code, 0) << r.out;  // (10, 11: a longer run, not scored)
+	for (const char* gone : {"000003.png", "000004.png", "000008.png"})
+		fs::remove(d + "/gt/" + gone);
+	r = run(kBin + "/bims-eval masks " + d + "/gt " + d +
+	        "/pred --no-plots -q");
+	EXPECT_EQ(r.code, 1) << r.out;
+	EXPECT_NE(r.out.find(d +
+	                     "/gt: no label of the same name for 3 "
+	                     "prediction(s) of " +
+	                     d +
+	                     "/pred inside the labels' span (000000.png to "
+	                     "000009.png): 000003.png, 000004.png, 000008.png: "
+	                     "missing label frames? (--sparse-labels"),
+	          std::string::npos)
+	    << r.out;
+	EXPECT_EQ(r.out.find("total precision"), std::string::npos) << r.out;
+	r = run(kBin + "/bims-eval masks " + d + "/gt " + d +
+	        "/pred --no-plots -q --sparse-labels");
+	EXPECT_EQ(r.code, 0) << r.out;
+	EXPECT_NE(r.out.find("5 predictions without a label (2 outside the "
+	                     "labels' span), not scored"),
+	          std::string::npos)
+	    << r.out;
+}
+
 TEST(EvalMasks, LabelsByTimestampWithIgnoredValues)
 {
 	// A TUM/Bonn-style label folder (named by depth stamp; 255 moving, 0

@@ -237,6 +237,16 @@ TEST(MatchMasks, ByIndexPairsEqualNames)
 	ASSERT_EQ(m.labelsWithoutPrediction.size(), 1u);
 	EXPECT_EQ(m.labelsWithoutPrediction[0]->index, 2);
 	EXPECT_EQ(m.labelsOutsidePredictions.size(), 1u);  // after the last
+	// prediction 1 lies inside the labels' span without its label: a
+	// missing label (issue 55); one after the last label: a longer run
+	ASSERT_EQ(m.predictionsWithoutLabel.size(), 1u);
+	EXPECT_EQ(m.predictionsWithoutLabel[0]->index, 1);
+	EXPECT_EQ(m.predictionsOutside, 0);
+	const std::vector<ev::MaskFile> longer = {byIndex(0), byIndex(2),
+	                                          byIndex(3)};
+	const auto l = ev::matchMasks(labels, longer, {}, 0.01);
+	EXPECT_TRUE(l.predictionsWithoutLabel.empty());
+	EXPECT_EQ(l.predictionsOutside, 1);
 	// labels by index, predictions by time: an error
 	EXPECT_THROW(ev::matchMasks(labels, {byTime(1.0)}, {}, 0.01),
 	             std::runtime_error);

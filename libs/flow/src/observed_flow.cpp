@@ -2,8 +2,12 @@
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 
 namespace bims::flow
@@ -26,6 +30,86 @@ DisPreset disPresetFor(DisPreset preset, int width)
 	                                      : DisPreset::Fast;
 }
 
+namespace
+{
+int disCode(DisPreset preset)
+{
+	return preset == DisPreset::Ultrafast ? cv::DISOpticalFlow::PRESET_ULTRAFAST
+	       : preset == DisPreset::Medium  ? cv::DISOpticalFlow::PRESET_MEDIUM
+	                                      : cv::DISOpticalFlow::PRESET_FAST;
+}
+
+/** A DIS preset's patch size and finest scale, as OpenCV sets them. */
+struct DisScales
+{
+	int patch = 8, finest = 2;
+};
+DisScales disScales(DisPreset preset)
+{
+	static const std::array<DisScales, 3> table = []
+	{
+		std::array<DisScales, 3> t;
+		for (DisPreset p :
+		     {DisPreset::Ultrafast, DisPreset::Fast, DisPreset::Medium})
+		{
+			const auto dis = cv::DISOpticalFlow::create(disCode(p));
+			t[static_cast<size_t>(p) - 1] = {dis->getPatchSize(),
+			                                 dis->getFinestScale()};
+		}
+		return t;
+	}();
+	return table[static_cast<size_t>(preset) - 1];
+}
+
+/** The coarsest scale OpenCV's DIS computes for a w x h image (its own
+ * expression, DISOpticalFlowImpl::calc). */
+int disCoarsestScale(int w, int h, int patch)
+{
+	return std::min(
+	    static_cast<int>(
+	        std::log(std::max(w, h) / (4.0 * patch)) / std::log(2.0) + 0.5),
+	    static_cast<int>(std::log(std::min(w, h) / double(patch)) /
+	                     std::log(2.0)));
+}
+}  // namespace
+
+std::string observedFlowSizeProblem(const FlowParams& p, int width, int height)
+{
+	const int d = std::max(1, p.downscale);
+	const int w = width / d, h = height / d;
+	const std::string size =
+	    std::to_string(width) + "x" + std::to_string(height);
+	const std::string scaled =
+	    d > 1 ? " (" + std::to_string(w) + "x" + std::to_string(h) +
+	                " after [flow] downscale " + std::to_string(d) + ")"
+	          : std::string();
+	if (p.method != FlowMethod::Dis)
+		return w >= 1 && h >= 1
+		           ? std::string()
+		           : size +
+		                 " is too small for the observed flow: [flow] "
+		                 "downscale " +
+		                 std::to_string(d) + " leaves no pixel";
+	const DisPreset preset = disPresetFor(p.dis_preset, w);
+	const DisScales s = disScales(preset);
+	if (w >= 1 && h >= 1 && disCoarsestScale(w, h, s.patch) >= s.finest)
+		return {};
+	// the least shorter side, and the least longer side with it
+	const int shorter = s.patch << s.finest;
+	int longer = shorter;
+	while (disCoarsestScale(longer, shorter, s.patch) < s.finest) ++longer;
+	const char* name = preset == DisPreset::Ultrafast ? "ultrafast"
+	                   : preset == DisPreset::Medium  ? "medium"
+	                                                  : "fast";
+	return size + scaled +
+	       " is too small for the observed flow (OpenCV's DIS, preset " + name +
+	       "): it needs at least " + std::to_string(shorter * d) +
+	       " pixels on the shorter side and " + std::to_string(longer * d) +
+	       " on the longer one" +
+	       (d > 1 ? " at [flow] downscale " + std::to_string(d) : "") +
+	       " ([flow] method = farneback takes any size)";
+}
+
 ObservedFlow::ObservedFlow(const FlowParams& p) : p_(p)
 {
 	// (DIS is created by the first compute(): "auto" depends on the width)
@@ -39,6 +123,9 @@ cv::Mat ObservedFlow::compute(const cv::Mat& prev, const cv::Mat& cur)
 	    prev.type() != CV_8UC1 || cur.type() != CV_8UC1)
 		throw std::invalid_argument(
 		    "observed flow: need two non-empty CV_8UC1 images of one size");
+	if (const std::string why = observedFlowSizeProblem(p_, cur.cols, cur.rows);
+	    !why.empty())
+		throw std::invalid_argument("observed flow: " + why);
 	// The last tensor may still be held by the caller (the pipeline keeps it
 	// for its frame while the next flow runs): it becomes the spare, and the
 	// one before it is written again only if nobody else holds it.
@@ -61,12 +148,7 @@ cv::Mat ObservedFlow::compute(const cv::Mat& prev, const cv::Mat& cur)
 		const DisPreset preset = disPresetFor(p_.dis_preset, a.cols);
 		if (!dis_ || preset != disPreset_)
 		{
-			dis_ = cv::DISOpticalFlow::create(
-			    preset == DisPreset::Ultrafast
-			        ? cv::DISOpticalFlow::PRESET_ULTRAFAST
-			    : preset == DisPreset::Medium
-			        ? cv::DISOpticalFlow::PRESET_MEDIUM
-			        : cv::DISOpticalFlow::PRESET_FAST);
+			dis_ = cv::DISOpticalFlow::create(disCode(preset));
 			disPreset_ = preset;
 		}
 		dis_->calc(a, b, flow);

@@ -64,6 +64,67 @@ TEST(ObservedFlow, RejectsMismatchedImages)
 	             std::invalid_argument);
 }
 
+// Issue 55: OpenCV's DIS reads outside an image whose size does not reach
+// its preset's finest scale (SIGSEGV at 40 x 8, 128 x 24, 320 x 20 ...);
+// the observed flow names the least size instead, and runs on every size
+// it accepts.
+TEST(ObservedFlow, ImagesTooSmallForDisAreRefusedNotRun)
+{
+	FlowParams fast;
+	EXPECT_EQ(
+	    observedFlowSizeProblem(fast, 40, 8),
+	    "40x8 is too small for the observed flow (OpenCV's DIS, preset "
+	    "fast): it needs at least 32 pixels on the shorter side and 91 on "
+	    "the longer one ([flow] method = farneback takes any size)");
+	// the least sizes, each preset (downscale: of the images DIS sees)
+	struct Least
+	{
+		const char* preset;
+		int downscale, shorter, longer;
+	};
+	for (const Least& l :
+	     {Least{"fast", 1, 32, 91}, Least{"ultrafast", 1, 32, 91},
+	      Least{"medium", 1, 16, 46}, Least{"fast", 2, 64, 182}})
+	{
+		FlowParams p;
+		p.dis_preset = bims::parseChoice<DisPreset>(l.preset);
+		p.downscale = l.downscale;
+		const std::string what =
+		    std::string(l.preset) + " /" + std::to_string(l.downscale);
+		EXPECT_EQ(observedFlowSizeProblem(p, l.longer, l.shorter), "") << what;
+		EXPECT_EQ(observedFlowSizeProblem(p, l.shorter, l.longer), "") << what;
+		EXPECT_NE(observedFlowSizeProblem(p, l.longer - l.downscale, l.shorter),
+		          "")
+		    << what;
+		EXPECT_NE(observedFlowSizeProblem(p, l.longer, l.shorter - l.downscale),
+		          "")
+		    << what;
+	}
+	// every size: refused, or run (sizes where DIS crashed among them)
+	for (const char* preset : {"fast", "ultrafast", "medium"})
+		for (int w : {1, 4, 12, 24, 32, 40, 64, 91, 128, 320, 700})
+			for (int h : {1, 8, 16, 20, 24, 32, 91})
+			{
+				FlowParams p;
+				p.dis_preset = bims::parseChoice<DisPreset>(preset);
+				ObservedFlow of(p);
+				const cv::Mat prev = test::texture(w, h, 5);
+				const cv::Mat cur = test::shifted(prev, 0.7, 0.2);
+				if (observedFlowSizeProblem(p, w, h).empty())
+					EXPECT_EQ(of.compute(prev, cur).size(), cur.size())
+					    << preset << " " << w << "x" << h;
+				else
+					EXPECT_THROW(of.compute(prev, cur), std::invalid_argument)
+					    << preset << " " << w << "x" << h;
+			}
+	// Farneback takes any size but an empty one
+	FlowParams fb;
+	fb.method = FlowMethod::Farneback;
+	EXPECT_EQ(observedFlowSizeProblem(fb, 1, 1), "");
+	fb.downscale = 2;
+	EXPECT_NE(observedFlowSizeProblem(fb, 1, 1), "");
+}
+
 namespace
 {
 /** Median end-point error against a reference flow over the pixels whose

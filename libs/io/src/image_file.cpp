@@ -143,16 +143,34 @@ bool imageSizeWithinLimits(uint64_t rows, uint64_t cols,
 	       rows * cols <= static_cast<uint64_t>(limits.max_pixels);
 }
 
+namespace
+{
+/** "beyond the N per side and M pixels bims reads (ORIGIN": the refusal of
+ * every image's size, without its closing parenthesis. */
+std::string beyondLimits(const ImageLimits& limits)
+{
+	return "beyond the " + std::to_string(limits.max_side) + " per side and " +
+	       std::to_string(limits.max_pixels) + " pixels bims reads (" +
+	       limits.origin;
+}
+}  // namespace
+
+std::string imageSizeBeyondLimits(uint64_t rows, uint64_t cols,
+                                  const ImageLimits& limits)
+{
+	if (imageSizeWithinLimits(rows, cols, limits)) return {};
+	return std::to_string(cols) + " x " + std::to_string(rows) + " pixels, " +
+	       beyondLimits(limits) + ")";
+}
+
 void checkImageWithinLimits(const ImageHeader& h, const ImageLimits& limits)
 {
 	using std::runtime_error;
 	if (!imageSizeWithinLimits(h.height, h.width, limits))
-		throw runtime_error(
-		    "declares " + std::to_string(h.width) + " x " +
-		    std::to_string(h.height) + " pixels in its " + h.format +
-		    " header, beyond the " + std::to_string(limits.max_side) +
-		    " per side and " + std::to_string(limits.max_pixels) +
-		    " pixels bims reads (" + limits.origin + "; not decoded)");
+		throw runtime_error("declares " + std::to_string(h.width) + " x " +
+		                    std::to_string(h.height) + " pixels in its " +
+		                    h.format + " header, " + beyondLimits(limits) +
+		                    "; not decoded)");
 	if (h.width == 0 || h.height == 0)
 		throw runtime_error(std::string("declares an empty image in its ") +
 		                    h.format + " header");

@@ -217,6 +217,8 @@ void checkRawlogPath(const std::string& path)
 	}
 	if (!fs::is_regular_file(st))
 		throw RawlogError(path + ": not a regular file, not a rawlog");
+	if (fs::file_size(path, ec) == 0 && !ec)
+		throw RawlogError(path + ": an empty file (0 bytes), not a rawlog");
 	if (!std::ifstream(path))
 		throw RawlogError(path + ": cannot open rawlog file (permissions?)");
 }

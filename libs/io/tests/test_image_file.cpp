@@ -112,6 +112,19 @@ TEST(ImageFile, ADeviceOrALinkLoopIsRefusedNamingWhatItIs)
 	    << errorOf(d + "/loop1.png");
 }
 
+// The refusal of an image's size in the same words for an array (the
+// Python module's) as for a file's header (issue 55).
+TEST(ImageFile, AnArraysSizeBeyondTheLimitsIsNamedWithTheLimits)
+{
+	EXPECT_EQ(bims::imageSizeBeyondLimits(16384, 16384, {}),
+	          "16384 x 16384 pixels, beyond the 16384 per side and 67108864 "
+	          "pixels bims reads ([input] image_max_side, image_max_pixels)");
+	EXPECT_EQ(bims::imageSizeBeyondLimits(480, 640, {}), "");
+	EXPECT_EQ(bims::imageSizeBeyondLimits(2, 16385, {}).substr(0, 9),
+	          "16385 x 2");
+	EXPECT_NE(bims::imageSizeBeyondLimits(10, 10, {100, 99, "[input] x"}), "");
+}
+
 TEST(ImageFile, EveryOtherBadFileIsAnErrorNamingIt)
 {
 	const std::string d = bims::test::freshTmpDir("bims_test_image", "bad");

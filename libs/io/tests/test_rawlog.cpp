@@ -65,6 +65,25 @@ TEST(Rawlog, MissingFileIsAClearError)
 	}
 }
 
+// Issue 55: an empty file read as a rawlog of nothing (bims.read_rawlog
+// yielded nothing without an error); it is no rawlog, not even a gzip
+// header: an error naming it, for every reader.
+TEST(Rawlog, AnEmptyFileIsNotARawlog)
+{
+	const auto p = tmpPath("bims_test_io", "empty.rawlog");
+	std::ofstream(p).close();
+	try
+	{
+		bims::RawlogReader r(p);
+		FAIL() << "no exception";
+	}
+	catch (const bims::RawlogError& e)
+	{
+		EXPECT_EQ(std::string(e.what()),
+		          p + ": an empty file (0 bytes), not a rawlog");
+	}
+}
+
 TEST(Rawlog, TruncatedFileIsAnErrorNamingFileAndEntry)
 {
 	const auto p = tmpPath("bims_test_io", "trunc.rawlog");

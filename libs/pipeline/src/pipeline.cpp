@@ -1,7 +1,9 @@
 #include <bims/common/clock.h>
 #include <bims/flow/expected_flow.h>
+#include <bims/flow/observed_flow.h>
 #include <bims/pipeline/pipeline.h>
 
+#include <algorithm>
 #include <chrono>
 #include <functional>
 #include <future>
@@ -107,9 +109,63 @@ Pipeline::Observed Pipeline::observe(const cv::Mat& prevGrey,
 	return o;
 }
 
+std::string frameSizeProblem(const ExperimentConfig& cfg, int width, int height,
+                             bool hasImage)
+{
+	const std::string size =
+	    std::to_string(width) + "x" + std::to_string(height);
+	if (width < 1 || height < 1) return size + ": an empty image";
+	const auto& anchor = cfg.ego.anchor;
+	if (anchor.enable)
+	{
+		const int least = 1 << anchor.coarsest_level;
+		if (width < least || height < least)
+			return size +
+			       " is too small for the keyframe alignment, whose "
+			       "pyramid halves it [anchor] coarsest_level = " +
+			       std::to_string(anchor.coarsest_level) +
+			       " times: it needs at least " + std::to_string(least) +
+			       " pixels per side";
+	}
+	if (hasImage) return flow::observedFlowSizeProblem(cfg.flow, width, height);
+	return {};
+}
+
+double farthestDepthUsed(const ExperimentConfig& cfg)
+{
+	return std::max({cfg.grids.max_range, cfg.ego.translation.max_depth_m,
+	                 cfg.ego.anchor.max_depth_m, cfg.flow.max_depth_m});
+}
+
+std::string Pipeline::frameSizeProblem(int width, int height,
+                                       bool hasImage) const
+{
+	if (std::string why =
+	        pipeline::frameSizeProblem(cfg_, width, height, hasImage);
+	    !why.empty())
+		return why;
+	if (havePrev_ && prev_.size() != cv::Size(width, height))
+		return std::to_string(width) + "x" + std::to_string(height) +
+		       " differs from the previous frames' " +
+		       std::to_string(prev_.size().width) + "x" +
+		       std::to_string(prev_.size().height) +
+		       ": one pipeline takes one image size (a new one for another "
+		       "camera mode)";
+	return {};
+}
+
 std::string Pipeline::decode(const FrameInput& in, ego::RgbdFrame& out) const
 {
-	if (in.scan) return ego::rgbdFrameFrom(*in.scan, cfg_.ego.camera, out);
+	if (in.scan)
+	{
+		std::string why = ego::rgbdFrameFrom(*in.scan, cfg_.ego.camera, out);
+		if (why.empty())
+			if (const std::string small = frameSizeProblem(
+			        out.depth.cols, out.depth.rows, out.hasImage());
+			    !small.empty())
+				why = "depth image " + small;
+		return why;
+	}
 	if (!in.frame) return "no frame";
 	const ego::RgbdFrame& f = *in.frame;
 	const cv::Size size = f.depth.size();
@@ -119,6 +175,10 @@ std::string Pipeline::decode(const FrameInput& in, ego::RgbdFrame& out) const
 		return "the raw depth is not a CV_16UC1 image of the depth's size";
 	if (!f.grey.empty() && (f.grey.type() != CV_8UC1 || f.grey.size() != size))
 		return "the image is not a CV_8UC1 image of the depth's size";
+	if (const std::string small =
+	        frameSizeProblem(size.width, size.height, f.hasImage());
+	    !small.empty())
+		return "depth image " + small;
 	out = f;  // headers: the frame's images are shared, not copied
 	return {};
 }

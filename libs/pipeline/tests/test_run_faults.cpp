@@ -277,6 +277,68 @@ TEST(RunFaults, AChangedImageSizeIsAnErrorNamingFileScanAndSizes)
 	EXPECT_TRUE(fs::exists(d + "/out/masks/000004.png"));
 }
 
+// Issue 55: a 1 x 1 depth image hit OpenCV's !ssize.empty() assertion (the
+// keyframe alignment's pyramid), and a short wide image with colour crashed
+// inside OpenCV's DIS (40 x 8: SIGSEGV). bims-run refuses the first frame
+// too small for the pipeline, naming the scan, the size and the least one.
+TEST(RunFaults, ImagesTooSmallForThePipelineAreAnErrorNamingTheScan)
+{
+	struct Case
+	{
+		int w, h;
+		bool colour;
+		const char* why;
+	};
+	for (const Case& c :
+	     {Case{1, 1, false,
+	           "depth image 1x1 is too small for the keyframe alignment, whose "
+	           "pyramid halves it [anchor] coarsest_level = 2 times: it needs "
+	           "at least 4 pixels per side"},
+	      Case{40, 8, true,
+	           "depth image 40x8 is too small for the observed flow (OpenCV's "
+	           "DIS, preset fast): it needs at least 32 pixels on the shorter "
+	           "side and 91 on the longer one"}})
+	{
+		const auto d = tmpDir("small_" + std::to_string(c.w));
+		const auto in = sampleWith(
+		    d, 4,
+		    [&](mrpt::obs::CObservation& o, int scan, int)
+		    {
+			    auto* s = dynamic_cast<mrpt::obs::CObservation3DRangeScan*>(&o);
+			    if (!s || scan < 0) return;
+			    s->load();
+			    mrpt::math::CMatrix_u16 r(c.h, c.w);
+			    for (int v = 0; v < c.h; v++)
+				    for (int u = 0; u < c.w; u++)
+					    r(v, u) = s->rangeImage(100 + v, 100 + u);
+			    s->rangeImage = r;
+			    for (auto* cam : {&s->cameraParams, &s->cameraParamsIntensity})
+			    {
+				    cam->ncols = c.w;
+				    cam->nrows = c.h;
+				    cam->cx(cam->cx() - 100);
+				    cam->cy(cam->cy() - 100);
+			    }
+			    if (c.colour)
+			    {
+				    mrpt::img::CImage patch;
+				    s->intensityImage.extract_patch(patch, 100, 100, c.w, c.h);
+				    s->intensityImage = patch;
+			    }
+			    else
+			    {
+				    s->hasIntensityImage = false;
+				    s->intensityImage = mrpt::img::CImage();
+			    }
+		    });
+		const auto sum = runOn({in}, d + "/out");
+		EXPECT_NE(sum.error.find("3D scan #0 ('RGBD'): " + std::string(c.why)),
+		          std::string::npos)
+		    << sum.error;
+		EXPECT_EQ(sum.framesProcessed, 0u);
+	}
+}
+
 TEST(RunOutputs, TheLayoutNamesEveryFileARunWrites)
 {
 	// bims-run --overwrite clears runOutputLayout()'s files: a file a run

@@ -12,6 +12,8 @@ on NumPy arrays (docs/python.md)::
         r.pose   # 4 x 4 float64, T_WC
 """
 
+import math
+import numbers
 from dataclasses import dataclass
 from typing import Iterator, Optional
 
@@ -54,15 +56,50 @@ class DepthArray(np.ndarray):
 
     def __new__(cls, array, K=None, units=None, range_is_depth=True):
         obj = np.asarray(array).view(cls)
-        obj.K = None if K is None else np.asarray(K, dtype=np.float64)
-        obj.units = units
+        if K is not None:
+            try:
+                K = np.asarray(K, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise TypeError(
+                    "K: a 3 x 3 camera matrix of numbers expected, got "
+                    + type(K).__name__
+                ) from None
+        obj.K = K
+        obj.units = _checked_units(units, obj.dtype)
         obj.range_is_depth = bool(range_is_depth)
         return obj
 
     def __array_finalize__(self, obj):
         self.K = getattr(obj, "K", None)
-        self.units = getattr(obj, "units", None)
+        # units are those of integer readings: an array converted to float
+        # (metres, e.g. by astype) does not keep them
+        units = getattr(obj, "units", None)
+        self.units = units if self.dtype.kind in "ui" else None
         self.range_is_depth = getattr(obj, "range_is_depth", True)
+
+
+def _checked_units(units, dtype):
+    """``units`` of a DepthArray of ``dtype``: None, or a finite number > 0
+    (metres per reading); float depth is in metres (units 1 or None)."""
+    if units is None:
+        return None
+    if isinstance(units, (bool, np.bool_)) or not isinstance(
+        units, (numbers.Real, np.number)
+    ):
+        raise TypeError(
+            "units: metres per reading (a number, e.g. 0.001) expected, got "
+            + type(units).__name__
+            + (f" {units!r}" if isinstance(units, (str, bytes)) else "")
+        )
+    u = float(units)
+    if not (math.isfinite(u) and u > 0):
+        raise ValueError(f"units: {u} is not a finite value > 0 [m]")
+    if dtype.kind == "f" and u != 1:
+        raise ValueError(
+            f"units: {u} for float depth, which is in metres: units apply to "
+            "uint16 readings (leave it None)"
+        )
+    return units
 
 
 @dataclass
@@ -81,8 +118,14 @@ class Frame:
 def read_rawlog(path: str, config: Optional[Config] = None) -> Iterator[Frame]:
     """The frames of an MRPT rawlog, in the order bims-run runs them: the
     config's [sensors] labels, its IMU checks and depth correction (the
-    built-in defaults without one)."""
-    reader = _RawlogReader(str(path), config if config is not None else Config())
+    built-in defaults without one). The file is opened here (a missing,
+    empty or unreadable one raises now); a rawlog without a 3D scan raises
+    ``RawlogError`` when it is read, as bims-run does."""
+    reader = _RawlogReader(path, config if config is not None else Config())
+    return _frames(reader)
+
+
+def _frames(reader) -> Iterator[Frame]:
     for d in reader:
         depth = DepthArray(
             d["depth"],

@@ -1,5 +1,6 @@
 """Type stubs of the C++ module bims._bims (see bims/__init__.py)."""
 
+import os
 from typing import Any, Callable, Dict, List, Optional, Sequence, Union
 
 import numpy as np
@@ -10,11 +11,13 @@ class RawlogError(OSError): ...
 class UsageError(ValueError): ...
 
 ProgressFn = Callable[[int, int], None]
+#: a file path: str or os.PathLike (not empty)
+Path = Union[str, "os.PathLike[str]"]
 
 def import_tum(
-    folder: str,
-    out: str,
-    config: Optional[str] = None,
+    folder: Path,
+    out: Path,
+    config: Optional[Path] = None,
     max_frames: int = 0,
     gz_level: int = 1,
     bonn_gt: bool = False,
@@ -23,18 +26,18 @@ def import_tum(
     progress: Optional[ProgressFn] = None,
 ) -> Dict[str, Any]: ...
 def import_stray(
-    folder: str,
-    out: str,
-    config: Optional[str] = None,
+    folder: Path,
+    out: Path,
+    config: Optional[Path] = None,
     max_frames: int = 0,
     gz_level: int = 1,
     progress: Optional[ProgressFn] = None,
 ) -> Dict[str, Any]: ...
 def import_bag(
-    bags: Union[str, Sequence[str]],
-    out: str,
-    config: Optional[str] = None,
-    layout: Optional[str] = None,
+    bags: Union[Path, Sequence[Path]],
+    out: Path,
+    config: Optional[Path] = None,
+    layout: Optional[Path] = None,
     max_frames: int = 0,
     gz_level: int = 1,
     progress: Optional[ProgressFn] = None,
@@ -45,7 +48,7 @@ class Config:
 
     def __init__(self) -> None: ...
     @staticmethod
-    def from_file(path: str) -> "Config": ...
+    def from_file(path: Path) -> "Config": ...
     @staticmethod
     def from_string(text: str) -> "Config": ...
     def get(self, section: str, key: str) -> str: ...
@@ -82,7 +85,8 @@ class Voxels:
     def __len__(self) -> int: ...
 
 class Pipeline:
-    """The segmentation pipeline, one frame at a time."""
+    """The segmentation pipeline, one frame at a time. Its calls are
+    serialised: it may be shared by threads, one call at a time."""
 
     def __init__(self, config: Config) -> None: ...
     def process(
@@ -96,12 +100,14 @@ class Pipeline:
     ) -> Result: ...
     @property
     def frames_processed(self) -> int: ...
+    @property
+    def imu_rejected(self) -> int: ...
     def occupied_voxels(self, p_occupied: float = 0.5) -> Voxels: ...
     def moving_voxels(self) -> Voxels: ...
     def static_voxels(self, p_occupied: Optional[float] = None) -> Voxels: ...
-    def save_static_map(self, path: str, p_occupied: Optional[float] = None) -> int: ...
+    def save_static_map(self, path: Path, p_occupied: Optional[float] = None) -> int: ...
 
 class _RawlogReader:
-    def __init__(self, path: str, config: Config) -> None: ...
+    def __init__(self, path: Path, config: Config) -> None: ...
     def __iter__(self) -> "_RawlogReader": ...
     def __next__(self) -> dict: ...

@@ -12,9 +12,11 @@
 #endif
 #include <bims/common/config.h>
 #include <bims/common/depth_image.h>
+#include <bims/common/imu_check.h>
 #include <bims/ego/attitude_filter.h>
 #include <bims/ego/flags.h>
 #include <bims/ego/rgbd_input.h>
+#include <bims/io/image_file.h>
 #include <bims/io/rawlog.h>
 #include <bims/maps/export.h>
 #include <bims/pipeline/config.h>
@@ -28,12 +30,17 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <thread>
+#include <vector>
 
 namespace py = pybind11;
 using namespace bims;
@@ -44,6 +51,10 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /** Columns of an IMU array: t, gyro xyz, accel xyz, mag xyz, quaternion
  * wxyz (R_WI); the first 7 are required, NaN = the channel is absent. */
 constexpr int kImuColumns = 14;
+/** The largest frame stamp [s] taken (from 0, 1970): a frame's stamp
+ * becomes an mrpt::Clock time, a 64-bit count of 100 ns since 1601 (up to
+ * 9.2e11 s), whose conversion back to seconds wraps below 0. */
+constexpr double kMaxStamp = 1e11;
 
 /** Raises FileNotFoundError with \a what. */
 [[noreturn]] void fileNotFound(const std::string& what)
@@ -56,6 +67,65 @@ constexpr int kImuColumns = 14;
 [[noreturn]] void bad(const std::string& arg, const std::string& what)
 {
 	throw py::value_error(arg + ": " + what);
+}
+
+/** \a v as "%g" prints it. */
+std::string numText(double v)
+{
+	char buf[32];
+	std::snprintf(buf, sizeof(buf), "%g", v);
+	return buf;
+}
+
+/** The name of \a h's type, for a TypeError. */
+std::string typeName(const py::handle& h)
+{
+	return py::str(py::type::handle_of(h).attr("__name__"));
+}
+
+/** \a h as a double: a Python or NumPy number (not a bool, a string or
+ * bytes); else a TypeError naming the argument and what it is. */
+double number(const py::handle& h, const std::string& arg,
+              const std::string& what)
+{
+	if (!h.is_none() && !py::isinstance<py::bool_>(h) &&
+	    !py::isinstance<py::str>(h) && !py::isinstance<py::bytes>(h) &&
+	    PyNumber_Check(h.ptr()))
+	{
+		PyObject* f = PyNumber_Float(h.ptr());
+		if (f)
+		{
+			const double v = PyFloat_AsDouble(f);
+			Py_DECREF(f);
+			return v;
+		}
+		// not convertible (e.g. an array of several values): ours below;
+		// what the object's own conversion raised otherwise passes on
+		if (!PyErr_ExceptionMatches(PyExc_TypeError) &&
+		    !PyErr_ExceptionMatches(PyExc_ValueError))
+			throw py::error_already_set();
+		PyErr_Clear();
+	}
+	throw py::type_error(arg + ": " + what + " expected, got " + typeName(h));
+}
+
+/** \a h as a file path: a str or an os.PathLike (e.g. pathlib.Path), not
+ * empty; else a TypeError (None, a number, ...) or a ValueError naming the
+ * argument. The programs take paths the same way: a text, never empty. */
+std::string pathArg(const py::handle& h, const std::string& arg)
+{
+	if (!py::isinstance<py::str>(h) && !py::hasattr(h, "__fspath__"))
+		throw py::type_error(
+		    arg + ": a path (str or os.PathLike) expected, got " + typeName(h));
+	const py::object p = py::module_::import("os").attr("fspath")(h);
+	if (!py::isinstance<py::str>(p))
+		throw py::type_error(
+		    arg + ": a path (str or os.PathLike) expected, got " + typeName(p));
+	std::string s = p.cast<std::string>();
+	if (s.empty()) bad(arg, "an empty path");
+	if (s.find('\0') != std::string::npos)
+		bad(arg, "a path with a NUL character");
+	return s;
 }
 
 /** A C-contiguous array of \a dtype with \a ndim dimensions (else a
@@ -243,12 +313,14 @@ Voxels voxelsOf(const maps::VoxelSet& v)
 /** \a p, or the config's [output] static_p_occupied when None, checked. */
 double occupiedThreshold(const py::object& p, double fallback)
 {
-	const double v = p.is_none() ? fallback : p.cast<double>();
+	const double v = p.is_none()
+	                     ? fallback
+	                     : number(p, "p_occupied", "a probability in [0, 1)");
 	if (!(v >= 0 && v < 1)) bad("p_occupied", "must be in [0, 1)");
 	return v;
 }
 
-Result resultOf(const pipeline::FrameResult& r)
+Result resultOf(const pipeline::FrameResult& r, uint32_t moreFlags)
 {
 	Result o;
 	o.index = r.index;
@@ -260,8 +332,8 @@ Result resultOf(const pipeline::FrameResult& r)
 	o.labels = toNumpy(r.labels);
 	o.pose = poseMatrix(r.T_WC);
 	o.motion = poseMatrix(r.T_CprevC);
-	o.flagBits = r.ego.flags;
-	for (const char* n : ego::flagNames(r.ego.flags)) o.flags.emplace_back(n);
+	o.flagBits = r.ego.flags | moreFlags;
+	for (const char* n : ego::flagNames(o.flagBits)) o.flags.emplace_back(n);
 	o.warmup = r.warmup;
 	o.flowOff = r.flowOff;
 	o.times["input"] = r.ms.input;
@@ -274,25 +346,105 @@ Result resultOf(const pipeline::FrameResult& r)
 	return o;
 }
 
-/** The pipeline on arrays. */
+/** One call at a time on an object used from several Python threads: a
+ * call holds the object's mutex from its start to its end. The GIL is
+ * released while a call waits for the mutex (the thread holding it may
+ * need the GIL to finish: no deadlock), so the calls of two threads run
+ * one after the other, whole, in the order they get the mutex. A call made
+ * again from inside a call on the same thread (e.g. by an argument's
+ * __float__) would wait for itself: a RuntimeError instead. */
+class CallLock
+{
+ public:
+	/** The mutex, held for one call. */
+	class Held
+	{
+	 public:
+		explicit Held(CallLock& l) : l_(l) {}
+		~Held()
+		{
+			l_.owner_.store(std::thread::id());
+			l_.mu_.unlock();
+		}
+		Held(const Held&) = delete;
+		Held& operator=(const Held&) = delete;
+
+	 private:
+		CallLock& l_;
+	};
+
+	/** Waits for the other threads' calls on the object \a what. */
+	[[nodiscard]] Held hold(const char* what)
+	{
+		if (owner_.load() == std::this_thread::get_id())
+			throw std::runtime_error(
+			    std::string(what) +
+			    ": called again from inside one of its own calls on the "
+			    "same thread (e.g. by an argument's __float__); the first "
+			    "call must return first");
+		if (!mu_.try_lock())
+		{
+			py::gil_scoped_release nogil;
+			mu_.lock();
+		}
+		owner_.store(std::this_thread::get_id());
+		return Held(*this);
+	}
+
+ private:
+	std::mutex mu_;
+	std::atomic<std::thread::id> owner_{};
+};
+
+/** The IMU rows of one process() call, checked before any is used. */
+struct ImuRows
+{
+	std::vector<sensors::ImuSample> used;
+	size_t rejected = 0;  ///< rows no IMU measures (imuSampleProblem)
+	std::string firstRejected;
+	double last = 0;  ///< the last row's time
+	bool any = false;
+};
+
+/** The pipeline on arrays. Its calls are serialised (CallLock): one
+ * pipeline may be used from several threads, one call at a time. */
 class PyPipeline
 {
  public:
-	explicit PyPipeline(const Config& c) : cfg_(c.cfg), pipe_(c.cfg) {}
+	explicit PyPipeline(const Config& c)
+	    : cfg_(c.cfg),
+	      pipe_(c.cfg),
+	      farthest_(pipeline::farthestDepthUsed(c.cfg))
+	{
+	}
 
 	Result process(const py::object& depth, const py::object& rgb,
 	               const py::object& stamp, const py::object& imu,
 	               const py::object& K, const py::object& units)
 	{
+		const auto held = calls_.hold("bims.Pipeline");
 		if (stamp.is_none()) bad("stamp", "required (the frame's time [s])");
-		const double t = stamp.cast<double>();
+		const double t = number(stamp, "stamp", "a time [s] (a number)");
 		if (!std::isfinite(t)) bad("stamp", "not finite");
+		if (!(t >= 0 && t <= kMaxStamp))
+			bad("stamp", numText(t) +
+			                 " s is outside the times MRPT's clock holds (0 to "
+			                 "1e11 s since 1970)");
 		if (haveLast_ && !(t > lastStamp_))
 			bad("stamp", std::to_string(t) +
 			                 " is not after the previous frame's " +
 			                 std::to_string(lastStamp_));
 		ego::RgbdFrame frame = decode(depth, rgb, t, K, units);
-		if (!imu.is_none()) addImu(imu);
+		const ImuRows rows = imuRows(imu);
+		if (rows.rejected > 0)
+			warnRejected(rows);  // (may raise: warnings as errors)
+		for (const auto& s : rows.used) pipe_.addImu(s);
+		if (rows.any)
+		{
+			lastImu_ = rows.last;
+			haveImu_ = true;
+		}
+		imuRejected_ += rows.rejected;
 		const pipeline::FrameResult* r = nullptr;
 		{
 			py::gil_scoped_release nogil;
@@ -301,31 +453,45 @@ class PyPipeline
 		++index_;
 		lastStamp_ = t;
 		haveLast_ = true;
-		return resultOf(*r);
+		return resultOf(*r, rows.rejected ? ego::kFlagImuRejected : 0u);
 	}
 
-	size_t framesProcessed() const { return pipe_.framesProcessed(); }
+	size_t framesProcessed()
+	{
+		const auto held = calls_.hold("bims.Pipeline");
+		return pipe_.framesProcessed();
+	}
+	size_t imuRejected()
+	{
+		const auto held = calls_.hold("bims.Pipeline");
+		return imuRejected_;
+	}
 
 	Voxels occupiedVoxels(const py::object& p)
 	{
+		const auto held = calls_.hold("bims.Pipeline");
 		const double th = occupiedThreshold(p, 0.5);
 		return voxelsOf(maps::occupiedVoxels(*pipe_.grids().occupancy(), th));
 	}
-	Voxels movingVoxels() const
+	Voxels movingVoxels()
 	{
+		const auto held = calls_.hold("bims.Pipeline");
 		const auto* m = pipe_.maskGrid();
 		return voxelsOf(m ? maps::movingVoxels(*m) : maps::VoxelSet{});
 	}
 	Voxels staticVoxels(const py::object& p)
 	{
+		const auto held = calls_.hold("bims.Pipeline");
 		const double th = occupiedThreshold(p, cfg_.output.static_p_occupied);
 		return voxelsOf(maps::staticVoxels(*pipe_.grids().occupancy(),
 		                                   pipe_.maskGrid(), th));
 	}
 	/** The static map as bims-run writes it: a .ply (centres and
 	 * occupancy) or an OctoMap .bt, by the file's extension. */
-	size_t saveStaticMap(const std::string& path, const py::object& p)
+	size_t saveStaticMap(const py::object& pathObj, const py::object& p)
 	{
+		const auto held = calls_.hold("bims.Pipeline");
+		const std::string path = pathArg(pathObj, "path");
 		const double th = occupiedThreshold(p, cfg_.output.static_p_occupied);
 		const std::string ext = mrpt::system::extractFileExtension(path);
 		const auto& occ = *pipe_.grids().occupancy();
@@ -353,12 +519,43 @@ class PyPipeline
 		return M;
 	}
 
+	/** Metres per reading: \a unitsObj, else the array's units, else
+	 * 0.001 (uint16 readings); checked. */
+	double readingUnits(const py::object& unitsObj,
+	                    const py::object& attached) const
+	{
+		if (unitsObj.is_none() && attached.is_none()) return 0.001;
+		const char* name = unitsObj.is_none() ? "depth.units" : "depth_units";
+		const double u = number(unitsObj.is_none() ? attached : unitsObj, name,
+		                        "metres per reading (a number)");
+		if (!(u > 0) || !std::isfinite(u))
+			bad(name, "must be a finite value > 0 [m]");
+		return u;
+	}
+
+	/** Float depth is in metres: units other than 1 contradict it. */
+	static void checkMetres(const py::object& unitsObj,
+	                        const py::object& attached)
+	{
+		for (const auto& [obj, name] : {std::pair{unitsObj, "depth_units"},
+		                                std::pair{attached, "depth.units"}})
+		{
+			if (obj.is_none()) continue;
+			const double u = number(obj, name, "metres per reading");
+			if (u != 1)
+				bad(name, numText(u) +
+				              " for float32 depth, which is in metres: units "
+				              "apply to uint16 readings (leave it None)");
+		}
+	}
+
 	ego::RgbdFrame decode(const py::object& depthObj, const py::object& rgbObj,
 	                      double t, const py::object& K,
 	                      const py::object& unitsObj)
 	{
 		if (!py::isinstance<py::array>(depthObj))
-			throw py::type_error("depth: a numpy array expected");
+			throw py::type_error("depth: a numpy array expected, got " +
+			                     typeName(depthObj));
 		const py::array any = py::reinterpret_borrow<py::array>(depthObj);
 		DepthImage d;
 		cv::Mat quantized;  // float metres -> readings
@@ -366,16 +563,25 @@ class PyPipeline
 		py::array a = checked(
 		    depthObj, "depth",
 		    isFloat ? py::dtype::of<float>() : py::dtype::of<uint16_t>(), 2);
+		const auto rows = a.shape(0), cols = a.shape(1);
+		if (rows == 0 || cols == 0) bad("depth", "empty image");
+		// the limits of input image files ([input]), before any copy
+		if (const std::string beyond =
+		        imageSizeBeyondLimits(static_cast<uint64_t>(rows),
+		                              static_cast<uint64_t>(cols), cfg_.input);
+		    !beyond.empty())
+			bad("depth", beyond);
+		const int H = static_cast<int>(rows), W = static_cast<int>(cols);
+		if (const std::string small =
+		        pipe_.frameSizeProblem(W, H, !rgbObj.is_none());
+		    !small.empty())
+			bad("depth", small);
 		const Eigen::Matrix3d Km = cameraOf(depthObj, K);
-		const int H = static_cast<int>(a.shape(0)),
-		          W = static_cast<int>(a.shape(1));
-		if (H == 0 || W == 0) bad("depth", "empty image");
 		const py::object attachedUnits =
 		    py::getattr(depthObj, "units", py::none());
 		if (isFloat)
 		{
-			// Readings of 0.1 mm, or coarser when the farthest reading needs
-			// it (the 16 bits span the frame's range).
+			checkMetres(unitsObj, attachedUnits);
 			const cv::Mat m(H, W, CV_32FC1, const_cast<void*>(a.data()));
 			cv::Point at;
 			if (!cv::checkRange(m, true, &at))
@@ -385,20 +591,25 @@ class PyPipeline
 			double lo = 0, hi = 0;
 			cv::minMaxLoc(m, &lo, &hi);
 			if (lo < 0) bad("depth", "negative depth (0 marks no reading)");
+			// Readings farther than any stage reads are no reading (as a
+			// depth file's beyond its 16 bits), so that one far value does
+			// not coarsen the others' scale.
+			cv::Mat kept = m;
+			if (hi > farthest_)
+			{
+				kept = m.clone();
+				kept.setTo(0, m > farthest_);
+				cv::minMaxLoc(kept, nullptr, &hi);
+			}
+			// Readings of 0.1 mm, or coarser when the farthest reading needs
+			// it (the 16 bits span the frame's range).
 			d.units = static_cast<float>(std::max(1e-4, hi / 65535.0));
-			m.convertTo(quantized, CV_16UC1, 1.0 / d.units);
+			kept.convertTo(quantized, CV_16UC1, 1.0 / d.units);
 			d.data = quantized.ptr<uint16_t>(0);
 		}
 		else
 		{
-			double u = 0.001;
-			if (!unitsObj.is_none())
-				u = unitsObj.cast<double>();
-			else if (!attachedUnits.is_none())
-				u = attachedUnits.cast<double>();
-			if (!(u > 0) || !std::isfinite(u))
-				bad("depth_units", "must be a finite value > 0 [m]");
-			d.units = static_cast<float>(u);
+			d.units = static_cast<float>(readingUnits(unitsObj, attachedUnits));
 			d.data = static_cast<const uint16_t*>(a.data());
 		}
 		d.width = W;
@@ -408,14 +619,20 @@ class PyPipeline
 		// false), when the array says so
 		const py::object isDepth =
 		    py::getattr(depthObj, "range_is_depth", py::none());
-		d.isDepth = isDepth.is_none() || isDepth.cast<bool>();
+		if (!isDepth.is_none())
+		{
+			const int truth = PyObject_IsTrue(isDepth.ptr());
+			if (truth < 0) throw py::error_already_set();
+			d.isDepth = truth == 1;
+		}
 		d.timestamp = mrpt::Clock::fromDouble(t);
 		d.label = "depth";
 		cv::Mat grey;
 		if (!rgbObj.is_none())
 		{
 			if (!py::isinstance<py::array>(rgbObj))
-				throw py::type_error("rgb: a numpy array expected");
+				throw py::type_error("rgb: a numpy array expected, got " +
+				                     typeName(rgbObj));
 			const py::array ra = py::reinterpret_borrow<py::array>(rgbObj);
 			const int nd = static_cast<int>(ra.ndim());
 			py::array c = checked(rgbObj, "rgb", py::dtype::of<uint8_t>(),
@@ -443,8 +660,16 @@ class PyPipeline
 		return f;
 	}
 
-	void addImu(const py::object& imuObj)
+	/** The rows of \a imuObj (None: none), checked: a row with a time not
+	 * finite or before the previous row's is a ValueError; a row holding a
+	 * value no IMU gives (bims::imuSampleProblem, the rawlog readers' rule:
+	 * a field infinite or beyond any sensor's range) is not used,
+	 * counted. NaN marks a channel absent. Converted as a rawlog's samples
+	 * are (sensors::imuSampleFrom). */
+	ImuRows imuRows(const py::object& imuObj) const
 	{
+		ImuRows out;
+		if (imuObj.is_none()) return out;
 		py::array a = checked(imuObj, "imu", py::dtype::of<double>(), 2);
 		const auto cols = a.shape(1);
 		if (cols != 7 && cols != 10 && cols != kImuColumns)
@@ -452,45 +677,83 @@ class PyPipeline
 			               " columns: 7 (t, gyro xyz, accel xyz), 10 (and mag "
 			               "xyz) or 14 (and the quaternion wxyz) expected");
 		auto m = a.unchecked<double, 2>();
-		auto has = [&](py::ssize_t i, int c0, int n)
+		using namespace mrpt::obs;  // the IMU_* data indices
+		// the columns of each channel, with MRPT's fields
+		struct Channel
 		{
-			if (c0 + n > cols) return false;
-			for (int k = 0; k < n; ++k)
-				if (std::isnan(m(i, c0 + k))) return false;
-			return true;
+			int col;
+			std::vector<TIMUDataIndex> fields;
 		};
+		static const Channel channels[] = {
+		    {1, {IMU_WX, IMU_WY, IMU_WZ}},
+		    {4, {IMU_X_ACC, IMU_Y_ACC, IMU_Z_ACC}},
+		    {7, {IMU_MAG_X, IMU_MAG_Y, IMU_MAG_Z}},
+		    {10,
+		     {IMU_ORI_QUAT_W, IMU_ORI_QUAT_X, IMU_ORI_QUAT_Y, IMU_ORI_QUAT_Z}}};
+		double last = lastImu_;
+		bool have = haveImu_;
 		for (py::ssize_t i = 0; i < a.shape(0); ++i)
 		{
 			const double t = m(i, 0);
 			if (!std::isfinite(t))
 				bad("imu", "row " + std::to_string(i) + ": time not finite");
-			if (haveImu_ && t < lastImu_)
+			if (have && t < last)
 				bad("imu", "row " + std::to_string(i) + ": time " +
 				               std::to_string(t) +
 				               " is before the previous sample's " +
-				               std::to_string(lastImu_) +
+				               std::to_string(last) +
 				               " (samples in time order expected)");
-			sensors::ImuSample s;
-			s.t = t;
-			if ((s.hasGyro = has(i, 1, 3)))
-				s.gyro = Eigen::Vector3d(m(i, 1), m(i, 2), m(i, 3));
-			if ((s.hasAcc = has(i, 4, 3)))
-				s.acc = Eigen::Vector3d(m(i, 4), m(i, 5), m(i, 6));
-			if ((s.hasMag = has(i, 7, 3)))
-				s.mag = Eigen::Vector3d(m(i, 7), m(i, 8), m(i, 9));
-			if (has(i, 10, 4))
-				s.q_WI =
-				    Eigen::Quaterniond(m(i, 10), m(i, 11), m(i, 12), m(i, 13))
-				        .normalized();
-			pipe_.addImu(s);
-			lastImu_ = t;
-			haveImu_ = true;
+			CObservationIMU o;
+			for (const Channel& c : channels)
+			{
+				const int n = static_cast<int>(c.fields.size());
+				if (c.col + n > cols) continue;
+				bool present = true;  // (NaN: the channel is absent)
+				for (int k = 0; k < n; ++k)
+					present = present && !std::isnan(m(i, c.col + k));
+				if (present)
+					for (int k = 0; k < n; ++k)
+						o.set(c.fields[k], m(i, c.col + k));
+			}
+			if (std::string why = imuSampleProblem(o); !why.empty())
+			{
+				if (out.rejected++ == 0)
+					out.firstRejected = "row " + std::to_string(i) + " (t " +
+					                    std::to_string(t) + "): " + why;
+			}
+			else
+			{
+				sensors::ImuSample s = sensors::imuSampleFrom(o);
+				s.t = t;
+				out.used.push_back(s);
+			}
+			last = t;
+			have = true;
+			out.any = true;
 		}
+		out.last = last;
+		return out;
+	}
+
+	/** A RuntimeWarning for the rows not used, as the programs warn. */
+	void warnRejected(const ImuRows& rows) const
+	{
+		const std::string msg =
+		    "imu: " + std::to_string(rows.rejected) +
+		    " sample(s) not used, holding values no IMU measures (first: " +
+		    rows.firstRejected + "); the frame is flagged imu_rejected, " +
+		    std::to_string(imuRejected_ + rows.rejected) +
+		    " so far (Pipeline.imu_rejected)";
+		if (PyErr_WarnEx(PyExc_RuntimeWarning, msg.c_str(), 1) != 0)
+			throw py::error_already_set();
 	}
 
 	pipeline::ExperimentConfig cfg_;
 	pipeline::Pipeline pipe_;
-	size_t index_ = 0;
+	/** Readings farther [m] are no reading (pipeline::farthestDepthUsed). */
+	double farthest_;
+	CallLock calls_;
+	size_t index_ = 0, imuRejected_ = 0;
 	double lastStamp_ = 0, lastImu_ = 0;
 	bool haveLast_ = false, haveImu_ = false;
 };
@@ -529,12 +792,14 @@ py::array_t<double> imuArray(const source::SourceFrame& f)
 class PyRawlogReader
 {
  public:
-	PyRawlogReader(const std::string& path, const Config& c) : cfg_(c.cfg)
+	PyRawlogReader(const py::object& pathObj, const Config& c)
+	    : path_(pathArg(pathObj, "path")), cfg_(c.cfg)
 	{
-		if (!mrpt::system::fileExists(path))
-			fileNotFound(path + ": no such rawlog");
+		if (!mrpt::system::fileExists(path_))
+			fileNotFound(path_ + ": no such rawlog");
+		checkRawlogPath(path_);  // (a folder, an empty file: RawlogError)
 		src_ = std::make_unique<source::RawlogFrameSource>(
-		    std::vector<std::string>{path},
+		    std::vector<std::string>{path_},
 		    source::FrameOrderParams::of(cfg_.ego, cfg_.pipeline.imu_wait_s,
 		                                 "bims.read_rawlog"),
 		    false);
@@ -542,6 +807,7 @@ class PyRawlogReader
 
 	py::dict next()
 	{
+		const auto held = calls_.hold("bims.read_rawlog");
 		std::optional<source::SourceFrame> f;
 		{
 			py::gil_scoped_release nogil;
@@ -550,6 +816,15 @@ class PyRawlogReader
 		if (!f)
 		{
 			if (!src_->error().empty()) throw std::runtime_error(src_->error());
+			// as bims-run: a rawlog without a 3D scan is an error
+			if (src_->stats().scansRead == 0)
+			{
+				const std::string& label = cfg_.ego.sensors.rgbd_label;
+				throw RawlogError(
+				    path_ + ": no CObservation3DRangeScan (RGB-D) observation" +
+				    (label.empty() ? std::string()
+				                   : " with label '" + label + "'"));
+			}
 			throw py::stop_iteration();
 		}
 		const auto& scan = *f->scan;
@@ -592,8 +867,10 @@ class PyRawlogReader
 	}
 
  private:
+	std::string path_;
 	pipeline::ExperimentConfig cfg_;
 	std::unique_ptr<source::RawlogFrameSource> src_;
+	CallLock calls_;
 };
 
 #ifdef BIMS_PYTHON_IMPORTERS
@@ -611,11 +888,12 @@ ProgressCallback progressOf(const py::object& cb)
 	};
 }
 
-/** \a path, or nullopt for None. */
-std::optional<std::string> optionalPath(const py::object& path)
+/** \a path (pathArg), or nullopt for None. */
+std::optional<std::string> optionalPath(const py::object& path,
+                                        const std::string& arg)
 {
 	if (path.is_none()) return std::nullopt;
-	return py::str(path).cast<std::string>();
+	return pathArg(path, arg);
 }
 
 /** The options every importer's run shares (apps/import_options.h). */
@@ -624,8 +902,8 @@ Options importOptions(const py::object& out, const py::object& config,
                       size_t maxFrames, int gz)
 {
 	Options o;
-	o.out = py::str(out);
-	o.config = optionalPath(config);
+	o.out = pathArg(out, "out");
+	o.config = optionalPath(config, "config");
 	o.max_frames = maxFrames;
 	o.gz = gz;
 	return o;
@@ -646,7 +924,7 @@ py::dict importTum(const py::object& folder, const py::object& out,
                    const py::object& progress)
 {
 	auto o = importOptions<apps::ImportRunOptions>(out, config, maxFrames, gz);
-	o.folder = py::str(folder);
+	o.folder = pathArg(folder, "folder");
 	o.bonn_gt = bonnGt;
 	o.synth_imu = synthImu;
 	o.seed = seed;
@@ -672,7 +950,7 @@ py::dict importStray(const py::object& folder, const py::object& out,
 {
 	auto o =
 	    importOptions<apps::StrayImportRunOptions>(out, config, maxFrames, gz);
-	o.folder = py::str(folder);
+	o.folder = pathArg(folder, "folder");
 	const auto cb = progressOf(progress);
 	const auto s = withoutGil([&] { return apps::importStrayChecked(o, cb); });
 	py::dict d;
@@ -694,11 +972,13 @@ py::dict importBag(const py::object& bags, const py::object& out,
 {
 	auto o =
 	    importOptions<apps::BagImportRunOptions>(out, config, maxFrames, gz);
-	if (py::isinstance<py::str>(bags) || !py::isinstance<py::iterable>(bags))
-		o.bags.push_back(py::str(bags));
+	if (py::isinstance<py::str>(bags) || py::hasattr(bags, "__fspath__") ||
+	    !py::isinstance<py::iterable>(bags))
+		o.bags.push_back(pathArg(bags, "bags"));
 	else
-		for (const auto& b : bags) o.bags.push_back(py::str(b));
-	o.layout = optionalPath(layout);
+		for (const auto& b : bags) o.bags.push_back(pathArg(b, "bags"));
+	if (o.bags.empty()) bad("bags", "no bag given");
+	o.layout = optionalPath(layout, "layout");
 	const auto cb = progressOf(progress);
 	const apps::BagImport r =
 	    withoutGil([&] { return apps::importBagChecked(o, cb); });
@@ -752,11 +1032,11 @@ PYBIND11_MODULE(_bims, m)
 	    .def(py::init<>(), "The built-in defaults (config/default.ini's)")
 	    .def_static(
 	        "from_file",
-	        [](const std::string& path)
+	        [](const py::object& path)
 	        {
 		        try
 		        {
-			        return Config::fromFile(path);
+			        return Config::fromFile(pathArg(path, "path"));
 		        }
 		        catch (const ConfigFileMissing& e)
 		        {
@@ -810,7 +1090,10 @@ PYBIND11_MODULE(_bims, m)
 	    .def("__repr__", [](const Voxels& v)
 	         { return "<bims.Voxels: " + std::to_string(v.size()) + ">"; });
 
-	py::class_<PyPipeline>(m, "Pipeline", "The segmentation pipeline")
+	py::class_<PyPipeline>(
+	    m, "Pipeline",
+	    "The segmentation pipeline. Its calls are serialised: from several "
+	    "threads they run one at a time, whole")
 	    .def(py::init<const Config&>(), py::arg("config"))
 	    .def(
 	        "process", &PyPipeline::process, py::arg("depth"),
@@ -822,6 +1105,9 @@ PYBIND11_MODULE(_bims, m)
 	        "(RGB) or H x W; stamp [s]; imu N x 7/10/14 float64 rows (t, gyro, "
 	        "accel[, mag[, quaternion wxyz]]) up to this frame")
 	    .def_property_readonly("frames_processed", &PyPipeline::framesProcessed)
+	    .def_property_readonly(
+	        "imu_rejected", &PyPipeline::imuRejected,
+	        "IMU rows not used: values no IMU measures (a warning each call)")
 	    .def("occupied_voxels", &PyPipeline::occupiedVoxels,
 	         py::arg("p_occupied") = 0.5,
 	         "Tier 0's voxels with occupancy probability > p_occupied")
@@ -839,7 +1125,7 @@ PYBIND11_MODULE(_bims, m)
 	         "value) or PATH.bt (OctoMap); returns the number of voxels");
 
 	py::class_<PyRawlogReader>(m, "_RawlogReader")
-	    .def(py::init<const std::string&, const Config&>())
+	    .def(py::init<const py::object&, const Config&>())
 	    .def("__iter__", [](PyRawlogReader& r) -> PyRawlogReader& { return r; })
 	    .def("__next__", &PyRawlogReader::next);
 }

@@ -6,6 +6,7 @@ import os
 import subprocess
 import tempfile
 import unittest
+import warnings
 
 import numpy as np
 
@@ -383,6 +384,215 @@ class BadInput(unittest.TestCase):
         r = p.process(metres, stamp=f.stamp, K=f.K)
         self.assertEqual(r.mask.shape, f.depth.shape)
         self.assertTrue(r.flow_off)
+
+
+class Issue55(unittest.TestCase):
+    """Hostile input, third round: each refusal or repair of issue 55's
+    campaign on the Python module."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.frames = [f for _, f in zip(range(12), bims.read_rawlog(SAMPLE))]
+        cls.f = cls.frames[0]
+
+    def pipe(self, **sets):
+        cfg = bims.Config.from_file(CONFIG)
+        for key, v in sets.items():
+            section, name = key.split("__")
+            cfg.set(section, name, v)
+        return bims.Pipeline(cfg)
+
+    def raises(self, error, start, call):
+        with self.assertRaises(error) as e:
+            call()
+        self.assertTrue(str(e.exception).startswith(start), str(e.exception))
+        return str(e.exception)
+
+    def test_arrays_beyond_the_input_image_limits_are_refused(self):
+        """[input] image_max_side / image_max_pixels apply to arrays as to
+        files: before, 16384 x 16384 took 4.9 GB, then MemoryError."""
+        f = self.f
+        p = self.pipe(input__image_max_side=300)  # the config's limits
+        self.raises(ValueError, "depth: 320 x 240 pixels, beyond the 300 per side",
+                    lambda: p.process(f.depth, rgb=f.rgb, stamp=f.stamp))
+        p = self.pipe(input__image_max_pixels=320 * 240 - 1)
+        self.raises(ValueError, "depth: 320 x 240 pixels",
+                    lambda: p.process(f.depth.astype(np.float32) * np.float32(0.001),
+                                      stamp=f.stamp, K=f.K))
+        self.assertEqual(p.frames_processed, 0)
+        self.raises(  # the defaults (zeros: their pages are never touched)
+            ValueError, "depth: 16384 x 16384 pixels, beyond the 16384 per side "
+            "and 67108864 pixels bims reads ([input] image_max_side, "
+            "image_max_pixels)",
+            lambda: self.pipe().process(
+                np.zeros((16384, 16384), np.uint16), stamp=f.stamp, K=f.K),
+        )
+
+    def run_frames(self, imu_of):
+        """Poses, masks and flags of the first frames, each with the IMU
+        rows imu_of(i, f) gives."""
+        p = self.pipe()
+        out = []
+        for i, f in enumerate(self.frames):
+            r = p.process(f.depth, rgb=f.rgb, stamp=f.stamp, imu=imu_of(i, f))
+            out.append((r.pose.copy(), r.mask.copy(), r.flags))
+        return p, out
+
+    def test_imu_rows_no_imu_gives_are_dropped_counted_and_warned(self):
+        """One IMU row with gyro inf or 1e300 turned every later pose NaN
+        and every mask empty, without a word; now it is not used, as the
+        rawlog readers do (bims::imuSampleProblem), with a RuntimeWarning,
+        the frame flagged imu_rejected and Pipeline.imu_rejected counting."""
+
+        def bad(i, f):
+            imu = f.imu
+            if i in (3, 7) and len(imu):
+                row = imu[:1].copy()
+                row[0, 1] = np.inf if i == 3 else 1e300  # gyro x
+                imu = np.vstack([row, imu])
+            return imu
+
+        _, clean = self.run_frames(lambda i, f: f.imu)
+        with warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always")
+            p, dirty = self.run_frames(bad)
+        said = [str(w.message) for w in seen if w.category is RuntimeWarning]
+        self.assertEqual(len(said), 2, said)
+        self.assertTrue(said[0].startswith("imu: 1 sample(s) not used"), said[0])
+        self.assertIn("IMU_WX = inf (not finite)", said[0])
+        self.assertIn("IMU_WX = 1e+300 (beyond +-100 rad/s)", said[1])
+        self.assertEqual(p.imu_rejected, 2)
+        for i, ((pc, mc, fc), (pd, md, fd)) in enumerate(zip(clean, dirty)):
+            self.assertTrue(np.isfinite(pd).all(), f"frame {i}")
+            np.testing.assert_array_equal(pc, pd, err_msg=f"frame {i}")
+            np.testing.assert_array_equal(mc, md, err_msg=f"frame {i}")
+            self.assertEqual("imu_rejected" in fd, i in (3, 7), f"frame {i}: {fd}")
+            self.assertEqual([x for x in fd if x != "imu_rejected"], fc)
+        with warnings.catch_warnings():  # warnings as errors: nothing used
+            warnings.simplefilter("error")
+            p = self.pipe()
+            f = self.f
+            with self.assertRaises(RuntimeWarning):
+                p.process(f.depth, rgb=f.rgb, stamp=f.stamp, imu=bad(3, f))
+            self.assertEqual(p.frames_processed, 0)
+
+    def test_float_depth_beyond_the_farthest_range_is_no_reading(self):
+        """One float32 pixel at 1e6 m made the 16-bit scale follow it: every
+        other reading became 0 and the frame's cloud was empty. A reading
+        farther than any stage reads is no reading, as a depth file's."""
+        f = self.f
+        metres = np.ascontiguousarray(f.depth.astype(np.float32) * np.float32(0.001))
+        far = metres.copy()
+        far[5, 5] = 1e6
+        far[100, 7] = 9.5  # beyond [grids] max_range 8 and every stage's
+        near = metres.copy()
+        near[5, 5] = near[100, 7] = 0
+        a = self.pipe().process(far, rgb=f.rgb, stamp=f.stamp, K=f.K)
+        b = self.pipe().process(near, rgb=f.rgb, stamp=f.stamp, K=f.K)
+        self.assertGreater(b.hit_voxels, 1000)
+        self.assertEqual(a.hit_voxels, b.hit_voxels)
+        np.testing.assert_array_equal(a.mask, b.mask)
+        np.testing.assert_array_equal(a.pose, b.pose)
+
+    def test_importers_check_their_arguments(self):
+        """bims.import_stray(folder, None) wrote files named None: paths are
+        str or os.PathLike, not empty, as the programs take them."""
+        import pathlib
+
+        with tempfile.TemporaryDirectory() as d:
+            cwd = os.getcwd()
+            os.chdir(d)
+            try:
+                self.raises(TypeError, "out: a path (str or os.PathLike) expected, "
+                            "got NoneType", lambda: bims.import_stray(d, None))
+                self.raises(TypeError, "folder: a path", lambda: bims.import_stray(None, "x.rawlog"))
+                self.raises(ValueError, "out: an empty path", lambda: bims.import_tum(d, ""))
+                self.raises(TypeError, "config: a path",
+                            lambda: bims.import_tum(d, "x.rawlog", config=3))
+                if bims.import_bag is not None:
+                    self.raises(TypeError, "bags: a path", lambda: bims.import_bag([d, 5], "x.rawlog"))
+                    self.raises(ValueError, "bags: no bag given", lambda: bims.import_bag([], "x.rawlog"))
+                    self.raises(TypeError, "layout: a path",
+                                lambda: bims.import_bag(d, "x.rawlog", layout=1.5))
+                # a pathlib.Path is a path (here: not a capture)
+                self.raises(RuntimeError, d, lambda: bims.import_stray(pathlib.Path(d), pathlib.Path(d) / "o.rawlog"))
+                self.assertEqual(os.listdir(d), [])
+            finally:
+                os.chdir(cwd)
+        self.raises(TypeError, "path: a path", lambda: bims.Config.from_file(None))
+        self.raises(TypeError, "path: a path", lambda: bims.read_rawlog(7))
+        self.raises(TypeError, "path: a path", lambda: bims.Pipeline(bims.Config()).save_static_map(None))
+
+    def test_unclear_messages_made_clear(self):
+        f = self.f
+        # DepthArray(units='0.001') was pybind11's "Unable to cast"
+        self.raises(TypeError, "units: metres per reading (a number, e.g. 0.001) "
+                    "expected, got str '0.001'",
+                    lambda: bims.DepthArray(f.depth, K=f.K, units="0.001"))
+        d = bims.DepthArray(f.depth, K=f.K)
+        d.units = "0.001"  # set afterwards
+        self.raises(TypeError, "depth.units: metres per reading",
+                    lambda: self.pipe().process(d, stamp=f.stamp))
+        self.raises(TypeError, "depth_units: metres per reading",
+                    lambda: self.pipe().process(f.depth, stamp=f.stamp, depth_units="1"))
+        self.raises(TypeError, "stamp: a time [s] (a number) expected, got str",
+                    lambda: self.pipe().process(f.depth, stamp="1.5"))
+        self.raises(TypeError, "p_occupied: a probability in [0, 1) expected",
+                    lambda: self.pipe().occupied_voxels("0.5"))
+        self.raises(ValueError, "stamp: -1 s is outside the times MRPT's clock holds",
+                    lambda: self.pipe().process(f.depth, stamp=-1.0))
+        # depth_units with float depth (metres) contradicts it: refused
+        metres = f.depth.astype(np.float32) * np.float32(0.001)
+        self.assertIsNone(metres.units)  # (astype to float drops them)
+        self.raises(ValueError, "depth_units: 0.001 for float32 depth, which is in "
+                    "metres", lambda: self.pipe().process(metres, stamp=f.stamp, depth_units=0.001))
+        self.raises(ValueError, "units: 0.001 for float depth",
+                    lambda: bims.DepthArray(metres, K=f.K, units=0.001))
+        self.pipe().process(metres, stamp=f.stamp, depth_units=1)  # agrees
+        # an empty file is not a rawlog; a rawlog without a 3D scan of the
+        # label raises as bims-run does
+        with tempfile.TemporaryDirectory() as tmp:
+            empty = os.path.join(tmp, "e.rawlog")
+            open(empty, "w").close()
+            msg = self.raises(bims.RawlogError, empty, lambda: bims.read_rawlog(empty))
+            self.assertIn("an empty file (0 bytes), not a rawlog", msg)
+        other = bims.Config.from_file(CONFIG)
+        other.set("sensors", "rgbd_label", "OTHER")
+        self.raises(bims.RawlogError, SAMPLE + ": no CObservation3DRangeScan (RGB-D) "
+                    "observation with label 'OTHER'", lambda: list(bims.read_rawlog(SAMPLE, other)))
+
+    def test_images_too_small_for_the_pipeline_are_refused(self):
+        """A 1 x 1 depth hit OpenCV's !ssize.empty() assertion; 40 x 8 with
+        an image crashed in OpenCV's DIS. The smallest sizes the keyframe
+        alignment's pyramid and the observed flow take, named."""
+        f = self.f
+        K = np.array([[30.0, 0, 2], [0, 30.0, 2], [0, 0, 1]])
+        one = np.full((1, 1), 1000, np.uint16)
+        self.raises(ValueError, "depth: 1x1 is too small for the keyframe alignment, "
+                    "whose pyramid halves it [anchor] coarsest_level = 2 times: it "
+                    "needs at least 4 pixels per side",
+                    lambda: self.pipe().process(one, stamp=1.0, K=K))
+        p = self.pipe(anchor__enable=False)  # then depth only runs at any size
+        p.process(one, stamp=1.0, K=K)
+        p.process(one, stamp=1.1, K=K)
+        wide = np.full((8, 40), 1000, np.uint16)
+        rgb = np.zeros((8, 40, 3), np.uint8)
+        self.raises(ValueError, "depth: 40x8 is too small for the observed flow "
+                    "(OpenCV's DIS, preset fast): it needs at least 32 pixels on the "
+                    "shorter side and 91 on the longer one",
+                    lambda: self.pipe().process(wide, rgb=rgb, stamp=1.0, K=K))
+        self.pipe().process(wide, stamp=1.0, K=K)  # depth only: no flow
+        p = self.pipe(flow__method="farneback")
+        for k in range(3):
+            p.process(wide, rgb=rgb, stamp=1.0 + k, K=K)
+        # one pipeline takes one image size (the tracker's, the grids'
+        # images): another is named, not an assertion inside a stage
+        p = self.pipe()
+        p.process(f.depth, rgb=f.rgb, stamp=f.stamp)
+        self.raises(ValueError, "depth: 80x60 differs from the previous frames' 320x240",
+                    lambda: p.process(np.ascontiguousarray(f.depth[:60, :80]), stamp=f.stamp + 1, K=f.K))
+        p.process(f.depth, rgb=f.rgb, stamp=f.stamp + 2)
+        self.assertEqual(p.frames_processed, 2)
 
 
 if __name__ == "__main__":

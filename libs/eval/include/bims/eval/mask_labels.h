@@ -120,8 +120,10 @@ struct MaskMatch
 	 * after the last, by index, or by time beyond the tolerance): a run of
 	 * part of the labelled frames (bims-run --frames A:B). */
 	std::vector<const MaskFile*> labelsOutsidePredictions;
-	/** Predictions inside the labels' time span without a label within
-	 * the tolerance: a label folder with a missing frame (by time only). */
+	/** Predictions inside the labels' span without a label: by index, no
+	 * label of their index between the first label's and the last's; by
+	 * time, none within the tolerance. A label folder with missing
+	 * frames. */
 	std::vector<const MaskFile*> predictionsWithoutLabel;
 	/** Predictions outside the labels' span (a longer run): not scored. */
 	int predictionsOutside = 0;

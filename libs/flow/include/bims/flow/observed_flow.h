@@ -7,6 +7,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include <cmath>
+#include <string>
 
 namespace bims::flow
 {
@@ -25,6 +26,20 @@ constexpr int kDisUltrafastMinWidth = 640;
  * (the images DIS sees: after [flow] downscale). */
 DisPreset disPresetFor(DisPreset preset, int width);
 
+/** Why the observed flow of \a p cannot run on width x height images:
+ * "" when it can. DIS (OpenCV 4's) builds its pyramid from the image's
+ * size down to the preset's finest scale; when the size does not reach
+ * that scale OpenCV picks its scales from the width alone and reads
+ * outside a short image (a crash, e.g. at 40 x 8 or 320 x 20), or fails
+ * below 12 px. The images must reach it: at least patch x 2^finest pixels
+ * on the shorter side and about 4 patch x 2^(finest - 1/2) on the longer
+ * one (OpenCV 4.6's presets: 32 and 91 for ultrafast and fast, 16 and
+ * 46 for medium), after [flow] downscale; the preset's patch size and
+ * finest scale are asked of OpenCV. Farneback takes any size (downscale
+ * px per side).
+ * The message names the size, the least one and the keys. */
+std::string observedFlowSizeProblem(const FlowParams& p, int width, int height);
+
 class ObservedFlow
 {
  public:
@@ -32,7 +47,8 @@ class ObservedFlow
 
 	/** Backward flow of \a cur (frame t) towards \a prev (frame t-1), both
 	 * CV_8UC1 of the same size. Returns CV_32FC2 of that size. Throws
-	 * std::invalid_argument on empty or mismatched images. */
+	 * std::invalid_argument on empty or mismatched images, and on images
+	 * too small for the method (observedFlowSizeProblem). */
 	cv::Mat compute(const cv::Mat& prev, const cv::Mat& cur);
 
 	/** The same flow, measured after derotation: \a prev is first warped

@@ -62,6 +62,13 @@ std::optional<ImageHeader> imageHeader(const uint8_t* p, size_t n);
 bool imageSizeWithinLimits(uint64_t rows, uint64_t cols,
                            const ImageLimits& limits = {});
 
+/** Why a rows x cols image (an array given to the Python module) is not
+ * taken: "W x H pixels, beyond the N per side and M pixels bims reads
+ * (ORIGIN)", in the words of checkImageWithinLimits(); empty when it is
+ * within \a limits. */
+std::string imageSizeBeyondLimits(uint64_t rows, uint64_t cols,
+                                  const ImageLimits& limits);
+
 /** Throws std::runtime_error when the size \a h declares is beyond \a limits
  * (naming the size, the format and where the limits come from) or empty:
  * decodeImage()'s check, for a size read before anything is decoded (also a

@@ -42,7 +42,8 @@ uint64_t rawlogDataBytes(const std::string& path);
 
 /** Throws RawlogError naming \a path unless it is a readable regular file:
  * missing, a folder (with the importer to use when it is a TUM RGB-D folder
- * or a Stray Scanner capture), or unreadable. Programs check every input
+ * or a Stray Scanner capture), empty (0 bytes: no rawlog, not even a gzip
+ * header), or unreadable. Programs check every input
  * rawlog with it before they write anything. */
 void checkRawlogPath(const std::string& path);
 

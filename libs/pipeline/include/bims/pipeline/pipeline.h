@@ -107,6 +107,24 @@ struct FrameInput
 /** The frame after the one Pipeline::processFrame() runs, already at hand. */
 using NextFrame = FrameInput;
 
+/** Why a \a width x \a height frame (\a hasImage: with an image, else depth
+ * only) cannot run in a pipeline of \a cfg; "" when it can. The keyframe
+ * alignment ([anchor] enable) halves the frame [anchor] coarsest_level
+ * times: at least 2^coarsest_level pixels per side; the observed flow of a
+ * frame with an image: flow::observedFlowSizeProblem. Every other stage
+ * takes any size. The one check of a frame's size: Pipeline::processFrame
+ * (bims-run, the viewer, bims-grab) and the Python module make it before
+ * any stage runs. */
+std::string frameSizeProblem(const ExperimentConfig& cfg, int width, int height,
+                             bool hasImage);
+
+/** The farthest depth reading [m] a stage of \a cfg uses: the largest of
+ * [grids] max_range, [translation] max_depth_m, [anchor] max_depth_m and
+ * [flow] max_depth_m. Every stage skips a reading beyond it (only the
+ * grids' decay sees such a reading, as free space up to max_range). The
+ * Python module takes float depth beyond it as no reading. */
+double farthestDepthUsed(const ExperimentConfig& cfg);
+
 class Pipeline
 {
  public:
@@ -124,7 +142,8 @@ class Pipeline
 
 	/** Runs one RGB-D frame; \a index is its 3D-scan index. Throws
 	 * std::runtime_error naming the frame when the observation has no
-	 * usable depth image (or an unusable intensity image). A scan without
+	 * usable depth image (or an unusable intensity image), or one too small
+	 * for the pipeline (frameSizeProblem). A scan without
 	 * an intensity image is a depth-only frame: no flow tier
 	 * (FrameResult::flowOff), the egomotion without features.
 	 *
@@ -146,6 +165,13 @@ class Pipeline
 	const FrameResult& processFrame(const ego::RgbdFrame& frame, size_t index,
 	                                Next next = {});
 	const FrameResult& processFrame(const FrameInput& in, Next next = {});
+
+	/** Why this pipeline cannot run a \a width x \a height frame (with an
+	 * image or depth only): ::frameSizeProblem() of its config, or a size
+	 * other than its previous frames' (one pipeline takes one image size,
+	 * as a run: its keyframes, masks and flow are of that size); "" when it
+	 * can. processFrame() checks it; a caller may ask first. */
+	std::string frameSizeProblem(int width, int height, bool hasImage) const;
 
 	const FrameResult& last() const { return res_; }
 	const ExperimentConfig& config() const { return cfg_; }
