@@ -11,6 +11,7 @@
 #include <bims/io/rawlog.h>
 #include <bims_test/bag_writer.h>
 #include <bims_test/error_of.h>
+#include <bims_test/observations.h>
 #include <bims_test/run_command.h>
 #include <bims_test/sample.h>
 #include <bims_test/text.h>
@@ -42,53 +43,17 @@ using mrpt::obs::CObservationIMU;
 const std::string kImport = std::string(BIMS_BIN_DIR) + "/bims-import-bag";
 const std::string kRun = std::string(BIMS_BIN_DIR) + "/bims-run";
 
-/** The first frames of the bundled sample and the IMU samples between. */
-struct Sample
+/** The sample's first 24 frames and their IMU samples. */
+const test::Observations& sample()
 {
-	std::vector<CObservation3DRangeScan::Ptr> frames;
-	std::vector<CObservationIMU::Ptr> imu;
-};
-
-const Sample& sample()
-{
-	static const Sample s = []
-	{
-		Sample r;
-		RawlogReader in(test::kSample);
-		while (auto o = in.next())
-		{
-			if (auto f = std::dynamic_pointer_cast<CObservation3DRangeScan>(o))
-			{
-				f->load();
-				r.frames.push_back(f);
-				if (r.frames.size() == 24) break;
-			}
-			else if (auto m = std::dynamic_pointer_cast<CObservationIMU>(o))
-				r.imu.push_back(m);
-		}
-		return r;
-	}();
-	return s;
+	return test::sampleObservations();
 }
 
-struct Imported
-{
-	std::vector<CObservation3DRangeScan::Ptr> frames;
-	std::vector<CObservationIMU::Ptr> imu;
-};
+using Imported = test::Observations;
 
 Imported readRawlog(const std::string& path)
 {
-	Imported r;
-	RawlogReader in(path);
-	while (auto o = in.next())
-	{
-		if (auto f = std::dynamic_pointer_cast<CObservation3DRangeScan>(o))
-			r.frames.push_back(f);
-		else if (auto m = std::dynamic_pointer_cast<CObservationIMU>(o))
-			r.imu.push_back(m);
-	}
-	return r;
+	return test::readObservations(path);
 }
 
 bag::BagImportSummary import(const std::string& bagPath, const std::string& out,
