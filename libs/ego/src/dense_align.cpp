@@ -636,7 +636,7 @@ Mat6 measuredInformation(const DenseLevel& ref, const std::vector<Sample>& cur,
 	Association moved, held;
 	moved.residuals = held.residuals = true;
 	held.keep = true;
-	held.pixel = at.pixel;
+	held.pixel = std::move(at.pixel);  // not read again
 	Eigen::Vector3d scale = Eigen::Vector3d::Ones();
 	for (int k = 0; k < 3; k++)
 	{

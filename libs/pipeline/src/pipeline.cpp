@@ -429,8 +429,9 @@ void Pipeline::runGrids(const maps::PixelLabels* labels, FrameResult& r,
 		// The frame's cloud stays out of the grids; the tracker keeps the
 		// last mask fed back (what moved is likely still there).
 		r.held = true;
-		r.mask = r.maskTier1 = r.maskTier2 =
-		    cv::Mat::zeros(cur_.size(), CV_8UC1);
+		r.maskTier1 = cv::Mat::zeros(cur_.size(), CV_8UC1);
+		r.maskTier2 = cv::Mat::zeros(cur_.size(), CV_8UC1);
+		r.mask = cv::Mat::zeros(cur_.size(), CV_8UC1);
 		r.ms.grids = msSince(t);
 		return;
 	}
