@@ -1182,6 +1182,61 @@ std::vector<BagTopicInfo> bagTopics(const std::vector<std::string>& bagPaths,
 	return out;
 }
 
+/** An observation of the import: an IMU sample or a frame. */
+struct Item
+{
+	double t;
+	int kind;  // 0 IMU, 1 frame
+	size_t i;  ///< in the IMU samples or the frames
+};
+
+/** Frames and IMU samples in time order, IMU first at equal stamps; the
+ * IMU within the frames' span (as bims-import-tum), the others counted in
+ * \a sum.imuOutside. */
+std::vector<Item> timeOrder(const std::vector<ImuSample>& imu,
+                            const std::vector<Frame>& frames,
+                            BagImportSummary& sum)
+{
+	const double t0 = frames.front().t, t1 = frames.back().t;
+	std::vector<Item> items;
+	for (size_t i = 0; i < imu.size(); i++)
+		if (imu[i].t >= t0 && imu[i].t <= t1)
+			items.push_back({imu[i].t, 0, i});
+		else
+			sum.imuOutside++;
+	for (size_t i = 0; i < frames.size(); i++)
+		items.push_back({frames[i].t, 1, i});
+	std::stable_sort(items.begin(), items.end(),
+	                 [](const Item& a, const Item& b)
+	                 { return a.t < b.t || (a.t == b.t && a.kind < b.kind); });
+	return items;
+}
+
+/** An SDK recording's depth image (Z16) with the units it carries (\a own,
+ * 0 none) checked against the recording's, registered to the colour camera
+ * \a cam when the depth has a camera of its own; \a units is set to the
+ * result's metres per unit. */
+cv::Mat sdkMetricDepth(const cv::Mat& depth, float own, const RsSdkDepth& sdk,
+                       const std::string& unitsFrom,
+                       const mrpt::img::TCamera& cam, double& units)
+{
+	if (depth.type() != CV_16UC1)
+		throw std::runtime_error(
+		    "the depth image is not 16-bit: not a RealSense SDK's Z16 depth");
+	if (sdk.fromImages && own == 0)
+		throw std::runtime_error("it carries no depth units, as the first did");
+	if (!sdk.unitsGiven && own != 0 &&
+	    std::abs(own - sdk.units) > 1e-6 * sdk.units)
+		throw std::runtime_error(
+		    mrpt::format("its own depth units %g m differ from %s's %g m", own,
+		                 unitsFrom.c_str(), sdk.units));
+	units = sdk.units;
+	if (!sdk.depthCamera) return depth;
+	units = 1.0;
+	return registerDepth(depth, sdk.units, *sdk.depthCamera, cam,
+	                     sdk.depthToColour);
+}
+
 BagImportSummary importBag(const std::vector<std::string>& bagPaths,
                            const std::string& outRawlog,
                            const BagImportParams& params,
@@ -1239,26 +1294,7 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 	        : RsSdkDepth();
 	const std::vector<ImuSample> imu = imuStream(ix, t, sum);
 
-	// frames and IMU samples in time order, IMU first at equal stamps; the
-	// IMU within the frames' span (as bims-import-tum)
-	const double t0 = frames.front().t, t1 = frames.back().t;
-	struct Item
-	{
-		double t;
-		int kind;  // 0 IMU, 1 frame
-		size_t i;
-	};
-	std::vector<Item> items;
-	for (size_t i = 0; i < imu.size(); i++)
-		if (imu[i].t >= t0 && imu[i].t <= t1)
-			items.push_back({imu[i].t, 0, i});
-		else
-			sum.imuOutside++;
-	for (size_t i = 0; i < frames.size(); i++)
-		items.push_back({frames[i].t, 1, i});
-	std::stable_sort(items.begin(), items.end(),
-	                 [](const Item& a, const Item& b)
-	                 { return a.t < b.t || (a.t == b.t && a.kind < b.kind); });
+	const std::vector<Item> items = timeOrder(imu, frames, sum);
 
 	// Decoding (the bag's chunks, the images' conversion) on a thread of its
 	// own, a few observations ahead of the writing (and its compression).
@@ -1327,28 +1363,8 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 			double units = depth.type() == CV_32FC1 ? 1.0 : 0.001;
 			cv::Mat metric = depth;
 			if (sdk.on)
-			{
-				const float own = f.depth->msg->value;
-				if (depth.type() != CV_16UC1)
-					throw std::runtime_error(
-					    "the depth image is not 16-bit: not a RealSense "
-					    "SDK's Z16 depth");
-				if (sdk.fromImages && own == 0)
-					throw std::runtime_error(
-					    "it carries no depth units, as the first did");
-				if (!sdk.unitsGiven && own != 0 &&
-				    std::abs(own - sdk.units) > 1e-6 * sdk.units)
-					throw std::runtime_error(mrpt::format(
-					    "its own depth units %g m differ from %s's %g m", own,
-					    sum.depthUnitsFrom.c_str(), sdk.units));
-				units = sdk.units;
-				if (sdk.depthCamera)
-				{
-					metric = registerDepth(depth, units, *sdk.depthCamera, cam,
-					                       sdk.depthToColour);
-					units = 1.0;
-				}
-			}
+				metric = sdkMetricDepth(depth, f.depth->msg->value, sdk,
+				                        sum.depthUnitsFrom, cam, units);
 			auto o = eval::depthObservation(
 			    metric, units, cam, params.rgbdLabel, f.t, params.rangeUnits);
 			if (f.colour)
