@@ -4,6 +4,7 @@
 #include <bims/ego/flags.h>
 #include <bims/eval/mask_metrics.h>
 #include <bims/eval/trajectory_metrics.h>
+#include <bims/io/frame_files.h>
 #include <bims/io/json.h>
 #include <bims/io/rawlog.h>
 #include <bims/pipeline/pipeline.h>
@@ -80,8 +81,7 @@ bims::eval::MaskMetrics score(ExperimentConfig cfg, Variant v, size_t last,
 	{
 		if (more) more(r);
 		if (r.warmup) return;
-		char name[32];
-		std::snprintf(name, sizeof(name), "/%06zu.png", r.index);
+		const std::string name = "/" + bims::frameFileName(long(r.index));
 		m.accumulate(bims::eval::loadMask(kGtMasks + name), r.mask,
 		             validDepth(scan));
 	};
@@ -637,8 +637,7 @@ TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 		    << "frames.csv differs (" << name << ")";
 		for (int i = 0; i < 20; i++)
 		{
-			char f[32];
-			std::snprintf(f, sizeof(f), "/masks/%06d.png", i);
+			const std::string f = "/masks/" + bims::frameFileName(i);
 			EXPECT_TRUE(bims::test::fileText(a + f) ==
 			            bims::test::fileText(b + f))
 			    << f << " differs (" << name << ")";
@@ -671,8 +670,7 @@ TEST(EndToEnd, ThreadedAndSequentialRunsWriteTheSameOutputs)
 	ASSERT_EQ(labels.size(), 20u);
 	for (int i : {0, 10, 19})
 	{
-		char name[32];
-		std::snprintf(name, sizeof(name), "/masks/%06d.png", i);
+		const std::string name = "/masks/" + bims::frameFileName(i);
 		const cv::Mat m = cv::imread(b + name, cv::IMREAD_UNCHANGED);
 		ASSERT_EQ(m.size(), labels[i].size());
 		EXPECT_EQ(cv::countNonZero(m != labels[i]), 0) << name;
@@ -840,8 +838,7 @@ TEST(EndToEnd, ARunFromItsEffectiveIniWritesTheSameOutputs)
 	            csvWithoutTimes(b + "/frames.csv"));
 	for (int i = 0; i < 15; i++)
 	{
-		char f[32];
-		std::snprintf(f, sizeof(f), "/masks/%06d.png", i);
+		const std::string f = "/masks/" + bims::frameFileName(i);
 		EXPECT_TRUE(bims::test::fileText(a + f) == bims::test::fileText(b + f))
 		    << f << " differs";
 	}
@@ -943,8 +940,8 @@ TEST(EndToEnd, FramesWhosePoseNothingCheckedAreHeldOutOfTheGrids)
 			      if (r.index < 60 || r.index >= 63) return;
 			      // the frames of the slip: moving pixels where the
 			      // truth has none
-			      char name[32];
-			      std::snprintf(name, sizeof(name), "/%06zu.png", r.index);
+			      const std::string name =
+			          "/" + bims::frameFileName(long(r.index));
 			      const cv::Mat truth =
 			          bims::eval::loadMask(kGtMasks + name) > 0;
 			      falseAlarm[hold] +=

@@ -287,10 +287,9 @@ TEST(EvalMasks, IndexNamedLabelsMissingInsideTheirSpanAreAnError)
 	cv::Mat g(8, 8, CV_8UC1, cv::Scalar(0)), p = g.clone();
 	g(cv::Rect(0, 0, 4, 8)) = 255;
 	p(cv::Rect(0, 0, 3, 8)) = 255;
-	char name[16];
 	for (int k = 0; k < 12; ++k)  // predictions 0-11, labels 0-9
 	{
-		std::snprintf(name, sizeof(name), "/%06d.png", k);
+		const std::string name = "/" + bims::frameFileName(k);
 		cv::imwrite(d + "/pred" + name, p);
 		if (k < 10) cv::imwrite(d + "/gt" + name, g);
 	}
