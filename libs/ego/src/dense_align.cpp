@@ -201,6 +201,157 @@ struct Association
 	std::vector<float> r, w;
 };
 
+/** A pass's pose in the loop's float arithmetic, and the reference's
+ * camera. */
+struct PassFrame
+{
+	float r00, r01, r02, r10, r11, r12, r20, r21, r22, t0, t1, t2;
+	float fx, fy, cx, cy;
+	int W, H;
+	PassFrame(const DenseLevel& ref, const Eigen::Matrix3d& R,
+	          const Eigen::Vector3d& t)
+	    : r00(float(R(0, 0))),
+	      r01(float(R(0, 1))),
+	      r02(float(R(0, 2))),
+	      r10(float(R(1, 0))),
+	      r11(float(R(1, 1))),
+	      r12(float(R(1, 2))),
+	      r20(float(R(2, 0))),
+	      r21(float(R(2, 1))),
+	      r22(float(R(2, 2))),
+	      t0(float(t[0])),
+	      t1(float(t[1])),
+	      t2(float(t[2])),
+	      fx(ref.fx),
+	      fy(ref.fy),
+	      cx(ref.cx),
+	      cy(ref.cy),
+	      W(ref.depth.cols),
+	      H(ref.depth.rows)
+	{
+	}
+	/** The sample in the reference's camera. */
+	void transform(const Sample& s, float& X, float& Y, float& Z) const
+	{
+		X = r00 * s.x + r01 * s.y + r02 * s.z + t0;
+		Y = r10 * s.x + r11 * s.y + r12 * s.z + t1;
+		Z = r20 * s.x + r21 * s.y + r22 * s.z + t2;
+	}
+	/** The reference pixel nearest to (u, v), -1 outside the image. */
+	int nearestPixel(float u, float v) const
+	{
+		if (!(u > -0.5f && v > -0.5f && u < W - 0.5f && v < H - 0.5f))
+			return -1;
+		return static_cast<int>(v + 0.5f) * W + static_cast<int>(u + 0.5f);
+	}
+};
+
+/** A pass's optional outputs (each may be null): 255 in \a outliers at the
+ * samples associated but not inliers, the reference pixels the frame sees
+ * through, 255 in \a consistent at the inliers, the association. */
+struct PassOutputs
+{
+	cv::Mat* outliers;
+	std::vector<int>* seenThrough;
+	cv::Mat* consistent;
+	Association* assoc;
+};
+
+/** The point-to-plane term of a sample associated on the reference's
+ * surface q (X, Y, Z: the sample in the reference's camera): the
+ * classification images, the counts, the cost and, with \a rows, the
+ * normal equations' row. true when the sample goes on to the photometric
+ * term (it counts and is an inlier). */
+bool geometricTerm(const RefPixel& q, const Sample& s, size_t i, float X,
+                   float Y, float Z, bool counts, const AnchorParams& p,
+                   NormalEquations6* rows, const PassOutputs& o, Pass& out)
+{
+	// no normal at depth edges: no geometric term there (weight 1, no
+	// cost), but the photometric one (where the texture is) still applies
+	const bool hasNormal = !(q.nx == 0 && q.ny == 0 && q.nz == 0);
+	const double c = p.tukey_c;
+	Tukey tg{1, 0};
+	double rg = 0, invSg = 1;
+	if (hasNormal)
+	{
+		rg = pointToPlaneResidual(X, Y, Z, q.nx, q.ny, q.nz, q.d);
+		invSg = 1 / (p.geo_sigma_m + p.geo_sigma_z2 * q.z * q.z);
+		tg = Tukey::at(rg * invSg * (1 / c), c);
+		if (o.assoc && o.assoc->residuals)
+		{
+			o.assoc->r[i] = float(rg * invSg);
+			o.assoc->w[i] = float(tg.s * tg.s);
+		}
+	}
+	if (tg.s <= 0 && o.outliers) o.outliers->data[s.pix] = 255;
+	if (tg.s > 0 && o.consistent) o.consistent->data[s.pix] = 255;
+	if (!counts) return false;
+	++out.associated;
+	out.cost += tg.loss;
+	if (tg.s <= 0) return false;
+	++out.inliers;
+	out.sumGeo2 += rg * rg;
+	if (hasNormal && rows)
+	{
+		// point-to-plane: d r / d(v, w) = [n, X x n]
+		float Jg[6];
+		pointToPlaneJacobian(X, Y, Z, q.nx, q.ny, q.nz, Jg);
+		// weight s^2 / sg^2
+		rows->add(Jg, tg.s * invSg, rg);
+	}
+	return true;
+}
+
+/** The photometric term of a pass: the reference's grey level, bilinear
+ * at the sample's projection, against the sample's plus the offset. */
+struct PhotometricTerm
+{
+	const PassFrame& f;
+	const RefPixel* P;
+	float offset;
+	double weight;  ///< photo_weight
+	double c;       ///< Tukey's constant
+	/** the residual's a = r / (sp c), and the square root of its weight's
+	 * scale, photo_weight / sp^2 */
+	double a, rootScale;
+
+	void add(const Sample& s, float X, float Y, float Z, float iz, float u,
+	         float v, NormalEquations6* rows, Pass& out) const
+	{
+		const int W = f.W;
+		if (!(u >= 0 && v >= 0 && u < W - 1 && v < f.H - 1))
+		{
+			out.cost += weight * (c * c / 6);
+			return;
+		}
+		const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
+		const float au = u - u0, av = v - v0;
+		const RefPixel& a0 = P[v0 * W + u0];
+		const RefPixel& a1 = P[v0 * W + u0 + 1];
+		const RefPixel& b0 = P[(v0 + 1) * W + u0];
+		const RefPixel& b1 = P[(v0 + 1) * W + u0 + 1];
+		const float w00 = (1 - av) * (1 - au), w01 = (1 - av) * au,
+		            w10 = av * (1 - au), w11 = av * au;
+		auto bil = [&](float RefPixel::*m)
+		{ return w00 * a0.*m + w01 * a1.*m + w10 * b0.*m + w11 * b1.*m; };
+		const float Ir = bil(&RefPixel::g);
+		const double rp = Ir - s.grey - offset;
+		++out.photoN;
+		++out.photoHist[std::min(Pass::kBins - 1,
+		                         static_cast<int>(std::abs(rp) * 0.5))];
+		const Tukey tp = Tukey::at(rp * a, c);
+		const double wp = tp.s * tp.s;
+		out.cost += weight * tp.loss;
+		out.photoSum += wp * (Ir - s.grey);
+		out.photoW += wp;
+		if (wp <= 0 || !rows) return;
+		const float gx = bil(&RefPixel::gx), gy = bil(&RefPixel::gy);
+		float Jp[6];
+		photometricJacobian(X, Y, Z, iz, gx, gy, f.fx, f.fy, Jp);
+		rows->add(Jp, tp.s * rootScale, rp);
+	}
+};
+
 /** One pass over the samples at pose (R, t): the normal equations (with
  * \a rows, their scratch) and the counts; \a outliers (optional) gets 255 at
  * the samples that are associated but not inliers. \a assoc (optional):
@@ -212,6 +363,7 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
           cv::Mat* outliers, std::vector<int>* seenThrough = nullptr,
           cv::Mat* consistent = nullptr, Association* assoc = nullptr)
 {
+	const PassOutputs o{outliers, seenThrough, consistent, assoc};
 	const bool record = assoc && assoc->record,
 	           keep = assoc && assoc->keep && !record;
 	if (record) assoc->pixel.assign(cur.size(), -1);
@@ -220,28 +372,21 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 		assoc->r.assign(cur.size(), std::numeric_limits<float>::quiet_NaN());
 		assoc->w.assign(cur.size(), 0.f);
 	}
-	const bool normalEquations = rows != nullptr;
 	Pass out;
-	const int W = ref.depth.cols, H = ref.depth.rows;
-	const float r00 = float(R(0, 0)), r01 = float(R(0, 1)),
-	            r02 = float(R(0, 2));
-	const float r10 = float(R(1, 0)), r11 = float(R(1, 1)),
-	            r12 = float(R(1, 2));
-	const float r20 = float(R(2, 0)), r21 = float(R(2, 1)),
-	            r22 = float(R(2, 2));
-	const float t0 = float(t[0]), t1 = float(t[1]), t2 = float(t[2]);
-	const float fx = ref.fx, fy = ref.fy, cx = ref.cx, cy = ref.cy;
+	const PassFrame f(ref, R, t);
 	const float zmin = float(p.min_depth_m);
-	const double c = p.tukey_c;
+	const double c = p.tukey_c, rhoMax = c * c / 6;
 	const bool photo = p.photo_weight > 0 && !outliers;
-	const double sp = photoSigma;
-	const double photoScale = p.photo_weight / (sp * sp);
-	const double rhoMax = c * c / 6;
+	const double photoScale = p.photo_weight / (photoSigma * photoSigma);
+	const RefPixel* P = ref.packed.data();
+	const PhotometricTerm photometric{f,
+	                                  P,
+	                                  offset,
+	                                  p.photo_weight,
+	                                  c,
+	                                  1 / (photoSigma * c),
+	                                  std::sqrt(photoScale)};
 	if (rows) rows->clear();
-	const double invC = 1 / c;
-	// the photometric residual's a = r / (sp c), and the square root of
-	// its weight's scale, photo_weight / sp^2
-	const double photoA = 1 / (sp * c), photoRootScale = std::sqrt(photoScale);
 	for (size_t i = 0; i < cur.size(); i++)
 	{
 		const Sample& s = cur[i];
@@ -249,41 +394,23 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 		// final pass, for the outlier image
 		if (s.excluded && !outliers) continue;
 		const bool counts = !s.excluded;
-		const float X = r00 * s.x + r01 * s.y + r02 * s.z + t0;
-		const float Y = r10 * s.x + r11 * s.y + r12 * s.z + t1;
-		const float Z = r20 * s.x + r21 * s.y + r22 * s.z + t2;
-		if (Z < zmin)
+		float X, Y, Z;
+		f.transform(s, X, Y, Z);
+		float u = 0, v = 0, iz = 0;
+		int pix = -1;
+		if (Z >= zmin)
+		{
+			iz = 1.f / Z;
+			denseProject(X, Y, iz, f.fx, f.fy, f.cx, f.cy, u, v);
+			pix = keep ? assoc->pixel[i] : f.nearestPixel(u, v);
+			if (record) assoc->pixel[i] = pix;
+		}
+		const float zr = pix < 0 ? 0.f : P[pix].z;
+		if (zr == 0)  // in no reference reading (or too near)
 		{
 			if (counts) out.cost += rhoMax;
 			continue;
 		}
-		const float iz = 1.f / Z;
-		float u, v;
-		denseProject(X, Y, iz, fx, fy, cx, cy, u, v);
-		int pix;
-		if (keep)
-			pix = assoc->pixel[i];
-		else if (!(u > -0.5f && v > -0.5f && u < W - 0.5f && v < H - 0.5f))
-			pix = -1;
-		else
-			pix = static_cast<int>(v + 0.5f) * W + static_cast<int>(u + 0.5f);
-		if (record) assoc->pixel[i] = pix;
-		if (pix < 0)
-		{
-			if (counts) out.cost += rhoMax;
-			continue;
-		}
-		const RefPixel* P = ref.packed.data();
-		const RefPixel& q = P[pix];
-		const float zr = q.z;
-		if (zr == 0)
-		{
-			if (counts) out.cost += rhoMax;
-			continue;
-		}
-		// no normal at depth edges: no geometric term there, but the
-		// photometric one (where the texture is) still applies
-		const bool hasNormal = !(q.nx == 0 && q.ny == 0 && q.nz == 0);
 		const float gate = float(p.gate_m + p.gate_z2 * zr * zr);
 		if (zr > 0 && Z > zr + gate)
 		{
@@ -310,67 +437,9 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 			out.cost += rhoMax;
 			continue;
 		}
-		// (no normal: weight 1, no cost)
-		Tukey tg{1, 0};
-		double rg = 0, invSg = 1;
-		if (hasNormal)
-		{
-			rg = pointToPlaneResidual(X, Y, Z, q.nx, q.ny, q.nz, q.d);
-			invSg = 1 / (p.geo_sigma_m + p.geo_sigma_z2 * zr * zr);
-			tg = Tukey::at(rg * invSg * invC, c);
-			if (assoc && assoc->residuals)
-			{
-				assoc->r[i] = float(rg * invSg);
-				assoc->w[i] = float(tg.s * tg.s);
-			}
-		}
-		if (tg.s <= 0 && outliers) outliers->data[s.pix] = 255;
-		if (tg.s > 0 && consistent) consistent->data[s.pix] = 255;
-		if (!counts) continue;
-		++out.associated;
-		out.cost += tg.loss;
-		if (tg.s <= 0) continue;
-		++out.inliers;
-		out.sumGeo2 += rg * rg;
-		if (hasNormal && normalEquations)
-		{
-			// point-to-plane: d r / d(v, w) = [n, X x n]
-			float Jg[6];
-			pointToPlaneJacobian(X, Y, Z, q.nx, q.ny, q.nz, Jg);
-			// weight s^2 / sg^2
-			rows->add(Jg, tg.s * invSg, rg);
-		}
-		if (!photo) continue;
-		if (!(u >= 0 && v >= 0 && u < W - 1 && v < H - 1))
-		{
-			out.cost += p.photo_weight * rhoMax;
+		if (!geometricTerm(P[pix], s, i, X, Y, Z, counts, p, rows, o, out))
 			continue;
-		}
-		const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
-		const float au = u - u0, av = v - v0;
-		const RefPixel& a0 = P[v0 * W + u0];
-		const RefPixel& a1 = P[v0 * W + u0 + 1];
-		const RefPixel& b0 = P[(v0 + 1) * W + u0];
-		const RefPixel& b1 = P[(v0 + 1) * W + u0 + 1];
-		const float w00 = (1 - av) * (1 - au), w01 = (1 - av) * au,
-		            w10 = av * (1 - au), w11 = av * au;
-		auto bil = [&](float RefPixel::*f)
-		{ return w00 * a0.*f + w01 * a1.*f + w10 * b0.*f + w11 * b1.*f; };
-		const float Ir = bil(&RefPixel::g);
-		const double rp = Ir - s.grey - offset;
-		++out.photoN;
-		++out.photoHist[std::min(Pass::kBins - 1,
-		                         static_cast<int>(std::abs(rp) * 0.5))];
-		const Tukey tp = Tukey::at(rp * photoA, c);
-		const double wp = tp.s * tp.s;
-		out.cost += p.photo_weight * tp.loss;
-		out.photoSum += wp * (Ir - s.grey);
-		out.photoW += wp;
-		if (wp <= 0 || !normalEquations) continue;
-		const float gx = bil(&RefPixel::gx), gy = bil(&RefPixel::gy);
-		float Jp[6];
-		photometricJacobian(X, Y, Z, iz, gx, gy, fx, fy, Jp);
-		rows->add(Jp, tp.s * photoRootScale, rp);
+		if (photo) photometric.add(s, X, Y, Z, iz, u, v, rows, out);
 	}
 	if (rows) rows->get(out.H, out.b);
 	return out;
