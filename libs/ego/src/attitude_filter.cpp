@@ -105,7 +105,6 @@ bool AttitudeFilter::magUsable(const Eigen::Vector3d& m,
 
 uint32_t AttitudeFilter::add(const ImuSample& s)
 {
-	uint32_t flags = 0;
 	if (!std::isfinite(s.t)) return kFlagOutOfOrder;
 	if (initialized_ && s.t <= tLast_)
 	{
@@ -116,31 +115,14 @@ uint32_t AttitudeFilter::add(const ImuSample& s)
 	if (!initialized_)
 	{
 		tryInitialize(s);
-		return flags;
+		return 0;
 	}
 	if (p_.use_sensor_orientation && s.q_WI)
 	{
-		// The sensor's attitude as is; the gyro-only chain still integrates
-		// the raw gyro (uncorrected bias) for inter-frame rotations.
-		const double dt = s.t - tLast_;
-		if (s.hasGyro && haveGyro_ && dt <= p_.max_gap_s)
-			qg_ = Eigen::Quaterniond(qg_.toRotationMatrix() *
-			                         expSO3(0.5 * (s.gyro + lastGyro_) * dt));
-		else
-			qg_ = *s.q_WI;
-		qg_.normalize();
-		if (s.hasGyro)
-		{
-			lastGyro_ = s.gyro;
-			lastRate_ = s.gyro;
-			haveGyro_ = true;
-		}
-		q_ = *s.q_WI;
-		tLast_ = s.t;
-		push(s.t);
-		return flags;
+		takeSensorOrientation(s);
+		return 0;
 	}
-
+	uint32_t flags = 0;
 	double dt = s.t - tLast_;
 	if (dt > p_.max_gap_s)
 	{
@@ -150,81 +132,112 @@ uint32_t AttitudeFilter::add(const ImuSample& s)
 	}
 	const Eigen::Matrix3d R_WI = q_.toRotationMatrix();
 	const Eigen::Vector3d up_I = R_WI.transpose().col(2);  // e_z in {I}
-
 	// Innovation: measured x predicted directions (Mahony's omega_mes).
 	Eigen::Vector3d e = Eigen::Vector3d::Zero();
-	bool corrected = false;
 	const bool fast = (s.t - tInit_) < p_.init_time_s;
-	if (s.hasAcc)
-	{
-		const double fn = s.acc.norm();
-		const Eigen::Vector3d ea =
-		    fn > 0 ? Eigen::Vector3d((s.acc / fn).cross(up_I))
-		           : Eigen::Vector3d::Zero();
-		// Norm gate, then innovation-angle gate (not while converging, and
-		// released when the disagreement persists: then the estimate, not
-		// the accelerometer, is wrong).
-		bool use = fn > 0 && std::abs(fn - p_.gravity) <= p_.accel_gate;
-		const double ang = std::asin(std::min(1.0, ea.norm()));
-		if (use && !fast && ang > p_.accel_angle_gate_deg * M_PI / 180 &&
-		    s.t - tAccelOk_ < p_.accel_gate_max_s)
-			use = false;
-		if (use)
-		{
-			e += ea;
-			corrected = true;
-			if (ang <= p_.accel_angle_gate_deg * M_PI / 180) tAccelOk_ = s.t;
-		}
-		else
-		{
-			flags |= kFlagAccelGated;
-			++stats_.accelGated;
-		}
-	}
-	if (p_.use_magnetometer && s.hasMag)
-	{
-		const Eigen::Vector3d h_W = R_WI * s.mag;
-		// Dip against the measured vertical when the accelerometer is
-		// plausible (independent of the estimate), else the estimated one.
-		const bool accOk =
-		    s.hasAcc && std::abs(s.acc.norm() - p_.gravity) <= p_.accel_gate;
-		const Eigen::Vector3d vert =
-		    accOk ? Eigen::Vector3d(s.acc.normalized()) : up_I;
-		// Heading innovation: angle of the horizontal field from north (+x
-		// of {W}). A disturbance that rotates the field horizontally barely
-		// changes its norm and dip, so large innovations are gated too
-		// (after convergence; released when they persist mag_gate_max_s).
-		const double psi = std::atan2(h_W.y(), h_W.x());
-		const double gate = p_.mag_heading_gate_deg * M_PI / 180;
-		const bool usable =
-		    magUsable(s.mag, vert) && std::hypot(h_W.x(), h_W.y()) > 0;
-		const bool fastNow = (s.t - tInit_) < p_.init_time_s;
-		if (usable && std::abs(psi) <= gate && !fastNow)
-		{
-			tMagOk_ = s.t;
-			headingConverged_ = true;
-		}
-		if (usable && (fastNow || !headingConverged_ || std::abs(psi) <= gate ||
-		               s.t - tMagOk_ >= p_.mag_gate_max_s))
-		{
-			// About the vertical only, so a tilted or disturbed field never
-			// tilts the estimate; heading gain kp_mag (kp while converging).
-			const double ratio =
-			    fastNow ? 1.0 : (p_.kp > 0 ? p_.kp_mag / p_.kp : 0.0);
-			e += -psi * ratio * up_I;
-			corrected = true;
-		}
-		else
-		{
-			flags |= kFlagMagGated;
-			++stats_.magGated;
-		}
-	}
+	const bool byAcc = accelInnovation(s, up_I, fast, e, flags);
+	const bool byMag = p_.use_magnetometer && s.hasMag &&
+	                   magInnovation(s, R_WI, up_I, fast, e, flags);
+	integrate(s, R_WI, e, byAcc || byMag, fast, dt, flags);
+	return flags;
+}
 
+void AttitudeFilter::takeSensorOrientation(const ImuSample& s)
+{
+	// The sensor's attitude as is; the gyro-only chain still integrates
+	// the raw gyro (uncorrected bias) for inter-frame rotations.
+	const double dt = s.t - tLast_;
+	if (s.hasGyro && haveGyro_ && dt <= p_.max_gap_s)
+		qg_ = Eigen::Quaterniond(qg_.toRotationMatrix() *
+		                         expSO3(0.5 * (s.gyro + lastGyro_) * dt));
+	else
+		qg_ = *s.q_WI;
+	qg_.normalize();
+	if (s.hasGyro)
+	{
+		lastGyro_ = s.gyro;
+		lastRate_ = s.gyro;
+		haveGyro_ = true;
+	}
+	q_ = *s.q_WI;
+	tLast_ = s.t;
+	push(s.t);
+}
+
+bool AttitudeFilter::accelInnovation(const ImuSample& s,
+                                     const Eigen::Vector3d& up_I, bool fast,
+                                     Eigen::Vector3d& e, uint32_t& flags)
+{
+	if (!s.hasAcc) return false;
+	const double fn = s.acc.norm();
+	const Eigen::Vector3d ea = fn > 0
+	                               ? Eigen::Vector3d((s.acc / fn).cross(up_I))
+	                               : Eigen::Vector3d::Zero();
+	// Norm gate, then innovation-angle gate (not while converging, and
+	// released when the disagreement persists: then the estimate, not
+	// the accelerometer, is wrong).
+	bool use = fn > 0 && std::abs(fn - p_.gravity) <= p_.accel_gate;
+	const double ang = std::asin(std::min(1.0, ea.norm()));
+	if (use && !fast && ang > p_.accel_angle_gate_deg * M_PI / 180 &&
+	    s.t - tAccelOk_ < p_.accel_gate_max_s)
+		use = false;
+	if (!use)
+	{
+		flags |= kFlagAccelGated;
+		++stats_.accelGated;
+		return false;
+	}
+	e += ea;
+	if (ang <= p_.accel_angle_gate_deg * M_PI / 180) tAccelOk_ = s.t;
+	return true;
+}
+
+bool AttitudeFilter::magInnovation(const ImuSample& s,
+                                   const Eigen::Matrix3d& R_WI,
+                                   const Eigen::Vector3d& up_I, bool fast,
+                                   Eigen::Vector3d& e, uint32_t& flags)
+{
+	const Eigen::Vector3d h_W = R_WI * s.mag;
+	// Dip against the measured vertical when the accelerometer is
+	// plausible (independent of the estimate), else the estimated one.
+	const bool accOk =
+	    s.hasAcc && std::abs(s.acc.norm() - p_.gravity) <= p_.accel_gate;
+	const Eigen::Vector3d vert =
+	    accOk ? Eigen::Vector3d(s.acc.normalized()) : up_I;
+	// Heading innovation: angle of the horizontal field from north (+x
+	// of {W}). A disturbance that rotates the field horizontally barely
+	// changes its norm and dip, so large innovations are gated too
+	// (after convergence; released when they persist mag_gate_max_s).
+	const double psi = std::atan2(h_W.y(), h_W.x());
+	const double gate = p_.mag_heading_gate_deg * M_PI / 180;
+	const bool usable =
+	    magUsable(s.mag, vert) && std::hypot(h_W.x(), h_W.y()) > 0;
+	if (usable && std::abs(psi) <= gate && !fast)
+	{
+		tMagOk_ = s.t;
+		headingConverged_ = true;
+	}
+	if (!(usable && (fast || !headingConverged_ || std::abs(psi) <= gate ||
+	                 s.t - tMagOk_ >= p_.mag_gate_max_s)))
+	{
+		flags |= kFlagMagGated;
+		++stats_.magGated;
+		return false;
+	}
+	// About the vertical only, so a tilted or disturbed field never
+	// tilts the estimate; heading gain kp_mag (kp while converging).
+	const double ratio = fast ? 1.0 : (p_.kp > 0 ? p_.kp_mag / p_.kp : 0.0);
+	e += -psi * ratio * up_I;
+	return true;
+}
+
+void AttitudeFilter::integrate(const ImuSample& s, const Eigen::Matrix3d& R_WI,
+                               const Eigen::Vector3d& e, bool corrected,
+                               bool fast, double dt, uint32_t flags)
+{
 	const double kp = fast ? std::max(p_.kp_init, p_.kp) : p_.kp;
 	// Bias integration only near convergence (no wind-up on large errors).
 	if (corrected && !fast && e.norm() < 0.05) bias_ -= p_.ki * e * dt;
-
 	// Trapezoidal gyro rate over the interval (zero-order hold if only one).
 	Eigen::Vector3d w = Eigen::Vector3d::Zero();
 	if (s.hasGyro)
@@ -245,7 +258,6 @@ uint32_t AttitudeFilter::add(const ImuSample& s)
 	}
 	tLast_ = s.t;
 	push(s.t);
-	return flags;
 }
 
 std::optional<Eigen::Quaterniond> AttitudeFilter::attitudeAt(

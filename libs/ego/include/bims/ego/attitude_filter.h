@@ -84,6 +84,22 @@ class AttitudeFilter
 
  private:
 	bool tryInitialize(const ImuSample& s);
+	/** use_sensor_orientation: the sample's attitude as the estimate. */
+	void takeSensorOrientation(const ImuSample& s);
+	/** The accelerometer's tilt innovation added to \a e (false: gated or
+	 * no accelerometer; kFlagAccelGated in \a flags when gated). */
+	bool accelInnovation(const ImuSample& s, const Eigen::Vector3d& up_I,
+	                     bool fast, Eigen::Vector3d& e, uint32_t& flags);
+	/** The magnetometer's heading innovation added to \a e (false: gated,
+	 * kFlagMagGated in \a flags). */
+	bool magInnovation(const ImuSample& s, const Eigen::Matrix3d& R_WI,
+	                   const Eigen::Vector3d& up_I, bool fast,
+	                   Eigen::Vector3d& e, uint32_t& flags);
+	/** The gyro rate plus kp times the innovation \a e over \a dt, the
+	 * bias's integral, the gyro-only chain. */
+	void integrate(const ImuSample& s, const Eigen::Matrix3d& R_WI,
+	               const Eigen::Vector3d& e, bool corrected, bool fast,
+	               double dt, uint32_t flags);
 	bool magUsable(const Eigen::Vector3d& m, const Eigen::Vector3d& up_I);
 	void push(double t);
 
