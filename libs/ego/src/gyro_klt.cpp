@@ -61,114 +61,133 @@ const std::vector<Track>& GyroAidedKLT::track(const cv::Mat& grey,
                                               const Eigen::Matrix3d* R_CprevC,
                                               const cv::Mat* movingMaskPrev)
 {
+	const cv::Mat* mask = checkedMask(grey, movingMaskPrev);
+	stats_ = {};
+	tracks_.clear();
+	tried_.clear();
+	std::vector<cv::Mat> pyr;
+	cv::buildOpticalFlowPyramid(grey, pyr, cv::Size(p_.window, p_.window),
+	                            p_.pyramid_levels, true);
+	if (!prevPyr_.empty() && !pts_.empty())
+	{
+		std::vector<int> idx;
+		tried_ = featuresOffMask(mask, grey.size(), idx);
+		stats_.attempted = static_cast<int>(tried_.size());
+		follow(pyr, grey.size(), K, R_CprevC, idx);
+		stats_.tracked = static_cast<int>(tracks_.size());
+	}
+	else
+		pts_.clear(), ids_.clear(), ages_.clear();
+	size_ = grey.size();
+	replenish(grey, mask);
+	prevPyr_.swap(pyr);
+	return tracks_;
+}
+
+const cv::Mat* GyroAidedKLT::checkedMask(const cv::Mat& grey,
+                                         const cv::Mat* movingMaskPrev) const
+{
 	if (grey.empty() || grey.type() != CV_8UC1)
 		throw std::invalid_argument(
 		    "GyroAidedKLT::track: expected a non-empty 8-bit grey image");
 	if (!prevPyr_.empty() && grey.size() != size_)
 		throw std::invalid_argument(
 		    "GyroAidedKLT::track: image size changed between frames");
-	const cv::Mat* mask = nullptr;
-	if (movingMaskPrev && !movingMaskPrev->empty())
-	{
-		if (movingMaskPrev->size() != grey.size() ||
-		    movingMaskPrev->type() != CV_8UC1)
-			throw std::invalid_argument(
-			    "GyroAidedKLT::track: moving mask must be CV_8UC1 of the "
-			    "image size");
-		mask = movingMaskPrev;
-	}
-	stats_ = {};
-	tracks_.clear();
-	tried_.clear();
-	const cv::Size win(p_.window, p_.window);
-	std::vector<cv::Mat> pyr;
-	cv::buildOpticalFlowPyramid(grey, pyr, win, p_.pyramid_levels, true);
+	if (!movingMaskPrev || movingMaskPrev->empty()) return nullptr;
+	if (movingMaskPrev->size() != grey.size() ||
+	    movingMaskPrev->type() != CV_8UC1)
+		throw std::invalid_argument(
+		    "GyroAidedKLT::track: moving mask must be CV_8UC1 of the "
+		    "image size");
+	return movingMaskPrev;
+}
 
-	if (!prevPyr_.empty() && !pts_.empty())
+std::vector<cv::Point2f> GyroAidedKLT::featuresOffMask(const cv::Mat* mask,
+                                                       cv::Size size,
+                                                       std::vector<int>& idx)
+{
+	// Drop features standing on regions labelled moving.
+	std::vector<cv::Point2f> p0;
+	for (size_t i = 0; i < pts_.size(); i++)
 	{
-		// Drop features standing on regions labelled moving.
-		std::vector<cv::Point2f> p0;
-		std::vector<int> idx;
-		for (size_t i = 0; i < pts_.size(); i++)
+		const cv::Point pi(cvRound(pts_[i].x), cvRound(pts_[i].y));
+		if (mask && mask->at<uint8_t>(std::clamp(pi.y, 0, size.height - 1),
+		                              std::clamp(pi.x, 0, size.width - 1)))
 		{
-			const cv::Point pi(cvRound(pts_[i].x), cvRound(pts_[i].y));
-			if (mask && mask->at<uint8_t>(std::clamp(pi.y, 0, grey.rows - 1),
-			                              std::clamp(pi.x, 0, grey.cols - 1)))
-			{
-				++stats_.droppedMask;
-				continue;
-			}
-			p0.push_back(pts_[i]);
-			idx.push_back(static_cast<int>(i));
+			++stats_.droppedMask;
+			continue;
 		}
-		stats_.attempted = static_cast<int>(p0.size());
-		tried_ = p0;
-		std::vector<cv::Point2f> p1(p0.size());
-		int flags = 0;
-		if (R_CprevC)
-		{
-			const Eigen::Matrix3d H = infiniteHomography(K, *R_CprevC);
-			for (size_t i = 0; i < p0.size(); i++) p1[i] = warp(H, p0[i]);
-			flags = cv::OPTFLOW_USE_INITIAL_FLOW;
-		}
-		const std::vector<cv::Point2f> guess =
-		    R_CprevC ? p1 : p0;  // what LK started from
-		std::vector<uint8_t> st, stBack;
-		std::vector<float> err;
-		const cv::TermCriteria term(
-		    cv::TermCriteria::COUNT | cv::TermCriteria::EPS, p_.max_iterations,
-		    p_.epsilon);
-		if (!p0.empty())
-		{
-			cv::calcOpticalFlowPyrLK(prevPyr_, pyr, p0, p1, st, err, win,
-			                         p_.pyramid_levels, term, flags, 1e-4);
-			std::vector<cv::Point2f> back = p0;
-			cv::calcOpticalFlowPyrLK(pyr, prevPyr_, p1, back, stBack, err, win,
-			                         p_.pyramid_levels, term,
-			                         cv::OPTFLOW_USE_INITIAL_FLOW, 1e-4);
-			std::vector<cv::Point2f> keepPts;
-			std::vector<int> keepIds, keepAges;
-			const float b = static_cast<float>(p_.border_px);
-			for (size_t i = 0; i < p0.size(); i++)
-			{
-				if (!st[i] || !stBack[i]) continue;
-				const cv::Point2f& q = p1[i];
-				if (q.x < b || q.y < b || q.x > grey.cols - 1 - b ||
-				    q.y > grey.rows - 1 - b)
-					continue;
-				const cv::Point2f d = back[i] - p0[i];
-				if (std::hypot(d.x, d.y) > p_.fb_threshold_px)
-				{
-					++stats_.lostFb;
-					continue;
-				}
-				const int k = idx[i];
-				Track t;
-				t.id = ids_[k];
-				t.age = ages_[k] + 1;
-				t.prev = p0[i];
-				t.cur = q;
-				t.predicted = guess[i];
-				tracks_.push_back(t);
-				keepPts.push_back(q);
-				keepIds.push_back(t.id);
-				keepAges.push_back(t.age);
-			}
-			pts_.swap(keepPts);
-			ids_.swap(keepIds);
-			ages_.swap(keepAges);
-		}
-		else
-			pts_.clear(), ids_.clear(), ages_.clear();
-		stats_.tracked = static_cast<int>(tracks_.size());
+		p0.push_back(pts_[i]);
+		idx.push_back(static_cast<int>(i));
 	}
-	else
+	return p0;
+}
+
+void GyroAidedKLT::follow(const std::vector<cv::Mat>& pyr, cv::Size size,
+                          const Eigen::Matrix3d& K,
+                          const Eigen::Matrix3d* R_CprevC,
+                          const std::vector<int>& idx)
+{
+	const std::vector<cv::Point2f>& p0 = tried_;
+	if (p0.empty())
+	{
 		pts_.clear(), ids_.clear(), ages_.clear();
-
-	size_ = grey.size();
-	replenish(grey, mask);
-	prevPyr_.swap(pyr);
-	return tracks_;
+		return;
+	}
+	// Lucas-Kanade from the gyro's prediction, and back (forward-backward
+	// check)
+	std::vector<cv::Point2f> p1(p0.size());
+	int flags = 0;
+	if (R_CprevC)
+	{
+		const Eigen::Matrix3d H = infiniteHomography(K, *R_CprevC);
+		for (size_t i = 0; i < p0.size(); i++) p1[i] = warp(H, p0[i]);
+		flags = cv::OPTFLOW_USE_INITIAL_FLOW;
+	}
+	const std::vector<cv::Point2f> guess =
+	    R_CprevC ? p1 : p0;  // what LK started from
+	std::vector<uint8_t> st, stBack;
+	std::vector<float> err;
+	const cv::Size win(p_.window, p_.window);
+	const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+	                            p_.max_iterations, p_.epsilon);
+	cv::calcOpticalFlowPyrLK(prevPyr_, pyr, p0, p1, st, err, win,
+	                         p_.pyramid_levels, term, flags, 1e-4);
+	std::vector<cv::Point2f> back = p0;
+	cv::calcOpticalFlowPyrLK(pyr, prevPyr_, p1, back, stBack, err, win,
+	                         p_.pyramid_levels, term,
+	                         cv::OPTFLOW_USE_INITIAL_FLOW, 1e-4);
+	std::vector<cv::Point2f> keepPts;
+	std::vector<int> keepIds, keepAges;
+	const float b = static_cast<float>(p_.border_px);
+	for (size_t i = 0; i < p0.size(); i++)
+	{
+		if (!st[i] || !stBack[i]) continue;
+		const cv::Point2f& q = p1[i];
+		if (q.x < b || q.y < b || q.x > size.width - 1 - b ||
+		    q.y > size.height - 1 - b)
+			continue;
+		const cv::Point2f d = back[i] - p0[i];
+		if (std::hypot(d.x, d.y) > p_.fb_threshold_px)
+		{
+			++stats_.lostFb;
+			continue;
+		}
+		const int k = idx[i];
+		Track t;
+		t.id = ids_[k];
+		t.age = ages_[k] + 1;
+		t.prev = p0[i];
+		t.cur = q;
+		t.predicted = guess[i];
+		tracks_.push_back(t);
+		keepPts.push_back(q);
+		keepIds.push_back(t.id);
+		keepAges.push_back(t.age);
+	}
+	pts_.swap(keepPts);
+	ids_.swap(keepIds);
+	ages_.swap(keepAges);
 }
 
 void GyroAidedKLT::replenish(const cv::Mat& grey, const cv::Mat* movingMask)

@@ -82,6 +82,17 @@ class GyroAidedKLT
 	const TrackerParams& params() const { return p_; }
 
  private:
+	/** Checks the image and the mask; the mask to use (null: none). */
+	const cv::Mat* checkedMask(const cv::Mat& grey,
+	                           const cv::Mat* movingMaskPrev) const;
+	/** The previous features not on \a mask; \a idx their indices. */
+	std::vector<cv::Point2f> featuresOffMask(const cv::Mat* mask, cv::Size size,
+	                                         std::vector<int>& idx);
+	/** Tracks tried_ (the features at \a idx) into \a pyr: tracks_, and
+	 * the features kept for the next frame. */
+	void follow(const std::vector<cv::Mat>& pyr, cv::Size size,
+	            const Eigen::Matrix3d& K, const Eigen::Matrix3d* R_CprevC,
+	            const std::vector<int>& idx);
 	void replenish(const cv::Mat& grey, const cv::Mat* movingMask);
 
 	TrackerParams p_;
