@@ -557,25 +557,25 @@ void DenseFrame::prepareReference(const AnchorParams& p)
 
 namespace
 {
-/** Levenberg-Marquardt at one level from (R, t): a step is taken only if
- * it lowers the robust cost (the photometric scale and brightness offset
- * stay fixed within the level, so that costs compare; they are estimated
- * afresh for the next level at the end). \a first: the pass at (R, t)
- * with this offset and scale, when already made (unused when the rotation
- * is held at the prior). Returns the steps taken. */
-int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
-                 Eigen::Matrix3d& R, Eigen::Vector3d& t, float& offset,
-                 double& photoSigma, const AnchorParams& p,
-                 const Eigen::Matrix3d* R_prior, double sigmaPrior_rad,
-                 const TranslationPrior* tPrior, NormalEquations6& rows,
-                 int* inliers, const Pass* first = nullptr,
-                 Mat6* information = nullptr)
+/** The priors of one level's Gauss-Newton: the rotation's (the IMU's;
+ * fixed without a sigma) and the translation's (the inertial filter's):
+ * their cost, their rows and the damped step. */
+struct LevelPriors
 {
-	const bool fixRotation = R_prior && !(sigmaPrior_rad > 0);
-	if (fixRotation) R = *R_prior;
-	const double wPrior =
-	    R_prior && !fixRotation ? 1 / (sigmaPrior_rad * sigmaPrior_rad) : 0;
-	auto priorCost = [&](const Eigen::Matrix3d& Rx, const Eigen::Vector3d& tx)
+	const Eigen::Matrix3d* R_prior;
+	const TranslationPrior* tPrior;
+	bool fixRotation;
+	double wPrior;
+
+	LevelPriors(const Eigen::Matrix3d* R, double sigma_rad,
+	            const TranslationPrior* t)
+	    : R_prior(R),
+	      tPrior(t),
+	      fixRotation(R && !(sigma_rad > 0)),
+	      wPrior(R && !fixRotation ? 1 / (sigma_rad * sigma_rad) : 0)
+	{
+	}
+	double cost(const Eigen::Matrix3d& Rx, const Eigen::Vector3d& tx) const
 	{
 		double c =
 		    wPrior > 0
@@ -587,17 +587,11 @@ int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
 			c += 0.5 * e.dot(tPrior->info * e);
 		}
 		return c;
-	};
-	Pass cur = first && !fixRotation ? *first
-	                                 : pass(Lr, samples, R, t, offset,
-	                                        photoSigma, p, &rows, nullptr);
-	double curCost = cur.cost + priorCost(R, t);
-	double lambda = 1e-4;
-	int steps = 0;
-	for (int it = 0; it < p.iterations && cur.inliers >= 6; it++)
+	}
+	/** Adds the priors' rows at (R, t) to the normal equations. */
+	void addTo(Mat6& H, Vec6& b, const Eigen::Matrix3d& R,
+	           const Eigen::Vector3d& t) const
 	{
-		Mat6 H = cur.H;
-		Vec6 b = cur.b;
 		if (wPrior > 0)
 		{
 			// r = Log(R_prior^T R), dr/dw ~ R^T (left perturbation)
@@ -615,6 +609,11 @@ int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
 			H += J.transpose() * tPrior->info * J;
 			b += J.transpose() * (tPrior->info * (t - tPrior->t));
 		}
+	}
+	/** The Levenberg-Marquardt step (v, w) of H d = -b, damped by \a lambda
+	 * (the translation only when the rotation is fixed). */
+	Vec6 step(Mat6 H, const Vec6& b, double lambda) const
+	{
 		Vec6 d = Vec6::Zero();
 		if (fixRotation)
 		{
@@ -627,13 +626,46 @@ int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
 			H.diagonal() *= 1 + lambda;
 			d = H.ldlt().solve(-b);
 		}
+		return d;
+	}
+};
+
+/** Levenberg-Marquardt at one level from (R, t): a step is taken only if
+ * it lowers the robust cost (the photometric scale and brightness offset
+ * stay fixed within the level, so that costs compare; they are estimated
+ * afresh for the next level at the end). \a first: the pass at (R, t)
+ * with this offset and scale, when already made (unused when the rotation
+ * is held at the prior). Returns the steps taken. */
+int iterateLevel(const DenseLevel& Lr, const std::vector<Sample>& samples,
+                 Eigen::Matrix3d& R, Eigen::Vector3d& t, float& offset,
+                 double& photoSigma, const AnchorParams& p,
+                 const Eigen::Matrix3d* R_prior, double sigmaPrior_rad,
+                 const TranslationPrior* tPrior, NormalEquations6& rows,
+                 int* inliers, const Pass* first = nullptr,
+                 Mat6* information = nullptr)
+{
+	const LevelPriors priors(R_prior, sigmaPrior_rad, tPrior);
+	if (priors.fixRotation) R = *R_prior;
+	Pass cur =
+	    first && !priors.fixRotation
+	        ? *first
+	        : pass(Lr, samples, R, t, offset, photoSigma, p, &rows, nullptr);
+	double curCost = cur.cost + priors.cost(R, t);
+	double lambda = 1e-4;
+	int steps = 0;
+	for (int it = 0; it < p.iterations && cur.inliers >= 6; it++)
+	{
+		Mat6 H = cur.H;
+		Vec6 b = cur.b;
+		priors.addTo(H, b, R, t);
+		const Vec6 d = priors.step(H, b, lambda);
 		if (!d.allFinite()) break;
 		const Eigen::Matrix3d dR = expSO3(d.segment<3>(3));
 		const Eigen::Matrix3d Rn = dR * R;
 		const Eigen::Vector3d tn = dR * t + d.head<3>();
 		Pass nxt =
 		    pass(Lr, samples, Rn, tn, offset, photoSigma, p, &rows, nullptr);
-		const double nxtCost = nxt.cost + priorCost(Rn, tn);
+		const double nxtCost = nxt.cost + priors.cost(Rn, tn);
 		++steps;
 		if (nxtCost < curCost)
 		{
