@@ -447,6 +447,79 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 
 }  // namespace
 
+namespace
+{
+/** A depth reading inside [zmin, zmax], else 0 (no reading; NaN fails both
+ * comparisons). */
+struct Readings
+{
+	float zmin, zmax;
+	float operator()(float z) const
+	{
+		return (z >= zmin && z <= zmax) ? z : 0.f;
+	}
+};
+
+/** Level 0: the input's readings and grey levels. */
+void fullLevel(const cv::Mat& depth, const cv::Mat& grey, Readings reading,
+               DenseLevel& L0)
+{
+	L0.depth.create(depth.size(), CV_32FC1);
+	for (int v = 0; v < depth.rows; v++)
+	{
+		const float* d = depth.ptr<float>(v);
+		float* o = L0.depth.ptr<float>(v);
+		for (int u = 0; u < depth.cols; u++) o[u] = reading(d[u]);
+	}
+	grey.convertTo(L0.grey, CV_32F);
+}
+
+/** Level 1 straight from the input (level 0 is not used): the same
+ * readings and the same 2x2 rules, in one pass. */
+void halfLevel(const cv::Mat& depth, const cv::Mat& grey, Readings reading,
+               const DenseLevel& L0, DenseLevel& L1)
+{
+	const int W = depth.cols / 2, H = depth.rows / 2;
+	L1.depth.create(H, W, CV_32FC1);
+	L1.grey.create(H, W, CV_32FC1);
+	for (int v = 0; v < H; v++)
+	{
+		const float* d0 = depth.ptr<float>(2 * v);
+		const float* d1 = depth.ptr<float>(2 * v + 1);
+		const uint8_t* g0 = grey.ptr<uint8_t>(2 * v);
+		const uint8_t* g1 = grey.ptr<uint8_t>(2 * v + 1);
+		float* od = L1.depth.ptr<float>(v);
+		float* og = L1.grey.ptr<float>(v);
+		for (int u = 0; u < W; u++)
+		{
+			const int a = 2 * u, b = 2 * u + 1;
+			og[u] = 0.25f * float(g0[a] + g0[b] + g1[a] + g1[b]);
+			const float z[4] = {reading(d0[a]), reading(d0[b]), reading(d1[a]),
+			                    reading(d1[b])};
+			od[u] = blockDepth(z);
+		}
+	}
+	halveIntrinsics(L0, L1);
+}
+
+/** The excluded pixels of every level: a pixel is excluded when any of the
+ * pixels it covers is (INTER_AREA: any non-zero stays non-zero). */
+void excludedPixels(const cv::Mat& exclude, std::vector<DenseLevel>& levels)
+{
+	const cv::Mat* src = &exclude;
+	for (size_t l = 0; l < levels.size(); l++)
+	{
+		DenseLevel& L = levels[l];
+		if (l == 0 && L.depth.empty()) continue;
+		if (src->size() == L.depth.size())
+			L.exclude = src->clone();
+		else
+			cv::resize(*src, L.exclude, L.depth.size(), 0, 0, cv::INTER_AREA);
+		src = &L.exclude;
+	}
+}
+}  // namespace
+
 void DenseFrame::build(const cv::Mat& image, const cv::Mat& depth,
                        const Eigen::Matrix3d& K, const AnchorParams& p,
                        const cv::Mat& exclude)
@@ -464,12 +537,7 @@ void DenseFrame::build(const cv::Mat& image, const cv::Mat& depth,
 		noImage_ = cv::Mat::zeros(depth.size(), CV_8UC1);
 	const cv::Mat& grey = image_ ? image : noImage_;
 	levels.assign(static_cast<size_t>(p.coarsest_level) + 1, DenseLevel());
-	const float zmin = float(p.min_depth_m), zmax = float(p.max_depth_m);
-	auto reading = [zmin, zmax](float z)
-	{
-		// (NaN fails both comparisons)
-		return (z >= zmin && z <= zmax) ? z : 0.f;
-	};
+	const Readings reading{float(p.min_depth_m), float(p.max_depth_m)};
 	DenseLevel& L0 = levels[0];
 	L0.fx = float(K(0, 0));
 	L0.fy = float(K(1, 1));
@@ -477,42 +545,10 @@ void DenseFrame::build(const cv::Mat& image, const cv::Mat& depth,
 	L0.cy = float(K(1, 2));
 	size_t first = 1;
 	if (p.finest_level == 0 || levels.size() == 1)
-	{
-		L0.depth.create(depth.size(), CV_32FC1);
-		for (int v = 0; v < depth.rows; v++)
-		{
-			const float* d = depth.ptr<float>(v);
-			float* o = L0.depth.ptr<float>(v);
-			for (int u = 0; u < depth.cols; u++) o[u] = reading(d[u]);
-		}
-		grey.convertTo(L0.grey, CV_32F);
-	}
+		fullLevel(depth, grey, reading, L0);
 	else
 	{
-		// Level 1 straight from the input (level 0 is not used): the same
-		// readings and the same 2x2 rules, in one pass.
-		DenseLevel& L1 = levels[1];
-		const int W = depth.cols / 2, H = depth.rows / 2;
-		L1.depth.create(H, W, CV_32FC1);
-		L1.grey.create(H, W, CV_32FC1);
-		for (int v = 0; v < H; v++)
-		{
-			const float* d0 = depth.ptr<float>(2 * v);
-			const float* d1 = depth.ptr<float>(2 * v + 1);
-			const uint8_t* g0 = grey.ptr<uint8_t>(2 * v);
-			const uint8_t* g1 = grey.ptr<uint8_t>(2 * v + 1);
-			float* od = L1.depth.ptr<float>(v);
-			float* og = L1.grey.ptr<float>(v);
-			for (int u = 0; u < W; u++)
-			{
-				const int a = 2 * u, b = 2 * u + 1;
-				og[u] = 0.25f * float(g0[a] + g0[b] + g1[a] + g1[b]);
-				const float z[4] = {reading(d0[a]), reading(d0[b]),
-				                    reading(d1[a]), reading(d1[b])};
-				od[u] = blockDepth(z);
-			}
-		}
-		halveIntrinsics(L0, L1);
+		halfLevel(depth, grey, reading, L0, levels[1]);
 		first = 2;
 	}
 	for (size_t l = first; l < levels.size(); l++)
@@ -523,23 +559,7 @@ void DenseFrame::build(const cv::Mat& image, const cv::Mat& depth,
 		cv::resize(a.grey, b.grey, b.depth.size(), 0, 0, cv::INTER_AREA);
 		halveIntrinsics(a, b);
 	}
-	// the excluded pixels of every level: a pixel is excluded when any of
-	// the pixels it covers is (INTER_AREA: any non-zero stays non-zero)
-	if (!exclude.empty())
-	{
-		const cv::Mat* src = &exclude;
-		for (size_t l = 0; l < levels.size(); l++)
-		{
-			DenseLevel& L = levels[l];
-			if (l == 0 && L.depth.empty()) continue;
-			if (src->size() == L.depth.size())
-				L.exclude = src->clone();
-			else
-				cv::resize(*src, L.exclude, L.depth.size(), 0, 0,
-				           cv::INTER_AREA);
-			src = &L.exclude;
-		}
-	}
+	if (!exclude.empty()) excludedPixels(exclude, levels);
 }
 
 void DenseFrame::prepareReference(const AnchorParams& p)
