@@ -132,6 +132,80 @@ void KeyframeAnchor::take(Attempt& a)
 	a.k->frame.dropReadings(m, p_);
 }
 
+namespace
+{
+/** The alignment against a keyframe at (R_WK, t_WK): the guesses and the
+ * priors turned into its frame (T_KC = T_WK^-1 T_WC). */
+DenseAlignResult alignInKeyframe(
+    const DenseFrame& key, const Eigen::Matrix3d& R_WK,
+    const Eigen::Vector3d& t_WK, const DenseFrame& cur,
+    const std::vector<InitialGuess>& guesses, const Eigen::Matrix3d* R_prior,
+    const TranslationPrior* tPrior, const AnchorParams& p)
+{
+	std::vector<InitialGuess> inits;
+	for (const auto& g : guesses)
+		inits.push_back(
+		    {R_WK.transpose() * g.R, R_WK.transpose() * (g.t - t_WK)});
+	Eigen::Matrix3d R_KCprior;
+	if (R_prior) R_KCprior = R_WK.transpose() * *R_prior;
+	// the translation prior in the keyframe's frame: t_KC = R_WK^T (t - t_WK)
+	TranslationPrior tK;
+	if (tPrior)
+	{
+		tK.t = R_WK.transpose() * (tPrior->t - t_WK);
+		tK.info = R_WK.transpose() * tPrior->info * R_WK;
+	}
+	return alignDense(key, cur, inits, p, R_prior ? &R_KCprior : nullptr,
+	                  p.rotation_prior_sigma_deg * kDeg,
+	                  tPrior ? &tK : nullptr);
+}
+
+/** The correction of (R_WC, t_WC) against the nearest of the guesses: a
+ * result next to the constant-velocity guess is no jump even when the
+ * frame-to-frame one (that people in view can corrupt) is far. */
+void nearestCorrection(const Eigen::Matrix3d& R_WC, const Eigen::Vector3d& t_WC,
+                       const std::vector<InitialGuess>& guesses,
+                       const AnchorParams& p, AnchorResult& r)
+{
+	r.correction_m = 1e300;
+	r.correction_deg = 0;
+	for (const auto& g : guesses)
+	{
+		const double dm = (t_WC - g.t).norm();
+		const double dd = angleSO3(g.R.transpose() * R_WC) / kDeg;
+		if (dm / p.max_correction_m + dd / p.max_correction_deg <
+		    r.correction_m / p.max_correction_m +
+		        r.correction_deg / p.max_correction_deg)
+		{
+			r.correction_m = dm;
+			r.correction_deg = dd;
+		}
+	}
+}
+
+/** Why the alignment \a a is refused (r.why; empty: taken), and whether a
+ * large correction is a relocalisation. */
+void judge(const DenseAlignResult& a, const AnchorParams& p, AnchorResult& r)
+{
+	r.why.clear();
+	r.accepted = false;
+	r.relocalised = false;
+	if (!a.ok)
+		r.why = a.why;
+	else if (r.correction_m > p.max_correction_m ||
+	         r.correction_deg > p.max_correction_deg)
+	{
+		// A large correction is taken only from a keyframe the frame fits
+		// almost entirely: the pose had drifted (flagged, not silent).
+		if (a.inlier_fraction >= p.relocalise_inlier_fraction &&
+		    a.overlap >= p.relocalise_overlap)
+			r.relocalised = true;
+		else
+			r.why = "correction too large";
+	}
+}
+}  // namespace
+
 KeyframeAnchor::Attempt KeyframeAnchor::alignTo(
     Keyframe& k, const Eigen::Matrix3d& R_pred, const Eigen::Vector3d& t_pred,
     const std::vector<InitialGuess>& others, const Eigen::Matrix3d* R_prior,
@@ -140,26 +214,11 @@ KeyframeAnchor::Attempt KeyframeAnchor::alignTo(
 {
 	Attempt out{start, &k, cv::Mat(), {}};
 	AnchorResult& r = out.r;
-	// guesses of T_KC = T_WK^-1 T_WC
-	std::vector<InitialGuess> inits;
-	inits.push_back(
-	    {k.R_WK.transpose() * R_pred, k.R_WK.transpose() * (t_pred - k.t_WK)});
-	for (const auto& g : others)
-		inits.push_back(
-		    {k.R_WK.transpose() * g.R, k.R_WK.transpose() * (g.t - k.t_WK)});
-	Eigen::Matrix3d R_KCprior;
-	if (R_prior) R_KCprior = k.R_WK.transpose() * *R_prior;
-	// the translation prior in the keyframe's frame: t_KC = R_WK^T (t - t_WK)
-	TranslationPrior tK;
-	if (tPrior)
-	{
-		tK.t = k.R_WK.transpose() * (tPrior->t - k.t_WK);
-		tK.info = k.R_WK.transpose() * tPrior->info * k.R_WK;
-	}
+	std::vector<InitialGuess> guesses = {{R_pred, t_pred}};
+	guesses.insert(guesses.end(), others.begin(), others.end());
+	const DenseAlignResult a = alignInKeyframe(k.frame, k.R_WK, k.t_WK, cur_,
+	                                           guesses, R_prior, tPrior, p_);
 	const double sigmaRot = p_.rotation_prior_sigma_deg * kDeg;
-	const DenseAlignResult a =
-	    alignDense(k.frame, cur_, inits, p_, R_prior ? &R_KCprior : nullptr,
-	               sigmaRot, tPrior ? &tK : nullptr);
 	const double rotationInfo = !R_prior ? 0.0
 	                            : sigmaRot > 0
 	                                ? 1 / (sigmaRot * sigmaRot)
@@ -179,41 +238,8 @@ KeyframeAnchor::Attempt KeyframeAnchor::alignTo(
 	out.consistent = a.consistent;
 	const Eigen::Matrix3d R_WC = k.R_WK * a.R_RC;
 	const Eigen::Vector3d t_WC = k.R_WK * a.t_RC + k.t_WK;
-	// The correction against the nearest guess: a result next to the
-	// constant-velocity guess is no jump even when the frame-to-frame one
-	// (that people in view can corrupt) is far.
-	r.correction_m = 1e300;
-	r.correction_deg = 0;
-	std::vector<InitialGuess> all = {{R_pred, t_pred}};
-	all.insert(all.end(), others.begin(), others.end());
-	for (const auto& g : all)
-	{
-		const double dm = (t_WC - g.t).norm();
-		const double dd = angleSO3(g.R.transpose() * R_WC) / kDeg;
-		if (dm / p_.max_correction_m + dd / p_.max_correction_deg <
-		    r.correction_m / p_.max_correction_m +
-		        r.correction_deg / p_.max_correction_deg)
-		{
-			r.correction_m = dm;
-			r.correction_deg = dd;
-		}
-	}
-	r.why.clear();
-	r.accepted = false;
-	r.relocalised = false;
-	if (!a.ok)
-		r.why = a.why;
-	else if (r.correction_m > p_.max_correction_m ||
-	         r.correction_deg > p_.max_correction_deg)
-	{
-		// A large correction is taken only from a keyframe the frame fits
-		// almost entirely: the pose had drifted (flagged, not silent).
-		if (a.inlier_fraction >= p_.relocalise_inlier_fraction &&
-		    a.overlap >= p_.relocalise_overlap)
-			r.relocalised = true;
-		else
-			r.why = "correction too large";
-	}
+	nearestCorrection(R_WC, t_WC, guesses, p_, r);
+	judge(a, p_, r);
 	r.gated = false;
 	if (r.why.empty() && gate && !(*gate)(t_WC, r.position_information))
 	{
