@@ -488,25 +488,8 @@ void Odometry::anchorToKeyframes(const RgbdFrame& f, const cv::Mat* mask,
 	    [this, infoScale](const Eigen::Vector3d& t, const Eigen::Matrix3d& info)
 	{ return inertial_.check(t, infoScale * info).accepted; };
 	const Eigen::Matrix3d R_prior = R_WC_;
-	// The previous frame's movers where they are expected in this one,
-	// with the motion predicted as for the alignment's second guess (the
-	// gyro's rotation, else the last frame's; the last translation), not
-	// the frame-to-frame estimate that features on movers can corrupt.
-	cv::Mat exclude;
 	double excluded = 0;
-	if (mask)
-	{
-		exclude = cfg_.anchor.predict_mask
-		              ? predictMovingMask(*mask, depthPrev_, f.K,
-		                                  predictRotation(f.t), lastT_rel_,
-		                                  cfg_.anchor.mask_margin_px)
-		              : *mask;
-		if (tooLarge(exclude, &excluded))
-		{
-			r.flags |= kFlagMaskIgnored;
-			exclude.release();
-		}
-	}
+	const cv::Mat exclude = expectedMovers(f, mask, r, excluded);
 	r.anchor =
 	    anchor_.track(f, R_WC_, t_WC_, {second}, m.useImu ? &R_prior : nullptr,
 	                  exclude, in ? &in->prior : nullptr, in ? &gate : nullptr);
@@ -515,42 +498,9 @@ void Odometry::anchorToKeyframes(const RgbdFrame& f, const cv::Mat* mask,
 	if (r.anchor.maskIgnored) r.flags |= kFlagMaskIgnored;
 	bool lost = false;
 	if (r.anchor.accepted)
-	{
-		R_WC_ = orthonormalize(r.anchor.R_WC);
-		t_WC_ = r.anchor.t_WC;
-		if (in)
-		{
-			// the position the filter keeps: the alignment's where it
-			// measured, the prediction along what it left unconstrained
-			const InertialUpdate u = inertial_.update(
-			    t_WC_, infoScale * r.anchor.position_information);
-			r.degenerate = u.degeneracy.count;
-			r.inertial_nis = u.nis;
-			r.position_information = u.degeneracy.eigenvalues;
-			t_WC_ = inertial_.state().p_WC;
-		}
-		m.R_rel = R_WCprev_.transpose() * R_WC_;
-		m.t_rel = R_WCprev_.transpose() * (t_WC_ - t_WCprev_);
-		r.flags |= kFlagAnchored;
-		if (r.anchor.relocalised) r.flags |= kFlagAnchorRelocalised;
-		anchorFailures_ = 0;
-		lastAnchored_ = true;
-	}
+		takeAnchor(in, m, r);
 	else if (r.anchor.tried)
-	{
-		r.flags |= kFlagAnchorFailed;
-		if (r.anchor.gated) r.flags |= kFlagInertialRejected;
-		if (in)
-		{
-			const Degeneracy d =
-			    analyseDegeneracy(infoScale * r.anchor.position_information,
-			                      cfg_.inertial.degenerate_sigma_m,
-			                      cfg_.inertial.degenerate_ratio);
-			r.degenerate = d.count;
-			r.position_information = d.eigenvalues;
-		}
-		lost = ++anchorFailures_ >= cfg_.anchor.lost_frames;
-	}
+		lost = missedAnchor(in, r);
 	if (lost)
 	{
 		// Go on from this frame's (frame-to-frame) pose: it becomes a
@@ -561,6 +511,68 @@ void Odometry::anchorToKeyframes(const RgbdFrame& f, const cv::Mat* mask,
 	if (r.degenerate > 0) r.flags |= kFlagDegenerate;
 	anchor_.wantKeyframe(r.anchor, R_WC_, t_WC_,
 	                     lost || (r.flags & kFlagWorldReanchored));
+}
+
+cv::Mat Odometry::expectedMovers(const RgbdFrame& f, const cv::Mat* mask,
+                                 FrameEgomotion& r, double& excluded) const
+{
+	// The previous frame's movers where they are expected in this one,
+	// with the motion predicted as for the alignment's second guess (the
+	// gyro's rotation, else the last frame's; the last translation), not
+	// the frame-to-frame estimate that features on movers can corrupt.
+	if (!mask) return cv::Mat();
+	cv::Mat exclude =
+	    cfg_.anchor.predict_mask
+	        ? predictMovingMask(*mask, depthPrev_, f.K, predictRotation(f.t),
+	                            lastT_rel_, cfg_.anchor.mask_margin_px)
+	        : *mask;
+	if (tooLarge(exclude, &excluded))
+	{
+		r.flags |= kFlagMaskIgnored;
+		exclude.release();
+	}
+	return exclude;
+}
+
+void Odometry::takeAnchor(const InertialPrediction* in, FrameToFrame& m,
+                          FrameEgomotion& r)
+{
+	R_WC_ = orthonormalize(r.anchor.R_WC);
+	t_WC_ = r.anchor.t_WC;
+	if (in)
+	{
+		// the position the filter keeps: the alignment's where it
+		// measured, the prediction along what it left unconstrained
+		const InertialUpdate u =
+		    inertial_.update(t_WC_, cfg_.inertial.alignment_information_scale *
+		                                r.anchor.position_information);
+		r.degenerate = u.degeneracy.count;
+		r.inertial_nis = u.nis;
+		r.position_information = u.degeneracy.eigenvalues;
+		t_WC_ = inertial_.state().p_WC;
+	}
+	m.R_rel = R_WCprev_.transpose() * R_WC_;
+	m.t_rel = R_WCprev_.transpose() * (t_WC_ - t_WCprev_);
+	r.flags |= kFlagAnchored;
+	if (r.anchor.relocalised) r.flags |= kFlagAnchorRelocalised;
+	anchorFailures_ = 0;
+	lastAnchored_ = true;
+}
+
+bool Odometry::missedAnchor(const InertialPrediction* in, FrameEgomotion& r)
+{
+	r.flags |= kFlagAnchorFailed;
+	if (r.anchor.gated) r.flags |= kFlagInertialRejected;
+	if (in)
+	{
+		const Degeneracy d = analyseDegeneracy(
+		    cfg_.inertial.alignment_information_scale *
+		        r.anchor.position_information,
+		    cfg_.inertial.degenerate_sigma_m, cfg_.inertial.degenerate_ratio);
+		r.degenerate = d.count;
+		r.position_information = d.eigenvalues;
+	}
+	return ++anchorFailures_ >= cfg_.anchor.lost_frames;
 }
 
 void Odometry::commit(const RgbdFrame& f, const ImuPrediction& imu,

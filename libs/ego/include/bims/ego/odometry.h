@@ -209,6 +209,18 @@ class Odometry
 	void anchorToKeyframes(const RgbdFrame& f, const cv::Mat* mask,
 	                       const InertialPrediction* in, FrameToFrame& m,
 	                       FrameEgomotion& r);
+	/** The previous frame's mask moved to where its movers are expected in
+	 * this frame (empty: none, or too large: kFlagMaskIgnored); \a excluded
+	 * gets its share of the image. */
+	cv::Mat expectedMovers(const RgbdFrame& f, const cv::Mat* mask,
+	                       FrameEgomotion& r, double& excluded) const;
+	/** An accepted alignment: the pose, the filter's update, \a m's
+	 * motion. */
+	void takeAnchor(const InertialPrediction* in, FrameToFrame& m,
+	                FrameEgomotion& r);
+	/** An alignment tried and refused: the flags, the degeneracy; whether
+	 * the anchor is lost (lost_frames in a row). */
+	bool missedAnchor(const InertialPrediction* in, FrameEgomotion& r);
 	/** Whether the depth-inertial filter runs ([inertial] enable, mode imu
 	 * with R_IC). */
 	bool inertialOn() const;
