@@ -335,37 +335,9 @@ Odometry::FrameToFrame Odometry::estimate(const RgbdFrame& f,
 	MotionEstimate m;
 	if (out.useImu)
 	{
-		// Relative prior anchored on the absolute IMU attitude, so that the
-		// estimated R_WC never drifts from the filter's.
-		// Inter-frame rotation from the gyro; the absolute attitude pulled
-		// towards the filter's by attitude_blend per frame (no drift, and
-		// no correction noise in the inter-frame rotations).
-		Eigen::Matrix3d R_new = *imu.R_WC;
-		if (imu.R_rel_gyro)
-		{
-			const Eigen::Matrix3d R_pred = R_WC_ * *imu.R_rel_gyro;
-			const double blend =
-			    out.filterConverging &&
-			            !cfg_.odometry.follow_converging_attitude
-			        ? 0.0
-			        : cfg_.odometry.attitude_blend;
-			R_new =
-			    R_pred * expSO3(blend * logSO3(R_pred.transpose() * *imu.R_WC));
-		}
-		const Eigen::Matrix3d R_rel = R_WC_.transpose() * R_new;
-		R_imuRel = R_rel;
+		R_imuRel = R_WC_.transpose() * imuAttitude(imu, out.filterConverging);
 		r.R_source = RotationSource::Imu;
-		if (image) m = est_.estimateTranslation(corr, R_rel);
-		if (m.ok && cfg_.translation.reprojection &&
-		    cfg_.translation.refine != TranslationRefine::SE3)
-			m = est_.refineReprojection(corr, m, f.K, false);
-		if (m.ok && cfg_.translation.refine == TranslationRefine::SE3)
-		{
-			m = est_.refineSE3(
-			    corr, m, R_rel,
-			    cfg_.translation.rotation_prior_sigma_deg * M_PI / 180);
-			r.R_source = RotationSource::ImuRefined;
-		}
+		if (image) m = translationGivenRotation(corr, R_imuRel, f.K, r);
 	}
 	else if (image)
 	{
@@ -400,6 +372,40 @@ Odometry::FrameToFrame Odometry::estimate(const RgbdFrame& f,
 	}
 	out.R_rel = orthonormalize(out.R_rel);
 	return out;
+}
+
+Eigen::Matrix3d Odometry::imuAttitude(const ImuPrediction& imu,
+                                      bool converging) const
+{
+	// Relative prior anchored on the absolute IMU attitude, so that the
+	// estimated R_WC never drifts from the filter's.
+	// Inter-frame rotation from the gyro; the absolute attitude pulled
+	// towards the filter's by attitude_blend per frame (no drift, and
+	// no correction noise in the inter-frame rotations).
+	if (!imu.R_rel_gyro) return *imu.R_WC;
+	const Eigen::Matrix3d R_pred = R_WC_ * *imu.R_rel_gyro;
+	const double blend = converging && !cfg_.odometry.follow_converging_attitude
+	                         ? 0.0
+	                         : cfg_.odometry.attitude_blend;
+	return R_pred * expSO3(blend * logSO3(R_pred.transpose() * *imu.R_WC));
+}
+
+MotionEstimate Odometry::translationGivenRotation(
+    const std::vector<Correspondence>& corr, const Eigen::Matrix3d& R_rel,
+    const Eigen::Matrix3d& K, FrameEgomotion& r)
+{
+	MotionEstimate m = est_.estimateTranslation(corr, R_rel);
+	if (m.ok && cfg_.translation.reprojection &&
+	    cfg_.translation.refine != TranslationRefine::SE3)
+		m = est_.refineReprojection(corr, m, K, false);
+	if (m.ok && cfg_.translation.refine == TranslationRefine::SE3)
+	{
+		m = est_.refineSE3(
+		    corr, m, R_rel,
+		    cfg_.translation.rotation_prior_sigma_deg * M_PI / 180);
+		r.R_source = RotationSource::ImuRefined;
+	}
+	return m;
 }
 
 void Odometry::predictPose(const ImuPrediction& imu, const FrameToFrame& m,

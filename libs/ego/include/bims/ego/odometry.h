@@ -186,6 +186,17 @@ class Odometry
 	 * vision SE(3); the best guess when it fails. */
 	FrameToFrame estimate(const RgbdFrame& f, const ImuPrediction& imu,
 	                      FrameEgomotion& r);
+	/** The frame's attitude R_WC from the IMU: the gyro's rotation since
+	 * the previous frame pulled towards the filter's attitude by
+	 * attitude_blend (not while it converges, unless
+	 * follow_converging_attitude), or the filter's as is. */
+	Eigen::Matrix3d imuAttitude(const ImuPrediction& imu,
+	                            bool converging) const;
+	/** The translation of the correspondences given the IMU's rotation
+	 * R_rel, refined as [translation] says. */
+	MotionEstimate translationGivenRotation(
+	    const std::vector<Correspondence>& corr, const Eigen::Matrix3d& R_rel,
+	    const Eigen::Matrix3d& K, FrameEgomotion& r);
 	/** The pose that motion predicts (the IMU's attitude while the filter
 	 * converges; the world turned to the IMU's first attitude). */
 	void predictPose(const ImuPrediction& imu, const FrameToFrame& m,
