@@ -199,6 +199,17 @@ struct Association
 	 * no normal) and Tukey's weight s^2 of it. */
 	bool residuals = false;
 	std::vector<float> r, w;
+
+	/** Before a pass over \a n samples: no pixel recorded, no residual. */
+	void prepare(size_t n)
+	{
+		if (record) pixel.assign(n, -1);
+		if (residuals)
+		{
+			r.assign(n, std::numeric_limits<float>::quiet_NaN());
+			w.assign(n, 0.f);
+		}
+	}
 };
 
 /** A pass's pose in the loop's float arithmetic, and the reference's
@@ -256,6 +267,42 @@ struct PassOutputs
 	cv::Mat* consistent;
 	Association* assoc;
 };
+
+/** A sample associated with reference reading \a zr beyond the depth gate
+ * (seen through the reference's surface, or in front of it): its counts
+ * and cost. false when it is on the surface. */
+bool offSurface(float zr, float Z, const Sample& s, int pix, bool counts,
+                const AnchorParams& p, const PassOutputs& o, Pass& out)
+{
+	const float gate = float(p.gate_m + p.gate_z2 * zr * zr);
+	const double rhoMax = p.tukey_c * p.tukey_c / 6;
+	if (zr > 0 && Z > zr + gate)
+	{
+		// The current frame sees through the reference's surface: that
+		// surface was not static (it has moved away); the current point
+		// is no outlier of its own frame.
+		if (!counts) return true;
+		++out.associated;
+		++out.seenThrough;
+		if (o.seenThrough) o.seenThrough->push_back(pix);
+		out.cost += rhoMax;
+		return true;
+	}
+	if (zr < 0 || Z < zr - gate)
+	{
+		// In front of the reference's surface: an occluder (moving, or
+		// static but new), no evidence against the pose. Or where the
+		// reference saw something moving (zr < 0): covered (no reason
+		// for a new keyframe), and likely moving itself.
+		if (o.outliers) o.outliers->data[s.pix] = 255;
+		if (!counts) return true;
+		++out.associated;
+		++out.occluding;
+		out.cost += rhoMax;
+		return true;
+	}
+	return false;
+}
 
 /** The point-to-plane term of a sample associated on the reference's
  * surface q (X, Y, Z: the sample in the reference's camera): the
@@ -366,12 +413,7 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 	const PassOutputs o{outliers, seenThrough, consistent, assoc};
 	const bool record = assoc && assoc->record,
 	           keep = assoc && assoc->keep && !record;
-	if (record) assoc->pixel.assign(cur.size(), -1);
-	if (assoc && assoc->residuals)
-	{
-		assoc->r.assign(cur.size(), std::numeric_limits<float>::quiet_NaN());
-		assoc->w.assign(cur.size(), 0.f);
-	}
+	if (assoc) assoc->prepare(cur.size());
 	Pass out;
 	const PassFrame f(ref, R, t);
 	const float zmin = float(p.min_depth_m);
@@ -411,32 +453,7 @@ Pass pass(const DenseLevel& ref, const std::vector<Sample>& cur,
 			if (counts) out.cost += rhoMax;
 			continue;
 		}
-		const float gate = float(p.gate_m + p.gate_z2 * zr * zr);
-		if (zr > 0 && Z > zr + gate)
-		{
-			// The current frame sees through the reference's surface: that
-			// surface was not static (it has moved away); the current point
-			// is no outlier of its own frame.
-			if (!counts) continue;
-			++out.associated;
-			++out.seenThrough;
-			if (seenThrough) seenThrough->push_back(pix);
-			out.cost += rhoMax;
-			continue;
-		}
-		if (zr < 0 || Z < zr - gate)
-		{
-			// In front of the reference's surface: an occluder (moving, or
-			// static but new), no evidence against the pose. Or where the
-			// reference saw something moving (zr < 0): covered (no reason
-			// for a new keyframe), and likely moving itself.
-			if (outliers) outliers->data[s.pix] = 255;
-			if (!counts) continue;
-			++out.associated;
-			++out.occluding;
-			out.cost += rhoMax;
-			continue;
-		}
+		if (offSurface(zr, Z, s, pix, counts, p, o, out)) continue;
 		if (!geometricTerm(P[pix], s, i, X, Y, Z, counts, p, rows, o, out))
 			continue;
 		if (photo) photometric.add(s, X, Y, Z, iz, u, v, rows, out);
