@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -120,20 +119,6 @@ std::string scores(const RunReportInputs& in)
 	return o.str();
 }
 
-Json readMetrics(const std::string& path)
-{
-	std::ifstream f(path);
-	if (!f) throw std::runtime_error(path + ": cannot open");
-	try
-	{
-		return Json::parse(f);
-	}
-	catch (const std::exception& e)
-	{
-		throw std::runtime_error(path + ": not JSON: " + e.what());
-	}
-}
-
 /** The report's head: status, variant, parameters, input. */
 void reportHead(std::ostringstream& o, Json& j, const RunReportInputs& in)
 {
@@ -217,7 +202,7 @@ void reportOutputs(std::ostringstream& o, const Json& j,
 std::string runReport(const RunReportInputs& in)
 {
 	// (not const: a figure missing from it reads as null, as before)
-	Json j = readMetrics(in.outDir + "/metrics.json");
+	Json j = readJsonFile(in.outDir + "/metrics.json");
 	std::ostringstream o;
 	reportHead(o, j, in);
 	reportRun(o, j, in);
