@@ -1,4 +1,5 @@
 #include <bims/apps/app.h>
+#include <bims/apps/warnings.h>
 #include <bims/common/errors.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
@@ -140,6 +141,8 @@ std::vector<std::string> renameOptions(int argc, char** argv,
 
 int runApp(const std::string& program, const std::function<int()>& body)
 {
+	// the libraries' warnings, worded as this program's
+	setProgramWarnings(stderrWarnings(program));
 	try
 	{
 		return body();

@@ -34,21 +34,13 @@ std::string channels(const BagImportSummary& s)
 }
 }  // namespace
 
-std::string bagImportReport(const std::string& out, const BagImportSummary& sum,
-                            const BagImportParams& params)
+namespace
 {
-	std::string r = mrpt::format(
-	    "%s: %zu RGB-D frames of %dx%d (depth %s from %s, %s)\n", out.c_str(),
-	    sum.frames, sum.width, sum.height, sum.depthEncoding.c_str(),
-	    sum.topics.depth.c_str(),
-	    sum.topics.colour.empty()
-	        ? "no colour"
-	        : ("colour " + sum.colourEncoding + " from " + sum.topics.colour)
-	              .c_str());
-	for (const auto& n : sum.notes) r += n + "\n";
-	if (sum.layout != BagLayout::Auto)
-		r += "layout: " + std::string(choices(sum.layout).name(sum.layout)) +
-		     "\n";
+/** The report's lines on the depth's units, the extrinsics and the
+ * intrinsics. */
+std::string bagCameraLines(const BagImportSummary& sum)
+{
+	std::string r;
 	if (sum.depthUnits > 0)
 		r += mrpt::format("depth units %g m from %s\n", sum.depthUnits,
 		                  sum.depthUnitsFrom.c_str());
@@ -80,16 +72,14 @@ std::string bagImportReport(const std::string& out, const BagImportSummary& sum,
 		r += "the CameraInfo's " + sum.distortionModel +
 		     " distortion is not modelled: the images are used as they are "
 		     "(a pinhole camera)\n";
-	if (sum.unpaired > 0)
-		r += mrpt::format(
-		    "%zu of %zu depth images had no colour image within %g s "
-		    "([import_bag] max_time_gap_s): left out\n",
-		    sum.unpaired, sum.depthMessages, params.maxTimeGap);
-	if (sum.stampsBack > 0)
-		r += mrpt::format(
-		    "%zu images had a stamp not after the one before on their "
-		    "topic: left out\n",
-		    sum.stampsBack);
+	return r;
+}
+
+/** The report's lines on the IMU. */
+std::string bagImuLines(const BagImportSummary& sum,
+                        const BagImportParams& params)
+{
+	std::string r;
 	if (sum.imuSource.empty())
 		r += "no IMU topic\n";
 	else
@@ -120,6 +110,37 @@ std::string bagImportReport(const std::string& out, const BagImportSummary& sum,
 			    "out\n",
 			    sum.imuStampsBack);
 	}
+	return r;
+}
+}  // namespace
+
+std::string bagImportReport(const std::string& out, const BagImportSummary& sum,
+                            const BagImportParams& params)
+{
+	std::string r = mrpt::format(
+	    "%s: %zu RGB-D frames of %dx%d (depth %s from %s, %s)\n", out.c_str(),
+	    sum.frames, sum.width, sum.height, sum.depthEncoding.c_str(),
+	    sum.topics.depth.c_str(),
+	    sum.topics.colour.empty()
+	        ? "no colour"
+	        : ("colour " + sum.colourEncoding + " from " + sum.topics.colour)
+	              .c_str());
+	for (const auto& n : sum.notes) r += n + "\n";
+	if (sum.layout != BagLayout::Auto)
+		r += "layout: " + std::string(choices(sum.layout).name(sum.layout)) +
+		     "\n";
+	r += bagCameraLines(sum);
+	if (sum.unpaired > 0)
+		r += mrpt::format(
+		    "%zu of %zu depth images had no colour image within %g s "
+		    "([import_bag] max_time_gap_s): left out\n",
+		    sum.unpaired, sum.depthMessages, params.maxTimeGap);
+	if (sum.stampsBack > 0)
+		r += mrpt::format(
+		    "%zu images had a stamp not after the one before on their "
+		    "topic: left out\n",
+		    sum.stampsBack);
+	r += bagImuLines(sum, params);
 	return r;
 }
 

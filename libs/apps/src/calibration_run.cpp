@@ -9,6 +9,7 @@
 #include <bims/io/trajectory.h>
 #include <bims/source/frame_source.h>
 
+#include <mrpt/core/format.h>
 #include <mrpt/system/filesystem.h>
 
 #include <cstdio>
@@ -125,25 +126,27 @@ double largestDepthCorrection(const sensors::DepthCorrectionParams& p,
 	return worst;
 }
 
-int runDepthCalibration(const DepthCalibrationOptions& o)
+namespace
 {
-	checkOutputsSpareInputs({o.config, o.rawlog, o.poses}, {o.out});
-	ego::EgoConfig ec = egoConfigOption(o.config);
-	// raw depth, frame-to-frame vision odometry
-	ec.odometry.mode = ego::OdometryMode::Vision;
-	ec.anchor.enable = false;
-	ec.depth_correction.enable = false;
-	// (the same A:B rule as bims-run's)
-	const FrameRange range =
-	    frameRangeOption(o.frames, {o.rawlog}, ec.sensors.rgbd_label);
-	const size_t first = range.first, last = range.last;
-	Trajectory known;
-	if (!o.poses.empty()) known = loadTumTrajectory(o.poses);
-
-	ego::Odometry odo(ec);
+/** The frames of a depth calibration and their poses T_WC. */
+struct CalibFrames
+{
 	std::vector<ego::RgbdFrame> frames;
 	std::vector<Eigen::Matrix4d> poses;
-	size_t index = 0, noPose = 0;
+	size_t noPose = 0;  ///< frames without a pose in \a known
+};
+
+/** The frames of \a range of the rawlog with their poses: the vision
+ * odometry's, or those of \a known (when not empty) near each frame's
+ * stamp. */
+CalibFrames calibrationFrames(const DepthCalibrationOptions& o,
+                              const ego::EgoConfig& ec, const FrameRange& range,
+                              const Trajectory& known)
+{
+	const size_t first = range.first, last = range.last;
+	ego::Odometry odo(ec);
+	CalibFrames c;
+	size_t index = 0;
 	ReplayOptions ro;
 	ro.progress = o.progress;
 	if (last != static_cast<size_t>(-1)) ro.max_frames = last + 1;
@@ -161,60 +164,72 @@ int runDepthCalibration(const DepthCalibrationOptions& o)
 			    const StampedPose* p = poseNear(known, r.t, 5e-3);
 			    if (!p)
 			    {
-				    ++noPose;
+				    ++c.noPose;
 				    return;
 			    }
 			    T = p->T_WC;
 		    }
 		    ego::RgbdFrame f;
 		    if (!ego::rgbdFrameFrom(scan, ec.camera, f).empty()) return;
-		    frames.push_back(std::move(f));
-		    poses.push_back(
+		    c.frames.push_back(std::move(f));
+		    c.poses.push_back(
 		        T.getHomogeneousMatrixVal<mrpt::math::CMatrixDouble44>()
 		            .asEigen());
 	    },
 	    ro);
-	if (frames.empty())
+	return c;
+}
+}  // namespace
+
+int runDepthCalibration(const DepthCalibrationOptions& o)
+{
+	checkOutputsSpareInputs({o.config, o.rawlog, o.poses}, {o.out});
+	ego::EgoConfig ec = egoConfigOption(o.config);
+	// raw depth, frame-to-frame vision odometry
+	ec.odometry.mode = ego::OdometryMode::Vision;
+	ec.anchor.enable = false;
+	ec.depth_correction.enable = false;
+	// (the same A:B rule as bims-run's)
+	const FrameRange range =
+	    frameRangeOption(o.frames, {o.rawlog}, ec.sensors.rgbd_label);
+	Trajectory known;
+	if (!o.poses.empty()) known = loadTumTrajectory(o.poses);
+	const CalibFrames c = calibrationFrames(o, ec, range, known);
+	if (c.frames.empty())
 		throw std::runtime_error(
 		    o.rawlog +
 		    ": no usable RGB-D frame in the range (check --frames, "
 		    "[sensors] rgbd_label" +
 		    std::string(known.empty() ? ")" : ", --poses stamps)"));
-	const ego::DepthFitResult res = ego::estimateDepthCorrection(frames, poses);
+	const ego::DepthFitResult res =
+	    ego::estimateDepthCorrection(c.frames, c.poses);
 	std::printf(
 	    "bims-calib-depth: %zu frames (%zu without a pose), %d pairs, "
 	    "%zu residuals; robust RMS point-to-plane %.4f -> %.4f m\n"
 	    "bims-calib-depth: correction (1 + delta): left %+.2f %%, right "
 	    "%+.2f %%, top %+.2f %%, bottom %+.2f %%, top-left corner %+.2f %%\n",
-	    frames.size(), noPose, res.pairs, res.residuals, res.rms_before_m,
+	    c.frames.size(), c.noPose, res.pairs, res.residuals, res.rms_before_m,
 	    res.rms_after_m, 100 * res.left, 100 * res.right, 100 * res.top,
 	    100 * res.bottom, 100 * res.corner);
 	// A sensor's distortion is a few percent: a larger fit absorbed pose
 	// errors (a poor odometry, or moving objects in the stretch).
-	const ego::RgbdFrame& f0 = frames.front();
+	const ego::RgbdFrame& f0 = c.frames.front();
 	const double worst =
 	    largestDepthCorrection(res.params, f0.K, f0.depth.size());
 	if (worst > o.max_correction)
-	{
-		char msg[400];
-		std::snprintf(
-		    msg, sizeof(msg),
+		throw std::runtime_error(mrpt::format(
 		    "the fitted correction reaches %.1f %% (limit --max-correction "
 		    "%.1f %%): the %s do not fit a static scene well enough; give "
 		    "--poses (e.g. ground truth) or a slower, longer static stretch "
 		    "(nothing written)",
 		    100 * worst, 100 * o.max_correction,
-		    known.empty() ? "odometry's poses" : "given poses");
-		throw std::runtime_error(msg);
-	}
-	char note[512];
-	std::snprintf(note, sizeof(note),
-	              "# bims-calib-depth: %zu frames of %s (%s poses), robust "
-	              "RMS %.4f -> %.4f m\n",
-	              frames.size(),
-	              mrpt::system::extractFileName(o.rawlog).c_str(),
-	              known.empty() ? "vision odometry" : "given", res.rms_before_m,
-	              res.rms_after_m);
+		    known.empty() ? "odometry's poses" : "given poses"));
+	const std::string note = mrpt::format(
+	    "# bims-calib-depth: %zu frames of %s (%s poses), robust RMS %.4f -> "
+	    "%.4f m\n",
+	    c.frames.size(), mrpt::system::extractFileName(o.rawlog).c_str(),
+	    known.empty() ? "vision odometry" : "given", res.rms_before_m,
+	    res.rms_after_m);
 	writeFileAtomically(o.out, res.params.toIni(note));
 	return 0;
 }

@@ -7,6 +7,8 @@
 #include <bims/io/json.h>
 #include <bims/io/trajectory.h>
 
+#include <mrpt/core/format.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -67,9 +69,8 @@ void printJumps(const ev::JumpResult& j)
 	    "there)\n",
 	    j.maxSpeed, j.maxSpeedTime, j.maxSpeedEstIndex, j.refSpeedAtMax);
 }
-}  // namespace
 
-int runEvalTraj(const EvalTrajOptions& o)
+void checkEvalTrajOptions(const EvalTrajOptions& o)
 {
 	if (!(o.jumpM >= 0) || !std::isfinite(o.jumpM))
 		throw UsageError("--jump-m must be >= 0");
@@ -77,12 +78,18 @@ int runEvalTraj(const EvalTrajOptions& o)
 	for (const auto* out : {&o.plot, &o.json})
 		if (*out) outputs.push_back(**out);
 	checkOutputsSpareInputs({o.gt, o.est}, outputs);
+}
 
+/** The scores of \a est against \a gt (ATE, RPE, jumps); \a rpeError:
+ * why the RPE is not available ("" when it is). */
+ev::TrajectoryReport scoreTrajectory(const EvalTrajOptions& o,
+                                     const Trajectory& gt,
+                                     const Trajectory& est,
+                                     std::string& rpeError)
+{
 	ev::TrajectoryReport rep;
 	rep.gtPath = o.gt;
 	rep.estPath = o.est;
-	const auto gt = load(rep.gtPath);
-	const auto est = load(rep.estPath);
 	rep.gtPoses = gt.size();
 	rep.estPoses = est.size();
 	rep.ateOptions.maxTimeDifference = o.maxDt;
@@ -98,7 +105,6 @@ int runEvalTraj(const EvalTrajOptions& o)
 	{
 		throw std::runtime_error(both + e.what());
 	}
-	std::string rpeError;
 	try
 	{
 		rep.rpe = ev::computeRpe(gt, est, rep.rpeOptions);
@@ -107,9 +113,16 @@ int runEvalTraj(const EvalTrajOptions& o)
 	{
 		rpeError = e.what();
 	}
-
 	rep.jumps = ev::computeJumps(gt, est, rep.ate.pairs, {o.jumpM});
+	return rep;
+}
 
+/** The score lines on stdout (docs/eval.md). */
+void printTrajectoryScores(const EvalTrajOptions& o,
+                           const ev::TrajectoryReport& rep,
+                           const Trajectory& gt, const Trajectory& est,
+                           const std::string& rpeError)
+{
 	std::printf(
 	    "associated %zu of %zu estimated poses with %zu ground-truth poses "
 	    "(max dt %.3f s)\n",
@@ -131,30 +144,39 @@ int runEvalTraj(const EvalTrajOptions& o)
 	else
 		std::printf("rpe not available: %s\n", rpeError.c_str());
 	printJumps(rep.jumps);
+}
 
-	if (o.json)
-	{
-		writeJsonFile(*o.json, rep.toJson());
-	}
-	if (!o.noPlot)
-	{
-		std::string path = o.plot.value_or("");
-		if (path.empty())
-			path = std::filesystem::path(rep.estPath)
-			           .replace_extension()
-			           .string() +
-			       "_traj.png";
-		char title[256];
-		std::snprintf(title, sizeof(title), "%s  ATE RMSE %.3f m (%zu poses)",
-		              std::filesystem::path(rep.estPath).filename().c_str(),
-		              a.rmse, rep.ate.pairs.size());
-		ev::writePng(path,
-		             ev::plotTrajectories(
-		                 gt, ev::alignTrajectory(est, rep.ate.T_alignment),
-		                 rep.ate.pairs, title));
-		std::fprintf(stderr, "bims-eval traj: plot written to %s\n",
-		             path.c_str());
-	}
+/** The plot of both trajectories (the estimate aligned): --plot, or
+ * EST_traj.png beside the estimate. */
+void writeTrajectoryPlot(const EvalTrajOptions& o,
+                         const ev::TrajectoryReport& rep, const Trajectory& gt,
+                         const Trajectory& est)
+{
+	std::string path = o.plot.value_or("");
+	if (path.empty())
+		path = std::filesystem::path(rep.estPath).replace_extension().string() +
+		       "_traj.png";
+	const std::string title =
+	    mrpt::format("%s  ATE RMSE %.3f m (%zu poses)",
+	                 std::filesystem::path(rep.estPath).filename().c_str(),
+	                 rep.ate.stats.rmse, rep.ate.pairs.size());
+	ev::writePng(path, ev::plotTrajectories(
+	                       gt, ev::alignTrajectory(est, rep.ate.T_alignment),
+	                       rep.ate.pairs, title));
+	std::fprintf(stderr, "bims-eval traj: plot written to %s\n", path.c_str());
+}
+}  // namespace
+
+int runEvalTraj(const EvalTrajOptions& o)
+{
+	checkEvalTrajOptions(o);
+	const auto gt = load(o.gt);
+	const auto est = load(o.est);
+	std::string rpeError;
+	const ev::TrajectoryReport rep = scoreTrajectory(o, gt, est, rpeError);
+	printTrajectoryScores(o, rep, gt, est, rpeError);
+	if (o.json) writeJsonFile(*o.json, rep.toJson());
+	if (!o.noPlot) writeTrajectoryPlot(o, rep, gt, est);
 	return 0;
 }
 

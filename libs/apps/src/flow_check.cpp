@@ -100,13 +100,11 @@ cv::Mat stripTile(const mrpt::obs::CObservation3DRangeScan& scan,
 	return rgb;
 }
 
-int runFlowCheck(const FlowCheckOptions& o)
+namespace
 {
-	std::vector<std::string> outputs;
-	if (o.csv) outputs.push_back(*o.csv);
-	if (o.strip) outputs.push_back(*o.strip);
-	checkOutputsSpareInputs({o.config, o.rawlog, o.gt}, outputs);
-
+/** The experiment of --config with --variant. */
+pipeline::ExperimentConfig flowCheckConfig(const FlowCheckOptions& o)
+{
 	pipeline::ExperimentConfig cfg;
 	cfg.loadFromFile(o.config);
 	try
@@ -117,6 +115,29 @@ int runFlowCheck(const FlowCheckOptions& o)
 	{
 		throw UsageError(std::string("--variant: ") + e.what());
 	}
+	return cfg;
+}
+
+/** --strip: the frames' tiles side by side. */
+void writeStrip(const std::string& path, const std::map<size_t, cv::Mat>& tiles)
+{
+	if (tiles.empty())
+		throw std::runtime_error("--strip: none of the frames ran");
+	std::vector<cv::Mat> strip;
+	for (auto& [i, m] : tiles) strip.push_back(m);
+	eval::writePng(path, eval::imageStrip(strip, 0.5));
+	std::printf("strip: %s (%zu frames)\n", path.c_str(), tiles.size());
+}
+}  // namespace
+
+int runFlowCheck(const FlowCheckOptions& o)
+{
+	std::vector<std::string> outputs;
+	if (o.csv) outputs.push_back(*o.csv);
+	if (o.strip) outputs.push_back(*o.strip);
+	checkOutputsSpareInputs({o.config, o.rawlog, o.gt}, outputs);
+
+	const pipeline::ExperimentConfig cfg = flowCheckConfig(o);
 	const Trajectory gt = loadTumTrajectory(o.gt);
 	const auto stripFrames = parseIndexList(o.stripFrames, "--strip-frames");
 	if (o.strip && stripFrames.empty())
@@ -170,15 +191,7 @@ int runFlowCheck(const FlowCheckOptions& o)
 	    "%zu frames with the motion not measured\n",
 	    100 * sum.meanMovingPixelFraction, sum.variant.c_str(),
 	    sum.framesNotMeasured, sum.framesProcessed);
-	if (o.strip)
-	{
-		if (tiles.empty())
-			throw std::runtime_error("--strip: none of the frames ran");
-		std::vector<cv::Mat> strip;
-		for (auto& [i, m] : tiles) strip.push_back(m);
-		eval::writePng(*o.strip, eval::imageStrip(strip, 0.5));
-		std::printf("strip: %s (%zu frames)\n", o.strip->c_str(), tiles.size());
-	}
+	if (o.strip) writeStrip(*o.strip, tiles);
 	return 0;
 }
 

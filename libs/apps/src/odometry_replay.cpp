@@ -1,5 +1,6 @@
 #include <bims/apps/odometry_replay.h>
 #include <bims/apps/progress_bar.h>
+#include <bims/apps/warnings.h>
 #include <bims/ego/flags.h>
 #include <bims/io/frame_files.h>
 #include <bims/io/image_file.h>
@@ -44,10 +45,10 @@ ReplayStats replayRawlog(const std::string& path, ego::Odometry& odo,
                          const ImuCallback& onImu)
 {
 	ReplayStats st;
-	source::RawlogFrameSource src(
-	    {path},
-	    source::FrameOrderParams::of(odo.config(), opt.imu_wait_s, "bims-odom"),
-	    false);
+	source::FrameOrderParams order =
+	    source::FrameOrderParams::of(odo.config(), opt.imu_wait_s, "bims-odom");
+	order.warn = stderrWarnings("bims-odom");
+	source::RawlogFrameSource src({path}, order, false);
 	ProgressBar bar("bims-odom", opt.max_frames, opt.progress);
 	while (!opt.max_frames || st.frames < opt.max_frames)
 	{

@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -119,23 +118,10 @@ std::string scores(const RunReportInputs& in)
 	}
 	return o.str();
 }
-}  // namespace
 
-std::string runReport(const RunReportInputs& in)
+/** The report's head: status, variant, parameters, input. */
+void reportHead(std::ostringstream& o, Json& j, const RunReportInputs& in)
 {
-	const std::string path = in.outDir + "/metrics.json";
-	std::ifstream f(path);
-	if (!f) throw std::runtime_error(path + ": cannot open");
-	Json j;
-	try
-	{
-		j = Json::parse(f);
-	}
-	catch (const std::exception& e)
-	{
-		throw std::runtime_error(path + ": not JSON: " + e.what());
-	}
-	std::ostringstream o;
 	o << "# bims-run report\n\n";
 	o << "- status: **" << j.value("status", std::string("?")) << "**";
 	if (!j.value("error", std::string()).empty())
@@ -144,11 +130,15 @@ std::string runReport(const RunReportInputs& in)
 	  << "; parameters: `" << in.config << "` (every value in "
 	  << "[effective.ini](effective.ini))\n- input:";
 	for (const auto& r : in.rawlogs) o << " `" << r << "`";
+}
+
+/** ## Frames, ## IMU and ## Speed (a figure missing from \a j: null). */
+void reportRun(std::ostringstream& o, Json& j, const RunReportInputs& in)
+{
 	o << "\n\n## Frames\n\n";
-	const size_t frames = count(j, "frames_processed");
-	o << "- " << frames << " frames of " << count(j, "scans_read")
-	  << " 3D scans read, " << num(j["data_seconds"], 1)
-	  << " s of data; the motion not measured on "
+	o << "- " << count(j, "frames_processed") << " frames of "
+	  << count(j, "scans_read") << " 3D scans read, "
+	  << num(j["data_seconds"], 1) << " s of data; the motion not measured on "
 	  << count(j, "frames_not_measured") << "\n";
 	o << "- egomotion flags (frames; docs/ego.md):";
 	if (!j.contains("frames_flagged_by") || j["frames_flagged_by"].empty())
@@ -172,33 +162,26 @@ std::string runReport(const RunReportInputs& in)
 	  << " s CPU, peak memory " << num(j["peak_resident_mib"], 0)
 	  << " MiB)\n\n";
 	if (j.contains("stage_ms")) o << stageTable(j["stage_ms"]);
-	const std::string sc = scores(in);
-	o << "\n## Scores\n\n";
-	if (sc.empty())
-		o << "No ground truth beside the input (IN_gt/groundtruth.txt, "
-		     "IN_gt/masks/): score with `bims-eval traj` and `bims-eval masks` "
-		     "(docs/eval.md).\n";
-	else
-		o << sc;
+}
+
+/** ## Outputs: the run folder's files, the middle frame's mask shown. */
+void reportOutputs(std::ostringstream& o, const Json& j,
+                   const RunReportInputs& in)
+{
 	o << "\n## Outputs\n\n";
 	o << "- [trajectory.txt](trajectory.txt): the camera's poses (TUM)\n";
 	o << "- [masks/](masks/): moving pixels per frame (255 moving)";
-	if (frames > 0 && j.contains("frames_processed"))
+	std::vector<std::string> names;
+	if (count(j, "frames_processed") > 0 && j.contains("frames_processed") &&
+	    fs::is_directory(in.outDir + "/masks"))
+		for (const auto& e : fs::directory_iterator(in.outDir + "/masks"))
+			names.push_back(e.path().filename().string());
+	std::sort(names.begin(), names.end());
+	if (!names.empty())
 	{
-		// the middle frame's mask, shown
-		std::vector<std::string> names;
-		if (fs::is_directory(in.outDir + "/masks"))
-			for (const auto& e : fs::directory_iterator(in.outDir + "/masks"))
-				names.push_back(e.path().filename().string());
-		std::sort(names.begin(), names.end());
-		if (!names.empty())
-		{
-			const std::string mid = names[names.size() / 2];
-			o << "; the middle one:\n\n  ![mask " << mid << "](masks/" << mid
-			  << ")\n";
-		}
-		else
-			o << "\n";
+		const std::string mid = names[names.size() / 2];
+		o << "; the middle one:\n\n  ![mask " << mid << "](masks/" << mid
+		  << ")\n";
 	}
 	else
 		o << "\n";
@@ -213,6 +196,25 @@ std::string runReport(const RunReportInputs& in)
 	          "input; [output] labelled_rawlog_images copies its images)"}})
 		if (fs::exists(in.outDir + "/" + file))
 			o << "- [" << file << "](" << file << "): " << what << "\n";
+}
+}  // namespace
+
+std::string runReport(const RunReportInputs& in)
+{
+	// (not const: a figure missing from it reads as null, as before)
+	Json j = readJsonFile(in.outDir + "/metrics.json");
+	std::ostringstream o;
+	reportHead(o, j, in);
+	reportRun(o, j, in);
+	const std::string sc = scores(in);
+	o << "\n## Scores\n\n";
+	if (sc.empty())
+		o << "No ground truth beside the input (IN_gt/groundtruth.txt, "
+		     "IN_gt/masks/): score with `bims-eval traj` and `bims-eval masks` "
+		     "(docs/eval.md).\n";
+	else
+		o << sc;
+	reportOutputs(o, j, in);
 	return o.str();
 }
 

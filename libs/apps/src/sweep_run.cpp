@@ -3,6 +3,7 @@
 #include <bims/apps/output_checks.h>
 #include <bims/apps/progress_bar.h>
 #include <bims/apps/sweep_run.h>
+
 #include <bims/common/share.h>
 #include <bims/io/output_paths.h>
 #include <bims/pipeline/run.h>
@@ -10,6 +11,7 @@
 #include <bims/sweep/processes.h>
 #include <bims/sweep/results.h>
 #include <fcntl.h>
+#include <mrpt/core/format.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -304,22 +306,23 @@ std::string submitToSlurm(const SweepOptions& opt, const SweepPlan& plan,
 	const std::string last = text.substr(text.rfind('\n') + 1);
 	return last.substr(0, last.find(';'));
 }
-}  // namespace
 
-int runSweep(const SweepOptions& opt)
+/** bims-sweep --collect OUTDIR: the results of an earlier sweep's runs. */
+int collectSweep(const SweepOptions& opt)
 {
-	if (!opt.collect.empty())
-	{
-		if (!opt.sweepFile.empty() || !opt.outDir.empty() ||
-		    !opt.jobsFile.empty() || opt.dryRun || opt.slurm)
-			throw UsageError(
-			    "--collect OUTDIR takes no SWEEP.ini, -o, --jobs-file, "
-			    "--slurm nor --dry-run");
-		ResultTable t{SweepPlan::readJson(opt.collect + "/sweep.json"), {}};
-		for (size_t i = 0; i < t.plan.runs.size(); i++)
-			t.rows.push_back(scoreAndCollect(t.plan, i, opt.collect, nullptr));
-		return report(t, opt.collect, opt.plotMetric);
-	}
+	if (!opt.sweepFile.empty() || !opt.outDir.empty() ||
+	    !opt.jobsFile.empty() || opt.dryRun || opt.slurm)
+		throw UsageError(
+		    "--collect OUTDIR takes no SWEEP.ini, -o, --jobs-file, "
+		    "--slurm nor --dry-run");
+	ResultTable t{SweepPlan::readJson(opt.collect + "/sweep.json"), {}};
+	for (size_t i = 0; i < t.plan.runs.size(); i++)
+		t.rows.push_back(scoreAndCollect(t.plan, i, opt.collect, nullptr));
+	return report(t, opt.collect, opt.plotMetric);
+}
+
+void checkSweepOptions(const SweepOptions& opt)
+{
 	if (opt.sweepFile.empty())
 		throw UsageError("give SWEEP.ini (or --collect OUTDIR)");
 	if (opt.outDir.empty())
@@ -330,10 +333,123 @@ int runSweep(const SweepOptions& opt)
 		    "--dry-run writes nothing: no --jobs-file nor --slurm with it");
 	if (!opt.sbatchArgs.empty() && !opt.slurm)
 		throw UsageError("--sbatch goes with --slurm");
+}
+
+/** The sweep's output folder: an earlier sweep's plan and results refused,
+ * or replaced; its manifest; the plan (sweep.json). */
+void prepareSweepFolder(const SweepOptions& opt, const SweepPlan& plan)
+{
+	prepareOutputFolder(
+	    opt.outDir,
+	    {{"sweep.json", "results.csv", "results.md", "results.png"}, {}},
+	    opt.overwrite);
+	makeDirs(opt.outDir);
+	// what the sweep writes into OUTDIR (each run's out/ has bims-run's)
+	OutputManifest manifest(opt.outDir, "bims-sweep");
+	for (const char* f :
+	     {"sweep.json", "results.csv", "results.md", "results.png"})
+		manifest.file(f);
+	for (const auto& r : plan.runs)
+		for (const char* f : {"config.ini", "log.txt"})
+			manifest.file("runs/" + r.id + "/" + f);
+	writePlan(plan, opt.outDir);
+}
+
+/** The runs handed to others: submitted to Slurm, or written as a jobs
+ * file. */
+int handOffSweep(const SweepOptions& opt, const SweepPlan& plan,
+                 const std::string& program, const std::string& jobsFile)
+{
+	writeJobsFile(jobsFile, program, plan, opt.outDir);
+	if (opt.slurm)
+	{
+		const std::string id = submitToSlurm(opt, plan, jobsFile);
+		std::printf(
+		    "bims-sweep: %zu runs submitted as Slurm array job %s (tasks' "
+		    "output in %s/slurm/); when it is done: bims-sweep --collect "
+		    "%s\n",
+		    plan.runs.size(), id.c_str(), opt.outDir.c_str(),
+		    opt.outDir.c_str());
+		return 0;
+	}
+	std::printf(
+	    "bims-sweep: %zu jobs in %s (one shell line each: e.g. "
+	    "'parallel -j 4 < %s'); then bims-sweep --collect %s\n",
+	    plan.runs.size(), opt.jobsFile.c_str(), opt.jobsFile.c_str(),
+	    opt.outDir.c_str());
+	return 0;
+}
+
+/** The line of a finished run: [done/all] ID: status, fps, time, ETA. */
+void printRunDone(const SweepPlan& plan, size_t i, const RunResult& row,
+                  const JobOutcome& o, size_t done, double wall, bool eta)
+{
+	std::string fps;
+	if (std::isfinite(row.metric("fps")))
+		fps = mrpt::format(", %.1f fps", row.metric("fps"));
+	const size_t left = plan.runs.size() - done;
+	eta = eta && left;
+	std::fprintf(stderr, "[%zu/%zu] %s: %s%s, %s%s%s\n", done, plan.runs.size(),
+	             plan.runs[i].id.c_str(), row.status.c_str(), fps.c_str(),
+	             formatDuration(o.seconds).c_str(), eta ? ", ETA " : "",
+	             eta ? formatDuration(wall / done * left).c_str() : "");
+}
+
+/** The runs here, \a workers at a time; the results table and exit code. */
+int runSweepHere(const SweepOptions& opt, const SweepPlan& plan,
+                 const std::string& program, size_t workers)
+{
+	std::vector<Job> jobs;
+	for (const auto& r : plan.runs)
+		jobs.push_back({runCommand(program, plan, r, opt.outDir),
+		                runDir(opt.outDir, r.id) + "/log.txt"});
+	std::printf(
+	    "bims-sweep: %zu at a time; each run in %s/runs/ID/ (config.ini, "
+	    "log.txt, out/)\n",
+	    workers, opt.outDir.c_str());
+	std::fflush(stdout);
+	ResultTable t{plan, std::vector<RunResult>(plan.runs.size())};
+	const auto start = std::chrono::steady_clock::now();
+	size_t done = 0;
+	PoolOptions pool;
+	pool.workers = workers;
+	pool.stop = opt.stop;
+	pool.stopSignal = stopSignal;
+	pool.onDone = [&](size_t i, const JobOutcome& o)
+	{
+		t.rows[i] = scoreAndCollect(plan, i, opt.outDir, &o);
+		done++;
+		if (opt.quiet) return;
+		const double wall = std::chrono::duration<double>(
+		                        std::chrono::steady_clock::now() - start)
+		                        .count();
+		printRunDone(plan, i, t.rows[i], o, done, wall,
+		             !(opt.stop && *opt.stop));
+	};
+	const auto outcomes = runJobs(jobs, pool);
+	for (size_t i = 0; i < outcomes.size(); i++)
+		if (!outcomes[i].started)
+			t.rows[i] = collectRun(plan.runs[i], opt.outDir, &outcomes[i]);
+	const int code = report(t, opt.outDir, opt.plotMetric);
+	if (opt.stop && *opt.stop)
+	{
+		const int sig = stopSignal();
+		std::fprintf(stderr,
+		             "bims-sweep: interrupted: %zu of %zu runs not started\n",
+		             plan.runs.size() - done, plan.runs.size());
+		return 128 + (sig ? sig : SIGINT);
+	}
+	return code;
+}
+}  // namespace
+
+int runSweep(const SweepOptions& opt)
+{
+	if (!opt.collect.empty()) return collectSweep(opt);
+	checkSweepOptions(opt);
 	const std::string jobsFile = opt.slurm && opt.jobsFile.empty()
 	                                 ? opt.outDir + "/jobs.txt"
 	                                 : opt.jobsFile;
-
 	const SweepSpec spec = SweepSpec::load(opt.sweepFile);
 	checkPlotMetric(opt.plotMetric, spec.truth);
 	std::vector<std::string> inputs = {spec.file};
@@ -365,94 +481,9 @@ int runSweep(const SweepOptions& opt)
 		std::printf("bims-sweep: dry run, nothing written\n");
 		return 0;
 	}
-	// an earlier sweep's plan and results are refused, or replaced
-	prepareOutputFolder(
-	    opt.outDir,
-	    {{"sweep.json", "results.csv", "results.md", "results.png"}, {}},
-	    opt.overwrite);
-	makeDirs(opt.outDir);
-	// what the sweep writes into OUTDIR (each run's out/ has bims-run's)
-	OutputManifest manifest(opt.outDir, "bims-sweep");
-	for (const char* f :
-	     {"sweep.json", "results.csv", "results.md", "results.png"})
-		manifest.file(f);
-	for (const auto& r : plan.runs)
-		for (const char* f : {"config.ini", "log.txt"})
-			manifest.file("runs/" + r.id + "/" + f);
-	writePlan(plan, opt.outDir);
-	if (opt.slurm)
-	{
-		writeJobsFile(jobsFile, program, plan, opt.outDir);
-		const std::string id = submitToSlurm(opt, plan, jobsFile);
-		std::printf(
-		    "bims-sweep: %zu runs submitted as Slurm array job %s (tasks' "
-		    "output in %s/slurm/); when it is done: bims-sweep --collect "
-		    "%s\n",
-		    plan.runs.size(), id.c_str(), opt.outDir.c_str(),
-		    opt.outDir.c_str());
-		return 0;
-	}
-	if (!opt.jobsFile.empty())
-	{
-		writeJobsFile(opt.jobsFile, program, plan, opt.outDir);
-		std::printf(
-		    "bims-sweep: %zu jobs in %s (one shell line each: e.g. "
-		    "'parallel -j 4 < %s'); then bims-sweep --collect %s\n",
-		    plan.runs.size(), opt.jobsFile.c_str(), opt.jobsFile.c_str(),
-		    opt.outDir.c_str());
-		return 0;
-	}
-
-	std::vector<Job> jobs;
-	for (const auto& r : plan.runs)
-		jobs.push_back({runCommand(program, plan, r, opt.outDir),
-		                runDir(opt.outDir, r.id) + "/log.txt"});
-	std::printf(
-	    "bims-sweep: %zu at a time; each run in %s/runs/ID/ (config.ini, "
-	    "log.txt, out/)\n",
-	    workers, opt.outDir.c_str());
-	std::fflush(stdout);
-	ResultTable t{plan, std::vector<RunResult>(plan.runs.size())};
-	const auto start = std::chrono::steady_clock::now();
-	size_t done = 0;
-	PoolOptions pool;
-	pool.workers = workers;
-	pool.stop = opt.stop;
-	pool.stopSignal = stopSignal;
-	pool.onDone = [&](size_t i, const JobOutcome& o)
-	{
-		t.rows[i] = scoreAndCollect(plan, i, opt.outDir, &o);
-		done++;
-		if (opt.quiet) return;
-		char fps[32] = "";
-		if (std::isfinite(t.rows[i].metric("fps")))
-			std::snprintf(fps, sizeof(fps), ", %.1f fps",
-			              t.rows[i].metric("fps"));
-		const double wall = std::chrono::duration<double>(
-		                        std::chrono::steady_clock::now() - start)
-		                        .count();
-		const size_t left = plan.runs.size() - done;
-		const bool eta = left && !(opt.stop && *opt.stop);
-		std::fprintf(stderr, "[%zu/%zu] %s: %s%s, %s%s%s\n", done,
-		             plan.runs.size(), plan.runs[i].id.c_str(),
-		             t.rows[i].status.c_str(), fps,
-		             formatDuration(o.seconds).c_str(), eta ? ", ETA " : "",
-		             eta ? formatDuration(wall / done * left).c_str() : "");
-	};
-	const auto outcomes = runJobs(jobs, pool);
-	for (size_t i = 0; i < outcomes.size(); i++)
-		if (!outcomes[i].started)
-			t.rows[i] = collectRun(plan.runs[i], opt.outDir, &outcomes[i]);
-	const int code = report(t, opt.outDir, opt.plotMetric);
-	if (opt.stop && *opt.stop)
-	{
-		const int sig = stopSignal();
-		std::fprintf(stderr,
-		             "bims-sweep: interrupted: %zu of %zu runs not started\n",
-		             plan.runs.size() - done, plan.runs.size());
-		return 128 + (sig ? sig : SIGINT);
-	}
-	return code;
+	prepareSweepFolder(opt, plan);
+	if (!jobsFile.empty()) return handOffSweep(opt, plan, program, jobsFile);
+	return runSweepHere(opt, plan, program, workers);
 }
 
 }  // namespace bims::apps

@@ -76,19 +76,12 @@ std::string imuSampleProblem(const mrpt::obs::CObservationIMU& imu)
 }
 
 std::string RejectedImuSamples::check(const mrpt::obs::CObservationIMU& imu,
-                                      double t, const char* prog,
-                                      const std::string& path, size_t obsIndex)
+                                      double t)
 {
 	std::string bad = imuSampleProblem(imu);
 	if (bad.empty()) return bad;
 	++n_;
 	stamps_.push_back(t);
-	if (prog)
-		std::fprintf(
-		    stderr,
-		    "%s: warning: %s: observation #%zu (IMU, t %.6f): %s; sample "
-		    "not used (%zu so far)\n",
-		    prog, path.c_str(), obsIndex, t, bad.c_str(), n_);
 	return bad;
 }
 

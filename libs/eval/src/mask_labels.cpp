@@ -292,51 +292,50 @@ std::map<long, double> readFrameStamps(const std::string& csvPath)
 	return out;
 }
 
-MaskMatch matchMasks(const std::vector<MaskFile>& labels,
-                     const std::vector<MaskFile>& preds,
-                     const std::map<long, double>& predStamps, double maxDt)
+namespace
+{
+/** matchMasks() by scan index: a label and the prediction of its index. */
+MaskMatch matchMasksByIndex(const std::vector<MaskFile>& labels,
+                            const std::vector<MaskFile>& preds)
 {
 	MaskMatch m;
-	if (labels.empty() || preds.empty()) return m;
-	const bool byTime = labels.front().byTime();
-	if (!byTime && preds.front().byTime())
-		throw std::runtime_error(
-		    "labels are named by scan index, predictions by time: name both "
-		    "the same way");
-	if (!byTime)
+	size_t j = 0;
+	for (const MaskFile& l : labels)
 	{
-		size_t j = 0;
-		for (const MaskFile& l : labels)
+		while (j < preds.size() && preds[j].index < l.index) ++j;
+		if (j < preds.size() && preds[j].index == l.index)
+			m.pairs.push_back({&l, &preds[j], 0});
+		else
 		{
-			while (j < preds.size() && preds[j].index < l.index) ++j;
-			if (j < preds.size() && preds[j].index == l.index)
-				m.pairs.push_back({&l, &preds[j], 0});
-			else
-			{
-				m.labelsWithoutPrediction.push_back(&l);
-				if (l.index < preds.front().index ||
-				    l.index > preds.back().index)
-					m.labelsOutsidePredictions.push_back(&l);
-			}
+			m.labelsWithoutPrediction.push_back(&l);
+			if (l.index < preds.front().index || l.index > preds.back().index)
+				m.labelsOutsidePredictions.push_back(&l);
 		}
-		// predictions without the label of their index: inside the labels'
-		// span a missing label, outside it a longer run
-		size_t i = 0;
-		for (const MaskFile& p : preds)
-		{
-			while (i < labels.size() && labels[i].index < p.index) ++i;
-			if (i < labels.size() && labels[i].index == p.index) continue;
-			if (p.index < labels.front().index || p.index > labels.back().index)
-				++m.predictionsOutside;
-			else
-				m.predictionsWithoutLabel.push_back(&p);
-		}
-		return m;
 	}
-	// time stamps of both sides, sorted (the files are)
-	std::vector<double> tl, tp;
-	for (const MaskFile& l : labels) tl.push_back(l.stamp);
+	// predictions without the label of their index: inside the labels'
+	// span a missing label, outside it a longer run
+	size_t i = 0;
+	for (const MaskFile& p : preds)
+	{
+		while (i < labels.size() && labels[i].index < p.index) ++i;
+		if (i < labels.size() && labels[i].index == p.index) continue;
+		if (p.index < labels.front().index || p.index > labels.back().index)
+			++m.predictionsOutside;
+		else
+			m.predictionsWithoutLabel.push_back(&p);
+	}
+	return m;
+}
+
+/** The predictions in time order (their own stamps, or the run's for those
+ * named by scan index) and their stamps. */
+void predictionsByTime(const std::vector<MaskFile>& preds,
+                       const std::map<long, double>& predStamps,
+                       std::vector<const MaskFile*>& sorted,
+                       std::vector<double>& stamps)
+{
 	std::vector<const MaskFile*> ps;
+	std::vector<double> tp;
 	for (const MaskFile& p : preds)
 	{
 		double t = p.stamp;
@@ -356,13 +355,36 @@ MaskMatch matchMasks(const std::vector<MaskFile>& labels,
 	for (size_t i = 0; i < order.size(); i++) order[i] = i;
 	std::sort(order.begin(), order.end(),
 	          [&tp](size_t a, size_t b) { return tp[a] < tp[b]; });
-	std::vector<double> tps;
-	for (size_t i : order) tps.push_back(tp[i]);
+	for (size_t i : order)
+	{
+		sorted.push_back(ps[i]);
+		stamps.push_back(tp[i]);
+	}
+}
+}  // namespace
+
+MaskMatch matchMasks(const std::vector<MaskFile>& labels,
+                     const std::vector<MaskFile>& preds,
+                     const std::map<long, double>& predStamps, double maxDt)
+{
+	if (labels.empty() || preds.empty()) return {};
+	const bool byTime = labels.front().byTime();
+	if (!byTime && preds.front().byTime())
+		throw std::runtime_error(
+		    "labels are named by scan index, predictions by time: name both "
+		    "the same way");
+	if (!byTime) return matchMasksByIndex(labels, preds);
+	// time stamps of both sides, sorted (the files are)
+	MaskMatch m;
+	std::vector<double> tl, tps;
+	for (const MaskFile& l : labels) tl.push_back(l.stamp);
+	std::vector<const MaskFile*> ps;
+	predictionsByTime(preds, predStamps, ps, tps);
 	const IndexPairs pairs = associateGreedy(tl, tps, maxDt);
 	std::vector<bool> labelUsed(tl.size()), predUsed(tps.size());
 	for (const auto& [i, j] : pairs)
 	{
-		m.pairs.push_back({&labels[i], ps[order[j]], std::abs(tl[i] - tps[j])});
+		m.pairs.push_back({&labels[i], ps[j], std::abs(tl[i] - tps[j])});
 		labelUsed[i] = predUsed[j] = true;
 	}
 	for (size_t i = 0; i < tl.size(); i++)
@@ -378,7 +400,7 @@ MaskMatch matchMasks(const std::vector<MaskFile>& labels,
 		if (tps[j] < tl.front() - maxDt || tps[j] > tl.back() + maxDt)
 			++m.predictionsOutside;
 		else
-			m.predictionsWithoutLabel.push_back(ps[order[j]]);
+			m.predictionsWithoutLabel.push_back(ps[j]);
 	}
 	return m;
 }

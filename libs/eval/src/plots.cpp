@@ -154,6 +154,179 @@ void putLabel(cv::Mat& img, const std::string& t, cv::Point at, double scale)
 }
 }  // namespace
 
+namespace
+{
+constexpr double kBarLabelScale = 0.45, kBarValueScale = 0.38;
+constexpr int kBarMin = 28, kBarMax = 64, kGroupGap = 24, kBarsLeft = 96,
+              kBarsRight = 30, kBarsHeight = 640, kBarsMinWidth = 1024;
+
+/** The horizontal layout of a bar chart: each group as wide as its bars or
+ * its longest label line, whichever is wider, stretched to the width. */
+struct BarLayout
+{
+	std::vector<int> natural;  ///< each group's width before stretching
+	size_t labelLines = 1;     ///< of the longest group label
+	int width = 0;             ///< of the image
+	double stretch = 1;
+	int barW = kBarMax;
+};
+
+BarLayout barLayout(const GroupedBars& c)
+{
+	const size_t nG = c.groups.size(), nS = c.series.size();
+	BarLayout L;
+	L.natural.resize(nG);
+	for (size_t g = 0; g < nG; g++)
+	{
+		int w = static_cast<int>(std::max<size_t>(nS, 1)) * kBarMin;
+		const auto ls = lines(c.groups[g]);
+		L.labelLines = std::max(L.labelLines, ls.size());
+		for (const auto& l : ls) w = std::max(w, textWidth(l, kBarLabelScale));
+		L.natural[g] = w + kGroupGap;
+	}
+	int sum = 0;
+	for (int w : L.natural) sum += w;
+	L.width = std::max(kBarsMinWidth, kBarsLeft + kBarsRight + sum);
+	L.stretch =
+	    sum > 0 ? static_cast<double>(L.width - kBarsLeft - kBarsRight) / sum
+	            : 1.0;
+	for (size_t g = 0; g < nG; g++)
+		L.barW = std::min(
+		    L.barW, static_cast<int>((L.natural[g] * L.stretch - kGroupGap) /
+		                             std::max<size_t>(nS, 1)));
+	return L;
+}
+
+/** The legend: a row of swatches under the title, wrapped (and the mark of
+ * a missing value when there is one). Returns the baseline of its last
+ * row. */
+int drawBarLegend(cv::Mat& img, const GroupedBars& c, int width)
+{
+	bool anyMissing = false;
+	for (const auto& row : c.values)
+		for (double v : row) anyMissing |= !std::isfinite(v);
+	int lx = kBarsLeft, ly = 52;
+	auto legendRoom = [&](const std::string& t)
+	{
+		const int w = 22 + textWidth(t, kBarLabelScale) + 20;
+		if (lx + w > width - kBarsRight && lx > kBarsLeft)
+			lx = kBarsLeft, ly += 22;
+		return w;
+	};
+	for (size_t s = 0; s < c.series.size(); s++)
+	{
+		const int w = legendRoom(c.series[s]);
+		cv::rectangle(img, {lx, ly - 12}, {lx + 14, ly + 2}, seriesColour(s),
+		              cv::FILLED);
+		putLabel(img, c.series[s], {lx + 22, ly}, kBarLabelScale);
+		lx += w;
+	}
+	if (anyMissing)
+	{
+		const std::string& t = c.missingLabel;
+		const int w = legendRoom(t);
+		cv::line(img, {lx + 1, ly - 11}, {lx + 13, ly + 1}, kMissingColour, 2);
+		cv::line(img, {lx + 1, ly + 1}, {lx + 13, ly - 11}, kMissingColour, 2);
+		putLabel(img, t, {lx + 22, ly}, kBarLabelScale);
+		lx += w;
+	}
+	return ly;
+}
+
+/** The plot area [top, bottom] and its value scale [lo, hi] in steps. */
+struct ValueScale
+{
+	int top, bottom;
+	double lo = 0, hi = 0, step = 1;
+	/** The image row of value \a v. */
+	int py(double v) const
+	{
+		return static_cast<int>(
+		    std::lround(bottom - (v - lo) / (hi - lo) * (bottom - top)));
+	}
+};
+
+ValueScale valueScale(const GroupedBars& c, int top, int bottom)
+{
+	ValueScale a{top, bottom};
+	for (const auto& row : c.values)
+		for (double v : row)
+			if (std::isfinite(v))
+				a.lo = std::min(a.lo, v), a.hi = std::max(a.hi, v);
+	if (c.yMax && *c.yMax > a.lo) a.hi = std::max(a.hi, *c.yMax);
+	if (!(a.hi > a.lo)) a.hi = a.lo + 1;
+	a.step = niceLength((a.hi - a.lo) / 5);
+	a.lo = std::floor(a.lo / a.step) * a.step;
+	if (!(c.yMax && a.hi == *c.yMax))
+		a.hi = std::ceil(a.hi * 1.06 / a.step) * a.step;  // room for labels
+	return a;
+}
+
+/** The grid lines with their values, the axes, and the vertical axis'
+ * name turned by 90 degrees. */
+void drawValueAxis(cv::Mat& img, const GroupedBars& c, const ValueScale& a)
+{
+	const int width = img.cols;
+	char txt[64];
+	for (double t = a.lo; t <= a.hi + 0.5 * a.step; t += a.step)
+	{
+		const int y = a.py(t);
+		cv::line(img, {kBarsLeft, y}, {width - kBarsRight, y}, kGridColour, 1);
+		std::snprintf(txt, sizeof(txt), "%g", std::abs(t) < 1e-12 ? 0.0 : t);
+		putLabel(img, txt,
+		         {kBarsLeft - 8 - textWidth(txt, kBarLabelScale), y + 5},
+		         kBarLabelScale);
+	}
+	cv::line(img, {kBarsLeft, a.top}, {kBarsLeft, a.bottom}, kTextColour, 1);
+	cv::line(img, {kBarsLeft, a.py(0)}, {width - kBarsRight, a.py(0)},
+	         kTextColour, 1);
+	const int tw = textWidth(c.yLabel, 0.5) + 8;
+	cv::Mat t(24, tw, CV_8UC3, cv::Scalar(255, 255, 255));
+	cv::putText(t, c.yLabel, {4, 17}, kFont, 0.5, kTextColour, 1, cv::LINE_AA);
+	cv::rotate(t, t, cv::ROTATE_90_COUNTERCLOCKWISE);
+	const int y0 = std::max(0, (a.top + a.bottom) / 2 - t.rows / 2);
+	const int h = std::min(t.rows, img.rows - y0);
+	t(cv::Rect(0, 0, t.cols, h)).copyTo(img(cv::Rect(8, y0, t.cols, h)));
+}
+
+/** Group \a g's bars (a cross for a missing value), values and label,
+ * centred at column \a cx. */
+void drawBarGroup(cv::Mat& img, const GroupedBars& c, size_t g, int cx,
+                  int barW, const ValueScale& a)
+{
+	const size_t nS = c.series.size();
+	const int x0 = cx - static_cast<int>(nS) * barW / 2;
+	char txt[64];
+	for (size_t s = 0; s < nS; s++)
+	{
+		const int bx = x0 + static_cast<int>(s) * barW;
+		const double v = c.values[g][s];
+		if (!std::isfinite(v))
+		{
+			const int mx = bx + barW / 2, my = a.py(0) - 8;
+			cv::line(img, {mx - 6, my - 6}, {mx + 6, my + 6}, kMissingColour,
+			         2);
+			cv::line(img, {mx - 6, my + 6}, {mx + 6, my - 6}, kMissingColour,
+			         2);
+			continue;
+		}
+		cv::rectangle(img, {bx + 2, a.py(v)}, {bx + barW - 2, a.py(0)},
+		              seriesColour(s), cv::FILLED);
+		std::snprintf(txt, sizeof(txt), "%.3g", v);
+		putLabel(img, txt,
+		         {bx + barW / 2 - textWidth(txt, kBarValueScale) / 2,
+		          a.py(std::max(v, 0.0)) - 5},
+		         kBarValueScale);
+	}
+	const auto ls = lines(c.groups[g]);
+	for (size_t i = 0; i < ls.size(); i++)
+		putLabel(img, ls[i],
+		         {cx - textWidth(ls[i], kBarLabelScale) / 2,
+		          a.bottom + 20 + 18 * static_cast<int>(i)},
+		         kBarLabelScale);
+}
+}  // namespace
+
 cv::Mat plotGroupedBars(const GroupedBars& c)
 {
 	const size_t nG = c.groups.size(), nS = c.series.size();
@@ -163,145 +336,27 @@ cv::Mat plotGroupedBars(const GroupedBars& c)
 		if (row.size() != nS)
 			throw std::invalid_argument(
 			    "plotGroupedBars: one value per series in each group");
-	const double labelScale = 0.45, valueScale = 0.38;
-	const int barMin = 28, barMax = 64, groupGap = 24, left = 96, right = 30;
-	const int height = 640, minWidth = 1024;
-
-	// Group widths: the bars or the longest label line, whichever is wider.
-	std::vector<int> natural(nG);
-	size_t labelLines = 1;
-	for (size_t g = 0; g < nG; g++)
-	{
-		int w = static_cast<int>(std::max<size_t>(nS, 1)) * barMin;
-		const auto ls = lines(c.groups[g]);
-		labelLines = std::max(labelLines, ls.size());
-		for (const auto& l : ls) w = std::max(w, textWidth(l, labelScale));
-		natural[g] = w + groupGap;
-	}
-	int sum = 0;
-	for (int w : natural) sum += w;
-	const int width = std::max(minWidth, left + right + sum);
-	const double stretch =
-	    sum > 0 ? static_cast<double>(width - left - right) / sum : 1.0;
-	int barW = barMax;
-	for (size_t g = 0; g < nG; g++)
-		barW =
-		    std::min(barW, static_cast<int>((natural[g] * stretch - groupGap) /
-		                                    std::max<size_t>(nS, 1)));
-
-	cv::Mat img(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
+	const BarLayout L = barLayout(c);
+	const int width = L.width;
+	cv::Mat img(kBarsHeight, width, CV_8UC3, cv::Scalar(255, 255, 255));
 	putLabel(img, c.title, {12, 28}, 0.65);
-
-	// Legend: a row of swatches under the title, wrapped.
-	bool anyMissing = false;
-	for (const auto& row : c.values)
-		for (double v : row) anyMissing |= !std::isfinite(v);
-	int lx = left, ly = 52;
-	auto legendRoom = [&](const std::string& t)
-	{
-		const int w = 22 + textWidth(t, labelScale) + 20;
-		if (lx + w > width - right && lx > left) lx = left, ly += 22;
-		return w;
-	};
-	for (size_t s = 0; s < nS; s++)
-	{
-		const int w = legendRoom(c.series[s]);
-		cv::rectangle(img, {lx, ly - 12}, {lx + 14, ly + 2}, seriesColour(s),
-		              cv::FILLED);
-		putLabel(img, c.series[s], {lx + 22, ly}, labelScale);
-		lx += w;
-	}
-	if (anyMissing)
-	{
-		const std::string& t = c.missingLabel;
-		const int w = legendRoom(t);
-		cv::line(img, {lx + 1, ly - 11}, {lx + 13, ly + 1}, kMissingColour, 2);
-		cv::line(img, {lx + 1, ly + 1}, {lx + 13, ly - 11}, kMissingColour, 2);
-		putLabel(img, t, {lx + 22, ly}, labelScale);
-		lx += w;
-	}
-
-	// Plot area and value scale.
-	const int top = ly + 30;
-	const int bottom = height - 16 - 18 * static_cast<int>(labelLines) - 36;
-	double lo = 0, hi = 0;
-	for (const auto& row : c.values)
-		for (double v : row)
-			if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
-	if (c.yMax && *c.yMax > lo) hi = std::max(hi, *c.yMax);
-	if (!(hi > lo)) hi = lo + 1;
-	const double step = niceLength((hi - lo) / 5);
-	lo = std::floor(lo / step) * step;
-	if (!(c.yMax && hi == *c.yMax))
-		hi = std::ceil(hi * 1.06 / step) * step;  // room for the value labels
-	auto py = [&](double v)
-	{
-		return static_cast<int>(
-		    std::lround(bottom - (v - lo) / (hi - lo) * (bottom - top)));
-	};
-	char txt[64];
-	for (double t = lo; t <= hi + 0.5 * step; t += step)
-	{
-		const int y = py(t);
-		cv::line(img, {left, y}, {width - right, y}, kGridColour, 1);
-		std::snprintf(txt, sizeof(txt), "%g", std::abs(t) < 1e-12 ? 0.0 : t);
-		putLabel(img, txt, {left - 8 - textWidth(txt, labelScale), y + 5},
-		         labelScale);
-	}
-	cv::line(img, {left, top}, {left, bottom}, kTextColour, 1);
-	cv::line(img, {left, py(0)}, {width - right, py(0)}, kTextColour, 1);
-
-	// The vertical axis' name, turned by 90 degrees.
-	{
-		const int tw = textWidth(c.yLabel, 0.5) + 8;
-		cv::Mat t(24, tw, CV_8UC3, cv::Scalar(255, 255, 255));
-		cv::putText(t, c.yLabel, {4, 17}, kFont, 0.5, kTextColour, 1,
-		            cv::LINE_AA);
-		cv::rotate(t, t, cv::ROTATE_90_COUNTERCLOCKWISE);
-		const int y0 = std::max(0, (top + bottom) / 2 - t.rows / 2);
-		const int h = std::min(t.rows, height - y0);
-		t(cv::Rect(0, 0, t.cols, h)).copyTo(img(cv::Rect(8, y0, t.cols, h)));
-	}
-
-	// Bars, values, group labels.
-	double x = left;
+	const int ly = drawBarLegend(img, c, width);
+	const ValueScale a =
+	    valueScale(c, ly + 30,
+	               kBarsHeight - 16 - 18 * static_cast<int>(L.labelLines) - 36);
+	drawValueAxis(img, c, a);
+	double x = kBarsLeft;
 	for (size_t g = 0; g < nG; g++)
 	{
-		const double gw = natural[g] * stretch;
-		const int cx = static_cast<int>(std::lround(x + gw / 2));
-		const int x0 = cx - static_cast<int>(nS) * barW / 2;
-		for (size_t s = 0; s < nS; s++)
-		{
-			const int bx = x0 + static_cast<int>(s) * barW;
-			const double v = c.values[g][s];
-			if (!std::isfinite(v))
-			{
-				const int mx = bx + barW / 2, my = py(0) - 8;
-				cv::line(img, {mx - 6, my - 6}, {mx + 6, my + 6},
-				         kMissingColour, 2);
-				cv::line(img, {mx - 6, my + 6}, {mx + 6, my - 6},
-				         kMissingColour, 2);
-				continue;
-			}
-			cv::rectangle(img, {bx + 2, py(v)}, {bx + barW - 2, py(0)},
-			              seriesColour(s), cv::FILLED);
-			std::snprintf(txt, sizeof(txt), "%.3g", v);
-			putLabel(img, txt,
-			         {bx + barW / 2 - textWidth(txt, valueScale) / 2,
-			          py(std::max(v, 0.0)) - 5},
-			         valueScale);
-		}
-		const auto ls = lines(c.groups[g]);
-		for (size_t i = 0; i < ls.size(); i++)
-			putLabel(img, ls[i],
-			         {cx - textWidth(ls[i], labelScale) / 2,
-			          bottom + 20 + 18 * static_cast<int>(i)},
-			         labelScale);
+		const double gw = L.natural[g] * L.stretch;
+		drawBarGroup(img, c, g, static_cast<int>(std::lround(x + gw / 2)),
+		             L.barW, a);
 		x += gw;
 	}
 	putLabel(img, c.xLabel,
-	         {left + (width - left - right) / 2 - textWidth(c.xLabel, 0.5) / 2,
-	          height - 14},
+	         {kBarsLeft + (width - kBarsLeft - kBarsRight) / 2 -
+	              textWidth(c.xLabel, 0.5) / 2,
+	          kBarsHeight - 14},
 	         0.5);
 	return img;
 }

@@ -2,6 +2,7 @@
 // camera_matrix.csv and the depth/ listing (stray_import.h).
 #include <bims/common/input_file.h>
 #include <bims/eval/stray_import.h>
+#include <mrpt/core/format.h>
 #include <mrpt/poses/CPose3DQuat.h>
 
 #include <cerrno>
@@ -282,23 +283,11 @@ void readStrayCameraMatrix(const std::string& path, double K[3][3])
 		                         " rows, expected 3 (a 3x3 camera matrix)");
 }
 
-StrayCapture readStrayCapture(const std::string& folder)
+namespace
 {
-	const fs::path dir(folder);
-	if (!fs::is_directory(dir))
-		throw std::runtime_error(folder + ": not a directory");
-	StrayCapture c;
-	c.path = folder;
-	const std::string odometry = (dir / "odometry.csv").string();
-	if (absent(odometry))
-		throw std::runtime_error(odometry +
-		                         ": not found (the frames' poses and clock; "
-		                         "is this a Stray Scanner capture?)");
-	c.frames = readStrayOdometry(odometry);
-
-	// depth/NNNNNN.png: exactly the frames of odometry.csv
-	std::error_code ec;
-	const fs::path depthDir = dir / "depth";
+/** depth/NNNNNN.png by frame number (any other .png: an error). */
+std::map<long, std::string> strayDepthImages(const fs::path& depthDir)
+{
 	if (!fs::is_directory(depthDir))
 		throw std::runtime_error(depthDir.string() +
 		                         ": not a directory (the depth images)");
@@ -314,9 +303,16 @@ StrayCapture readStrayCapture(const std::string& folder)
 			    "odometry.csv)");
 		depthOf[k] = e.path().string();
 	}
-	const std::string confDir = (dir / "confidence").string();
-	c.hasConfidence = !absent(confDir);
-	if (c.hasConfidence && !fs::is_directory(confDir, ec))
+	return depthOf;
+}
+
+/** Whether the capture has confidence images (confidence/ that is no
+ * folder: an error). */
+bool hasConfidenceFolder(const std::string& confDir)
+{
+	if (absent(confDir)) return false;
+	std::error_code ec;
+	if (!fs::is_directory(confDir, ec))
 	{
 		const std::string why = inputFileProblem(confDir);
 		throw std::runtime_error(confDir +
@@ -324,17 +320,24 @@ StrayCapture readStrayCapture(const std::string& folder)
 		                         (why.empty() ? std::string("a file") : why) +
 		                         "): remove it to import without confidence");
 	}
+	return true;
+}
+
+/** Each frame of \a c its depth image (and confidence image): exactly the
+ * frames of odometry.csv have one (else an error naming both). */
+void matchDepthImages(StrayCapture& c, std::map<long, std::string> depthOf,
+                      const fs::path& dir, const std::string& odometry)
+{
 	for (auto& f : c.frames)
 	{
 		const auto it = depthOf.find(f.index);
 		if (it == depthOf.end())
 		{
-			char name[32];
-			std::snprintf(name, sizeof(name), "%06ld.png", f.index);
-			throw std::runtime_error(odometry + ":" + std::to_string(f.line) +
-			                         ": frame " + std::to_string(f.index) +
-			                         " has no depth image (" +
-			                         (depthDir / name).string() + ")");
+			throw std::runtime_error(
+			    odometry + ":" + std::to_string(f.line) + ": frame " +
+			    std::to_string(f.index) + " has no depth image (" +
+			    (dir / "depth" / mrpt::format("%06ld.png", f.index)).string() +
+			    ")");
 		}
 		f.depthPath = it->second;
 		if (c.hasConfidence)
@@ -346,33 +349,57 @@ StrayCapture readStrayCapture(const std::string& folder)
 		throw std::runtime_error(depthOf.begin()->second + ": frame " +
 		                         std::to_string(depthOf.begin()->first) +
 		                         " has no row in " + odometry);
+}
 
-	readStrayCameraMatrix((dir / "camera_matrix.csv").string(), c.K);
-
+/** imu.csv, confidence/ and rgb.mp4 when present; said to \a warn when
+ * not. */
+void readStrayExtras(StrayCapture& c, const fs::path& dir,
+                     const WarningCallback& warn)
+{
 	const std::string imu = (dir / "imu.csv").string();
 	c.hasImu = !absent(imu);
 	if (c.hasImu)
 		c.imu = readStrayImu(imu);
 	else
-		std::fprintf(stderr,
-		             "bims-import-stray: warning: %s: not found: depth only, "
-		             "no IMU observations\n",
-		             imu.c_str());
+		reportWarning(warn, {Warning::Kind::Warning, imu,
+		                     "not found: depth only, no IMU observations"});
 	if (!c.hasConfidence)
-		std::fprintf(stderr,
-		             "bims-import-stray: warning: %s: not found: every depth "
-		             "reading kept (no ARKit confidence to filter by)\n",
-		             (dir / "confidence").string().c_str());
+		reportWarning(warn,
+		              {Warning::Kind::Warning, (dir / "confidence").string(),
+		               "not found: every depth reading kept (no ARKit "
+		               "confidence to filter by)"});
 	if (!absent((dir / "rgb.mp4").string()))
 	{
 		c.videoPath = (dir / "rgb.mp4").string();
 		checkInputFile(c.videoPath, "video");  // (a FIFO would block)
 	}
 	else
-		std::fprintf(stderr,
-		             "bims-import-stray: note: %s: not found: depth and IMU "
-		             "only, the scans have no colour image\n",
-		             (dir / "rgb.mp4").string().c_str());
+		reportWarning(warn, {Warning::Kind::Note, (dir / "rgb.mp4").string(),
+		                     "not found: depth and IMU only, the scans have "
+		                     "no colour image"});
+}
+}  // namespace
+
+StrayCapture readStrayCapture(const std::string& folder,
+                              const WarningCallback& warn)
+{
+	const fs::path dir(folder);
+	if (!fs::is_directory(dir))
+		throw std::runtime_error(folder + ": not a directory");
+	StrayCapture c;
+	c.path = folder;
+	const std::string odometry = (dir / "odometry.csv").string();
+	if (absent(odometry))
+		throw std::runtime_error(odometry +
+		                         ": not found (the frames' poses and clock; "
+		                         "is this a Stray Scanner capture?)");
+	c.frames = readStrayOdometry(odometry);
+	// depth/NNNNNN.png: exactly the frames of odometry.csv
+	std::map<long, std::string> depthOf = strayDepthImages(dir / "depth");
+	c.hasConfidence = hasConfidenceFolder((dir / "confidence").string());
+	matchDepthImages(c, std::move(depthOf), dir, odometry);
+	readStrayCameraMatrix((dir / "camera_matrix.csv").string(), c.K);
+	readStrayExtras(c, dir, warn);
 	return c;
 }
 

@@ -6,6 +6,9 @@
 #include <bims/io/output_paths.h>
 #include <bims/io/rawlog.h>
 #include <bims/sensors/camera.h>
+
+#include "import_rawlog.h"
+
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/system/datetime.h>
 
@@ -91,11 +94,43 @@ ImportSummary importTum(const std::string& folder, const std::string& outRawlog,
 	return importTum(readTumFolder(folder, params), outRawlog, params, options);
 }
 
+namespace
+{
+/** The ground truth of the import: T_WC of the optical frame at each
+ * frame's stamp (interpolated; the frames without one counted), written to
+ * \a gtFile. */
+void writeTumGroundTruth(const TumFolder& tum, const ImportParams& params,
+                         const ImportOptions& options,
+                         const std::string& gtFile, ImportSummary& sum)
+{
+	const std::string& folder = tum.path;
+	Trajectory gt = tum.groundTruth;
+	if (options.bonnGt || params.bonnGt)
+		for (auto& p : gt) p.T_WC = bonnMarkerToCamera(p.T_WC);
+	for (const auto& f : tum.frames)
+	{
+		const auto T = interpolatePose(gt, f.t, params.gtMaxGap);
+		if (T)
+			sum.groundTruth.push_back({f.t, *T});
+		else
+			sum.framesWithoutGt++;
+	}
+	sum.gtPoses = sum.groundTruth.size();
+	saveTumTrajectory(
+	    gtFile, sum.groundTruth,
+	    std::string("T_WC of the camera optical frame at each 3D scan's "
+	                "stamp, from ") +
+	        folder + "/groundtruth.txt" +
+	        ((options.bonnGt || params.bonnGt)
+	             ? " (Bonn marker-to-camera conversion applied)"
+	             : ""));
+}
+}  // namespace
+
 ImportSummary importTum(TumFolder tum, const std::string& outRawlog,
                         const ImportParams& params,
                         const ImportOptions& options)
 {
-	const std::string& folder = tum.path;
 	// the intrinsics can be a camera of the images they are given for
 	sensors::checkIntrinsics(params.camera, "[camera] of the import");
 	if (options.maxFrames > 0 && tum.frames.size() > options.maxFrames)
@@ -113,38 +148,12 @@ ImportSummary importTum(TumFolder tum, const std::string& outRawlog,
 
 	// Ground truth: T_WC of the optical frame at each frame's stamp.
 	if (tum.hasGroundTruth)
-	{
-		Trajectory gt = tum.groundTruth;
-		if (options.bonnGt || params.bonnGt)
-			for (auto& p : gt) p.T_WC = bonnMarkerToCamera(p.T_WC);
-		for (const auto& f : tum.frames)
-		{
-			const auto T = interpolatePose(gt, f.t, params.gtMaxGap);
-			if (T)
-				sum.groundTruth.push_back({f.t, *T});
-			else
-				sum.framesWithoutGt++;
-		}
-		sum.gtPoses = sum.groundTruth.size();
-		saveTumTrajectory(
-		    gtPart.path() + "/groundtruth.txt", sum.groundTruth,
-		    std::string("T_WC of the camera optical frame at each 3D scan's "
-		                "stamp, from ") +
-		        folder + "/groundtruth.txt" +
-		        ((options.bonnGt || params.bonnGt)
-		             ? " (Bonn marker-to-camera conversion applied)"
-		             : ""));
-	}
+		writeTumGroundTruth(tum, params, options,
+		                    gtPart.path() + "/groundtruth.txt", sum);
 
 	// Merge frames and IMU by time: (t, kind, index); kind 0 = IMU first at
-	// equal stamps.
-	struct Item
-	{
-		double t;
-		int kind;  // 0 accel file, 1 extra, 2 frame
-		size_t i;
-	};
-	std::vector<Item> items;
+	// equal stamps (kind 0 accel file, 1 extra, 2 frame).
+	std::vector<TimedInput> items;
 	for (size_t i = 0; i < tum.accel.size(); i++)
 		if (tum.accel[i].t >= t0 && tum.accel[i].t <= t1)
 			items.push_back({tum.accel[i].t, 0, i});
@@ -155,24 +164,17 @@ ImportSummary importTum(TumFolder tum, const std::string& outRawlog,
 	}
 	for (size_t i = 0; i < tum.frames.size(); i++)
 		items.push_back({tum.frames[i].t, 2, i});
-	std::stable_sort(items.begin(), items.end(),
-	                 [](const Item& a, const Item& b)
-	                 { return a.t < b.t || (a.t == b.t && a.kind < b.kind); });
+	sortByTime(items);
 
-	// OUT.rawlog.partial until complete: a failed import leaves no
-	// half-written rawlog under the final name
-	PartialFile part(outRawlog);
-	RawlogWriter w(part.path(), options.gzLevel);
-	Progress progress;
-	progress.total = tum.frames.size();
-	reportProgress(options.progress, progress);
+	ImportRawlog out(outRawlog, options.gzLevel, tum.frames.size(),
+	                 options.progress);
+	RawlogWriter& w = out.w;
 	for (const auto& it : items)
 	{
 		if (it.kind == 2)
 		{
 			w.write(*loadFrame(tum.frames[it.i], params));
-			progress.done = ++sum.frames;
-			reportProgress(options.progress, progress);
+			out.frameWritten(++sum.frames);
 		}
 		else if (it.kind == 1)
 		{
@@ -189,10 +191,9 @@ ImportSummary importTum(TumFolder tum, const std::string& outRawlog,
 		}
 	}
 	w.close();
-	part.commit();
+	out.part.commit();
 	gtPart.commit();
-	progress.finished = true;
-	reportProgress(options.progress, progress);
+	out.finished();
 	return sum;
 }
 

@@ -198,6 +198,17 @@ std::string makeCapture(const std::string& name, const CaptureSpec& spec = {})
 ev::StrayImportOptions quiet()
 {
 	ev::StrayImportOptions o;
+	o.warn = {};  // what the capture lacks: not said
+	return o;
+}
+
+/** quiet() but what the capture lacks collected into \a said ("WHERE:
+ * TEXT" lines). */
+ev::StrayImportOptions telling(std::string& said)
+{
+	ev::StrayImportOptions o = quiet();
+	o.warn = [&said](const bims::Warning& w)
+	{ said += w.where + ": " + w.text + "\n"; };
 	return o;
 }
 
@@ -478,9 +489,9 @@ TEST(ImportStray, WithoutVideoScansHaveNoColourAndItIsSaidOnce)
 	CaptureSpec spec;
 	spec.video = false;
 	const auto d = makeCapture("novideo", spec);
-	testing::internal::CaptureStderr();
-	const auto sum = ev::importStray(d, d + "/../novideo.rawlog", {}, quiet());
-	const std::string err = testing::internal::GetCapturedStderr();
+	std::string err;
+	const auto sum =
+	    ev::importStray(d, d + "/../novideo.rawlog", {}, telling(err));
 	EXPECT_EQ(count(err, "rgb.mp4: not found"), 1u) << err;
 	EXPECT_EQ(count(err, "the scans have no colour image"), 1u) << err;
 	EXPECT_FALSE(sum.colour);
@@ -514,9 +525,9 @@ TEST(ImportStray, WithoutConfidenceEveryReadingIsKeptAndItIsSaidOnce)
 	spec.confidence = false;
 	spec.imu = false;
 	const auto d = makeCapture("noconf", spec);
-	testing::internal::CaptureStderr();
-	const auto sum = ev::importStray(d, d + "/../noconf.rawlog", {}, quiet());
-	const std::string err = testing::internal::GetCapturedStderr();
+	std::string err;
+	const auto sum =
+	    ev::importStray(d, d + "/../noconf.rawlog", {}, telling(err));
 	EXPECT_EQ(count(err, "confidence: not found"), 1u) << err;
 	EXPECT_EQ(count(err, "imu.csv: not found"), 1u) << err;
 	EXPECT_FALSE(sum.confidence);

@@ -8,11 +8,11 @@
 
 namespace bims::flow
 {
-cv::Mat labelConsistency(const cv::Mat& observed, const cv::Mat& expected,
-                         const cv::Mat& depth, const mrpt::img::TCamera& cam,
-                         const mrpt::poses::CPose3D& T_CprevC,
-                         const FlowParams& p, LabelStats* stats,
-                         const cv::Mat* tensor)
+namespace
+{
+void checkConsistencyInputs(const cv::Mat& observed, const cv::Mat& expected,
+                            const cv::Mat& depth, const FlowParams& p,
+                            const cv::Mat* tensor)
 {
 	if (observed.type() != CV_32FC2 || expected.type() != CV_32FC2 ||
 	    depth.type() != CV_32FC1 || observed.size() != expected.size() ||
@@ -20,80 +20,102 @@ cv::Mat labelConsistency(const cv::Mat& observed, const cv::Mat& expected,
 		throw std::invalid_argument(
 		    "labelConsistency: need CV_32FC2 flows and CV_32FC1 depth of one "
 		    "size");
-	const bool visible = p.visible_change_grey > 0;
-	if (visible && (!tensor || tensor->type() != CV_32FC3 ||
-	                tensor->size() != depth.size()))
+	if (p.visible_change_grey > 0 && (!tensor || tensor->type() != CV_32FC3 ||
+	                                  tensor->size() != depth.size()))
 		throw std::invalid_argument(
 		    "labelConsistency: visible_change_grey needs the current image's "
 		    "structure tensor (CV_32FC3 of the depth's size)");
-	const double minChange2 = p.visible_change_grey * p.visible_change_grey;
+}
+
+/** The per-pixel rule's constants for one frame. */
+struct ConsistencyRule
+{
+	float maxDepth;     ///< z <= max_depth_m, as a float comparison
+	float W, H;         ///< the largest pixel coordinates
+	double thr2;        ///< squared threshold of the flow difference [px^2]
+	double minChange2;  ///< squared visible change (0: no gate)
+	float lo, hi;       ///< thr2's float bounds (see consistencyRule())
+};
+
+ConsistencyRule consistencyRule(const cv::Mat& depth,
+                                const mrpt::img::TCamera& cam,
+                                const mrpt::poses::CPose3D& T_CprevC,
+                                const FlowParams& p)
+{
+	ConsistencyRule r;
+	r.minChange2 = p.visible_change_grey * p.visible_change_grey;
 	const double tx = T_CprevC.x(), ty = T_CprevC.y();
 	const double f = 0.5 * (cam.fx() + cam.fy());
 	const double noiseGain = p.depth_noise_sigmas * f *
 	                         std::sqrt(tx * tx + ty * ty) * p.depth_noise_a;
-	const float W = static_cast<float>(depth.cols - 1);
-	const float H = static_cast<float>(depth.rows - 1);
+	r.W = static_cast<float>(depth.cols - 1);
+	r.H = static_cast<float>(depth.rows - 1);
 	// z <= max_depth_m (double) exactly as a float comparison: against the
 	// largest float not above it. It also rejects NaN and +inf, z > 0 rejects
 	// -inf; a non-finite flow fails the bounds tests below.
-	float maxDepth = static_cast<float>(p.max_depth_m);
-	if (static_cast<double>(maxDepth) > p.max_depth_m)
-		maxDepth = std::nextafter(maxDepth, 0.0f);
+	r.maxDepth = static_cast<float>(p.max_depth_m);
+	if (static_cast<double>(r.maxDepth) > p.max_depth_m)
+		r.maxDepth = std::nextafter(r.maxDepth, 0.0f);
 	const double thr = p.diff_threshold_px + noiseGain;
-	const double thr2 = thr * thr;
-	cv::Mat edges;
-	if (p.depth_edge_rel > 0)
-		edges = depthEdgeMask(depth, p.depth_edge_rel, p.depth_edge_px);
+	r.thr2 = thr * thr;
 	// The squared flow difference in float is within 2^-22 (relative) of the
 	// double one: outside [lo, hi] the float comparison decides as the
 	// double one would; inside it, and for the visibility gate, the pixel is
-	// labelled in double (exactLabel).
-	const float hi = static_cast<float>(thr2 * (1 + 1e-5));
-	const float lo = static_cast<float>(thr2 * (1 - 1e-5));
-	cv::Mat labels(depth.size(), CV_8SC1);
-	LabelStats st;
-	for (int v = 0; v < depth.rows; v++)
+	// labelled in double (ConsistencyRow::exact).
+	r.hi = static_cast<float>(r.thr2 * (1 + 1e-5));
+	r.lo = static_cast<float>(r.thr2 * (1 - 1e-5));
+	return r;
+}
+
+/** One row of the inputs. */
+struct ConsistencyRow
+{
+	const ConsistencyRule& r;
+	const float* zr;     ///< depth
+	const float* o;      ///< observed flow (u, v interleaved)
+	const float* e;      ///< expected flow
+	const cv::Vec3f* S;  ///< structure tensor (nullptr: no gate)
+	float fv;            ///< the row's index
+
+	/** The definition, one pixel (depth edges apart). */
+	int8_t exact(int u) const
 	{
-		const float* zr = depth.ptr<float>(v);
-		const float* o = observed.ptr<float>(v);
-		const float* e = expected.ptr<float>(v);
-		auto* l = labels.ptr<int8_t>(v);
-		const cv::Vec3f* S = visible ? tensor->ptr<cv::Vec3f>(v) : nullptr;
-		const float fv = static_cast<float>(v);
-		// The definition, one pixel (depth edges apart).
-		auto exactLabel = [&](int u) -> int8_t
-		{
-			const float z = zr[u];
-			const float fu = static_cast<float>(u);
-			const float e0 = e[2 * u], e1 = e[2 * u + 1];
-			const float o0 = o[2 * u], o1 = o[2 * u + 1];
-			const float eu = fu + e0, ev = fv + e1;
-			const float ou = fu + o0, ov = fv + o1;
-			// (the bounds also reject NaN and infinite flows)
-			if (!(z > 0.0f && z <= maxDepth && eu >= 0 && ev >= 0 && eu <= W &&
-			      ev <= H && ou >= 0 && ov >= 0 && ou <= W && ov <= H))
-				return kNoLabel;
-			const double du = o0 - e0, dv = o1 - e1;
-			if (!(du * du + dv * dv > thr2)) return kNotDiff;
-			// d^T S d: squared RMS intensity change d would cause
-			if (S &&
-			    du * du * S[u][0] + 2 * du * dv * S[u][1] + dv * dv * S[u][2] <
-			        minChange2)
-				return kNotDiff;
-			return kDiff;
-		};
+		const float z = zr[u];
+		const float fu = static_cast<float>(u);
+		const float e0 = e[2 * u], e1 = e[2 * u + 1];
+		const float o0 = o[2 * u], o1 = o[2 * u + 1];
+		const float eu = fu + e0, ev = fv + e1;
+		const float ou = fu + o0, ov = fv + o1;
+		// (the bounds also reject NaN and infinite flows)
+		if (!(z > 0.0f && z <= r.maxDepth && eu >= 0 && ev >= 0 && eu <= r.W &&
+		      ev <= r.H && ou >= 0 && ov >= 0 && ou <= r.W && ov <= r.H))
+			return kNoLabel;
+		const double du = o0 - e0, dv = o1 - e1;
+		if (!(du * du + dv * dv > r.thr2)) return kNotDiff;
+		// d^T S d: squared RMS intensity change d would cause
+		if (S && du * du * S[u][0] + 2 * du * dv * S[u][1] + dv * dv * S[u][2] <
+		             r.minChange2)
+			return kNotDiff;
+		return kDiff;
+	}
+
+	/** Labels the pixels of the row four at a time where the float
+	 * comparison decides (exact() where it may not); returns the first
+	 * pixel left for exact(). */
+	int labelFast(int8_t* l, int cols) const
+	{
 		int u = 0;
 #if CV_SIMD128
 		const cv::v_float32x4 zero = cv::v_setall_f32(0.0f),
-		                      vmax = cv::v_setall_f32(maxDepth),
-		                      vW = cv::v_setall_f32(W),
-		                      vH = cv::v_setall_f32(H),
+		                      vmax = cv::v_setall_f32(r.maxDepth),
+		                      vW = cv::v_setall_f32(r.W),
+		                      vH = cv::v_setall_f32(r.H),
 		                      vfv = cv::v_setall_f32(fv),
-		                      vhi = cv::v_setall_f32(hi),
-		                      vlo = cv::v_setall_f32(lo),
+		                      vhi = cv::v_setall_f32(r.hi),
+		                      vlo = cv::v_setall_f32(r.lo),
 		                      four = cv::v_setall_f32(4.0f);
 		cv::v_float32x4 vu(0.0f, 1.0f, 2.0f, 3.0f);
-		for (; u + 4 <= depth.cols; u += 4, vu += four)
+		for (; u + 4 <= cols; u += 4, vu += four)
 		{
 			const cv::v_float32x4 z = cv::v_load(zr + u);
 			cv::v_float32x4 e0, e1, o0, o1;
@@ -118,24 +140,62 @@ cv::Mat labelConsistency(const cv::Mat& observed, const cv::Mat& expected,
 				                               ((okBits >> k) & 1) - 1);
 			if (exactBits)
 				for (int k = 0; k < 4; k++)
-					if (exactBits & (1 << k)) l[u + k] = exactLabel(u + k);
+					if (exactBits & (1 << k)) l[u + k] = exact(u + k);
 		}
+#else
+		(void)l;
+		(void)cols;
 #endif
-		for (; u < depth.cols; u++) l[u] = exactLabel(u);
-		if (!edges.empty())
-		{
-			const uint8_t* ed = edges.ptr<uint8_t>(v);
-			for (u = 0; u < depth.cols; u++)
-				if (ed[u]) l[u] = kNoLabel;
-		}
-		size_t nDiff = 0, nNot = 0;
-		for (u = 0; u < depth.cols; u++)
-		{
-			nDiff += l[u] == kDiff;
-			nNot += l[u] == kNotDiff;
-		}
-		st.diff += nDiff;
-		st.notDiff += nNot;
+		return u;
+	}
+};
+
+/** No label on depth edges (\a ed: the row of the edge mask, nullptr if
+ * none), then the row's labels counted into \a st. */
+void finishConsistencyRow(int8_t* l, const uint8_t* ed, int cols,
+                          LabelStats& st)
+{
+	if (ed)
+		for (int u = 0; u < cols; u++)
+			if (ed[u]) l[u] = kNoLabel;
+	size_t nDiff = 0, nNot = 0;
+	for (int u = 0; u < cols; u++)
+	{
+		nDiff += l[u] == kDiff;
+		nNot += l[u] == kNotDiff;
+	}
+	st.diff += nDiff;
+	st.notDiff += nNot;
+}
+}  // namespace
+
+cv::Mat labelConsistency(const cv::Mat& observed, const cv::Mat& expected,
+                         const cv::Mat& depth, const mrpt::img::TCamera& cam,
+                         const mrpt::poses::CPose3D& T_CprevC,
+                         const FlowParams& p, LabelStats* stats,
+                         const cv::Mat* tensor)
+{
+	checkConsistencyInputs(observed, expected, depth, p, tensor);
+	const bool visible = p.visible_change_grey > 0;
+	const ConsistencyRule rule = consistencyRule(depth, cam, T_CprevC, p);
+	cv::Mat edges;
+	if (p.depth_edge_rel > 0)
+		edges = depthEdgeMask(depth, p.depth_edge_rel, p.depth_edge_px);
+	cv::Mat labels(depth.size(), CV_8SC1);
+	LabelStats st;
+	for (int v = 0; v < depth.rows; v++)
+	{
+		const ConsistencyRow row{rule,
+		                         depth.ptr<float>(v),
+		                         observed.ptr<float>(v),
+		                         expected.ptr<float>(v),
+		                         visible ? tensor->ptr<cv::Vec3f>(v) : nullptr,
+		                         static_cast<float>(v)};
+		auto* l = labels.ptr<int8_t>(v);
+		for (int u = row.labelFast(l, depth.cols); u < depth.cols; u++)
+			l[u] = row.exact(u);
+		finishConsistencyRow(l, edges.empty() ? nullptr : edges.ptr<uint8_t>(v),
+		                     depth.cols, st);
 	}
 	st.none = depth.total() - st.diff - st.notDiff;
 	if (stats) *stats = st;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <stdexcept>
 
 namespace bims
 {
@@ -31,6 +33,20 @@ std::string jsonLine(const Json& j)
 void writeJsonFile(const std::string& path, const Json& j)
 {
 	writeFileAtomically(path, jsonText(j));
+}
+
+Json readJsonFile(const std::string& path)
+{
+	std::ifstream f(path);
+	if (!f) throw std::runtime_error(path + ": cannot open");
+	try
+	{
+		return Json::parse(f);
+	}
+	catch (const std::exception& e)
+	{
+		throw std::runtime_error(path + ": not JSON: " + e.what());
+	}
 }
 
 }  // namespace bims

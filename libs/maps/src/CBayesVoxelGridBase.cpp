@@ -9,7 +9,7 @@
 #include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/serialization/CArchive.h>
 
-#include <iostream>
+#include <string>
 
 namespace bims::maps
 {
@@ -60,6 +60,18 @@ bool CBayesVoxelGridBase::buildFrame(
 	return !out.stats.badPose;
 }
 
+bool CBayesVoxelGridBase::buildFrameOf(
+    const mrpt::obs::CObservation& obs,
+    const std::optional<const mrpt::poses::CPose3D>& robotPose,
+    FrameCloud& out) const
+{
+	const auto* scan =
+	    dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
+	return scan &&
+	       buildFrame(*scan, robotPose ? *robotPose : mrpt::poses::CPose3D(),
+	                  out);
+}
+
 void CBayesVoxelGridBase::accountFrame(const FrameStats& s) const
 {
 	totalStats_ += s;
@@ -79,9 +91,12 @@ void CBayesVoxelGridBase::accountFrame(const FrameStats& s) const
 	{
 		if (reasons[i].n == 0 || (warned_ & (1u << i))) continue;
 		warned_ |= 1u << i;
-		std::cerr << "bims::maps warning (" << GetRuntimeClass()->className
-		          << "): " << reasons[i].what << " (" << reasons[i].n
-		          << " in this frame; totals in totalStats(), warned once)\n";
+		reportWarning(warn_,
+		              {Warning::Kind::Warning, GetRuntimeClass()->className,
+		               std::string(reasons[i].what) + " (" +
+		                   std::to_string(reasons[i].n) +
+		                   " in this frame; totals in totalStats(), "
+		                   "warned once)"});
 	}
 }
 

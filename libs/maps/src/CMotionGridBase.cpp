@@ -104,43 +104,34 @@ void CMotionGridBase::storeCells(const FrameCloud& f,
 	storeCellsOf<1>(maps, posts, f);
 }
 
-template <size_t N>
-void CMotionGridBase::storeCellsOf(CMotionGridBase* const (&maps)[N],
-                                   const std::vector<float>* const (&posts)[N],
-                                   const FrameCloud& f)
+namespace
 {
-	for (size_t g = 0; g < N; ++g)
-		if (posts[g]->size() != f.cells.size())
-			throw std::invalid_argument(
-			    "CMotionGridBase::store: one posterior per frame cell "
-			    "expected");
-	uint32_t F[N];
-	FrameStats st[N];
-	const float* post[N];
-	for (size_t g = 0; g < N; ++g)
-	{
-		F[g] = maps[g]->frameCount_ + 1;
-		post[g] = posts[g]->data();
-	}
-	const size_t m = f.cells.size();
-	const uint32_t* hits = f.hits.data();
-	// The decisions (MAP: posterior > 1/2) of the N maps, bit g of one byte
-	// per cell: what the cells store, and a fraction of the posteriors'
-	// size for the readings' scattered lookups below.
-	auto& mvv = maps[0]->movingBits_;
-	mvv.resize(m);
-	uint8_t* mv = mvv.data();
+// The decisions (MAP: posterior > 1/2) of N maps, bit g of one byte per
+// cell (into mv, m cells): what the cells store, and a fraction of the
+// posteriors' size for the readings' scattered lookups.
+template <size_t N>
+void decisionBits(const float* const (&post)[N], size_t m, uint8_t* mv)
+{
 	for (size_t i = 0; i < m; ++i)
 	{
 		uint8_t b = 0;
 		for (size_t g = 0; g < N; ++g) b |= uint8_t((post[g][i] > 0) << g);
 		mv[i] = b;
 	}
-	// One index lookup per block and map (the cells come ordered by
-	// block). A block is 512 bytes (8 lines): no prefetching needed.
+}
+
+// The decisions into the cells of the N grids: one index lookup per block
+// and grid (the cells come ordered by block; a block is 512 bytes, 8 lines:
+// no prefetching needed). The readings of cells over the memory budget are
+// counted in st[g].
+template <size_t N, class Storage>
+void storeDecisions(Storage* const (&grids)[N], const FrameCloud& f,
+                    const uint8_t* mv, FrameStats (&st)[N])
+{
+	const uint32_t* hits = f.hits.data();
 	uint64_t lastKey = FlatHashMap::kEmpty;
-	Storage::Block* last[N] = {};
-	for (size_t i = 0; i < m; ++i)
+	typename Storage::Block* last[N] = {};
+	for (size_t i = 0; i < f.cells.size(); ++i)
 	{
 		const VoxelKey& k = f.cells[i];
 		const uint64_t bk = Storage::blockKeyOf(k.x, k.y, k.z);
@@ -148,10 +139,9 @@ void CMotionGridBase::storeCellsOf(CMotionGridBase* const (&maps)[N],
 		{
 			for (size_t g = 0; g < N; ++g)
 			{
-				auto& grid = maps[g]->grid_;
-				const uint32_t b = grid.findOrCreateBlock(bk);
+				const uint32_t b = grids[g]->findOrCreateBlock(bk);
 				last[g] =
-				    b == FlatHashMap::kNotFound ? nullptr : &grid.block(b);
+				    b == FlatHashMap::kNotFound ? nullptr : &grids[g]->block(b);
 			}
 			lastKey = bk;
 		}
@@ -166,32 +156,64 @@ void CMotionGridBase::storeCellsOf(CMotionGridBase* const (&maps)[N],
 			last[g]->cells[ci].moving = uint8_t((mv[i] >> g) & 1);
 		}
 	}
+}
+
+// The decisions into the pixel masks of the N grids: every reading has its
+// own pixel, written without a branch on the (unpredictable) decision.
+template <size_t N>
+void maskDecisions(const FrameCloud& f, const uint8_t* mv,
+                   uint8_t* const (&mask)[N])
+{
+	const uint32_t* cop = f.cellOfPoint.data();
+	const uint32_t* pix = f.pixel.data();
+	const size_t n = f.pixel.size();
+	for (size_t j = 0; j < n; ++j)
+	{
+		const uint32_t p = pix[j];
+		const uint8_t b = mv[cop[j]];
+		for (size_t g = 0; g < N; ++g)
+			mask[g][p] = uint8_t(-uint8_t((b >> g) & 1));
+	}
+}
+}  // namespace
+
+template <size_t N>
+void CMotionGridBase::storeCellsOf(CMotionGridBase* const (&maps)[N],
+                                   const std::vector<float>* const (&posts)[N],
+                                   const FrameCloud& f)
+{
+	for (size_t g = 0; g < N; ++g)
+		if (posts[g]->size() != f.cells.size())
+			throw std::invalid_argument(
+			    "CMotionGridBase::store: one posterior per frame cell "
+			    "expected");
+	FrameStats st[N];
+	const float* post[N];
+	Storage* grids[N];
+	for (size_t g = 0; g < N; ++g)
+	{
+		post[g] = posts[g]->data();
+		grids[g] = &maps[g]->grid_;
+	}
+	auto& mvv = maps[0]->movingBits_;
+	mvv.resize(f.cells.size());
+	decisionBits(post, f.cells.size(), mvv.data());
+	storeDecisions(grids, f, mvv.data(), st);
 	if (f.K.width > 0 && f.K.height > 0)
 	{
-		// Every reading has its own pixel: written without a branch on the
-		// (unpredictable) decision.
 		uint8_t* mask[N];
 		for (size_t g = 0; g < N; ++g)
 		{
 			maps[g]->lastMask_.reset(f.K.width, f.K.height);
 			mask[g] = maps[g]->lastMask_.data.data();
 		}
-		const uint32_t* cop = f.cellOfPoint.data();
-		const uint32_t* pix = f.pixel.data();
-		const size_t n = f.pixel.size();
-		for (size_t j = 0; j < n; ++j)
-		{
-			const uint32_t p = pix[j];
-			const uint8_t b = mv[cop[j]];
-			for (size_t g = 0; g < N; ++g)
-				mask[g][p] = uint8_t(-uint8_t((b >> g) & 1));
-		}
+		maskDecisions(f, mvv.data(), mask);
 	}
 	else
 		for (size_t g = 0; g < N; ++g) maps[g]->lastMask_.reset(0, 0);
 	for (size_t g = 0; g < N; ++g)
 	{
-		maps[g]->frameCount_ = F[g];
+		maps[g]->frameCount_ = maps[g]->frameCount_ + 1;
 		maps[g]->lastTimestamp_ = f.timestamp;
 		if (st[g].overBudget) maps[g]->accountFrame(st[g]);
 	}
@@ -229,12 +251,8 @@ bool CMotionGridBase::internal_insertObservation(
     const mrpt::obs::CObservation& obs,
     const std::optional<const mrpt::poses::CPose3D>& robotPose)
 {
-	const auto* scan =
-	    dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
-	if (!scan) return false;
 	FrameCloud f;
-	if (!buildFrame(*scan, robotPose ? *robotPose : mrpt::poses::CPose3D(), f))
-		return false;
+	if (!buildFrameOf(obs, robotPose, f)) return false;
 	std::vector<float> prior, post;
 	occupancySource().priorLogOdds(f, prior);
 	if (!linked_) private_->integrate(f);

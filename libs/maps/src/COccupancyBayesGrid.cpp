@@ -198,6 +198,124 @@ void COccupancyBayesGrid::integratePending(const FrameCloud& f,
 	applyFrame(f, nullptr, hold, true);
 }
 
+namespace
+{
+// applyFrame()'s loop over the cells found by beginFrame(): update(i, c)
+// of each (c prefetched kPrefetchAhead cells ahead).
+template <class Cell, class Update>
+void updateResolvedCells(Cell* const* cells, size_t m, Update& update)
+{
+	for (size_t i = 0; i < m; ++i)
+	{
+#if defined(__GNUC__)
+		if (i + kPrefetchAhead < m && cells[i + kPrefetchAhead])
+			__builtin_prefetch(cells[i + kPrefetchAhead], 1);
+#endif
+		update(i, cells[i]);
+	}
+}
+
+// applyFrame()'s loop finding the cells on the way: found kPrefetchAhead
+// cells ahead of the update (one index lookup per block, blocks created in
+// the order of the cells as by Storage::resolve()) and prefetched.
+template <class Cell, class Storage, class Update>
+void updateFindingCells(Storage& grid, const VoxelKey* keys, size_t m,
+                        Update& update)
+{
+	constexpr size_t kRing = 2 * kPrefetchAhead;
+	static_assert((kRing & (kRing - 1)) == 0, "ring size: a power of two");
+	Cell* ring[kRing];
+	uint64_t lastKey = FlatHashMap::kEmpty;
+	typename Storage::Block* last = nullptr;
+	for (size_t i = 0; i < m + kPrefetchAhead; ++i)
+	{
+		if (i < m)
+		{
+			const VoxelKey& k = keys[i];
+			const uint64_t bk = Storage::blockKeyOf(k.x, k.y, k.z);
+			if (bk != lastKey)
+			{
+				const uint32_t b = grid.findOrCreateBlock(bk);
+				last = b == FlatHashMap::kNotFound ? nullptr : &grid.block(b);
+				lastKey = bk;
+			}
+			Cell* c = last ? &last->cells[Storage::cellIndexOf(k.x, k.y, k.z)]
+			               : nullptr;
+#if defined(__GNUC__)
+			if (c) __builtin_prefetch(c, 1);
+#endif
+			ring[i % kRing] = c;
+		}
+		if (i >= kPrefetchAhead)
+			update(i - kPrefetchAhead, ring[(i - kPrefetchAhead) % kRing]);
+	}
+}
+
+// The cells of neighbouring voxels: mostly in the block of the cell or of
+// the previous neighbour, so the last two blocks looked up are kept.
+template <class Cell, class Storage>
+struct NeighbourCells
+{
+	const Storage& grid;
+	uint64_t lastKey[2] = {FlatHashMap::kEmpty, FlatHashMap::kEmpty};
+	const typename Storage::Block* lastBlk[2] = {nullptr, nullptr};
+	unsigned next = 0;
+
+	const Cell* find(const VoxelKey& n)
+	{
+		const uint64_t bk = Storage::blockKeyOf(n.x, n.y, n.z);
+		const typename Storage::Block* b;
+		if (bk == lastKey[0])
+			b = lastBlk[0];
+		else if (bk == lastKey[1])
+			b = lastBlk[1];
+		else
+		{
+			b = grid.findBlock(bk);
+			lastKey[next] = bk;
+			lastBlk[next] = b;
+			next ^= 1;
+		}
+		return b ? &b->cells[Storage::cellIndexOf(n.x, n.y, n.z)] : nullptr;
+	}
+};
+
+// The voxels one edge in front of and behind the centre of \a k (side \a s),
+// along the sensor ray from \a o (where depth noise moves a reading):
+// consider(key) of each that is not \a k; keyOf(point) gives a key.
+template <class KeyOf, class Consider>
+void forRayNeighbours(const VoxelKey& k, double s,
+                      const mrpt::math::TPoint3D& o, const KeyOf& keyOf,
+                      Consider& consider)
+{
+	const double cx = (k.x + 0.5) * s, cy = (k.y + 0.5) * s,
+	             cz = (k.z + 0.5) * s;
+	double dx = cx - o.x, dy = cy - o.y, dz = cz - o.z;
+	const double n = std::sqrt(dx * dx + dy * dy + dz * dz);
+	if (!(n > 0)) return;
+	dx *= s / n, dy *= s / n, dz *= s / n;
+	for (int sg : {-1, 1})
+	{
+		const VoxelKey nk = keyOf({cx + sg * dx, cy + sg * dy, cz + sg * dz});
+		if (!(nk == k)) consider(nk);
+	}
+}
+
+// The 6 (faces only) or 26 voxels around \a k: consider(key) of each.
+template <class Consider>
+void forGridNeighbours(const VoxelKey& k, bool facesOnly, Consider& consider)
+{
+	for (int dz = -1; dz <= 1; ++dz)
+		for (int dy = -1; dy <= 1; ++dy)
+			for (int dx = -1; dx <= 1; ++dx)
+			{
+				const int m = std::abs(dx) + std::abs(dy) + std::abs(dz);
+				if (m == 0 || (facesOnly && m > 1)) continue;
+				consider({k.x + dx, k.y + dy, k.z + dz});
+			}
+}
+}  // namespace
+
 void COccupancyBayesGrid::applyFrame(const FrameCloud& f,
                                      std::vector<float>* priorOut,
                                      const std::vector<uint8_t>* hold,
@@ -241,53 +359,9 @@ void COccupancyBayesGrid::applyFrame(const FrameCloud& f,
 		if (pOut) pOut[i] = float(fromFixed(prior));
 	};
 	if (resolved)
-	{
-		Cell* const* cells = cellPtr_.data();
-		for (size_t i = 0; i < m; ++i)
-		{
-#if defined(__GNUC__)
-			if (i + kPrefetchAhead < m && cells[i + kPrefetchAhead])
-				__builtin_prefetch(cells[i + kPrefetchAhead], 1);
-#endif
-			update(i, cells[i]);
-		}
-	}
+		updateResolvedCells(cellPtr_.data(), m, update);
 	else
-	{
-		// The cells are found kPrefetchAhead cells ahead of the update (one
-		// index lookup per block, blocks created in the order of the cells
-		// as by Storage::resolve()) and prefetched.
-		constexpr size_t kRing = 2 * kPrefetchAhead;
-		static_assert((kRing & (kRing - 1)) == 0, "ring size: a power of two");
-		Cell* ring[kRing];
-		uint64_t lastKey = FlatHashMap::kEmpty;
-		Storage::Block* last = nullptr;
-		const VoxelKey* keys = f.cells.data();
-		for (size_t i = 0; i < m + kPrefetchAhead; ++i)
-		{
-			if (i < m)
-			{
-				const VoxelKey& k = keys[i];
-				const uint64_t bk = Storage::blockKeyOf(k.x, k.y, k.z);
-				if (bk != lastKey)
-				{
-					const uint32_t b = grid_.findOrCreateBlock(bk);
-					last =
-					    b == FlatHashMap::kNotFound ? nullptr : &grid_.block(b);
-					lastKey = bk;
-				}
-				Cell* c =
-				    last ? &last->cells[Storage::cellIndexOf(k.x, k.y, k.z)]
-				         : nullptr;
-#if defined(__GNUC__)
-				if (c) __builtin_prefetch(c, 1);
-#endif
-				ring[i % kRing] = c;
-			}
-			if (i >= kPrefetchAhead)
-				update(i - kPrefetchAhead, ring[(i - kPrefetchAhead) % kRing]);
-		}
-	}
+		updateFindingCells<Cell>(grid_, f.cells.data(), m, update);
 	// The decay last (hits win), now or by applyPendingDecay().
 	if (params_.decay != DecayMode::All)
 	{
@@ -340,28 +414,9 @@ void COccupancyBayesGrid::neighbourhoodMaxPrior(const FrameCloud& f,
 	const uint32_t G = frameCount_ + 1;
 	const double s = params_.voxel_size;
 	const auto& o = f.origin_W;
-	// Neighbours are mostly in the block of the cell or of the previous
-	// neighbour: the last blocks looked up are kept.
-	uint64_t lastKey[2] = {FlatHashMap::kEmpty, FlatHashMap::kEmpty};
-	const Storage::Block* lastBlk[2] = {nullptr, nullptr};
-	unsigned next = 0;
-	auto findCell = [&](const VoxelKey& n) -> const Cell*
-	{
-		const uint64_t bk = Storage::blockKeyOf(n.x, n.y, n.z);
-		const Storage::Block* b;
-		if (bk == lastKey[0])
-			b = lastBlk[0];
-		else if (bk == lastKey[1])
-			b = lastBlk[1];
-		else
-		{
-			b = grid_.findBlock(bk);
-			lastKey[next] = bk;
-			lastBlk[next] = b;
-			next ^= 1;
-		}
-		return b ? &b->cells[Storage::cellIndexOf(n.x, n.y, n.z)] : nullptr;
-	};
+	NeighbourCells<Cell, Storage> cells{grid_};
+	const auto keyOfPoint = [this](const mrpt::math::TPoint3D& p)
+	{ return keyOf(p); };
 	for (size_t i = 0; i < f.cells.size(); ++i)
 	{
 		out[i] = prior[i];
@@ -369,39 +424,13 @@ void COccupancyBayesGrid::neighbourhoodMaxPrior(const FrameCloud& f,
 		LogOddsFx best = std::numeric_limits<LogOddsFx>::min();
 		auto consider = [&](const VoxelKey& n)
 		{
-			const Cell* c = findCell(n);
+			const Cell* c = cells.find(n);
 			if (c && c->stamp != 0) best = std::max(best, priorFixed(*c, G));
 		};
 		if (nb == BgNeighbourhood::Ray)
-		{
-			// The voxels one edge in front of and behind the centre, along
-			// the sensor ray (where depth noise moves a reading).
-			const double cx = (k.x + 0.5) * s, cy = (k.y + 0.5) * s,
-			             cz = (k.z + 0.5) * s;
-			double dx = cx - o.x, dy = cy - o.y, dz = cz - o.z;
-			const double n = std::sqrt(dx * dx + dy * dy + dz * dz);
-			if (n > 0)
-			{
-				dx *= s / n, dy *= s / n, dz *= s / n;
-				for (int sg : {-1, 1})
-				{
-					const VoxelKey nk =
-					    keyOf({cx + sg * dx, cy + sg * dy, cz + sg * dz});
-					if (!(nk == k)) consider(nk);
-				}
-			}
-		}
+			forRayNeighbours(k, s, o, keyOfPoint, consider);
 		else
-			for (int dz = -1; dz <= 1; ++dz)
-				for (int dy = -1; dy <= 1; ++dy)
-					for (int dx = -1; dx <= 1; ++dx)
-					{
-						const int m =
-						    std::abs(dx) + std::abs(dy) + std::abs(dz);
-						if (m == 0 || (nb == BgNeighbourhood::Faces && m > 1))
-							continue;
-						consider({k.x + dx, k.y + dy, k.z + dz});
-					}
+			forGridNeighbours(k, nb == BgNeighbourhood::Faces, consider);
 		if (best != std::numeric_limits<LogOddsFx>::min())
 			out[i] = std::max(out[i], float(fromFixed(best)));
 	}
@@ -411,12 +440,8 @@ bool COccupancyBayesGrid::internal_insertObservation(
     const mrpt::obs::CObservation& obs,
     const std::optional<const mrpt::poses::CPose3D>& robotPose)
 {
-	const auto* scan =
-	    dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
-	if (!scan) return false;
 	FrameCloud f;
-	if (!buildFrame(*scan, robotPose ? *robotPose : mrpt::poses::CPose3D(), f))
-		return false;
+	if (!buildFrameOf(obs, robotPose, f)) return false;
 	integrate(f);
 	return true;
 }

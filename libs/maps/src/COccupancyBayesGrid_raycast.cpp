@@ -39,6 +39,105 @@ constexpr int kTile = 8;
 constexpr size_t kMaxMarkedVoxels = size_t(1) << 28;
 // Rays per work item of a thread (32 tiles).
 constexpr size_t kChunk = 2048;
+
+// castMarked()'s walk: the rays of \a ends from \a a marked in \a marks
+// (one per thread, \a threads of them; crossed voxels, blocks stored or
+// not, first visits), merged into the first, which is returned.
+template <class Storage>
+RayMarks& walkRays(const double a[3], const std::vector<RayEnd>& ends,
+                   const RayBox& box, size_t threads, const Storage& grid,
+                   std::vector<RayMarks>& marks)
+{
+	marks.resize(threads);
+	const BlockStored stored =
+	    [](const void* g, int32_t bx, int32_t by, int32_t bz)
+	{
+		return static_cast<const Storage*>(g)->findBlock(packKey(bx, by, bz)) !=
+		       nullptr;
+	};
+	std::atomic<size_t> next{0};
+	auto worker = [&](size_t t)
+	{
+		RayMarks& m = marks[t];
+		m.reset(box);
+		for (;;)
+		{
+			const size_t r0 = next.fetch_add(kChunk);
+			if (r0 >= ends.size()) break;
+			markRays(a, ends.data(), r0, std::min(ends.size(), r0 + kChunk),
+			         box, stored, &grid, m);
+		}
+	};
+	if (threads == 1)
+		worker(0);
+	else
+	{
+		std::vector<std::thread> pool;
+		for (size_t t = 1; t < threads; ++t) pool.emplace_back(worker, t);
+		worker(0);
+		for (auto& th : pool) th.join();
+	}
+	RayMarks& m = marks[0];
+	for (size_t t = 1; t < threads; ++t) mergeRayMarks(m, marks[t]);
+	return m;
+}
+
+// The cells of each block \a m entered (into \a cells, one entry per
+// m.touched); the missing blocks created in the order of their first
+// visit, as a plain walk creates them. Returns whether the memory budget
+// left one uncreated (its state then kUnknown).
+template <class Cell, class Storage>
+bool cellsOfTouchedBlocks(RayMarks& m, const RayBox& box, Storage& grid,
+                          std::vector<Cell*>& cells)
+{
+	cells.assign(m.touched.size(), nullptr);
+	std::vector<std::pair<uint64_t, size_t>> missing;
+	auto keyOf = [&](size_t b)
+	{
+		int32_t c[3];
+		box.blockCoords(b, c);
+		return packKey(c[0], c[1], c[2]);
+	};
+	for (size_t i = 0; i < m.touched.size(); ++i)
+	{
+		const size_t b = m.touched[i];
+		if (m.stored(b))
+			cells[i] = grid.findBlock(keyOf(b))->cells;
+		else
+			missing.emplace_back(m.firstVisit[b], i);
+	}
+	std::sort(missing.begin(), missing.end());
+	bool budgetHit = false;
+	for (const auto& [visit, i] : missing)
+	{
+		const uint32_t id = grid.findOrCreateBlock(keyOf(m.touched[i]));
+		if (id == FlatHashMap::kNotFound)
+		{
+			budgetHit = true;
+			m.state[m.touched[i]] = RayMarks::kUnknown;  // not created
+		}
+		else
+			cells[i] = grid.block(id).cells;
+	}
+	return budgetHit;
+}
+
+// Over the budget: the steps into blocks that could not be created, as a
+// plain walk counts them (every step).
+size_t stepsIntoUncreatedBlocks(const double a[3],
+                                const std::vector<RayEnd>& ends,
+                                const RayMarks& m, const RayBox& box)
+{
+	size_t over = 0;
+	for (const auto& e : ends)
+		traverseRay(a, e.p,
+		            [&](int32_t x, int32_t y, int32_t z)
+		            {
+			            over += m.state[box.blockOf(x >> 3, y >> 3, z >> 3)] ==
+			                    RayMarks::kUnknown;
+		            });
+	return over;
+}
 }  // namespace
 
 void COccupancyBayesGrid::collectRayEnds(const FrameCloud& f, double inv)
@@ -159,88 +258,13 @@ size_t COccupancyBayesGrid::castMarked(const double a[3], const RayBox& box,
 	const size_t threads =
 	    std::clamp<size_t>(size_t(params_.raycast_threads), 1,
 	                       (ends.size() + kChunk - 1) / kChunk);
-	rayMarks_.resize(threads);
 	// 1. The walk: crossed voxels, blocks stored or not, first visits.
-	const BlockStored stored =
-	    [](const void* g, int32_t bx, int32_t by, int32_t bz)
-	{
-		return static_cast<const Storage*>(g)->findBlock(packKey(bx, by, bz)) !=
-		       nullptr;
-	};
-	std::atomic<size_t> next{0};
-	auto worker = [&](size_t t)
-	{
-		RayMarks& m = rayMarks_[t];
-		m.reset(box);
-		for (;;)
-		{
-			const size_t r0 = next.fetch_add(kChunk);
-			if (r0 >= ends.size()) break;
-			markRays(a, ends.data(), r0, std::min(ends.size(), r0 + kChunk),
-			         box, stored, &grid_, m);
-		}
-	};
-	if (threads == 1)
-		worker(0);
-	else
-	{
-		std::vector<std::thread> pool;
-		for (size_t t = 1; t < threads; ++t) pool.emplace_back(worker, t);
-		worker(0);
-		for (auto& th : pool) th.join();
-	}
-	RayMarks& m = rayMarks_[0];
-	for (size_t t = 1; t < threads; ++t) mergeRayMarks(m, rayMarks_[t]);
-
-	// 2. The cells of each block entered; the missing blocks created in
-	// the order of their first visit, as a plain walk creates them.
-	auto& cells = blockCells_;
-	cells.assign(m.touched.size(), nullptr);
-	std::vector<std::pair<uint64_t, size_t>> missing;
-	auto keyOf = [&](size_t b)
-	{
-		int32_t c[3];
-		box.blockCoords(b, c);
-		return packKey(c[0], c[1], c[2]);
-	};
-	for (size_t i = 0; i < m.touched.size(); ++i)
-	{
-		const size_t b = m.touched[i];
-		if (m.stored(b))
-			cells[i] = grid_.findBlock(keyOf(b))->cells;
-		else
-			missing.emplace_back(m.firstVisit[b], i);
-	}
-	std::sort(missing.begin(), missing.end());
-	bool budgetHit = false;
-	for (const auto& [visit, i] : missing)
-	{
-		const uint32_t id = grid_.findOrCreateBlock(keyOf(m.touched[i]));
-		if (id == FlatHashMap::kNotFound)
-		{
-			budgetHit = true;
-			m.state[m.touched[i]] = RayMarks::kUnknown;  // not created
-		}
-		else
-			cells[i] = grid_.block(id).cells;
-	}
-
+	RayMarks& m = walkRays(a, ends, box, threads, grid_, rayMarks_);
+	// 2. The cells of each block entered.
+	const bool budgetHit = cellsOfTouchedBlocks(m, box, grid_, blockCells_);
 	// 3. One miss per crossed cell.
-	applyRayMarks(m, cells.data(), F);
-
-	// Over the budget: the steps into blocks that could not be created, as
-	// a plain walk counts them (every step).
-	size_t over = 0;
-	if (budgetHit)
-		for (const auto& e : ends)
-			traverseRay(a, e.p,
-			            [&](int32_t x, int32_t y, int32_t z)
-			            {
-				            over +=
-				                m.state[box.blockOf(x >> 3, y >> 3, z >> 3)] ==
-				                RayMarks::kUnknown;
-			            });
-	return over;
+	applyRayMarks(m, blockCells_.data(), F);
+	return budgetHit ? stepsIntoUncreatedBlocks(a, ends, m, box) : 0;
 }
 
 void COccupancyBayesGrid::applyRayMarks(const RayMarks& m, Cell* const* cells,

@@ -285,14 +285,13 @@ void FrameCloudBuilder::build(const mrpt::obs::CObservation3DRangeScan& scan,
 	build(depthImageOf(scan), cam, T_WC, out);
 }
 
-void FrameCloudBuilder::build(const DepthImage& img,
-                              const sensors::PinholeCamera& cam,
-                              const mrpt::poses::CPose3D& T_WC, FrameCloud& out)
+namespace
 {
-	resetFrame(out, true);
-	out.voxel_size = p_.voxel_size;
-	out.timestamp = img.timestamp;
-	// Before an error or an empty frame, the readings of the last frame go.
+// The input checks of build(): an empty image or a camera model that does
+// not fit it is an error (after which the readings of the last frame go).
+void checkDepthInput(const DepthImage& img, const sensors::PinholeCamera& cam,
+                     FrameCloud& out)
+{
 	auto fail = [&](const std::string& what)
 	{
 		resetFrame(out);
@@ -306,40 +305,41 @@ void FrameCloudBuilder::build(const DepthImage& img,
 		     std::to_string(cam.height) + " differs from the range image " +
 		     std::to_string(W) + "x" + std::to_string(H));
 	if (!(cam.fx > 0 && cam.fy > 0)) fail(": focal lengths must be > 0");
-	out.K = cam;
-	if (!finitePose(T_WC))
-	{
-		resetFrame(out);
-		out.stats.badPose = true;
-		out.K = {};
-		return;
-	}
-	out.T_WC = T_WC;
-	const auto& R = out.T_WC.getRotationMatrix();
-	const mrpt::math::TPoint3D t = out.T_WC.translation();
-	out.origin_W = t;
-	const size_t N = size_t(W) * H;
-	// Every pixel's depth, reading and run slot is written below before it
-	// is read (depth: 0 where no reading is kept), so the buffers only grow
-	// (one slot more than readings) and are shrunk to the kept readings.
-	out.depth.resize(N);
-	float* depth = out.depth.data();
-	// A slot more for the 16-byte stores of points (see fastRow()).
-	mrpt::math::TPoint3Df* pts = growTo(out.points_W, N + 1);
-	uint32_t* pix = growTo(out.pixel, N);
-	uint32_t* runOf = growTo(out.cellOfPoint, N);
-	uint64_t* runKey = growTo(runKey_, N + 1);
-	uint32_t* runStart = growTo(runStart_, N + 1);
+}
 
-	const double units = img.units;
-	const double maxR = p_.max_range;
-	const double ifx = 1 / cam.fx, ify = 1 / cam.fy;
-	const double cx = cam.cx, cy = cam.cy;
-	const bool isDepth = img.isDepth;
+// What every row of build() reads: the image's units, the camera, the pose,
+// the per-column terms and the bound of the exact fast path.
+struct CloudUnprojection
+{
+	double units, maxR, inv;
+	bool isDepth;
+	double ify, cy;
+	const mrpt::math::CMatrixDouble33& R;  ///< R_WC
+	mrpt::math::TPoint3D t;                ///< t_WC
 	// Per column: 1 + xn^2 and xn * R.col0 (the terms of the unprojection
-	// that depend on u only, computed as per pixel before), one array each.
-	colTab_.resize(4 * size_t(W));
-	double* colA = colTab_.data();
+	// that depend on u only), one array each, and the largest colA.
+	const double *colA, *colX, *colY, *colZ;
+	double maxA;
+	// Fast path, exact: a reading whose distance d * norm is safely below
+	// max_range (with the largest norm of its row, fl() being monotonic) is
+	// kept by every check of the plain path (range in double, then in float;
+	// finite and within the extent when the whole sensor range is), so these
+	// checks and the square root (depth images) are skipped for it.
+	bool fast;
+	double rSafe;
+	// The fast branch also takes the pixels without depth (raw 0: d = 0, the
+	// sensor origin, inside the extent), which are not kept; its depth
+	// scale is 0 when there is no fast path (raw 0 is all it takes then).
+	double unitsFast;
+};
+
+// Fills \a colTab with the per-column terms of a W-pixel row (4 arrays of
+// W) and returns the largest 1 + xn^2.
+double fillColumnTerms(std::vector<double>& colTab, int W, double cx,
+                       double ifx, const mrpt::math::CMatrixDouble33& R)
+{
+	colTab.resize(4 * size_t(W));
+	double* colA = colTab.data();
 	double* colX = colA + W;
 	double* colY = colX + W;
 	double* colZ = colY + W;
@@ -353,96 +353,162 @@ void FrameCloudBuilder::build(const DepthImage& img,
 		colZ[u] = xn * R(2, 0);
 		maxA = std::max(maxA, colA[u]);
 	}
-	const double inv = 1.0 / p_.voxel_size;
-	Keyer keyer{inv, p_.extent, p_.max_range * p_.max_range, t, out.stats};
-	// Fast path, exact: a reading whose distance d * norm is safely below
-	// max_range (with the largest norm of its row, fl() being monotonic) is
-	// kept by every check of the plain path (range in double, then in float;
-	// finite and within the extent when the whole sensor range is), so these
-	// checks and the square root (depth images) are skipped for it.
+	return maxA;
+}
+
+CloudUnprojection cloudUnprojection(const DepthImage& img,
+                                    const sensors::PinholeCamera& cam,
+                                    const mrpt::poses::CPose3D& T_WC,
+                                    const GridParams& p,
+                                    std::vector<double>& colTab)
+{
+	const auto& R = T_WC.getRotationMatrix();
+	const mrpt::math::TPoint3D t = T_WC.translation();
+	const int W = img.width;
+	const double maxA = fillColumnTerms(colTab, W, cam.cx, 1 / cam.fx, R);
+	const double units = img.units, maxR = p.max_range;
 	const double tMax = std::max({std::abs(t.x), std::abs(t.y), std::abs(t.z)});
 	const double rSafe =
 	    maxR - (4 * (tMax + maxR) * std::ldexp(1.0, -24) + 1e-9 * maxR);
-	const bool fast = isDepth && std::isfinite(units) && units >= 1e-300 &&
+	const bool fast = img.isDepth && std::isfinite(units) && units >= 1e-300 &&
 	                  std::isfinite(units * 65535.0) &&
-	                  (tMax + maxR) * (1 + 1e-6) + 1 < p_.extent && rSafe > 0;
-	// The fast branch also takes the pixels without depth (raw 0: d = 0, the
-	// sensor origin, inside the extent), which are not kept; its depth
-	// scale is 0 when there is no fast path (raw 0 is all it takes then).
-	const double unitsFast = fast ? units : 0.0;
-	// Runs: a slot is written for every reading of the fast path and kept
-	// (r advanced) only where a kept reading's voxel changes, without a
-	// branch on it; each kept reading notes its run (runOf, the future
-	// cellOfPoint).
-	Readings o{pts, pix, runOf, runKey, runStart};
-	for (int v = 0; v < H; ++v)
+	                  (tMax + maxR) * (1 + 1e-6) + 1 < p.extent && rSafe > 0;
+	const double* colA = colTab.data();
+	return {units,
+	        maxR,
+	        1.0 / p.voxel_size,
+	        img.isDepth,
+	        1 / cam.fy,
+	        cam.cy,
+	        R,
+	        t,
+	        colA,
+	        colA + W,
+	        colA + 2 * W,
+	        colA + 3 * W,
+	        maxA,
+	        fast,
+	        rSafe,
+	        fast ? units : 0.0};
+}
+
+// The largest raw value of the fast path in a row whose largest norm is
+// \a normMax: d * normMax (d = raw * units, exact) is monotonic in raw.
+uint32_t rowRawFast(const CloudUnprojection& un, double normMax)
+{
+	if (!un.fast) return 0;
+	auto isFast = [&](uint32_t raw)
+	{ return double(raw) * un.units * normMax <= un.rSafe; };
+	const double e = std::floor(un.rSafe / (un.units * normMax));
+	uint32_t rawFast = uint32_t(std::clamp(e, 0.0, 65535.0));
+	while (rawFast < 65535 && isFast(rawFast + 1)) ++rawFast;
+	while (rawFast > 0 && !isFast(rawFast)) --rawFast;
+	return rawFast;
+}
+
+// Row v of the image into the readings \a o and the depth row: runs, a slot
+// written for every reading of the fast path and kept (r advanced) only
+// where a kept reading's voxel changes, without a branch on it; each kept
+// reading notes its run (runOf, the future cellOfPoint).
+template <class KeyerT>
+void unprojectRow(const DepthImage& img, int v, const CloudUnprojection& un,
+                  const KeyerT& keyer, float* depth, Readings& o,
+                  FrameStats& st)
+{
+	const int W = img.width;
+	const double yn = (v - un.cy) * un.ify;
+	const double yn2 = yn * yn;
+	const uint32_t rawFast = rowRawFast(un, std::sqrt(un.maxA + yn2));
+	const auto& R = un.R;
+	const mrpt::math::TPoint3D& t = un.t;
+	const double *colX = un.colX, *colY = un.colY, *colZ = un.colZ;
+	// Ray direction in {W} for depth 1: xn*R.col0 + yn*R.col1 + R.col2.
+	const double b[3] = {yn * R(0, 1) + R(0, 2), yn * R(1, 1) + R(1, 2),
+	                     yn * R(2, 1) + R(2, 2)};
+	const uint32_t rowPix = uint32_t(size_t(v) * W);
+	const uint16_t* rawRow = img.row(v);
+	float* depthRow = depth + rowPix;
+	// One pixel, any case (the fast path in scalar code).
+	auto pixel = [&](int u)
 	{
-		const double yn = (v - cy) * ify;
-		const double yn2 = yn * yn;
-		const double normMax = std::sqrt(maxA + yn2);
-		// The largest raw value of the fast path in this row: d * normMax
-		// (d = raw * units, exact) is monotonic in raw.
-		uint32_t rawFast = 0;
-		if (fast)
+		const uint32_t raw = rawRow[u];
+		mrpt::math::TPoint3Df p;
+		if (raw <= rawFast)
 		{
-			auto isFast = [&](uint32_t raw)
-			{ return double(raw) * units * normMax <= rSafe; };
-			const double e = std::floor(rSafe / (units * normMax));
-			rawFast = uint32_t(std::clamp(e, 0.0, 65535.0));
-			while (rawFast < 65535 && isFast(rawFast + 1)) ++rawFast;
-			while (rawFast > 0 && !isFast(rawFast)) --rawFast;
-		}
-		// Ray direction in {W} for depth 1: xn*R.col0 + yn*R.col1 + R.col2.
-		const double b[3] = {yn * R(0, 1) + R(0, 2), yn * R(1, 1) + R(1, 2),
-		                     yn * R(2, 1) + R(2, 2)};
-		const uint32_t rowPix = uint32_t(size_t(v) * W);
-		const uint16_t* rawRow = img.row(v);
-		float* depthRow = depth + rowPix;
-		// One pixel, any case (the fast path in scalar code).
-		auto pixel = [&](int u)
-		{
-			const uint32_t raw = rawRow[u];
-			mrpt::math::TPoint3Df p;
-			if (raw <= rawFast)
-			{
-				const double d = double(raw) * unitsFast;
-				p = {float(t.x + d * (colX[u] + b[0])),
-				     float(t.y + d * (colY[u] + b[1])),
-				     float(t.z + d * (colZ[u] + b[2]))};
-				depthRow[u] = float(d);  // 0 for raw 0
-				o.pts[o.w] = p;
-				addFast(o,
-				        packKey(floorSmall(p.x * inv), floorSmall(p.y * inv),
-				                floorSmall(p.z * inv)),
-				        rowPix + uint32_t(u), raw != 0);
-				return;
-			}
-			depthRow[u] = 0;
-			const double norm = std::sqrt(colA[u] + yn2);
-			double d = raw * units;
-			if (!isDepth) d /= norm;
-			if (!(d > 0) || !std::isfinite(d))
-			{
-				out.stats.nonFinite++;
-				return;
-			}
-			if (d * norm > maxR)
-			{
-				out.stats.beyondRange++;
-				return;
-			}
+			const double d = double(raw) * un.unitsFast;
 			p = {float(t.x + d * (colX[u] + b[0])),
 			     float(t.y + d * (colY[u] + b[1])),
 			     float(t.z + d * (colZ[u] + b[2]))};
-			VoxelKey k;
-			if (!keyer(p, k)) return;
-			depthRow[u] = float(d);
+			depthRow[u] = float(d);  // 0 for raw 0
 			o.pts[o.w] = p;
-			addFast(o, packKey(k), rowPix + uint32_t(u), true);
-		};
-		fastRow(rawRow, W, rawFast, rowPix, colX, colY, colZ, b, t, unitsFast,
-		        inv, depthRow, o, pixel);
+			addFast(o,
+			        packKey(floorSmall(p.x * un.inv), floorSmall(p.y * un.inv),
+			                floorSmall(p.z * un.inv)),
+			        rowPix + uint32_t(u), raw != 0);
+			return;
+		}
+		depthRow[u] = 0;
+		const double norm = std::sqrt(un.colA[u] + yn2);
+		double d = raw * un.units;
+		if (!un.isDepth) d /= norm;
+		if (!(d > 0) || !std::isfinite(d))
+		{
+			st.nonFinite++;
+			return;
+		}
+		if (d * norm > un.maxR)
+		{
+			st.beyondRange++;
+			return;
+		}
+		p = {float(t.x + d * (colX[u] + b[0])),
+		     float(t.y + d * (colY[u] + b[1])),
+		     float(t.z + d * (colZ[u] + b[2]))};
+		VoxelKey k;
+		if (!keyer(p, k)) return;
+		depthRow[u] = float(d);
+		o.pts[o.w] = p;
+		addFast(o, packKey(k), rowPix + uint32_t(u), true);
+	};
+	fastRow(rawRow, W, rawFast, rowPix, colX, colY, colZ, b, t, un.unitsFast,
+	        un.inv, depthRow, o, pixel);
+}
+}  // namespace
+
+void FrameCloudBuilder::build(const DepthImage& img,
+                              const sensors::PinholeCamera& cam,
+                              const mrpt::poses::CPose3D& T_WC, FrameCloud& out)
+{
+	resetFrame(out, true);
+	out.voxel_size = p_.voxel_size;
+	out.timestamp = img.timestamp;
+	checkDepthInput(img, cam, out);
+	const int W = img.width, H = img.height;
+	out.K = cam;
+	if (!finitePose(T_WC))
+	{
+		resetFrame(out);
+		out.stats.badPose = true;
+		out.K = {};
+		return;
 	}
+	out.T_WC = T_WC;
+	out.origin_W = out.T_WC.translation();
+	const size_t N = size_t(W) * H;
+	// Every pixel's depth, reading and run slot is written below before it
+	// is read (depth: 0 where no reading is kept), so the buffers only grow
+	// (one slot more than readings) and are shrunk to the kept readings.
+	out.depth.resize(N);
+	// A slot more for the 16-byte stores of points (see fastRow()).
+	Readings o{growTo(out.points_W, N + 1), growTo(out.pixel, N),
+	           growTo(out.cellOfPoint, N), growTo(runKey_, N + 1),
+	           growTo(runStart_, N + 1)};
+	const CloudUnprojection un =
+	    cloudUnprojection(img, cam, out.T_WC, p_, colTab_);
+	const Keyer keyer{un.inv, p_.extent, p_.max_range * p_.max_range, un.t,
+	                  out.stats};
+	for (int v = 0; v < H; ++v)
+		unprojectRow(img, v, un, keyer, out.depth.data(), o, out.stats);
 	const size_t w = o.w;
 	out.stats.noDepth += o.noDepth;
 	nRuns_ = o.r;

@@ -93,6 +93,63 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 	return processFrame(f, labels, false);
 }
 
+void MotionGrids::holdMoving(const FrameCloud& f, bool flowOff)
+{
+	const auto& dec = decisionTier_ == 1 || flowOff ? post1_ : post2_;
+	const bool either =
+	    p_.exclude_by == ExcludeBy::Either ||
+	    (p_.exclude_by == ExcludeBy::Auto && p_.decay != DecayMode::Raycast);
+	hold_.resize(f.cells.size());
+	for (size_t i = 0; i < f.cells.size(); ++i)
+		hold_[i] = dec[i] > 0 || (either && post1_[i] > 0);
+}
+
+void MotionGrids::updateTiers(const FrameCloud& f, const PixelLabels& labels,
+                              bool exclude, bool flowOff)
+{
+	const bool neighbours = p_.bg_neighbourhood != BgNeighbourhood::None;
+	if (!exclude && !neighbours)
+	{
+		// (1)+(2): tier 0 hands out O- of the hit voxels, then folds the
+		// frame in.
+		tier0_->integrate(f, &prior_);
+		// (3) tier 1 from O-, tier 2 from tier 1 and the flow labels.
+		tier1_->posterior(f, prior_, post1_);
+		tier2_->posterior(f, labels, post1_, post2_);
+		return;
+	}
+	// O- first (with its neighbourhood), both posteriors, then tier 0 folds
+	// the frame in: with exclude_moving only the voxels the decision tier
+	// calls static (the moving ones keep their belief).
+	tier0_->beginFrame(f, prior_);
+	const std::vector<float>* o = &prior_;
+	if (neighbours)
+	{
+		tier0_->neighbourhoodMaxPrior(f, prior_, p_.bg_neighbourhood, priorN_);
+		o = &priorN_;
+	}
+	tier1_->posterior(f, *o, post1_);
+	tier2_->posterior(f, labels, post1_, post2_);
+	if (exclude)
+	{
+		holdMoving(f, flowOff);
+		tier0_->integratePending(f, &hold_);
+	}
+	else
+		tier0_->integratePending(f, nullptr);
+}
+
+std::shared_ptr<std::vector<VoxelKey>> MotionGrids::keptCells(
+    const FrameCloud& f)
+{
+	if (&f == frame_.get())
+		return std::shared_ptr<std::vector<VoxelKey>>(frame_, &frame_->cells);
+	auto& buf = cellsBuf_[0].use_count() <= 1 ? cellsBuf_[0] : cellsBuf_[1];
+	if (buf.use_count() != 1) buf = std::make_shared<std::vector<VoxelKey>>();
+	*buf = f.cells;
+	return buf;
+}
+
 const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
                                                    const PixelLabels* labels,
                                                    bool flowOff)
@@ -112,45 +169,7 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 	// without a flow tier (flowOff) tier 1's is the decision (tier 2
 	// equals it without labels).
 	const bool exclude = p_.exclude_moving && (labels || flowOff);
-	const bool neighbours = p_.bg_neighbourhood != BgNeighbourhood::None;
-	if (!exclude && !neighbours)
-	{
-		// (1)+(2): tier 0 hands out O- of the hit voxels, then folds the
-		// frame in.
-		tier0_->integrate(f, &prior_);
-		// (3) tier 1 from O-, tier 2 from tier 1 and the flow labels.
-		tier1_->posterior(f, prior_, post1_);
-		tier2_->posterior(f, labels ? *labels : none, post1_, post2_);
-	}
-	else
-	{
-		// O- first (with its neighbourhood), both posteriors, then tier 0
-		// folds the frame in: with exclude_moving only the voxels the
-		// decision tier calls static (the moving ones keep their belief).
-		tier0_->beginFrame(f, prior_);
-		const std::vector<float>* o = &prior_;
-		if (neighbours)
-		{
-			tier0_->neighbourhoodMaxPrior(f, prior_, p_.bg_neighbourhood,
-			                              priorN_);
-			o = &priorN_;
-		}
-		tier1_->posterior(f, *o, post1_);
-		tier2_->posterior(f, labels ? *labels : none, post1_, post2_);
-		if (exclude)
-		{
-			const auto& dec = decisionTier_ == 1 || flowOff ? post1_ : post2_;
-			const bool either = p_.exclude_by == ExcludeBy::Either ||
-			                    (p_.exclude_by == ExcludeBy::Auto &&
-			                     p_.decay != DecayMode::Raycast);
-			hold_.resize(f.cells.size());
-			for (size_t i = 0; i < f.cells.size(); ++i)
-				hold_[i] = dec[i] > 0 || (either && post1_[i] > 0);
-			tier0_->integratePending(f, &hold_);
-		}
-		else
-			tier0_->integratePending(f, nullptr);
-	}
+	updateTiers(f, labels ? *labels : none, exclude, flowOff);
 	// (4) MAP per voxel; masks.
 	result_.hitVoxels = f.cells.size();
 	for (size_t i = 0; i < f.cells.size(); ++i)
@@ -160,21 +179,10 @@ const MotionFrameResult& MotionGrids::processFrame(const FrameCloud& f,
 	}
 	// Tiers 1 and 2 keep the cells of lastFrame() (shared, no copy) or one
 	// copy of a caller's frame's, and the posteriors without a copy (post1_,
-	// post2_ are recomputed every frame).
-	std::shared_ptr<std::vector<VoxelKey>> cells;
-	if (&f == frame_.get())
-		cells = std::shared_ptr<std::vector<VoxelKey>>(frame_, &frame_->cells);
-	else
-	{
-		auto& buf = cellsBuf_[0].use_count() <= 1 ? cellsBuf_[0] : cellsBuf_[1];
-		if (buf.use_count() != 1)
-			buf = std::make_shared<std::vector<VoxelKey>>();
-		*buf = f.cells;
-		cells = buf;
-	}
-	// One sweep over the cells and readings stores both tiers.
+	// post2_ are recomputed every frame). One sweep over the cells and
+	// readings stores both tiers.
 	CMotionGridBase::storePair(*tier1_, std::move(post1_), *tier2_,
-	                           std::move(post2_), f, cells);
+	                           std::move(post2_), f, keptCells(f));
 	result_.mask1_ = &tier1_->lastMovingMask();
 	result_.mask2_ = &tier2_->lastMovingMask();
 	result_.updateMs = msSince(t0);

@@ -108,105 +108,97 @@ Renderer::Renderer(const CameraParams& cam, const DepthParams& depth,
 	rgb_.lightDir_W.normalize();
 }
 
-void Renderer::render(const Scene& scene, double t, const Eigen::Matrix3d& R_WC,
-                      const Eigen::Vector3d& p_WC, uint64_t seed,
-                      uint64_t frameIndex, RenderedFrame& out) const
+struct Renderer::Hits
 {
-	const int W = cam_.width, H = cam_.height, N = W * H;
+	std::vector<Eigen::Matrix3d> R_PC;  ///< per primitive
+	std::vector<Eigen::Vector3d> o_P;   ///< per primitive: camera in {P}
+	std::vector<double> zbuf;           ///< per pixel: depth, +inf if none
+	std::vector<int16_t> ibuf;          ///< per pixel: primitive, -1 if none
+};
+
+bool Renderer::screenRect(const Primitive& pr, const Eigen::Matrix3d& R_PC,
+                          const Eigen::Vector3d& o_P, int rect[4]) const
+{
+	const int W = cam_.width, H = cam_.height;
 	const double fx = cam_.fxS(), fy = cam_.fyS(), cx = cam_.cxS(),
 	             cy = cam_.cyS();
-	out.width = W;
-	out.height = H;
-	out.depthTrue.assign(N, 0.f);
-	out.depthMm.assign(N, 0);
-	out.rgb.assign(3 * size_t(N), 0);
-	out.mask.assign(N, 0);
-	out.objectId.assign(N, 0);
+	rect[0] = 0, rect[1] = W - 1, rect[2] = 0, rect[3] = H - 1;
+	if (pr.shape == Shape::Room) return true;
+	const Eigen::Vector3d h = pr.shape == Shape::Sphere
+	                              ? Eigen::Vector3d::Constant(pr.half.x())
+	                              : pr.half;
+	double umin = 1e18, umax = -1e18, vmin = 1e18, vmax = -1e18;
+	for (int c = 0; c < 8; c++)
+	{
+		const Eigen::Vector3d x_P(c & 1 ? h.x() : -h.x(),
+		                          c & 2 ? h.y() : -h.y(),
+		                          c & 4 ? h.z() : -h.z());
+		const Eigen::Vector3d x_C = R_PC.transpose() * (x_P - o_P);
+		if (x_C.z() < 1e-3) return true;  // partly behind: the whole image
+		const double u = fx * x_C.x() / x_C.z() + cx,
+		             v = fy * x_C.y() / x_C.z() + cy;
+		umin = std::min(umin, u), umax = std::max(umax, u);
+		vmin = std::min(vmin, v), vmax = std::max(vmax, v);
+	}
+	if (umax < -1 || vmax < -1 || umin > W || vmin > H) return false;
+	rect[0] = std::max(0, int(std::floor(umin)) - 1);
+	rect[1] = std::min(W - 1, int(std::ceil(umax)) + 1);
+	rect[2] = std::max(0, int(std::floor(vmin)) - 1);
+	rect[3] = std::min(H - 1, int(std::ceil(vmax)) + 1);
+	return true;
+}
 
-	const std::vector<Primitive> prims = scene.primitivesAt(t);
-	const size_t P = prims.size();
-	std::vector<Eigen::Matrix3d> R_PC(P);
-	std::vector<Eigen::Vector3d> o_P(P);
-	std::vector<double> zbuf(N, std::numeric_limits<double>::infinity());
-	std::vector<int16_t> ibuf(N, -1);
-
-	// Pass 1: nearest hit per pixel, each primitive tested only inside the
-	// screen rectangle of its projected bounding box.
-	for (size_t i = 0; i < P; i++)
+void Renderer::nearestHits(const std::vector<Primitive>& prims,
+                           const Eigen::Matrix3d& R_WC,
+                           const Eigen::Vector3d& p_WC, Hits& h) const
+{
+	const int W = cam_.width;
+	for (size_t i = 0; i < prims.size(); i++)
 	{
 		const Primitive& pr = prims[i];
-		R_PC[i] = pr.R_WP.transpose() * R_WC;
-		o_P[i] = pr.R_WP.transpose() * (p_WC - pr.t_WP);
-		int u0 = 0, u1 = W - 1, v0 = 0, v1 = H - 1;
-		if (pr.shape != Shape::Room)
-		{
-			const Eigen::Vector3d h =
-			    pr.shape == Shape::Sphere
-			        ? Eigen::Vector3d::Constant(pr.half.x())
-			        : pr.half;
-			double umin = 1e18, umax = -1e18, vmin = 1e18, vmax = -1e18;
-			bool behind = false;
-			for (int c = 0; c < 8; c++)
-			{
-				const Eigen::Vector3d x_P(c & 1 ? h.x() : -h.x(),
-				                          c & 2 ? h.y() : -h.y(),
-				                          c & 4 ? h.z() : -h.z());
-				const Eigen::Vector3d x_C =
-				    R_PC[i].transpose() * (x_P - o_P[i]);
-				if (x_C.z() < 1e-3)
-				{
-					behind = true;
-					break;
-				}
-				const double u = fx * x_C.x() / x_C.z() + cx,
-				             v = fy * x_C.y() / x_C.z() + cy;
-				umin = std::min(umin, u), umax = std::max(umax, u);
-				vmin = std::min(vmin, v), vmax = std::max(vmax, v);
-			}
-			if (!behind)
-			{
-				if (umax < -1 || vmax < -1 || umin > W || vmin > H) continue;
-				u0 = std::max(0, int(std::floor(umin)) - 1);
-				u1 = std::min(W - 1, int(std::ceil(umax)) + 1);
-				v0 = std::max(0, int(std::floor(vmin)) - 1);
-				v1 = std::min(H - 1, int(std::ceil(vmax)) + 1);
-			}
-		}
-		const Eigen::Matrix3d& R = R_PC[i];
-		const Eigen::Vector3d& o = o_P[i];
-		for (int v = v0; v <= v1; v++)
+		h.R_PC[i] = pr.R_WP.transpose() * R_WC;
+		h.o_P[i] = pr.R_WP.transpose() * (p_WC - pr.t_WP);
+		int rect[4];
+		if (!screenRect(pr, h.R_PC[i], h.o_P[i], rect)) continue;
+		const Eigen::Matrix3d& R = h.R_PC[i];
+		const Eigen::Vector3d& o = h.o_P[i];
+		for (int v = rect[2]; v <= rect[3]; v++)
 		{
 			const double y = yn_[v];
-			for (int u = u0; u <= u1; u++)
+			for (int u = rect[0]; u <= rect[1]; u++)
 			{
 				const Eigen::Vector3d d =
 				    R.col(0) * xn_[u] + R.col(1) * y + R.col(2);
 				const double lam = intersectLocal(pr, o, d);
 				const int k = v * W + u;
-				if (lam < zbuf[k])
+				if (lam < h.zbuf[k])
 				{
-					zbuf[k] = lam;
-					ibuf[k] = int16_t(i);
+					h.zbuf[k] = lam;
+					h.ibuf[k] = int16_t(i);
 				}
 			}
 		}
 	}
+}
 
-	// Pass 2: shading, sensor model.
-	Rng rng(seed, 0x5EED0000ULL + frameIndex);
+void Renderer::shadeAndSense(const std::vector<Primitive>& prims, const Hits& h,
+                             const Eigen::Matrix3d& R_WC, Rng& rng,
+                             RenderedFrame& out) const
+{
+	const int W = cam_.width, H = cam_.height;
 	const double cosGraze = std::cos(depth_.grazingDeg * kDeg);
 	for (int v = 0; v < H; v++)
 	{
 		for (int u = 0; u < W; u++)
 		{
 			const int k = v * W + u;
-			const int i = ibuf[k];
+			const int i = h.ibuf[k];
 			if (i < 0) continue;
 			const Primitive& pr = prims[size_t(i)];
-			const double z = zbuf[k];
+			const double z = h.zbuf[k];
 			const Eigen::Vector3d d_C(xn_[u], yn_[v], 1.0);
-			const Eigen::Vector3d d_P = R_PC[i] * d_C;
-			const SurfaceHit hit = surfaceAt(pr, o_P[i] + z * d_P);
+			const Eigen::Vector3d d_P = h.R_PC[i] * d_C;
+			const SurfaceHit hit = surfaceAt(pr, h.o_P[i] + z * d_P);
 			double col[3];
 			textureColor(pr.texture, hit.face, hit.s, hit.t, pr.cell, col);
 			const double shade =
@@ -235,28 +227,34 @@ void Renderer::render(const Scene& scene, double t, const Eigen::Matrix3d& R_WC,
 			out.depthMm[k] = uint16_t(std::clamp(mm, 0L, 65535L));
 		}
 	}
-	// Projector shadows: a pixel's projector column is x_p = u - fx b / z. A
-	// surface point is lit only if no point to its right (nearer to the
-	// projector's line of sight) maps to a smaller projector column.
-	if (depth_.projectorBaseline > 0)
+}
+
+void Renderer::projectorShadows(const Hits& h, RenderedFrame& out) const
+{
+	// A pixel's projector column is x_p = u - fx b / z. A surface point is
+	// lit only if no point to its right (nearer to the projector's line of
+	// sight) maps to a smaller projector column.
+	const int W = cam_.width, H = cam_.height;
+	const double fb = cam_.fxS() * depth_.projectorBaseline;
+	for (int v = 0; v < H; v++)
 	{
-		const double fb = fx * depth_.projectorBaseline;
-		for (int v = 0; v < H; v++)
+		double minXp = std::numeric_limits<double>::infinity();
+		for (int u = W - 1; u >= 0; u--)
 		{
-			double minXp = std::numeric_limits<double>::infinity();
-			for (int u = W - 1; u >= 0; u--)
-			{
-				const int k = v * W + u;
-				if (ibuf[k] < 0) continue;
-				const double xp = u - fb / zbuf[k];
-				if (xp > minXp)
-					out.depthMm[k] = 0;
-				else
-					minXp = xp;
-			}
+			const int k = v * W + u;
+			if (h.ibuf[k] < 0) continue;
+			const double xp = u - fb / h.zbuf[k];
+			if (xp > minXp)
+				out.depthMm[k] = 0;
+			else
+				minXp = xp;
 		}
 	}
-	// Small round holes.
+}
+
+void Renderer::depthHoles(Rng& rng, RenderedFrame& out) const
+{
+	const int W = cam_.width, H = cam_.height, N = W * H;
 	const int nHoles = int(std::lround(depth_.holesPerMpx * N * 1e-6));
 	const double rMax = depth_.holeRadiusPx * W / 640.0;
 	for (int h = 0; h < nHoles; h++)
@@ -270,6 +268,31 @@ void Renderer::render(const Scene& scene, double t, const Eigen::Matrix3d& R_WC,
 				if ((u - hu) * (u - hu) + (v - hv) * (v - hv) <= r * r)
 					out.depthMm[v * W + u] = 0;
 	}
+}
+
+void Renderer::render(const Scene& scene, double t, const Eigen::Matrix3d& R_WC,
+                      const Eigen::Vector3d& p_WC, uint64_t seed,
+                      uint64_t frameIndex, RenderedFrame& out) const
+{
+	const int W = cam_.width, H = cam_.height, N = W * H;
+	out.width = W;
+	out.height = H;
+	out.depthTrue.assign(N, 0.f);
+	out.depthMm.assign(N, 0);
+	out.rgb.assign(3 * size_t(N), 0);
+	out.mask.assign(N, 0);
+	out.objectId.assign(N, 0);
+
+	const std::vector<Primitive> prims = scene.primitivesAt(t);
+	const size_t P = prims.size();
+	Hits h{std::vector<Eigen::Matrix3d>(P), std::vector<Eigen::Vector3d>(P),
+	       std::vector<double>(N, std::numeric_limits<double>::infinity()),
+	       std::vector<int16_t>(N, -1)};
+	nearestHits(prims, R_WC, p_WC, h);
+	Rng rng(seed, 0x5EED0000ULL + frameIndex);
+	shadeAndSense(prims, h, R_WC, rng, out);
+	if (depth_.projectorBaseline > 0) projectorShadows(h, out);
+	depthHoles(rng, out);
 }
 
 }  // namespace bims::sim

@@ -148,6 +148,97 @@ void writeCalibration(const SimConfig& cfg, const std::string& path)
 	f << buf;
 	writeFileAtomically(path, f.str());
 }
+
+/** The ground truth's files that grow frame by frame beside the rawlog
+ * (their headers written at once). */
+struct GroundTruthFiles
+{
+	AppendFile poses, imu, objects;
+
+	explicit GroundTruthFiles(const std::string& gt)
+	    : poses(gt + "/groundtruth.txt"),
+	      imu(gt + "/imu.txt"),
+	      objects(gt + "/objects.txt")
+	{
+		poses.append(tumHeader(
+		    "bims-sim ground truth: camera optical frame poses T_WC, world z "
+		    "up, x north"));
+		imu.append(imuTruthHeader());
+		objects.append(
+		    "# bims-sim moving-object poses T_WO (root frame of each object in "
+		    "{W}), one line\n"
+		    "# per frame and object: frame object_id name t[s] tx ty tz qx qy "
+		    "qz qw\n"
+		    "# (object_id = the value in RenderedFrame::objectId; masks are "
+		    "255 for any id > 0)\n");
+	}
+	void close()
+	{
+		for (auto* f : {&poses, &imu, &objects}) f->close();
+	}
+};
+
+/** The IMU samples into the rawlog and their truth lines, in order. */
+struct ImuStream
+{
+	const SimConfig& cfg;
+	ImuSimulator& imu;
+	const HandheldMotion& motion;
+	RawlogWriter& out;
+	AppendFile& truth;
+	double t0;        ///< the sequence's start [s]
+	size_t next = 0;  ///< samples written
+
+	/** The samples stamped up to sequence time \a tSeq (inclusive); their
+	 * truth lines reach the file in one write. */
+	void writeUntil(double tSeq)
+	{
+		std::string lines;
+		while (double(next) / cfg.imu.rateHz <= tSeq + 1e-9)
+		{
+			ImuTruth tr;
+			const double stamp = t0 + double(next) / cfg.imu.rateHz;
+			out.write(*imu.sample(motion, stamp, t0, &tr));
+			lines += imuTruthLine(tr);
+			next++;
+		}
+		truth.append(lines);
+	}
+};
+
+/** The moving objects' poses at sequence time \a tSeq of frame \a j
+ * (objects.txt's lines). */
+std::string objectPoseLines(const Scene& scene, int j, double t0, double tSeq)
+{
+	std::string lines;
+	for (size_t o = 0; o < scene.objects.size(); o++)
+	{
+		Eigen::Matrix3d R;
+		Eigen::Vector3d x;
+		scene.objects[o]->pose(tSeq, R, x);
+		lines += std::to_string(j) + " " + std::to_string(o + 1) + " " +
+		         scene.objects[o]->name() + " " +
+		         tumLine(t0 + tSeq, toPose(R, x)) + "\n";
+	}
+	return lines;
+}
+
+/** Frame \a j's ground-truth mask (masks/), and the preview if \a preview. */
+void writeFrameImages(const SimConfig& cfg, RenderedFrame& frame,
+                      const std::string& gt, int j, bool preview)
+{
+	const cv::Mat mask(frame.height, frame.width, CV_8UC1, frame.mask.data());
+	writeImageFile(gt + "/masks/" + frameFileName(j), mask);
+	if (preview) writePreview(frame, cfg.depth.maxRange, gt + "/preview.png");
+}
+
+/** The share of the frame's pixels on a moving object. */
+double movingShare(const RenderedFrame& frame)
+{
+	size_t nMoving = 0;
+	for (auto m : frame.mask) nMoving += m ? 1 : 0;
+	return double(nMoving) / double(frame.mask.size());
+}
 }  // namespace
 
 const OutputFolderLayout& groundTruthLayout()
@@ -185,38 +276,9 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	// (OUT.rawlog.partial, OUT_gt.partial/) readable up to the last whole
 	// frame (docs/sim.md).
 	writeCalibration(cfg, gt + "/calibration.ini");
-	AppendFile gtPoses(gt + "/groundtruth.txt");
-	AppendFile gtImu(gt + "/imu.txt");
-	AppendFile gtObjects(gt + "/objects.txt");
-	gtPoses.append(tumHeader(
-	    "bims-sim ground truth: camera optical frame poses T_WC, world z up, "
-	    "x north"));
-	gtImu.append(imuTruthHeader());
-	gtObjects.append(
-	    "# bims-sim moving-object poses T_WO (root frame of each object in "
-	    "{W}), one line\n"
-	    "# per frame and object: frame object_id name t[s] tx ty tz qx qy "
-	    "qz qw\n"
-	    "# (object_id = the value in RenderedFrame::objectId; masks are "
-	    "255 for any id > 0)\n");
-
+	GroundTruthFiles truth(gt);
 	const double t0 = cfg.seq.startTime;
-	size_t nextImu = 0;
-	auto writeImuUntil = [&](double tSeq)
-	{
-		// IMU samples stamped up to sequence time tSeq (inclusive); their
-		// truth lines reach the file in one write
-		std::string lines;
-		while (double(nextImu) / cfg.imu.rateHz <= tSeq + 1e-9)
-		{
-			ImuTruth tr;
-			const double stamp = t0 + double(nextImu) / cfg.imu.rateHz;
-			out.write(*imu.sample(motion, stamp, t0, &tr));
-			lines += imuTruthLine(tr);
-			nextImu++;
-		}
-		gtImu.append(lines);
-	};
+	ImuStream imuOut{cfg, imu, motion, out, truth.imu, t0};
 
 	Progress rendered;
 	rendered.total = size_t(cfg.seq.frames);
@@ -228,7 +290,7 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 	{
 		const int j = done;
 		const double tSeq = double(j) / cfg.seq.fps;
-		writeImuUntil(tSeq);
+		imuOut.writeUntil(tSeq);
 		const Kinematics k = motion.at(tSeq);
 		const auto r0 = std::chrono::steady_clock::now();
 		renderer.render(scene, tSeq, k.R_WC, k.p_WC, seed, uint64_t(j), frame);
@@ -238,43 +300,26 @@ SimStats runSimulation(const SimConfig& cfg, const std::string& outRawlog,
 		out.write(*makeScan(cfg, frame, t0 + tSeq));
 		out.flush();
 
-		gtPoses.append(tumLine(t0 + tSeq, toPose(k.R_WC, k.p_WC)) + "\n");
-		const std::string name = "/masks/" + frameFileName(j);
-		const cv::Mat mask(frame.height, frame.width, CV_8UC1,
-		                   frame.mask.data());
-		writeImageFile(gt + name, mask);
-		if (j == previewFrame)
-			writePreview(frame, cfg.depth.maxRange, gt + "/preview.png");
-		size_t nMoving = 0;
-		for (auto m : frame.mask) nMoving += m ? 1 : 0;
-		movingSum += double(nMoving) / double(frame.mask.size());
-		std::string objectLines;  // one write per frame
-		for (size_t o = 0; o < scene.objects.size(); o++)
-		{
-			Eigen::Matrix3d R;
-			Eigen::Vector3d x;
-			scene.objects[o]->pose(tSeq, R, x);
-			objectLines += std::to_string(j) + " " + std::to_string(o + 1) +
-			               " " + scene.objects[o]->name() + " " +
-			               tumLine(t0 + tSeq, toPose(R, x)) + "\n";
-		}
-		gtObjects.append(objectLines);
+		truth.poses.append(tumLine(t0 + tSeq, toPose(k.R_WC, k.p_WC)) + "\n");
+		writeFrameImages(cfg, frame, gt, j, j == previewFrame);
+		movingSum += movingShare(frame);
+		truth.objects.append(objectPoseLines(scene, j, t0, tSeq));
 		rendered.done = size_t(j + 1);
 		reportProgress(progress, rendered);
 	}
 	st.interrupted = done < cfg.seq.frames;
 	// IMU a little past the last frame written
-	writeImuUntil(double(std::max(0, done - 1)) / cfg.seq.fps +
-	              0.5 / cfg.seq.fps);
+	imuOut.writeUntil(double(std::max(0, done - 1)) / cfg.seq.fps +
+	                  0.5 / cfg.seq.fps);
 	out.close();
-	for (auto* f : {&gtPoses, &gtImu, &gtObjects}) f->close();
+	truth.close();
 	part.commit();
 	gtPart.commit();
 	rendered.finished = true;
 	reportProgress(progress, rendered);
 
 	st.frames = size_t(done);
-	st.imuSamples = nextImu;
+	st.imuSamples = imuOut.next;
 	st.movingFraction = movingSum / std::max(1, done);
 	st.cpuSeconds = double(std::clock() - cpuStart) / CLOCKS_PER_SEC;
 	st.seconds =

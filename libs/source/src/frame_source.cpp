@@ -5,10 +5,10 @@
 #include "read_ahead.h"
 
 #include <mrpt/core/Clock.h>
+#include <mrpt/core/format.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <stdexcept>
 
@@ -84,16 +84,19 @@ void FrameOrder::accept(SourceFrame&& f)
 	waiting_.push_back(std::move(f));
 }
 
+void FrameOrder::tell(Warning::Kind kind, const std::string& where,
+                      std::string text) const
+{
+	if (p_.warnings) reportWarning(p_.warn, {kind, where, std::move(text)});
+}
+
 void FrameOrder::dropHeld(const InputPlace& at, const char* why)
 {
 	st_.scansBadStamp++;
-	if (p_.warnings)
-		std::fprintf(
-		    stderr,
-		    "%s: warning: %s: 3D scan #%zu (t %.6f) is %.6g s after the "
-		    "previous scan and %s: a stray timestamp; skipped\n",
-		    p_.program.c_str(), at.path ? at.path->c_str() : "input",
-		    held_->index, held_->t, held_->t - lastScanT_, why);
+	tell(Warning::Kind::Warning, at.path ? *at.path : "input",
+	     mrpt::format("3D scan #%zu (t %.6f) is %.6g s after the previous "
+	                  "scan and %s: a stray timestamp; skipped",
+	                  held_->index, held_->t, held_->t - lastScanT_, why));
 	// the observations read before it stay, in order
 	input_.insert(input_.begin(), held_->before.begin(), held_->before.end());
 	held_.reset();
@@ -103,13 +106,12 @@ bool FrameOrder::imuStampUsable(const mrpt::obs::CObservationIMU::Ptr& imu,
                                 double t, const std::string& where)
 {
 	if (!(t <= imuStampT_)) return true;
-	if (st_.imuOutOfOrder++ == 0 && p_.warnings)
-		std::fprintf(stderr,
-		             "%s: warning: %s: IMU sample '%s' at t %.6f is not after "
-		             "the previous one (t %.6f): skipped (the next ones too, "
-		             "counted in the summary, not warned about)\n",
-		             p_.program.c_str(), where.c_str(),
-		             imu->sensorLabel.c_str(), t, imuStampT_);
+	if (st_.imuOutOfOrder++ == 0)
+		tell(Warning::Kind::Warning, where,
+		     mrpt::format("IMU sample '%s' at t %.6f is not after the "
+		                  "previous one (t %.6f): skipped (the next ones "
+		                  "too, counted in the summary, not warned about)",
+		                  imu->sensorLabel.c_str(), t, imuStampT_));
 	return false;
 }
 
@@ -117,28 +119,30 @@ void FrameOrder::useImu(const mrpt::obs::CObservationIMU::Ptr& imu, double t,
                         const std::string& where, size_t entry)
 {
 	imuStampT_ = t;
-	if (rejected_
-	        .check(*imu, t, p_.warnings ? p_.program.c_str() : nullptr, where,
-	               entry)
-	        .empty())
+	const std::string bad = rejected_.check(*imu, t);
+	if (bad.empty())
 	{
 		imu_.push_back(imu);
 		lastImuT_ = std::max(lastImuT_, t);
 	}
+	else
+		tell(Warning::Kind::Warning, where,
+		     mrpt::format("observation #%zu (IMU, t %.6f): %s; sample not "
+		                  "used (%zu so far)",
+		                  entry, t, bad.c_str(), rejected_.count()));
 	st_.imuRejected = rejected_.count();
 }
 
 void FrameOrder::dropHeldImu(const std::string& where, const char* why)
 {
-	if (st_.imuBadStamp++ == 0 && p_.warnings)
-		std::fprintf(stderr,
-		             "%s: warning: %s: IMU sample '%s' at t %.6f is %.6g s "
-		             "after the previous one and %s: a stray timestamp; "
-		             "skipped (the next ones too, counted in the summary, not "
-		             "warned about)\n",
-		             p_.program.c_str(), where.c_str(),
-		             heldImu_->sensorLabel.c_str(), heldImuT_,
-		             heldImuT_ - imuStampT_, why);
+	if (st_.imuBadStamp++ == 0)
+		tell(Warning::Kind::Warning, where,
+		     mrpt::format("IMU sample '%s' at t %.6f is %.6g s after the "
+		                  "previous one and %s: a stray timestamp; skipped "
+		                  "(the next ones too, counted in the summary, not "
+		                  "warned about)",
+		                  heldImu_->sensorLabel.c_str(), heldImuT_,
+		                  heldImuT_ - imuStampT_, why));
 	heldImu_.reset();
 }
 
@@ -158,6 +162,168 @@ void FrameOrder::release(bool all)
 	}
 }
 
+void FrameOrder::skipOtherImu(const mrpt::obs::CObservationIMU& imu,
+                              uint8_t channels, const std::string& where)
+{
+	st_.otherSkipped++;
+	auto& o = st_.imuOtherLabels[imu.sensorLabel];
+	o.channels |= channels;
+	if (o.samples++ == 0)
+		tell(Warning::Kind::Warning, where,
+		     "IMU samples labelled " + quoted(imu.sensorLabel) + " (" +
+		         imuChannelNames(channels) +
+		         ") are not used: [sensors] imu_label is " +
+		         quoted(p_.sensors.imu_label));
+}
+
+void FrameOrder::noteFirstImu(const mrpt::obs::CObservationIMU& imu,
+                              uint8_t channels, const std::string& where)
+{
+	const std::string which = "the IMU labelled " + quoted(imu.sensorLabel);
+	if (channels & kImuGyro)
+		tell(Warning::Kind::Info, where,
+		     "using " + which + " (" + imuChannelNames(channels) + ")");
+	else
+		tell(Warning::Kind::Warning, where,
+		     which + " measures " + imuChannelNames(channels) +
+		         ": without a gyro the egomotion cannot use it (frames run "
+		         "as vision, flagged imu_missing)");
+}
+
+void FrameOrder::settleHeldImu(double t, const std::string& where)
+{
+	// the sample after a far one: it follows within the gap (the recording
+	// jumped, both are used) or the far stamp was stray
+	if (followsHeld(t, heldImuT_))
+	{
+		useImu(heldImu_, heldImuT_, where, heldImuEntry_);
+		heldImu_.reset();
+	}
+	else
+		dropHeldImu(where, "the next sample is not");
+}
+
+FrameOrder::Pushed FrameOrder::pushImu(
+    const mrpt::obs::CObservationIMU::Ptr& imu, double t, const InputPlace& at,
+    const std::string& where)
+{
+	const uint8_t channels = imuChannels(*imu);
+	if (!labelMatches(p_.sensors.imu_label, imu->sensorLabel))
+	{
+		skipOtherImu(*imu, channels, where);
+		return Pushed::Skipped;
+	}
+	// at the start, which IMU the run uses and what it measures (its count:
+	// in the summary; counting first would read the input twice)
+	if (st_.imuRead++ == 0) noteFirstImu(*imu, channels, where);
+	st_.imuChannels |= channels;
+	if (p_.keepInput) input_.push_back(imu);
+	if (heldImu_) settleHeldImu(t, where);
+	if (!imuStampUsable(imu, t, where)) return Pushed::Taken;
+	if (farAhead(t, imuStampT_))
+	{
+		heldImu_ = imu;  // the next sample decides
+		heldImuT_ = t;
+		heldImuEntry_ = at.entry;
+	}
+	else
+		useImu(imu, t, where, at.entry);
+	return Pushed::Taken;
+}
+
+void FrameOrder::noteNoImuYet(const std::string& where)
+{
+	tell(Warning::Kind::Info, where,
+	     "no IMU sample " +
+	         (p_.sensors.imu_label.empty()
+	              ? std::string("of any label")
+	              : "labelled " + quoted(p_.sensors.imu_label)) +
+	         " before the second 3D scan (" +
+	         (st_.imuOtherLabels.empty()
+	              ? "none in the input so far"
+	              : "only under other labels so far: [sensors] imu_label") +
+	         "): frames without one run without IMU data (imu_missing)");
+}
+
+void FrameOrder::settleHeldScan(double t, const InputPlace& at)
+{
+	// this scan follows the held one: the recording jumped
+	if (followsHeld(t, held_->t))
+	{
+		accept(std::move(*held_));
+		held_.reset();
+	}
+	else
+		dropHeld(at, "the next scan is not");
+}
+
+bool FrameOrder::sameImageSize(const mrpt::obs::CObservation3DRangeScan& scan,
+                               size_t idx, const std::string& where)
+{
+	if (!scan.hasRangeImage) return true;
+	const std::string size = std::to_string(scan.rangeImage.cols()) + "x" +
+	                         std::to_string(scan.rangeImage.rows());
+	if (firstSize_.empty())
+	{
+		firstSize_ =
+		    size + " (3D scan #" + std::to_string(idx) + " of " + where + ")";
+		return true;
+	}
+	if (firstSize_.compare(0, size.size() + 1, size + " ") == 0) return true;
+	error_ = where + ": 3D scan #" + std::to_string(idx) + " has a " + size +
+	         " depth image where the run's first had " + firstSize_ +
+	         ": one run takes one image size (camera mode)";
+	ended_ = true;
+	return false;
+}
+
+FrameOrder::Pushed FrameOrder::pushScan(
+    const mrpt::obs::CObservation3DRangeScan::Ptr& scan, double t,
+    const std::string& where, double inputFraction, const InputPlace& at)
+{
+	if (!labelMatches(p_.sensors.rgbd_label, scan->sensorLabel))
+	{
+		st_.otherSkipped++;
+		return Pushed::Skipped;
+	}
+	const size_t idx = scanIndex_++;
+	// the second scan and still no IMU sample of the label: said now, not
+	// only in the summary
+	if (++st_.scansRead == 2 && st_.imuRead == 0) noteNoImuYet(where);
+	if (held_) settleHeldScan(t, at);
+	if (idx > p_.frames.last)
+	{
+		ended_ = true;  // the range is read
+		return Pushed::End;
+	}
+	if (!p_.frames.contains(idx)) return Pushed::Skipped;
+	if (t <= lastScanT_)
+	{
+		st_.scansOutOfOrder++;
+		tell(Warning::Kind::Warning, where,
+		     "3D scan #" + std::to_string(idx) +
+		         " has a timestamp not after the previous one; skipped");
+		return Pushed::Skipped;
+	}
+	if (!sameImageSize(*scan, idx, where)) return Pushed::End;
+	SourceFrame f;
+	f.scan = scan;
+	f.index = idx;
+	f.t = t;
+	f.cost = cost_;
+	f.inputFraction = inputFraction;
+	f.before.swap(input_);
+	input_.clear();
+	cost_ = {};
+	if (farAhead(t, lastScanT_))
+	{
+		held_ = std::move(f);  // the next scan decides
+		return Pushed::Skipped;
+	}
+	accept(std::move(f));
+	return Pushed::Taken;
+}
+
 bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
                       const InputPlace& at, const InputCost& cost,
                       double inputFraction)
@@ -169,161 +335,15 @@ bool FrameOrder::push(const mrpt::obs::CObservation::Ptr& obs,
 	static const std::string kInput = "input";
 	const std::string& where = at.path ? *at.path : kInput;  // no copy
 	const double t = mrpt::Clock::toDouble(obs->timestamp);
+	Pushed step = Pushed::Taken;
 	if (auto imu = std::dynamic_pointer_cast<CObservationIMU>(obs))
-	{
-		const uint8_t channels = imuChannels(*imu);
-		if (!labelMatches(p_.sensors.imu_label, imu->sensorLabel))
-		{
-			st_.otherSkipped++;
-			auto& o = st_.imuOtherLabels[imu->sensorLabel];
-			o.channels |= channels;
-			if (o.samples++ == 0 && p_.warnings)
-				std::fprintf(
-				    stderr,
-				    "%s: warning: %s: IMU samples labelled %s (%s) are "
-				    "not used: [sensors] imu_label is %s\n",
-				    p_.program.c_str(), where.c_str(),
-				    quoted(imu->sensorLabel).c_str(),
-				    imuChannelNames(channels).c_str(),
-				    quoted(p_.sensors.imu_label).c_str());
-			return true;
-		}
-		// at the start, which IMU the run uses and what it measures (its
-		// count: in the summary; counting first would read the input twice)
-		if (st_.imuRead++ == 0 && p_.warnings)
-		{
-			if (channels & kImuGyro)
-				std::fprintf(stderr, "%s: %s: using the IMU labelled %s (%s)\n",
-				             p_.program.c_str(), where.c_str(),
-				             quoted(imu->sensorLabel).c_str(),
-				             imuChannelNames(channels).c_str());
-			else
-				std::fprintf(
-				    stderr,
-				    "%s: warning: %s: the IMU labelled %s measures %s: "
-				    "without a gyro the egomotion cannot use it (frames "
-				    "run as vision, flagged imu_missing)\n",
-				    p_.program.c_str(), where.c_str(),
-				    quoted(imu->sensorLabel).c_str(),
-				    imuChannelNames(channels).c_str());
-		}
-		st_.imuChannels |= channels;
-		if (p_.keepInput) input_.push_back(imu);
-		if (heldImu_)
-		{
-			// the sample after a far one: it follows within the gap (the
-			// recording jumped, both are used) or the far stamp was stray
-			if (followsHeld(t, heldImuT_))
-			{
-				useImu(heldImu_, heldImuT_, where, heldImuEntry_);
-				heldImu_.reset();
-			}
-			else
-				dropHeldImu(where, "the next sample is not");
-		}
-		if (imuStampUsable(imu, t, where))
-		{
-			if (farAhead(t, imuStampT_))
-			{
-				heldImu_ = imu;  // the next sample decides
-				heldImuT_ = t;
-				heldImuEntry_ = at.entry;
-			}
-			else
-				useImu(imu, t, where, at.entry);
-		}
-	}
+		step = pushImu(imu, t, at, where);
 	else if (auto scan =
 	             std::dynamic_pointer_cast<CObservation3DRangeScan>(obs))
-	{
-		if (!labelMatches(p_.sensors.rgbd_label, scan->sensorLabel))
-		{
-			st_.otherSkipped++;
-			return true;
-		}
-		const size_t idx = scanIndex_++;
-		// the second scan and still no IMU sample of the label: said now,
-		// not only in the summary
-		if (++st_.scansRead == 2 && st_.imuRead == 0 && p_.warnings)
-			std::fprintf(
-			    stderr,
-			    "%s: %s: no IMU sample %s before the second 3D scan "
-			    "(%s): frames without one run without IMU data "
-			    "(imu_missing)\n",
-			    p_.program.c_str(), where.c_str(),
-			    p_.sensors.imu_label.empty()
-			        ? "of any label"
-			        : ("labelled " + quoted(p_.sensors.imu_label)).c_str(),
-			    st_.imuOtherLabels.empty()
-			        ? "none in the input so far"
-			        : "only under other labels so far: [sensors] "
-			          "imu_label");
-		if (held_)
-		{
-			// this scan follows the held one: the recording jumped
-			if (followsHeld(t, held_->t))
-			{
-				accept(std::move(*held_));
-				held_.reset();
-			}
-			else
-				dropHeld(at, "the next scan is not");
-		}
-		if (idx > p_.frames.last)
-		{
-			ended_ = true;  // the range is read
-			return false;
-		}
-		if (!p_.frames.contains(idx)) return true;
-		if (t <= lastScanT_)
-		{
-			st_.scansOutOfOrder++;
-			if (p_.warnings)
-				std::fprintf(
-				    stderr,
-				    "%s: warning: %s: 3D scan #%zu has a timestamp not "
-				    "after the previous one; skipped\n",
-				    p_.program.c_str(), where.c_str(), idx);
-			return true;
-		}
-		if (scan->hasRangeImage)
-		{
-			const std::string size = std::to_string(scan->rangeImage.cols()) +
-			                         "x" +
-			                         std::to_string(scan->rangeImage.rows());
-			if (firstSize_.empty())
-				firstSize_ = size + " (3D scan #" + std::to_string(idx) +
-				             " of " + where + ")";
-			else if (firstSize_.compare(0, size.size() + 1, size + " ") != 0)
-			{
-				error_ = where + ": 3D scan #" + std::to_string(idx) +
-				         " has a " + size +
-				         " depth image where the run's first had " +
-				         firstSize_ +
-				         ": one run takes one image size (camera "
-				         "mode)";
-				ended_ = true;
-				return false;
-			}
-		}
-		SourceFrame f;
-		f.scan = scan;
-		f.index = idx;
-		f.t = t;
-		f.cost = cost_;
-		f.inputFraction = inputFraction;
-		f.before.swap(input_);
-		input_.clear();
-		cost_ = {};
-		if (farAhead(t, lastScanT_))
-		{
-			held_ = std::move(f);  // the next scan decides
-			return true;
-		}
-		accept(std::move(f));
-	}
+		step = pushScan(scan, t, where, inputFraction, at);
 	else
 		st_.otherSkipped++;
+	if (step != Pushed::Taken) return step == Pushed::Skipped;
 	newestT_ = std::max(newestT_, t);
 	release(false);
 	return true;

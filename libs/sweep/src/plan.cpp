@@ -239,6 +239,70 @@ bool TruthSpec::any() const
 	return false;
 }
 
+namespace
+{
+using Overrides = std::vector<std::pair<std::string, std::string>>;
+
+/** The base of every run of \a config: its text with the constants set,
+ * each constant checked alone, then all, then each grid value alone (the
+ * error names the key and the value). */
+std::string checkedBase(const SweepSpec& spec, const SweepPlan& plan,
+                        const ListedFile& config)
+{
+	checkIniFile(config.path);
+	std::string base = mrpt::io::file_get_contents(config.path);
+	checkWithLoader(base, config.path);
+	for (const auto& a : spec.constants)
+		checkWithLoader(derive(base, {a}, {{a.name, a.values[0]}}),
+		                spec.file + ": [" + a.from + "] " + a.name + " = " +
+		                    a.values[0] + ": on " + config.written);
+	Overrides constants;
+	for (const auto& a : spec.constants)
+		constants.emplace_back(a.name, a.values[0]);
+	base = derive(base, spec.constants, constants);
+	if (constants.size() > 1)
+		checkWithLoader(base, spec.file + ": " + constantsText(plan) + ": on " +
+		                          config.written);
+	for (const auto& a : spec.grid)
+		for (const auto& v : a.values)
+			checkWithLoader(derive(base, {a}, {{a.name, v}}),
+			                spec.file + ": [grid] " + a.name + " = " + v +
+			                    ": on " + config.written);
+	return base;
+}
+
+/** Combination \a c of the grid's values (the last key varies fastest). */
+Overrides gridCombination(const std::vector<GridAxis>& grid, size_t c)
+{
+	Overrides ov;
+	for (size_t i = 0, rest = c; i < grid.size(); i++)
+	{
+		size_t stride = 1;
+		for (size_t j = i + 1; j < grid.size(); j++)
+			stride *= grid[j].values.size();
+		ov.emplace_back(grid[i].name, grid[i].values[rest / stride]);
+		rest %= stride;
+	}
+	return ov;
+}
+
+/** A run's id: its number (\a digits wide), then what tells it apart:
+ * the config, the grid values, the rawlog (each when there are several). */
+std::string runId(const SweepSpec& spec, size_t number, size_t digits,
+                  const ListedFile& config, const Overrides& ov,
+                  const std::vector<std::string>& shortKeys,
+                  const ListedFile& rawlog)
+{
+	const std::string num = std::to_string(number);
+	std::string id = std::string(digits - num.size(), '0') + num;
+	if (spec.configs.size() > 1) id += "_" + idPart(stem(config.path));
+	for (size_t i = 0; i < ov.size(); i++)
+		id += "_" + idPart(shortKeys[i]) + "=" + idPart(ov[i].second);
+	if (spec.rawlogs.size() > 1) id += "_" + idPart(stem(rawlog.path));
+	return id;
+}
+}  // namespace
+
 SweepPlan SweepPlan::make(const SweepSpec& spec)
 {
 	SweepPlan plan;
@@ -258,40 +322,10 @@ SweepPlan SweepPlan::make(const SweepSpec& spec)
 
 	for (const auto& config : spec.configs)
 	{
-		checkIniFile(config.path);
-		std::string base = mrpt::io::file_get_contents(config.path);
-		checkWithLoader(base, config.path);
-		// each constant alone, then all: the base of every run
-		for (const auto& a : spec.constants)
-			checkWithLoader(derive(base, {a}, {{a.name, a.values[0]}}),
-			                spec.file + ": [" + a.from + "] " + a.name + " = " +
-			                    a.values[0] + ": on " + config.written);
-		std::vector<std::pair<std::string, std::string>> constants;
-		for (const auto& a : spec.constants)
-			constants.emplace_back(a.name, a.values[0]);
-		base = derive(base, spec.constants, constants);
-		if (constants.size() > 1)
-			checkWithLoader(base, spec.file + ": " + constantsText(plan) +
-			                          ": on " + config.written);
-		// each override alone: the error names the grid key and the value
-		for (const auto& a : spec.grid)
-			for (const auto& v : a.values)
-				checkWithLoader(derive(base, {a}, {{a.name, v}}),
-				                spec.file + ": [grid] " + a.name + " = " + v +
-				                    ": on " + config.written);
+		const std::string base = checkedBase(spec, plan, config);
 		for (size_t c = 0; c < combos; c++)
 		{
-			std::vector<std::pair<std::string, std::string>> ov;
-			for (size_t i = 0, rest = c; i < spec.grid.size(); i++)
-			{
-				// the last key varies fastest
-				size_t stride = 1;
-				for (size_t j = i + 1; j < spec.grid.size(); j++)
-					stride *= spec.grid[j].values.size();
-				ov.emplace_back(spec.grid[i].name,
-				                spec.grid[i].values[rest / stride]);
-				rest %= stride;
-			}
+			const Overrides ov = gridCombination(spec.grid, c);
 			const std::string text = derive(base, spec.grid, ov);
 			if (ov.size() > 1)  // the combination (each value alone passed)
 			{
@@ -303,23 +337,15 @@ SweepPlan SweepPlan::make(const SweepSpec& spec)
 			}
 			for (size_t k = 0; k < spec.rawlogs.size(); k++)
 			{
-				const ListedFile& rawlog = spec.rawlogs[k];
 				RunSpec r;
 				r.config = config;
-				r.rawlog = rawlog;
+				r.rawlog = spec.rawlogs[k];
 				r.truthMasks = spec.truth.masks[k];
 				r.truthTrajectory = spec.truth.trajectories[k];
 				r.overrides = ov;
 				r.configText = text;
-				std::string num = std::to_string(plan.runs.size() + 1);
-				r.id = std::string(digits - num.size(), '0') + num;
-				if (spec.configs.size() > 1)
-					r.id += "_" + idPart(stem(config.path));
-				for (size_t i = 0; i < ov.size(); i++)
-					r.id +=
-					    "_" + idPart(shortKeys[i]) + "=" + idPart(ov[i].second);
-				if (spec.rawlogs.size() > 1)
-					r.id += "_" + idPart(stem(rawlog.path));
+				r.id = runId(spec, plan.runs.size() + 1, digits, config, ov,
+				             shortKeys, r.rawlog);
 				plan.runs.push_back(std::move(r));
 			}
 		}

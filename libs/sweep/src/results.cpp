@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <set>
@@ -32,20 +31,6 @@ void flatten(const Json& j, const std::string& path,
 		out.emplace_back(path, j.get<double>());
 	else if (j.is_null() && !path.empty())
 		out.emplace_back(path, kNaN);
-}
-
-Json readJson(const std::string& path)
-{
-	std::ifstream f(path);
-	if (!f) throw std::runtime_error(path + ": cannot open");
-	try
-	{
-		return Json::parse(f);
-	}
-	catch (const std::exception& e)
-	{
-		throw std::runtime_error(path + ": not JSON: " + e.what());
-	}
 }
 
 /** "" for NaN; whole numbers without decimals; else \a digits significant
@@ -153,7 +138,7 @@ RunResult collectRun(const RunSpec& run, const std::string& outDir,
 	}
 	try
 	{
-		const Json m = readJson(mpath);
+		const Json m = readJsonFile(mpath);
 		r.status = m.value("status", std::string("?"));
 		r.error = m.value("error", std::string());
 		flatten(m, "", r.metrics);
@@ -173,7 +158,7 @@ RunResult collectRun(const RunSpec& run, const std::string& outDir,
 	{
 		try
 		{
-			flatten(readJson(p.string()), p.stem().string(), r.metrics);
+			flatten(readJsonFile(p.string()), p.stem().string(), r.metrics);
 		}
 		catch (const std::exception& e)
 		{

@@ -21,17 +21,15 @@ namespace bims
     const mrpt::obs::CObservationIMU& imu);
 
 /** The IMU samples a replay does not use (imuSampleProblem), for bims-run
- * and bims-odom alike: each is counted and warned about, naming the rawlog
- * and the observation, and the frame whose interval held one is flagged. */
+ * and bims-odom alike: each is counted, and the frame whose interval held
+ * one is flagged. */
 class RejectedImuSamples
 {
  public:
-	/** imuSampleProblem(imu); when not empty, a warning on stderr ("PROG:
-	 * warning: PATH: observation #N (IMU, t T): PROBLEM; sample not used";
-	 * none when \a prog is null) and \a t [s] remembered. */
+	/** imuSampleProblem(imu); when not empty, the sample at \a t [s] is
+	 * counted and remembered (the caller warns of it, naming the input). */
 	[[nodiscard]] std::string check(const mrpt::obs::CObservationIMU& imu,
-	                                double t, const char* prog,
-	                                const std::string& path, size_t obsIndex);
+	                                double t);
 	/** Whether samples stamped at or before \a t were rejected since the
 	 * last call (each sample answers once). */
 	bool upTo(double t);

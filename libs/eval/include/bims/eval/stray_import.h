@@ -9,6 +9,7 @@
 
 #include <bims/common/options.h>
 #include <bims/common/progress.h>
+#include <bims/common/warnings.h>
 #include <bims/io/image_file.h>
 #include <bims/io/trajectory.h>
 #include <mrpt/config/CConfigFileBase.h>
@@ -112,10 +113,11 @@ void readStrayCameraMatrix(const std::string& path, double K[3][3]);
 
 /** Indexes the folder: odometry.csv, depth/ (every depth/NNNNNN.png has a row
  * and every row its PNG, else an error naming both), camera_matrix.csv,
- * imu.csv and confidence/ when present (a note once on stderr when not;
- * confidence that is no folder: an error), rgb.mp4 when present (a note
- * once on stderr when not; one that is no regular file: an error). */
-StrayCapture readStrayCapture(const std::string& folder);
+ * imu.csv and confidence/ when present (a warning once to \a warn when
+ * not; confidence that is no folder: an error), rgb.mp4 when present (a
+ * note once to \a warn when not; one that is no regular file: an error). */
+StrayCapture readStrayCapture(const std::string& folder,
+                              const WarningCallback& warn = programWarnings());
 
 /** Every file of \a cap the import reads (the output guard's inputs). */
 std::vector<std::string> strayInputFiles(const StrayCapture& cap);
@@ -132,6 +134,9 @@ struct StrayImportOptions
 	int gzLevel = 1;       ///< 0 = plain rawlog, 1..9 gzip
 	/** The frames written (none: silent). */
 	ProgressCallback progress;
+	/** What the capture lacks (readStrayCapture()): the program's own
+	 * (bims::programWarnings()) unless set. */
+	WarningCallback warn = programWarnings();
 };
 
 struct StrayImportSummary

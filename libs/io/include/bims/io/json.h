@@ -1,7 +1,8 @@
 // The one home of JSON writing: every JSON file bims writes (bims-run's
 // metrics.json, bims-eval's reports) is built as a Json value (nlohmann's
 // JSON library, keys in insertion order) and written by writeJsonFile, so
-// quotes, backslashes and control characters in any text are escaped.
+// quotes, backslashes and control characters in any text are escaped; and
+// of reading one back (readJsonFile).
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -26,5 +27,9 @@ std::string jsonLine(const Json& j);
 /** Writes jsonText(j) to \a path (writeFileAtomically: complete or not at
  * all; throws naming the file). */
 void writeJsonFile(const std::string& path, const Json& j);
+
+/** The JSON value in the file \a path; throws std::runtime_error "PATH:
+ * cannot open" or "PATH: not JSON: WHY". */
+Json readJsonFile(const std::string& path);
 
 }  // namespace bims

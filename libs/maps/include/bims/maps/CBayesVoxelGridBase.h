@@ -2,6 +2,7 @@
 // bad-input accounting and the parts of mrpt::maps::CMetricMap they share.
 #pragma once
 
+#include <bims/common/warnings.h>
 #include <bims/maps/frame_cloud.h>
 #include <bims/maps/grid_params.h>
 
@@ -9,7 +10,9 @@
 #include <mrpt/maps/CMetricMap.h>
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace bims::maps
@@ -45,10 +48,21 @@ class CBayesVoxelGridBase : public mrpt::maps::CMetricMap
 	bool buildFrame(const mrpt::obs::CObservation3DRangeScan& scan,
 	                const mrpt::poses::CPose3D& robotPose,
 	                FrameCloud& out) const;
+	/** buildFrame() of \a obs if it is a 3D range scan (CMetricMap's
+	 * insertObservation: \a robotPose, none the origin). Returns false (no
+	 * frame) for another observation or a non-finite pose. */
+	bool buildFrameOf(
+	    const mrpt::obs::CObservation& obs,
+	    const std::optional<const mrpt::poses::CPose3D>& robotPose,
+	    FrameCloud& out) const;
 
-	/** Adds a frame's statistics to the totals; warns once per reason on
-	 * stderr. Called by the update functions. */
+	/** Adds a frame's statistics to the totals; warns once per reason
+	 * (warnings()). Called by the update functions. */
 	void accountFrame(const FrameStats& s) const;
+	/** Receives the warnings of accountFrame() (readings skipped, cells
+	 * over the memory budget): the program's own (bims::programWarnings())
+	 * unless set. */
+	void setWarnings(WarningCallback cb) { warn_ = std::move(cb); }
 
 	bool isEmpty() const override { return frameCount_ == 0; }
 
@@ -87,6 +101,7 @@ class CBayesVoxelGridBase : public mrpt::maps::CMetricMap
 	mutable size_t badPoseFrames_ = 0;
 	mutable FrameCloudBuilder builder_;
 	mutable unsigned warned_ = 0;
+	WarningCallback warn_ = programWarnings();
 
  private:
 	static GridParams readParamRows(mrpt::serialization::CArchive& in);

@@ -129,6 +129,17 @@ class MotionGrids
 	 * makes it lastFrame(). */
 	template <class Build>
 	const FrameCloud& buildInto(const Build& build);
+	/** processFrame()'s update of the tiers: O- of the hit voxels (with its
+	 * neighbourhood), the posteriors of tiers 1 and 2 (post1_, post2_),
+	 * tier 0 folding the frame in (holding the voxels the decision calls
+	 * moving when \a exclude). */
+	void updateTiers(const FrameCloud& f, const PixelLabels& labels,
+	                 bool exclude, bool flowOff);
+	/** Which cells tier 0 holds under exclude_moving (into hold_). */
+	void holdMoving(const FrameCloud& f, bool flowOff);
+	/** The cells of \a f as tiers 1 and 2 keep them: lastFrame()'s shared,
+	 * a caller's frame's copied once. */
+	std::shared_ptr<std::vector<VoxelKey>> keptCells(const FrameCloud& f);
 	FrameCloudBuilder builder_;
 	// lastFrame() and the buffer the next frame is built into (tiers 1 and
 	// 2 may still hold the cells of either: a held buffer is replaced).

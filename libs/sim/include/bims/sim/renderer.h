@@ -82,6 +82,8 @@ struct RenderedFrame
 	std::vector<uint8_t> objectId;  ///< 0 = static, k = moving object k
 };
 
+class Rng;
+
 class Renderer
 {
  public:
@@ -94,6 +96,27 @@ class Renderer
 	            RenderedFrame& out) const;
 
  private:
+	/** The nearest surface per pixel (render()'s first pass). */
+	struct Hits;
+	/** The screen rectangle [u0, u1] x [v0, v1] of the projected bounding
+	 * box of \a pr (seen from o_P with R_PC); false if off the image. The
+	 * whole image for a room, or for a box partly behind the camera. */
+	bool screenRect(const Primitive& pr, const Eigen::Matrix3d& R_PC,
+	                const Eigen::Vector3d& o_P, int rect[4]) const;
+	/** Pass 1: the nearest hit per pixel, each primitive tested only inside
+	 * its screenRect(). */
+	void nearestHits(const std::vector<Primitive>& prims,
+	                 const Eigen::Matrix3d& R_WC, const Eigen::Vector3d& p_WC,
+	                 Hits& h) const;
+	/** Pass 2: shading and the depth sensor's model (noise from \a rng). */
+	void shadeAndSense(const std::vector<Primitive>& prims, const Hits& h,
+	                   const Eigen::Matrix3d& R_WC, Rng& rng,
+	                   RenderedFrame& out) const;
+	/** The projector's shadows in the depth (projector_baseline > 0). */
+	void projectorShadows(const Hits& h, RenderedFrame& out) const;
+	/** Small round holes in the depth. */
+	void depthHoles(Rng& rng, RenderedFrame& out) const;
+
 	CameraParams cam_;
 	DepthParams depth_;
 	RgbParams rgb_;

@@ -36,6 +36,7 @@
 #pragma once
 
 #include <bims/common/imu_check.h>
+#include <bims/common/warnings.h>
 #include <bims/sensors/depth_correction.h>
 #include <bims/sensors/imu_sample.h>
 #include <bims/sensors/params.h>
@@ -94,11 +95,15 @@ void checkFrameRangeInInputs(const FrameRange& range,
 /** What the rule takes from an experiment's configuration. */
 struct FrameOrderParams
 {
-	/** The program named in the warnings ("bims-run: warning: ..."). */
+	/** The program the frames are read for (the callers' name for the
+	 * run; the warnings are worded by the program's \a warn). */
 	std::string program = "bims";
-	/** Warn on stderr of what is skipped (counted in FrameOrderStats
-	 * either way): off for a pass that only indexes the input. */
+	/** Report what is skipped (counted in FrameOrderStats either way)
+	 * through \a warn: off for a pass that only indexes the input. */
 	bool warnings = true;
+	/** Receives the warnings and notes (what is skipped, which IMU is
+	 * used): the program's own (bims::programWarnings()) unless set. */
+	WarningCallback warn = programWarnings();
 	sensors::SensorsParams sensors;
 	/** IMU stamp = camera stamp + offset for the same instant [s]. */
 	double imuOffsetS = 0;
@@ -232,6 +237,42 @@ class FrameOrder
  private:
 	bool ready(const SourceFrame& f) const;
 	void accept(SourceFrame&& f);
+	/** Hands a warning (or a note) about \a where to p_.warn, if
+	 * p_.warnings. */
+	void tell(Warning::Kind kind, const std::string& where,
+	          std::string text) const;
+	/** What push() did with an observation: taken (the frames that became
+	 * ready are released), skipped (nothing more to do), or the end of the
+	 * input. */
+	enum class Pushed
+	{
+		Taken,
+		Skipped,
+		End
+	};
+	/** push() of an IMU sample stamped \a t read from \a where. */
+	Pushed pushImu(const mrpt::obs::CObservationIMU::Ptr& imu, double t,
+	               const InputPlace& at, const std::string& where);
+	/** push() of a 3D scan. */
+	Pushed pushScan(const mrpt::obs::CObservation3DRangeScan::Ptr& scan,
+	                double t, const std::string& where, double inputFraction,
+	                const InputPlace& at);
+	/** Counts a sample of another IMU label (warned once per label). */
+	void skipOtherImu(const mrpt::obs::CObservationIMU& imu, uint8_t channels,
+	                  const std::string& where);
+	/** The first sample of the IMU used: which it is and what it measures. */
+	void noteFirstImu(const mrpt::obs::CObservationIMU& imu, uint8_t channels,
+	                  const std::string& where);
+	/** The sample after a held one (a far stamp) decides it. */
+	void settleHeldImu(double t, const std::string& where);
+	/** The second scan and still no IMU sample of the label: said now. */
+	void noteNoImuYet(const std::string& where);
+	/** The scan after a held one (a far stamp) decides it. */
+	void settleHeldScan(double t, const InputPlace& at);
+	/** The one image size of a run: false (error_ set) if \a scan's range
+	 * image differs from the first one's. */
+	bool sameImageSize(const mrpt::obs::CObservation3DRangeScan& scan,
+	                   size_t idx, const std::string& where);
 	void dropHeld(const InputPlace& at, const char* why);
 	void release(bool all);
 	/** The stamp rule of IMU samples: false if \a imu is skipped or held. */
