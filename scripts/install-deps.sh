@@ -15,6 +15,7 @@ PACKAGES=(
   librosbag-storage-dev libcv-bridge-dev libsensor-msgs-dev pluginlib-dev
   libroslz4-dev libbz2-dev
   libzstd-dev liblz4-dev libsqlite3-dev libyaml-cpp-dev
+  cyclonedds-dev cyclonedds-tools
   nodejs
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth imagemagick xdotool x11-apps libgl1-mesa-dri
