@@ -1,5 +1,7 @@
 #include <bims/bag/cdr.h>
+#include <bims/common/errors.h>
 #include <bims/eval/rgbd_frame.h>
+#include <bims/pipeline/run.h>
 #include <bims/pipeline/stepper.h>
 #include <bims/ros2/dds.h>
 #include <bims/ros2/node.h>
@@ -124,22 +126,15 @@ class FrameQueue
 /** Checks an image's declared size against its data; "" when it agrees. */
 std::string imageProblem(const bag::ImageView& v, int bytesPerPixel)
 {
-	char buf[200];
+	using std::to_string;
+	const std::string size = to_string(v.width) + "x" + to_string(v.height);
 	if (v.width == 0 || v.height == 0 || v.width > 16384 || v.height > 16384)
-	{
-		std::snprintf(buf, sizeof buf, "its size %ux%u is not an image's",
-		              v.width, v.height);
-		return buf;
-	}
+		return "its size " + size + " is not an image's";
 	if (uint64_t(v.step) < uint64_t(v.width) * bytesPerPixel ||
 	    uint64_t(v.step) * v.height != v.size)
-	{
-		std::snprintf(buf, sizeof buf,
-		              "its step %u and size %ux%u (%d bytes a pixel) disagree "
-		              "with its %zu bytes of data",
-		              v.step, v.width, v.height, bytesPerPixel, v.size);
-		return buf;
-	}
+		return "its step " + to_string(v.step) + " and size " + size + " (" +
+		       to_string(bytesPerPixel) + " bytes a pixel) disagree with its " +
+		       to_string(v.size) + " bytes of data";
 	if (v.bigEndian && bytesPerPixel > 1) return "it is big-endian";
 	return {};
 }
@@ -324,22 +319,14 @@ void Node::onDepth(const std::vector<uint8_t>& b)
 void Node::onImu(const std::vector<uint8_t>& b)
 {
 	const auto s = bag::cdr::imu(b.data(), b.size());
-	using namespace mrpt::obs;
-	auto o = CObservationIMU::Create();
-	o->sensorLabel = cfg_.ego.sensors.imu_label;
-	o->timestamp = stampOf(bag::cdr::headerTime(b.data(), b.size()));
-	auto put = [&](bool has, const double* x, TIMUDataIndex i0,
-	               TIMUDataIndex i1, TIMUDataIndex i2)
-	{
-		if (!has) return;
-		o->set(i0, x[0]);
-		o->set(i1, x[1]);
-		o->set(i2, x[2]);
-	};
-	put(s.hasGyro, s.w, IMU_WX, IMU_WY, IMU_WZ);
-	put(s.hasAccel, s.a, IMU_X_ACC, IMU_Y_ACC, IMU_Z_ACC);
+	const auto t = stampOf(bag::cdr::headerTime(b.data(), b.size()));
+	auto o = eval::imuObservation(
+	    cfg_.ego.sensors.imu_label, mrpt::Clock::toDouble(t),
+	    s.hasGyro ? s.w : nullptr, s.hasAccel ? s.a : nullptr, nullptr);
+	o->timestamp = t;  // exactly the header's
 	if (s.hasOrientation)
 	{
+		using namespace mrpt::obs;
 		o->set(IMU_ORI_QUAT_X, s.q[0]);
 		o->set(IMU_ORI_QUAT_Y, s.q[1]);
 		o->set(IMU_ORI_QUAT_Z, s.q[2]);
@@ -582,29 +569,48 @@ void Node::publish(const source::SourceFrame& f, const pipeline::FrameResult& r)
 
 void Node::process()
 {
-	pipeline::LiveSegmentation seg(cfg_, opt_.program, "ROS 2 topics");
+	pipeline::RunOptions ro;
+	ro.outDir = opt_.outDir;
+	ro.laterFiles = opt_.laterFiles;
+	pipeline::RunRecorder rec(cfg_, ro);
+	pipeline::LiveSegmentation seg(cfg_, opt_.program, "ROS 2 topics",
+	                               !opt_.outDir.empty());
+	const auto maxed = [&]
+	{ return opt_.maxFrames > 0 && st_.framesProcessed >= opt_.maxFrames; };
 	const auto onFrame =
 	    [&](const source::SourceFrame& f, const pipeline::FrameResult& r)
 	{
-		publish(f, r);
+		publish(f, r);  // first: the recorder then owns the scan
+		rec.frame(f, r, seg.lastCpuMs());
 		st_.framesProcessed++;
-		if (opt_.maxFrames > 0 && st_.framesProcessed >= opt_.maxFrames)
-			done_ = true;
+		if (maxed()) done_ = true;
 	};
-	while (auto it = queue_.pop())
+	std::string error;
+	try
 	{
-		if (opt_.maxFrames > 0 && st_.framesProcessed >= opt_.maxFrames)
-			continue;  // drain
-		if (it->scan)
+		while (auto it = queue_.pop())
 		{
-			headers_[it->scan->timestamp] = it->header;
-			seg.push(it->scan, onFrame);
+			if (maxed()) continue;  // drain
+			if (it->scan)
+			{
+				headers_[it->scan->timestamp] = it->header;
+				seg.push(it->scan, onFrame);
+			}
+			else
+				seg.push(it->imu, onFrame);
 		}
-		else
-			seg.push(it->imu, onFrame);
+		if (!maxed())
+		{
+			seg.finish(onFrame);
+			rec.trailing(seg.takeTrailing());
+		}
 	}
-	if (opt_.maxFrames == 0 || st_.framesProcessed < opt_.maxFrames)
-		seg.finish(onFrame);
+	catch (const std::exception& e)
+	{
+		error = withoutBacktrace(e.what());
+		done_ = true;  // the receiver stops
+	}
+	st_.run = rec.finish(seg.pipeline(), seg.stats(), error, false);
 }
 
 NodeStats Node::run()

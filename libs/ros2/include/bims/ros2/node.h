@@ -10,12 +10,14 @@
 #pragma once
 
 #include <bims/pipeline/config.h>
+#include <bims/pipeline/run.h>
 #include <bims/ros2/params.h>
 
 #include <atomic>
 #include <cstddef>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace bims::ros2
 {
@@ -23,6 +25,11 @@ struct NodeOptions
 {
 	std::string program = "bims-ros2";
 	size_t maxFrames = 0;  ///< stop after N frames processed (0: never)
+	/** Where to write what bims-run writes (pipeline::RunRecorder; the
+	 * caller prepares the folder); empty: nothing. */
+	std::string outDir;
+	/** Files the caller writes into outDir afterwards (its manifest). */
+	std::vector<std::string> laterFiles;
 	/** When it turns true: stop, process the frames received, return. */
 	const std::atomic<bool>* stop = nullptr;
 	/** Warnings and the report's lines (default: stderr). */
@@ -38,6 +45,8 @@ struct NodeStats
 	size_t framesProcessed = 0;
 	size_t imuReceived = 0;
 	size_t messagesRejected = 0;  ///< samples that did not decode
+	/** The run as bims-run reports it (its error: what stopped it). */
+	pipeline::RunSummary run;
 };
 
 /** Runs until the stop flag or maxFrames; throws std::runtime_error when
