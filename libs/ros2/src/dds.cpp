@@ -41,6 +41,15 @@ dds_qos_t* sensorQos(int depth)
 	return q;
 }
 
+dds_qos_t* outputQos(int depth)
+{
+	dds_qos_t* q = dds_create_qos();
+	dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(10));
+	dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
+	dds_qset_history(q, DDS_HISTORY_KEEP_LAST, depth);
+	return q;
+}
+
 namespace
 {
 dds_entity_t topicOf(dds_entity_t participant, const std::string& topic,
@@ -64,10 +73,11 @@ dds_entity_t createReader(dds_entity_t participant, const std::string& topic,
 }
 
 dds_entity_t createWriter(dds_entity_t participant, const std::string& topic,
-                          const dds_topic_descriptor_t& desc, int depth)
+                          const dds_topic_descriptor_t& desc, int depth,
+                          bool sensor)
 {
 	const dds_entity_t t = topicOf(participant, topic, desc);
-	dds_qos_t* q = sensorQos(depth);
+	dds_qos_t* q = sensor ? sensorQos(depth) : outputQos(depth);
 	const dds_entity_t w = dds_create_writer(participant, t, q, nullptr);
 	dds_delete_qos(q);
 	return ddsCheck(w, "writer of " + topic);

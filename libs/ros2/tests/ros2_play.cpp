@@ -7,13 +7,16 @@
 //
 //   test_ros2_play IN.rawlog OUTDIR [--lag N] [--stop-pid PID]
 //                  [--stop-after K] [--mag-topic T] [--bad-step K]
+//                  [--wait-file PATH] [--frames K]
 //
 // OUTDIR/sent.csv: "sec,nsec" of each depth image sent; received.csv:
 // "sec,nsec,width,height,encoding,frame_id" of each mask received, its
 // pixels in masks/SEC_NSEC.png; odometry.txt: the count of odometry
-// messages. --stop-pid: SIGINT to that process after K frames
-// (--stop-after) or after the last one. --bad-step K: the K-th depth image
-// (1-based) goes out with a step that disagrees with its data.
+// messages. --stop-pid: SIGINT to that process as soon as K frames are
+// sent (--stop-after), or 0.2 s after the last one. --bad-step K: the K-th
+// depth image (1-based) goes out with a step that disagrees with its data.
+// --wait-file: play only once PATH exists (another subscriber is ready).
+// --frames K: the first K frames only.
 #include <bims/io/rawlog.h>
 #include <bims/ros2/dds.h>
 #include <bims/ros2/params.h>
@@ -39,8 +42,8 @@ using Clock = std::chrono::steady_clock;
 
 struct Args
 {
-	std::string rawlog, outDir, magTopic = "none";
-	size_t lag = 2, stopAfter = 0, badStep = 0;
+	std::string rawlog, outDir, magTopic = "none", waitFile;
+	size_t lag = 2, stopAfter = 0, badStep = 0, frames = 0;
 	int stopPid = 0;
 };
 
@@ -66,6 +69,10 @@ Args parse(int argc, char** argv)
 			a.magTopic = v;
 		else if (k == "--bad-step")
 			a.badStep = std::stoul(v);
+		else if (k == "--wait-file")
+			a.waitFile = v;
+		else if (k == "--frames")
+			a.frames = std::stoul(v);
 		else
 			throw std::invalid_argument("unknown option " + k);
 	}
@@ -148,6 +155,12 @@ void Player::waitForPeers()
 		if (w.current_count > 0 && r.current_count > 0) break;
 		if (Clock::now() - t0 > std::chrono::seconds(30))
 			throw std::runtime_error("the node was not discovered in 30 s");
+		std::this_thread::sleep_for(std::chrono::milliseconds(20));
+	}
+	while (!a_.waitFile.empty() && !std::filesystem::exists(a_.waitFile))
+	{
+		if (Clock::now() - t0 > std::chrono::seconds(30))
+			throw std::runtime_error(a_.waitFile + " did not come in 30 s");
 		std::this_thread::sleep_for(std::chrono::milliseconds(20));
 	}
 	// the node's other readers match at the same time as its depth reader
@@ -297,7 +310,8 @@ void Player::play()
 			collect();
 		}
 		sendScan(*scan);
-		if (a_.stopAfter > 0 && sent_ == a_.stopAfter) break;
+		if (a_.stopAfter > 0 && sent_ == a_.stopAfter) stopNode();  // mid-run
+		if (stopped_ || sent_ == a_.frames) break;
 	}
 	// the node then runs the frames it holds and publishes their masks
 	std::this_thread::sleep_for(std::chrono::milliseconds(200));

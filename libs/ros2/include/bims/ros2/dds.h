@@ -42,12 +42,19 @@ dds_entity_t ddsCheck(dds_entity_t rc, const std::string& what);
  * volatile, keep last \a depth. */
 dds_qos_t* sensorQos(int depth);
 
+/** The QoS of bims's own topics: reliable, transient local, keep last
+ * \a depth: what best-effort and reliable, volatile and transient-local
+ * subscribers all match (e.g. Foxglove's, which asks for reliable and
+ * transient local); a write waits at most 10 ms for a slow reader. */
+dds_qos_t* outputQos(int depth);
+
 /** A reader of ROS 2 topic \a topic with type \a desc in \a participant. */
 dds_entity_t createReader(dds_entity_t participant, const std::string& topic,
                           const dds_topic_descriptor_t& desc, int depth);
-/** A writer, the same way. */
+/** A writer, the same way: outputQos, or sensorQos when \a sensor. */
 dds_entity_t createWriter(dds_entity_t participant, const std::string& topic,
-                          const dds_topic_descriptor_t& desc, int depth);
+                          const dds_topic_descriptor_t& desc, int depth,
+                          bool sensor = false);
 
 /** One sample taken from a reader as its serialized bytes (the CDR
  * encapsulation header first). */
