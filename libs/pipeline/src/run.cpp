@@ -80,6 +80,16 @@ class OpenCvThreads
 	bool set_ = false;
 };
 
+/** The error of a run whose \a rawlogs held no 3D scan with \a label. */
+std::string noScansError(const std::vector<std::string>& rawlogs,
+                         const std::string& label)
+{
+	std::string files;
+	for (const auto& f : rawlogs) files += (files.empty() ? "" : ", ") + f;
+	return files + ": no CObservation3DRangeScan (RGB-D) observation" +
+	       (label.empty() ? std::string() : " with label '" + label + "'");
+}
+
 void addError(RunSummary& sum, const std::string& e)
 {
 	if (sum.error.find(e) != std::string::npos) return;  // reported already
@@ -293,7 +303,6 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	const OpenCvThreads cvThreads(cfg.pipeline.opencv_threads);
 	RunRecorder rec(cfg, opt);
 	Pipeline pipe(cfg);
-	const std::string& rgbdLabel = cfg.ego.sensors.rgbd_label;
 	// a bounded range has a known total; otherwise it is estimated from the
 	// share of the input read
 	const bool bounded = opt.frames.bounded();
@@ -358,14 +367,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 	if (!readError.empty())  // first: it came first
 		error = readError + (error.empty() ? "" : "; then: " + error);
 	if (stats.scansRead == 0 && error.empty())
-	{
-		std::string files;
-		for (const auto& f : opt.rawlogs)
-			files += (files.empty() ? "" : ", ") + f;
-		error = files + ": no CObservation3DRangeScan (RGB-D) observation" +
-		        (rgbdLabel.empty() ? std::string()
-		                           : " with label '" + rgbdLabel + "'");
-	}
+		error = noScansError(opt.rawlogs, cfg.ego.sensors.rgbd_label);
 	progress.finished = true;
 	progress.note.clear();
 	reportProgress(opt.progress, progress);

@@ -4,6 +4,7 @@
 #include <bims/pipeline/run.h>
 #include <bims/pipeline/stepper.h>
 #include <bims/ros2/dds.h>
+#include <bims/ros2/frame_queue.h>
 #include <bims/ros2/node.h>
 #include <mrpt/core/Clock.h>
 #include <mrpt/math/CQuaternion.h>
@@ -67,61 +68,7 @@ struct Item
 	Header header;  // of the scan
 };
 
-/** The queue between the receiving and the processing thread: IMU samples
- * are never dropped; frames beyond \a maxFrames drop the oldest frame. */
-class FrameQueue
-{
- public:
-	explicit FrameQueue(size_t maxFrames) : max_(maxFrames) {}
-	/** Returns the number of frames dropped for this one. */
-	size_t push(Item it)
-	{
-		std::lock_guard<std::mutex> lk(m_);
-		size_t dropped = 0;
-		if (it.scan)
-		{
-			frames_++;
-			while (frames_ > max_)
-			{
-				for (auto i = q_.begin(); i != q_.end(); ++i)
-					if (i->scan)
-					{
-						q_.erase(i);
-						break;
-					}
-				frames_--;
-				dropped++;
-			}
-		}
-		q_.push_back(std::move(it));
-		cv_.notify_one();
-		return dropped;
-	}
-	/** The next item, or nullopt when closed and empty. */
-	std::optional<Item> pop()
-	{
-		std::unique_lock<std::mutex> lk(m_);
-		cv_.wait(lk, [&] { return !q_.empty() || closed_; });
-		if (q_.empty()) return std::nullopt;
-		Item it = std::move(q_.front());
-		q_.pop_front();
-		if (it.scan) frames_--;
-		return it;
-	}
-	void close()
-	{
-		std::lock_guard<std::mutex> lk(m_);
-		closed_ = true;
-		cv_.notify_all();
-	}
-
- private:
-	std::mutex m_;
-	std::condition_variable cv_;
-	std::deque<Item> q_;
-	size_t max_, frames_ = 0;
-	bool closed_ = false;
-};
+using FrameQueue = DropOldestQueue<Item>;
 
 /** Checks an image's declared size against its data; "" when it agrees. */
 std::string imageProblem(const bag::ImageView& v, int bytesPerPixel)

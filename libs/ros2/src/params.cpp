@@ -12,7 +12,7 @@ void Ros2Params::describe(OptionVisitor& v)
 	       "sensor_msgs/Image rgb8/bgr8/mono8 registered to the depth; none: "
 	       "depth only");
 	v.text("camera_info_topic", cameraInfoTopic,
-	       "sensor_msgs/CameraInfo of the depth image ([camera] overrides)");
+	       "sensor_msgs/CameraInfo of the depth image (its K, D and size)");
 	v.text("imu_topic", imuTopic, "sensor_msgs/Imu; none: no IMU");
 	v.text("mag_topic", magTopic,
 	       "sensor_msgs/MagneticField attached to the IMU sample of its "

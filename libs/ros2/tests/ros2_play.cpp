@@ -7,7 +7,7 @@
 //
 //   test_ros2_play IN.rawlog OUTDIR [--lag N] [--stop-pid PID]
 //                  [--stop-after K] [--mag-topic T] [--bad-step K]
-//                  [--wait-file PATH] [--frames K]
+//                  [--wait-file PATH] [--frames K] [--wrong-type]
 //
 // OUTDIR/sent.csv: "sec,nsec" of each depth image sent; received.csv:
 // "sec,nsec,width,height,encoding,frame_id" of each mask received, its
@@ -16,7 +16,8 @@
 // sent (--stop-after), or 0.2 s after the last one. --bad-step K: the K-th
 // depth image (1-based) goes out with a step that disagrees with its data.
 // --wait-file: play only once PATH exists (another subscriber is ready).
-// --frames K: the first K frames only.
+// --frames K: the first K frames only. --wrong-type: a second participant
+// publishes sensor_msgs/Imu on the depth topic's name too.
 #include <bims/io/rawlog.h>
 #include <bims/ros2/dds.h>
 #include <bims/ros2/params.h>
@@ -45,6 +46,7 @@ struct Args
 	std::string rawlog, outDir, magTopic = "none", waitFile;
 	size_t lag = 2, stopAfter = 0, badStep = 0, frames = 0;
 	int stopPid = 0;
+	bool wrongType = false;
 };
 
 Args parse(int argc, char** argv)
@@ -56,9 +58,17 @@ Args parse(int argc, char** argv)
 	Args a;
 	a.rawlog = argv[1];
 	a.outDir = argv[2];
-	for (int i = 3; i + 1 < argc; i += 2)
+	for (int i = 3; i < argc; i += 2)
 	{
-		const std::string k = argv[i], v = argv[i + 1];
+		const std::string k = argv[i];
+		if (k == "--wrong-type")
+		{
+			a.wrongType = true;
+			i--;
+			continue;
+		}
+		if (i + 1 == argc) throw std::invalid_argument(k + " needs a value");
+		const std::string v = argv[i + 1];
 		if (k == "--lag")
 			a.lag = std::stoul(v);
 		else if (k == "--stop-pid")
@@ -111,7 +121,7 @@ class Player
 
 	Args a_;
 	Ros2Params p_;
-	DdsEntity pp_;
+	DdsEntity pp_, wrongPp_;
 	dds_entity_t wDepth_, wColour_, wInfo_, wImu_, wMag_ = 0, rMask_, rOdom_;
 	size_t sent_ = 0, received_ = 0, odometry_ = 0;
 	bool stopped_ = false;
@@ -127,16 +137,27 @@ Player::Player(const Args& a) : a_(a)
 	    ddsCheck(dds_create_participant(DDS_DOMAIN_DEFAULT, nullptr, nullptr),
 	             "participant"));
 	const auto pp = pp_.get();
-	wDepth_ =
-	    createWriter(pp, p_.depthTopic, sensor_msgs_msg_dds__Image__desc, 5);
-	wColour_ =
-	    createWriter(pp, p_.colourTopic, sensor_msgs_msg_dds__Image__desc, 5);
+	// as a sensor driver: best effort, volatile
+	wDepth_ = createWriter(pp, p_.depthTopic, sensor_msgs_msg_dds__Image__desc,
+	                       5, true);
+	wColour_ = createWriter(pp, p_.colourTopic,
+	                        sensor_msgs_msg_dds__Image__desc, 5, true);
 	wInfo_ = createWriter(pp, p_.cameraInfoTopic,
-	                      sensor_msgs_msg_dds__CameraInfo__desc, 5);
-	wImu_ = createWriter(pp, p_.imuTopic, sensor_msgs_msg_dds__Imu__desc, 50);
+	                      sensor_msgs_msg_dds__CameraInfo__desc, 5, true);
+	wImu_ =
+	    createWriter(pp, p_.imuTopic, sensor_msgs_msg_dds__Imu__desc, 50, true);
 	if (topicGiven(a_.magTopic))
-		wMag_ = createWriter(pp, a_.magTopic,
-		                     sensor_msgs_msg_dds__MagneticField__desc, 50);
+		wMag_ =
+		    createWriter(pp, a_.magTopic,
+		                 sensor_msgs_msg_dds__MagneticField__desc, 50, true);
+	if (a_.wrongType)
+	{
+		wrongPp_ = DdsEntity(ddsCheck(
+		    dds_create_participant(DDS_DOMAIN_DEFAULT, nullptr, nullptr),
+		    "participant"));
+		createWriter(wrongPp_.get(), p_.depthTopic,
+		             sensor_msgs_msg_dds__Imu__desc, 5, true);
+	}
 	rMask_ =
 	    createReader(pp, p_.maskTopic, sensor_msgs_msg_dds__Image__desc, 50);
 	rOdom_ = createReader(pp, p_.odometryTopic,

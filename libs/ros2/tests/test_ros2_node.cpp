@@ -334,3 +334,22 @@ TEST(Ros2Node, AnImageWhoseStepDisagreesWithItsDataIsWarnedAboutNamingTheTopic)
 }
 
 }  // namespace
+
+namespace
+{
+TEST(Ros2Node, APeerPublishingAnotherTypeOnATopicIsWarnedAboutNamingIt)
+{
+	SKIP_WITHOUT_NAMESPACES();
+	const auto d = test::freshTmpDir("bims_ros2_node", "type");
+	const auto l = runLoopback(d, "--lag 2 --frames 12 --wrong-type");
+	ASSERT_EQ(l.code, 0) << l.nodeLog << l.playLog;
+	EXPECT_NE(l.nodeLog.find("topic " + kDepthTopic +
+	                         ": a peer publishes type "
+	                         "sensor_msgs::msg::dds_::Imu_, not "
+	                         "sensor_msgs::msg::dds_::Image_"),
+	          std::string::npos)
+	    << l.nodeLog;
+	// the right publisher's frames all ran
+	EXPECT_EQ(receivedStamps(l.playDir).size(), 12u) << l.playLog;
+}
+}  // namespace
