@@ -167,19 +167,15 @@ bool sameImage(const std::string& a, const std::string& b)
 	       cv::countNonZero(x != y) == 0;
 }
 
-/** bims-run's masks of the sample, made once. */
-const std::string& bimsRunOut()
+/** bims-run's outputs of the sample, into DIR/run (each test its own:
+ * CTest runs the cases in parallel processes). */
+std::string runBimsRun(const std::string& dir)
 {
-	static const std::string out = []
-	{
-		const auto d = test::freshTmpDir("bims_ros2_node", "run");
-		const auto r =
-		    test::runCommand("'" + kBin + "/bims-run' '" + writeConfig(d) +
-		                     "' '" + test::kSample + "' -o '" + d + "/out' -q");
-		EXPECT_EQ(r.code, 0) << r.out;
-		return d + "/out";
-	}();
-	return out;
+	const auto r =
+	    test::runCommand("'" + kBin + "/bims-run' '" + writeConfig(dir) +
+	                     "' '" + test::kSample + "' -o '" + dir + "/run' -q");
+	EXPECT_EQ(r.code, 0) << r.out;
+	return dir + "/run";
 }
 
 std::string frameName(size_t i)
@@ -189,9 +185,9 @@ std::string frameName(size_t i)
 }
 
 /** How many of the masks received into \a dir (masks/SEC_NSEC\a ext, in
- * the order of \a stamps) are bims-run's of the same frame. */
+ * the order of \a stamps) are those of bims-run's output \a run. */
 size_t sameMasks(const std::string& dir, const std::vector<std::string>& stamps,
-                 const std::string& ext)
+                 const std::string& ext, const std::string& run)
 {
 	size_t same = 0;
 	for (size_t i = 0; i < stamps.size(); i++)
@@ -199,7 +195,7 @@ size_t sameMasks(const std::string& dir, const std::vector<std::string>& stamps,
 		std::string stamp = stamps[i];
 		stamp[stamp.find(',')] = '_';
 		same += sameImage(dir + "/masks/" + stamp + ext,
-		                  bimsRunOut() + "/masks/" + frameName(i));
+		                  run + "/masks/" + frameName(i));
 	}
 	return same;
 }
@@ -228,10 +224,10 @@ TEST(Ros2Node, EveryMaskComesWithItsDepthStampAndEqualsBimsRuns)
 	EXPECT_EQ(lines(l.playDir + "/odometry.txt"),
 	          std::vector<std::string>{"150"});
 	// the masks received and those -o wrote are bims-run's
-	const auto& run = bimsRunOut();
+	const auto run = runBimsRun(d);
 	ASSERT_EQ(lines(run + "/frames.csv").size(), 151u);
 	EXPECT_EQ(lines(l.outDir + "/frames.csv").size(), 151u) << l.nodeLog;
-	EXPECT_EQ(sameMasks(l.playDir, got, ".png"), 150u);
+	EXPECT_EQ(sameMasks(l.playDir, got, ".png", run), 150u);
 	size_t sameOut = 0;
 	for (size_t i = 0; i < got.size(); i++)
 		sameOut += sameImage(l.outDir + "/masks/" + frameName(i),
@@ -262,7 +258,7 @@ TEST(Ros2Node, AnIndependentRos2SubscriberGetsEveryMaskWithItsStamp)
 	// image's stamp, in order, equal to bims-run's; and every odometry
 	const auto got = receivedStamps(d + "/sub");
 	EXPECT_EQ(got, sent) << test::fileText(d + "/sub.log");
-	EXPECT_EQ(sameMasks(d + "/sub", got, ".pgm"), 150u);
+	EXPECT_EQ(sameMasks(d + "/sub", got, ".pgm", runBimsRun(d)), 150u);
 	EXPECT_EQ(lines(d + "/sub/odometry.txt"), std::vector<std::string>{"150"});
 }
 
