@@ -15,7 +15,8 @@ PACKAGES=(
   librosbag-storage-dev libcv-bridge-dev libsensor-msgs-dev pluginlib-dev
   libroslz4-dev libbz2-dev
   libzstd-dev liblz4-dev libsqlite3-dev libyaml-cpp-dev
-  nodejs
+  cyclonedds-dev cyclonedds-tools
+  nodejs iproute2
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth imagemagick xdotool x11-apps libgl1-mesa-dri
   python3-dev pybind11-dev python3-numpy python3-opencv
@@ -32,9 +33,11 @@ for p in "${PACKAGES[@]}"; do
   fi
 done
 
-# The ROS 2 bag tests' independent writer (tests/ros2_writer: MCAP and CDR
-# by npm packages, locked in its package-lock.json; never the product's
-# runtime): installed once, again when the lock file changes.
+# The ROS 2 tests' independent side (tests/ros2_writer: the bags' MCAP and
+# CDR writer, the live node's @foxglove/ros2 subscriber; npm packages locked
+# in its package-lock.json; never the product's runtime): installed once,
+# again when the lock file changes. (iproute2's ip: the node test's private
+# network namespace.)
 npm_writer() {
   local dir
   dir="$(cd "$(dirname "$0")/.." && pwd)/tests/ros2_writer"
@@ -46,9 +49,9 @@ npm_writer() {
     [ "$dir/node_modules/.package-lock.json" -nt "$dir/package-lock.json" ]; then
     return 0
   fi
-  echo "[deps] npm ci in tests/ros2_writer (the ROS 2 bag tests' writer)"
+  echo "[deps] npm ci in tests/ros2_writer (the ROS 2 tests' writer and subscriber)"
   (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error) ||
-    echo "[deps] warning: npm ci failed: the ROS 2 bag tests will skip" >&2
+    echo "[deps] warning: npm ci failed: the ROS 2 bag tests and the node's independent subscriber will skip" >&2
 }
 
 SUDO=""

@@ -35,7 +35,8 @@ const std::vector<std::string> kPrograms = {
     "bims-calib-depth", "bims-import-tum",  "bims-import-stray",
     "bims-eval traj",   "bims-eval masks",  "bims-eval depth-consistency",
     "bims-info",        "bims-flow-labels", "bims-flow-check",
-    "bims-sweep",       "bims-maps-figure", "bims-import-bag"};
+    "bims-sweep",       "bims-maps-figure", "bims-import-bag",
+    "bims-ros2"};
 
 bool built(const std::string& program)
 {
@@ -125,11 +126,11 @@ TEST(Cli, SharedOptionsAreSpelledTheSameWayInEveryProgram)
 	    "--max_frames", "--frame", "--nframes",  "--silent"};
 	// who must have them: outputs (-o), a progress line or chatter (-q)
 	const std::set<std::string> withOut = {
-	    "bims-run",          "bims-sim",       "bims-grab",
-	    "bims-odom",         "bims-calib-imu", "bims-calib-depth",
-	    "bims-import-tum",   "bims-eval traj", "bims-eval masks",
-	    "bims-flow-labels",  "bims-sweep",     "bims-maps-figure",
-	    "bims-import-stray", "bims-import-bag"};
+	    "bims-run",          "bims-sim",        "bims-grab",
+	    "bims-odom",         "bims-calib-imu",  "bims-calib-depth",
+	    "bims-import-tum",   "bims-eval traj",  "bims-eval masks",
+	    "bims-flow-labels",  "bims-sweep",      "bims-maps-figure",
+	    "bims-import-stray", "bims-import-bag", "bims-ros2"};
 	const std::set<std::string> withQuiet = {
 	    "bims-run",        "bims-sim",          "bims-grab",
 	    "bims-odom",       "bims-calib-imu",    "bims-calib-depth",

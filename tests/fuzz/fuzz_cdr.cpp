@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <exception>
 
-#include "../../libs/bag/src/cdr.h"
+#include <bims/bag/cdr.h>
 #include "fuzz_common.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)

@@ -1,10 +1,12 @@
-#include "cdr.h"
+#include <bims/bag/cdr.h>
 
 #include <bims/bag/bag_import.h>
 #include <mrpt/core/format.h>
 
 #include <cstring>
 #include <stdexcept>
+
+#include "messages.h"
 
 namespace bims::bag::cdr
 {
@@ -87,6 +89,13 @@ class Reader
 	/** std_msgs/Header: its stamp [s], frame_id skipped. */
 	double header()
 	{
+		const HeaderTime h = headerTime();
+		(void)string("header's frame_id");
+		return stampSeconds(h.sec, h.nsec);
+	}
+	/** std_msgs/Header's stamp, checked. */
+	HeaderTime headerTime()
+	{
 		const int32_t sec = get<int32_t>("header's stamp");
 		const uint32_t nsec = u32("header's stamp");
 		// (nanoseconds of a second or more: carried into the seconds by
@@ -95,8 +104,7 @@ class Reader
 			throw runtime_error(mrpt::format(
 			    "its header's stamp %d s %u ns is not a time: corrupt", sec,
 			    nsec));
-		(void)string("header's frame_id");
-		return stampSeconds(static_cast<uint32_t>(sec), nsec);
+		return {static_cast<uint32_t>(sec), nsec};
 	}
 
  private:
@@ -119,6 +127,12 @@ double headerStamp(const uint8_t* p, size_t n)
 {
 	Reader r(p, n);
 	return r.header();
+}
+
+HeaderTime headerTime(const uint8_t* p, size_t n)
+{
+	Reader r(p, n);
+	return r.headerTime();
 }
 
 ImageView image(const uint8_t* p, size_t n)
@@ -186,7 +200,14 @@ ImuSample imu(const uint8_t* p, size_t n)
 	r.f64s(wCov, 9, "angular_velocity_covariance");
 	r.f64s(a, 3, "linear_acceleration");
 	r.f64s(aCov, 9, "linear_acceleration_covariance");
-	return imuSampleOf(t, w, wCov[0], a, aCov[0]);
+	ImuSample s = imuSampleOf(t, w, wCov[0], a, aCov[0]);
+	// covariance -1: no orientation (the message's convention)
+	if (cov[0] != -1)
+	{
+		s.hasOrientation = true;
+		for (int k = 0; k < 4; k++) s.q[k] = q[k];
+	}
+	return s;
 }
 
 ImuSample magneticField(const uint8_t* p, size_t n)

@@ -7,8 +7,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include <bims/bag/cdr.h>
 #include "bag_guard.h"
-#include "cdr.h"
 
 namespace bims::bag
 {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <bims/bag/bag_import.h>
+#include <bims/bag/message_views.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -16,40 +17,6 @@
 
 namespace bims::bag
 {
-/** A sensor_msgs/Image read in place: its fields, and its pixels where
- * they are in the recording's bytes (not copied). */
-struct ImageView
-{
-	double t = 0;  ///< its header stamp [s]
-	uint32_t height = 0, width = 0, step = 0;
-	std::string encoding;
-	bool bigEndian = false;
-	const uint8_t* data = nullptr;
-	size_t size = 0;
-	/** Bytes after the message's data (ROS 1): librealsense's recorder
-	 * appends its depth units there (a float32) in its newer versions. */
-	const uint8_t* tail = nullptr;
-	size_t tailSize = 0;
-};
-
-/** A sensor_msgs/CompressedImage read in place. */
-struct CompressedView
-{
-	double t = 0;  ///< its header stamp [s]
-	std::string format;
-	const uint8_t* data = nullptr;
-	size_t size = 0;
-};
-
-/** What the import reads of a sensor_msgs/CameraInfo. */
-struct CameraInfoView
-{
-	uint32_t width = 0, height = 0;
-	std::string distortionModel;
-	std::vector<double> D;
-	double K[9] = {};
-};
-
 /** The message types the import reads. */
 enum class MessageKind
 {
@@ -92,12 +59,6 @@ CameraInfoView readCameraInfo(const BagConnection& c, const uint8_t* p,
 ImuSample readImu(const BagConnection& c, const uint8_t* p, size_t n);
 ImuSample readMagneticField(const BagConnection& c, const uint8_t* p, size_t n);
 float readFloat32(const BagConnection& c, const uint8_t* p, size_t n);
-/** geometry_msgs/Transform: translation, then the rotation's quaternion
- * x y z w, as they are (not checked: the caller says what is wrong). */
-struct TransformView
-{
-	double t[3] = {}, q[4] = {};
-};
 TransformView readTransform(const BagConnection& c, const uint8_t* p, size_t n);
 
 }  // namespace bims::bag

@@ -33,7 +33,7 @@
 #include <set>
 #include <sstream>
 
-#include "../src/cdr.h"
+#include <bims/bag/cdr.h>
 
 namespace
 {

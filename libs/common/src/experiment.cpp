@@ -31,6 +31,7 @@ const std::vector<ExperimentSection>& experimentSectionTable()
 	     "Stray Scanner import: confidence, colour size"},
 	    {"import_bag", "bag (bims-import-bag)",
 	     "ROS 1 bag import: topics, pairing"},
+	    {"ros2", "ros2 (bims-ros2)", "ROS 2 live node: topics, QoS, frames"},
 	};
 	return t;
 }

@@ -155,8 +155,9 @@ std::string configReference()
 		md += std::string("| `[") + s.name + "]` | " + s.readBy + " | " +
 		      s.title + " |\n";
 	md +=
-	    "\nThe import sections (`docs/eval.md`, `docs/import-bag.md`) and MRPT "
-	    "map\ndefinitions (`[map...]`) are not listed below.\n";
+	    "\nThe import sections (`docs/eval.md`, `docs/import-bag.md`), the "
+	    "live node's\n`[ros2]` (`docs/ros2.md`) and MRPT map definitions "
+	    "(`[map...]`) are not listed\nbelow.\n";
 	const ExperimentConfig defaults;
 	forEachSection(defaults,
 	               [&](const char* section, const auto& opts)

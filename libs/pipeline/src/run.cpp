@@ -80,6 +80,16 @@ class OpenCvThreads
 	bool set_ = false;
 };
 
+/** The error of a run whose \a rawlogs held no 3D scan with \a label. */
+std::string noScansError(const std::vector<std::string>& rawlogs,
+                         const std::string& label)
+{
+	std::string files;
+	for (const auto& f : rawlogs) files += (files.empty() ? "" : ", ") + f;
+	return files + ": no CObservation3DRangeScan (RGB-D) observation" +
+	       (label.empty() ? std::string() : " with label '" + label + "'");
+}
+
 void addError(RunSummary& sum, const std::string& e)
 {
 	if (sum.error.find(e) != std::string::npos) return;  // reported already
@@ -87,164 +97,134 @@ void addError(RunSummary& sum, const std::string& e)
 }
 }  // namespace
 
-RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
+RunRecorder::RunRecorder(const ExperimentConfig& cfg, const RunOptions& opt)
+    : imuLabel_(cfg.ego.sensors.imu_label),
+      odometryMode_(cfg.ego.odometry.mode),
+      firstT_(NAN),
+      lastT_(NAN),
+      wall0_(std::chrono::steady_clock::now()),
+      cpu0_(processCpuMs())
 {
-	const auto wall0 = std::chrono::steady_clock::now();
-	const double cpu0 = processCpuMs();
-	RunSummary sum;
-	sum.variant = choiceName(cfg.pipeline.variant);
-	if (opt.rawlogs.empty())
-		throw std::invalid_argument("no input rawlog given");
+	sum_.variant = choiceName(cfg.pipeline.variant);
+	if (opt.outDir.empty()) return;
+	out_ =
+	    std::make_unique<OutputWriter>(opt.outDir, cfg.output, opt.laterFiles);
+	writeFileAtomically(out_->file("effective.ini"), cfg.effectiveIni());
+}
 
-	const OpenCvThreads cvThreads(cfg.pipeline.opencv_threads);
-	Pipeline pipe(cfg);
-	std::unique_ptr<OutputWriter> out;
-	if (!opt.outDir.empty())
-	{
-		out = std::make_unique<OutputWriter>(opt.outDir, cfg.output,
-		                                     opt.laterFiles);
-		writeFileAtomically(out->file("effective.ini"), cfg.effectiveIni());
-	}
+RunRecorder::~RunRecorder() = default;
 
-	const std::string& rgbdLabel = cfg.ego.sensors.rgbd_label;
-	const std::string& imuLabel = cfg.ego.sensors.imu_label;
-	std::map<std::string, std::vector<double>> stage;
-	double firstT = NAN, lastT = NAN, movingFracSum = 0;
-	// a bounded range has a known total; otherwise it is estimated from the
-	// share of the input read
-	const bool bounded = opt.frames.bounded();
-	Progress progress;
-	progress.total = bounded ? opt.frames.last - opt.frames.first + 1 : 0;
-	reportProgress(opt.progress, progress);
+void RunRecorder::frame(const source::SourceFrame& f, const FrameResult& r,
+                        double cpuMs, const FrameCallback& onFrame)
+{
+	stage_["total_cpu"].push_back(cpuMs);
+	checkFiniteOutputs(r);
+	uint32_t flags = r.ego.flags;
+	if (f.imuRejected) flags |= ego::kFlagImuRejected;
+	RunSummary& sum = sum_;
+	sum.framesProcessed++;
+	if (r.flowAhead) sum.framesFlowAhead++;
+	if (r.flowOff) sum.framesWithoutFlow++;
+	if (r.held) sum.framesHeld++;
+	if (r.surfaceFill.added > 0)
+	{
+		sum.framesSurfaceFilled++;
+		sum.pixelsSurfaceFilled += static_cast<size_t>(r.surfaceFill.added);
+	}
+	const uint32_t counted =
+	    flags & ~static_cast<uint32_t>(ego::kFlagFirstFrame);
+	if (counted) sum.framesFlagged++;
+	if (!r.ego.ok() && !(flags & ego::kFlagFirstFrame)) sum.framesNotMeasured++;
+	for (const char* name : ego::flagNames(counted))
+		sum.framesFlaggedBy[name]++;
+	if (flags & (ego::kFlagImuMissing | ego::kFlagImuGap))
+		sum.framesWithoutImu++;
+	auto& st = stage_;
+	st["read"].push_back(f.cost.readMs);
+	st["read_cpu"].push_back(f.cost.readCpuMs);
+	st["wait_input"].push_back(f.cost.waitMs);
+	st["input"].push_back(r.ms.input);
+	st["egomotion"].push_back(r.ms.egomotion);
+	st["flow"].push_back(r.ms.flow);
+	if (r.ms.flowObserved > 0) st["flow_observed"].push_back(r.ms.flowObserved);
+	st["grids"].push_back(r.ms.grids);
+	st["grids_cloud"].push_back(r.ms.gridsCloud);
+	if (r.ms.gridsDecay > 0) st["grids_decay"].push_back(r.ms.gridsDecay);
+	st["total"].push_back(r.ms.total);
+	const double validPx = static_cast<double>(r.cloudStats.valid);
+	if (validPx > 0) movingFracSum_ += cv::countNonZero(r.mask) / validPx;
+	if (std::isnan(firstT_)) firstT_ = r.t;
+	lastT_ = r.t;
+	// the callback first: the writer then owns the scan
+	if (onFrame) onFrame(r, *f.scan);
+	if (!out_) return;
+	for (const auto& o : f.before) out_->writeOther(o);
+	st["wait_output"].push_back(out_->writeFrame(r, f.scan, flags));
+}
 
-	FrameStepper stepper(pipe);
-	// after a frame ran: its statistics and outputs
-	auto process = [&](const source::SourceFrame& f, const FrameResult& r)
-	{
-		stage["total_cpu"].push_back(stepper.lastCpuMs());
-		checkFiniteOutputs(r);
-		uint32_t flags = r.ego.flags;
-		if (f.imuRejected) flags |= ego::kFlagImuRejected;
-		sum.framesProcessed++;
-		if (r.flowAhead) sum.framesFlowAhead++;
-		if (r.flowOff) sum.framesWithoutFlow++;
-		if (r.held) sum.framesHeld++;
-		if (r.surfaceFill.added > 0)
-		{
-			sum.framesSurfaceFilled++;
-			sum.pixelsSurfaceFilled += static_cast<size_t>(r.surfaceFill.added);
-		}
-		const uint32_t counted =
-		    flags & ~static_cast<uint32_t>(ego::kFlagFirstFrame);
-		if (counted) sum.framesFlagged++;
-		if (!r.ego.ok() && !(flags & ego::kFlagFirstFrame))
-			sum.framesNotMeasured++;
-		for (const char* name : ego::flagNames(counted))
-			sum.framesFlaggedBy[name]++;
-		if (flags & (ego::kFlagImuMissing | ego::kFlagImuGap))
-			sum.framesWithoutImu++;
-		stage["read"].push_back(f.cost.readMs);
-		stage["read_cpu"].push_back(f.cost.readCpuMs);
-		stage["wait_input"].push_back(f.cost.waitMs);
-		stage["input"].push_back(r.ms.input);
-		stage["egomotion"].push_back(r.ms.egomotion);
-		stage["flow"].push_back(r.ms.flow);
-		if (r.ms.flowObserved > 0)
-			stage["flow_observed"].push_back(r.ms.flowObserved);
-		stage["grids"].push_back(r.ms.grids);
-		stage["grids_cloud"].push_back(r.ms.gridsCloud);
-		if (r.ms.gridsDecay > 0)
-			stage["grids_decay"].push_back(r.ms.gridsDecay);
-		stage["total"].push_back(r.ms.total);
-		const double validPx = static_cast<double>(r.cloudStats.valid);
-		if (validPx > 0) movingFracSum += cv::countNonZero(r.mask) / validPx;
-		if (std::isnan(firstT)) firstT = r.t;
-		lastT = r.t;
-		// the callback first: the writer then owns the scan
-		if (opt.onFrame) opt.onFrame(r, *f.scan);
-		if (out)
-		{
-			for (const auto& o : f.before) out->writeOther(o);
-			stage["wait_output"].push_back(out->writeFrame(r, f.scan, flags));
-		}
-		if (!bounded && f.inputFraction > 0)
-		{
-			const double scans = (f.index + 1) / f.inputFraction;
-			progress.total = std::max(sum.framesProcessed,
-			                          static_cast<size_t>(scans + 0.5) -
-			                              std::min(opt.frames.first, f.index));
-			progress.estimated = true;
-		}
-		progress.done = sum.framesProcessed;
-		progress.note = "frame " + std::to_string(f.index);
-		reportProgress(opt.progress, progress);
-	};
+void RunRecorder::trailing(const std::vector<mrpt::obs::CObservation::Ptr>& obs)
+{
+	if (out_)
+		for (const auto& o : obs) out_->writeOther(o);
+}
 
-	std::string readError;  ///< the input's, after the frames before it
-	source::FrameOrderParams order = source::FrameOrderParams::of(
-	    cfg.ego, cfg.pipeline.imu_wait_s, "bims-run");
-	order.frames = opt.frames;
-	order.keepInput = out != nullptr;
-	std::optional<source::RawlogFrameSource> input;
-	try
-	{
-		input.emplace(opt.rawlogs, order, cfg.pipeline.read_ahead);
-		for (bool end = false; !end;)
-		{
-			if (opt.stop && *opt.stop)
-			{
-				sum.interrupted = true;  // the frames done stay written
-				break;
-			}
-			auto f = input->next();
-			end = !f;
-			if (f) stepper.add(std::move(*f));
-			while (auto done = stepper.run(end))
-				process(done->input, done->result);
-		}
-		if (out && !sum.interrupted)
-			for (const auto& o : input->takeTrailing()) out->writeOther(o);
-	}
-	catch (const std::exception& e)
-	{
-		sum.error = withoutBacktrace(e.what());
-	}
-	if (input)
-	{
-		readError = input->error();
-		static_cast<source::FrameOrderStats&>(sum) = input->stats();
-	}
-	if (!readError.empty())  // first: it came first
-		sum.error =
-		    readError + (sum.error.empty() ? "" : "; then: " + sum.error);
-	if (sum.scansRead == 0 && sum.error.empty())
-	{
-		std::string files;
-		for (const auto& f : opt.rawlogs)
-			files += (files.empty() ? "" : ", ") + f;
-		sum.error = files + ": no CObservation3DRangeScan (RGB-D) observation" +
-		            (rgbdLabel.empty() ? std::string()
-		                               : " with label '" + rgbdLabel + "'");
-	}
-	progress.finished = true;
-	progress.note.clear();
-	reportProgress(opt.progress, progress);
-
+RunSummary RunRecorder::finish(Pipeline& pipe,
+                               const source::FrameOrderStats& stats,
+                               const std::string& error, bool interrupted)
+{
+	static_cast<source::FrameOrderStats&>(sum_) = stats;
+	sum_.error = error;
+	sum_.interrupted = interrupted;
 	// Every output complete (queued frames, static map) before the clock
 	// stops: the frames/s are end to end.
-	if (out)
+	if (out_)
 	{
 		try
 		{
-			sum.staticMapVoxels = out->close(pipe);
+			sum_.staticMapVoxels = out_->close(pipe);
 		}
 		catch (const std::exception& e)
 		{
-			addError(sum, e.what());
+			addError(sum_, e.what());
 		}
-		stage["outputs"] = out->frameMs();
-		stage["outputs_cpu"] = out->frameCpuMs();
+		stage_["outputs"] = out_->frameMs();
+		stage_["outputs_cpu"] = out_->frameCpuMs();
 	}
+	addNotes();
+	for (auto& [name, v] : stage_)
+	{
+		const auto& known = stageNames();
+		if (std::find(known.begin(), known.end(), name) == known.end())
+			throw std::logic_error("stage " + name +
+			                       " is not one of stageNames()");
+		sum_.stageMs[name] = Percentiles::of(v);
+	}
+	sum_.dataSeconds = std::isnan(firstT_) ? 0 : lastT_ - firstT_;
+	sum_.meanMovingPixelFraction =
+	    sum_.framesProcessed ? movingFracSum_ / sum_.framesProcessed : 0;
+	sum_.seconds =
+	    std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_)
+	        .count();
+	sum_.cpuSeconds = 1e-3 * (processCpuMs() - cpu0_);
+	sum_.peakResidentMiB = peakResidentMiB();
+	if (out_)
+	{
+		try
+		{
+			out_->writeMetrics(pipe, sum_);
+		}
+		catch (const std::exception& e)
+		{
+			addError(sum_, e.what());  // reported by the caller
+		}
+	}
+	return sum_;
+}
+
+void RunRecorder::addNotes()
+{
+	RunSummary& sum = sum_;
+	const std::string& imuLabel = imuLabel_;
 	for (auto& n : source::imuNotes(sum, imuLabel))
 		sum.notes.push_back(std::move(n));
 	sum.imuUnusable = imuMostlyUnusable(sum);
@@ -258,7 +238,7 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		    std::to_string(sum.imuRead) +
 		    " IMU samples: are its stamps on the camera's clock?");
 	if (sum.framesProcessed > 0 && sum.imuRead == 0 &&
-	    cfg.ego.odometry.mode == ego::OdometryMode::Imu)
+	    odometryMode_ == ego::OdometryMode::Imu)
 		sum.notes.push_back(
 		    "no IMU samples in the input" +
 		    (imuLabel.empty() ? std::string()
@@ -314,34 +294,84 @@ RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
 		    std::to_string(sum.framesSurfaceFilled) +
 		    " frames: the rest of depth surfaces the tiers called mostly "
 		    "moving (frames.csv filled_px)");
-	for (auto& [name, v] : stage)
+}
+
+RunSummary runExperiment(const ExperimentConfig& cfg, const RunOptions& opt)
+{
+	if (opt.rawlogs.empty())
+		throw std::invalid_argument("no input rawlog given");
+	const OpenCvThreads cvThreads(cfg.pipeline.opencv_threads);
+	RunRecorder rec(cfg, opt);
+	Pipeline pipe(cfg);
+	// a bounded range has a known total; otherwise it is estimated from the
+	// share of the input read
+	const bool bounded = opt.frames.bounded();
+	Progress progress;
+	progress.total = bounded ? opt.frames.last - opt.frames.first + 1 : 0;
+	reportProgress(opt.progress, progress);
+
+	FrameStepper stepper(pipe);
+	// after a frame ran: its statistics and outputs
+	auto process = [&](const source::SourceFrame& f, const FrameResult& r)
 	{
-		const auto& known = stageNames();
-		if (std::find(known.begin(), known.end(), name) == known.end())
-			throw std::logic_error("stage " + name +
-			                       " is not one of stageNames()");
-		sum.stageMs[name] = Percentiles::of(v);
-	}
-	sum.dataSeconds = std::isnan(firstT) ? 0 : lastT - firstT;
-	sum.meanMovingPixelFraction =
-	    sum.framesProcessed ? movingFracSum / sum.framesProcessed : 0;
-	sum.seconds =
-	    std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0)
-	        .count();
-	sum.cpuSeconds = 1e-3 * (processCpuMs() - cpu0);
-	sum.peakResidentMiB = peakResidentMiB();
-	if (out)
+		rec.frame(f, r, stepper.lastCpuMs(), opt.onFrame);
+		const size_t done = rec.summary().framesProcessed;
+		if (!bounded && f.inputFraction > 0)
+		{
+			const double scans = (f.index + 1) / f.inputFraction;
+			progress.total =
+			    std::max(done, static_cast<size_t>(scans + 0.5) -
+			                       std::min(opt.frames.first, f.index));
+			progress.estimated = true;
+		}
+		progress.done = done;
+		progress.note = "frame " + std::to_string(f.index);
+		reportProgress(opt.progress, progress);
+	};
+
+	std::string error, readError;  ///< the input's, after the frames before it
+	bool interrupted = false;
+	source::FrameOrderParams order = source::FrameOrderParams::of(
+	    cfg.ego, cfg.pipeline.imu_wait_s, "bims-run");
+	order.frames = opt.frames;
+	order.keepInput = !opt.outDir.empty();
+	std::optional<source::RawlogFrameSource> input;
+	source::FrameOrderStats stats;
+	try
 	{
-		try
+		input.emplace(opt.rawlogs, order, cfg.pipeline.read_ahead);
+		for (bool end = false; !end;)
 		{
-			out->writeMetrics(pipe, sum);
+			if (opt.stop && *opt.stop)
+			{
+				interrupted = true;  // the frames done stay written
+				break;
+			}
+			auto f = input->next();
+			end = !f;
+			if (f) stepper.add(std::move(*f));
+			while (auto done = stepper.run(end))
+				process(done->input, done->result);
 		}
-		catch (const std::exception& e)
-		{
-			addError(sum, e.what());  // reported by the caller
-		}
+		if (!interrupted) rec.trailing(input->takeTrailing());
 	}
-	return sum;
+	catch (const std::exception& e)
+	{
+		error = withoutBacktrace(e.what());
+	}
+	if (input)
+	{
+		readError = input->error();
+		stats = input->stats();
+	}
+	if (!readError.empty())  // first: it came first
+		error = readError + (error.empty() ? "" : "; then: " + error);
+	if (stats.scansRead == 0 && error.empty())
+		error = noScansError(opt.rawlogs, cfg.ego.sensors.rgbd_label);
+	progress.finished = true;
+	progress.note.clear();
+	reportProgress(opt.progress, progress);
+	return rec.finish(pipe, stats, error, interrupted);
 }
 
 bool imuMostlyUnusable(const RunSummary& s)

@@ -38,10 +38,16 @@ std::optional<SteppedFrame> FrameStepper::run(bool end)
 
 LiveSegmentation::LiveSegmentation(const ExperimentConfig& cfg,
                                    const std::string& program,
-                                   std::string device)
+                                   std::string device, bool keepInput)
     : pipe_(cfg),
-      order_(source::FrameOrderParams::of(cfg.ego, cfg.pipeline.imu_wait_s,
-                                          program)),
+      order_(
+          [&]
+          {
+	          auto p = source::FrameOrderParams::of(
+	              cfg.ego, cfg.pipeline.imu_wait_s, program);
+	          p.keepInput = keepInput;
+	          return p;
+          }()),
       stepper_(pipe_),
       device_(std::move(device))
 {

@@ -157,9 +157,9 @@ TEST(PipelineConfig, EffectiveIniHasEverySectionAndAMeaningPerKey)
 	std::vector<std::string> sections;
 	m.getAllSections(sections);
 	// all but [camera] (only when a file gives intrinsics), [import]
-	// (bims-import-tum's), [import_stray] (bims-import-stray's) and
-	// [import_bag] (bims-import-bag's)
-	EXPECT_EQ(sections.size(), bims::experimentSections().size() - 4);
+	// (bims-import-tum's), [import_stray] (bims-import-stray's),
+	// [import_bag] (bims-import-bag's) and [ros2] (bims-ros2's)
+	EXPECT_EQ(sections.size(), bims::experimentSections().size() - 5);
 	for (const char* s :
 	     {"sensors", "calibration", "depth_correction", "attitude", "tracker",
 	      "translation", "odometry", "anchor", "inertial", "flow", "grids",

@@ -178,6 +178,10 @@ struct ImuSample
 	double t = 0;
 	bool hasGyro = false, hasAccel = false, hasMag = false;
 	double w[3] = {}, a[3] = {}, m[3] = {};
+	/** sensor_msgs/Imu's orientation when its covariance says it is given
+	 * (x y z w; the import does not use it, the ROS 2 node passes it on). */
+	bool hasOrientation = false;
+	double q[4] = {0, 0, 0, 1};
 };
 
 /** Merges separate accelerometer and gyro streams (time-sorted) into whole

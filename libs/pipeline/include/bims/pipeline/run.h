@@ -11,6 +11,7 @@
 #include <bims/source/frame_source.h>
 
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <map>
 #include <memory>
@@ -147,6 +148,54 @@ std::vector<std::string> metricNames();
  * folder), for bims::prepareOutputFolder: the files refused as an earlier
  * run's and cleared by --overwrite. */
 const OutputFolderLayout& runOutputLayout();
+
+class OutputWriter;
+
+/** What bims-run does with the frames that ran, whatever their source: the
+ * run's statistics, its outputs into RunOptions::outDir (when set:
+ * effective.ini at once, then each frame's files as it comes) and, at the
+ * end, the summary with its notes and metrics.json. One home for the batch
+ * run (runExperiment) and the live ROS 2 node (bims-ros2 -o). */
+class RunRecorder
+{
+ public:
+	/** Starts the run's clocks; opens the output folder when \a opt.outDir
+	 * is set (uses its outDir and laterFiles only). */
+	RunRecorder(const ExperimentConfig& cfg, const RunOptions& opt);
+	~RunRecorder();
+	RunRecorder(const RunRecorder&) = delete;
+	RunRecorder& operator=(const RunRecorder&) = delete;
+
+	/** A frame that ran: its statistics, then RunOptions::onFrame, then its
+	 * outputs (the IMU observations of \a f.before first; the writer then
+	 * owns \a f.scan). \a cpuMs: the frame's CPU time
+	 * (FrameStepper::lastCpuMs). Throws as checkFiniteOutputs does, and the
+	 * error of an earlier write. */
+	void frame(const source::SourceFrame& f, const FrameResult& r, double cpuMs,
+	           const FrameCallback& onFrame = {});
+	/** Observations after the last frame (FrameOrder::takeTrailing), for
+	 * the labelled rawlog. */
+	void trailing(const std::vector<mrpt::obs::CObservation::Ptr>& obs);
+	/** The summary so far (the frames' counts). */
+	const RunSummary& summary() const { return sum_; }
+	/** Ends the run: the input's \a stats and \a error (empty: none), every
+	 * output closed (the static map of \a pipe), the notes, the timings and
+	 * metrics.json; returns the summary. Call once. */
+	RunSummary finish(Pipeline& pipe, const source::FrameOrderStats& stats,
+	                  const std::string& error, bool interrupted);
+
+ private:
+	void addNotes();
+
+	std::string imuLabel_;
+	ego::OdometryMode odometryMode_;
+	std::unique_ptr<OutputWriter> out_;
+	RunSummary sum_;
+	std::map<std::string, std::vector<double>> stage_;
+	double firstT_, lastT_, movingFracSum_ = 0;
+	std::chrono::steady_clock::time_point wall0_;
+	double cpu0_;
+};
 
 /** Runs \a cfg over the rawlogs, reading ahead on a thread ([pipeline]
  * read_ahead) and writing on another ([output] writer_thread); returns when

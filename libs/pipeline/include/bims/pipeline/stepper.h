@@ -57,15 +57,27 @@ class LiveSegmentation
 	using OnFrame =
 	    std::function<void(const source::SourceFrame&, const FrameResult&)>;
 
-	/** \a program names it in warnings; \a device in them too. */
+	/** \a program names it in warnings; \a device in them too.
+	 * \a keepInput: each frame carries the IMU observations before it
+	 * (source::SourceFrame::before), for a writer of the input
+	 * (RunRecorder). */
 	LiveSegmentation(const ExperimentConfig& cfg, const std::string& program,
-	                 std::string device);
+	                 std::string device, bool keepInput = false);
 	/** Takes the next observation (IMU or 3D scan, in the order they came)
 	 * and runs the frames it makes ready. */
 	void push(const mrpt::obs::CObservation::Ptr& obs, const OnFrame& onFrame);
 	/** The end of the input: runs every frame left. */
 	void finish(const OnFrame& onFrame);
 	const source::FrameOrderStats& stats() const { return order_.stats(); }
+	/** The pipeline that runs the frames (its grids: the static map). */
+	Pipeline& pipeline() { return pipe_; }
+	/** The CPU time of the last frame run [ms] (FrameStepper::lastCpuMs). */
+	double lastCpuMs() const { return stepper_.lastCpuMs(); }
+	/** keepInput: the observations after the last frame, after finish(). */
+	std::vector<mrpt::obs::CObservation::Ptr> takeTrailing()
+	{
+		return order_.takeTrailing();
+	}
 
  private:
 	void runReady(bool end, const OnFrame& onFrame);
