@@ -28,7 +28,8 @@ void PipelineParams::describe(OptionVisitor& v)
 	v.flag("flow_thread", flow_thread,
 	       "the observed flow on a thread of its own (same results)");
 	v.flag("flow_lookahead", flow_lookahead,
-	       "and the next frame's observed flow during this frame's grids");
+	       "and the next frame's observed flow during this frame's grids "
+	       "(recordings; live input never waits for its next frame)");
 	v.flag("cloud_thread", cloud_thread,
 	       "the voxel cloud built on a thread beside the labels, and tier "
 	       "0's decay of a frame on another during the next frame");

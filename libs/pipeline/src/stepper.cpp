@@ -5,9 +5,9 @@
 
 namespace bims::pipeline
 {
-FrameStepper::FrameStepper(Pipeline& pipe)
+FrameStepper::FrameStepper(Pipeline& pipe, bool live)
     : pipe_(pipe),
-      lookahead_(pipe.config().pipeline.flow_thread &&
+      lookahead_(!live && pipe.config().pipeline.flow_thread &&
                  pipe.config().pipeline.flow_lookahead)
 {
 }
@@ -48,7 +48,7 @@ LiveSegmentation::LiveSegmentation(const ExperimentConfig& cfg,
 	          p.keepInput = keepInput;
 	          return p;
           }()),
-      stepper_(pipe_),
+      stepper_(pipe_, true),
       device_(std::move(device))
 {
 }

@@ -17,7 +17,11 @@
 // depth image (1-based) goes out with a step that disagrees with its data.
 // --wait-file: play only once PATH exists (another subscriber is ready).
 // --frames K: the first K frames only. --wrong-type: a second participant
-// publishes sensor_msgs/Imu on the depth topic's name too.
+// publishes sensor_msgs/Imu on the depth topic's name too. --realtime: every
+// observation at its own time in the recording (a driver's rate; the node
+// may fall behind and drop), the masks not written; OUTDIR/times.csv gets
+// "sec,nsec,sent_ns,received_ns" of each depth image (steady clock; -1:
+// no mask came) for bench/ros2_node.sh.
 #include <bims/io/rawlog.h>
 #include <bims/ros2/dds.h>
 #include <bims/ros2/params.h>
@@ -30,6 +34,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -41,12 +46,19 @@ namespace
 using namespace bims::ros2;
 using Clock = std::chrono::steady_clock;
 
+int64_t nowNs()
+{
+	return std::chrono::duration_cast<std::chrono::nanoseconds>(
+	           Clock::now().time_since_epoch())
+	    .count();
+}
+
 struct Args
 {
 	std::string rawlog, outDir, magTopic = "none", waitFile;
 	size_t lag = 2, stopAfter = 0, badStep = 0, frames = 0;
 	int stopPid = 0;
-	bool wrongType = false;
+	bool wrongType = false, realtime = false;
 };
 
 Args parse(int argc, char** argv)
@@ -61,9 +73,9 @@ Args parse(int argc, char** argv)
 	for (int i = 3; i < argc; i += 2)
 	{
 		const std::string k = argv[i];
-		if (k == "--wrong-type")
+		if (k == "--wrong-type" || k == "--realtime")
 		{
-			a.wrongType = true;
+			(k == "--realtime" ? a.realtime : a.wrongType) = true;
 			i--;
 			continue;
 		}
@@ -124,6 +136,9 @@ class Player
 	DdsEntity pp_, wrongPp_;
 	dds_entity_t wDepth_, wColour_, wInfo_, wImu_, wMag_ = 0, rMask_, rOdom_;
 	size_t sent_ = 0, received_ = 0, odometry_ = 0;
+	using Stamp = std::pair<int32_t, uint32_t>;
+	std::vector<std::pair<Stamp, int64_t>> sentNs_;  // steady clock [ns]
+	std::map<Stamp, int64_t> receivedNs_;
 	bool stopped_ = false;
 	std::ofstream sentCsv_, receivedCsv_;
 };
@@ -204,7 +219,8 @@ void Player::collect()
 			receivedCsv_ << t.sec << "," << t.nanosec << "," << m->width << ","
 			             << m->height << "," << m->encoding << ","
 			             << m->header.frame_id << "\n";
-			if (m->data._length == size_t(m->width) * m->height)
+			receivedNs_[{t.sec, t.nanosec}] = nowNs();
+			if (!a_.realtime && m->data._length == size_t(m->width) * m->height)
 				cv::imwrite(a_.outDir + "/masks/" + std::to_string(t.sec) +
 				                "_" + std::to_string(t.nanosec) + ".png",
 				            cv::Mat(int(m->height), int(m->width), CV_8UC1,
@@ -296,6 +312,7 @@ void Player::sendScan(const mrpt::obs::CObservation3DRangeScan& s)
 	im.data = bytesOf(depth.data, depth.step[0] * depth.rows);
 	dds_write(wDepth_, &im);
 	sentCsv_ << stamp.sec << "," << stamp.nanosec << std::endl;
+	sentNs_.push_back({{stamp.sec, stamp.nanosec}, nowNs()});
 	sent_++;
 }
 
@@ -309,9 +326,25 @@ void Player::play()
 {
 	waitForPeers();
 	bims::RawlogReader in(a_.rawlog);
+	const auto start = Clock::now();
+	double t0 = -1;
 	while (auto o = in.next())
 	{
 		collect();
+		if (a_.realtime)
+		{
+			// at the observation's own time since the first one
+			const double t = mrpt::Clock::toDouble(o->timestamp);
+			if (t0 < 0) t0 = t;
+			const auto due =
+			    start + std::chrono::duration_cast<Clock::duration>(
+			                std::chrono::duration<double>(t - t0));
+			while (Clock::now() < due)
+			{
+				std::this_thread::sleep_for(std::chrono::microseconds(500));
+				collect();
+			}
+		}
 		if (auto imu = std::dynamic_pointer_cast<mrpt::obs::CObservationIMU>(o))
 		{
 			sendImu(*imu);
@@ -323,7 +356,8 @@ void Player::play()
 		scan->load();
 		// never more than lag frames ahead of the node's masks
 		const auto t0 = Clock::now();
-		while (received_ + a_.lag + (a_.badStep && sent_ >= a_.badStep) <
+		while (!a_.realtime &&
+		       received_ + a_.lag + (a_.badStep && sent_ >= a_.badStep) <
 		           sent_ + 1 &&
 		       Clock::now() - t0 < std::chrono::seconds(60))
 		{
@@ -351,6 +385,13 @@ void Player::play()
 	std::this_thread::sleep_for(std::chrono::milliseconds(300));
 	collect();
 	std::ofstream(a_.outDir + "/odometry.txt") << odometry_ << "\n";
+	std::ofstream times(a_.outDir + "/times.csv");
+	for (const auto& [stamp, ns] : sentNs_)
+	{
+		const auto it = receivedNs_.find(stamp);
+		times << stamp.first << "," << stamp.second << "," << ns << ","
+		      << (it == receivedNs_.end() ? -1 : it->second) << "\n";
+	}
 	std::printf("test_ros2_play: %zu depth images sent, %zu masks received\n",
 	            sent_, received_);
 }

@@ -28,7 +28,10 @@ struct SteppedFrame
 class FrameStepper
 {
  public:
-	explicit FrameStepper(Pipeline& pipe);
+	/** \a live: frames come from a sensor as it records, so none waits
+	 * for the next one (the look-ahead of [pipeline] flow_lookahead would
+	 * add a sensor period to every frame's latency). */
+	explicit FrameStepper(Pipeline& pipe, bool live = false);
 
 	/** Takes the input's next frame: its IMU samples go to the pipeline. */
 	void add(source::SourceFrame f);
@@ -49,7 +52,8 @@ class FrameStepper
 };
 
 /** The pipeline over observations as they come from live sensors: the one
- * ordering rule (source::FrameOrder) and a FrameStepper. */
+ * ordering rule (source::FrameOrder) and a live FrameStepper (no frame
+ * waits for the next). */
 class LiveSegmentation
 {
  public:
