@@ -44,13 +44,14 @@ SAN_BUILD_DIR ?= build-sanitize
 # programs' command lines, sweeps and the installed package (labels cli,
 # sweep, package: process plumbing, no code of their own); the whole-program
 # runs on recordings (e2e), the simulator (sim), the replay viewer (viewer)
-# and the live grabber (grab), whose code the other labels' tests run under
+# and the live grabber (grab) and ROS 2 node (ros2: whole programs over DDS
+# on a private loopback), whose code the other labels' tests run under
 # the sanitizers on smaller inputs (the readers, the stages one by one, the
 # pipeline with its threads: test_pipeline_stages); and the two longest
 # equivalence tests left (1-1.5 min each under the sanitizers). The CI run
 # has to stay under 30 min. Its tree does not build the test programs of
 # those labels, nor the programs only they run (BIMS_SKIP_TEST_LABELS).
-SAN_SKIP_LABELS = cli;sweep;package;e2e;sim;viewer;grab
+SAN_SKIP_LABELS = cli;sweep;package;e2e;sim;viewer;grab;ros2
 SAN_EXCLUDE_LABELS = ^($(subst ;,|,$(SAN_SKIP_LABELS)))$$
 # Its tree runs each test program as SAN_SHARDS processes (GoogleTest's
 # sharding, BIMS_TEST_SHARDS), not one per case: starting a sanitized
