@@ -64,6 +64,8 @@ int main(int argc, char** argv)
 			                              aOverwrite.getValue());
 		    }
 		    opt.stop = &bims::installStopSignals();
+		    opt.log = [](const std::string& line)
+		    { std::fprintf(stderr, "%s\n", line.c_str()); };
 		    const auto st = bims::ros2::runNode(cfg, p, opt);
 		    std::printf("%s", bims::pipeline::formatSummary(st.run).c_str());
 		    std::fprintf(stderr, "bims-ros2: %s\n",

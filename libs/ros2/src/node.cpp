@@ -102,9 +102,7 @@ class Node
 	     const NodeOptions& opt)
 	    : cfg_(cfg), p_(p), opt_(opt), queue_(size_t(p.queueFrames))
 	{
-		if (!opt_.log)
-			opt_.log = [](const std::string& s)
-			{ std::fprintf(stderr, "%s\n", s.c_str()); };
+		if (!opt_.log) opt_.log = [](const std::string&) {};
 	}
 
 	NodeStats run();

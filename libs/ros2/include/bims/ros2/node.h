@@ -32,7 +32,8 @@ struct NodeOptions
 	std::vector<std::string> laterFiles;
 	/** When it turns true: stop, process the frames received, return. */
 	const std::atomic<bool>* stop = nullptr;
-	/** Warnings and the report's lines (default: stderr). */
+	/** Warnings and the report's lines, worded (default: none; the
+	 * library prints nothing, bims-ros2 writes them to stderr). */
 	std::function<void(const std::string&)> log;
 };
 
