@@ -60,26 +60,13 @@ void cutHorizontal(const cv::Mat& depth, const Eigen::Matrix3d& K,
 		}
 	}
 }
-}  // namespace
 
-SurfaceFillStats fillMovingSurfaces(const cv::Mat& depth,
-                                    const Eigen::Matrix3d& K, cv::Mat& mask,
-                                    const SurfaceFillParams& p,
-                                    const Eigen::Vector3d* upC)
+/** Interior pixels: a reading joined to each of its neighbours in the
+ * image (four, fewer on its border). The rest (edges, holes) separate the
+ * surfaces. */
+cv::Mat interiorPixels(const cv::Mat& depth, float jump)
 {
-	if (depth.type() != CV_32FC1 || mask.type() != CV_8UC1 ||
-	    depth.size() != mask.size())
-		throw std::invalid_argument(
-		    "fillMovingSurfaces: a CV_32FC1 depth and a CV_8UC1 mask of one "
-		    "size are needed");
-	SurfaceFillStats st;
-	if (cv::countNonZero(mask) == 0) return st;
 	const int h = depth.rows, w = depth.cols;
-	const auto jump = static_cast<float>(p.depthJump);
-
-	// Interior pixels: a reading joined to each of its neighbours in the
-	// image (four, fewer on its border). The rest (edges, holes) separate
-	// the surfaces.
 	cv::Mat inner(depth.size(), CV_8UC1, cv::Scalar(0));
 	for (int y = 0; y < h; ++y)
 	{
@@ -96,20 +83,18 @@ SurfaceFillStats fillMovingSurfaces(const cv::Mat& depth,
 			        (!down || joined(z, down[x], jump));
 		}
 	}
-	// Horizontal pixels (2 in inner): in no surface, and never filled.
-	cv::Mat flat;
-	if (upC && p.horizontalDeg > 0)
-	{
-		cutHorizontal(depth, K, *upC, p, inner);
-		cv::compare(inner, 2, flat, cv::CMP_EQ);
-		inner.setTo(0, flat);
-	}
-	// connectedComponents without its statistics: they cost twice the
-	// labelling (3.6 against 1.2 ms at 640x480), and the areas are counted
-	// below with the moving pixels.
-	cv::Mat labels;
-	const int n = cv::connectedComponents(inner, labels, 4, CV_32S);
+	return inner;
+}
 
+/** Which of the \a n surfaces (\a labels) to fill: those with moving
+ * pixels, no larger than maxArea of the image and at least minMoving of
+ * them moving. */
+std::vector<uint8_t> surfacesToFill(const cv::Mat& labels, int n,
+                                    const cv::Mat& mask,
+                                    const SurfaceFillParams& p,
+                                    SurfaceFillStats& st)
+{
+	const int h = labels.rows, w = labels.cols;
 	std::vector<int> moving(static_cast<size_t>(n), 0);
 	std::vector<int> area(static_cast<size_t>(n), 0);
 	for (int y = 0; y < h; ++y)
@@ -135,40 +120,56 @@ SurfaceFillStats fillMovingSurfaces(const cv::Mat& depth,
 			++st.filled;
 		}
 	}
-	if (st.filled == 0) return st;
+	return fill;
+}
 
-	// How far each pixel is from the nearest moving one, in the image and
-	// turned into metres at its depth: the fill stays near what moves, not
-	// over the floor that a mover's feet join to its legs. On blocks of
-	// kBlock x kBlock pixels (a block is moving when one of its pixels is):
-	// the distance is a tolerance, and the transform of the whole image
-	// would cost more than the rest of the fill (3.3 ms at 640x480).
-	constexpr int kBlock = 4;
-	cv::Mat blocks, notMoving, dist;
-	cv::resize(mask, blocks,
-	           cv::Size((w + kBlock - 1) / kBlock, (h + kBlock - 1) / kBlock),
-	           0, 0, cv::INTER_AREA);
-	cv::compare(blocks, 0, notMoving, cv::CMP_EQ);
-	cv::distanceTransform(notMoving, dist, cv::DIST_L2, cv::DIST_MASK_3);
-	const double reach = p.margin * K(0, 0) / kBlock;  // [blocks x m]
-	auto near = [&](int y, int x, float z)
+/** How far each pixel is from the nearest moving one, in the image and
+ * turned into metres at its depth: the fill stays near what moves, not
+ * over the floor that a mover's feet join to its legs. On blocks of
+ * kBlock x kBlock pixels (a block is moving when one of its pixels is):
+ * the distance is a tolerance, and the transform of the whole image
+ * would cost more than the rest of the fill (3.3 ms at 640x480). */
+class NearMoving
+{
+ public:
+	NearMoving(const cv::Mat& mask, const Eigen::Matrix3d& K,
+	           const SurfaceFillParams& p)
+	    : reach_(p.margin * K(0, 0) / kBlock)  // [blocks x m]
 	{
-		return dist.at<float>(std::min(y / kBlock, dist.rows - 1),
-		                      std::min(x / kBlock, dist.cols - 1)) *
+		cv::Mat blocks, notMoving;
+		cv::resize(mask, blocks,
+		           cv::Size((mask.cols + kBlock - 1) / kBlock,
+		                    (mask.rows + kBlock - 1) / kBlock),
+		           0, 0, cv::INTER_AREA);
+		cv::compare(blocks, 0, notMoving, cv::CMP_EQ);
+		cv::distanceTransform(notMoving, dist_, cv::DIST_L2, cv::DIST_MASK_3);
+	}
+	/** Whether pixel (x, y) at depth z is within the margin. */
+	bool operator()(int y, int x, float z) const
+	{
+		return dist_.at<float>(std::min(y / kBlock, dist_.rows - 1),
+		                       std::min(x / kBlock, dist_.cols - 1)) *
 		           z <=
-		       reach;
-	};
+		       reach_;
+	}
 
-	// The interior of each filled surface near its moving pixels, then its
-	// rim: a pixel with a reading joined to a filled interior one of its
-	// eight neighbours (the surface's own edge pixels, not the far side of
-	// its depth edges).
-	for (int y = 0; y < h; ++y)
+ private:
+	static constexpr int kBlock = 4;
+	double reach_;
+	cv::Mat dist_;
+};
+
+/** The interior of each filled surface near its moving pixels. */
+void fillInteriors(const cv::Mat& depth, const cv::Mat& labels,
+                   const std::vector<uint8_t>& fill, const NearMoving& near,
+                   cv::Mat& mask, SurfaceFillStats& st)
+{
+	for (int y = 0; y < depth.rows; ++y)
 	{
 		const float* row = depth.ptr<float>(y);
 		const int* l = labels.ptr<int>(y);
 		uint8_t* m = mask.ptr<uint8_t>(y);
-		for (int x = 0; x < w; ++x)
+		for (int x = 0; x < depth.cols; ++x)
 		{
 			const auto k = static_cast<size_t>(l[x]);
 			if (m[x] || !fill[k] || !near(y, x, row[x])) continue;
@@ -176,6 +177,18 @@ SurfaceFillStats fillMovingSurfaces(const cv::Mat& depth,
 			++st.added;
 		}
 	}
+}
+
+/** The rim of the filled surfaces: a pixel near the moving ones with a
+ * reading joined to a filled interior one of its eight neighbours (the
+ * surface's own edge pixels, not the far side of its depth edges), not
+ * horizontal (\a flat). */
+void fillRims(const cv::Mat& depth, const cv::Mat& labels,
+              const std::vector<uint8_t>& fill, const cv::Mat& flat,
+              const NearMoving& near, float jump, cv::Mat& mask,
+              SurfaceFillStats& st)
+{
+	const int h = depth.rows, w = depth.cols;
 	auto joinedFilled = [&](int y, int x, float z)
 	{
 		return labels.at<int>(y, x) > 0 && mask.at<uint8_t>(y, x) &&
@@ -208,6 +221,41 @@ SurfaceFillStats fillMovingSurfaces(const cv::Mat& depth,
 			}
 		}
 	}
+}
+}  // namespace
+
+SurfaceFillStats fillMovingSurfaces(const cv::Mat& depth,
+                                    const Eigen::Matrix3d& K, cv::Mat& mask,
+                                    const SurfaceFillParams& p,
+                                    const Eigen::Vector3d* upC)
+{
+	if (depth.type() != CV_32FC1 || mask.type() != CV_8UC1 ||
+	    depth.size() != mask.size())
+		throw std::invalid_argument(
+		    "fillMovingSurfaces: a CV_32FC1 depth and a CV_8UC1 mask of one "
+		    "size are needed");
+	SurfaceFillStats st;
+	if (cv::countNonZero(mask) == 0) return st;
+	const auto jump = static_cast<float>(p.depthJump);
+	cv::Mat inner = interiorPixels(depth, jump);
+	// Horizontal pixels (2 in inner): in no surface, and never filled.
+	cv::Mat flat;
+	if (upC && p.horizontalDeg > 0)
+	{
+		cutHorizontal(depth, K, *upC, p, inner);
+		cv::compare(inner, 2, flat, cv::CMP_EQ);
+		inner.setTo(0, flat);
+	}
+	// connectedComponents without its statistics: they cost twice the
+	// labelling (3.6 against 1.2 ms at 640x480), and the areas are counted
+	// with the moving pixels.
+	cv::Mat labels;
+	const int n = cv::connectedComponents(inner, labels, 4, CV_32S);
+	const std::vector<uint8_t> fill = surfacesToFill(labels, n, mask, p, st);
+	if (st.filled == 0) return st;
+	const NearMoving near(mask, K, p);
+	fillInteriors(depth, labels, fill, near, mask, st);
+	fillRims(depth, labels, fill, flat, near, jump, mask, st);
 	return st;
 }
 
