@@ -1237,29 +1237,32 @@ cv::Mat sdkMetricDepth(const cv::Mat& depth, float own, const RsSdkDepth& sdk,
 	                     sdk.depthToColour);
 }
 
-BagImportSummary importBag(const std::vector<std::string>& bagPaths,
-                           const std::string& outRawlog,
-                           const BagImportParams& params,
-                           const BagImportOptions& options)
+namespace
 {
-	if (bagPaths.empty()) throw std::runtime_error("no bag to import");
-	const Bags bags = openBags(bagPaths, options.chunkCacheBytes);
-	const std::string bagNames = joined(bagPaths);
-	const Scan scan = scanBags(bags);
-
-	BagImportSummary sum;
-	sum.notes = scan.notes;
+/** What the import reads: the topics chosen, their index, the frames paired
+ * (at most --max-frames) and the damage found after them (empty: none). */
+struct ImportPlan
+{
 	BagLayout layout = BagLayout::Auto;
 	BagTopics t;
 	Index ix;
 	std::vector<Frame> frames;
+	std::string lost;
+};
+
+ImportPlan planImport(const Scan& scan, const Bags& bags,
+                      const BagImportParams& params,
+                      const BagImportOptions& options,
+                      const std::string& bagNames, BagImportSummary& sum)
+{
+	ImportPlan plan;
 	try
 	{
-		t = chooseTopics(params, scan.topicInfo(), bagNames, layout);
-		sum.topics = t;
-		sum.layout = layout;
-		ix = readIndex(scan, bags, t, bagNames, sum);
-		frames = pairFrames(ix, params, bagNames, sum);
+		plan.t = chooseTopics(params, scan.topicInfo(), bagNames, plan.layout);
+		sum.topics = plan.t;
+		sum.layout = plan.layout;
+		plan.ix = readIndex(scan, bags, plan.t, bagNames, sum);
+		plan.frames = pairFrames(plan.ix, params, bagNames, sum);
 	}
 	catch (const std::exception& e)
 	{
@@ -1270,91 +1273,79 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 	// a bag damaged where messages were: every whole frame before the
 	// damage is written, then the error says so (unless --max-frames is
 	// reached before it)
-	std::string lost = scan.lost;
-	if (options.maxFrames > 0 && frames.size() >= options.maxFrames)
+	plan.lost = scan.lost;
+	if (options.maxFrames > 0 && plan.frames.size() >= options.maxFrames)
 	{
-		if (!lost.empty())
-			sum.notes.push_back(lost + " (after the frames imported)");
-		lost.clear();
-		frames.resize(options.maxFrames);
+		if (!plan.lost.empty())
+			sum.notes.push_back(plan.lost + " (after the frames imported)");
+		plan.lost.clear();
+		plan.frames.resize(options.maxFrames);
 	}
-	const mrpt::img::TCamera cam = cameraOf(ix, params, t, bagNames, sum);
-	if (ix.info &&
-	    (ix.info->width != cam.ncols || ix.info->height != cam.nrows))
+	return plan;
+}
+
+/** The colour camera, checked against the CameraInfo topic's size; into
+ * \a sum too. */
+mrpt::img::TCamera checkedCamera(const ImportPlan& plan,
+                                 const BagImportParams& params,
+                                 const std::string& bagNames,
+                                 BagImportSummary& sum)
+{
+	const mrpt::img::TCamera cam =
+	    cameraOf(plan.ix, params, plan.t, bagNames, sum);
+	const auto& info = plan.ix.info;
+	if (info && (info->width != cam.ncols || info->height != cam.nrows))
 		throw std::runtime_error(mrpt::format(
 		    "%s: topic %s: CameraInfo of a %ux%u image, but %s says %ux%u",
-		    bagNames.c_str(), t.cameraInfo.c_str(), ix.info->width,
-		    ix.info->height, sum.cameraFrom.c_str(), cam.ncols, cam.nrows));
+		    bagNames.c_str(), plan.t.cameraInfo.c_str(), info->width,
+		    info->height, sum.cameraFrom.c_str(), cam.ncols, cam.nrows));
 	sum.camera = cam;
 	sum.width = static_cast<int>(cam.ncols);
 	sum.height = static_cast<int>(cam.nrows);
-	const RsSdkDepth sdk =
-	    layout == BagLayout::RsSdk
-	        ? rsSdkDepth(ix, t, params, frames, bagNames, sum)
-	        : RsSdkDepth();
-	const std::vector<ImuSample> imu = imuStream(ix, t, sum);
+	return cam;
+}
 
-	const std::vector<Item> items = timeOrder(imu, frames, sum);
-
-	// Decoding (the bag's chunks, the images' conversion) on a thread of its
-	// own, a few observations ahead of the writing (and its compression).
-	static const std::set<std::string> depthEncodings = {"16UC1", "32FC1",
-	                                                     "mono16"};
-	static const std::set<std::string> colourEncodings = {"rgb8", "bgr8",
-	                                                      "mono8"};
-	// the SDK's depth: Z16 as mono16 (or 16UC1), in its Depth Units
-	static const std::set<std::string> sdkDepthEncodings = {"16UC1", "mono16"};
-	const int W = sum.width, H = sum.height;
-	// the depth image's size: the colour camera's, unless registered to it
-	const int DW = sdk.depthCamera ? static_cast<int>(sdk.depthCamera->ncols)
-	                               : W,
-	          DH = sdk.depthCamera ? static_cast<int>(sdk.depthCamera->nrows)
-	                               : H;
-	std::string depthEncoding, colourEncoding;  // the decoder's
-	auto decode = [&](const Item& it) -> mrpt::obs::CObservation::Ptr
+/** Each item of the import as its observation: an IMU sample, or a frame's
+ * depth (in metres, the SDK's registered to the colour camera) with its
+ * colour image. Run on the decoding thread, a few items ahead. */
+class ItemDecoder
+{
+ public:
+	ItemDecoder(const Bags& bags, const BagImportParams& params,
+	            const RsSdkDepth& sdk, const std::vector<Frame>& frames,
+	            const std::vector<ImuSample>& imu,
+	            const mrpt::img::TCamera& cam, const BagImportSummary& sum,
+	            const std::string& bagNames)
+	    : bags_(bags),
+	      params_(params),
+	      sdk_(sdk),
+	      frames_(frames),
+	      imu_(imu),
+	      cam_(cam),
+	      sum_(sum),
+	      bagNames_(bagNames),
+	      W_(int(cam.ncols)),
+	      H_(int(cam.nrows)),
+	      // the depth image's size: the colour camera's, unless registered
+	      // to it
+	      DW_(sdk.depthCamera ? int(sdk.depthCamera->ncols) : W_),
+	      DH_(sdk.depthCamera ? int(sdk.depthCamera->nrows) : H_)
+	{
+	}
+	mrpt::obs::CObservation::Ptr operator()(const Item& it)
 	{
 		if (it.kind == 0)
 		{
-			const auto& s = imu[it.i];
+			const auto& s = imu_[it.i];
 			return eval::imuObservation(
-			    s.hasGyro ? params.imuLabel : params.accelLabel, s.t,
+			    s.hasGyro ? params_.imuLabel : params_.accelLabel, s.t,
 			    s.hasGyro ? s.w : nullptr, s.hasAccel ? s.a : nullptr,
 			    s.hasMag ? s.m : nullptr);
 		}
-		const Frame& f = frames[it.i];
+		const Frame& f = frames_[it.i];
 		const ImageRef* current = f.depth;
 		try
 		{
-			// the image of a message, raw or compressed (its topic's type);
-			// \a held keeps a raw message's bytes while its pixels are used
-			auto image = [&](const ImageRef& ref, bool depth,
-			                 std::string& encoding, BagBytes& held) -> cv::Mat
-			{
-				const Scanned& m = *ref.msg;
-				MessageSource& bag = *bags[m.bag];
-				const BagConnection& c = bag.connections()[m.ref.connection];
-				held = bag.message(m.ref);
-				if (messageKind(c.type) == MessageKind::CompressedImage)
-				{
-					const CompressedView ci =
-					    readCompressed(c, held.data, held.size);
-					encoding = ci.format;
-					return depth ? decodeCompressedDepth(ci.format, ci.data,
-					                                     ci.size, DW, DH,
-					                                     params.images)
-					             : decodeCompressedColour(ci.format, ci.data,
-					                                      ci.size, W, H,
-					                                      params.images);
-				}
-				const ImageView r = readImage(c, held.data, held.size);
-				encoding = r.encoding;
-				return depth
-				           ? checkedImage(
-				                 r, sdk.on ? sdkDepthEncodings : depthEncodings,
-				                 "the depth image", DW, DH, false)
-				           : checkedImage(r, colourEncodings,
-				                          "the colour image", W, H, true);
-			};
 			BagBytes heldDepth, heldColour;
 			const cv::Mat depth =
 			    image(*f.depth, true, depthEncoding, heldDepth);
@@ -1362,11 +1353,12 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 			// Depth Units
 			double units = depth.type() == CV_32FC1 ? 1.0 : 0.001;
 			cv::Mat metric = depth;
-			if (sdk.on)
-				metric = sdkMetricDepth(depth, f.depth->msg->value, sdk,
-				                        sum.depthUnitsFrom, cam, units);
-			auto o = eval::depthObservation(
-			    metric, units, cam, params.rgbdLabel, f.t, params.rangeUnits);
+			if (sdk_.on)
+				metric = sdkMetricDepth(depth, f.depth->msg->value, sdk_,
+				                        sum_.depthUnitsFrom, cam_, units);
+			auto o =
+			    eval::depthObservation(metric, units, cam_, params_.rgbdLabel,
+			                           f.t, params_.rangeUnits);
 			if (f.colour)
 			{
 				current = f.colour;
@@ -1378,17 +1370,74 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 		catch (const std::exception& e)
 		{
 			throw std::runtime_error(
-			    bagNames + ": " +
+			    bagNames_ + ": " +
 			    where(*current->topic, current->n, current->t) + ": " +
 			    e.what());
 		}
-	};
-	AheadQueue ahead(items.size(), [&](size_t k) { return decode(items[k]); });
+	}
+	std::string depthEncoding, colourEncoding;  ///< the last decoded
 
+ private:
+	/** The image of a message, raw or compressed (its topic's type); \a held
+	 * keeps a raw message's bytes while its pixels are used. */
+	cv::Mat image(const ImageRef& ref, bool depth, std::string& encoding,
+	              BagBytes& held) const
+	{
+		static const std::set<std::string> depthEncodings = {"16UC1", "32FC1",
+		                                                     "mono16"};
+		static const std::set<std::string> colourEncodings = {"rgb8", "bgr8",
+		                                                      "mono8"};
+		// the SDK's depth: Z16 as mono16 (or 16UC1), in its Depth Units
+		static const std::set<std::string> sdkDepthEncodings = {"16UC1",
+		                                                        "mono16"};
+		const Scanned& m = *ref.msg;
+		MessageSource& bag = *bags_[m.bag];
+		const BagConnection& c = bag.connections()[m.ref.connection];
+		held = bag.message(m.ref);
+		if (messageKind(c.type) == MessageKind::CompressedImage)
+		{
+			const CompressedView ci = readCompressed(c, held.data, held.size);
+			encoding = ci.format;
+			return depth ? decodeCompressedDepth(ci.format, ci.data, ci.size,
+			                                     DW_, DH_, params_.images)
+			             : decodeCompressedColour(ci.format, ci.data, ci.size,
+			                                      W_, H_, params_.images);
+		}
+		const ImageView r = readImage(c, held.data, held.size);
+		encoding = r.encoding;
+		return depth ? checkedImage(
+		                   r, sdk_.on ? sdkDepthEncodings : depthEncodings,
+		                   "the depth image", DW_, DH_, false)
+		             : checkedImage(r, colourEncodings, "the colour image", W_,
+		                            H_, true);
+	}
+
+	const Bags& bags_;
+	const BagImportParams& params_;
+	const RsSdkDepth& sdk_;
+	const std::vector<Frame>& frames_;
+	const std::vector<ImuSample>& imu_;
+	const mrpt::img::TCamera& cam_;
+	const BagImportSummary& sum_;
+	const std::string& bagNames_;
+	const int W_, H_, DW_, DH_;
+};
+
+/** Writes the items into \a outRawlog (with OUT_gt/calibration.ini for an
+ * SDK recording), decoding a few ahead on a thread of their own; counts
+ * them into \a sum. An error after whole frames keeps them and says so. */
+void writeItems(const std::vector<Item>& items, ItemDecoder& decode,
+                const std::vector<ImuSample>& imu, const std::string& lost,
+                const std::string& outRawlog, bool sdk,
+                const BagImportParams& params, const std::string& bagNames,
+                const BagImportOptions& options, size_t frames,
+                BagImportSummary& sum)
+{
+	AheadQueue ahead(items.size(), [&](size_t k) { return decode(items[k]); });
 	PartialFile part(outRawlog);
 	// rs-sdk: OUT_gt/calibration.ini, put in place with the rawlog
 	std::optional<PartialDir> gt;
-	if (sdk.on)
+	if (sdk)
 	{
 		gt.emplace(groundTruthDirFor(outRawlog),
 		           OutputFolderLayout{{"calibration.ini"}, {}});
@@ -1398,9 +1447,8 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 	}
 	RawlogWriter w(part.path(), options.gzLevel);
 	Progress progress;
-	progress.total = frames.size();
+	progress.total = frames;
 	reportProgress(options.progress, progress);
-	// an error after whole frames: they are kept, and the error says so
 	auto keepAndThrow = [&](const std::string& error)
 	{
 		if (sum.frames == 0) throw std::runtime_error(error);
@@ -1432,14 +1480,39 @@ BagImportSummary importBag(const std::vector<std::string>& bagPaths,
 		sum.imuHasMag |= s.hasMag;
 	}
 	ahead.join();
-	sum.depthEncoding = depthEncoding;
-	sum.colourEncoding = colourEncoding;
+	sum.depthEncoding = decode.depthEncoding;
+	sum.colourEncoding = decode.colourEncoding;
 	if (!lost.empty()) keepAndThrow(lost);
 	w.close();
 	part.commit();
 	if (gt) gt->commit();
 	progress.finished = true;
 	reportProgress(options.progress, progress);
+}
+}  // namespace
+
+BagImportSummary importBag(const std::vector<std::string>& bagPaths,
+                           const std::string& outRawlog,
+                           const BagImportParams& params,
+                           const BagImportOptions& options)
+{
+	if (bagPaths.empty()) throw std::runtime_error("no bag to import");
+	const Bags bags = openBags(bagPaths, options.chunkCacheBytes);
+	const std::string bagNames = joined(bagPaths);
+	const Scan scan = scanBags(bags);
+	BagImportSummary sum;
+	sum.notes = scan.notes;
+	ImportPlan plan = planImport(scan, bags, params, options, bagNames, sum);
+	const mrpt::img::TCamera cam = checkedCamera(plan, params, bagNames, sum);
+	const RsSdkDepth sdk =
+	    plan.layout == BagLayout::RsSdk
+	        ? rsSdkDepth(plan.ix, plan.t, params, plan.frames, bagNames, sum)
+	        : RsSdkDepth();
+	const std::vector<ImuSample> imu = imuStream(plan.ix, plan.t, sum);
+	const std::vector<Item> items = timeOrder(imu, plan.frames, sum);
+	ItemDecoder decode(bags, params, sdk, plan.frames, imu, cam, sum, bagNames);
+	writeItems(items, decode, imu, plan.lost, outRawlog, sdk.on, params,
+	           bagNames, options, plan.frames.size(), sum);
 	return sum;
 }
 
