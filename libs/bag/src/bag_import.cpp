@@ -887,15 +887,14 @@ double unitsOf(const std::vector<float>& v, const std::string& topic,
 	return v.front();
 }
 
-/** The rs-sdk layout's depth units, registration and extrinsics (into
- * \a sum, with notes): errors name the bag, topic and message. */
-RsSdkDepth rsSdkDepth(const Index& ix, const BagTopics& t,
-                      const BagImportParams& params,
-                      const std::vector<Frame>& frames,
-                      const std::string& bagNames, BagImportSummary& sum)
+/** The rs-sdk layout's depth units: given, the Depth Units option's, or
+ * the depth images' own (into \a sum). */
+void sdkDepthUnits(const Index& ix, const BagTopics& t,
+                   const BagImportParams& params,
+                   const std::vector<Frame>& frames,
+                   const std::string& bagNames, RsSdkDepth& d,
+                   BagImportSummary& sum)
 {
-	RsSdkDepth d;
-	d.on = true;
 	if (params.depthUnits > 0)
 	{
 		d.units = params.depthUnits;
@@ -924,69 +923,92 @@ RsSdkDepth rsSdkDepth(const Index& ix, const BagTopics& t,
 		    ") carry none; give them with --depth-units M ([import_bag] "
 		    "depth_units), e.g. 0.001 (1 mm, a D400's default)");
 	sum.depthUnits = d.units;
+}
 
-	if (!t.depthCameraInfo.empty())
-	{
-		// the depth registered to the colour camera with their extrinsics
-		d.depthCamera =
-		    cameraOfInfo(ix.depthInfo.get(), t.depthCameraInfo, bagNames);
-		if (t.depthTf.empty() || t.colourTf.empty())
-			throw std::runtime_error(
-			    bagNames + ": no extrinsics between the depth stream " +
-			    t.depth + " and the colour stream " + t.colour +
-			    " (no tf/N topic of the " +
-			    (t.depthTf.empty() ? "depth" : "colour") +
-			    " stream): the depth cannot be registered to the colour "
-			    "camera ([import_bag] colour_topic = none imports the depth "
-			    "alone)");
-		if (tfReference(t.depthTf) != tfReference(t.colourTf))
-			throw std::runtime_error(
-			    bagNames + ": the extrinsics " + t.depthTf + " and " +
-			    t.colourTf +
-			    " are from different reference streams: not supported");
-		d.depthToColour =
-		    compose(transformOf(ix, t.colourTf, bagNames),
-		            inverse(transformOf(ix, t.depthTf, bagNames)));
-		sum.depthToColour = d.depthToColour;
-	}
-	// the IMU's axes: the gyro's (the merged samples are at its stamps),
-	// else the accelerometer's; the frames' camera: the colour's when the
-	// depth is registered to it
-	const std::string& cameraTf = d.depthCamera ? t.colourTf : t.depthTf;
+/** The depth stream's own camera and its extrinsics to the colour stream,
+ * when the depth is to be registered to the colour camera. */
+void sdkRegistration(const Index& ix, const BagTopics& t,
+                     const std::string& bagNames, RsSdkDepth& d,
+                     BagImportSummary& sum)
+{
+	d.depthCamera =
+	    cameraOfInfo(ix.depthInfo.get(), t.depthCameraInfo, bagNames);
+	if (t.depthTf.empty() || t.colourTf.empty())
+		throw std::runtime_error(
+		    bagNames + ": no extrinsics between the depth stream " + t.depth +
+		    " and the colour stream " + t.colour + " (no tf/N topic of the " +
+		    (t.depthTf.empty() ? "depth" : "colour") +
+		    " stream): the depth cannot be registered to the colour "
+		    "camera ([import_bag] colour_topic = none imports the depth "
+		    "alone)");
+	if (tfReference(t.depthTf) != tfReference(t.colourTf))
+		throw std::runtime_error(
+		    bagNames + ": the extrinsics " + t.depthTf + " and " + t.colourTf +
+		    " are from different reference streams: not supported");
+	d.depthToColour = compose(transformOf(ix, t.colourTf, bagNames),
+	                          inverse(transformOf(ix, t.depthTf, bagNames)));
+	sum.depthToColour = d.depthToColour;
+}
+
+/** The camera-to-IMU extrinsics from tf (the IMU's axes: the gyro's, the
+ * merged samples being at its stamps, else the accelerometer's; the
+ * camera: \a cameraTf), or a note saying why there are none. */
+void sdkImuExtrinsics(const Index& ix, const BagTopics& t,
+                      const std::string& cameraTf, const std::string& bagNames,
+                      BagImportSummary& sum)
+{
 	const std::string& imuTf = t.gyro.empty() ? t.accelTf : t.gyroTf;
 	const std::string& imuTopic = t.gyro.empty() ? t.accel : t.gyro;
-	if (!imuTopic.empty())
+	if (imuTopic.empty()) return;
+	if (imuTf.empty() || cameraTf.empty())
 	{
-		if (imuTf.empty() || cameraTf.empty())
-			sum.notes.push_back(
-			    "warning: no extrinsics (tf/N) of the IMU stream " + imuTopic +
-			    " or of the camera: no [calibration] R_IC written; give it "
-			    "in the experiment's .ini");
-		else if (tfReference(imuTf) != tfReference(cameraTf))
-			sum.notes.push_back("warning: the extrinsics " + imuTf + " and " +
-			                    cameraTf +
-			                    " are from different reference streams: no "
-			                    "[calibration] R_IC written");
-		else
-		{
-			const RigidTransform imu = transformOf(ix, imuTf, bagNames);
-			sum.cameraToImu =
-			    compose(imu, inverse(transformOf(ix, cameraTf, bagNames)));
-			sum.cameraToImuFrom = "tf " + imuTf + " and " + cameraTf;
-			if (!t.gyro.empty() && !t.accel.empty() && !t.accelTf.empty() &&
-			    tfReference(t.accelTf) == tfReference(imuTf))
-			{
-				const double deg = rotationDeg(compose(
-				    transformOf(ix, t.accelTf, bagNames), inverse(imu)));
-				if (deg > 0.5)
-					sum.notes.push_back(mrpt::format(
-					    "warning: the accelerometer's axes (%s) are %.2f deg "
-					    "from the gyro's (%s): the merged samples are in the "
-					    "gyro's axes, the accelerometer's not rotated",
-					    t.accelTf.c_str(), deg, imuTf.c_str()));
-			}
-		}
+		sum.notes.push_back(
+		    "warning: no extrinsics (tf/N) of the IMU stream " + imuTopic +
+		    " or of the camera: no [calibration] R_IC written; give it "
+		    "in the experiment's .ini");
+		return;
 	}
+	if (tfReference(imuTf) != tfReference(cameraTf))
+	{
+		sum.notes.push_back("warning: the extrinsics " + imuTf + " and " +
+		                    cameraTf +
+		                    " are from different reference streams: no "
+		                    "[calibration] R_IC written");
+		return;
+	}
+	const RigidTransform imu = transformOf(ix, imuTf, bagNames);
+	sum.cameraToImu =
+	    compose(imu, inverse(transformOf(ix, cameraTf, bagNames)));
+	sum.cameraToImuFrom = "tf " + imuTf + " and " + cameraTf;
+	if (!t.gyro.empty() && !t.accel.empty() && !t.accelTf.empty() &&
+	    tfReference(t.accelTf) == tfReference(imuTf))
+	{
+		const double deg = rotationDeg(
+		    compose(transformOf(ix, t.accelTf, bagNames), inverse(imu)));
+		if (deg > 0.5)
+			sum.notes.push_back(mrpt::format(
+			    "warning: the accelerometer's axes (%s) are %.2f deg "
+			    "from the gyro's (%s): the merged samples are in the "
+			    "gyro's axes, the accelerometer's not rotated",
+			    t.accelTf.c_str(), deg, imuTf.c_str()));
+	}
+}
+
+/** The rs-sdk layout's depth units, registration and extrinsics (into
+ * \a sum, with notes): errors name the bag, topic and message. */
+RsSdkDepth rsSdkDepth(const Index& ix, const BagTopics& t,
+                      const BagImportParams& params,
+                      const std::vector<Frame>& frames,
+                      const std::string& bagNames, BagImportSummary& sum)
+{
+	RsSdkDepth d;
+	d.on = true;
+	sdkDepthUnits(ix, t, params, frames, bagNames, d, sum);
+	// the depth registered to the colour camera with their extrinsics
+	if (!t.depthCameraInfo.empty()) sdkRegistration(ix, t, bagNames, d, sum);
+	// the frames' camera: the colour's when the depth is registered to it
+	sdkImuExtrinsics(ix, t, d.depthCamera ? t.colourTf : t.depthTf, bagNames,
+	                 sum);
 	if (!t.accel.empty() && t.gyro.empty())
 		sum.notes.push_back(
 		    "warning: the accelerometer stream " + t.accel +
