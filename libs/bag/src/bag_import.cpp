@@ -358,6 +358,43 @@ BagTopics presetFor(BagLayout layout, const std::vector<BagTopicInfo>& topics)
 	return layoutTopics(layout);
 }
 
+/** rs-sdk: the depth alone in its own camera (colour_topic = none), or
+ * its camera_info to register it to the colour camera. */
+void sdkCameras(const BagImportParams& params,
+                const std::vector<BagTopicInfo>& topics,
+                const std::string& bagNames, BagTopics& t)
+{
+	if (t.colour.empty() && !t.depthCameraInfo.empty())
+	{
+		if (params.topics.cameraInfo.empty()) t.cameraInfo = t.depthCameraInfo;
+		t.depthCameraInfo.clear();
+	}
+	if (!t.colour.empty() && t.depthCameraInfo.empty())
+		throw std::runtime_error(
+		    bagNames + ": the depth stream " + t.depth +
+		    " has no camera_info (" + rsSdkTopics(topics).depthCameraInfo +
+		    "): its depth cannot be registered to the colour camera "
+		    "([import_bag] colour_topic = none imports the depth alone, "
+		    "which needs it too). The bag has: " +
+		    topicList(topics));
+}
+
+/** Every chosen topic has its message type (errors name the topic). */
+void requireTypes(const std::vector<BagTopicInfo>& topics, const BagTopics& t,
+                  const std::string& bagNames)
+{
+	requireType(topics, t.depth, kImage, bagNames, kCompressed);
+	requireType(topics, t.colour, kImage, bagNames, kCompressed);
+	requireType(topics, t.cameraInfo, "sensor_msgs/CameraInfo", bagNames);
+	for (const auto* n : {&t.imu, &t.accel, &t.gyro})
+		requireType(topics, *n, "sensor_msgs/Imu", bagNames);
+	requireType(topics, t.mag, "sensor_msgs/MagneticField", bagNames);
+	requireType(topics, t.depthCameraInfo, "sensor_msgs/CameraInfo", bagNames);
+	requireType(topics, t.depthUnits, "std_msgs/Float32", bagNames);
+	for (const auto* n : {&t.depthTf, &t.colourTf, &t.accelTf, &t.gyroTf})
+		requireType(topics, *n, "geometry_msgs/Transform", bagNames);
+}
+
 /** The topics actually read: those of the layout the bag has, and every
  * topic the .ini names explicitly (missing: an error). */
 BagTopics chooseTopics(const BagImportParams& params,
@@ -417,22 +454,7 @@ BagTopics chooseTopics(const BagImportParams& params,
 	                &t.accelTf, &t.gyroTf})
 		keep(*n, "", "");
 	if (!t.imu.empty()) t.accel.clear(), t.gyro.clear();  // one IMU
-	if (layout == BagLayout::RsSdk && t.colour.empty() &&
-	    !t.depthCameraInfo.empty())
-	{
-		// colour_topic = none: the depth alone, in its own camera
-		if (params.topics.cameraInfo.empty()) t.cameraInfo = t.depthCameraInfo;
-		t.depthCameraInfo.clear();
-	}
-	if (layout == BagLayout::RsSdk && !t.colour.empty() &&
-	    t.depthCameraInfo.empty())
-		throw std::runtime_error(
-		    bagNames + ": the depth stream " + t.depth +
-		    " has no camera_info (" + rsSdkTopics(topics).depthCameraInfo +
-		    "): its depth cannot be registered to the colour camera "
-		    "([import_bag] colour_topic = none imports the depth alone, "
-		    "which needs it too). The bag has: " +
-		    topicList(topics));
+	if (layout == BagLayout::RsSdk) sdkCameras(params, topics, bagNames, t);
 	const std::string presetInfo = presetFor(layout, topics).cameraInfo;
 	if (t.cameraInfo.empty() && !params.camera)
 		throw std::runtime_error(
@@ -442,16 +464,7 @@ BagTopics chooseTopics(const BagImportParams& params,
 		    "[import_bag] camera_info_topic or give [camera] fx fy cx cy "
 		    "width height (-c). The bag has: " +
 		    topicList(topics));
-	requireType(topics, t.depth, kImage, bagNames, kCompressed);
-	requireType(topics, t.colour, kImage, bagNames, kCompressed);
-	requireType(topics, t.cameraInfo, "sensor_msgs/CameraInfo", bagNames);
-	for (const auto* n : {&t.imu, &t.accel, &t.gyro})
-		requireType(topics, *n, "sensor_msgs/Imu", bagNames);
-	requireType(topics, t.mag, "sensor_msgs/MagneticField", bagNames);
-	requireType(topics, t.depthCameraInfo, "sensor_msgs/CameraInfo", bagNames);
-	requireType(topics, t.depthUnits, "std_msgs/Float32", bagNames);
-	for (const auto* n : {&t.depthTf, &t.colourTf, &t.accelTf, &t.gyroTf})
-		requireType(topics, *n, "geometry_msgs/Transform", bagNames);
+	requireTypes(topics, t, bagNames);
 	return t;
 }
 
