@@ -639,6 +639,85 @@ struct Index
 	std::map<std::string, std::shared_ptr<const TransformView>> tf;
 };
 
+/** Files the messages of one chosen topic into the index, in their order:
+ * images and IMU samples whose stamp goes back are counted and left out;
+ * of camera_info, Depth Units and tf the first is kept. */
+struct TopicIndexer
+{
+	const BagTopics& t;
+	const std::string& topic;
+	Index& ix;
+	BagImportSummary& sum;
+	double last = -1;
+	bool any = false;
+
+	bool stampBack(double s)
+	{
+		if (any && s <= last) return true;
+		any = true;
+		last = s;
+		return false;
+	}
+	void add(const Scanned& m, size_t n)
+	{
+		if (topic == t.depth || topic == t.colour)
+		{
+			if (stampBack(m.t))
+			{
+				sum.stampsBack++;
+				return;
+			}
+			(topic == t.depth ? ix.depth : ix.colour)
+			    .push_back({m.t, n, &topic, &m});
+		}
+		else if (topic == t.cameraInfo)
+		{
+			if (!ix.info)
+				ix.info = m.info;
+			else if (!sameCamera(*ix.info, *m.info))
+			{
+				// the first is used for every frame: said once
+				if (sum.cameraInfoChanges++ == 0) sum.firstCameraInfoChange = n;
+			}
+			ix.infoMessages++;
+		}
+		else if (topic == t.depthCameraInfo)
+		{
+			if (!ix.depthInfo) ix.depthInfo = m.info;
+		}
+		else if (topic == t.depthUnits)
+			ix.units.push_back(m.value);
+		else if (m.tf)
+		{
+			if (!ix.tf.count(topic)) ix.tf[topic] = m.tf;
+		}
+		else if (stampBack(m.t))
+			sum.imuStampsBack++;
+		else
+			addImu(m);
+	}
+	void addImu(const Scanned& m)
+	{
+		if (topic == t.mag)
+		{
+			ix.mag.push_back(m.imu);
+			return;
+		}
+		ImuSample s = m.imu;
+		if (topic == t.imu) ix.imu.push_back(s);
+		if (topic == t.accel)
+		{
+			s.hasGyro = false;
+			ix.accel.push_back(s);
+		}
+		if (topic == t.gyro)
+		{
+			s.hasAccel = false;
+			ix.gyro.push_back(s);
+		}
+	}
+};
+
 /** The first pass: the chosen topics' messages in the bags' time order;
  * a message that cannot be read is an error naming it. */
 Index readIndex(const Scan& scan, const Bags& bags, const BagTopics& t,
@@ -654,16 +733,8 @@ Index readIndex(const Scan& scan, const Bags& bags, const BagTopics& t,
 	{
 		const auto it = scan.topics.find(topic);
 		if (it == scan.topics.end()) continue;
-		double last = -1;
-		bool any = false;
-		auto stampBack = [&](double s)
-		{
-			if (any && s <= last) return true;
-			any = true;
-			last = s;
-			return false;
-		};
 		const std::string& name = it->first;
+		TopicIndexer indexer{t, name, ix, sum};
 		for (size_t n = 0; n < it->second.messages.size(); n++)
 		{
 			const Scanned& m = it->second.messages[n];
@@ -676,57 +747,7 @@ Index readIndex(const Scan& scan, const Bags& bags, const BagTopics& t,
 			if (!m.error.empty())
 				throw std::runtime_error(bagNames + ": " + where(name, n) +
 				                         " cannot be read: " + m.error);
-			if (topic == t.depth || topic == t.colour)
-			{
-				if (stampBack(m.t))
-				{
-					sum.stampsBack++;
-					continue;
-				}
-				(topic == t.depth ? ix.depth : ix.colour)
-				    .push_back({m.t, n, &name, &m});
-			}
-			else if (topic == t.cameraInfo)
-			{
-				if (!ix.info)
-					ix.info = m.info;
-				else if (!sameCamera(*ix.info, *m.info))
-				{
-					// the first is used for every frame: said once
-					if (sum.cameraInfoChanges++ == 0)
-						sum.firstCameraInfoChange = n;
-				}
-				ix.infoMessages++;
-			}
-			else if (topic == t.depthCameraInfo)
-			{
-				if (!ix.depthInfo) ix.depthInfo = m.info;
-			}
-			else if (topic == t.depthUnits)
-				ix.units.push_back(m.value);
-			else if (m.tf)
-			{
-				if (!ix.tf.count(topic)) ix.tf[topic] = m.tf;
-			}
-			else if (stampBack(m.t))
-				sum.imuStampsBack++;
-			else if (topic == t.mag)
-				ix.mag.push_back(m.imu);
-			else
-			{
-				ImuSample s = m.imu;
-				if (topic == t.imu) ix.imu.push_back(s);
-				if (topic == t.accel)
-				{
-					s.hasGyro = false;
-					ix.accel.push_back(s);
-				}
-				if (topic == t.gyro)
-				{
-					s.hasAccel = false;
-					ix.gyro.push_back(s);
-				}
-			}
+			indexer.add(m, n);
 		}
 	}
 	sum.depthMessages = ix.depth.size();
