@@ -204,119 +204,42 @@ void McapFile::record(uint8_t op, const uint8_t* p, uint64_t n, uint32_t chunk,
 	}
 }
 
+bool McapFile::cutAt(uint64_t pos)
+{
+	if (pos == size_)
+		setDamage(pos,
+		          "it ends at byte " + std::to_string(pos) +
+		              " without its data section's end (DataEnd) and "
+		              "footer: cut short",
+		          true);
+	else if (size_ - pos < 9)
+		setDamage(pos,
+		          at(pos) +
+		              ": the file ends inside its opcode and "
+		              "length: cut short",
+		          true);
+	else
+		return false;
+	return true;
+}
+
 void McapFile::walk()
 {
 	uint64_t pos = sizeof(kMagic);
 	bool first = true;
-	while (true)
+	while (!cutAt(pos))
 	{
-		if (pos == size_)
-		{
-			setDamage(pos,
-			          "it ends at byte " + std::to_string(pos) +
-			              " without its data section's end (DataEnd) and "
-			              "footer: cut short",
-			          true);
-			return;
-		}
-		if (size_ - pos < 9)
-		{
-			setDamage(pos,
-			          at(pos) +
-			              ": the file ends inside its opcode and "
-			              "length: cut short",
-			          true);
-			return;
-		}
 		const uint8_t op = bytes_[pos];
 		uint64_t len = 0;
 		for (int k = 8; k-- > 0;) len = len << 8 | bytes_[pos + 1 + k];
 		const uint64_t content = pos + 9;
-		const uint64_t left = size_ - content;
 		if (first && op != kHeader)
 			throw runtime_error(mrpt::format(
 			    "its first record (opcode 0x%02x) is not MCAP's Header", op));
 		first = false;
 		try
 		{
-			if (len > left && op != kChunk)
-				throw runtime_error(
-				    mrpt::format("it declares %llu bytes, %llu follow",
-				                 static_cast<unsigned long long>(len),
-				                 static_cast<unsigned long long>(left)));
-			Cursor c(bytes_ + content, std::min(len, left));
-			switch (op)
-			{
-				case kHeader:
-					c.string("profile");
-					c.string("library");
-					break;
-				case kSchema:
-				case kChannel:
-					record(op, bytes_ + content, len, kNoChunk, 0, nullptr);
-					break;
-				case kMessage:
-					// checked now, handed over by scan()
-					Cursor(bytes_ + content, len).take(22, "message header");
-					items_.push_back({op, pos, content, len, kNoChunk});
-					break;
-				case kChunk:
-				{
-					Chunk ch;
-					ch.pos = pos;
-					c.u64("message_start_time");
-					c.u64("message_end_time");
-					ch.size = c.u64("uncompressed_size");
-					ch.crc = c.u32("uncompressed_crc");
-					ch.compression = c.string("compression");
-					ch.dataLen = c.u64("records' length");
-					ch.data = content + c.offset();
-					if (len > left || ch.dataLen > c.left())
-					{
-						// cut: an uncompressed chunk's whole records are read
-						ch.cut = true;
-						const uint64_t declared = ch.dataLen;
-						ch.dataLen = std::min(ch.dataLen, c.left());
-						const auto u = [](uint64_t v)
-						{ return static_cast<unsigned long long>(v); };
-						setDamage(
-						    pos,
-						    len > left
-						        ? mrpt::format("the chunk at byte %llu: it "
-						                       "declares %llu bytes, %llu "
-						                       "follow",
-						                       u(pos), u(len), u(left))
-						        : mrpt::format("the chunk at byte %llu: its "
-						                       "records declare %llu bytes, "
-						                       "the chunk has %llu left: "
-						                       "corrupt",
-						                       u(pos), u(declared),
-						                       u(ch.dataLen)),
-						    true);
-						if (!ch.compression.empty()) return;
-					}
-					items_.push_back({op, pos, content, len,
-					                  static_cast<uint32_t>(chunks_.size())});
-					chunks_.push_back(ch);
-					if (ch.cut) return;
-					break;
-				}
-				case kDataEnd:
-				{
-					const uint32_t crc = c.u32("data_section_crc");
-					if (crc != 0 && crc32Of(bytes_, pos) != crc)
-						setDamage(pos,
-						          at(pos) +
-						              " (DataEnd): the data section's CRC "
-						              "does not match its bytes: damaged",
-						          true);
-					return;
-				}
-				case kFooter:
-					return;
-				default:
-					break;  // index, attachment, metadata: not needed
-			}
+			if (walkRecord(op, pos, len)) return;
 		}
 		catch (const std::exception& e)
 		{
@@ -328,6 +251,92 @@ void McapFile::walk()
 		}
 		pos = content + len;
 	}
+}
+
+bool McapFile::walkRecord(uint8_t op, uint64_t pos, uint64_t len)
+{
+	const uint64_t content = pos + 9;
+	const uint64_t left = size_ - content;
+	if (len > left && op != kChunk)
+		throw runtime_error(
+		    mrpt::format("it declares %llu bytes, %llu follow",
+		                 static_cast<unsigned long long>(len),
+		                 static_cast<unsigned long long>(left)));
+	Cursor c(bytes_ + content, std::min(len, left));
+	switch (op)
+	{
+		case kHeader:
+			c.string("profile");
+			c.string("library");
+			return false;
+		case kSchema:
+		case kChannel:
+			record(op, bytes_ + content, len, kNoChunk, 0, nullptr);
+			return false;
+		case kMessage:
+			// checked now, handed over by scan()
+			Cursor(bytes_ + content, len).take(22, "message header");
+			items_.push_back({op, pos, content, len, kNoChunk});
+			return false;
+		case kChunk:
+			return walkChunk(pos, len);
+		case kDataEnd:
+		{
+			const uint32_t crc = c.u32("data_section_crc");
+			if (crc != 0 && crc32Of(bytes_, pos) != crc)
+				setDamage(pos,
+				          at(pos) +
+				              " (DataEnd): the data section's CRC "
+				              "does not match its bytes: damaged",
+				          true);
+			return true;
+		}
+		case kFooter:
+			return true;
+		default:
+			return false;  // index, attachment, metadata: not needed
+	}
+}
+
+bool McapFile::walkChunk(uint64_t pos, uint64_t len)
+{
+	const uint64_t content = pos + 9;
+	const uint64_t left = size_ - content;
+	Cursor c(bytes_ + content, std::min(len, left));
+	Chunk ch;
+	ch.pos = pos;
+	c.u64("message_start_time");
+	c.u64("message_end_time");
+	ch.size = c.u64("uncompressed_size");
+	ch.crc = c.u32("uncompressed_crc");
+	ch.compression = c.string("compression");
+	ch.dataLen = c.u64("records' length");
+	ch.data = content + c.offset();
+	if (len > left || ch.dataLen > c.left())
+	{
+		// cut: an uncompressed chunk's whole records are read
+		ch.cut = true;
+		const uint64_t declared = ch.dataLen;
+		ch.dataLen = std::min(ch.dataLen, c.left());
+		const auto u = [](uint64_t v)
+		{ return static_cast<unsigned long long>(v); };
+		setDamage(pos,
+		          len > left ? mrpt::format("the chunk at byte %llu: it "
+		                                    "declares %llu bytes, %llu "
+		                                    "follow",
+		                                    u(pos), u(len), u(left))
+		                     : mrpt::format("the chunk at byte %llu: its "
+		                                    "records declare %llu bytes, "
+		                                    "the chunk has %llu left: "
+		                                    "corrupt",
+		                                    u(pos), u(declared), u(ch.dataLen)),
+		          true);
+		if (!ch.compression.empty()) return true;
+	}
+	items_.push_back(
+	    {kChunk, pos, content, len, static_cast<uint32_t>(chunks_.size())});
+	chunks_.push_back(ch);
+	return ch.cut;
 }
 
 void McapFile::readSummary()

@@ -74,6 +74,13 @@ class McapFile : public MessageSource
 
 	/** The data section's records from byte 8. */
 	void walk();
+	/** Whether the file ends at \a pos without its footer (damage set). */
+	bool cutAt(uint64_t pos);
+	/** One record of the data section at \a pos; true: the walk ends
+	 * there (its end, or a damage that stops it). */
+	bool walkRecord(uint8_t op, uint64_t pos, uint64_t len);
+	/** A chunk record; true: the walk ends there. */
+	bool walkChunk(uint64_t pos, uint64_t len);
 	/** The summary section, when the footer points to a whole one. */
 	void readSummary();
 	/** Reads a schema, channel or message record's content \a p (\a n
