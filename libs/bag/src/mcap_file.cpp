@@ -339,6 +339,70 @@ bool McapFile::walkChunk(uint64_t pos, uint64_t len)
 	return ch.cut;
 }
 
+namespace
+{
+/** The summary section's schemas, channels and message counts. */
+struct SummaryRecords
+{
+	std::map<uint16_t, std::pair<std::string, std::string>> schemas;
+	std::map<uint16_t, std::pair<std::string, std::string>> channels;
+	std::map<uint16_t, uint64_t> counts;
+	bool stats = false;  ///< a Statistics record was read
+
+	void add(uint8_t op, Cursor& r)
+	{
+		if (op == kSchema)
+		{
+			const uint16_t id = r.u16("id");
+			std::string name = r.string("name");
+			schemas[id] = {name, r.string("encoding")};
+		}
+		else if (op == kChannel)
+		{
+			const uint16_t id = r.u16("id");
+			const uint16_t schema = r.u16("schema_id");
+			std::string topic = r.string("topic");
+			const auto s = schemas.find(schema);
+			channels[id] = {
+			    topic, s == schemas.end() ? "(no schema)" : s->second.first};
+		}
+		else if (op == kStatistics)
+		{
+			r.u64("message_count");
+			r.u16("schema_count");
+			for (const char* w : {"channel_count", "attachment_count",
+			                      "metadata_count", "chunk_count"})
+				r.u32(w);
+			r.u64("message_start_time");
+			r.u64("message_end_time");
+			Cursor m = r.sub32("channel_message_counts");
+			while (m.left() > 0)
+			{
+				const uint16_t id = m.u16("channel id");
+				counts[id] += m.u64("count");
+			}
+			stats = true;
+		}
+	}
+	/** Per topic: its type and its messages over its channels. */
+	std::vector<BagTopicInfo> topics() const
+	{
+		std::map<std::string, BagTopicInfo> byName;
+		for (const auto& [id, ch] : channels)
+		{
+			auto& t = byName[ch.first];
+			t.name = ch.first;
+			if (t.type.empty()) t.type = ch.second;
+			const auto n = counts.find(id);
+			t.messages += n == counts.end() ? 0 : n->second;
+		}
+		std::vector<BagTopicInfo> out;
+		for (auto& [name, t] : byName) out.push_back(t);
+		return out;
+	}
+};
+}  // namespace
+
 void McapFile::readSummary()
 {
 	// <Footer record: 9 + 20 bytes><magic>
@@ -358,10 +422,7 @@ void McapFile::readSummary()
 	const uint64_t end = offsets >= start && offsets <= footer ? offsets
 	                     : offsets == 0                        ? footer
 	                                                           : start;
-	std::map<uint16_t, std::pair<std::string, std::string>> schemas;
-	std::map<uint16_t, std::pair<std::string, std::string>> channels;
-	std::map<uint16_t, uint64_t> counts;
-	bool stats = false;
+	SummaryRecords records;
 	try
 	{
 		uint64_t pos = start;
@@ -373,38 +434,7 @@ void McapFile::readSummary()
 			for (int k = 8; k-- > 0;) len = len << 8 | bytes_[pos + 1 + k];
 			if (len > end - pos - 9) return;
 			Cursor r(bytes_ + pos + 9, len);
-			if (op == kSchema)
-			{
-				const uint16_t id = r.u16("id");
-				std::string name = r.string("name");
-				schemas[id] = {name, r.string("encoding")};
-			}
-			else if (op == kChannel)
-			{
-				const uint16_t id = r.u16("id");
-				const uint16_t schema = r.u16("schema_id");
-				std::string topic = r.string("topic");
-				const auto s = schemas.find(schema);
-				channels[id] = {topic, s == schemas.end() ? "(no schema)"
-				                                          : s->second.first};
-			}
-			else if (op == kStatistics)
-			{
-				r.u64("message_count");
-				r.u16("schema_count");
-				for (const char* w : {"channel_count", "attachment_count",
-				                      "metadata_count", "chunk_count"})
-					r.u32(w);
-				r.u64("message_start_time");
-				r.u64("message_end_time");
-				Cursor m = r.sub32("channel_message_counts");
-				while (m.left() > 0)
-				{
-					const uint16_t id = m.u16("channel id");
-					counts[id] += m.u64("count");
-				}
-				stats = true;
-			}
+			records.add(op, r);
 			pos += 9 + len;
 		}
 	}
@@ -412,17 +442,7 @@ void McapFile::readSummary()
 	{
 		return;  // a damaged summary: the chunks are counted instead
 	}
-	if (!stats) return;
-	std::map<std::string, BagTopicInfo> topics;
-	for (const auto& [id, ch] : channels)
-	{
-		auto& t = topics[ch.first];
-		t.name = ch.first;
-		if (t.type.empty()) t.type = ch.second;
-		const auto n = counts.find(id);
-		t.messages += n == counts.end() ? 0 : n->second;
-	}
-	for (auto& [name, t] : topics) summary_.push_back(t);
+	if (records.stats) summary_ = records.topics();
 }
 
 std::vector<BagTopicInfo> McapFile::indexTopics() const
