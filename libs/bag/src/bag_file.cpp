@@ -216,7 +216,6 @@ void BagFile::walk(uint64_t start)
 	uint64_t pos = start;
 	bool first = true;
 	std::map<uint32_t, std::string> indexTopicOf;  // id: topic
-	std::map<uint32_t, std::string> indexTypeOf;
 	for (; pos < size_; first = false)
 	{
 		Record r;
@@ -229,48 +228,7 @@ void BagFile::walk(uint64_t start)
 			    (r.op != kChunk || r.fields.count("compression") == 0 ||
 			     r.fields.at("compression") != "none"))
 				record(bytes_, pos, size_);  // throws what is cut
-			switch (r.op)
-			{
-				case kBagHeader:
-					if (!first)
-						throw runtime_error(at(pos) + ": a second bag header");
-					number(r.fields, "index_pos", 8, pos, indexPos_);
-					number(r.fields, "conn_count", 4, pos,
-					       declaredConnections_);
-					number(r.fields, "chunk_count", 4, pos, declaredChunks_);
-					break;
-				case kChunk:
-					addChunk(r, pos);
-					break;
-				case kConnection:
-				{
-					const uint32_t id = addConnection(r, bytes_, pos);
-					indexTopicOf[id] = r.fields.at("topic");
-					break;
-				}
-				case kChunkInfo:
-				{
-					const uint64_t count =
-					    required(r.fields, "count", 4, pos, "a chunk info");
-					if (count * 8 > r.dataLen)
-						throw runtime_error(at(pos) + ": " +
-						                    std::to_string(count) +
-						                    " index entries of 8 bytes in " +
-						                    std::to_string(r.dataLen));
-					for (uint64_t k = 0; k < count; k++)
-						indexCounts_[u32(bytes_ + r.data + 8 * k)] +=
-						    u32(bytes_ + r.data + 8 * k + 4);
-					chunkInfos_++;
-					break;
-				}
-				case kIndex:
-				case kMessage:
-					break;  // the messages are read from their chunks
-				default:
-					throw runtime_error(at(pos) + ": a record of op " +
-					                    std::to_string(r.op) +
-					                    ", none of a bag's");
-			}
+			walkRecord(r, pos, first, indexTopicOf);
 		}
 		catch (const runtime_error& e)
 		{
@@ -289,7 +247,54 @@ void BagFile::walk(uint64_t start)
 	                        chunkInfos_ == chunks_.size() &&
 	                        chunkInfos_ == declaredChunks_ &&
 	                        indexTopicOf.size() == declaredConnections_;
-	if (!indexWhole) return;
+	if (indexWhole) indexFrom(indexTopicOf);
+}
+
+void BagFile::walkRecord(const detail::BagRecord& r, uint64_t pos, bool first,
+                         std::map<uint32_t, std::string>& indexTopicOf)
+{
+	switch (r.op)
+	{
+		case kBagHeader:
+			if (!first) throw runtime_error(at(pos) + ": a second bag header");
+			number(r.fields, "index_pos", 8, pos, indexPos_);
+			number(r.fields, "conn_count", 4, pos, declaredConnections_);
+			number(r.fields, "chunk_count", 4, pos, declaredChunks_);
+			break;
+		case kChunk:
+			addChunk(r, pos);
+			break;
+		case kConnection:
+		{
+			const uint32_t id = addConnection(r, bytes_, pos);
+			indexTopicOf[id] = r.fields.at("topic");
+			break;
+		}
+		case kChunkInfo:
+		{
+			const uint64_t count =
+			    required(r.fields, "count", 4, pos, "a chunk info");
+			if (count * 8 > r.dataLen)
+				throw runtime_error(at(pos) + ": " + std::to_string(count) +
+				                    " index entries of 8 bytes in " +
+				                    std::to_string(r.dataLen));
+			for (uint64_t k = 0; k < count; k++)
+				indexCounts_[u32(bytes_ + r.data + 8 * k)] +=
+				    u32(bytes_ + r.data + 8 * k + 4);
+			chunkInfos_++;
+			break;
+		}
+		case kIndex:
+		case kMessage:
+			break;  // the messages are read from their chunks
+		default:
+			throw runtime_error(at(pos) + ": a record of op " +
+			                    std::to_string(r.op) + ", none of a bag's");
+	}
+}
+
+void BagFile::indexFrom(const std::map<uint32_t, std::string>& indexTopicOf)
+{
 	std::map<std::string, BagTopicInfo> topics;
 	for (const auto& [id, topic] : indexTopicOf)
 	{

@@ -95,6 +95,12 @@ class BagFile : public MessageSource
 
 	/** The records from byte \a start (after the version line). */
 	void walk(uint64_t start);
+	/** One record of the walk (\a first: the file's first); connections
+	 * into \a indexTopicOf (id: topic). */
+	void walkRecord(const detail::BagRecord& r, uint64_t pos, bool first,
+	                std::map<uint32_t, std::string>& indexTopicOf);
+	/** The topics and their counts from a whole index. */
+	void indexFrom(const std::map<uint32_t, std::string>& indexTopicOf);
 	void addChunk(const detail::BagRecord& r, uint64_t pos);
 	/** Registers the connection record \a r (at \a pos of \a bytes) unless
 	 * its id is known; returns its id. */
