@@ -224,33 +224,35 @@ void ReplayWorker::publish()
 	latest_ = std::move(v);
 }
 
+void ReplayWorker::runUnlocked(std::unique_lock<std::mutex>& lk,
+                               const std::function<void()>& f)
+{
+	lk.unlock();
+	std::string err;
+	try
+	{
+		f();
+	}
+	catch (const std::exception& e)
+	{
+		err = e.what();
+		ctl_->setPlaying(false);
+	}
+	lk.lock();
+	if (!err.empty()) error_ = err;
+	ctlFrame_ = ctl_->currentFrame();
+	state_.playing = ctl_->playing();
+	state_.speed = ctl_->speed();
+	state_.processed = static_cast<size_t>(ctlFrame_ + 1);
+	cv_.notify_all();
+}
+
 void ReplayWorker::loop()
 {
 	auto lastTick = Clock::now();
 	std::unique_lock<std::mutex> lk(m_);
-	// Runs \a f unlocked; an exception stops playback and is kept for the
-	// GUI. Then mirrors the controller's state for the other threads.
 	const auto unlocked = [&](const std::function<void()>& f)
-	{
-		lk.unlock();
-		std::string err;
-		try
-		{
-			f();
-		}
-		catch (const std::exception& e)
-		{
-			err = e.what();
-			ctl_->setPlaying(false);
-		}
-		lk.lock();
-		if (!err.empty()) error_ = err;
-		ctlFrame_ = ctl_->currentFrame();
-		state_.playing = ctl_->playing();
-		state_.speed = ctl_->speed();
-		state_.processed = static_cast<size_t>(ctlFrame_ + 1);
-		cv_.notify_all();
-	};
+	{ runUnlocked(lk, f); };
 	while (!quit_)
 	{
 		if (!queue_.empty())

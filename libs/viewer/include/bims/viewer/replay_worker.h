@@ -100,6 +100,11 @@ class ReplayWorker
 	using Command = std::function<void()>;
 	void post(Command c, bool interrupts = false);
 	void loop();
+	/** Runs \a f with \a lk unlocked; an exception stops playback and is
+	 * kept for the GUI. Then mirrors the controller's state for the other
+	 * threads. */
+	void runUnlocked(std::unique_lock<std::mutex>& lk,
+	                 const std::function<void()>& f);
 	void publish();
 	bool interrupted() const;  // a command that interrupts a seek is queued
 	void doSeek(size_t i);
