@@ -549,6 +549,61 @@ class PyPipeline
 		}
 	}
 
+	/** Float metres \a m (checked: finite, not negative) as 16-bit
+	 * readings of \a units: 0.1 mm, or coarser when the farthest reading
+	 * needs it (the 16 bits span the frame's range). Readings farther than
+	 * any stage reads are no reading (as a depth file's beyond its 16
+	 * bits), so that one far value does not coarsen the others' scale. */
+	cv::Mat readingsOfMetres(const cv::Mat& m, float& units) const
+	{
+		cv::Point at;
+		if (!cv::checkRange(m, true, &at))
+			bad("depth", "non-finite value at row " + std::to_string(at.y) +
+			                 ", column " + std::to_string(at.x) +
+			                 " (0 marks a pixel without depth)");
+		double lo = 0, hi = 0;
+		cv::minMaxLoc(m, &lo, &hi);
+		if (lo < 0) bad("depth", "negative depth (0 marks no reading)");
+		cv::Mat kept = m;
+		if (hi > farthest_)
+		{
+			kept = m.clone();
+			kept.setTo(0, m > farthest_);
+			cv::minMaxLoc(kept, nullptr, &hi);
+		}
+		units = static_cast<float>(std::max(1e-4, hi / 65535.0));
+		cv::Mat readings;
+		kept.convertTo(readings, CV_16UC1, 1.0 / units);
+		return readings;
+	}
+
+	/** The grey image of \a rgbObj (H x W x 3 RGB or H x W uint8, the
+	 * depth's W x H). */
+	static cv::Mat greyOf(const py::object& rgbObj, int W, int H)
+	{
+		if (!py::isinstance<py::array>(rgbObj))
+			throw py::type_error("rgb: a numpy array expected, got " +
+			                     typeName(rgbObj));
+		const py::array ra = py::reinterpret_borrow<py::array>(rgbObj);
+		const int nd = static_cast<int>(ra.ndim());
+		py::array c =
+		    checked(rgbObj, "rgb", py::dtype::of<uint8_t>(), nd == 2 ? 2 : 3);
+		if (c.shape(0) != H || c.shape(1) != W)
+			bad("rgb",
+			    std::to_string(c.shape(1)) + "x" + std::to_string(c.shape(0)) +
+			        " differs from the depth's " + std::to_string(W) + "x" +
+			        std::to_string(H) + " (registered RGB-D expected)");
+		cv::Mat grey;
+		if (nd == 2)
+			grey = cv::Mat(H, W, CV_8UC1, const_cast<void*>(c.data())).clone();
+		else if (c.shape(2) == 3)
+			cv::cvtColor(cv::Mat(H, W, CV_8UC3, const_cast<void*>(c.data())),
+			             grey, cv::COLOR_RGB2GRAY);
+		else
+			bad("rgb", "H x W x 3 (RGB) or H x W (grey) expected");
+		return grey;
+	}
+
 	ego::RgbdFrame decode(const py::object& depthObj, const py::object& rgbObj,
 	                      double t, const py::object& K,
 	                      const py::object& unitsObj)
@@ -582,29 +637,8 @@ class PyPipeline
 		if (isFloat)
 		{
 			checkMetres(unitsObj, attachedUnits);
-			const cv::Mat m(H, W, CV_32FC1, const_cast<void*>(a.data()));
-			cv::Point at;
-			if (!cv::checkRange(m, true, &at))
-				bad("depth", "non-finite value at row " + std::to_string(at.y) +
-				                 ", column " + std::to_string(at.x) +
-				                 " (0 marks a pixel without depth)");
-			double lo = 0, hi = 0;
-			cv::minMaxLoc(m, &lo, &hi);
-			if (lo < 0) bad("depth", "negative depth (0 marks no reading)");
-			// Readings farther than any stage reads are no reading (as a
-			// depth file's beyond its 16 bits), so that one far value does
-			// not coarsen the others' scale.
-			cv::Mat kept = m;
-			if (hi > farthest_)
-			{
-				kept = m.clone();
-				kept.setTo(0, m > farthest_);
-				cv::minMaxLoc(kept, nullptr, &hi);
-			}
-			// Readings of 0.1 mm, or coarser when the farthest reading needs
-			// it (the 16 bits span the frame's range).
-			d.units = static_cast<float>(std::max(1e-4, hi / 65535.0));
-			kept.convertTo(quantized, CV_16UC1, 1.0 / d.units);
+			quantized = readingsOfMetres(
+			    cv::Mat(H, W, CV_32FC1, const_cast<void*>(a.data())), d.units);
 			d.data = quantized.ptr<uint16_t>(0);
 		}
 		else
@@ -627,32 +661,8 @@ class PyPipeline
 		}
 		d.timestamp = mrpt::Clock::fromDouble(t);
 		d.label = "depth";
-		cv::Mat grey;
-		if (!rgbObj.is_none())
-		{
-			if (!py::isinstance<py::array>(rgbObj))
-				throw py::type_error("rgb: a numpy array expected, got " +
-				                     typeName(rgbObj));
-			const py::array ra = py::reinterpret_borrow<py::array>(rgbObj);
-			const int nd = static_cast<int>(ra.ndim());
-			py::array c = checked(rgbObj, "rgb", py::dtype::of<uint8_t>(),
-			                      nd == 2 ? 2 : 3);
-			if (c.shape(0) != H || c.shape(1) != W)
-				bad("rgb", std::to_string(c.shape(1)) + "x" +
-				               std::to_string(c.shape(0)) +
-				               " differs from the depth's " +
-				               std::to_string(W) + "x" + std::to_string(H) +
-				               " (registered RGB-D expected)");
-			if (nd == 2)
-				grey =
-				    cv::Mat(H, W, CV_8UC1, const_cast<void*>(c.data())).clone();
-			else if (c.shape(2) == 3)
-				cv::cvtColor(
-				    cv::Mat(H, W, CV_8UC3, const_cast<void*>(c.data())), grey,
-				    cv::COLOR_RGB2GRAY);
-			else
-				bad("rgb", "H x W x 3 (RGB) or H x W (grey) expected");
-		}
+		const cv::Mat grey =
+		    rgbObj.is_none() ? cv::Mat() : greyOf(rgbObj, W, H);
 		ego::RgbdFrame f;
 		f.t = t;
 		const std::string why = ego::rgbdFrameFrom(d, grey, Km, f);
@@ -995,11 +1005,11 @@ py::dict importBag(const py::object& bags, const py::object& out,
 
 }  // namespace
 
-PYBIND11_MODULE(_bims, m)
+namespace
 {
-	m.doc() = "bims: Bayesian independent motion segmentation (C++ core)";
-	py::register_exception<ConfigError>(m, "ConfigError", PyExc_ValueError);
-	py::register_exception<RawlogError>(m, "RawlogError", PyExc_OSError);
+/** bims.import_tum, import_stray, import_bag: the programs' imports. */
+void defineImporters([[maybe_unused]] py::module_& m)
+{
 #ifdef BIMS_PYTHON_IMPORTERS
 	// the programs' usage errors (options that do not fit)
 	py::register_exception<UsageError>(m, "UsageError", PyExc_ValueError);
@@ -1027,7 +1037,11 @@ PYBIND11_MODULE(_bims, m)
 	      "rawlog, as bims-import-bag; returns its summary");
 #endif
 #endif
+}
 
+/** bims.Config. */
+void defineConfig(py::module_& m)
+{
 	py::class_<Config>(m, "Config", "An experiment configuration (.ini)")
 	    .def(py::init<>(), "The built-in defaults (config/default.ini's)")
 	    .def_static(
@@ -1058,7 +1072,11 @@ PYBIND11_MODULE(_bims, m)
 	        "Every section and key with the value in use (effective.ini)")
 	    .def_property_readonly("source",
 	                           [](const Config& c) { return c.cfg.source; });
+}
 
+/** bims.Result and bims.Voxels: what a frame produced. */
+void defineResults(py::module_& m)
+{
 	py::class_<Result>(m, "Result", "What one frame produced")
 	    .def_readonly("index", &Result::index)
 	    .def_readonly("stamp", &Result::stamp)
@@ -1089,7 +1107,11 @@ PYBIND11_MODULE(_bims, m)
 	    .def("__len__", &Voxels::size)
 	    .def("__repr__", [](const Voxels& v)
 	         { return "<bims.Voxels: " + std::to_string(v.size()) + ">"; });
+}
 
+/** bims.Pipeline and the rawlog reader. */
+void definePipeline(py::module_& m)
+{
 	py::class_<PyPipeline>(
 	    m, "Pipeline",
 	    "The segmentation pipeline. Its calls are serialised: from several "
@@ -1128,4 +1150,16 @@ PYBIND11_MODULE(_bims, m)
 	    .def(py::init<const py::object&, const Config&>())
 	    .def("__iter__", [](PyRawlogReader& r) -> PyRawlogReader& { return r; })
 	    .def("__next__", &PyRawlogReader::next);
+}
+}  // namespace
+
+PYBIND11_MODULE(_bims, m)
+{
+	m.doc() = "bims: Bayesian independent motion segmentation (C++ core)";
+	py::register_exception<ConfigError>(m, "ConfigError", PyExc_ValueError);
+	py::register_exception<RawlogError>(m, "RawlogError", PyExc_OSError);
+	defineImporters(m);
+	defineConfig(m);
+	defineResults(m);
+	definePipeline(m);
 }
